@@ -1,0 +1,1 @@
+"""The ``albot1`` command line (Typer). Thin: parsing and printing only."""

@@ -1,0 +1,68 @@
+"""The ``albot1`` entry point: assembles the command groups and turns the
+project's known errors into one line on stderr with a non-zero exit.
+
+Each command module imports only typer at module level; heavy libraries are
+imported inside the commands, so ``albot1 --help`` is instant.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+import typer
+
+from albot1.errors import Albot1Error
+
+app = typer.Typer(
+    name="albot1",
+    help="Albot1 perceptual mapping vs SLAM baselines on 2D laser datasets.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+#: (module, attribute, group name or None to add its commands at top level)
+_COMMANDS: tuple[tuple[str, str, str | None], ...] = (
+    ("albot1.cli.datasets", "app", "datasets"),
+    ("albot1.cli.convert", "register", None),
+    ("albot1.cli.run", "register", None),
+    ("albot1.cli.evaluate", "register", None),
+    ("albot1.cli.bench", "register", None),
+)
+
+for _module_name, _attr, _group in _COMMANDS:
+    try:
+        _module = importlib.import_module(_module_name)
+    except ModuleNotFoundError as _exc:  # DEV-ONLY: made strict before landing
+        if _exc.name != _module_name:
+            raise
+        continue
+    if _group is None:
+        getattr(_module, _attr)(app)
+    else:
+        app.add_typer(getattr(_module, _attr), name=_group)
+
+
+def main() -> None:
+    """Console-script entry: known errors -> ``albot1: error: ...`` on stderr, exit 1."""
+    try:
+        app(standalone_mode=False)
+    except Albot1Error as exc:
+        typer.echo(f"albot1: error: {exc}", err=True)
+        sys.exit(1)
+    except KeyboardInterrupt:
+        typer.echo("albot1: interrupted", err=True)
+        sys.exit(130)
+    except typer.Exit as exc:
+        sys.exit(exc.exit_code)
+    except typer.Abort:
+        typer.echo("albot1: aborted", err=True)
+        sys.exit(1)
+    except Exception as exc:  # click usage errors
+        import click
+
+        if isinstance(exc, click.ClickException):
+            exc.show()
+            sys.exit(exc.exit_code)
+        raise

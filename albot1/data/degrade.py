@@ -1,0 +1,118 @@
+"""Seeded odometry degradation, applied identically for every method.
+
+Degradation acts on the *relative* motion between consecutive scans (the
+odometry increment ``inv(o[i-1]) * o[i]``), then re-integrates from the first
+pose, which is how odometry error arises physically. SPEC strings
+(DESIGN.md 4b):
+
+``none``
+    unchanged.
+``thesis``
+    the thesis's Experiment 3: "0.1 meter and 1 degree added to translation
+    and rotation data of two consecutive robot locations". The step's
+    translation grows by 0.1 m along its own direction (along the robot's
+    forward axis when the step does not translate) and its rotation by +1 deg.
+    It is meant for start-stop data (one view per ~1 m): on a high-rate log
+    it adds 0.1 m per scan, so thin such logs first.
+``gauss:SIGMA_XY_M:SIGMA_THETA_DEG``
+    zero-mean Gaussian noise on each step's dx, dy (step frame) and dtheta.
+``bias:DX_M:DTHETA_DEG``
+    a constant forward offset and rotation added to every step.
+
+Only the odometry changes; scans, reference poses and relations are kept.
+The noise stream is a ``numpy.random.default_rng(seed)`` re-created for every
+iteration, so a re-read of the sequence gives the same degraded odometry.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from albot1.data.errors import DataError
+from albot1.data.model import Frame, Sequence
+from albot1.geometry import se2
+
+
+class DegradationSpecError(DataError):
+    """A degradation SPEC string does not parse."""
+
+
+@dataclass(frozen=True)
+class Degradation:
+    """A parsed SPEC; ``kind`` is none | thesis | gauss | bias."""
+
+    kind: str
+    a: float = 0.0  # translation (m): offset or sigma
+    b: float = 0.0  # rotation (rad): offset or sigma
+
+    @property
+    def spec(self) -> str:
+        if self.kind in ("none", "thesis"):
+            return self.kind
+        return f"{self.kind}:{self.a:g}:{math.degrees(self.b):g}"
+
+    def perturb(self, step: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """One degraded increment ``(dx, dy, dtheta)``."""
+        dx, dy, dth = step
+        if self.kind == "thesis":
+            dist = math.hypot(dx, dy)
+            if dist > 1e-9:
+                dx, dy = dx * (dist + self.a) / dist, dy * (dist + self.a) / dist
+            else:
+                dx += self.a
+            return np.array([dx, dy, dth + self.b])
+        if self.kind == "gauss":
+            noise = rng.normal(0.0, 1.0, size=3)
+            return np.array([dx + self.a * noise[0], dy + self.a * noise[1], dth + self.b * noise[2]])
+        if self.kind == "bias":
+            return np.array([dx + self.a, dy, dth + self.b])
+        return np.asarray(step, dtype=float)
+
+
+def parse_spec(spec: str) -> Degradation:
+    """Parse a SPEC string (see module doc); DegradationSpecError says what is expected."""
+    text = spec.strip().lower()
+    if text in ("", "none"):
+        return Degradation("none")
+    if text == "thesis":
+        return Degradation("thesis", 0.1, math.radians(1.0))
+    kind, _, rest = text.partition(":")
+    parts = rest.split(":") if rest else []
+    if kind not in ("gauss", "bias") or len(parts) != 2:
+        raise DegradationSpecError(
+            f"degradation {spec!r} not understood; expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG "
+            f"or bias:DX_M:DTHETA_DEG")
+    try:
+        a, b_deg = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise DegradationSpecError(f"degradation {spec!r}: the two values must be numbers") from None
+    if not (math.isfinite(a) and math.isfinite(b_deg)) or (kind == "gauss" and (a < 0 or b_deg < 0)):
+        raise DegradationSpecError(f"degradation {spec!r}: values must be finite (and sigmas >= 0)")
+    return Degradation(kind, a, math.radians(b_deg))
+
+
+def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Sequence:
+    """``sequence`` with degraded odometry (streamed; the same seed gives the same result)."""
+    deg = parse_spec(spec) if isinstance(spec, str) else spec
+    if deg.kind == "none":
+        return sequence
+
+    def frames(source: Iterator[Frame]) -> Iterator[Frame]:
+        rng = np.random.default_rng(seed)
+        prev_raw: np.ndarray | None = None
+        current: np.ndarray | None = None
+        for frame in source:
+            if prev_raw is None or current is None:
+                current = np.asarray(frame.odometry, dtype=float)
+            else:
+                step = se2.between(prev_raw, frame.odometry)
+                current = se2.compose(current, deg.perturb(step, rng))
+            prev_raw = np.asarray(frame.odometry, dtype=float)
+            yield replace(frame, odometry=current)
+
+    meta = replace(sequence.metadata, odometry_source=f"{sequence.metadata.odometry_source} degraded {deg.spec} seed {seed}")
+    return sequence.with_frames(frames, metadata=meta)

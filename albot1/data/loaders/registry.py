@@ -1,0 +1,74 @@
+"""Format names -> loader/writer classes, imported lazily, and sniffing.
+
+Entries are ``"module:Class"`` strings so that, e.g., ``rosbags`` is imported
+only when a bag is actually opened.
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+from typing import Any
+
+from albot1.data.errors import DataError, UnknownFormatError
+from albot1.data.loaders.base import SequenceLoader, SequenceWriter
+from albot1.data.model import Sequence
+
+#: format name -> (loader "module:Class", writer "module:Class" or None)
+FORMATS: dict[str, tuple[str, str | None]] = {
+    "carmen": ("albot1.data.loaders.carmen:CarmenLoader", "albot1.data.loaders.carmen_writer:CarmenWriter"),
+    "ros1": ("albot1.data.loaders.rosbag:Ros1BagLoader", "albot1.data.loaders.rosbag_writer:Ros1BagWriter"),
+    "ros2-sqlite3": ("albot1.data.loaders.rosbag:Ros2BagLoader", "albot1.data.loaders.rosbag_writer:Ros2Sqlite3Writer"),
+    "ros2-mcap": ("albot1.data.loaders.rosbag:Ros2BagLoader", "albot1.data.loaders.rosbag_writer:Ros2McapWriter"),
+    "albot-log": ("albot1.data.loaders.albot_log:AlbotLogLoader", "albot1.data.loaders.albot_log:AlbotLogWriter"),
+}
+
+
+def _import(target: str) -> Any:
+    module_name, _, attr = target.partition(":")
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise UnknownFormatError(f"the loader module {module_name} cannot be imported: {exc}") from exc
+    return getattr(module, attr)
+
+
+def _check_format(name: str) -> tuple[str, str | None]:
+    try:
+        return FORMATS[name]
+    except KeyError:
+        raise UnknownFormatError(f"unknown format {name!r}; expected one of: {', '.join(FORMATS)}") from None
+
+
+def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoader:
+    """The loader for ``format_name``, or the first whose ``sniff`` accepts the file."""
+    p = Path(path)
+    if format_name is not None:
+        return _import(_check_format(format_name)[0])()
+    if not p.exists():
+        raise DataError(f"{p}: no such file or directory")
+    seen: set[str] = set()
+    for loader_target, _ in FORMATS.values():
+        if loader_target in seen:
+            continue
+        seen.add(loader_target)
+        loader: SequenceLoader = _import(loader_target)()
+        if loader.sniff(p):
+            return loader
+    raise UnknownFormatError(
+        f"{p}: not a recognised log; expected a CARMEN log (.clf/.log, optionally .gz/.bz2), "
+        f"a ROS1 .bag, a ROS2 bag folder (sqlite3 or MCAP) or an albot log"
+    )
+
+
+def writer_for(format_name: str) -> SequenceWriter:
+    """The writer of a format name (see :data:`FORMATS`)."""
+    writer_target = _check_format(format_name)[1]
+    if writer_target is None:
+        raise UnknownFormatError(f"format {format_name!r} can be read but not written")
+    return _import(writer_target)()
+
+
+def load(path: str | Path, format_name: str | None = None, **options: Any) -> Sequence:
+    """Open a file of any known format as a Sequence."""
+    return loader_for(path, format_name).load(Path(path), **options)

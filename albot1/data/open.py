@@ -1,0 +1,37 @@
+"""One entry point from a user's dataset argument to a Sequence.
+
+``ref`` may be an embedded synthetic world name, a registered dataset name
+(resolved through the catalog and the dataset settings) or a path to a file
+of any known format.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from albot1.data.errors import DatasetNotFoundError
+from albot1.data.model import Sequence
+from albot1.settings import Settings, get_settings
+
+
+def open_sequence(ref: str | Path, *, settings: Settings | None = None, format_name: str | None = None,
+                  **options: Any) -> Sequence:
+    """Open ``ref`` (world name, dataset name or path) as a streamed Sequence."""
+    from albot1.data import catalog
+    from albot1.data.loaders.registry import load
+    from albot1.data.synthetic import worlds
+
+    text = str(ref)
+    if text in worlds.WORLDS:
+        return worlds.load_world(text)
+    settings = settings or get_settings()
+    if text in catalog.names():
+        return catalog.open_dataset(text, settings, **options)
+    path = Path(text).expanduser()
+    if path.exists():
+        return load(path, format_name, **options)
+    raise DatasetNotFoundError(
+        f"{text!r} is neither a dataset name nor an existing file; known datasets: "
+        f"{', '.join(sorted(catalog.names()) + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
+    )

@@ -1,0 +1,1 @@
+"""Pure geometry: SE(2) poses and line segments (numpy only, no I/O)."""

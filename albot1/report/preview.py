@@ -1,0 +1,55 @@
+"""The PNG preview stored in each run folder: map + trajectory (+ reference).
+
+The reference is drawn after a rigid least-squares alignment onto the
+estimate so that both share a frame; the picture is for eyes, the numbers
+come from the metrics.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.runs.protocol import RunResult
+
+
+def _align(src: NDArray[np.float64], dst: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Rigid 2D least-squares (Umeyama, no scale) mapping ``src`` points onto ``dst``."""
+    mu_s, mu_d = src.mean(axis=0), dst.mean(axis=0)
+    cov = (dst - mu_d).T @ (src - mu_s)
+    u, _, vt = np.linalg.svd(cov)
+    d = np.sign(np.linalg.det(u @ vt))
+    rot = u @ np.diag([1.0, d]) @ vt
+    return (src - mu_s) @ rot.T + mu_d
+
+
+def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+
+    fig, ax = plt.subplots(figsize=(7, 7), dpi=110)
+    data = result.map
+    if data.points is not None and len(data.points):
+        pts = np.asarray(data.points)
+        if len(pts) > max_points:
+            pts = pts[np.random.default_rng(0).choice(len(pts), max_points, replace=False)]
+        ax.scatter(pts[:, 0], pts[:, 1], s=0.2, c="0.35", linewidths=0, label="map points")
+    if data.segments is not None and len(data.segments):
+        seg = np.asarray(data.segments).reshape(-1, 2, 2)
+        ax.add_collection(LineCollection(seg, colors="tab:green", linewidths=0.8, label="map surfaces"))
+    if result.reference is not None and len(result.reference) > 2:
+        ref = _align(result.reference[:, :2], result.poses[:, :2])
+        ax.plot(ref[:, 0], ref[:, 1], color="tab:orange", lw=0.8, label="reference (aligned)")
+    ax.plot(result.poses[:, 0], result.poses[:, 1], color="tab:blue", lw=0.8, label=f"{result.method} estimate")
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.set_title(f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]",
+                 fontsize=9)
+    ax.legend(loc="best", fontsize=7)
+    fig.savefig(path, format="png", bbox_inches="tight")
+    plt.close(fig)

@@ -1,0 +1,123 @@
+"""Run one method on one sequence with the measurements every result carries.
+
+Per-scan time is ``perf_counter_ns`` around ``Mapper.process`` only (decoding
+and degradation happen outside it); ``finish`` is timed separately and added
+to ``total_s``. ``peak_mb`` is the process's resident-set high-water mark
+(``ru_maxrss``) at the end of the run: the benchmark runs each cell in a fresh
+process, so there it is the cell's peak.
+"""
+
+from __future__ import annotations
+
+import resource
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from albot1 import versions
+from albot1.data.model import Sequence
+from albot1.errors import Albot1Error
+from albot1.runs.errors import RunError
+from albot1.runs.methods import get_method, resolve_config
+from albot1.runs.protocol import MapperOutput, RunResult
+
+
+def peak_rss_mb() -> float:
+    """Resident-set high-water mark of this process, MiB."""
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / (1024.0 * 1024.0) if sys.platform == "darwin" else peak / 1024.0
+
+
+def run_method(
+    method: str,
+    sequence: Sequence,
+    *,
+    preset: str = "default",
+    overrides: dict[str, Any] | None = None,
+    degradation: str = "none",
+    seed: int = 0,
+    dataset_name: str | None = None,
+    on_frame: Callable[[int], None] | None = None,
+) -> RunResult:
+    """Degrade (seeded), run and check one method; raises the method's error class on failure."""
+    from albot1.data.degrade import degrade
+
+    spec = get_method(method)
+    config = resolve_config(method, preset, overrides)
+    error_class = spec.load_error_class()
+    dataset = dataset_name or sequence.name
+    seq = degrade(sequence, degradation, seed=seed)
+    mapper = spec.load_class()(config, seed=seed)
+
+    wall_start = time.perf_counter()
+    per_scan: list[int] = []
+    stamps: list[float] = []
+    odometry: list[np.ndarray] = []
+    reference: list[np.ndarray] | None = []
+    index = -1
+    try:
+        for frame in seq.frames():
+            index = frame.index
+            start = time.perf_counter_ns()
+            mapper.process(frame)
+            per_scan.append(time.perf_counter_ns() - start)
+            stamps.append(frame.scan.timestamp)
+            odometry.append(frame.odometry)
+            if reference is not None:
+                # A reference counts only when every frame has one.
+                if frame.reference is None:
+                    reference = None
+                else:
+                    reference.append(frame.reference)
+            if on_frame is not None:
+                on_frame(index)
+        finish_start = time.perf_counter()
+        output = mapper.finish()
+        finish_s = time.perf_counter() - finish_start
+    except Albot1Error:
+        raise
+    except Exception as exc:  # a library failed deep inside: name method, dataset and scan
+        raise error_class(f"{method} on {dataset} failed at scan {index}: {type(exc).__name__}: {exc}") from exc
+
+    _check_output(output, len(per_scan), method, dataset, error_class)
+    per_scan_ns = np.asarray(per_scan, dtype=np.int64)
+    return RunResult(
+        method=method,
+        dataset=dataset,
+        preset=preset,
+        degradation=degradation,
+        seed=seed,
+        config=config.model_dump(mode="json"),
+        timestamps=np.asarray(stamps, dtype=float),
+        poses=np.asarray(output.poses, dtype=float),
+        odometry=np.asarray(odometry, dtype=float).reshape(-1, 3),
+        reference=np.asarray(reference, dtype=float).reshape(-1, 3) if reference else None,
+        relations=seq.relations,
+        map=output.map,
+        counters=dict(output.counters),
+        extras=dict(output.extras),
+        per_scan_ns=per_scan_ns,
+        finish_s=finish_s,
+        total_s=float(per_scan_ns.sum()) / 1e9 + finish_s,
+        wall_s=time.perf_counter() - wall_start,
+        peak_mb=peak_rss_mb(),
+        versions={"code": versions.code_version(), "git": versions.git_commit(), **versions.library_versions()},
+        dataset_info={"source": seq.metadata.source, "format": seq.metadata.format,
+                      "odometry_source": seq.metadata.odometry_source,
+                      "reference_source": seq.metadata.reference_source},
+    )
+
+
+def _check_output(output: MapperOutput, n: int, method: str, dataset: str, error_class: type[Exception]) -> None:
+    poses = np.asarray(output.poses, dtype=float)
+    if poses.shape != (n, 3):
+        raise error_class(f"{method} on {dataset}: expected {n} poses (one per scan) of (x, y, theta), got shape {poses.shape}")
+    bad = np.flatnonzero(~np.isfinite(poses).all(axis=1))
+    if len(bad):
+        raise error_class(f"{method} on {dataset}: {len(bad)} non-finite poses, first at scan {bad[0]} (diverged)")
+    for key in ("views", "updates"):
+        if key not in output.counters:
+            raise RunError(f"{method} on {dataset}: counters lack the required key {key!r}")

@@ -1,0 +1,203 @@
+"""The run-folder contract (DESIGN.md 4 and 4b).
+
+One folder per run, named by a content hash of (dataset, method, config,
+degradation, seed, code version)::
+
+    trajectory.tum   estimated pose per scan (scan timestamps)
+    odometry.tum     the odometry the method was given (after degradation)
+    reference.tum    reference poses, when the dataset has them
+    relations.txt    ground-truth relations, when the dataset has them
+    result.json      method, dataset, config, versions, counters, timing
+    map.geojson      line surfaces (Albot1) -- or map.npz (points) for baselines
+    extras.json      method-specific records (update trace, ...)
+    preview.png      the map with the trajectory
+    DONE             written last, by atomic rename: the run is complete
+
+Every file is written to a temporary name and renamed, so a killed process
+leaves either a complete file or none; a folder without DONE is incomplete
+and is recomputed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.data.model import Relations
+from albot1.runs.errors import RunError
+from albot1.runs.protocol import MapData, RunResult
+from albot1.runs.tum import read_tum, write_tum
+
+DONE = "DONE"
+
+
+def run_key(dataset: str, method: str, config: dict[str, Any], degradation: str, seed: int, code_version: str) -> str:
+    """Content hash naming a run folder (16 hex digits)."""
+    payload = json.dumps({"dataset": dataset, "method": method, "config": config, "degradation": degradation,
+                          "seed": seed, "code": code_version}, sort_keys=True, default=str)
+    return hashlib.sha256(payload.encode()).hexdigest()[:16]
+
+
+def _atomic_write(path: Path, writer: Callable[[Path], None]) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        writer(tmp_path)
+        os.replace(tmp_path, path)
+    finally:
+        tmp_path.unlink(missing_ok=True)
+
+
+def write_json(path: Path, data: Any) -> None:
+    """Atomically write JSON (NaN/inf are written as null)."""
+    _atomic_write(path, lambda p: p.write_text(json.dumps(_jsonable(data), indent=2, sort_keys=False) + "\n"))
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, (np.floating, float)):
+        return float(value) if np.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.bool_):
+        return bool(value)
+    return value
+
+
+def is_complete(run_dir: Path) -> bool:
+    return (run_dir / DONE).is_file()
+
+
+def write_run(result: RunResult, root: Path, *, preview: bool = True) -> Path:
+    """Store ``result`` under ``root/<key>`` and mark it DONE; returns the folder."""
+    key = run_key(result.dataset, result.method, result.config, result.degradation, result.seed,
+                  str(result.versions.get("code")))
+    run_dir = root / key
+    run_dir.mkdir(parents=True, exist_ok=True)
+    (run_dir / DONE).unlink(missing_ok=True)
+
+    _atomic_write(run_dir / "trajectory.tum", lambda p: write_tum(p, result.timestamps, result.poses))
+    _atomic_write(run_dir / "odometry.tum", lambda p: write_tum(p, result.timestamps, result.odometry))
+    if result.reference is not None:
+        _atomic_write(run_dir / "reference.tum", lambda p: write_tum(p, result.timestamps, result.reference))
+    if result.relations is not None:
+        _atomic_write(run_dir / "relations.txt", lambda p: write_relations(p, result.relations))
+    map_file = _write_map(run_dir, result.map)
+    write_json(run_dir / "extras.json", result.extras)
+    write_json(run_dir / "result.json", {
+        "key": key,
+        "method": result.method,
+        "dataset": result.dataset,
+        "preset": result.preset,
+        "degradation": result.degradation,
+        "seed": result.seed,
+        "scans": int(len(result.poses)),
+        "config": result.config,
+        "versions": result.versions,
+        "dataset_info": result.dataset_info,
+        "counters": result.counters,
+        "timing": result.timing(),
+        "map_file": map_file,
+        "has_reference": result.reference is not None,
+        "relations": len(result.relations) if result.relations is not None else 0,
+    })
+    np.save(run_dir / "per_scan_ns.npy", result.per_scan_ns)
+    if preview:
+        from albot1.report.preview import render_preview
+
+        _atomic_write(run_dir / "preview.png", lambda p: render_preview(result, p))
+    _atomic_write(run_dir / DONE, lambda p: p.write_text(key + "\n"))
+    return run_dir
+
+
+def write_relations(path: Path, relations: Relations) -> None:
+    rows = np.column_stack([relations.t1, relations.t2, relations.poses[:, 0], relations.poses[:, 1],
+                            np.zeros(len(relations)), np.zeros(len(relations)), np.zeros(len(relations)),
+                            relations.poses[:, 2]])
+    np.savetxt(path, rows, fmt="%.9f")
+
+
+def read_relations(path: Path) -> Relations:
+    """A relations file ``t1 t2 x y z roll pitch yaw`` (Kuemmerle et al. 2009)."""
+    rows = np.loadtxt(path, ndmin=2)
+    return Relations(t1=rows[:, 0], t2=rows[:, 1], poses=rows[:, [2, 3, 7]])
+
+
+def _write_map(run_dir: Path, data: MapData) -> str:
+    if data.segments is not None:
+        features = []
+        props = data.segment_properties or [{} for _ in range(len(data.segments))]
+        for seg, prop in zip(np.asarray(data.segments, dtype=float), props):
+            features.append({"type": "Feature", "properties": prop,
+                             "geometry": {"type": "LineString", "coordinates": [[seg[0], seg[1]], [seg[2], seg[3]]]}})
+        if data.points is not None and len(data.points):
+            features.append({"type": "Feature", "properties": {"kind": "points"},
+                             "geometry": {"type": "MultiPoint", "coordinates": np.asarray(data.points).tolist()}})
+        write_json(run_dir / "map.geojson", {"type": "FeatureCollection", "features": features})
+        return "map.geojson"
+    points = np.asarray(data.points if data.points is not None else np.empty((0, 2)), dtype=np.float32)
+    _atomic_write(run_dir / "map.npz", lambda p: np.savez_compressed(p.open("wb"), points=points))
+    return "map.npz"
+
+
+@dataclass
+class StoredRun:
+    """A run folder read back (what ``evaluate`` and the report consume)."""
+
+    path: Path
+    info: dict[str, Any]
+    timestamps: NDArray[np.float64]
+    poses: NDArray[np.float64]
+    odometry: NDArray[np.float64]
+    reference: NDArray[np.float64] | None
+    relations: Relations | None
+    per_scan_ns: NDArray[np.int64]
+
+    def load_map(self) -> MapData:
+        map_file = self.path / self.info["map_file"]
+        if map_file.suffix == ".npz":
+            with np.load(map_file) as npz:
+                return MapData(points=npz["points"].astype(float))
+        collection = json.loads(map_file.read_text())
+        segments, props, points = [], [], None
+        for feature in collection["features"]:
+            geom = feature["geometry"]
+            if geom["type"] == "LineString":
+                (x1, y1), (x2, y2) = geom["coordinates"][0], geom["coordinates"][-1]
+                segments.append([x1, y1, x2, y2])
+                props.append(feature.get("properties") or {})
+            elif geom["type"] == "MultiPoint":
+                points = np.asarray(geom["coordinates"], dtype=float).reshape(-1, 2)
+        return MapData(segments=np.asarray(segments, dtype=float).reshape(-1, 4), points=points,
+                       segment_properties=props)
+
+
+def read_run(run_dir: str | Path) -> StoredRun:
+    """Read a complete run folder; RunError if it is missing or incomplete."""
+    path = Path(run_dir)
+    if not (path / "result.json").is_file():
+        raise RunError(f"{path}: not a run folder (no result.json)")
+    if not is_complete(path):
+        raise RunError(f"{path}: the run is incomplete (no {DONE} marker); run it again")
+    info = json.loads((path / "result.json").read_text())
+    stamps, poses = read_tum(path / "trajectory.tum")
+    _, odom = read_tum(path / "odometry.tum")
+    reference = read_tum(path / "reference.tum")[1] if (path / "reference.tum").is_file() else None
+    relations = read_relations(path / "relations.txt") if (path / "relations.txt").is_file() else None
+    per_scan = np.load(path / "per_scan_ns.npy")
+    return StoredRun(path, info, stamps, poses, odom, reference, relations, per_scan)

@@ -1,0 +1,122 @@
+"""What every mapper (Albot1 and each baseline) implements and returns.
+
+A mapper is built from a typed (pydantic) config, is fed a Sequence frame by
+frame through :meth:`Mapper.process` (the runner times exactly that call) and
+hands back a :class:`MapperOutput` from :meth:`Mapper.finish`. Poses are
+per scan, in the method's own map frame (any rigid offset from the reference
+is removed by the metrics' alignment).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel
+
+from albot1.data.model import Frame, Relations
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass
+class MapData:
+    """A method's map: line surfaces (Albot1) and/or points (scan-projecting baselines).
+
+    ``segments`` is ``(M, 4)`` as ``x1, y1, x2, y2``; ``segment_properties``
+    (one JSON-able dict per segment: id, history, ...) is optional;
+    ``points`` is ``(K, 2)``. Both are in the same frame as the poses.
+    """
+
+    segments: FloatArray | None = None
+    points: FloatArray | None = None
+    segment_properties: list[dict[str, Any]] | None = None
+
+    def geometry_points(self, spacing: float = 0.05) -> FloatArray:
+        """Points sampling the map (segments every ``spacing`` m plus points)."""
+        parts: list[FloatArray] = []
+        if self.segments is not None and len(self.segments):
+            seg = np.asarray(self.segments, dtype=float)
+            lengths = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1])
+            counts = np.maximum(2, np.ceil(lengths / spacing).astype(int) + 1)
+            for s, n in zip(seg, counts):
+                t = np.linspace(0.0, 1.0, n)[:, None]
+                parts.append(s[:2] + t * (s[2:] - s[:2]))
+        if self.points is not None and len(self.points):
+            parts.append(np.asarray(self.points, dtype=float))
+        return np.concatenate(parts) if parts else np.empty((0, 2))
+
+
+@dataclass
+class MapperOutput:
+    """What :meth:`Mapper.finish` returns.
+
+    ``counters`` must hold at least ``views`` (scans processed) and
+    ``updates`` (map updates for Albot1; insertions/keyframes for baselines);
+    ``extras`` holds JSON-able, method-specific records (update trace, ...).
+    """
+
+    poses: FloatArray
+    map: MapData
+    counters: dict[str, int | float]
+    extras: dict[str, Any] = field(default_factory=dict)
+
+
+@runtime_checkable
+class Mapper(Protocol):
+    """A mapping method. Classes also carry ``name``, ``config_model`` and ``presets``."""
+
+    name: ClassVar[str]
+    config_model: ClassVar[type[BaseModel]]
+    #: preset name -> field overrides on top of the config model's defaults; has "default".
+    presets: ClassVar[dict[str, dict[str, Any]]]
+
+    def process(self, frame: Frame) -> None:
+        """Consume one frame (the only call that is timed per scan)."""
+        ...
+
+    def finish(self) -> MapperOutput:
+        """Final poses (one per processed frame), map and counters."""
+        ...
+
+
+@dataclass
+class RunResult:
+    """One method run on one (possibly degraded) sequence, ready to store."""
+
+    method: str
+    dataset: str
+    preset: str
+    degradation: str
+    seed: int
+    config: dict[str, Any]
+    timestamps: FloatArray
+    poses: FloatArray
+    odometry: FloatArray
+    reference: FloatArray | None
+    relations: Relations | None
+    map: MapData
+    counters: dict[str, int | float]
+    extras: dict[str, Any]
+    per_scan_ns: NDArray[np.int64]
+    finish_s: float
+    total_s: float
+    wall_s: float
+    peak_mb: float
+    versions: dict[str, Any]
+    dataset_info: dict[str, Any] = field(default_factory=dict)
+
+    def timing(self) -> dict[str, float]:
+        """The timing block of ``result.json`` (DESIGN.md 4b)."""
+        ms = self.per_scan_ns.astype(float) / 1e6
+        return {
+            "per_scan_ms_median": float(np.median(ms)) if len(ms) else float("nan"),
+            "per_scan_ms_p95": float(np.percentile(ms, 95)) if len(ms) else float("nan"),
+            "per_scan_ms_mean": float(np.mean(ms)) if len(ms) else float("nan"),
+            "finish_s": self.finish_s,
+            "total_s": self.total_s,
+            "wall_s": self.wall_s,
+            "peak_mb": self.peak_mb,
+        }

@@ -1,0 +1,47 @@
+"""Where the project finds datasets and keeps its caches.
+
+Datasets are never found through a hard-coded path: ``ALBOT1_DATA_DIR`` names
+a folder laid out like the shared dataset copies (``radish/``,
+``radish-corrected/``, ...), and downloads go to ``ALBOT1_CACHE_DIR``
+(default: the user's cache directory). Lookups try the data folder first and
+the cache second, so a read-only data folder works.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+DATA_DIR_ENV = "ALBOT1_DATA_DIR"
+CACHE_DIR_ENV = "ALBOT1_CACHE_DIR"
+
+
+def _default_cache_dir() -> Path:
+    from platformdirs import user_cache_dir
+
+    return Path(user_cache_dir("albot1-bench")) / "datasets"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Resolved dataset locations; build with :func:`get_settings`."""
+
+    data_dir: Path | None
+    cache_dir: Path
+
+    def search_roots(self) -> list[Path]:
+        """Folders searched for dataset files, most preferred first."""
+        roots = [self.data_dir] if self.data_dir is not None else []
+        roots.append(self.cache_dir)
+        return roots
+
+
+def get_settings(data_dir: str | Path | None = None, cache_dir: str | Path | None = None) -> Settings:
+    """Settings from explicit arguments (CLI options), else the environment, else defaults."""
+    data = data_dir if data_dir is not None else os.environ.get(DATA_DIR_ENV) or None
+    cache = cache_dir if cache_dir is not None else os.environ.get(CACHE_DIR_ENV) or None
+    return Settings(
+        data_dir=Path(data).expanduser() if data else None,
+        cache_dir=Path(cache).expanduser() if cache else _default_cache_dir(),
+    )
