@@ -1,0 +1,34 @@
+"""Group laws of SE(2) on random poses (hypothesis)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+
+from albot1.geometry import se2
+
+coord = st.floats(-1e3, 1e3, allow_nan=False)
+angle = st.floats(-10, 10, allow_nan=False)
+pose = st.tuples(coord, coord, angle).map(lambda t: np.array(t, dtype=float))
+
+
+def _close(a: np.ndarray, b: np.ndarray) -> None:
+    np.testing.assert_allclose(a[:2], b[:2], atol=1e-6)
+    assert abs(se2.wrap(a[2] - b[2])) < 1e-9
+
+
+@given(pose, pose, pose)
+def test_associative(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> None:
+    _close(se2.compose(se2.compose(a, b), c), se2.compose(a, se2.compose(b, c)))
+
+
+@given(pose, pose)
+def test_between_recovers(a: np.ndarray, b: np.ndarray) -> None:
+    _close(se2.compose(a, se2.between(a, b)), b)
+
+
+@given(pose, pose)
+def test_relative_pose_invariant_under_common_transform(a: np.ndarray, b: np.ndarray) -> None:
+    g = np.array([3.0, -7.0, 1.2])
+    _close(se2.between(se2.compose(g, a), se2.compose(g, b)), se2.between(a, b))
