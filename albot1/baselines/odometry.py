@@ -4,6 +4,11 @@ The pose at each scan is the odometry the method is given (after any
 degradation), re-expressed relative to the first scan so every method's map
 frame starts at the origin; the map is every scan projected with it,
 thinned on a voxel grid so large logs stay storable.
+
+Its settings' values live in ``baselines/odometry.toml`` (see
+:mod:`albot1.baselines.presets`); the field defaults below exist only so the
+config can be built directly in code and tests, and equal that file's
+``[presets.default]`` (a unit test checks it).
 """
 
 from __future__ import annotations
@@ -13,6 +18,8 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from albot1.baselines.point_map import ThinnedPointMap
+from albot1.baselines.presets import TomlPresets
 from albot1.data.model import Frame
 from albot1.geometry import se2
 from albot1.runs.protocol import MapData, MapperOutput
@@ -30,14 +37,13 @@ class OdometryConfig(BaseModel):
 class OdometryMapper:
     name: ClassVar[str] = "odometry"
     config_model: ClassVar[type[BaseModel]] = OdometryConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = {"default": {}}
+    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
 
     def __init__(self, config: OdometryConfig, *, seed: int = 0) -> None:
         self.config = config
         self._origin: np.ndarray | None = None
         self._poses: list[np.ndarray] = []
-        self._cells: set[tuple[int, int]] = set()
-        self._points: list[np.ndarray] = []
+        self._map = ThinnedPointMap(config.map_voxel_m)
 
     def process(self, frame: Frame) -> None:
         if self._origin is None:
@@ -46,18 +52,10 @@ class OdometryMapper:
         self._poses.append(pose)
         if frame.index % self.config.map_every:
             return
-        pts = se2.transform_points(pose, frame.scan.points())
-        if not len(pts):
-            return
-        cells = np.floor(pts / self.config.map_voxel_m).astype(np.int64)
-        _, first = np.unique(cells, axis=0, return_index=True)
-        fresh = [i for i in first if (cells[i, 0], cells[i, 1]) not in self._cells]
-        self._cells.update((int(cells[i, 0]), int(cells[i, 1])) for i in fresh)
-        if fresh:
-            self._points.append(pts[fresh])
+        self._map.add(se2.transform_points(pose, frame.scan.points()))
 
     def finish(self) -> MapperOutput:
-        points = np.concatenate(self._points) if self._points else np.empty((0, 2))
+        points = self._map.points()
         n = len(self._poses)
         return MapperOutput(
             poses=np.asarray(self._poses, dtype=float).reshape(-1, 3),

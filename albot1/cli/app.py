@@ -45,24 +45,13 @@ for _module_name, _attr, _group in _COMMANDS:
 
 
 def main() -> None:
-    """Console-script entry: known errors -> ``albot1: error: ...`` on stderr, exit 1."""
+    """Console-script entry: known errors -> ``albot1: error: ...`` on stderr, exit 1.
+
+    Typer's standalone mode already turns usage errors into a usage message
+    with exit 2; only the project's own errors need translating here.
+    """
     try:
-        app(standalone_mode=False)
+        app()
     except Albot1Error as exc:
         typer.echo(f"albot1: error: {exc}", err=True)
         sys.exit(1)
-    except KeyboardInterrupt:
-        typer.echo("albot1: interrupted", err=True)
-        sys.exit(130)
-    except typer.Exit as exc:
-        sys.exit(exc.exit_code)
-    except typer.Abort:
-        typer.echo("albot1: aborted", err=True)
-        sys.exit(1)
-    except Exception as exc:  # click usage errors
-        import click
-
-        if isinstance(exc, click.ClickException):
-            exc.show()
-            sys.exit(exc.exit_code)
-        raise

@@ -37,6 +37,9 @@ from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
 
+EXPECTED_SPEC = "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG or bias:DX_M:DTHETA_DEG"
+
+
 class DegradationSpecError(DataError):
     """A degradation SPEC string does not parse."""
 
@@ -83,15 +86,13 @@ def parse_spec(spec: str) -> Degradation:
     kind, _, rest = text.partition(":")
     parts = rest.split(":") if rest else []
     if kind not in ("gauss", "bias") or len(parts) != 2:
-        raise DegradationSpecError(
-            f"degradation {spec!r} not understood; expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG "
-            f"or bias:DX_M:DTHETA_DEG")
+        raise DegradationSpecError(f"degradation {spec!r} not understood; {EXPECTED_SPEC}")
     try:
         a, b_deg = float(parts[0]), float(parts[1])
     except ValueError:
-        raise DegradationSpecError(f"degradation {spec!r}: the two values must be numbers") from None
+        raise DegradationSpecError(f"degradation {spec!r}: the two values must be numbers; {EXPECTED_SPEC}") from None
     if not (math.isfinite(a) and math.isfinite(b_deg)) or (kind == "gauss" and (a < 0 or b_deg < 0)):
-        raise DegradationSpecError(f"degradation {spec!r}: values must be finite (and sigmas >= 0)")
+        raise DegradationSpecError(f"degradation {spec!r}: values must be finite (and sigmas >= 0); {EXPECTED_SPEC}")
     return Degradation(kind, a, math.radians(b_deg))
 
 
@@ -114,5 +115,6 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
             prev_raw = np.asarray(frame.odometry, dtype=float)
             yield replace(frame, odometry=current)
 
-    meta = replace(sequence.metadata, odometry_source=f"{sequence.metadata.odometry_source} degraded {deg.spec} seed {seed}")
+    source = sequence.metadata.odometry_source or "odometry"
+    meta = replace(sequence.metadata, odometry_source=f"{source} degraded {deg.spec} seed {seed}")
     return sequence.with_frames(frames, metadata=meta)

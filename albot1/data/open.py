@@ -7,6 +7,7 @@ of any known format.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +24,18 @@ def open_sequence(ref: str | Path, *, settings: Settings | None = None, format_n
     from albot1.data.synthetic import worlds
 
     text = str(ref)
+    # "NAME[:STOP]" / "NAME[:STOP:STEP]" / "NAME[::STEP]": the first STOP scans, every STEP-th of them
+    # (the benchmark suites name their slices of long logs this way, so a run's dataset reopens as run).
+    sliced = re.fullmatch(r"(?P<ref>.+)\[:(?P<stop>\d*)(?::(?P<step>\d+))?\]", text)
+    if sliced is not None and not Path(text).expanduser().exists():
+        from albot1.data.transforms import head, stride
+
+        sequence = open_sequence(sliced["ref"], settings=settings, format_name=format_name, **options)
+        if sliced["stop"]:
+            sequence = head(sequence, int(sliced["stop"]))
+        if sliced["step"]:
+            sequence = stride(sequence, int(sliced["step"]))
+        return sequence
     if text in worlds.WORLDS:
         return worlds.load_world(text)
     settings = settings or get_settings()

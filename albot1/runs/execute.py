@@ -77,8 +77,13 @@ def run_method(
         finish_start = time.perf_counter()
         output = mapper.finish()
         finish_s = time.perf_counter() - finish_start
-    except Albot1Error:
-        raise
+    except Albot1Error as exc:
+        if type(exc) is not error_class:
+            raise
+        # A mapper never sees the dataset's name: add it ("kiss-icp diverged ..." -> "kiss-icp on intel diverged ...").
+        text = str(exc)
+        rest = text[len(method):] if text.startswith(method) else f": {text}"
+        raise error_class(f"{method} on {dataset}{rest}") from exc
     except Exception as exc:  # a library failed deep inside: name method, dataset and scan
         raise error_class(f"{method} on {dataset} failed at scan {index}: {type(exc).__name__}: {exc}") from exc
 

@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.data.model import Relations
+from albot1.data.relations import read_relations, write_relations
 from albot1.runs.errors import RunError
 from albot1.runs.protocol import MapData, RunResult
 from albot1.runs.tum import read_tum, write_tum
@@ -123,19 +124,6 @@ def write_run(result: RunResult, root: Path, *, preview: bool = True) -> Path:
         _atomic_write(run_dir / "preview.png", lambda p: render_preview(result, p))
     _atomic_write(run_dir / DONE, lambda p: p.write_text(key + "\n"))
     return run_dir
-
-
-def write_relations(path: Path, relations: Relations) -> None:
-    rows = np.column_stack([relations.t1, relations.t2, relations.poses[:, 0], relations.poses[:, 1],
-                            np.zeros(len(relations)), np.zeros(len(relations)), np.zeros(len(relations)),
-                            relations.poses[:, 2]])
-    np.savetxt(path, rows, fmt="%.9f")
-
-
-def read_relations(path: Path) -> Relations:
-    """A relations file ``t1 t2 x y z roll pitch yaw`` (Kuemmerle et al. 2009)."""
-    rows = np.loadtxt(path, ndmin=2)
-    return Relations(t1=rows[:, 0], t2=rows[:, 1], poses=rows[:, [2, 3, 7]])
 
 
 def _write_map(run_dir: Path, data: MapData) -> str:

@@ -1,0 +1,129 @@
+"""The data that flows through the runner: cells, their outcomes and the grid plan.
+
+Plain dataclasses that pickle (to Dask workers and child processes) and
+round-trip through JSON (``grid.json``, ``cell.json``), so the report can be
+rebuilt from the results folder alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
+
+Status = Literal["done", "cached", "failed"]
+FailureKind = Literal["exception", "memory", "timeout", "crash", "config", "executor", "interrupted"]
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One run of the grid: a dataset slice x method entry x degradation x seed, with its limits.
+
+    ``key`` is the run folder name (:func:`albot1.runs.folder.run_key` of the
+    dataset label, method, resolved config, degradation, seed and code
+    version), so a stored result is found again exactly when every input is
+    the same.
+    """
+
+    suite: str
+    dataset: str
+    dataset_label: str
+    method: str
+    method_label: str
+    preset: str
+    degradation: str
+    seed: int
+    key: str
+    code_version: str
+    time_s: float
+    memory_mb: float
+    limit: int | None = None
+    stride: int | None = None
+    overrides: dict[str, Any] = field(default_factory=dict)
+    config: dict[str, Any] | None = None
+    target: str | None = None
+    error_class: str | None = None
+    requires: tuple[str, ...] = ()
+
+    def describe(self) -> str:
+        """One line naming the cell for humans (progress, failure lists)."""
+        return f"{self.method_label} on {self.dataset_label} [{self.degradation}, seed {self.seed}]"
+
+    def to_json(self) -> dict[str, Any]:
+        out = asdict(self)
+        out["requires"] = list(self.requires)
+        return out
+
+    @classmethod
+    def from_json(cls, data: dict[str, Any]) -> Cell:
+        values = dict(data)
+        values["requires"] = tuple(values.get("requires") or ())
+        return cls(**values)
+
+
+@dataclass(frozen=True)
+class CellOutcome:
+    """What became of one cell (returned by the job, shown by the progress view)."""
+
+    key: str
+    description: str
+    method_label: str
+    dataset_label: str
+    status: Status
+    elapsed_s: float = 0.0
+    reason: str | None = None
+    kind: FailureKind | None = None
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """A dataset or method left out of the grid on this machine, and what to do about it."""
+
+    name: str
+    reason: str
+    hint: str = ""
+
+
+@dataclass
+class GridPlan:
+    """A suite expanded against this machine: the cells to run and what was left out."""
+
+    suite: str
+    suite_path: str | None
+    description: str
+    cells: list[Cell]
+    skipped_datasets: list[Skipped]
+    skipped_methods: list[Skipped]
+    #: cells that cannot even start (their config does not resolve): key -> reason
+    config_failures: dict[str, str]
+    seeds: list[int]
+    degradations: list[str]
+    machine: dict[str, Any]
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "suite": self.suite,
+            "suite_path": self.suite_path,
+            "description": self.description,
+            "cells": [c.to_json() for c in self.cells],
+            "skipped_datasets": [asdict(s) for s in self.skipped_datasets],
+            "skipped_methods": [asdict(s) for s in self.skipped_methods],
+            "config_failures": self.config_failures,
+            "seeds": self.seeds,
+            "degradations": self.degradations,
+            "machine": self.machine,
+        }
+
+    @classmethod
+    def from_json(cls, data: dict[str, Any]) -> GridPlan:
+        return cls(
+            suite=data["suite"],
+            suite_path=data.get("suite_path"),
+            description=data.get("description", ""),
+            cells=[Cell.from_json(c) for c in data["cells"]],
+            skipped_datasets=[Skipped(**s) for s in data.get("skipped_datasets", [])],
+            skipped_methods=[Skipped(**s) for s in data.get("skipped_methods", [])],
+            config_failures=dict(data.get("config_failures", {})),
+            seeds=list(data.get("seeds", [])),
+            degradations=list(data.get("degradations", [])),
+            machine=dict(data.get("machine", {})),
+        )

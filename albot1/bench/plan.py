@@ -1,0 +1,196 @@
+"""Expand a suite into the cells that run on this machine.
+
+Datasets that are not downloaded and methods whose libraries are missing are
+*skipped* with the command that fixes it, never failed: a fresh machine must
+still produce a complete report from the synthetic worlds. A method entry
+whose config does not resolve (a bad override, a module that does not
+import) is not skipped: its cells are planned and recorded as failed with the
+reason, so the report shows the problem next to the results that did run.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import sys
+from collections.abc import Iterable
+from typing import Any
+
+from albot1 import versions
+from albot1.bench.errors import SuiteError
+from albot1.bench.grid import Cell, GridPlan, Skipped
+from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
+from albot1.errors import Albot1Error
+from albot1.runs.folder import run_key
+from albot1.settings import Settings
+
+
+def machine_info() -> dict[str, Any]:
+    """What the report states about where the numbers were measured."""
+    import psutil
+
+    return {
+        "cpu_count": os.cpu_count(),
+        "cpu_count_physical": psutil.cpu_count(logical=False),
+        "memory_gb": round(psutil.virtual_memory().total / 2**30, 1),
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "python": sys.version.split()[0],
+        "code_version": versions.code_version(),
+        "git": versions.git_commit(),
+        "libraries": versions.library_versions(),
+    }
+
+
+def register_plugin(name: str, target: str, error_class: str | None, requires: Iterable[str] = ()) -> None:
+    """Add a suite-defined method (``target = "module:Class"``) to the registry of this process.
+
+    Called by the planner and again inside each cell's child process, which
+    starts from a fresh registry.
+    """
+    from albot1.runs.methods import METHODS, MethodSpec
+
+    spec = MethodSpec(name, target, requires=tuple(requires),
+                      error_class=error_class or "albot1.baselines.errors:BaselineError",
+                      description=f"suite-defined method {target}")
+    existing = METHODS.get(name)
+    if existing is not None and existing.target != target:
+        raise SuiteError(f"method {name!r} is registered as {existing.target}; the suite's target {target} "
+                         "needs a different name")
+    METHODS[name] = spec
+
+
+def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
+    """(resolved config as JSON, None) or (None, reason it does not resolve)."""
+    from albot1.runs.methods import resolve_config
+
+    try:
+        config = resolve_config(entry.name, entry.preset, dict(entry.set))
+    except Albot1Error as exc:
+        return None, f"{type(exc).__name__}: {exc}"
+    except Exception as exc:  # the method's module itself is broken: a cell failure, not a runner crash
+        return None, f"cannot load method {entry.name!r}: {type(exc).__name__}: {exc}"
+    return config.model_dump(mode="json"), None
+
+
+def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
+    from albot1.runs.methods import METHODS
+
+    entries = list(suite.methods)
+    for entry in entries:
+        if entry.target is not None:
+            register_plugin(entry.name, entry.target, entry.error_class, entry.requires)
+        elif entry.name not in METHODS:
+            raise SuiteError(f"{suite.path or suite.name}: unknown method {entry.name!r}; "
+                             f"expected one of: {', '.join(METHODS)} (or give a `target`)")
+    if suite.registered_methods:
+        named = {e.name for e in entries}
+        entries += [MethodEntry(name=n) for n in METHODS if n not in named]
+    usable, skipped = [], []
+    for entry in entries:
+        spec = METHODS[entry.name]
+        if spec.available():
+            usable.append(entry)
+        else:
+            missing = [m for m in spec.requires if not _importable(m)]
+            skipped.append(Skipped(entry.display, f"needs {', '.join(missing)}, which is not installed",
+                                   f"pip install {' '.join(missing)}"))
+    return usable, skipped
+
+
+def _importable(module: str) -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec(module) is not None
+
+
+def _candidate_datasets(suite: Suite) -> list[str]:
+    from albot1.data import catalog
+    from albot1.data.synthetic import worlds
+
+    known = list(worlds.WORLDS) + sorted(catalog.names())
+    out = [n for n in known if suite.options_for(n) is not None]
+    for literal in suite.literal_datasets():
+        if literal not in out and suite.options_for(literal) is not None:
+            out.append(literal)
+    return out
+
+
+def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None]:
+    """(has reference poses, None) when the dataset can be opened, else (None, why skipped)."""
+    from albot1.data import catalog
+    from albot1.data.errors import DatasetNotFoundError
+    from albot1.data.open import open_sequence
+
+    if name in catalog.names():
+        try:
+            catalog.locate(name, settings)
+        except DatasetNotFoundError as exc:
+            manifest = catalog.get(name)
+            fetchable = not manifest.local_only and bool(manifest.log.urls)
+            return None, Skipped(name, f"not downloaded: {exc}", f"albot1 datasets fetch {name}" if fetchable else "")
+    try:
+        sequence = open_sequence(name, settings=settings)
+        first = next(iter(sequence.frames()), None)
+    except DatasetNotFoundError as exc:
+        return None, Skipped(name, str(exc))
+    if first is None:
+        return None, Skipped(name, "the dataset holds no scans")
+    return first.reference is not None, None
+
+
+def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tuple[str, int]]:
+    grid = suite.grid
+    runs = [("none", s) for s in (opts.undegraded_seeds if opts.undegraded_seeds is not None
+                                  else grid.undegraded_seeds)]
+    sweep = has_reference if opts.sweep == "auto" else bool(opts.sweep)
+    if sweep:
+        degradations = opts.degradations if opts.degradations is not None else grid.degradations
+        seeds = opts.seeds if opts.seeds is not None else grid.seeds
+        runs += [(d, s) for d in degradations if d != "none" for s in seeds]
+    return runs
+
+
+def _limit(*values: float | None, default: float) -> float:
+    given = [v for v in values if v is not None]
+    return max(given) if given else default
+
+
+def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
+    """The cells of ``suite`` on this machine (datasets present, methods installed)."""
+    code = versions.code_version()
+    methods, skipped_methods = _methods(suite)
+    resolved = {entry.display: _resolve(entry) for entry in methods}
+    cells: list[Cell] = []
+    skipped_datasets: list[Skipped] = []
+    config_failures: dict[str, str] = {}
+    for name in _candidate_datasets(suite):
+        opts = suite.options_for(name)
+        assert opts is not None  # _candidate_datasets keeps selected names only
+        has_reference, skipped = _availability(name, settings)
+        if skipped is not None:
+            skipped_datasets.append(skipped)
+            continue
+        for degradation, seed in _sweep(opts, suite, bool(has_reference)):
+            for entry in methods:
+                config, problem = resolved[entry.display]
+                key_config = config if config is not None else {
+                    "unresolved": True, "preset": entry.preset, "set": dict(entry.set)}
+                key = run_key(opts.label, entry.name, key_config, degradation, seed, code)
+                if problem is not None:
+                    config_failures[key] = problem
+                cells.append(Cell(
+                    suite=suite.name, dataset=name, dataset_label=opts.label, method=entry.name,
+                    method_label=entry.display, preset=entry.preset, degradation=degradation, seed=seed,
+                    key=key, code_version=code,
+                    time_s=_limit(opts.time_s, entry.time_s, default=suite.limits.time_s),
+                    memory_mb=_limit(opts.memory_mb, entry.memory_mb, default=suite.limits.memory_mb),
+                    limit=opts.limit, stride=opts.stride, overrides=dict(entry.set), config=config,
+                    target=entry.target, error_class=entry.error_class, requires=entry.requires,
+                ))
+    seeds = sorted({c.seed for c in cells})
+    degradations = list(dict.fromkeys(c.degradation for c in cells))
+    return GridPlan(suite=suite.name, suite_path=str(suite.path) if suite.path else None,
+                    description=suite.description, cells=cells, skipped_datasets=skipped_datasets,
+                    skipped_methods=skipped_methods, config_failures=config_failures, seeds=seeds,
+                    degradations=degradations, machine=machine_info())

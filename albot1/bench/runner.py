@@ -1,0 +1,133 @@
+"""Run a grid plan: skip completed cells, submit the rest, collect outcomes as they complete.
+
+The runner holds no result in memory that is not already on disk: the plan
+is written first, every cell writes its own folder, and the summary is
+recomputed from the store. Killing the runner at any moment therefore loses
+at most the cells that were in flight.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import time
+import traceback
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+from albot1.bench.grid import Cell, CellOutcome, GridPlan
+from albot1.bench.job import results_path, run_cell_job
+from albot1.bench.store import ResultsStore
+from albot1.settings import Settings
+
+
+class GridObserver(Protocol):
+    """What the runner reports while it works (the CLI attaches a progress bar)."""
+
+    def started(self, total: int, cached: int) -> None: ...
+
+    def finished(self, outcome: CellOutcome) -> None: ...
+
+
+@dataclass
+class GridSummary:
+    """Counts and outcomes of one runner invocation."""
+
+    outcomes: list[CellOutcome] = field(default_factory=list)
+    wall_s: float = 0.0
+
+    @property
+    def counts(self) -> Counter[str]:
+        return Counter(o.status for o in self.outcomes)
+
+    @property
+    def failures(self) -> list[CellOutcome]:
+        return [o for o in self.outcomes if o.status == "failed"]
+
+
+def _unique(cells: list[Cell]) -> list[Cell]:
+    """One cell per key: two labels resolving to the same inputs share one run folder."""
+    seen: dict[str, Cell] = {}
+    for cell in cells:
+        seen.setdefault(cell.key, cell)
+    return list(seen.values())
+
+
+def run_grid(plan: GridPlan, store: ResultsStore, executor: cf.Executor,
+             observer: GridObserver | None = None,
+             job: Callable[[Cell, str], CellOutcome] = run_cell_job) -> GridSummary:
+    """Run every incomplete cell of ``plan`` on ``executor``; failures are recorded, never raised."""
+    start = time.monotonic()
+    summary = GridSummary()
+    cells = _unique(plan.cells)
+    pending: list[Cell] = []
+    for cell in cells:
+        if cell.key in plan.config_failures:
+            store.prepare(cell)
+            store.record_failure(cell, plan.config_failures[cell.key], "config")
+            summary.outcomes.append(CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label,
+                                                "failed", 0.0, plan.config_failures[cell.key], "config"))
+        elif store.is_complete(cell.key):
+            summary.outcomes.append(CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label,
+                                                "cached"))
+        else:
+            pending.append(cell)
+    if observer is not None:
+        observer.started(len(cells), len(cells) - len(pending))
+        for outcome in summary.outcomes:
+            if outcome.status == "failed":
+                observer.finished(outcome)
+    root = results_path(store.root)
+    futures = {executor.submit(job, cell, root): cell for cell in pending}
+    try:
+        for future in cf.as_completed(futures):
+            cell = futures[future]
+            try:
+                outcome = future.result()
+            except Exception as exc:  # the executor lost the job (worker died, unpicklable, ...)
+                reason = f"executor error: {type(exc).__name__}: {exc}"
+                store.record_failure(cell, reason, "executor", traceback_text="".join(traceback.format_exception(exc)))
+                outcome = CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label, "failed",
+                                      0.0, reason, "executor")
+            summary.outcomes.append(outcome)
+            if observer is not None:
+                observer.finished(outcome)
+    finally:
+        for future in futures:
+            future.cancel()
+    summary.wall_s = time.monotonic() - start
+    return summary
+
+
+def bench_results_root(results: Path, suite_name: str) -> Path:
+    """``results/<suite>``: the folder `albot1 report` reads."""
+    return results / suite_name
+
+
+def run_suite(suite_ref: str, *, results: Path, jobs: int = 2, executor: str = "local",
+              observer: GridObserver | None = None, settings: Settings | None = None,
+              dask_processes: bool = True) -> tuple[GridPlan, GridSummary, ResultsStore]:
+    """Load, plan and run a suite into ``results/<suite>``: what `albot1 bench` does."""
+    from albot1.bench.executors import open_executor, parse_executor
+    from albot1.bench.limits import start_forkserver
+    from albot1.bench.plan import plan_suite
+    from albot1.bench.suite import find_suite, load_suite
+    from albot1.settings import get_settings
+
+    kind, _ = parse_executor(executor)  # a typo fails before any planning work
+    suite_file = find_suite(suite_ref)
+    suite = load_suite(suite_file)
+    if kind == "local":
+        start_forkserver()
+    plan = plan_suite(suite, settings or get_settings())
+    store = ResultsStore(bench_results_root(results, suite.name))
+    store.lock()
+    try:
+        store.write_plan(plan, suite_file)
+        with open_executor(executor, jobs, dask_processes=dask_processes) as pool:
+            summary = run_grid(plan, store, pool, observer)
+    finally:
+        store.unlock()
+    return plan, summary, store

@@ -1,0 +1,250 @@
+"""Benchmark suites: TOML files in ``benchmarks/`` parsed into a typed, validated model.
+
+A suite says *what could* run (dataset patterns x method entries x
+degradations x seeds, with per-cell limits); :mod:`albot1.bench.plan` turns
+it into the cells that *will* run on this machine (datasets present, method
+dependencies installed). Keeping the two apart lets one suite file serve a
+laptop without downloads and a machine with every log.
+
+Format (every key optional except ``methods`` and ``datasets``)::
+
+    name = "default"                 # defaults to the file stem
+    description = "..."
+    registered_methods = true        # also run every other registered, installed method
+
+    [limits]                         # per-cell defaults
+    time_s = 900                     # wall-clock limit of one cell
+    memory_mb = 4096                 # address-space growth allowed to one cell
+
+    [grid]
+    degradations = ["thesis", "gauss:0.05:0.5"]   # swept on datasets with reference poses
+    seeds = [0, 1, 2]                # seeds of every swept degradation
+    undegraded_seeds = [0]           # seeds of the run on the dataset's own odometry
+
+    [[methods]]
+    name = "albot1"
+    preset = "thesis"
+    set = { some_field = 1 }         # config overrides (highest precedence)
+    # label = "albot1:thesis"        # defaults to name, or name:preset
+    # target = "pkg.mod:Class"       # a method that is not in the registry (your own mapper)
+
+    [[datasets]]                     # applied in order; later entries override earlier ones
+    name = "*"                       # a glob over dataset and world names, a name, or a file path
+    [[datasets]]
+    name = "intel"
+    limit = 4000                     # first 4000 scans ...
+    stride = 2                       # ... every 2nd of them
+    sweep = false                    # true | false | "auto" (= when the dataset has reference poses)
+    # degradations / seeds / undegraded_seeds / time_s / memory_mb / skip = true
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import tomllib
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from albot1.bench.errors import SuiteError
+
+GLOB_CHARS = frozenset("*?[")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Limits(_Strict):
+    """Per-cell resource limits."""
+
+    time_s: float = Field(900.0, gt=0, description="wall-clock seconds before the cell is killed")
+    memory_mb: float = Field(4096.0, gt=0, description="address space the cell may add to its start size, MiB")
+
+
+class GridSpec(_Strict):
+    """The degradation sweep applied to datasets with reference poses."""
+
+    degradations: tuple[str, ...] = ()
+    seeds: tuple[int, ...] = (0,)
+    undegraded_seeds: tuple[int, ...] = (0,)
+
+    @field_validator("degradations")
+    @classmethod
+    def _valid_specs(cls, value: tuple[str, ...]) -> tuple[str, ...]:
+        return _check_degradations(value)
+
+
+class MethodEntry(_Strict):
+    """One method column of the grid: a registered method (or a plugin target) with preset and overrides."""
+
+    name: str = Field(min_length=1)
+    preset: str = "default"
+    set: dict[str, Any] = Field(default_factory=dict)
+    label: str | None = None
+    target: str | None = Field(None, description="module:Class of a mapper outside the registry")
+    error_class: str | None = Field(None, description="module:Class of that mapper's exception")
+    requires: tuple[str, ...] = ()
+    time_s: float | None = Field(None, gt=0)
+    memory_mb: float | None = Field(None, gt=0)
+
+    @field_validator("target", "error_class")
+    @classmethod
+    def _module_class(cls, value: str | None) -> str | None:
+        if value is not None and (value.count(":") != 1 or not all(value.split(":"))):
+            raise ValueError(f"expected 'module:Class', got {value!r}")
+        return value
+
+    @property
+    def display(self) -> str:
+        """The column name in reports: the label, else ``name`` or ``name:preset``."""
+        if self.label:
+            return self.label
+        return self.name if self.preset == "default" else f"{self.name}:{self.preset}"
+
+
+class DatasetEntry(_Strict):
+    """Options for the datasets whose names match ``name`` (glob, name or path)."""
+
+    name: str = Field(min_length=1)
+    skip: bool = False
+    limit: int | None = Field(None, ge=1, description="use the first LIMIT scans of the log")
+    stride: int | None = Field(None, ge=1, description="then every STRIDE-th of them")
+    sweep: bool | Literal["auto"] = "auto"
+    degradations: tuple[str, ...] | None = None
+    seeds: tuple[int, ...] | None = None
+    undegraded_seeds: tuple[int, ...] | None = None
+    time_s: float | None = Field(None, gt=0)
+    memory_mb: float | None = Field(None, gt=0)
+
+    @field_validator("degradations")
+    @classmethod
+    def _valid_specs(cls, value: tuple[str, ...] | None) -> tuple[str, ...] | None:
+        return None if value is None else _check_degradations(value)
+
+    @property
+    def is_pattern(self) -> bool:
+        return any(ch in GLOB_CHARS for ch in self.name)
+
+    def matches(self, name: str) -> bool:
+        return fnmatch.fnmatchcase(name, self.name) if self.is_pattern else name == self.name
+
+
+class DatasetOptions(_Strict):
+    """The merged options of one concrete dataset (all entries that match it, in order)."""
+
+    name: str
+    limit: int | None = None
+    stride: int | None = None
+    sweep: bool | Literal["auto"] = "auto"
+    degradations: tuple[str, ...] | None = None
+    seeds: tuple[int, ...] | None = None
+    undegraded_seeds: tuple[int, ...] | None = None
+    time_s: float | None = None
+    memory_mb: float | None = None
+
+    @property
+    def label(self) -> str:
+        """Name plus the slice actually used, e.g. ``intel[:4000:2]``: it is part of the run's identity."""
+        if self.limit is None and self.stride is None:
+            return self.name
+        return f"{self.name}[:{self.limit or ''}{f':{self.stride}' if self.stride else ''}]"
+
+
+class Suite(_Strict):
+    """A validated suite file."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    description: str = ""
+    path: Path | None = None
+    registered_methods: bool = False
+    limits: Limits = Field(default_factory=Limits)
+    grid: GridSpec = Field(default_factory=GridSpec)
+    methods: tuple[MethodEntry, ...] = Field(min_length=1)
+    datasets: tuple[DatasetEntry, ...] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _unique_labels(self) -> Suite:
+        seen: set[str] = set()
+        for entry in self.methods:
+            if entry.display in seen:
+                raise ValueError(f"two method entries are both labelled {entry.display!r}; give one a `label`")
+            seen.add(entry.display)
+        return self
+
+    def options_for(self, name: str) -> DatasetOptions | None:
+        """Merged options of dataset ``name``, or None when no entry selects it (or one skips it)."""
+        merged: dict[str, Any] = {}
+        selected = False
+        for entry in self.datasets:
+            if not entry.matches(name):
+                continue
+            if entry.skip:
+                selected = False
+                merged = {}
+                continue
+            selected = True
+            for field_name in entry.model_fields_set - {"name", "skip"}:
+                merged[field_name] = getattr(entry, field_name)
+        return DatasetOptions(name=name, **merged) if selected else None
+
+    def literal_datasets(self) -> list[str]:
+        """Dataset names or paths given literally (not as patterns), in suite order."""
+        out: list[str] = []
+        for entry in self.datasets:
+            if not entry.is_pattern and not entry.skip and entry.name not in out:
+                out.append(entry.name)
+        return out
+
+
+def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
+    from albot1.data.degrade import DegradationSpecError, parse_spec
+
+    for spec in specs:
+        try:
+            parse_spec(spec)
+        except DegradationSpecError as exc:
+            raise ValueError(str(exc)) from None
+    return specs
+
+
+def parse_suite(data: dict[str, Any], *, name: str, source: str, path: Path | None = None) -> Suite:
+    """Validate suite data (a parsed TOML table); SuiteError names ``source`` and the offending key."""
+    try:
+        return Suite.model_validate({"name": name, **data, "path": path})
+    except ValidationError as exc:
+        problems = "; ".join(
+            f"{'.'.join(str(p) for p in err['loc']) or '(top level)'}: {err['msg']}" for err in exc.errors())
+        raise SuiteError(f"{source}: invalid suite: {problems}") from None
+
+
+def load_suite(path: str | Path) -> Suite:
+    """Read and validate a suite file."""
+    file = Path(path)
+    try:
+        data = tomllib.loads(file.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise SuiteError(f"{file}: cannot read the suite file: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SuiteError(f"{file}: not valid TOML: {exc}") from None
+    name = data.pop("name", file.stem)
+    return parse_suite(data, name=name, source=str(file), path=file.resolve())
+
+
+def find_suite(ref: str) -> Path:
+    """A suite argument -> its file: an existing path, else ``benchmarks/<ref>.toml`` of the project."""
+    candidate = Path(ref).expanduser()
+    if candidate.suffix == ".toml" or candidate.is_file():
+        if not candidate.is_file():
+            raise SuiteError(f"{candidate}: suite file not found")
+        return candidate
+    from albot1.resources import project_dir
+
+    folder = project_dir() / "benchmarks"
+    path = folder / f"{ref}.toml"
+    if not path.is_file():
+        known = sorted(p.stem for p in folder.glob("*.toml"))
+        raise SuiteError(f"no suite named {ref!r} in {folder}; expected one of: {', '.join(known) or '(none)'} "
+                         "or a path to a .toml file")
+    return path

@@ -1,0 +1,80 @@
+"""``albot1 bench [SUITE]`` and ``albot1 report RESULTS_DIR``: the benchmark grid and its report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    app.command("bench")(bench)
+    app.command("report")(report)
+
+
+def bench(
+    suite: Annotated[str, typer.Argument(help="a suite name in benchmarks/ (default, quick, full) or a .toml path")]
+    = "default",
+    jobs: Annotated[int, typer.Option("-j", "--jobs", help="cells run in parallel")] = 2,
+    executor: Annotated[str, typer.Option(help="local | dask | dask://HOST:PORT")] = "local",
+    results: Annotated[Path, typer.Option(help="results root; cells go to RESULTS/<suite>/runs/<key>")]
+    = Path("results"),
+    data_dir: Annotated[Optional[Path], typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
+    progress: Annotated[bool, typer.Option(help="show the progress bar")] = True,
+    dry_run: Annotated[bool, typer.Option("--dry-run", help="print the planned cells per dataset and stop")]
+    = False,
+) -> None:
+    """Run a benchmark suite: every dataset x method x degradation x seed cell, each in its own
+    process under the suite's time and memory limits.
+
+    Completed cells are kept and skipped on the next run; failed cells are recorded with their
+    reason and retried. Then build the report with `albot1 report results/SUITE`.
+
+    Examples:\n
+      albot1 bench                       # the default suite, 2 cells at a time\n
+      albot1 bench quick -j 1\n
+      albot1 bench default --executor dask -j 4\n
+      albot1 bench benchmarks/full.toml --executor dask://scheduler:8786
+    """
+    from albot1.bench.progress import TqdmProgress, plan_table, summary_table
+    from albot1.bench.runner import run_suite
+    from albot1.settings import get_settings
+
+    if dry_run:
+        from albot1.bench.plan import plan_suite
+        from albot1.bench.suite import find_suite, load_suite
+
+        plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
+        typer.echo(plan_table(plan))
+        return
+    view = TqdmProgress(lambda line: typer.echo(line, err=True), disable=not progress)
+    try:
+        plan, summary, store = run_suite(suite, results=results, jobs=jobs, executor=executor, observer=view,
+                                         settings=get_settings(data_dir=data_dir))
+    finally:
+        view.close()
+    for skipped in plan.skipped_datasets:
+        typer.echo(f"skipped dataset {skipped.name}: {skipped.reason}"
+                   + (f" (get it with `{skipped.hint}`)" if skipped.hint else ""), err=True)
+    for skipped in plan.skipped_methods:
+        typer.echo(f"skipped method {skipped.name}: {skipped.reason}", err=True)
+    typer.echo(summary_table(summary))
+    typer.echo(f"results: {store.root}  (report: albot1 report {store.root})")
+
+
+def report(
+    results_dir: Annotated[Path, typer.Argument(help="a results folder written by `albot1 bench` (results/SUITE)")],
+    out: Annotated[Optional[Path], typer.Option(help="report folder (default: reports/<suite>)")] = None,
+    plots: Annotated[bool, typer.Option(help="render the plots (tables only with --no-plots)")] = True,
+) -> None:
+    """Build tables (Markdown, CSV), plots and an index page from a results folder.
+
+    Examples:\n
+      albot1 report results/default          # -> reports/default/README.md\n
+      albot1 report results/quick --out /tmp/quick-report
+    """
+    from albot1.report.index import build_report
+
+    index = build_report(results_dir, out, plots=plots)
+    typer.echo(f"report: {index}")

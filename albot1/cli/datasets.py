@@ -1,0 +1,127 @@
+"""``albot1 datasets list | fetch NAME | info NAME|PATH``: the dataset registry from the shell.
+
+Thin: every fact comes from :mod:`albot1.data.catalog` and
+:meth:`albot1.data.model.Sequence.summary`; heavy imports happen inside the
+commands so ``albot1 --help`` stays instant.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+from typing import Annotated, Any, Optional
+
+import typer
+
+app = typer.Typer(
+    help="Public datasets: what is registered, what is here, download, inspect.",
+    no_args_is_help=True,
+)
+
+DataDir = Annotated[Optional[Path], typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")]
+
+
+def _synthetic_worlds() -> dict[str, str]:
+    """Embedded synthetic worlds (name -> description), if that module is installed.
+
+    Only a *missing* module is tolerated; an existing module that fails to
+    import raises, so a broken world generator is never silently hidden.
+    """
+    if importlib.util.find_spec("albot1.data.synthetic.worlds") is None:
+        return {}
+    from albot1.data.synthetic import worlds
+
+    return {name: getattr(spec, "description", "") for name, spec in worlds.WORLDS.items()}
+
+
+@app.command("list")
+def list_(data_dir: DataDir = None,
+          as_json: Annotated[bool, typer.Option("--json", help="print one JSON object")] = False) -> None:
+    """Each registered dataset with its local availability, then the embedded synthetic worlds.
+
+    Examples:\n
+      albot1 datasets list\n
+      ALBOT1_DATA_DIR=../shared/datasets albot1 datasets list --json
+    """
+    from albot1.data import catalog
+    from albot1.settings import get_settings
+
+    settings = get_settings(data_dir=data_dir)
+    rows: list[dict[str, Any]] = []
+    for name in catalog.names():
+        manifest = catalog.get(name)
+        found = catalog.find_file(manifest.log, settings)
+        rows.append({"name": name, "available": catalog.is_available(name, settings),
+                     "path": str(found) if found else None, "local_only": manifest.local_only,
+                     "description": manifest.description})
+    worlds = _synthetic_worlds()
+    for name, description in sorted(worlds.items()):
+        rows.append({"name": name, "available": True, "path": None, "local_only": False, "synthetic": True,
+                     "description": description})
+    if as_json:
+        typer.echo(json.dumps({"datasets": rows, "search_roots": [str(r) for r in settings.search_roots()]}))
+        return
+    for row in rows:
+        state = "synthetic" if row.get("synthetic") else ("local" if row["available"] else
+                                                          ("missing (local only)" if row["local_only"]
+                                                           else "missing (fetch)"))
+        typer.echo(f"{row['name']:30s} {state:21s} {_first_sentence(row['description'])}")
+    typer.echo(f"searched: {', '.join(str(r) for r in settings.search_roots())}")
+
+
+def _first_sentence(text: str, width: int = 80) -> str:
+    head = text.split(": ", 1)[0]
+    return head if len(head) <= width else head[: width - 3] + "..."
+
+
+@app.command("fetch")
+def fetch(name: Annotated[str, typer.Argument(help="a dataset name (see `albot1 datasets list`)")],
+          data_dir: DataDir = None,
+          base_url: Annotated[Optional[str], typer.Option(help="download from BASE_URL/<path> instead of the "
+                                                                 "manifest URLs (a mirror)")] = None) -> None:
+    """Download NAME's files into the cache (sha256-verified, atomic); no-op if a verified copy exists.
+
+    Examples:\n
+      albot1 datasets fetch intel\n
+      ALBOT1_CACHE_DIR=/data/cache albot1 datasets fetch aces
+    """
+    from albot1.data import catalog
+    from albot1.settings import get_settings
+
+    path = catalog.fetch(name, get_settings(data_dir=data_dir), base_url=base_url)
+    typer.echo(f"{name}: {path}")
+
+
+@app.command("info")
+def info(
+    ref: Annotated[str, typer.Argument(help="a dataset name, a synthetic world or a log file path")],
+    as_json: Annotated[bool, typer.Option("--json", help="print Sequence.summary() as one JSON object")] = False,
+    scan_topic: Annotated[Optional[str], typer.Option(help="bag: the sensor_msgs/LaserScan topic")] = None,
+    odom_topic: Annotated[Optional[str], typer.Option(help="bag: the nav_msgs/Odometry topic")] = None,
+    reference_topic: Annotated[Optional[str], typer.Option(help="bag: the reference-pose topic")] = None,
+    data_dir: DataDir = None,
+) -> None:
+    """Scans, beams, duration, odometry path length, reference poses and relations of a dataset.
+
+    Decodes the whole log once. Examples:\n
+      albot1 datasets info intel --json\n
+      albot1 datasets info recording.bag --scan-topic /base_scan --odom-topic /odom_raw
+    """
+    from albot1.data.open import open_sequence
+    from albot1.settings import get_settings
+
+    options = {key: value for key, value in (("scan_topic", scan_topic), ("odom_topic", odom_topic),
+                                             ("reference_topic", reference_topic)) if value is not None}
+    summary = open_sequence(ref, settings=get_settings(data_dir=data_dir), **options).summary()
+    if as_json:
+        typer.echo(json.dumps(summary))
+        return
+    beams = summary["beams"]
+    typer.echo(f"{summary['name']}: {summary['scans']} scans x {beams} beams, {summary['duration_s']:.1f} s, "
+               f"odometry path {summary['odometry_path_m']:.1f} m")
+    typer.echo(f"  reference poses: {'yes' if summary['has_reference'] else 'no'}"
+               f"{' (' + summary['reference_source'] + ')' if summary.get('reference_source') else ''}; "
+               f"relations: {summary['relations']}")
+    typer.echo(f"  odometry: {summary.get('odometry_source', '')}")
+    typer.echo(f"  source: {summary.get('source', '')} ({summary.get('format', '')})")

@@ -1,0 +1,123 @@
+"""Conversion between the formats of :data:`~albot1.data.loaders.registry.FORMATS`.
+
+A conversion is "load as a Sequence, write with the target format's
+writer": the data model is the only interchange, so every pair of formats
+works and round trips are testable format by format. The target format is
+named, or guessed from the output name's suffix.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from albot1.data.errors import DataError, UnknownFormatError
+from albot1.data.model import Frame, Sequence
+
+if TYPE_CHECKING:
+    from albot1.settings import Settings
+
+#: Output name endings -> format (longest ending first wins). ROS2 bags are
+#: folders; naming them ``*.db3`` / ``*.mcap`` picks the storage.
+SUFFIX_FORMATS: tuple[tuple[str, str], ...] = (
+    (".albotlog.gz", "albot-log"),
+    (".albotlog", "albot-log"),
+    (".bag", "ros1"),
+    (".db3", "ros2-sqlite3"),
+    (".mcap", "ros2-mcap"),
+    (".clf.gz", "carmen"),
+    (".clf.bz2", "carmen"),
+    (".log.gz", "carmen"),
+    (".log.bz2", "carmen"),
+    (".clf", "carmen"),
+    (".log", "carmen"),
+)
+
+
+def guess_format(path: str | Path) -> str:
+    """The output format implied by ``path``'s name, or UnknownFormatError listing the endings."""
+    name = Path(path).name.lower()
+    for suffix, format_name in SUFFIX_FORMATS:
+        if name.endswith(suffix):
+            return format_name
+    endings = ", ".join(f"{s} ({f})" for s, f in SUFFIX_FORMATS)
+    raise UnknownFormatError(f"{path}: cannot tell the output format from its name; use --format or one of: {endings}")
+
+
+@dataclass(frozen=True)
+class Conversion:
+    """What :func:`convert` did; ``retimed`` counts scans whose timestamp was shifted."""
+
+    source: str
+    output: Path
+    format_name: str
+    scans: int
+    retimed: int = 0
+
+
+#: The smallest step ``retime`` leaves between consecutive scans: 1 us is
+#: representable at Unix-epoch magnitudes (float64 spacing there ~ 0.2 us)
+#: and far above a bag's 1 ns clock.
+RETIME_STEP_S = 1e-6
+
+
+def _retimed(frames: Iterator[Frame], shifted: list[int]) -> Iterator[Frame]:
+    """Frames whose timestamp is at least ``RETIME_STEP_S`` after the previous one's.
+
+    Only stamps that repeat or go backwards move, and only as far as needed;
+    ``shifted[0]`` counts them so the caller can report it.
+    """
+    previous = -math.inf
+    for frame in frames:
+        t = frame.scan.timestamp
+        if t < previous + RETIME_STEP_S:
+            t = previous + RETIME_STEP_S
+            shifted[0] += 1
+            frame = replace(frame, scan=replace(frame.scan, timestamp=t))
+        previous = t
+        yield frame
+
+
+def convert(src: str | Path | Sequence, dst: str | Path, format_name: str | None = None, *,
+            source_format: str | None = None, settings: Settings | None = None, retime: bool = False,
+            **load_options: Any) -> Conversion:
+    """Write ``src`` (a Sequence, a dataset name or any loadable path) to ``dst`` in ``format_name``.
+
+    ``source_format`` overrides sniffing the input; ``settings`` locate
+    dataset names; ``load_options`` (e.g. ``scan_topic``) go to the
+    source's loader, dropping those that are None so CLI defaults pass
+    through. The output must not exist (writers never overwrite).
+
+    ``retime`` shifts scans whose timestamp repeats or goes backwards to
+    ``RETIME_STEP_S`` after the previous scan. Bags need strictly increasing
+    stamps and several public CARMEN logs repeat or jitter theirs; since
+    this changes data it is never done unless asked for, and the count is
+    returned.
+    """
+    from albot1.data.loaders.registry import writer_for
+
+    target = format_name or guess_format(dst)
+    writer = writer_for(target)
+    if Path(dst).exists():  # one policy for every writer, checked before the (maybe long) load
+        raise DataError(f"{dst} exists already; remove it or choose another output path")
+    if isinstance(src, Sequence):
+        sequence = src
+    else:
+        from albot1.data.open import open_sequence
+
+        options = {k: v for k, v in load_options.items() if v is not None}
+        sequence = open_sequence(src, settings=settings, format_name=source_format, **options)
+    count, shifted = [0], [0]
+
+    def counted(frames: Iterator[Frame]) -> Iterator[Frame]:
+        count[0] = shifted[0] = 0  # per pass: a writer may read the sequence more than once
+        for frame in _retimed(frames, shifted) if retime else frames:
+            count[0] += 1
+            yield frame
+
+    writer.write(sequence.with_frames(counted), Path(dst))
+    return Conversion(source=sequence.metadata.source or sequence.name, output=Path(dst), format_name=target,
+                      scans=count[0], retimed=shifted[0])

@@ -1,0 +1,93 @@
+"""SE(2) alignment of an estimated trajectory to a reference one.
+
+Methods report poses in their own map frame, which differs from the
+reference frame by an unknown rigid motion; absolute errors are meaningless
+until that motion is removed, and *how* it is removed changes the numbers, so
+every absolute metric names its alignment:
+
+``none``
+    compare the coordinates as they are (both already share a frame).
+``first``
+    move the estimate so its first pose equals the reference's first pose
+    (evo's ``--align_origin``): errors then grow with the drift, which is
+    what a robot that starts at a known pose experiences.
+``rigid``
+    the rotation and translation minimising the summed squared position
+    error (Umeyama 1991 without scale, evo's ``--align``), in closed form for
+    the plane: the rotation angle is ``atan2(sum cross, sum dot)`` of the
+    centred positions, which is the 2-D case of the SVD solution and can
+    never return a reflection. Scale is never estimated: a metric map has
+    no free scale.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, get_args
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from albot1.geometry import se2
+from albot1.metrics.errors import MetricsError
+
+Alignment = Literal["none", "first", "rigid"]
+ALIGNMENTS: tuple[str, ...] = get_args(Alignment)
+
+FloatArray = NDArray[np.float64]
+
+
+def check_pair(estimate: ArrayLike, reference: ArrayLike, what: str = "trajectories") -> tuple[FloatArray, FloatArray]:
+    """Both as ``(N, 3)`` float arrays of equal length N >= 1, or MetricsError."""
+    est = np.asarray(estimate, dtype=float)
+    ref = np.asarray(reference, dtype=float)
+    for name, arr in (("estimate", est), ("reference", ref)):
+        if arr.ndim != 2 or arr.shape[1] != 3:
+            raise MetricsError(f"{what}: expected the {name} as (N, 3) poses (x, y, theta), got shape {arr.shape}")
+        if not np.isfinite(arr).all():
+            bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
+            raise MetricsError(f"{what}: the {name} has a non-finite pose at scan {bad}")
+    if len(est) != len(ref):
+        raise MetricsError(f"{what}: the estimate has {len(est)} poses and the reference {len(ref)}; "
+                           "expected one of each per scan")
+    if len(est) == 0:
+        raise MetricsError(f"{what}: no poses to compare")
+    return est, ref
+
+
+def rigid_transform(estimate: ArrayLike, reference: ArrayLike) -> FloatArray:
+    """The SE(2) pose ``T`` minimising ``sum |T * p_est - p_ref|^2`` over positions."""
+    est, ref = check_pair(estimate, reference, "rigid alignment")
+    p, q = est[:, :2], ref[:, :2]
+    mp, mq = p.mean(axis=0), q.mean(axis=0)
+    pc, qc = p - mp, q - mq
+    dot = float(np.sum(pc[:, 0] * qc[:, 0] + pc[:, 1] * qc[:, 1]))
+    cross = float(np.sum(pc[:, 0] * qc[:, 1] - pc[:, 1] * qc[:, 0]))
+    # One pose, or all positions equal: the rotation is undetermined; keep 0.
+    angle = np.arctan2(cross, dot) if (abs(dot) + abs(cross)) > 1e-12 else 0.0
+    c, s = np.cos(angle), np.sin(angle)
+    t = mq - np.array([c * mp[0] - s * mp[1], s * mp[0] + c * mp[1]])
+    return np.array([t[0], t[1], se2.wrap(angle)])
+
+
+def alignment_transform(estimate: ArrayLike, reference: ArrayLike, method: Alignment) -> FloatArray:
+    """The pose ``T`` with which ``compose(T, estimate)`` is compared to the reference."""
+    est, ref = check_pair(estimate, reference, f"{method} alignment")
+    if method == "none":
+        return np.zeros(3)
+    if method == "first":
+        return se2.compose(ref[0], se2.inverse(est[0]))
+    if method == "rigid":
+        return rigid_transform(est, ref)
+    raise MetricsError(f"unknown alignment {method!r}; expected one of {', '.join(ALIGNMENTS)}")
+
+
+def align(estimate: ArrayLike, reference: ArrayLike, method: Alignment) -> tuple[FloatArray, FloatArray]:
+    """``(aligned estimate, T)`` for one of :data:`ALIGNMENTS`."""
+    transform = alignment_transform(estimate, reference, method)
+    return se2.compose(transform, np.asarray(estimate, dtype=float)), transform
+
+
+def describe(transform: ArrayLike, method: Alignment) -> dict[str, object]:
+    """The JSON block naming an alignment and the motion it applied (m, deg)."""
+    t = np.asarray(transform, dtype=float)
+    return {"method": method, "x_m": float(t[0]), "y_m": float(t[1]), "theta_deg": float(np.degrees(t[2]))}

@@ -1,0 +1,163 @@
+"""Build ``reports/<suite>/``: tables, plots and the README that links them.
+
+The index states what a reader needs to trust or reproduce the numbers: the
+machine, the code and library versions, the seeds and degradations, every
+failed cell with its reason and log, every cell the runner never reached,
+and the datasets and methods that were skipped with the command that
+fetches or installs them.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+from albot1.bench.grid import GridPlan
+from albot1.report.collect import CellRecord, collect
+from albot1.report.plots import (plot_maps, plot_robustness, plot_runtime, plot_scan_time, plot_trajectories,
+                                 slug)
+from albot1.report.tables import aggregate, cells_frame, write_tables
+
+REPORTS_ROOT = Path("reports")
+
+
+def default_out(results_dir: Path) -> Path:
+    """``results/<suite>`` -> ``reports/<suite>`` (relative to the working directory, as `make bench` runs)."""
+    return REPORTS_ROOT / Path(results_dir).resolve().name
+
+
+def _rel(path: Path, start: Path) -> str:
+    return Path(os.path.relpath(path.resolve(), start.resolve())).as_posix()
+
+
+def render_plots(records: list[CellRecord], out: Path) -> dict[str, list[Path]]:
+    """Every plot of the report; dataset label -> its plot files (key "" for cross-dataset plots)."""
+    from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS
+
+    cells = cells_frame(records)
+    metrics = aggregate(cells, METRIC_COLUMNS)
+    cost = aggregate(cells, COST_COLUMNS)
+    plots_dir = out / "plots"
+    plots_dir.mkdir(parents=True, exist_ok=True)
+    made: dict[str, list[Path]] = {}
+    by_dataset: dict[str, list[CellRecord]] = {}
+    for rec in records:
+        by_dataset.setdefault(rec.cell.dataset_label, []).append(rec)
+    for dataset, recs in by_dataset.items():
+        stem = plots_dir / slug(dataset)
+        files = [
+            plot_maps(recs, dataset, stem.with_name(f"{stem.name}-maps.png")),
+            plot_trajectories(recs, dataset, stem.with_name(f"{stem.name}-trajectories.png")),
+            plot_robustness(metrics, dataset, "ate_rmse_m", "ATE RMSE (m)",
+                            stem.with_name(f"{stem.name}-robustness-ate.png")),
+            plot_robustness(metrics, dataset, "loop_gap_m", "loop gap (m)",
+                            stem.with_name(f"{stem.name}-robustness-loop-gap.png")),
+            plot_scan_time(recs, dataset, stem.with_name(f"{stem.name}-scan-time.png")),
+        ]
+        made[dataset] = [f for f in files if f is not None]
+    runtime = plot_runtime(cost, plots_dir / "runtime.png")
+    made[""] = [runtime] if runtime is not None else []
+    return made
+
+
+def _machine_lines(plan: GridPlan) -> list[str]:
+    m = plan.machine
+    libraries = ", ".join(f"{k} {v}" for k, v in (m.get("libraries") or {}).items() if v)
+    return [
+        f"- CPUs: {m.get('cpu_count')} logical ({m.get('cpu_count_physical')} physical), "
+        f"memory {m.get('memory_gb')} GB; {m.get('processor')}",
+        f"- platform: {m.get('platform')}; Python {m.get('python')}",
+        f"- code version: `{m.get('code_version')}` (git `{m.get('git')}`)",
+        f"- libraries: {libraries}",
+    ]
+
+
+def _status_counts(records: list[CellRecord]) -> dict[str, int]:
+    counts: dict[str, int] = {"done": 0, "failed": 0, "not run": 0}
+    for rec in records:
+        counts[rec.status] = counts.get(rec.status, 0) + 1
+    return counts
+
+
+def _failure_lines(records: list[CellRecord], out: Path) -> list[str]:
+    failed = [r for r in records if r.status == "failed"]
+    if not failed:
+        return ["No cell failed.", ""]
+    lines = ["| dataset | method | degradation | seed | kind | reason | log |", "|---|---|---|---|---|---|---|"]
+    for rec in failed:
+        c, f = rec.cell, rec.failure
+        assert f is not None
+        log = f"[log]({_rel(rec.run_dir / f.log, out)})" if f.log else "–"
+        reason = f.reason.replace("|", "\\|").replace("\n", " ")
+        lines.append(f"| {c.dataset_label} | {c.method_label} | {c.degradation} | {c.seed} | {f.kind} | "
+                     f"{reason} | {log} |")
+    return [*lines, ""]
+
+
+def write_index(plan: GridPlan, records: list[CellRecord], tables: dict[str, Path],
+                plots: dict[str, list[Path]], out: Path, results_dir: Path) -> Path:
+    counts = _status_counts(records)
+    lines: list[str] = [
+        f"# Benchmark report: suite `{plan.suite}`", "",
+        plan.description.strip() or "", "",
+        f"Generated {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from `{results_dir}` "
+        f"(suite file `{plan.suite_path}`).", "",
+        f"Cells: {len(records)} planned, {counts['done']} complete, {counts['failed']} failed, "
+        f"{counts['not run']} not run.", "",
+        "## Machine and versions", "", *_machine_lines(plan), "",
+        "## Grid", "",
+        f"- seeds: {', '.join(map(str, plan.seeds))}",
+        f"- degradations: {', '.join(f'`{d}`' for d in plan.degradations)} "
+        "(`none` = the dataset's own odometry; swept ones only on datasets with reference poses)",
+        f"- datasets: {', '.join(dict.fromkeys(r.cell.dataset_label for r in records)) or '(none)'}",
+        f"- methods: {', '.join(dict.fromkeys(r.cell.method_label for r in records)) or '(none)'}", "",
+        "## Tables", "",
+        f"- [accuracy (Markdown)]({_rel(tables['metrics.md'], out)}) · [CSV]({_rel(tables['metrics.csv'], out)})",
+        f"- [cost (Markdown)]({_rel(tables['cost.md'], out)}) · [CSV]({_rel(tables['cost.csv'], out)})",
+        f"- [every cell, accuracy and status (CSV)]({_rel(tables['cells.csv'], out)}) · "
+        f"[every cell, cost (CSV)]({_rel(tables['cells-cost.csv'], out)})", "",
+        "Cost numbers were measured with the suite's parallelism on a possibly shared machine; "
+        "compare them within one report.", "",
+    ]
+    if plots:
+        lines += ["## Plots", ""]
+        for plot in plots.get("", []):
+            lines += [f"![runtime]({_rel(plot, out)})", ""]
+        for dataset, files in plots.items():
+            if not dataset or not files:
+                continue
+            lines += [f"### {dataset}", "", *[f"- [{f.stem}]({_rel(f, out)})" for f in files], ""]
+    lines += ["## Failed cells", "", *_failure_lines(records, out)]
+    not_run = [r for r in records if r.status == "not run"]
+    if not_run:
+        lines += ["## Cells not run", "",
+                  "The runner stopped before these cells finished; run `albot1 bench` again to complete them.", "",
+                  *[f"- {r.cell.describe()}" for r in not_run], ""]
+    lines += ["## Skipped datasets", ""]
+    if plan.skipped_datasets:
+        lines += [f"- `{s.name}`: {s.reason}" + (f" — fetch it with `{s.hint}`" if s.hint else "")
+                  for s in plan.skipped_datasets]
+    else:
+        lines.append("None: every dataset the suite selects was available.")
+    lines += ["", "## Skipped methods", ""]
+    if plan.skipped_methods:
+        lines += [f"- `{s.name}`: {s.reason}" + (f" (`{s.hint}`)" if s.hint else "") for s in plan.skipped_methods]
+    else:
+        lines.append("None.")
+    lines.append("")
+    index = out / "README.md"
+    index.write_text("\n".join(lines), encoding="utf-8")
+    return index
+
+
+def build_report(results_dir: str | Path, out: str | Path | None = None, *, plots: bool = True) -> Path:
+    """Tables, plots and README for ``results_dir``; returns the README path."""
+    results = Path(results_dir)
+    target = Path(out) if out is not None else default_out(results)
+    plan, records = collect(results)
+    target.mkdir(parents=True, exist_ok=True)
+    tables = write_tables(records, target)
+    made: dict[str, Any] = render_plots(records, target) if plots else {}
+    return write_index(plan, records, tables, made, target, results)

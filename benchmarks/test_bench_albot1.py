@@ -1,0 +1,93 @@
+"""Per-scan cost of the Albot1 mapper (recorded by pytest-benchmark, never asserted).
+
+Frames are decoded into memory first, so only ``Albot1Mapper.process`` is
+timed (as the runner does, one ``perf_counter_ns`` pair per scan).
+``extra_info`` holds the per-scan median/mean/p95 in ms of the measured
+round; the issue's target is a median of at most 0.25 ms on the full Intel
+log, and a median on a 20x longer route within 1.5x of the short one.
+
+* ``test_albot1_intel_prefix``: first 1000 Intel scans (the CI timing).
+* ``test_albot1_intel_full`` (slow): all 13,631 Intel scans, both presets.
+* ``test_albot1_intel_full_cpu_time`` (slow): the same timed with the
+  thread's CPU clock (wall-clock tails on a shared machine are preemption).
+* ``test_albot1_route_length`` (slow): synthetic-office-loop vs the 20-lap
+  synthetic-office-long; ``extra_info["median_ratio_long_vs_short"]``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from albot1.data.loaders.registry import load
+from albot1.data.model import Frame
+from albot1.data.synthetic.worlds import load_world
+from albot1.data.transforms import head
+from albot1.mapping.config import PRESETS, Albot1Config
+from albot1.mapping.mapper import Albot1Mapper
+
+
+def _per_scan_ns(frames: list[Frame], preset: str = "thesis",
+                 clock: Callable[[], int] = time.perf_counter_ns) -> np.ndarray:
+    mapper = Albot1Mapper(Albot1Config(**PRESETS[preset]))
+    out = np.empty(len(frames), dtype=np.int64)
+    for i, frame in enumerate(frames):
+        t0 = clock()
+        mapper.process(frame)
+        out[i] = clock() - t0
+    mapper.finish()
+    return out
+
+
+def _record(benchmark: Any, ns: np.ndarray, prefix: str = "") -> None:
+    ms = ns / 1e6
+    benchmark.extra_info[prefix + "scans"] = int(len(ms))
+    benchmark.extra_info[prefix + "per_scan_ms_median"] = float(np.median(ms))
+    benchmark.extra_info[prefix + "per_scan_ms_mean"] = float(np.mean(ms))
+    benchmark.extra_info[prefix + "per_scan_ms_p95"] = float(np.percentile(ms, 95))
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _warm_kernels() -> None:
+    # Compile (or load from numba's cache) before timing anything.
+    Albot1Mapper(Albot1Config())
+    _per_scan_ns(list(head(load_world("synthetic-office-loop"), 30)))
+
+
+def test_albot1_intel_prefix(benchmark: Any, data_file: Callable[[str], Path]) -> None:
+    frames = list(head(load(data_file("radish/intel.clf.bz2")), 1000))
+    ns = benchmark.pedantic(_per_scan_ns, args=(frames,), rounds=3, iterations=1)
+    _record(benchmark, ns)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("preset", ["thesis", "exact"])
+def test_albot1_intel_full(benchmark: Any, data_file: Callable[[str], Path], preset: str) -> None:
+    frames = list(load(data_file("radish/intel.clf.bz2")))
+    ns = benchmark.pedantic(_per_scan_ns, args=(frames, preset), rounds=1, iterations=1)
+    _record(benchmark, ns)
+
+
+@pytest.mark.slow
+def test_albot1_intel_full_cpu_time(benchmark: Any, data_file: Callable[[str], Path]) -> None:
+    """The same, timed with the thread's CPU clock: on a loaded machine wall-clock
+    tails are preemption, this shows what the mapper itself costs."""
+    frames = list(load(data_file("radish/intel.clf.bz2")))
+    ns = benchmark.pedantic(_per_scan_ns, args=(frames, "thesis", time.thread_time_ns), rounds=1, iterations=1)
+    _record(benchmark, ns)
+
+
+@pytest.mark.slow
+def test_albot1_route_length(benchmark: Any) -> None:
+    short = list(load_world("synthetic-office-loop"))
+    long = list(load_world("synthetic-office-long"))
+    short_ns = _per_scan_ns(short)
+    long_ns = benchmark.pedantic(_per_scan_ns, args=(long,), rounds=1, iterations=1)
+    _record(benchmark, short_ns, "short_")
+    _record(benchmark, long_ns, "long_")
+    benchmark.extra_info["median_ratio_long_vs_short"] = float(np.median(long_ns) / np.median(short_ns))

@@ -1,0 +1,59 @@
+"""A mapper that fails on purpose, for the runner's failure-isolation tests.
+
+Suites register it with ``target = "bench_fault_mappers:FaultMapper"``; the
+cell child processes import it from the test folder (the runner hands them
+its ``sys.path``). Otherwise it behaves like dead reckoning, so ``mode = "ok"``
+and ``mode = "slow"`` give real, evaluable runs.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict
+
+from albot1.baselines.odometry import OdometryConfig, OdometryMapper
+from albot1.data.model import Frame
+from albot1.runs.protocol import MapperOutput
+
+
+class FaultConfig(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    mode: Literal["ok", "slow", "raise", "hang", "memory", "crash"] = "ok"
+    at_scan: int = 5
+    sleep_s: float = 0.01
+
+
+class FaultMapper:
+    name: ClassVar[str] = "fault"
+    config_model: ClassVar[type[BaseModel]] = FaultConfig
+    presets: ClassVar[dict[str, dict[str, Any]]] = {"default": {}}
+
+    def __init__(self, config: FaultConfig, *, seed: int = 0) -> None:
+        self.config = config
+        self._inner = OdometryMapper(OdometryConfig(), seed=seed)
+        self._hoard: list[np.ndarray] = []
+
+    def process(self, frame: Frame) -> None:
+        mode = self.config.mode
+        if mode == "slow":
+            time.sleep(self.config.sleep_s)
+        if frame.index == self.config.at_scan:
+            if mode == "raise":
+                raise RuntimeError(f"injected fault at scan {frame.index}")
+            if mode == "hang":
+                time.sleep(3600)
+            if mode == "memory":
+                while True:  # 256 MiB at a time until the address-space cap stops it
+                    self._hoard.append(np.ones(32 * 2**20))
+            if mode == "crash":
+                os.kill(os.getpid(), signal.SIGSEGV)
+        self._inner.process(frame)
+
+    def finish(self) -> MapperOutput:
+        return self._inner.finish()

@@ -1,0 +1,50 @@
+"""Property tests of the degradation SPEC parser: any string parses or raises DegradationSpecError."""
+
+from __future__ import annotations
+
+import math
+
+from hypothesis import given
+from hypothesis import strategies as st
+
+from albot1.data.degrade import EXPECTED_SPEC, DegradationSpecError, parse_spec
+
+KINDS = st.sampled_from(["none", "thesis", "gauss", "bias", "GAUSS", "Bias", "noise", "", " thesis "])
+NUMBERS = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(-10**6, 10**6).map(str),
+    st.text(alphabet="0123456789.-+eE_ naif", max_size=8),
+)
+
+
+def _check(spec: str) -> None:
+    try:
+        deg = parse_spec(spec)
+    except DegradationSpecError as exc:
+        assert repr(spec) in str(exc)
+        assert EXPECTED_SPEC in str(exc)
+        return
+    assert deg.kind in ("none", "thesis", "gauss", "bias")
+    assert math.isfinite(deg.a) and math.isfinite(deg.b)
+    if deg.kind == "gauss":
+        assert deg.a >= 0 and deg.b >= 0
+    # What parsed re-parses to the same degradation from its canonical text.
+    assert parse_spec(deg.spec).kind == deg.kind
+
+
+@given(st.text(max_size=40))
+def test_random_strings_parse_or_raise_the_documented_error(spec: str) -> None:
+    _check(spec)
+
+
+@given(KINDS, st.lists(NUMBERS, max_size=4), st.sampled_from([":", "::", ": "]))
+def test_mutated_specs_parse_or_raise_the_documented_error(kind: str, values: list[str], sep: str) -> None:
+    _check(sep.join([kind, *values]) if values else kind)
+
+
+@given(st.floats(0, 10, allow_nan=False), st.floats(0, 45, allow_nan=False))
+def test_valid_gauss_specs_parse_to_their_values(sigma_xy: float, sigma_deg: float) -> None:
+    deg = parse_spec(f"gauss:{sigma_xy!r}:{sigma_deg!r}")
+    assert deg.kind == "gauss"
+    assert deg.a == sigma_xy
+    assert deg.b == math.radians(sigma_deg)
