@@ -7,32 +7,40 @@ scan is a 3D cloud with z = 0 in the robot (base) frame.
 
 How the odometry prior is injected. ``KissICP.register_frame`` (1.3.0) has
 no initial-guess argument: it predicts ``last_pose @ last_delta`` (a
-constant-velocity model, which alone drifts to 12-14 m ATE on the Intel
-and MIT-CSAIL logs), registers, then updates the threshold, the map and
-``last_delta`` unconditionally. This mapper drives the same public Python
-components that ``register_frame`` is made of -- ``kiss_icp.voxelization.
+constant-velocity model, which alone gives 11.8 m ATE on intel-corrected,
+see docs/baselines.md), registers, then updates the threshold, the map and
+``last_delta`` unconditionally. Overwriting ``last_delta`` before each call
+would inject the prior too, but would leave no way to check a result before
+it enters the map. This mapper therefore drives the public Python components
+that ``register_frame`` is made of -- ``kiss_icp.voxelization.
 voxel_down_sample``, ``kiss_icp.mapping.VoxelHashMap``, ``kiss_icp.registration.
-Registration.align_points_to_map(initial_guess=...)`` and the adaptive
-threshold from ``kiss_icp.threshold`` -- in the same order, with three
-changes:
+Registration.align_points_to_map(initial_guess=...)`` and the thresholds of
+``kiss_icp.threshold`` -- in the same order, with these changes:
 
 1. the initial guess is ``last_pose`` composed with the *odometry* increment
    since the previous scan (``odometry_prior = false`` restores the
    constant-velocity model, for comparison);
-2. the result is checked (finite; its correction of the guess within
-   ``max_correction_m`` / ``max_correction_deg``) *before* it touches the
-   threshold model or the map, so a bad registration falls back to the
-   odometry prediction instead of corrupting the map; too many consecutive
-   fallbacks is a :class:`BaselineError` (the method has lost track);
+2. the result is checked (finite, else :class:`BaselineError`; its
+   correction of the guess within ``max_correction_m`` /
+   ``max_correction_deg``, else rejected) *before* it touches the threshold
+   model or the map: a rejected result never feeds the threshold, the scan's
+   pose (and its place in the map) is the odometry prediction, and more than
+   ``max_consecutive_failures`` rejections in a row is a
+   :class:`BaselineError` (the method has lost track);
 3. the pose is projected to SE(2) (x, y, yaw) at every scan, so z, roll and
    pitch cannot creep in through round-off; the largest out-of-plane
-   component removed is reported in ``extras``.
+   component removed is reported in ``extras``;
+4. a scan enters the voxel map only after ``map_update_distance_m`` or
+   ``map_update_angle_deg`` of motion since the last insertion (both 0 =
+   every scan, as KISS-ICP), and the two thinning resolutions are explicit
+   settings instead of KISS-ICP's fixed 0.5 x and 1.5 x the voxel size.
 
 These components and their signatures are those of kiss-icp 1.3.0 (hence
 the exact pin). Deskewing is off: the preprocessor is not used, its only
 remaining job (range cropping) is done here. Registration runs on one
-thread: with ~180 points per scan threads only add overhead, and a fixed
-summation order makes runs bit-for-bit repeatable.
+thread: a fixed summation order makes runs bit-for-bit repeatable (TBB's
+parallel reductions do not promise one), and ~50 source points per scan
+leave little to parallelise.
 
 The scan is moved from the sensor to the base frame with the config's
 ``sensor_offset_*`` fields: a Frame does not carry the offset (it lives in
@@ -40,12 +48,12 @@ The scan is moved from the sensor to the base frame with the config's
 pass it, e.g. ``--set sensor_offset_x_m=0.2``. The CARMEN logs used here
 have laser poses equal to the robot poses (offset zero).
 
-Counters: ``views`` (scans processed), ``updates`` (scans inserted into the
-voxel map), ``registrations`` (ICP runs), ``registration_failures``
-(results rejected by the correction bounds), ``odometry_fallbacks`` (scans
-whose pose is the odometry prediction: rejected results plus scans with
-fewer than ``min_points`` usable points) and ``map_points`` (points of the
-stored map). KISS-ICP keeps no keyframes.
+Counters: ``views`` (scans processed), ``updates`` (scans inserted into
+the voxel map; they play the role of keyframes), ``registrations`` (ICP
+runs), ``registration_failures`` (results rejected by the correction
+bounds), ``odometry_fallbacks`` (scans whose pose is the odometry
+prediction: rejected results plus scans with fewer than ``min_points``
+usable points) and ``map_points`` (points of the stored map).
 """
 
 from __future__ import annotations
@@ -58,6 +66,8 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from albot1.baselines.errors import BaselineError
+from albot1.baselines import planar
+from albot1.baselines.planar import planar_pose, pose_matrix
 from albot1.baselines.point_map import ThinnedPointMap
 from albot1.baselines.presets import TomlPresets
 from albot1.data.model import Frame
@@ -107,38 +117,6 @@ class KissIcpConfig(BaseModel):
     map_voxel_m: float = Field(gt=0, description="grid cell thinning the stored map (every scan projected with its pose)")
 
 
-def pose_matrix(pose: FloatArray) -> FloatArray:
-    """SE(2) ``(x, y, theta)`` as the 4x4 homogeneous SE(3) matrix KISS-ICP works with."""
-    x, y, theta = (float(v) for v in pose)
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s, 0.0, x], [s, c, 0.0, y], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
-
-
-def planar_pose(matrix: FloatArray) -> tuple[FloatArray, float]:
-    """Project a 4x4 pose to SE(2); also return the out-of-plane part dropped.
-
-    The dropped part is ``max(|z| in m, tilt of the z axis in rad)``: zero
-    for an exactly planar pose.
-    """
-    yaw = math.atan2(matrix[1, 0], matrix[0, 0])
-    tilt = math.acos(min(1.0, max(-1.0, float(matrix[2, 2]))))
-    return np.array([matrix[0, 3], matrix[1, 3], yaw]), max(abs(float(matrix[2, 3])), tilt)
-
-
-def _compose(a: FloatArray, b: FloatArray) -> FloatArray:
-    """``a * b`` for single SE(2) poses (scalar maths: the per-scan path calls this a few times)."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1],
-                     math.remainder(a[2] + b[2], math.tau)])
-
-
-def _between(a: FloatArray, b: FloatArray) -> FloatArray:
-    """``inv(a) * b`` for single SE(2) poses."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    return np.array([c * dx + s * dy, -s * dx + c * dy, math.remainder(b[2] - a[2], math.tau)])
-
-
 class KissIcpMapper:
     """KISS-ICP 1.3.0 components driven scan by scan with an odometry initial guess (module doc)."""
 
@@ -169,6 +147,8 @@ class KissIcpMapper:
         self._max_correction_rad = math.radians(config.max_correction_deg)
         self._map_update_angle_rad = math.radians(config.map_update_angle_deg)
         self._last_inserted: FloatArray | None = None
+        self._angles: FloatArray | None = None
+        self._cos = self._sin = np.empty(0)
         self._map = ThinnedPointMap(config.map_voxel_m)
         self._poses: list[FloatArray] = []
         self._last_odometry: FloatArray | None = None
@@ -191,44 +171,53 @@ class KissIcpMapper:
             raise BaselineError(f"kiss-icp: scan {frame.index}: odometry {odometry.tolist()} is not a finite "
                                 f"(x, y, theta); expected finite odometry at every scan")
         self._counters["views"] += 1
-        points = self._base_points(frame)
-        cloud = np.column_stack([points, np.zeros(len(points))])
+        cloud = self._base_cloud(frame)
         frame_down = voxel_down_sample(cloud, self.config.map_point_spacing_m)
 
         if self._last_odometry is None:
             pose = np.zeros(3)
         else:
             pose = self._register(frame, odometry, frame_down, voxel_down_sample)
-            self._last_delta = _between(self._poses[-1], pose)
+            self._last_delta = planar.between(self._poses[-1], pose)
         self._last_odometry = odometry
         self._poses.append(pose)
         if len(frame_down) and self._moved_since_insertion(pose):
             self._local_map.update(frame_down, pose_matrix(pose))
             self._last_inserted = pose
             self._counters["updates"] += 1
-        self._map.add(se2.transform_points(pose, points))
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        self._map.add(cloud[:, :2] @ np.array([[c, s], [-s, c]]) + pose[:2])
 
     def _moved_since_insertion(self, pose: FloatArray) -> bool:
         """Whether the pose is far enough from the last one inserted into the voxel map."""
         if self._last_inserted is None:
             return True
-        step = _between(self._last_inserted, pose)
+        step = planar.between(self._last_inserted, pose)
         return (math.hypot(step[0], step[1]) >= self.config.map_update_distance_m
                 or abs(float(step[2])) >= self._map_update_angle_rad)
 
-    def _base_points(self, frame: Frame) -> FloatArray:
-        """Valid beams within the range limits, in the base frame, ``(k, 2)``."""
+    def _base_cloud(self, frame: Frame) -> FloatArray:
+        """Valid beams within the range limits as 3D points (z = 0) in the base frame, ``(k, 3)``."""
         scan = frame.scan
-        keep = scan.valid() & (scan.ranges >= self.config.min_range_m) & (scan.ranges <= self.config.max_range_m)
-        r, a = scan.ranges[keep], scan.angles[keep]
-        points = np.column_stack([r * np.cos(a), r * np.sin(a)])
-        return se2.transform_points(self._sensor, points) if self._sensor.any() else points
+        if scan.angles is not self._angles or scan.angles.flags.writeable:
+            # Loaders share one read-only angle array across a log's scans: compute its cos/sin once.
+            self._angles, self._cos, self._sin = scan.angles, np.cos(scan.angles), np.sin(scan.angles)
+        ranges = scan.ranges
+        with np.errstate(invalid="ignore"):  # NaN (no return) compares False: dropped
+            keep = (ranges >= self.config.min_range_m) & (ranges <= self.config.max_range_m)
+        r = ranges[keep]
+        cloud = np.zeros((len(r), 3))
+        cloud[:, 0] = r * self._cos[keep]
+        cloud[:, 1] = r * self._sin[keep]
+        if self._sensor.any():
+            cloud[:, :2] = se2.transform_points(self._sensor, cloud[:, :2])
+        return cloud
 
     def _register(self, frame: Frame, odometry: FloatArray, frame_down: FloatArray, down_sample: Any) -> FloatArray:
         """The pose of this scan: ICP from the predicted pose, or the prediction when ICP cannot be trusted."""
         assert self._last_odometry is not None
-        step = _between(self._last_odometry, odometry) if self.config.odometry_prior else self._last_delta
-        guess = _compose(self._poses[-1], step)
+        step = planar.between(self._last_odometry, odometry) if self.config.odometry_prior else self._last_delta
+        guess = planar.compose(self._poses[-1], step)
         source = down_sample(frame_down, self.config.source_point_spacing_m)
         if len(source) < self.config.min_points:
             return self._fallback(frame.index, guess)
@@ -246,7 +235,7 @@ class KissIcpMapper:
         pose, out_of_plane = planar_pose(result)
         self._out_of_plane = max(self._out_of_plane, out_of_plane)
 
-        correction = _between(guess, pose)
+        correction = planar.between(guess, pose)
         shift, turn = math.hypot(correction[0], correction[1]), abs(float(correction[2]))
         if shift > self.config.max_correction_m or turn > self._max_correction_rad:
             self._counters["registration_failures"] += 1

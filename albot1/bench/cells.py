@@ -10,6 +10,7 @@ killed last time) is only re-evaluated, not re-run.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -55,6 +56,13 @@ def restrict_relations(relations: Relations, timestamps: np.ndarray) -> Relation
     return Relations(t1=relations.t1[mask], t2=relations.t2[mask], poses=relations.poses[mask])
 
 
+def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
+    """``field: planned A, ran B`` for each field that differs."""
+    fields = sorted(set(planned) | set(ran))
+    return "; ".join(f"{f}: planned {planned.get(f, '(absent)')!r}, ran {ran.get(f, '(absent)')!r}"
+                     for f in fields if planned.get(f) != ran.get(f))
+
+
 def execute_cell(cell: Cell, runs_root: Path, settings: Settings | None = None) -> Path:
     """Run, store and evaluate ``cell`` under ``runs_root/<key>``; returns the run folder."""
     from albot1.metrics.evaluate import evaluate_run
@@ -72,9 +80,9 @@ def execute_cell(cell: Cell, runs_root: Path, settings: Settings | None = None) 
         result = run_method(cell.method, sequence, preset=cell.preset, overrides=dict(cell.overrides),
                             degradation=cell.degradation, seed=cell.seed, dataset_name=cell.dataset_label)
         if result.config != cell.config:
-            raise BenchError(f"{cell.describe()}: the method resolved a different config in the cell process "
-                             f"than when the grid was planned (environment overrides changed?): "
-                             f"planned {cell.config}, ran {result.config}")
+            raise BenchError(f"{cell.describe()}: the config resolved in the cell process differs from the "
+                             f"planned one ({config_difference(cell.config or {}, result.config)}); did a "
+                             "baselines/*.toml file or an ALBOT1_* variable change during the run?")
         written = write_run(result, runs_root)
         if written.name != cell.key:
             raise BenchError(f"{cell.describe()}: stored under {written.name}, expected key {cell.key} "

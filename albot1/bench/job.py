@@ -10,12 +10,15 @@ from __future__ import annotations
 
 import json
 import signal
+import socket
+import time
 from pathlib import Path
 
 from albot1.bench.cell_main import ERROR_FILE, EXIT_OK
 from albot1.bench.grid import Cell, CellOutcome, FailureKind
 from albot1.bench.limits import ChildExit, run_limited
-from albot1.bench.store import LOG, ResultsStore
+from albot1.bench.store import ATTEMPT, LOG, ResultsStore
+from albot1.runs.folder import write_json
 
 
 def _signal_name(number: int) -> str:
@@ -65,6 +68,8 @@ def run_cell_job(cell: Cell, results_root: str) -> CellOutcome:
     ended = run_limited(cell, store.runs, run_dir / LOG)
     verdict = judge(cell, store, ended)
     if verdict is None:
+        write_json(run_dir / ATTEMPT, {"elapsed_s": ended.elapsed_s, "host": socket.gethostname(),
+                                       "finished": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
         return CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label, "done",
                            ended.elapsed_s)
     kind, reason = verdict

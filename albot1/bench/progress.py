@@ -15,9 +15,12 @@ from albot1.bench.runner import GridSummary
 
 
 class TqdmProgress:
-    """A progress bar over the grid; each failure is written above it when it happens."""
+    """A progress bar over the grid; each failure is handed to ``write`` when it happens.
 
-    def __init__(self, write: Callable[[str], None] | None = None, *, disable: bool = False) -> None:
+    The caller chooses where lines go; ``tqdm.write`` keeps them above the bar.
+    """
+
+    def __init__(self, write: Callable[[str], None], *, disable: bool = False) -> None:
         self._write = write
         self._disable = disable
         self._bar: Any = None
@@ -44,12 +47,7 @@ class TqdmProgress:
             self._bar.close()
 
     def _emit(self, line: str) -> None:
-        from tqdm import tqdm
-
-        if self._write is not None:
-            self._write(line)
-        else:
-            tqdm.write(line)
+        self._write(line)
 
 
 def summary_table(summary: GridSummary) -> str:

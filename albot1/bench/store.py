@@ -10,6 +10,7 @@ Layout::
             cell.json          the cell that made it
             metrics.json       written by albot1.metrics.evaluate
             cell.log           the child process's output (tracebacks included)
+            attempt.json       wall time of the successful attempt (run + store + evaluation)
             FAILED.json        only after a failure: reason, kind, exit code, elapsed
 
 A cell is complete when its run folder has ``DONE`` and a ``metrics.json``
@@ -41,6 +42,7 @@ CELL = "cell.json"
 LOG = "cell.log"
 METRICS = "metrics.json"
 PLAN = "grid.json"
+ATTEMPT = "attempt.json"
 
 
 @dataclass(frozen=True)

@@ -37,6 +37,10 @@ def bench(
       albot1 bench default --executor dask -j 4\n
       albot1 bench benchmarks/full.toml --executor dask://scheduler:8786
     """
+    import sys
+
+    from tqdm import tqdm
+
     from albot1.bench.progress import TqdmProgress, plan_table, summary_table
     from albot1.bench.runner import run_suite
     from albot1.settings import get_settings
@@ -48,7 +52,7 @@ def bench(
         plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))
         return
-    view = TqdmProgress(lambda line: typer.echo(line, err=True), disable=not progress)
+    view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not progress)
     try:
         plan, summary, store = run_suite(suite, results=results, jobs=jobs, executor=executor, observer=view,
                                          settings=get_settings(data_dir=data_dir))

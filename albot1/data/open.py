@@ -2,7 +2,13 @@
 
 ``ref`` may be an embedded synthetic world name, a registered dataset name
 (resolved through the catalog and the dataset settings) or a path to a file
-of any known format.
+of any known format, optionally followed by loader options and a slice::
+
+    intel-corrected?odometry=laser-pose      loader options (key=value&key=value)
+    intel[:1000]   intel[:5000:5]   intel[::2]   the first STOP scans, every STEP-th
+
+The whole string names what a run used, so a stored run reopens its data
+exactly (``albot1 evaluate`` relies on this).
 """
 
 from __future__ import annotations
@@ -36,7 +42,13 @@ def open_sequence(ref: str | Path, *, settings: Settings | None = None, format_n
         if sliced["step"]:
             sequence = stride(sequence, int(sliced["step"]))
         return sequence
+    name, has_query, query = text.partition("?")
+    if has_query and not Path(text).expanduser().exists():
+        return open_sequence(name, settings=settings, format_name=format_name,
+                             **{**parse_options(query, text), **options})
     if text in worlds.WORLDS:
+        if options:
+            raise DatasetNotFoundError(f"synthetic world {text!r} takes no loader options, got {', '.join(options)}")
         return worlds.load_world(text)
     settings = settings or get_settings()
     if text in catalog.names():
@@ -48,3 +60,21 @@ def open_sequence(ref: str | Path, *, settings: Settings | None = None, format_n
         f"{text!r} is neither a dataset name nor an existing file; known datasets: "
         f"{', '.join(sorted(catalog.names()) + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
     )
+
+
+def parse_options(query: str, ref: str) -> dict[str, Any]:
+    """``"a=1&b=x"`` -> ``{"a": 1, "b": "x"}`` (numbers become int/float)."""
+    options: dict[str, Any] = {}
+    for pair in filter(None, query.split("&")):
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise DatasetNotFoundError(f"{ref!r}: loader option {pair!r} is not of the form KEY=VALUE")
+        for convert in (int, float):
+            try:
+                options[key] = convert(value)
+                break
+            except ValueError:
+                continue
+        else:
+            options[key] = value
+    return options

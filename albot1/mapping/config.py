@@ -78,4 +78,7 @@ PRESETS: dict[str, dict[str, Any]] = {
     "default": {},
     "thesis": {},
     "exact": {"motion_model": "exact"},
+    # The bare text where our defaults read it otherwise (docs/albot1-mapper.md, "Presets"):
+    # the 40 cm delete margin from every polygon edge and no grazing-angle test.
+    "literal": {"delete_margin_from": "boundary", "continuation_tolerance_m": 0.0},
 }

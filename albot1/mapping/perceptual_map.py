@@ -42,11 +42,6 @@ class PerceptualMap:
         """Number of surfaces currently in the map."""
         return self._alive_count
 
-    @property
-    def created(self) -> int:
-        """Ids handed out so far (alive or deleted)."""
-        return self._n
-
     def _grow(self) -> None:
         cap = 2 * self._seg.shape[0]
         self._seg = np.resize(self._seg, (cap, 4))

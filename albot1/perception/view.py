@@ -70,11 +70,6 @@ class View:
         s = self.surfaces
         return np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
 
-    @classmethod
-    def empty(cls) -> View:
-        return cls(np.empty((0, 4)), np.empty((0, 2), dtype=np.int64), np.empty((0, 2), dtype=np.int64),
-                   np.empty(0, dtype=np.int64))
-
 
 def construct_view(
     ranges: FloatArray, angles: FloatArray, params: ViewParams, kernels: Kernels | None = None

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from albot1.bench.grid import Cell, GridPlan
-from albot1.bench.store import METRICS, Failure, ResultsStore
+from albot1.bench.store import ATTEMPT, METRICS, Failure, ResultsStore
 
 #: column -> (source file, dotted path, header text); accuracy numbers, identical for identical inputs
 METRIC_COLUMNS: dict[str, tuple[str, str, str]] = {
@@ -35,6 +35,7 @@ COST_COLUMNS: dict[str, tuple[str, str, str]] = {
     "per_scan_ms_p95": ("result", "timing.per_scan_ms_p95", "per-scan p95 (ms)"),
     "total_s": ("result", "timing.total_s", "total (s)"),
     "peak_mb": ("result", "timing.peak_mb", "peak (MB)"),
+    "cell_s": ("attempt", "elapsed_s", "cell wall (s)"),
 }
 KEY_COLUMNS = ("dataset", "method", "degradation")
 
@@ -49,6 +50,7 @@ class CellRecord:
     result: dict[str, Any] | None
     metrics: dict[str, Any] | None
     failure: Failure | None
+    attempt: dict[str, Any] | None = None
 
 
 def dig(data: dict[str, Any] | None, path: str) -> float | None:
@@ -72,7 +74,7 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
         run_dir = store.run_dir(cell.key)
         if store.is_complete(cell.key):
             records.append(CellRecord(cell, "done", run_dir, store.read_json(cell.key, "result.json"),
-                                      store.read_json(cell.key, METRICS), None))
+                                      store.read_json(cell.key, METRICS), None, store.read_json(cell.key, ATTEMPT)))
             continue
         failure = store.failure(cell.key)
         records.append(CellRecord(cell, "failed" if failure else "not run", run_dir, None, None, failure))
@@ -87,7 +89,7 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
         row: dict[str, Any] = {"dataset": c.dataset_label, "method": c.method_label, "degradation": c.degradation,
                                "seed": c.seed, "status": rec.status, "key": c.key,
                                "scans": (rec.result or {}).get("scans")}
-        sources = {"metrics": rec.metrics, "result": rec.result}
+        sources = {"metrics": rec.metrics, "result": rec.result, "attempt": rec.attempt}
         for column, (source, path, _) in {**METRIC_COLUMNS, **COST_COLUMNS}.items():
             row[column] = dig(sources[source], path)
         row["reason"] = rec.failure.reason if rec.failure else None

@@ -74,7 +74,8 @@ def test_intel_raw_prefix_run_is_stored_and_read_back(data_file: Callable[[str],
     result = run_method("kiss-icp", sequence, dataset_name="intel-head300")
     assert result.poses.shape == (300, 3)
     assert np.isfinite(result.poses).all()
-    assert result.counters["updates"] == 300
+    assert result.counters["registrations"] == 299
+    assert 0 < result.counters["updates"] < 300  # ~4 cm steps: most scans are not inserted into the voxel map
     assert result.versions["kiss-icp"] == "1.3.0"
     run_dir = write_run(result, tmp_path)
     stored = read_run(run_dir)

@@ -29,7 +29,7 @@ def reg(pose: tuple[float, float, float] = (0.1, 0.0, 0.0), fitness: float = 0.9
 
 def test_candidates_exclude_recent_nodes_and_far_nodes() -> None:
     positions = np.array([[0.0, 0.0], [5.0, 0.0], [0.5, 0.0], [0.2, 0.1], [0.1, 0.0]])
-    # Node 4 searches; gap 2 excludes nodes 3 and 4 themselves... and node 2? (4 - 2 = 2 is allowed.)
+    # Node 4 searches with a gap of 2: nodes 3 and 4 are too recent, node 1 is too far.
     assert find_candidates(positions, 4, radius_m=1.0, min_gap=2, max_candidates=5, separation=1) == [0, 2]
     assert find_candidates(positions, 4, radius_m=1.0, min_gap=5, max_candidates=5, separation=1) == []
 
@@ -78,7 +78,9 @@ def test_disagreeing_matches_expire_unconfirmed() -> None:
     confirmer.offer(10, [match(10, (0.5, 0.0, 0.0))], window=1)
     accepted, _ = confirmer.offer(11, [match(11, (-0.5, 0.0, 0.0))], window=1)
     assert accepted == []
-    accepted, expired = confirmer.offer(12, [], window=1)
+    # Node 10's match may still be confirmed by node 12 (two searching nodes later), not by node 13.
+    assert confirmer.offer(12, [], window=1) == ([], 0)
+    accepted, expired = confirmer.offer(13, [], window=1)
     assert accepted == [] and expired == 1
     assert confirmer.flush() == 1
 

@@ -106,7 +106,7 @@ def test_non_finite_odometry_names_the_scan() -> None:
     seq = room_sequence(10)
     frames = list(seq.frames())
     frames[4] = replace(frames[4], odometry=np.array([np.nan, 0.0, 0.0]))
-    with pytest.raises(BaselineError, match=r"gtsam-graph: scan 4: expected a finite odometry pose"):
+    with pytest.raises(BaselineError, match=r"^gtsam-graph on room-nan: scan 4: expected a finite odometry pose"):
         run_method("gtsam-graph", Sequence.from_frames("room-nan", frames))
 
 
@@ -115,7 +115,7 @@ def test_registration_that_never_converges_aborts_with_baseline_error() -> None:
     seq = room_sequence(40)
     frames = [replace(f, scan=replace(f.scan, ranges=np.full_like(f.scan.ranges, np.nan))) if f.index > 3 else f
               for f in seq.frames()]
-    with pytest.raises(BaselineError, match=r"scan registration failed on 3 consecutive nodes"):
+    with pytest.raises(BaselineError, match=r"^gtsam-graph on room-blind: scan \d+: scan registration failed on 3 consecutive nodes"):
         run_method("gtsam-graph", Sequence.from_frames("room-blind", frames),
                    overrides={"max_consecutive_fallbacks": 3})
 
@@ -126,5 +126,21 @@ def test_infinite_ranges_are_refused() -> None:
     ranges = frames[2].scan.ranges.copy()
     ranges[10] = np.inf
     frames[2] = replace(frames[2], scan=replace(frames[2].scan, ranges=ranges))
-    with pytest.raises(BaselineError, match=r"scan 2: ranges must be finite or NaN"):
+    with pytest.raises(BaselineError, match=r"^gtsam-graph on room-inf: scan 2: ranges must be finite or NaN"):
         run_method("gtsam-graph", Sequence.from_frames("room-inf", frames))
+
+
+def test_back_end_failure_is_a_baseline_error_naming_the_scan(monkeypatch: pytest.MonkeyPatch) -> None:
+    from albot1.baselines.gtsam_graph.errors import GraphError
+    from albot1.baselines.gtsam_graph.graph import PoseGraph
+
+    original = PoseGraph.update
+
+    def fail(self: PoseGraph, extra_iterations: int = 0) -> None:
+        if len(self) > 2:
+            raise GraphError(f"ISAM2 update with {len(self)} nodes failed: Indeterminant linear system")
+        original(self, extra_iterations)
+
+    monkeypatch.setattr(PoseGraph, "update", fail)
+    with pytest.raises(BaselineError, match=r"^gtsam-graph on room: scan \d+: ISAM2 update with 3 nodes failed"):
+        run_method("gtsam-graph", room_sequence(40))

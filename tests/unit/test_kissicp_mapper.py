@@ -7,9 +7,8 @@ import math
 from typing import Any
 
 import numpy as np
-import pytest
 
-from albot1.baselines.kiss_icp import KissIcpConfig, KissIcpMapper, planar_pose, pose_matrix
+from albot1.baselines.kiss_icp import KissIcpConfig, KissIcpMapper
 from albot1.data.model import Frame, Scan
 from albot1.geometry import se2
 from albot1.runs.methods import resolve_config
@@ -91,17 +90,18 @@ def test_poses_are_planar_and_the_removed_out_of_plane_part_is_reported() -> Non
     assert np.all(np.abs(out.poses[:, 2]) <= math.pi)
 
 
-def test_planar_pose_drops_z_and_tilt() -> None:
-    matrix = pose_matrix(np.array([1.0, -2.0, 0.5]))
-    np.testing.assert_allclose(planar_pose(matrix)[0], [1.0, -2.0, 0.5])
-    assert planar_pose(matrix)[1] == 0.0
-    tilted = matrix.copy()
-    tilted[2, 3] = 0.03
-    c, s = math.cos(0.01), math.sin(0.01)
-    tilted[:3, :3] = tilted[:3, :3] @ np.array([[1, 0, 0], [0, c, -s], [0, s, c]])  # 0.01 rad roll
-    pose, dropped = planar_pose(tilted)
-    np.testing.assert_allclose(pose, [1.0, -2.0, 0.5], atol=1e-4)
-    assert dropped == pytest.approx(0.03)
+def test_scans_enter_the_voxel_map_only_after_enough_motion() -> None:
+    truth = room.route(20)
+    out = _run(room.frames(truth, truth, beams=360), map_update_distance_m=1.0, map_update_angle_deg=90.0)
+    inserted, expected = out.poses[0], 1
+    for pose in out.poses[1:]:
+        step = se2.between(inserted, pose)
+        if math.hypot(step[0], step[1]) >= 1.0 or abs(step[2]) >= math.radians(90.0):
+            inserted, expected = pose, expected + 1
+    assert 3 < expected < 20
+    assert out.counters["updates"] == expected
+    every = _run(room.frames(truth, truth, beams=360), map_update_distance_m=0.0, map_update_angle_deg=0.0)
+    assert every.counters["updates"] == 20
 
 
 def test_scan_with_too_few_points_keeps_the_odometry_prediction() -> None:

@@ -60,6 +60,12 @@ def correlative_search(target: FloatArray, source: FloatArray, guess: FloatArray
         src = src[np.linspace(0, len(src) - 1, window.max_points).astype(int)]
     tgt = np.asarray(target, dtype=float).reshape(-1, 2)
     margin = 3.0 * window.sigma_m
+    # Only target points some moved source point can reach matter; the field's size (and cost) follows.
+    reach = float(np.hypot(src[:, 0], src[:, 1]).max()) + math.sqrt(2.0) * window.half_width_m + margin
+    near = np.abs(tgt - guess[:2]).max(axis=1) <= reach
+    if not near.any():
+        return CoarseMatch(np.asarray(guess, dtype=float).copy(), 0.0, 1.0)
+    tgt = tgt[near]
     lo = tgt.min(axis=0) - margin
     shape = np.ceil((tgt.max(axis=0) + margin - lo) / window.cell_m).astype(int) + 1
     occupied = np.ones(tuple(shape), dtype=bool)

@@ -31,6 +31,7 @@ from pydantic import BaseModel
 
 from albot1.baselines.errors import BaselineError
 from albot1.baselines.gtsam_graph.config import GtsamGraphConfig
+from albot1.baselines.gtsam_graph.errors import GraphError, RegistrationError
 from albot1.baselines.gtsam_graph.correlative import SearchWindow, correlative_search
 from albot1.baselines.gtsam_graph.graph import PoseGraph
 from albot1.baselines.gtsam_graph.loop_closure import (
@@ -103,14 +104,17 @@ class GtsamGraphMapper:
                                 f"got {odometry.tolist()}")
         points = self._preprocess(frame.scan, frame.index)
         self.counters["views"] += 1
-        if not self._node_odometry:
-            self._start(odometry, points, frame.index)
-        else:
-            last = len(self._node_odometry) - 1
-            step = se2.between(self._node_odometry[last], odometry)
-            if math.hypot(step[0], step[1]) >= self.config.node_translation_m or \
-                    abs(step[2]) >= math.radians(self.config.node_rotation_deg):
-                self._add_node(odometry, step, points, frame.index)
+        try:
+            if not self._node_odometry:
+                self._start(odometry, points, frame.index)
+            else:
+                last = len(self._node_odometry) - 1
+                step = se2.between(self._node_odometry[last], odometry)
+                if math.hypot(step[0], step[1]) >= self.config.node_translation_m or \
+                        abs(step[2]) >= math.radians(self.config.node_rotation_deg):
+                    self._add_node(odometry, step, points, frame.index)
+        except (GraphError, RegistrationError) as exc:  # re-raised as the method's error so the runner names the dataset
+            raise BaselineError(f"gtsam-graph: scan {frame.index}: {exc}") from exc
         node = len(self._node_odometry) - 1
         self._scan_node.append(node)
         self._scan_offset.append(se2.between(self._node_odometry[node], odometry))
@@ -297,7 +301,10 @@ class GtsamGraphMapper:
         unconfirmed = self._confirmer.flush()
         if unconfirmed:
             self._reject("not confirmed", unconfirmed)
-        nodes = self._graph.optimise(self.config.lm_max_iterations) if self.config.final_lm else self._graph.estimates()
+        try:
+            nodes = self._graph.optimise(self.config.lm_max_iterations) if self.config.final_lm else self._graph.estimates()
+        except GraphError as exc:
+            raise BaselineError(f"gtsam-graph: final optimisation: {exc}") from exc
         if not np.isfinite(nodes).all():
             raise BaselineError(f"gtsam-graph: the optimised graph of {len(nodes)} nodes has non-finite poses (diverged)")
         poses = se2.compose(nodes[np.asarray(self._scan_node)], np.asarray(self._scan_offset))

@@ -228,11 +228,18 @@ def _beam_count(path: Path, name: str, line: int, rest: bytes) -> int:
 
 def parse_old_lasers(path: Path, name: str, rows: list[tuple[int, bytes]]) -> list[LaserBlock]:
     """FLASER/RLASER lines -> one block per beam count."""
+    by_token: dict[bytes, list[tuple[int, bytes]]] = {}
+    for line, rest in rows:  # group by the beam-count *text*; convert each distinct one once
+        cut = rest.find(b" ")
+        by_token.setdefault(rest[:cut] if cut >= 0 else rest, []).append((line, rest))
     by_n: dict[int, list[tuple[int, bytes]]] = {}
-    for line, rest in rows:
-        by_n.setdefault(_beam_count(path, name, line, rest), []).append((line, rest))
+    for group in by_token.values():
+        line, rest = group[0]
+        by_n.setdefault(_beam_count(path, name, line, rest), []).extend(group)
     out: list[LaserBlock] = []
     for n, group in by_n.items():
+        if len(by_token) > 1:
+            group.sort()
         v = _bulk(path, name, group, n + 10)
         lines = np.fromiter((ln for ln, _ in group), dtype=np.int64, count=len(group))
         ranges = v[:, 1:n + 1]
