@@ -32,12 +32,7 @@ _COMMANDS: tuple[tuple[str, str, str | None], ...] = (
 )
 
 for _module_name, _attr, _group in _COMMANDS:
-    try:
-        _module = importlib.import_module(_module_name)
-    except ModuleNotFoundError as _exc:  # DEV-ONLY: made strict before landing
-        if _exc.name != _module_name:
-            raise
-        continue
+    _module = importlib.import_module(_module_name)
     if _group is None:
         getattr(_module, _attr)(app)
     else:

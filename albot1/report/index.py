@@ -85,7 +85,12 @@ def _failure_lines(records: list[CellRecord], out: Path) -> list[str]:
     failed = [r for r in records if r.status == "failed"]
     if not failed:
         return ["No cell failed.", ""]
-    lines = ["| dataset | method | degradation | seed | kind | reason | log |", "|---|---|---|---|---|---|---|"]
+    counts: dict[tuple[str, str], int] = {}
+    for rec in failed:
+        kind = rec.failure.kind if rec.failure else "?"
+        counts[(rec.cell.method_label, kind)] = counts.get((rec.cell.method_label, kind), 0) + 1
+    lines = [f"{len(failed)} cells failed: " + ", ".join(f"{m} {n} ({k})" for (m, k), n in counts.items()) + ".", "",
+             "| dataset | method | degradation | seed | kind | reason | log |", "|---|---|---|---|---|---|---|"]
     for rec in failed:
         c, f = rec.cell, rec.failure
         assert f is not None

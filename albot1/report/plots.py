@@ -177,8 +177,9 @@ def plot_robustness(table: pd.DataFrame, dataset: str, column: str, label: str, 
         group = group.iloc[np.argsort([x_of[d] for d in group["degradation"]], kind="stable")]
         xs = np.array([x_of[d] for d in group["degradation"]], dtype=float) + (i - 2) * 0.04
         mean = group[f"{column}_mean"].to_numpy(float)
-        low = mean - group[f"{column}_min"].to_numpy(float)
-        high = group[f"{column}_max"].to_numpy(float) - mean
+        # mean - min can come out as -1e-17 when every seed agrees: clip the rounding away
+        low = np.maximum(mean - group[f"{column}_min"].to_numpy(float), 0.0)
+        high = np.maximum(group[f"{column}_max"].to_numpy(float) - mean, 0.0)
         ax.errorbar(xs, mean, yerr=[low, high], marker="o", ms=4, capsize=3, lw=1,
                     color=COLORS[i % len(COLORS)], label=method)
     ax.set_xticks(range(len(levels)), levels, rotation=20, fontsize=8)
@@ -253,7 +254,7 @@ def plot_runtime(cost: pd.DataFrame, path: Path) -> Path | None:
     datasets = list(dict.fromkeys(rows["dataset"]))
     methods = list(dict.fromkeys(rows["method"]))
     width = 0.8 / len(methods)
-    fig, ax = plt.subplots(figsize=(max(7.0, 0.6 * len(datasets) * max(1, len(methods)) / 2), 4.5), dpi=110)
+    fig, ax = plt.subplots(figsize=(min(16.0, max(7.0, 0.12 * len(datasets) * len(methods))), 4.5), dpi=110)
     for i, method in enumerate(methods):
         sub = rows[rows["method"] == method].set_index("dataset")
         xs, med, p95 = [], [], []

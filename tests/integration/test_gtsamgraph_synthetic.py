@@ -20,7 +20,9 @@ def test_office_loop_is_closed_and_beats_odometry() -> None:
     graph = ate(result.poses, reference)["rmse_m"]
     odometry = ate(result.odometry, reference)["rmse_m"]
     assert result.counters["loop_closures_accepted"] >= 1
-    assert result.extras["loop_edges"], "loop edges are listed in extras"
+    nodes = result.counters["nodes"]
+    # One closure ties the return to the start (first nodes) to the last nodes.
+    assert any(a < 5 and b > nodes - 15 for a, b in result.extras["loop_edges"])
     assert graph < 0.1
     assert graph < 0.25 * odometry
     # The route ends where it starts: the estimate's end gap is small, odometry's is not.

@@ -66,7 +66,10 @@ class GtsamGraphMapper:
         self._seq_icp = config.icp(loop=False)
         self._loop_icp = config.icp(loop=True)
         self._seq_prior = np.diag([config.odometry_sigma_xy_m ** -2] * 2 + [math.radians(config.odometry_sigma_theta_deg) ** -2])
-        self._loop_prior = np.diag([config.loop_max_correction_m ** -2] * 2 + [math.radians(config.loop_max_correction_deg) ** -2])
+        # A vanishing prior keeps a loop match's covariance invertible while letting directions the scans do not
+        # constrain show up as huge variances, which is what the degeneracy (corridor) test looks for.
+        self._loop_prior = 1e-6 * np.diag([config.loop_max_correction_m ** -2] * 2
+                                          + [math.radians(config.loop_max_correction_deg) ** -2])
         self._floor = np.diag([config.match_sigma_floor_xy_m ** 2] * 2 + [math.radians(config.match_sigma_floor_theta_deg) ** 2])
         self._fallback = np.diag([config.fallback_sigma_xy_m ** 2] * 2 + [math.radians(config.fallback_sigma_theta_deg) ** 2])
         self._tests = LoopTests(
@@ -247,7 +250,7 @@ class GtsamGraphMapper:
             if reg is None:
                 self._reject("too few points")
                 continue
-            covariance, reason = verify(reg, guess, self._tests, self._loop_prior * 1e-6)
+            covariance, reason = verify(reg, guess, self._tests, self._loop_prior)
             if covariance is None and cfg.loop_coarse_max_half_width_m > 0:
                 # The estimate may have drifted beyond ICP's basin: seed ICP from a correlative search.
                 half = min(cfg.loop_coarse_max_half_width_m, max(cfg.loop_coarse_min_half_width_m,
@@ -261,7 +264,7 @@ class GtsamGraphMapper:
                 if coarse.ambiguity > cfg.loop_max_ambiguity:
                     reason = f"ambiguous ({coarse.ambiguity:.2f})"
                 elif retry is not None:
-                    cov, why = verify(retry, guess, self._tests, self._loop_prior * 1e-6)
+                    cov, why = verify(retry, guess, self._tests, self._loop_prior)
                     if cov is not None:
                         covariance, reason, reg = cov, "", retry
             if covariance is None:

@@ -25,7 +25,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.baselines.gtsam_graph.errors import RegistrationError
-from albot1.geometry import se2
 
 FloatArray = NDArray[np.float64]
 
@@ -176,7 +175,7 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         # Anneal the gate: wide while the guess may be far off, then down to the inlier gate.
         gate = max(params.min_correspondence_m, gate * params.gate_decay)
 
-    jac, res, w, dist = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m)
+    jac, res, w, _ = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m)
     inliers = int(len(res))
     information = (jac * (w * inv_var)[:, None]).T @ jac if inliers else np.zeros((3, 3))
     rmse = float(np.sqrt(np.mean(res ** 2))) if inliers else float("inf")
