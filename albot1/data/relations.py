@@ -20,6 +20,7 @@ import numpy as np
 
 from albot1.data.errors import ParseError
 from albot1.data.model import Relations
+from albot1.data.tokens import parse_floats
 
 _FIELDS = "t1 t2 x y z roll pitch yaw"
 _PLANAR_TOLERANCE = 1e-6
@@ -40,11 +41,7 @@ def read_relations(path: str | Path) -> Relations:
         tokens = line.split()
         if len(tokens) != 8:
             raise ParseError(p, f"{len(tokens)} fields, expected 8 ({_FIELDS})", line=number)
-        try:
-            values = [float(tok) for tok in tokens]
-        except ValueError:
-            bad = next(tok for tok in tokens if not _is_float(tok))
-            raise ParseError(p, f"field {bad!r} is not a number; expected {_FIELDS}", line=number) from None
+        values = parse_floats(p, number, tokens, "field", _FIELDS).tolist()
         if not all(math.isfinite(v) for v in values):
             raise ParseError(p, f"non-finite value; expected finite numbers ({_FIELDS})", line=number)
         if max(abs(values[4]), abs(values[5]), abs(values[6])) > _PLANAR_TOLERANCE:
@@ -52,14 +49,6 @@ def read_relations(path: str | Path) -> Relations:
         rows.append(values)
     arr = np.asarray(rows, dtype=np.float64).reshape(-1, 8)
     return Relations(t1=arr[:, 0].copy(), t2=arr[:, 1].copy(), poses=arr[:, [2, 3, 7]].copy())
-
-
-def _is_float(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
 
 
 def write_relations(path: str | Path, relations: Relations) -> None:

@@ -95,3 +95,16 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
         row["reason"] = rec.failure.reason if rec.failure else None
         rows.append(row)
     return rows
+
+
+def severity_order(levels: list[str]) -> list[str]:
+    """none, then Gaussian levels by sigma, then biases, then the thesis's systematic degradation."""
+    from albot1.data.degrade import parse_spec
+
+    rank = {"none": 0, "gauss": 1, "bias": 2, "thesis": 3}
+
+    def key(level: str) -> tuple[int, float, float]:
+        spec = parse_spec(level)
+        return rank.get(spec.kind, 4), spec.a, spec.b
+
+    return sorted(levels, key=key)

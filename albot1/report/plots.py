@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from albot1.report.collect import CellRecord
+from albot1.report.collect import CellRecord, severity_order
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -193,19 +193,6 @@ def plot_robustness(table: pd.DataFrame, dataset: str, column: str, label: str, 
     fig.savefig(path, format="png", bbox_inches="tight")
     plt.close(fig)
     return path
-
-
-def severity_order(levels: list[str]) -> list[str]:
-    """none, then Gaussian levels by sigma, then biases, then the thesis's systematic degradation."""
-    from albot1.data.degrade import parse_spec
-
-    rank = {"none": 0, "gauss": 1, "bias": 2, "thesis": 3}
-
-    def key(level: str) -> tuple[int, float, float]:
-        spec = parse_spec(level)
-        return rank.get(spec.kind, 4), spec.a, spec.b
-
-    return sorted(levels, key=key)
 
 
 def plot_scan_time(records: list[CellRecord], dataset: str, path: Path) -> Path | None:

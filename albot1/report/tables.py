@@ -14,7 +14,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from albot1.report.collect import COST_COLUMNS, KEY_COLUMNS, METRIC_COLUMNS, CellRecord, cell_rows
+from albot1.report.collect import COST_COLUMNS, KEY_COLUMNS, METRIC_COLUMNS, CellRecord, cell_rows, severity_order
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -39,7 +39,7 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, tuple[str, str, str]]) -> 
         return pd.DataFrame(columns=[*KEY_COLUMNS, "seeds"])
     order = {name: i for i, name in enumerate(dict.fromkeys(cells["dataset"]))}
     methods = {name: i for i, name in enumerate(dict.fromkeys(cells["method"]))}
-    degradations = {name: i for i, name in enumerate(dict.fromkeys(cells["degradation"]))}
+    degradations = {name: i for i, name in enumerate(severity_order(list(dict.fromkeys(cells["degradation"]))))}
     for (dataset, method, degradation), group in done.groupby(list(KEY_COLUMNS), sort=False):
         row: dict[str, Any] = {"dataset": dataset, "method": method, "degradation": degradation,
                                "seeds": int(group["seed"].nunique())}

@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from albot1.bench.grid import Cell
-from albot1.report.collect import CellRecord
-from albot1.report.plots import representative, severity_order, slug
+from albot1.report.collect import CellRecord, severity_order
+from albot1.report.plots import representative, slug
 
 
 def test_severity_order_puts_none_first_then_gaussian_by_sigma_then_thesis() -> None:

@@ -37,13 +37,13 @@ def test_aggregate_over_seeds_mean_median_min_max() -> None:
     records = [record("w", "odometry", "gauss:0.1:1", s, ate) for s, ate in ((0, 1.0), (1, 2.0), (2, 6.0))]
     records += [record("w", "odometry", "none", 0, 0.5), record("w", "odometry", "none", 1, None, status="failed")]
     table = aggregate(cells_frame(records), METRIC_COLUMNS)
-    assert list(table["degradation"]) == ["gauss:0.1:1", "none"]  # plan order of first appearance
-    swept = table.iloc[0]
+    assert list(table["degradation"]) == ["none", "gauss:0.1:1"]  # by severity, whatever the plan order
+    swept = table.iloc[1]
     assert swept["seeds"] == 3
     assert (swept["ate_rmse_m_mean"], swept["ate_rmse_m_median"], swept["ate_rmse_m_min"],
             swept["ate_rmse_m_max"]) == (3.0, 2.0, 1.0, 6.0)
     assert cell_text(swept, "ate_rmse_m") == "3.000 / 2.000 (1.000–6.000)"
-    single = table.iloc[1]
+    single = table.iloc[0]
     assert single["seeds"] == 1  # the failed seed is not averaged in
     assert cell_text(single, "ate_rmse_m") == "0.500"
 

@@ -145,12 +145,16 @@ class GtsamGraphMapper:
     def _start(self, odometry: FloatArray, points: FloatArray, index: int) -> None:
         self._graph.add_node(np.zeros(3))
         self._graph.update()
+        self._remember_node(odometry, points, index)
+        self._estimates = np.zeros((1, 3))
+
+    def _remember_node(self, odometry: FloatArray, points: FloatArray, index: int) -> None:
+        """Keep what later scan matching needs of a new node: its odometry, scan, line normals and frame."""
         self._node_odometry.append(odometry)
         self._node_scans.append(points)
         self._node_lines.append(line_normals(points, self.config.normal_neighbours, self.config.normal_radius_m,
                                              self.config.max_planarity))
         self._node_frame.append(index)
-        self._estimates = np.zeros((1, 3))
 
     def _add_node(self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int) -> None:
         prev = len(self._node_odometry) - 1
@@ -158,11 +162,7 @@ class GtsamGraphMapper:
         relative, covariance = self._sequential_edge(prev, step, points, index)
         self._graph.add_edge(prev, key, relative, covariance)
         self._graph.update()
-        self._node_odometry.append(odometry)
-        self._node_scans.append(points)
-        self._node_lines.append(line_normals(points, self.config.normal_neighbours, self.config.normal_radius_m,
-                                             self.config.max_planarity))
-        self._node_frame.append(index)
+        self._remember_node(odometry, points, index)
         self._estimates = np.vstack([self._estimates, se2.compose(self._estimates[prev], relative)])
         self._refresh_estimates(range(max(0, key - self.config.local_map_nodes), key + 1))
         self._path_since_closure += math.hypot(relative[0], relative[1])

@@ -15,6 +15,7 @@ import numpy as np
 
 from albot1.data.errors import DataError, ParseError
 from albot1.data.model import FloatArray, Frame, Scan
+from albot1.data.tokens import parse_floats
 
 MAGIC = "ALBOT1-LOG"
 VERSION = 1
@@ -41,25 +42,13 @@ class _Sensor:
 
 
 def _numbers(path: Path, line: int, tokens: list[str], what: str) -> FloatArray:
-    try:
-        return np.array(list(map(float, tokens)), dtype=np.float64)
-    except ValueError:
-        bad = next(t for t in tokens if not _is_float(t))
-        raise ParseError(path, f"{what}: {bad!r} is not a number", line=line) from None
+    return parse_floats(path, line, tokens, f"{what}:")
 
 
 def _is_count(token: str) -> bool:
     """A plain non-negative integer: ASCII digits only (``str.isdigit`` accepts superscripts that
     ``int`` rejects) and short enough for ``int`` (which refuses > 4300 digits)."""
     return token.isascii() and token.isdigit() and len(token) <= 12
-
-
-def _is_float(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
 
 
 class ViewParser:
