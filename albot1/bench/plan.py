@@ -122,13 +122,14 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
     from albot1.data.errors import DatasetNotFoundError
     from albot1.data.open import open_sequence
 
-    if name in catalog.names():
+    base = name.partition("?")[0]  # a reference with loader options needs its catalog file all the same
+    if base in catalog.names():
         try:
-            catalog.locate(name, settings)
+            catalog.locate(base, settings)
         except DatasetNotFoundError as exc:
-            manifest = catalog.get(name)
+            manifest = catalog.get(base)
             fetchable = not manifest.local_only and bool(manifest.log.urls)
-            return None, Skipped(name, f"not downloaded: {exc}", f"albot1 datasets fetch {name}" if fetchable else "")
+            return None, Skipped(name, f"not downloaded: {exc}", f"albot1 datasets fetch {base}" if fetchable else "")
     try:
         sequence = open_sequence(name, settings=settings)
         first = next(iter(sequence.frames()), None)

@@ -29,7 +29,8 @@ Format (every key optional except ``methods`` and ``datasets``)::
     # target = "pkg.mod:Class"       # a method that is not in the registry (your own mapper)
 
     [[datasets]]                     # applied in order; later entries override earlier ones
-    name = "*"                       # a glob over dataset and world names, a name, or a file path
+    name = "*"                       # a glob (* and [...]) over dataset and world names, a name, a
+                                     # dataset reference with loader options (NAME?KEY=VALUE), or a path
     [[datasets]]
     name = "intel"
     limit = 4000                     # first 4000 scans ...
@@ -49,7 +50,9 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from albot1.bench.errors import SuiteError
 
-GLOB_CHARS = frozenset("*?[")
+# "?" is not a glob character here: in a dataset reference it introduces loader options
+# (``intel-corrected?odometry=laser-pose``, see albot1.data.open), so such an entry is a literal.
+GLOB_CHARS = frozenset("*[")
 
 
 class _Strict(BaseModel):

@@ -95,3 +95,15 @@ def test_parse_executor() -> None:
     assert parse_executor("dask://10.0.0.1:8786") == ("dask", "tcp://10.0.0.1:8786")
     with pytest.raises(BenchError, match="expected local | dask"):
         parse_executor("ray")
+
+
+def test_reference_with_loader_options_is_a_literal_entry() -> None:
+    suite = parse_suite({"methods": [{"name": "odometry"}], "datasets": [
+        {"name": "*", "sweep": False},
+        {"name": "intel-corrected?odometry=laser-pose", "sweep": True},
+    ]}, name="s", source="s.toml")
+    assert suite.literal_datasets() == ["intel-corrected?odometry=laser-pose"]
+    opts = suite.options_for("intel-corrected?odometry=laser-pose")
+    assert opts is not None and opts.sweep is True
+    plain = suite.options_for("intel-corrected")
+    assert plain is not None and plain.sweep is False
