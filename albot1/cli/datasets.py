@@ -42,7 +42,7 @@ def list_(data_dir: DataDir = None,
 
     Examples:\n
       albot1 datasets list\n
-      ALBOT1_DATA_DIR=../shared/datasets albot1 datasets list --json
+      ALBOT1_DATA_DIR=/data/albot1 albot1 datasets list --json
     """
     from albot1.data import catalog
     from albot1.settings import get_settings
