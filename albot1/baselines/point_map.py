@@ -15,6 +15,18 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 
 
+def cell_keys(points: FloatArray, cell_m: float) -> NDArray[np.int64]:
+    """One int64 key per ``cell_m`` grid cell of each point ``(K, 2)`` (x in the high, y in the low 32 bits)."""
+    cells = np.floor(points / cell_m).astype(np.int64)
+    return (cells[:, 0] << 32) | (cells[:, 1] & 0xFFFFFFFF)
+
+
+def first_per_cell(points: FloatArray, cell_m: float) -> FloatArray:
+    """The first point of ``points`` ``(K, 2)`` in each ``cell_m`` grid cell, in input order (one-shot thinning)."""
+    _, first = np.unique(cell_keys(points, cell_m), return_index=True)
+    return points[np.sort(first)]
+
+
 class ThinnedPointMap:
     """2D points in the map frame, at most one per ``cell_m`` x ``cell_m`` grid cell.
 
@@ -48,10 +60,8 @@ class ThinnedPointMap:
             return
         points = np.concatenate(self._pending)
         self._pending, self._pending_count = [], 0
-        cells = np.floor(points / self.cell_m).astype(np.int64)
-        # One int64 key per cell (x in the high, y in the low 32 bits) keeps the bookkeeping in C-level set ops.
-        keys = (cells[:, 0] << 32) | (cells[:, 1] & 0xFFFFFFFF)
-        unique, first = np.unique(keys, return_index=True)
+        # One int64 key per cell keeps the bookkeeping in C-level set ops.
+        unique, first = np.unique(cell_keys(points, self.cell_m), return_index=True)
         fresh_keys = set(unique.tolist()).difference(self._cells)
         if not fresh_keys:
             return

@@ -70,12 +70,10 @@ def run_cell_job(cell: Cell, results_root: str) -> CellOutcome:
     if verdict is None:
         write_json(run_dir / ATTEMPT, {"elapsed_s": ended.elapsed_s, "host": socket.gethostname(),
                                        "finished": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
-        return CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label, "done",
-                           ended.elapsed_s)
+        return CellOutcome.of(cell, "done", ended.elapsed_s)
     kind, reason = verdict
     store.record_failure(cell, reason, kind, exit_code=ended.exit_code, elapsed_s=ended.elapsed_s)
-    return CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label, "failed",
-                       ended.elapsed_s, reason, kind)
+    return CellOutcome.of(cell, "failed", ended.elapsed_s, reason, kind)
 
 
 def results_path(root: Path) -> str:

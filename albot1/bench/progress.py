@@ -32,12 +32,12 @@ class TqdmProgress:
         self._bar = tqdm(total=total, initial=cached, unit="cell", desc="bench", disable=self._disable,
                          dynamic_ncols=True)
         if cached:
-            self._emit(f"{cached} of {total} cells already complete (kept)")
+            self._write(f"{cached} of {total} cells already complete (kept)")
 
     def finished(self, outcome: CellOutcome) -> None:
         if outcome.status == "failed":
             self._failed += 1
-            self._emit(f"FAILED {outcome.description}: {outcome.reason}")
+            self._write(f"FAILED {outcome.description}: {outcome.reason}")
         if self._bar is not None and outcome.status != "cached":
             self._bar.update(1)
             self._bar.set_postfix(failed=self._failed, refresh=False)
@@ -45,9 +45,6 @@ class TqdmProgress:
     def close(self) -> None:
         if self._bar is not None:
             self._bar.close()
-
-    def _emit(self, line: str) -> None:
-        self._write(line)
 
 
 def summary_table(summary: GridSummary) -> str:

@@ -67,11 +67,9 @@ def run_grid(plan: GridPlan, store: ResultsStore, executor: cf.Executor,
         if cell.key in plan.config_failures:
             store.prepare(cell)
             store.record_failure(cell, plan.config_failures[cell.key], "config")
-            summary.outcomes.append(CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label,
-                                                "failed", 0.0, plan.config_failures[cell.key], "config"))
+            summary.outcomes.append(CellOutcome.of(cell, "failed", 0.0, plan.config_failures[cell.key], "config"))
         elif store.is_complete(cell.key):
-            summary.outcomes.append(CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label,
-                                                "cached"))
+            summary.outcomes.append(CellOutcome.of(cell, "cached"))
         else:
             pending.append(cell)
     if observer is not None:
@@ -89,8 +87,7 @@ def run_grid(plan: GridPlan, store: ResultsStore, executor: cf.Executor,
             except Exception as exc:  # the executor lost the job (worker died, unpicklable, ...)
                 reason = f"executor error: {type(exc).__name__}: {exc}"
                 store.record_failure(cell, reason, "executor", traceback_text="".join(traceback.format_exception(exc)))
-                outcome = CellOutcome(cell.key, cell.describe(), cell.method_label, cell.dataset_label, "failed",
-                                      0.0, reason, "executor")
+                outcome = CellOutcome.of(cell, "failed", 0.0, reason, "executor")
             summary.outcomes.append(outcome)
             if observer is not None:
                 observer.finished(outcome)

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
+from albot1.atomic import atomic_write
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell, FailureKind, GridPlan
 from albot1.runs.folder import is_complete as run_is_complete
@@ -69,8 +70,7 @@ class ResultsStore:
         self.runs.mkdir(parents=True, exist_ok=True)
         write_json(self.root / PLAN, plan.to_json())
         if suite_file is not None and suite_file.is_file():
-            shutil.copyfile(suite_file, self.root / ".suite.toml.tmp")
-            os.replace(self.root / ".suite.toml.tmp", self.root / "suite.toml")
+            atomic_write(self.root / "suite.toml", lambda tmp: shutil.copyfile(suite_file, tmp))
 
     def read_plan(self) -> GridPlan:
         path = self.root / PLAN

@@ -58,7 +58,7 @@ def open_sequence(ref: str | Path, *, settings: Settings | None = None, format_n
         return load(path, format_name, **options)
     raise DatasetNotFoundError(
         f"{text!r} is neither a dataset name nor an existing file; known datasets: "
-        f"{', '.join(sorted(catalog.names()) + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
+        f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
     )
 
 

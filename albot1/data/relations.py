@@ -12,12 +12,11 @@ and ``#`` comments are allowed; a file without relations gives zero relations
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from albot1.atomic import atomic_write
 from albot1.data.errors import ParseError
 from albot1.data.model import Relations
 from albot1.data.tokens import parse_floats
@@ -58,10 +57,4 @@ def write_relations(path: str | Path, relations: Relations) -> None:
     zeros = np.zeros(n)
     rows = np.column_stack([relations.t1, relations.t2, relations.poses[:, 0], relations.poses[:, 1],
                             zeros, zeros, zeros, relations.poses[:, 2]])
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
-        np.savetxt(tmp, rows, fmt="%.9f")
-        os.replace(tmp, p)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
+    atomic_write(p, lambda tmp: np.savetxt(tmp, rows, fmt="%.9f"))

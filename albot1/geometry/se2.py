@@ -115,6 +115,12 @@ def interpolate(times: ArrayLike, poses: ArrayLike, query: ArrayLike) -> FloatAr
     return out
 
 
+def cumulative_length(poses: ArrayLike) -> FloatArray:
+    """Distance travelled up to each pose (0 at the first), metres."""
+    p = as_poses(poses)
+    return np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(p[:, 0]), np.diff(p[:, 1])))])
+
+
 def path_length(poses: ArrayLike) -> float:
     """Total translation along a trajectory, metres."""
     p = as_poses(poses)

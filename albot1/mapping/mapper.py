@@ -30,7 +30,14 @@ from albot1.mapping.localisation import Localisation, localise
 from albot1.mapping.perceptual_map import PerceptualMap
 from albot1.mapping.update import UpdateParams, update_map
 from albot1.perception.accel import get_kernels
-from albot1.perception.frames import Pose, compose, thesis_to_rep_pose, thesis_to_rep_segments, transform_segments
+from albot1.perception.frames import (
+    Pose,
+    between,
+    compose,
+    thesis_to_rep_pose,
+    thesis_to_rep_segments,
+    transform_segments,
+)
 from albot1.perception.landmarks import Landmarks, find_landmarks
 from albot1.perception.recognition import Tracked, motion_step, recognise
 from albot1.perception.view import View, construct_view
@@ -67,13 +74,6 @@ class _Counts:
     surfaces_extended: int = 0
     surfaces_trimmed: int = 0
     recognised: list[int] = field(default_factory=list)
-
-
-def _between(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    dth = (b[2] - a[2] + math.pi) % (2.0 * math.pi) - math.pi
-    return (c * dx + s * dy, -s * dx + c * dy, dth)
 
 
 class Albot1Mapper:
@@ -140,7 +140,7 @@ class Albot1Mapper:
     def _step(self, n: int, view: View, lms: Landmarks, odo: tuple[float, float, float],
               prev: _Step) -> tuple[Tracked, Pose]:
         c, cfg = self._counts, self.config
-        rel = _between(prev.odometry, odo)
+        rel = between(prev.odometry, odo)
         dist = math.hypot(rel[0], rel[1])
         if dist > cfg.odometry_jump_m:
             c.odometry_jumps += 1

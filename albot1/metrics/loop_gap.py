@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from albot1.geometry import se2
 from albot1.metrics.alignment import check_pair
 from albot1.metrics.errors import MetricsError
+from albot1.metrics.rpe import relative_errors
 from albot1.metrics.stats import summarize
 
 RADIUS_M = 0.5
@@ -70,7 +71,7 @@ def loop_pairs(timestamps: ArrayLike, reference: ArrayLike, *, radius_m: float =
         raise MetricsError(f"loop pairs: {len(t)} timestamps but {len(ref)} reference poses")
     if len(ref) < 2:
         return np.empty((0, 2), dtype=np.int64)
-    travel = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(ref[:, 0]), np.diff(ref[:, 1])))])
+    travel = se2.cumulative_length(ref)
     pairs = cKDTree(ref[:, :2]).query_pairs(radius_m, output_type="ndarray")
     if len(pairs) == 0:
         return np.empty((0, 2), dtype=np.int64)
@@ -98,7 +99,7 @@ def pair_gaps(timestamps: ArrayLike, estimate: ArrayLike, reference: ArrayLike, 
         block.update({"translation_m": None, "rotation_deg": None, "worst_pair": None})
         return block
     i, j = pairs[:, 0], pairs[:, 1]
-    err = se2.between(se2.between(ref[i], ref[j]), se2.between(est[i], est[j]))
+    err = relative_errors(est, ref, pairs)
     trans = np.hypot(err[:, 0], err[:, 1])
     worst = int(np.argmax(trans))
     block["translation_m"] = summarize(trans)

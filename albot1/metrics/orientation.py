@@ -34,7 +34,7 @@ def stop_indices(reference: ArrayLike, every_m: float = EVERY_M) -> NDArray[np.i
     if every_m <= 0:
         raise MetricsError(f"orientation: expected a positive stop spacing, got {every_m} m")
     ref = np.asarray(reference, dtype=float)
-    travel = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(ref[:, 0]), np.diff(ref[:, 1])))])
+    travel = se2.cumulative_length(ref)
     marks = np.arange(every_m, travel[-1] + 1e-12, every_m)
     stops = np.searchsorted(travel, marks - 1e-9, side="left")
     return np.unique(np.concatenate([stops, [len(ref) - 1]])).astype(np.int64)
@@ -52,7 +52,7 @@ def orientation_table(estimate: ArrayLike, reference: ArrayLike, timestamps: Arr
     """The ``orientation`` block: Table-3.1 rows and mean/max absolute differences."""
     est, ref = check_pair(estimate, reference, "orientation")
     stamps = None if timestamps is None else np.asarray(timestamps, dtype=float)
-    travel = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(ref[:, 0]), np.diff(ref[:, 1])))])
+    travel = se2.cumulative_length(ref)
     rows: list[dict[str, Any]] = []
     bearing_err: list[float] = []
     distance_err: list[float] = []

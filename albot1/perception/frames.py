@@ -20,19 +20,27 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.perception.kernels import wrap_angle
+
 FloatArray = NDArray[np.float64]
 Pose = tuple[float, float, float]
 
 
-def wrap(angle: float) -> float:
-    """``angle`` wrapped to ``[-pi, pi)``."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+#: ``angle`` wrapped to ``[-pi, pi)`` (the kernels' scalar wrap, so both agree bit for bit).
+wrap = wrap_angle
 
 
 def compose(a: Pose, b: Pose) -> Pose:
     """``a * b``: pose ``b`` (given in ``a``'s frame) in ``a``'s parent frame."""
     c, s = math.cos(a[2]), math.sin(a[2])
     return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap(a[2] + b[2]))
+
+
+def between(a: Pose, b: Pose) -> Pose:
+    """``inv(a) * b``: the pose of ``b`` seen from ``a`` (e.g. an odometry increment)."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return (c * dx + s * dy, -s * dx + c * dy, wrap(b[2] - a[2]))
 
 
 def rep_to_thesis_pose(pose: FloatArray | Pose) -> Pose:

@@ -76,7 +76,6 @@ def build_view(
     stack_a = np.empty(2 * k + 2, dtype=np.int64)
     stack_b = np.empty(2 * k + 2, dtype=np.int64)
     for c in range(nc):
-        top = 0
         stack_a[0] = starts[c]
         stack_b[0] = starts[c + 1] - 1
         top = 1
@@ -236,12 +235,14 @@ def recognise_landmarks(
     ss = np.empty(p * q, dtype=np.int64)
     gg = np.empty(p * q)
     aa = np.empty(p * q)
+    cur_dir = np.empty(q)
+    for j in range(q):
+        cur_dir[j] = math.atan2(cur[j, 3] - cur[j, 1], cur[j, 2] - cur[j, 0])
     n = 0
     for i in range(p):
         ai = math.atan2(pred[i, 3] - pred[i, 1], pred[i, 2] - pred[i, 0])
         for j in range(q):
-            aj = math.atan2(cur[j, 3] - cur[j, 1], cur[j, 2] - cur[j, 0])
-            da = abs(wrap_angle(aj - ai))
+            da = abs(wrap_angle(cur_dir[j] - ai))
             if da >= max_angle:
                 continue
             best = max_distance

@@ -10,12 +10,15 @@ the dotted paths in :data:`METRIC_COLUMNS` and :data:`COST_COLUMNS`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ATTEMPT, METRICS, Failure, ResultsStore
+
+if TYPE_CHECKING:
+    from albot1.runs.folder import StoredRun
 
 #: column -> (source file, dotted path, header text); accuracy numbers, identical for identical inputs
 METRIC_COLUMNS: dict[str, tuple[str, str, str]] = {
@@ -51,6 +54,15 @@ class CellRecord:
     metrics: dict[str, Any] | None
     failure: Failure | None
     attempt: dict[str, Any] | None = None
+    _stored: StoredRun | None = field(default=None, repr=False, compare=False)
+
+    def stored_run(self) -> StoredRun:
+        """The run folder read back, once per record (several plots draw the same run)."""
+        if self._stored is None:
+            from albot1.runs.folder import read_run
+
+            self._stored = read_run(self.run_dir)
+        return self._stored
 
 
 def dig(data: dict[str, Any] | None, path: str) -> float | None:

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from albot1.bench.grid import GridPlan
-from albot1.report.collect import CellRecord, collect
+from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
 from albot1.report.plots import (plot_maps, plot_robustness, plot_runtime, plot_scan_time, plot_trajectories,
                                  slug)
 from albot1.report.tables import aggregate, cells_frame, write_tables
@@ -34,8 +34,6 @@ def _rel(path: Path, start: Path) -> str:
 
 def render_plots(records: list[CellRecord], out: Path) -> dict[str, list[Path]]:
     """Every plot of the report; dataset label -> its plot files (key "" for cross-dataset plots)."""
-    from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS
-
     cells = cells_frame(records)
     metrics = aggregate(cells, METRIC_COLUMNS)
     cost = aggregate(cells, COST_COLUMNS)

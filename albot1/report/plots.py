@@ -86,9 +86,7 @@ def _transform_points(points: np.ndarray, poses: np.ndarray, reference: np.ndarr
 def _draw_run(ax: Axes, rec: CellRecord, color: str) -> None:
     from matplotlib.collections import LineCollection
 
-    from albot1.runs.folder import read_run
-
-    run = read_run(rec.run_dir)
+    run = rec.stored_run()
     ref = run.reference
     data = run.load_map()
     if data.points is not None and len(data.points):
@@ -135,8 +133,6 @@ def plot_maps(records: list[CellRecord], dataset: str, path: Path) -> Path | Non
 
 def plot_trajectories(records: list[CellRecord], dataset: str, path: Path) -> Path | None:
     """Every method's trajectory over the reference (aligned as for the ATE)."""
-    from albot1.runs.folder import read_run
-
     runs = representative(records)
     if not runs:
         return None
@@ -144,7 +140,7 @@ def plot_trajectories(records: list[CellRecord], dataset: str, path: Path) -> Pa
     fig, ax = plt.subplots(figsize=(7, 7), dpi=110)
     reference_drawn = False
     for i, (label, rec) in enumerate(runs.items()):
-        run = read_run(rec.run_dir)
+        run = rec.stored_run()
         if run.reference is not None and not reference_drawn:
             ax.plot(run.reference[:, 0], run.reference[:, 1], color="black", lw=1.4, alpha=0.5, label="reference")
             reference_drawn = True

@@ -10,19 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.runs.protocol import RunResult
-
-
-def _align(src: NDArray[np.float64], dst: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Rigid 2D least-squares (Umeyama, no scale) mapping ``src`` points onto ``dst``."""
-    mu_s, mu_d = src.mean(axis=0), dst.mean(axis=0)
-    cov = (dst - mu_d).T @ (src - mu_s)
-    u, _, vt = np.linalg.svd(cov)
-    d = np.sign(np.linalg.det(u @ vt))
-    rot = u @ np.diag([1.0, d]) @ vt
-    return (src - mu_s) @ rot.T + mu_d
 
 
 def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> None:
@@ -43,7 +32,9 @@ def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> 
         seg = np.asarray(data.segments).reshape(-1, 2, 2)
         ax.add_collection(LineCollection(seg, colors="tab:green", linewidths=0.8, label="map surfaces"))
     if result.reference is not None and len(result.reference) > 2:
-        ref = _align(result.reference[:, :2], result.poses[:, :2])
+        from albot1.metrics.alignment import align
+
+        ref, _ = align(result.reference, result.poses, "rigid")
         ax.plot(ref[:, 0], ref[:, 1], color="tab:orange", lw=0.8, label="reference (aligned)")
     ax.plot(result.poses[:, 0], result.poses[:, 1], color="tab:blue", lw=0.8, label=f"{result.method} estimate")
     ax.set_aspect("equal")

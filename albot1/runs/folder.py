@@ -22,9 +22,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -32,6 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.atomic import atomic_write
 from albot1.data.model import Relations
 from albot1.data.relations import read_relations, write_relations
 from albot1.runs.errors import RunError
@@ -48,20 +46,9 @@ def run_key(dataset: str, method: str, config: dict[str, Any], degradation: str,
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
 
-def _atomic_write(path: Path, writer: Callable[[Path], None]) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        writer(tmp_path)
-        os.replace(tmp_path, path)
-    finally:
-        tmp_path.unlink(missing_ok=True)
-
-
 def write_json(path: Path, data: Any) -> None:
     """Atomically write JSON (NaN/inf are written as null)."""
-    _atomic_write(path, lambda p: p.write_text(json.dumps(_jsonable(data), indent=2, sort_keys=False) + "\n"))
+    atomic_write(path, lambda p: p.write_text(json.dumps(_jsonable(data), indent=2, sort_keys=False) + "\n"))
 
 
 def _jsonable(value: Any) -> Any:
@@ -92,12 +79,12 @@ def write_run(result: RunResult, root: Path, *, preview: bool = True) -> Path:
     run_dir.mkdir(parents=True, exist_ok=True)
     (run_dir / DONE).unlink(missing_ok=True)
 
-    _atomic_write(run_dir / "trajectory.tum", lambda p: write_tum(p, result.timestamps, result.poses))
-    _atomic_write(run_dir / "odometry.tum", lambda p: write_tum(p, result.timestamps, result.odometry))
+    atomic_write(run_dir / "trajectory.tum", lambda p: write_tum(p, result.timestamps, result.poses))
+    atomic_write(run_dir / "odometry.tum", lambda p: write_tum(p, result.timestamps, result.odometry))
     if result.reference is not None:
-        _atomic_write(run_dir / "reference.tum", lambda p: write_tum(p, result.timestamps, result.reference))
+        atomic_write(run_dir / "reference.tum", lambda p: write_tum(p, result.timestamps, result.reference))
     if result.relations is not None:
-        _atomic_write(run_dir / "relations.txt", lambda p: write_relations(p, result.relations))
+        write_relations(run_dir / "relations.txt", result.relations)  # atomic itself
     map_file = _write_map(run_dir, result.map)
     write_json(run_dir / "extras.json", result.extras)
     write_json(run_dir / "result.json", {
@@ -121,8 +108,8 @@ def write_run(result: RunResult, root: Path, *, preview: bool = True) -> Path:
     if preview:
         from albot1.report.preview import render_preview
 
-        _atomic_write(run_dir / "preview.png", lambda p: render_preview(result, p))
-    _atomic_write(run_dir / DONE, lambda p: p.write_text(key + "\n"))
+        atomic_write(run_dir / "preview.png", lambda p: render_preview(result, p))
+    atomic_write(run_dir / DONE, lambda p: p.write_text(key + "\n"))
     return run_dir
 
 
@@ -139,7 +126,7 @@ def _write_map(run_dir: Path, data: MapData) -> str:
         write_json(run_dir / "map.geojson", {"type": "FeatureCollection", "features": features})
         return "map.geojson"
     points = np.asarray(data.points if data.points is not None else np.empty((0, 2)), dtype=np.float32)
-    _atomic_write(run_dir / "map.npz", lambda p: np.savez_compressed(p.open("wb"), points=points))
+    atomic_write(run_dir / "map.npz", lambda p: np.savez_compressed(p.open("wb"), points=points))
     return "map.npz"
 
 

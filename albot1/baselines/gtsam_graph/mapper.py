@@ -43,6 +43,7 @@ from albot1.baselines.gtsam_graph.loop_closure import (
     verify,
 )
 from albot1.baselines.gtsam_graph.registration import IcpParams, Registration, Target, line_normals, register
+from albot1.baselines.point_map import first_per_cell
 from albot1.baselines.presets import TomlPresets
 from albot1.data.model import Frame, Scan
 from albot1.geometry import se2
@@ -136,9 +137,7 @@ class GtsamGraphMapper:
         pts = np.column_stack([r * np.cos(a), r * np.sin(a)])
         cell = self.config.scan_voxel_m
         if cell > 0 and len(pts):
-            keys = np.floor(pts / cell).astype(np.int64)
-            _, first = np.unique(keys[:, 0] * 2_000_003 + keys[:, 1], return_index=True)
-            pts = pts[np.sort(first)]
+            pts = first_per_cell(pts, cell)
         return pts
 
     # ------------------------------------------------------------------ nodes and edges
@@ -289,7 +288,8 @@ class GtsamGraphMapper:
 
     def _reject(self, reason: str, count: int = 1) -> None:
         self.counters["loop_closures_rejected"] += count
-        self._rejections[reason.split(" ")[0]] = self._rejections.get(reason.split(" ")[0], 0) + count
+        kind = reason.split(" ")[0]
+        self._rejections[kind] = self._rejections.get(kind, 0) + count
 
     def _refresh_estimates(self, keys: range) -> None:
         for k in keys:
@@ -328,7 +328,4 @@ class GtsamGraphMapper:
                  if pts is not None and len(pts)]
         if not parts:
             return np.empty((0, 2))
-        allpts = np.concatenate(parts)
-        cells = np.floor(allpts / self.config.map_voxel_m).astype(np.int64)
-        _, first = np.unique(cells[:, 0] * 4_000_037 + cells[:, 1], return_index=True)
-        return allpts[np.sort(first)]
+        return first_per_cell(np.concatenate(parts), self.config.map_voxel_m)

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from albot1.data.errors import DataError, ParseError
+from albot1.data.loaders.rosmsg import even_spacing
 from albot1.data.model import FloatArray, Frame, Scan
 from albot1.data.tokens import parse_floats
 
@@ -172,10 +173,9 @@ def _fmt(values: Any) -> str:
 
 def sensor_line(scan: Scan) -> str:
     n = scan.beams
-    step = float(scan.angles[-1] - scan.angles[0]) / (n - 1) if n > 1 else 0.0
-    rebuilt = float(scan.angles[0]) + np.arange(n, dtype=np.float64) * step
-    if n > 1 and float(np.max(np.abs(rebuilt - scan.angles))) <= _SPACING_EXACT:
-        return f"SENSOR {n} {float(scan.max_range)!r} {float(scan.angles[0])!r} {step!r}"
+    spacing = even_spacing(scan.angles, _SPACING_EXACT) if n > 1 else None
+    if spacing is not None:
+        return f"SENSOR {n} {float(scan.max_range)!r} {spacing[0]!r} {spacing[1]!r}"
     return f"SENSOR-ANGLES {n} {float(scan.max_range)!r} {_fmt(scan.angles)}"
 
 

@@ -281,8 +281,8 @@ class _FrameIterator:
         for chunk in iter_line_chunks(self.path, parallel_bz2=self.opts.parallel_bz2):
             self.last_line = chunk.first_line + len(chunk.lines) - 1
             parsed = parse_chunk(self.path, chunk.first_line, chunk.lines, self.s.laser, self.skip)
-            yield from self._consume(parsed, final=False)
-        yield from self._flush()
+            yield from self._consume(parsed)
+        yield from self._emit(final=True)
         if self.index == 0:
             raise ParseError(self.path, f"no {self.s.laser} scans in the log; expected at least one",
                              line=max(self.last_line, 1))
@@ -311,7 +311,7 @@ class _FrameIterator:
             start[i], step[i], max_range[i] = g.start, g.step, g.max_range
         return start, step, max_range
 
-    def _consume(self, parsed: ParsedChunk, final: bool) -> Iterator[Frame]:
+    def _consume(self, parsed: ParsedChunk) -> Iterator[Frame]:
         params = sorted(parsed.params)
         rows: list[tuple[int, int, int]] = []  # (line, block, row) in file order
         decoded = []
@@ -352,7 +352,7 @@ class _FrameIterator:
         if self.opts.odometry == "odom-segments":
             self.seg_lines = np.concatenate([self.seg_lines, parsed.odom.lines])
             self.seg_poses = np.concatenate([self.seg_poses, parsed.odom.poses])
-        yield from self._emit(final)
+        yield from self._emit(final=False)
 
     def _check_time(self, line: int, stamp: float) -> None:
         last = self.last_stamp
@@ -367,17 +367,14 @@ class _FrameIterator:
                                             f"{self.opts.time_tolerance} s)", line=line)
         self.last_stamp = (stamp, line)
 
-    def _flush(self) -> Iterator[Frame]:
-        yield from self._emit(final=True)
-
-    def _ready(self, stamp: float, final: bool) -> bool:
-        return final or all(buf is None or buf.ready(stamp) for buf in (self.odom, self.truth))
+    def _ready(self, stamp: float) -> bool:
+        return all(buf is None or buf.ready(stamp) for buf in (self.odom, self.truth))
 
     def _emit(self, final: bool) -> Iterator[Frame]:
         done = 0
         wait = not final and (self.odom is not None or self.truth is not None)
         for item in self.pending:
-            if wait and not self._ready(item.timestamp, final):
+            if wait and not self._ready(item.timestamp):
                 break
             yield Frame(self.index, item.scan, self._odometry(item), self._reference(item))
             self.index += 1

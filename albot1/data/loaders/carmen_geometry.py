@@ -119,14 +119,8 @@ def beam_angles(beams: int, start: float, step: float) -> FloatArray:
 
 
 def clean_block(ranges: FloatArray, max_range: FloatArray) -> FloatArray:
-    """:func:`clean_ranges` for a ``(k, n)`` block with one max range per row (one numpy pass)."""
+    """A copy of a ``(k, n)`` block (one max range per row) with max-range and zero readings as NaN
+    (the no-return rule above), in one numpy pass."""
     out = ranges.copy()
     out[(out >= (max_range - NO_RETURN_MARGIN)[:, None]) | (out == 0.0)] = np.nan
-    return out
-
-
-def clean_ranges(ranges: FloatArray, max_range: float) -> FloatArray:
-    """A copy of ``ranges`` with max-range and zero readings as NaN (the no-return rule above)."""
-    out = ranges.copy()
-    out[(out >= max_range - NO_RETURN_MARGIN) | (out == 0.0)] = np.nan
     return out

@@ -297,13 +297,18 @@ def parse_params(path: Path, rows: list[tuple[int, bytes]]) -> list[tuple[int, s
     return out
 
 
+def _first_front_laser(groups: dict[str, list[tuple[int, bytes]]]) -> str | None:
+    """The front-laser message (FLASER, ROBOTLASER1 or RAWLASER1) that appears first in ``groups``."""
+    candidates = [(rows[0][0], nm) for nm, rows in groups.items() if nm in ("FLASER", "ROBOTLASER1", "RAWLASER1")]
+    return min(candidates)[1] if candidates else None
+
+
 def probe_chunk(path: Path, first_line: int, lines: list[bytes], laser: str | None) -> ParsedChunk:
     """What ``load()`` needs before streaming, cheaply: the laser message and its first line only,
     PARAM values, TRUEPOS lines and the names of skipped messages (ODOM is left to the stream)."""
     groups = split_messages(path, first_line, lines)
     if laser is None:
-        candidates = [(rows[0][0], nm) for nm, rows in groups.items() if nm in ("FLASER", "ROBOTLASER1", "RAWLASER1")]
-        laser = min(candidates)[1] if candidates else None
+        laser = _first_front_laser(groups)
     groups.pop("ODOM", None)
     if laser is not None and laser in groups:
         groups[laser] = groups[laser][:1]
@@ -321,8 +326,7 @@ def parse_chunk(path: Path, first_line: int, lines: list[bytes], laser: str | No
     for name in skip:
         groups.pop(name, None)
     if laser is None:
-        candidates = [(rows[0][0], nm) for nm, rows in groups.items() if nm in ("FLASER", "ROBOTLASER1", "RAWLASER1")]
-        laser = min(candidates)[1] if candidates else None
+        laser = _first_front_laser(groups)
     return _parse_groups(path, groups, laser)
 
 

@@ -23,13 +23,12 @@ from __future__ import annotations
 import bz2
 import gzip
 import math
-import os
-import tempfile
 from pathlib import Path
 from typing import IO, ClassVar
 
 import numpy as np
 
+from albot1.atomic import atomic_write
 from albot1.data.errors import DataError
 from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
@@ -92,10 +91,8 @@ class CarmenWriter:
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         offset = np.asarray(sequence.metadata.sensor_offset, dtype=np.float64)
-        fd, tmp_name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.name)
-        os.close(fd)
-        tmp = Path(tmp_name)
-        try:
+
+        def write_lines(tmp: Path) -> None:
             with _open(tmp) as out:
                 out.write(_HEADER)
                 out.write(f"PARAM robot_frontlaser_offset {offset[0]:.9f} 0.000000 {HOST} 0.000000\n")
@@ -108,6 +105,5 @@ class CarmenWriter:
                         out.write(f"TRUEPOS {_pose(frame.reference)} {_pose(frame.odometry)} "
                                   f"{stamp} {HOST} {stamp}\n")
                     out.write(_laser_line(frame, offset))
-            os.replace(tmp, path)
-        finally:
-            tmp.unlink(missing_ok=True)
+
+        atomic_write(path, write_lines)

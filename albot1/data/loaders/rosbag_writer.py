@@ -138,6 +138,18 @@ def _cleanup(path: Path) -> None:
         path.unlink(missing_ok=True)
 
 
+def _write_bag(sequence: Sequence, path: Path, open_bag: Callable[[], Any], ts: Typestore, *, ros1: bool) -> None:
+    """Write every frame through a ``rosbags`` writer; a failed write removes what it created."""
+    serialize = ts.serialize_ros1 if ros1 else ts.serialize_cdr
+    try:
+        with open_bag() as bag:
+            _write_frames(sequence, RosMessages(ts, ros1=ros1), serialize,
+                          lambda topic, msgtype: bag.add_connection(topic, msgtype, typestore=ts), bag.write)
+    except BaseException:
+        _cleanup(path)
+        raise
+
+
 class Ros1BagWriter:
     """A ROS1 bag (format 2.0, uncompressed) with ROS Noetic message definitions."""
 
@@ -149,14 +161,7 @@ class Ros1BagWriter:
 
         path = Path(path)
         _refuse_existing(path)
-        ts = get_typestore(Stores.ROS1_NOETIC)
-        try:
-            with Writer(path) as bag:
-                _write_frames(sequence, RosMessages(ts, ros1=True), ts.serialize_ros1,
-                              lambda topic, msgtype: bag.add_connection(topic, msgtype, typestore=ts), bag.write)
-        except BaseException:
-            _cleanup(path)
-            raise
+        _write_bag(sequence, path, lambda: Writer(path), get_typestore(Stores.ROS1_NOETIC), ros1=True)
 
 
 class _Ros2Writer:
@@ -171,15 +176,9 @@ class _Ros2Writer:
 
         path = Path(path)
         _refuse_existing(path)
-        ts = get_typestore(Stores.ROS2_HUMBLE)
         plugin = StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3
-        try:
-            with Writer(path, version=9, storage_plugin=plugin) as bag:
-                _write_frames(sequence, RosMessages(ts, ros1=False), ts.serialize_cdr,
-                              lambda topic, msgtype: bag.add_connection(topic, msgtype, typestore=ts), bag.write)
-        except BaseException:
-            _cleanup(path)
-            raise
+        _write_bag(sequence, path, lambda: Writer(path, version=9, storage_plugin=plugin),
+                   get_typestore(Stores.ROS2_HUMBLE), ros1=False)
 
 
 class Ros2Sqlite3Writer(_Ros2Writer):

@@ -73,15 +73,15 @@ def scan_arrays(
     return r, angles
 
 
-def even_spacing(angles: FloatArray) -> tuple[float, float] | None:
-    """``(angle_min, angle_increment)`` if the beams are evenly spaced, else None."""
+def even_spacing(angles: FloatArray, tolerance: float = ANGLE_SPACING_TOLERANCE) -> tuple[float, float] | None:
+    """``(angle_min, angle_increment)`` if the beams are evenly spaced (within ``tolerance`` rad), else None."""
     n = angles.shape[0]
     if n == 0:
         return None
     first = float(angles[0])
     step = float(angles[-1] - angles[0]) / (n - 1) if n > 1 else 0.0
     rebuilt = first + np.arange(n, dtype=np.float64) * step
-    if float(np.max(np.abs(rebuilt - angles))) > ANGLE_SPACING_TOLERANCE:
+    if float(np.max(np.abs(rebuilt - angles))) > tolerance:
         return None
     return first, step
 

@@ -98,13 +98,9 @@ def spec_for(name: str) -> WorldSpec:
 
 
 @functools.lru_cache(maxsize=None)
-def _cached(name: str) -> WorldData:
-    return generate(spec_for(name))
-
-
 def world_data(name: str) -> WorldData:
     """The generated world ``name`` (cached per process)."""
-    return _cached(name)
+    return generate(spec_for(name))
 
 
 def load_world(name: str) -> Sequence:

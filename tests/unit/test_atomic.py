@@ -1,0 +1,37 @@
+"""Atomic writes leave the old file or the new one, and no temporary file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from albot1.atomic import atomic_write
+
+
+def test_replaces_and_cleans_up(tmp_path: Path) -> None:
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+    atomic_write(target, lambda p: p.write_text("new"))
+    assert target.read_text() == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]
+
+
+def test_failure_keeps_the_old_file(tmp_path: Path) -> None:
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+
+    def broken(p: Path) -> None:
+        p.write_text("half")
+        raise RuntimeError("disk full")
+
+    with pytest.raises(RuntimeError, match="disk full"):
+        atomic_write(target, broken)
+    assert target.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]
+
+
+def test_temporary_name_keeps_the_suffixes(tmp_path: Path) -> None:
+    seen: list[str] = []
+    atomic_write(tmp_path / "log.clf.gz", lambda p: (seen.append(p.name), p.write_bytes(b"x")))
+    assert seen[0].endswith(".clf.gz")
