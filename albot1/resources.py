@@ -24,7 +24,8 @@ def project_dir() -> Path:
     if not (root / "baselines").is_dir() or not (root / "datasets").is_dir():
         raise ConfigError(
             f"{root} does not hold the project's datasets/ and baselines/ folders; "
-            f"set {PROJECT_DIR_ENV} to the albot1-bench checkout")
+            f"set {PROJECT_DIR_ENV} to the albot1-bench checkout"
+        )
     return root
 
 

@@ -35,14 +35,20 @@ def git_commit() -> str | None:
     try:
         out = subprocess.run(
             ["git", "describe", "--always", "--dirty", "--abbrev=12"],
-            cwd=_PACKAGE_DIR, capture_output=True, text=True, timeout=5, check=True,
+            cwd=_PACKAGE_DIR,
+            capture_output=True,
+            text=True,
+            timeout=5,
+            check=True,
         )
     except (OSError, subprocess.SubprocessError):
         return None
     return out.stdout.strip() or None
 
 
-def library_versions(names: tuple[str, ...] = ("numpy", "shapely", "scipy", "kiss-icp", "gtsam", "rosbags")) -> dict[str, str | None]:
+def library_versions(
+    names: tuple[str, ...] = ("numpy", "shapely", "scipy", "kiss-icp", "gtsam", "rosbags"),
+) -> dict[str, str | None]:
     """Installed versions of the libraries a result may depend on (None if absent)."""
     found: dict[str, str | None] = {}
     for name in names:

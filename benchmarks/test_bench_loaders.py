@@ -20,8 +20,8 @@ from typing import Any
 
 import pytest
 
-from albot1.data.loaders.bz2_parallel import iter_bz2_parallel
-from albot1.data.loaders.carmen import CarmenLoader
+from albot1.data.loaders.carmen.bz2_parallel import iter_bz2_parallel
+from albot1.data.loaders.carmen.loader import CarmenLoader
 
 
 def _decode(path: Path, **options: Any) -> int:

@@ -46,8 +46,9 @@ def test_bench_rosbag_load(benchmark: Any, converted: dict[str, Path], fmt: str)
 
 
 @pytest.mark.parametrize("fmt", list(TARGETS))
-def test_bench_rosbag_write(benchmark: Any, aces_prefix: Sequence, tmp_path_factory: pytest.TempPathFactory,
-                            fmt: str) -> None:
+def test_bench_rosbag_write(
+    benchmark: Any, aces_prefix: Sequence, tmp_path_factory: pytest.TempPathFactory, fmt: str
+) -> None:
     root = tmp_path_factory.mktemp(f"bench_write_{fmt}")
     outputs = iter(root / f"{k}_{TARGETS[fmt]}" for k in range(10))
 

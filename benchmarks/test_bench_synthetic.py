@@ -54,8 +54,9 @@ def test_bench_synthetic_cast_one_scan_few_hundred_walls(benchmark: Any, clutter
 
 def test_bench_synthetic_cast_office_lap_batched(benchmark: Any, office: dict[str, Any]) -> None:
     poses = office["poses"]
-    ranges = benchmark.pedantic(cast_many, (office["walls"], poses, LASER.angles, LASER.max_range),
-                                rounds=3, iterations=1)
+    ranges = benchmark.pedantic(
+        cast_many, (office["walls"], poses, LASER.angles, LASER.max_range), rounds=3, iterations=1
+    )
     benchmark.extra_info["scans"] = len(poses)
     assert ranges.shape == (len(poses), 181)
 

@@ -41,6 +41,7 @@ def _die_with_parent(parent_pid: int | None) -> None:
     """
     runner = multiprocessing.parent_process()
     if runner is not None:
+
         def watch() -> None:
             runner.join()
             os._exit(EXIT_ORPHAN)
@@ -97,8 +98,7 @@ def _write_error(run_dir: Path, kind: str, exc: BaseException) -> None:
     text = "".join(traceback.format_exception(exc))
     sys.stderr.write(text)
     sys.stderr.flush()
-    write_json(run_dir / ERROR_FILE, {"kind": kind, "type": type(exc).__name__, "message": str(exc),
-                                      "traceback": text})
+    write_json(run_dir / ERROR_FILE, {"kind": kind, "type": type(exc).__name__, "message": str(exc), "traceback": text})
 
 
 def child_main(args: dict[str, Any]) -> int:

@@ -35,8 +35,9 @@ def open_cell_sequence(cell: Cell, settings: Settings) -> Sequence:
     sequence = open_sequence(cell.dataset_label, settings=settings)
     if (cell.limit is None and cell.stride is None) or sequence.relations is None:
         return sequence
-    return Sequence(sequence.name, sequence.frames, sequence.metadata,
-                    restrict_relations(sequence.relations, sequence.timestamps))
+    return Sequence(
+        sequence.name, sequence.frames, sequence.metadata, restrict_relations(sequence.relations, sequence.timestamps)
+    )
 
 
 def restrict_relations(relations: Relations, timestamps: np.ndarray) -> Relations | None:
@@ -59,13 +60,16 @@ def restrict_relations(relations: Relations, timestamps: np.ndarray) -> Relation
 def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
     """``field: planned A, ran B`` for each field that differs."""
     fields = sorted(set(planned) | set(ran))
-    return "; ".join(f"{f}: planned {planned.get(f, '(absent)')!r}, ran {ran.get(f, '(absent)')!r}"
-                     for f in fields if planned.get(f) != ran.get(f))
+    return "; ".join(
+        f"{f}: planned {planned.get(f, '(absent)')!r}, ran {ran.get(f, '(absent)')!r}"
+        for f in fields
+        if planned.get(f) != ran.get(f)
+    )
 
 
 def execute_cell(cell: Cell, runs_root: Path, settings: Settings | None = None) -> Path:
     """Run, store and evaluate ``cell`` under ``runs_root/<key>``; returns the run folder."""
-    from albot1.metrics.evaluate import evaluate_run
+    from albot1.runs.evaluate import evaluate_run
     from albot1.runs.execute import run_method
     from albot1.runs.folder import write_run
 
@@ -77,15 +81,26 @@ def execute_cell(cell: Cell, runs_root: Path, settings: Settings | None = None) 
     run_dir = runs_root / cell.key
     if not is_complete(run_dir):
         sequence = open_cell_sequence(cell, settings)
-        result = run_method(cell.method, sequence, preset=cell.preset, overrides=dict(cell.overrides),
-                            degradation=cell.degradation, seed=cell.seed, dataset_name=cell.dataset_label)
+        result = run_method(
+            cell.method,
+            sequence,
+            preset=cell.preset,
+            overrides=dict(cell.overrides),
+            degradation=cell.degradation,
+            seed=cell.seed,
+            dataset_name=cell.dataset_label,
+        )
         if result.config != cell.config:
-            raise BenchError(f"{cell.describe()}: the config resolved in the cell process differs from the "
-                             f"planned one ({config_difference(cell.config or {}, result.config)}); did a "
-                             "baselines/*.toml file or an ALBOT1_* variable change during the run?")
+            raise BenchError(
+                f"{cell.describe()}: the config resolved in the cell process differs from the "
+                f"planned one ({config_difference(cell.config or {}, result.config)}); did a "
+                "baselines/*.toml file or an ALBOT1_* variable change during the run?"
+            )
         written = write_run(result, runs_root)
         if written.name != cell.key:
-            raise BenchError(f"{cell.describe()}: stored under {written.name}, expected key {cell.key} "
-                             "(the code changed while the grid was running?)")
+            raise BenchError(
+                f"{cell.describe()}: stored under {written.name}, expected key {cell.key} "
+                "(the code changed while the grid was running?)"
+            )
     evaluate_run(run_dir, settings=settings)
     return run_dir

@@ -35,7 +35,7 @@ def parse_executor(spec: str) -> tuple[str, str | None]:
         return text, None
     for prefix in ("dask://", "tcp://"):
         if text.startswith(prefix) and len(text) > len(prefix):
-            return "dask", "tcp://" + text[len(prefix):]
+            return "dask", "tcp://" + text[len(prefix) :]
     raise BenchError(f"executor {spec!r} not understood; expected {EXECUTORS_HELP}")
 
 
@@ -63,8 +63,7 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
             client.close()
         return
     with dask.config.set({"distributed.worker.daemon": False}):
-        cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=dask_processes,
-                               dashboard_address=None)
+        cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=dask_processes, dashboard_address=None)
     try:
         with Client(cluster) as client:
             yield client.get_executor(pure=False)

@@ -74,8 +74,14 @@ class CellOutcome:
     kind: FailureKind | None = None
 
     @classmethod
-    def of(cls, cell: Cell, status: Status, elapsed_s: float = 0.0, reason: str | None = None,
-           kind: FailureKind | None = None) -> CellOutcome:
+    def of(
+        cls,
+        cell: Cell,
+        status: Status,
+        elapsed_s: float = 0.0,
+        reason: str | None = None,
+        kind: FailureKind | None = None,
+    ) -> CellOutcome:
         """The outcome of ``cell``, named by its key, description and labels."""
         return cls(cell.key, cell.describe(), cell.method_label, cell.dataset_label, status, elapsed_s, reason, kind)
 

@@ -43,10 +43,12 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
         return "timeout", f"time limit exceeded: no result after {cell.time_s:g} s (killed)"
     if ended.exit_code is not None and ended.exit_code < 0:
         name = _signal_name(-ended.exit_code)
-        hint = {"SIGKILL": " (killed from outside, e.g. by the kernel's out-of-memory killer)",
-                "SIGSEGV": " (a native library crashed)",
-                "SIGABRT": f" (a native library aborted; a failed allocation under the "
-                           f"{cell.memory_mb:g} MB memory limit does this)"}.get(name, "")
+        hint = {
+            "SIGKILL": " (killed from outside, e.g. by the kernel's out-of-memory killer)",
+            "SIGSEGV": " (a native library crashed)",
+            "SIGABRT": f" (a native library aborted; a failed allocation under the "
+            f"{cell.memory_mb:g} MB memory limit does this)",
+        }.get(name, "")
         return "crash", f"the cell process died from {name}{hint}"
     if error is not None:
         kind: FailureKind = error.get("kind", "exception")
@@ -68,8 +70,14 @@ def run_cell_job(cell: Cell, results_root: str) -> CellOutcome:
     ended = run_limited(cell, store.runs, run_dir / LOG)
     verdict = judge(cell, store, ended)
     if verdict is None:
-        write_json(run_dir / ATTEMPT, {"elapsed_s": ended.elapsed_s, "host": socket.gethostname(),
-                                       "finished": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
+        write_json(
+            run_dir / ATTEMPT,
+            {
+                "elapsed_s": ended.elapsed_s,
+                "host": socket.gethostname(),
+                "finished": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            },
+        )
         return CellOutcome.of(cell, "done", ended.elapsed_s)
     kind, reason = verdict
     store.record_failure(cell, reason, kind, exit_code=ended.exit_code, elapsed_s=ended.elapsed_s)

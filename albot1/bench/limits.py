@@ -75,8 +75,13 @@ def launcher() -> str:
 
 def child_args(cell: Cell, runs_root: Path, log_path: Path) -> dict[str, Any]:
     env = {k: v for k, v in os.environ.items() if k.startswith("ALBOT1_")}
-    return {"cell": cell.to_json(), "runs_root": str(runs_root), "log_path": str(log_path),
-            "parent_pid": os.getpid(), "env": env}
+    return {
+        "cell": cell.to_json(),
+        "runs_root": str(runs_root),
+        "log_path": str(log_path),
+        "parent_pid": os.getpid(),
+        "env": env,
+    }
 
 
 def run_limited(cell: Cell, runs_root: Path, log_path: Path, *, how: str | None = None) -> ChildExit:
@@ -99,8 +104,13 @@ def run_limited(cell: Cell, runs_root: Path, log_path: Path, *, how: str | None 
     args_file = runs_root / cell.key / ".child-args.json"
     write_json(args_file, args)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
-    with subprocess.Popen([sys.executable, "-m", "albot1.bench.cell_main", str(args_file)], env=env,
-                          stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) as child:
+    with subprocess.Popen(
+        [sys.executable, "-m", "albot1.bench.cell_main", str(args_file)],
+        env=env,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    ) as child:
         try:
             code = child.wait(timeout=cell.time_s)
         except subprocess.TimeoutExpired:

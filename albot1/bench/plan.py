@@ -48,21 +48,26 @@ def register_plugin(name: str, target: str, error_class: str | None, requires: I
     Called by the planner and again inside each cell's child process, which
     starts from a fresh registry.
     """
-    from albot1.runs.methods import METHODS, MethodSpec
+    from albot1.methods.registry import METHODS, MethodSpec
 
-    spec = MethodSpec(name, target, requires=tuple(requires),
-                      error_class=error_class or "albot1.baselines.errors:BaselineError",
-                      description=f"suite-defined method {target}")
+    spec = MethodSpec(
+        name,
+        target,
+        requires=tuple(requires),
+        error_class=error_class or "albot1.methods.baselines.errors:BaselineError",
+        description=f"suite-defined method {target}",
+    )
     existing = METHODS.get(name)
     if existing is not None and existing.target != target:
-        raise SuiteError(f"method {name!r} is registered as {existing.target}; the suite's target {target} "
-                         "needs a different name")
+        raise SuiteError(
+            f"method {name!r} is registered as {existing.target}; the suite's target {target} needs a different name"
+        )
     METHODS[name] = spec
 
 
 def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
     """(resolved config as JSON, None) or (None, reason it does not resolve)."""
-    from albot1.runs.methods import resolve_config
+    from albot1.methods.registry import resolve_config
 
     try:
         config = resolve_config(entry.name, entry.preset, dict(entry.set))
@@ -74,15 +79,17 @@ def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
 
 
 def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
-    from albot1.runs.methods import METHODS
+    from albot1.methods.registry import METHODS
 
     entries = list(suite.methods)
     for entry in entries:
         if entry.target is not None:
             register_plugin(entry.name, entry.target, entry.error_class, entry.requires)
         elif entry.name not in METHODS:
-            raise SuiteError(f"{suite.path or suite.name}: unknown method {entry.name!r}; "
-                             f"expected one of: {', '.join(METHODS)} (or give a `target`)")
+            raise SuiteError(
+                f"{suite.path or suite.name}: unknown method {entry.name!r}; "
+                f"expected one of: {', '.join(METHODS)} (or give a `target`)"
+            )
     if suite.registered_methods:
         named = {e.name for e in entries}
         entries += [MethodEntry(name=n) for n in METHODS if n not in named]
@@ -93,8 +100,13 @@ def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
             usable.append(entry)
         else:
             missing = [m for m in spec.requires if not _importable(m)]
-            skipped.append(Skipped(entry.display, f"needs {', '.join(missing)}, which is not installed",
-                                   f"pip install {' '.join(missing)}"))
+            skipped.append(
+                Skipped(
+                    entry.display,
+                    f"needs {', '.join(missing)}, which is not installed",
+                    f"pip install {' '.join(missing)}",
+                )
+            )
     return usable, skipped
 
 
@@ -142,8 +154,9 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
 
 def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tuple[str, int]]:
     grid = suite.grid
-    runs = [("none", s) for s in (opts.undegraded_seeds if opts.undegraded_seeds is not None
-                                  else grid.undegraded_seeds)]
+    runs = [
+        ("none", s) for s in (opts.undegraded_seeds if opts.undegraded_seeds is not None else grid.undegraded_seeds)
+    ]
     sweep = has_reference if opts.sweep == "auto" else bool(opts.sweep)
     if sweep:
         degradations = opts.degradations if opts.degradations is not None else grid.degradations
@@ -175,23 +188,48 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
         for degradation, seed in _sweep(opts, suite, bool(has_reference)):
             for entry in methods:
                 config, problem = resolved[entry.display]
-                key_config = config if config is not None else {
-                    "unresolved": True, "preset": entry.preset, "set": dict(entry.set)}
+                key_config = (
+                    config
+                    if config is not None
+                    else {"unresolved": True, "preset": entry.preset, "set": dict(entry.set)}
+                )
                 key = run_key(opts.label, entry.name, key_config, degradation, seed, code)
                 if problem is not None:
                     config_failures[key] = problem
-                cells.append(Cell(
-                    suite=suite.name, dataset=name, dataset_label=opts.label, method=entry.name,
-                    method_label=entry.display, preset=entry.preset, degradation=degradation, seed=seed,
-                    key=key, code_version=code,
-                    time_s=_limit(opts.time_s, entry.time_s, default=suite.limits.time_s),
-                    memory_mb=_limit(opts.memory_mb, entry.memory_mb, default=suite.limits.memory_mb),
-                    limit=opts.limit, stride=opts.stride, overrides=dict(entry.set), config=config,
-                    target=entry.target, error_class=entry.error_class, requires=entry.requires,
-                ))
+                cells.append(
+                    Cell(
+                        suite=suite.name,
+                        dataset=name,
+                        dataset_label=opts.label,
+                        method=entry.name,
+                        method_label=entry.display,
+                        preset=entry.preset,
+                        degradation=degradation,
+                        seed=seed,
+                        key=key,
+                        code_version=code,
+                        time_s=_limit(opts.time_s, entry.time_s, default=suite.limits.time_s),
+                        memory_mb=_limit(opts.memory_mb, entry.memory_mb, default=suite.limits.memory_mb),
+                        limit=opts.limit,
+                        stride=opts.stride,
+                        overrides=dict(entry.set),
+                        config=config,
+                        target=entry.target,
+                        error_class=entry.error_class,
+                        requires=entry.requires,
+                    )
+                )
     seeds = sorted({c.seed for c in cells})
     degradations = list(dict.fromkeys(c.degradation for c in cells))
-    return GridPlan(suite=suite.name, suite_path=str(suite.path) if suite.path else None,
-                    description=suite.description, cells=cells, skipped_datasets=skipped_datasets,
-                    skipped_methods=skipped_methods, config_failures=config_failures, seeds=seeds,
-                    degradations=degradations, machine=machine_info())
+    return GridPlan(
+        suite=suite.name,
+        suite_path=str(suite.path) if suite.path else None,
+        description=suite.description,
+        cells=cells,
+        skipped_datasets=skipped_datasets,
+        skipped_methods=skipped_methods,
+        config_failures=config_failures,
+        seeds=seeds,
+        degradations=degradations,
+        machine=machine_info(),
+    )

@@ -34,7 +34,7 @@ _MODULES = (
     "albot1.data.catalog",
     "albot1.data.loaders.registry",
     "albot1.data.synthetic.worlds",
-    "albot1.metrics.evaluate",
+    "albot1.runs.evaluate",
     "albot1.metrics.ate",
     "albot1.metrics.rpe",
     "albot1.metrics.loop_gap",
@@ -53,7 +53,7 @@ def _warm() -> None:
         except Exception:  # noqa: BLE001 -- reported by the cell that needs the module
             continue
     from albot1.data.loaders.registry import FORMATS
-    from albot1.runs.methods import METHODS
+    from albot1.methods.registry import METHODS
 
     for loader_target, _ in FORMATS.values():
         try:

@@ -29,8 +29,9 @@ class TqdmProgress:
     def started(self, total: int, cached: int) -> None:
         from tqdm import tqdm
 
-        self._bar = tqdm(total=total, initial=cached, unit="cell", desc="bench", disable=self._disable,
-                         dynamic_ncols=True)
+        self._bar = tqdm(
+            total=total, initial=cached, unit="cell", desc="bench", disable=self._disable, dynamic_ncols=True
+        )
         if cached:
             self._write(f"{cached} of {total} cells already complete (kept)")
 
@@ -58,12 +59,15 @@ def summary_table(summary: GridSummary) -> str:
     lines = [header, "-" * len(header)]
     for label in sorted(rows):
         r = rows[label]
-        lines.append(f"{label:<22} {int(r['done']):>5} {int(r['cached']):>5} {int(r['failed']):>6} "
-                     f"{r['seconds']:>8.1f}")
+        lines.append(
+            f"{label:<22} {int(r['done']):>5} {int(r['cached']):>5} {int(r['failed']):>6} {r['seconds']:>8.1f}"
+        )
     counts = summary.counts
     lines.append("-" * len(header))
-    lines.append(f"{'total':<22} {counts['done']:>5} {counts['cached']:>5} {counts['failed']:>6} "
-                 f"{sum(o.elapsed_s for o in summary.outcomes):>8.1f}   wall {summary.wall_s:.1f} s")
+    lines.append(
+        f"{'total':<22} {counts['done']:>5} {counts['cached']:>5} {counts['failed']:>6} "
+        f"{sum(o.elapsed_s for o in summary.outcomes):>8.1f}   wall {summary.wall_s:.1f} s"
+    )
     return "\n".join(lines)
 
 

@@ -55,9 +55,13 @@ def _unique(cells: list[Cell]) -> list[Cell]:
     return list(seen.values())
 
 
-def run_grid(plan: GridPlan, store: ResultsStore, executor: cf.Executor,
-             observer: GridObserver | None = None,
-             job: Callable[[Cell, str], CellOutcome] = run_cell_job) -> GridSummary:
+def run_grid(
+    plan: GridPlan,
+    store: ResultsStore,
+    executor: cf.Executor,
+    observer: GridObserver | None = None,
+    job: Callable[[Cell, str], CellOutcome] = run_cell_job,
+) -> GridSummary:
     """Run every incomplete cell of ``plan`` on ``executor``; failures are recorded, never raised."""
     start = time.monotonic()
     summary = GridSummary()
@@ -103,9 +107,16 @@ def bench_results_root(results: Path, suite_name: str) -> Path:
     return results / suite_name
 
 
-def run_suite(suite_ref: str, *, results: Path, jobs: int = 2, executor: str = "local",
-              observer: GridObserver | None = None, settings: Settings | None = None,
-              dask_processes: bool = True) -> tuple[GridPlan, GridSummary, ResultsStore]:
+def run_suite(
+    suite_ref: str,
+    *,
+    results: Path,
+    jobs: int = 2,
+    executor: str = "local",
+    observer: GridObserver | None = None,
+    settings: Settings | None = None,
+    dask_processes: bool = True,
+) -> tuple[GridPlan, GridSummary, ResultsStore]:
     """Load, plan and run a suite into ``results/<suite>``: what `albot1 bench` does."""
     from albot1.bench.executors import open_executor, parse_executor
     from albot1.bench.limits import start_forkserver

@@ -8,7 +8,7 @@ Layout::
         .lock                  held while a runner works here (flock: released even on SIGKILL)
         runs/<key>/            the run folder (albot1.runs.folder) plus:
             cell.json          the cell that made it
-            metrics.json       written by albot1.metrics.evaluate
+            metrics.json       written by albot1.runs.evaluate
             cell.log           the child process's output (tracebacks included)
             attempt.json       wall time of the successful attempt (run + store + evaluation)
             FAILED.json        only after a failure: reason, kind, exit code, elapsed
@@ -75,8 +75,9 @@ class ResultsStore:
     def read_plan(self) -> GridPlan:
         path = self.root / PLAN
         if not path.is_file():
-            raise BenchError(f"{self.root}: not a results folder of `albot1 bench` (no {PLAN}); "
-                             "run `albot1 bench SUITE` first")
+            raise BenchError(
+                f"{self.root}: not a results folder of `albot1 bench` (no {PLAN}); run `albot1 bench SUITE` first"
+            )
         try:
             return GridPlan.from_json(json.loads(path.read_text()))
         except (json.JSONDecodeError, KeyError, TypeError) as exc:
@@ -125,12 +126,22 @@ class ResultsStore:
         run_dir.mkdir(parents=True, exist_ok=True)
         (run_dir / FAILED).unlink(missing_ok=True)
         write_json(run_dir / CELL, cell.to_json())
-        (run_dir / LOG).write_text(f"albot1 bench: {cell.describe()}, attempt started "
-                                   f"{time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n", encoding="utf-8")
+        (run_dir / LOG).write_text(
+            f"albot1 bench: {cell.describe()}, attempt started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n",
+            encoding="utf-8",
+        )
         return run_dir
 
-    def record_failure(self, cell: Cell, reason: str, kind: FailureKind, *, exit_code: int | None = None,
-                       elapsed_s: float = 0.0, traceback_text: str | None = None) -> None:
+    def record_failure(
+        self,
+        cell: Cell,
+        reason: str,
+        kind: FailureKind,
+        *,
+        exit_code: int | None = None,
+        elapsed_s: float = 0.0,
+        traceback_text: str | None = None,
+    ) -> None:
         """Write FAILED.json (and append a traceback to the cell log) for ``cell``."""
         run_dir = self.run_dir(cell.key)
         run_dir.mkdir(parents=True, exist_ok=True)
@@ -139,12 +150,21 @@ class ResultsStore:
             with log.open("a", encoding="utf-8") as handle:
                 handle.write(f"\n--- albot1 bench: {kind} ---\n{traceback_text}\n")
         write_json(run_dir / CELL, cell.to_json())
-        write_json(run_dir / FAILED, {
-            "key": cell.key, "cell": cell.describe(), "reason": reason, "kind": kind, "exit_code": exit_code,
-            "elapsed_s": elapsed_s, "log": LOG if log.is_file() else None,
-            "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "host": socket.gethostname(),
-            "description": cell.to_json(),
-        })
+        write_json(
+            run_dir / FAILED,
+            {
+                "key": cell.key,
+                "cell": cell.describe(),
+                "reason": reason,
+                "kind": kind,
+                "exit_code": exit_code,
+                "elapsed_s": elapsed_s,
+                "log": LOG if log.is_file() else None,
+                "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                "host": socket.gethostname(),
+                "description": cell.to_json(),
+            },
+        )
 
     def failure(self, key: str) -> Failure | None:
         path = self.run_dir(key) / FAILED
@@ -154,8 +174,13 @@ class ResultsStore:
             data = json.loads(path.read_text())
         except json.JSONDecodeError:
             return Failure("unreadable FAILED.json", "exception", None, 0.0, None)
-        return Failure(str(data.get("reason")), str(data.get("kind")), data.get("exit_code"),
-                       float(data.get("elapsed_s") or 0.0), data.get("log"))
+        return Failure(
+            str(data.get("reason")),
+            str(data.get("kind")),
+            data.get("exit_code"),
+            float(data.get("elapsed_s") or 0.0),
+            data.get("log"),
+        )
 
     def read_json(self, key: str, name: str) -> dict[str, Any] | None:
         path = self.run_dir(key) / name

@@ -218,7 +218,8 @@ def parse_suite(data: dict[str, Any], *, name: str, source: str, path: Path | No
         return Suite.model_validate({"name": name, **data, "path": path})
     except ValidationError as exc:
         problems = "; ".join(
-            f"{'.'.join(str(p) for p in err['loc']) or '(top level)'}: {err['msg']}" for err in exc.errors())
+            f"{'.'.join(str(p) for p in err['loc']) or '(top level)'}: {err['msg']}" for err in exc.errors()
+        )
         raise SuiteError(f"{source}: invalid suite: {problems}") from None
 
 
@@ -248,6 +249,8 @@ def find_suite(ref: str) -> Path:
     path = folder / f"{ref}.toml"
     if not path.is_file():
         known = sorted(p.stem for p in folder.glob("*.toml"))
-        raise SuiteError(f"no suite named {ref!r} in {folder}; expected one of: {', '.join(known) or '(none)'} "
-                         "or a path to a .toml file")
+        raise SuiteError(
+            f"no suite named {ref!r} in {folder}; expected one of: {', '.join(known) or '(none)'} "
+            "or a path to a .toml file"
+        )
     return path

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -14,16 +14,17 @@ def register(app: typer.Typer) -> None:
 
 
 def bench(
-    suite: Annotated[str, typer.Argument(help="a suite name in benchmarks/ (default, quick, full) or a .toml path")]
-    = "default",
+    suite: Annotated[
+        str, typer.Argument(help="a suite name in benchmarks/ (default, quick, full) or a .toml path")
+    ] = "default",
     jobs: Annotated[int, typer.Option("-j", "--jobs", help="cells run in parallel")] = 2,
     executor: Annotated[str, typer.Option(help="local | dask | dask://HOST:PORT")] = "local",
-    results: Annotated[Path, typer.Option(help="results root; cells go to RESULTS/<suite>/runs/<key>")]
-    = Path("results"),
-    data_dir: Annotated[Optional[Path], typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
+    results: Annotated[Path, typer.Option(help="results root; cells go to RESULTS/<suite>/runs/<key>")] = Path(
+        "results"
+    ),
+    data_dir: Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
     progress: Annotated[bool, typer.Option(help="show the progress bar")] = True,
-    dry_run: Annotated[bool, typer.Option("--dry-run", help="print the planned cells per dataset and stop")]
-    = False,
+    dry_run: Annotated[bool, typer.Option("--dry-run", help="print the planned cells per dataset and stop")] = False,
 ) -> None:
     """Run a benchmark suite: every dataset x method x degradation x seed cell, each in its own
     process under the suite's time and memory limits.
@@ -54,13 +55,22 @@ def bench(
         return
     view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not progress)
     try:
-        plan, summary, store = run_suite(suite, results=results, jobs=jobs, executor=executor, observer=view,
-                                         settings=get_settings(data_dir=data_dir))
+        plan, summary, store = run_suite(
+            suite,
+            results=results,
+            jobs=jobs,
+            executor=executor,
+            observer=view,
+            settings=get_settings(data_dir=data_dir),
+        )
     finally:
         view.close()
     for skipped in plan.skipped_datasets:
-        typer.echo(f"skipped dataset {skipped.name}: {skipped.reason}"
-                   + (f" (get it with `{skipped.hint}`)" if skipped.hint else ""), err=True)
+        typer.echo(
+            f"skipped dataset {skipped.name}: {skipped.reason}"
+            + (f" (get it with `{skipped.hint}`)" if skipped.hint else ""),
+            err=True,
+        )
     for skipped in plan.skipped_methods:
         typer.echo(f"skipped method {skipped.name}: {skipped.reason}", err=True)
     typer.echo(summary_table(summary))
@@ -69,7 +79,7 @@ def bench(
 
 def report(
     results_dir: Annotated[Path, typer.Argument(help="a results folder written by `albot1 bench` (results/SUITE)")],
-    out: Annotated[Optional[Path], typer.Option(help="report folder (default: reports/<suite>)")] = None,
+    out: Annotated[Path | None, typer.Option(help="report folder (default: reports/<suite>)")] = None,
     plots: Annotated[bool, typer.Option(help="render the plots (tables only with --no-plots)")] = True,
 ) -> None:
     """Build tables (Markdown, CSV), plots and an index page from a results folder.

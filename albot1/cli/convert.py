@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -17,21 +17,27 @@ def register(app: typer.Typer) -> None:
 def convert(
     source: Annotated[str, typer.Argument(metavar="IN", help="a dataset name (`albot1 datasets list`) or a log path")],
     output: Annotated[Path, typer.Argument(metavar="OUT", help="the file (or ROS2 bag folder) to create")],
-    format_name: Annotated[Optional[str], typer.Option("--format", help=FORMAT_HELP)] = None,
-    source_format: Annotated[Optional[str], typer.Option("--from", help="IN's format, when sniffing is not enough")
-                             ] = None,
-    scan_topic: Annotated[Optional[str], typer.Option(help="bag input: the LaserScan topic")] = None,
-    odom_topic: Annotated[Optional[str], typer.Option(help="bag input: the Odometry topic, or /tf")] = None,
-    reference_topic: Annotated[Optional[str], typer.Option(help="bag input: a ground-truth Odometry topic")] = None,
-    odom_frame: Annotated[Optional[str], typer.Option(help="bag input with /tf: parent frame (default odom)")] = None,
-    base_frame: Annotated[Optional[str], typer.Option(help="bag input with /tf: robot frame")] = None,
-    outside_odometry: Annotated[Optional[str], typer.Option(
-        help="bag input: scans outside the odometry time span -> error (default) | drop")] = None,
-    retime: Annotated[bool, typer.Option(
-        help="shift scans whose timestamp repeats or goes backwards to 1 us after the previous one "
-             "(bags need strictly increasing stamps)")] = False,
-    limit: Annotated[Optional[int], typer.Option(min=1, help="convert only the first N scans")] = None,
-    data_dir: Annotated[Optional[Path], typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
+    format_name: Annotated[str | None, typer.Option("--format", help=FORMAT_HELP)] = None,
+    source_format: Annotated[
+        str | None, typer.Option("--from", help="IN's format, when sniffing is not enough")
+    ] = None,
+    scan_topic: Annotated[str | None, typer.Option(help="bag input: the LaserScan topic")] = None,
+    odom_topic: Annotated[str | None, typer.Option(help="bag input: the Odometry topic, or /tf")] = None,
+    reference_topic: Annotated[str | None, typer.Option(help="bag input: a ground-truth Odometry topic")] = None,
+    odom_frame: Annotated[str | None, typer.Option(help="bag input with /tf: parent frame (default odom)")] = None,
+    base_frame: Annotated[str | None, typer.Option(help="bag input with /tf: robot frame")] = None,
+    outside_odometry: Annotated[
+        str | None, typer.Option(help="bag input: scans outside the odometry time span -> error (default) | drop")
+    ] = None,
+    retime: Annotated[
+        bool,
+        typer.Option(
+            help="shift scans whose timestamp repeats or goes backwards to 1 us after the previous one "
+            "(bags need strictly increasing stamps)"
+        ),
+    ] = False,
+    limit: Annotated[int | None, typer.Option(min=1, help="convert only the first N scans")] = None,
+    data_dir: Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
 ) -> None:
     """Convert IN to OUT (scans, odometry and reference poses; OUT must not exist).
 
@@ -49,15 +55,23 @@ def convert(
     from albot1.data.transforms import head
     from albot1.settings import get_settings
 
-    options = {"scan_topic": scan_topic, "odom_topic": odom_topic, "reference_topic": reference_topic,
-               "odom_frame": odom_frame, "base_frame": base_frame, "outside_odometry": outside_odometry}
+    options = {
+        "scan_topic": scan_topic,
+        "odom_topic": odom_topic,
+        "reference_topic": reference_topic,
+        "odom_frame": odom_frame,
+        "base_frame": base_frame,
+        "outside_odometry": outside_odometry,
+    }
     settings = get_settings(data_dir=data_dir)
     if limit is None:
-        done = run_conversion(source, output, format_name, source_format=source_format, settings=settings,
-                              retime=retime, **options)
+        done = run_conversion(
+            source, output, format_name, source_format=source_format, settings=settings, retime=retime, **options
+        )
     else:
-        sequence = open_sequence(source, settings=settings, format_name=source_format,
-                                 **{k: v for k, v in options.items() if v is not None})
+        sequence = open_sequence(
+            source, settings=settings, format_name=source_format, **{k: v for k, v in options.items() if v is not None}
+        )
         done = run_conversion(head(sequence, limit), output, format_name, retime=retime)
     shifted = f"; {done.retimed} timestamps shifted by --retime" if done.retimed else ""
     typer.echo(f"wrote {done.scans} scans from {done.source} to {done.output} ({done.format_name}){shifted}")

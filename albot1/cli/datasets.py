@@ -10,7 +10,7 @@ from __future__ import annotations
 import importlib.util
 import json
 from pathlib import Path
-from typing import Annotated, Any, Optional
+from typing import Annotated, Any
 
 import typer
 
@@ -19,7 +19,7 @@ app = typer.Typer(
     no_args_is_help=True,
 )
 
-DataDir = Annotated[Optional[Path], typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")]
+DataDir = Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")]
 
 
 def _synthetic_worlds() -> dict[str, str]:
@@ -36,8 +36,9 @@ def _synthetic_worlds() -> dict[str, str]:
 
 
 @app.command("list")
-def list_(data_dir: DataDir = None,
-          as_json: Annotated[bool, typer.Option("--json", help="print one JSON object")] = False) -> None:
+def list_(
+    data_dir: DataDir = None, as_json: Annotated[bool, typer.Option("--json", help="print one JSON object")] = False
+) -> None:
     """Each registered dataset with its local availability, then the embedded synthetic worlds.
 
     Examples:\n
@@ -52,20 +53,36 @@ def list_(data_dir: DataDir = None,
     for name in catalog.names():
         manifest = catalog.get(name)
         found = catalog.find_file(manifest.log, settings)
-        rows.append({"name": name, "available": catalog.is_available(name, settings),
-                     "path": str(found) if found else None, "local_only": manifest.local_only,
-                     "description": manifest.description})
+        rows.append(
+            {
+                "name": name,
+                "available": catalog.is_available(name, settings),
+                "path": str(found) if found else None,
+                "local_only": manifest.local_only,
+                "description": manifest.description,
+            }
+        )
     worlds = _synthetic_worlds()
     for name, description in sorted(worlds.items()):
-        rows.append({"name": name, "available": True, "path": None, "local_only": False, "synthetic": True,
-                     "description": description})
+        rows.append(
+            {
+                "name": name,
+                "available": True,
+                "path": None,
+                "local_only": False,
+                "synthetic": True,
+                "description": description,
+            }
+        )
     if as_json:
         typer.echo(json.dumps({"datasets": rows, "search_roots": [str(r) for r in settings.search_roots()]}))
         return
     for row in rows:
-        state = "synthetic" if row.get("synthetic") else ("local" if row["available"] else
-                                                          ("missing (local only)" if row["local_only"]
-                                                           else "missing (fetch)"))
+        state = (
+            "synthetic"
+            if row.get("synthetic")
+            else ("local" if row["available"] else ("missing (local only)" if row["local_only"] else "missing (fetch)"))
+        )
         typer.echo(f"{row['name']:30s} {state:21s} {_first_sentence(row['description'])}")
     typer.echo(f"searched: {', '.join(str(r) for r in settings.search_roots())}")
 
@@ -76,10 +93,13 @@ def _first_sentence(text: str, width: int = 80) -> str:
 
 
 @app.command("fetch")
-def fetch(name: Annotated[str, typer.Argument(help="a dataset name (see `albot1 datasets list`)")],
-          data_dir: DataDir = None,
-          base_url: Annotated[Optional[str], typer.Option(help="download from BASE_URL/<path> instead of the "
-                                                                 "manifest URLs (a mirror)")] = None) -> None:
+def fetch(
+    name: Annotated[str, typer.Argument(help="a dataset name (see `albot1 datasets list`)")],
+    data_dir: DataDir = None,
+    base_url: Annotated[
+        str | None, typer.Option(help="download from BASE_URL/<path> instead of the manifest URLs (a mirror)")
+    ] = None,
+) -> None:
     """Download NAME's files into the cache (sha256-verified, atomic); no-op if a verified copy exists.
 
     Examples:\n
@@ -97,9 +117,9 @@ def fetch(name: Annotated[str, typer.Argument(help="a dataset name (see `albot1 
 def info(
     ref: Annotated[str, typer.Argument(help="a dataset name, a synthetic world or a log file path")],
     as_json: Annotated[bool, typer.Option("--json", help="print Sequence.summary() as one JSON object")] = False,
-    scan_topic: Annotated[Optional[str], typer.Option(help="bag: the sensor_msgs/LaserScan topic")] = None,
-    odom_topic: Annotated[Optional[str], typer.Option(help="bag: the nav_msgs/Odometry topic")] = None,
-    reference_topic: Annotated[Optional[str], typer.Option(help="bag: the reference-pose topic")] = None,
+    scan_topic: Annotated[str | None, typer.Option(help="bag: the sensor_msgs/LaserScan topic")] = None,
+    odom_topic: Annotated[str | None, typer.Option(help="bag: the nav_msgs/Odometry topic")] = None,
+    reference_topic: Annotated[str | None, typer.Option(help="bag: the reference-pose topic")] = None,
     data_dir: DataDir = None,
 ) -> None:
     """Scans, beams, duration, odometry path length, reference poses and relations of a dataset.
@@ -111,17 +131,24 @@ def info(
     from albot1.data.open import open_sequence
     from albot1.settings import get_settings
 
-    options = {key: value for key, value in (("scan_topic", scan_topic), ("odom_topic", odom_topic),
-                                             ("reference_topic", reference_topic)) if value is not None}
+    options = {
+        key: value
+        for key, value in (("scan_topic", scan_topic), ("odom_topic", odom_topic), ("reference_topic", reference_topic))
+        if value is not None
+    }
     summary = open_sequence(ref, settings=get_settings(data_dir=data_dir), **options).summary()
     if as_json:
         typer.echo(json.dumps(summary))
         return
     beams = summary["beams"]
-    typer.echo(f"{summary['name']}: {summary['scans']} scans x {beams} beams, {summary['duration_s']:.1f} s, "
-               f"odometry path {summary['odometry_path_m']:.1f} m")
-    typer.echo(f"  reference poses: {'yes' if summary['has_reference'] else 'no'}"
-               f"{' (' + summary['reference_source'] + ')' if summary.get('reference_source') else ''}; "
-               f"relations: {summary['relations']}")
+    typer.echo(
+        f"{summary['name']}: {summary['scans']} scans x {beams} beams, {summary['duration_s']:.1f} s, "
+        f"odometry path {summary['odometry_path_m']:.1f} m"
+    )
+    typer.echo(
+        f"  reference poses: {'yes' if summary['has_reference'] else 'no'}"
+        f"{' (' + summary['reference_source'] + ')' if summary.get('reference_source') else ''}; "
+        f"relations: {summary['relations']}"
+    )
     typer.echo(f"  odometry: {summary.get('odometry_source', '')}")
     typer.echo(f"  source: {summary.get('source', '')} ({summary.get('format', '')})")

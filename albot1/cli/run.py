@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -21,9 +21,9 @@ def run(
     degrade: Annotated[str, typer.Option(help="none | thesis | gauss:SXY_M:STH_DEG | bias:DX_M:DTH_DEG")] = "none",
     seed: Annotated[int, typer.Option(help="seed of the degradation and of any random choice")] = 0,
     out: Annotated[Path, typer.Option(help="results root; the run folder is OUT/<hash>")] = Path("runs"),
-    set_: Annotated[Optional[list[str]], typer.Option("--set", help="config override FIELD=VALUE (repeatable)")] = None,
-    data_dir: Annotated[Optional[Path], typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
-    limit: Annotated[Optional[int], typer.Option(help="use only the first N scans")] = None,
+    set_: Annotated[list[str] | None, typer.Option("--set", help="config override FIELD=VALUE (repeatable)")] = None,
+    data_dir: Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
+    limit: Annotated[int | None, typer.Option(help="use only the first N scans")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object")] = False,
 ) -> None:
     """Run METHOD on DATASET and write the run folder (trajectory, map, counters, preview).
@@ -34,9 +34,9 @@ def run(
     """
     from albot1.data.open import open_sequence
     from albot1.data.transforms import head
+    from albot1.methods.registry import parse_overrides
     from albot1.runs.execute import run_method
     from albot1.runs.folder import write_run
-    from albot1.runs.methods import parse_overrides
     from albot1.settings import get_settings
 
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
@@ -44,23 +44,41 @@ def run(
         preset = "thesis"
     if limit is not None:
         sequence = head(sequence, limit)
-    result = run_method(method, sequence, preset=preset, overrides=parse_overrides(set_ or []),
-                        degradation=degrade, seed=seed, dataset_name=dataset)
+    result = run_method(
+        method,
+        sequence,
+        preset=preset,
+        overrides=parse_overrides(set_ or []),
+        degradation=degrade,
+        seed=seed,
+        dataset_name=dataset,
+    )
     run_dir = write_run(result, out)
-    summary = {"run_dir": str(run_dir), "method": method, "dataset": dataset, "preset": preset,
-               "degradation": degrade, "seed": seed, "scans": int(len(result.poses)), "status": "done",
-               "counters": result.counters, "timing": result.timing()}
+    summary = {
+        "run_dir": str(run_dir),
+        "method": method,
+        "dataset": dataset,
+        "preset": preset,
+        "degradation": degrade,
+        "seed": seed,
+        "scans": int(len(result.poses)),
+        "status": "done",
+        "counters": result.counters,
+        "timing": result.timing(),
+    }
     if as_json:
         typer.echo(json.dumps(summary, default=float))
     else:
         t = result.timing()
-        typer.echo(f"{method} on {dataset}: {summary['scans']} scans, {result.counters.get('updates')} updates, "
-                   f"{t['per_scan_ms_median']:.3f} ms/scan median -> {run_dir}")
+        typer.echo(
+            f"{method} on {dataset}: {summary['scans']} scans, {result.counters.get('updates')} updates, "
+            f"{t['per_scan_ms_median']:.3f} ms/scan median -> {run_dir}"
+        )
 
 
 def methods() -> None:
     """List the registered methods and whether their dependencies are installed."""
-    from albot1.runs.methods import METHODS
+    from albot1.methods.registry import METHODS
 
     for spec in METHODS.values():
         state = "available" if spec.available() else "missing: " + ", ".join(spec.requires)

@@ -20,7 +20,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from albot1.data.errors import DatasetNotFoundError, DataError
+from albot1.data.errors import DataError, DatasetNotFoundError
 from albot1.data.model import Sequence
 from albot1.settings import Settings
 
@@ -96,18 +96,32 @@ def _parse_manifest(path: Path) -> DatasetManifest:
         sha = _require(entry, "sha256", str, where).lower()
         if len(sha) != 64 or any(c not in "0123456789abcdef" for c in sha):
             raise DataError(f"{where}: sha256 must be 64 hex digits")
-        files.append(DataFile(role=role, path=_require(entry, "path", str, where), sha256=sha,
-                              size=entry.get("size"), urls=tuple(entry.get("urls", ()))))
+        files.append(
+            DataFile(
+                role=role,
+                path=_require(entry, "path", str, where),
+                sha256=sha,
+                size=entry.get("size"),
+                urls=tuple(entry.get("urls", ())),
+            )
+        )
     if sum(f.role == "log" for f in files) != 1:
-        raise DataError(f"{path}: expected exactly one file with role = \"log\"")
+        raise DataError(f'{path}: expected exactly one file with role = "log"')
     loader = data.get("loader", {})
     if not isinstance(loader, dict):
         raise DataError(f"{path}: [loader] must be a table of loader options")
     return DatasetManifest(
-        name=name, description=str(data.get("description", "")), format=str(data.get("format", "carmen")),
-        files=tuple(files), license=str(data.get("license", "")), citation=str(data.get("citation", "")),
-        source=str(data.get("source", "")), local_only=bool(data.get("local_only", False)),
-        reference=str(data.get("reference", "")), notes=str(data.get("notes", "")), loader=dict(loader),
+        name=name,
+        description=str(data.get("description", "")),
+        format=str(data.get("format", "carmen")),
+        files=tuple(files),
+        license=str(data.get("license", "")),
+        citation=str(data.get("citation", "")),
+        source=str(data.get("source", "")),
+        local_only=bool(data.get("local_only", False)),
+        reference=str(data.get("reference", "")),
+        notes=str(data.get("notes", "")),
+        loader=dict(loader),
         manifest_path=path,
     )
 
@@ -142,8 +156,11 @@ def find_file(data_file: DataFile, settings: Settings) -> Path | None:
 
 def _missing(manifest: DatasetManifest, data_file: DataFile, settings: Settings) -> DatasetNotFoundError:
     roots = ", ".join(str(r) for r in settings.search_roots())
-    hint = ("it is derived locally and cannot be downloaded" if manifest.local_only or not data_file.urls
-            else f"run `albot1 datasets fetch {manifest.name}` or set ALBOT1_DATA_DIR")
+    hint = (
+        "it is derived locally and cannot be downloaded"
+        if manifest.local_only or not data_file.urls
+        else f"run `albot1 datasets fetch {manifest.name}` or set ALBOT1_DATA_DIR"
+    )
     return DatasetNotFoundError(f"dataset {manifest.name!r}: {data_file.path} not found under {roots}; {hint}")
 
 

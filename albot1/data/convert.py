@@ -81,9 +81,16 @@ def _retimed(frames: Iterator[Frame], shifted: list[int]) -> Iterator[Frame]:
         yield frame
 
 
-def convert(src: str | Path | Sequence, dst: str | Path, format_name: str | None = None, *,
-            source_format: str | None = None, settings: Settings | None = None, retime: bool = False,
-            **load_options: Any) -> Conversion:
+def convert(
+    src: str | Path | Sequence,
+    dst: str | Path,
+    format_name: str | None = None,
+    *,
+    source_format: str | None = None,
+    settings: Settings | None = None,
+    retime: bool = False,
+    **load_options: Any,
+) -> Conversion:
     """Write ``src`` (a Sequence, a dataset name or any loadable path) to ``dst`` in ``format_name``.
 
     ``source_format`` overrides sniffing the input; ``settings`` locate
@@ -119,5 +126,10 @@ def convert(src: str | Path | Sequence, dst: str | Path, format_name: str | None
             yield frame
 
     writer.write(sequence.with_frames(counted), Path(dst))
-    return Conversion(source=sequence.metadata.source or sequence.name, output=Path(dst), format_name=target,
-                      scans=count[0], retimed=shifted[0])
+    return Conversion(
+        source=sequence.metadata.source or sequence.name,
+        output=Path(dst),
+        format_name=target,
+        scans=count[0],
+        retimed=shifted[0],
+    )

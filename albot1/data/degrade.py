@@ -36,7 +36,6 @@ from albot1.data.errors import DataError
 from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
-
 EXPECTED_SPEC = "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG or bias:DX_M:DTHETA_DEG"
 
 

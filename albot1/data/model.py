@@ -157,8 +157,12 @@ class Sequence:
         seq._arrays = self._arrays
         return seq
 
-    def with_frames(self, transform: Callable[[Iterator[Frame]], Iterator[Frame]], name: str | None = None,
-                    metadata: SequenceMetadata | None = None) -> Sequence:
+    def with_frames(
+        self,
+        transform: Callable[[Iterator[Frame]], Iterator[Frame]],
+        name: str | None = None,
+        metadata: SequenceMetadata | None = None,
+    ) -> Sequence:
         """A new sequence whose frames are ``transform(self.frames())``, still streamed."""
         return Sequence(name or self.name, lambda: transform(self.frames()), metadata or self.metadata, self.relations)
 

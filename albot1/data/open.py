@@ -22,8 +22,9 @@ from albot1.data.model import Sequence
 from albot1.settings import Settings, get_settings
 
 
-def open_sequence(ref: str | Path, *, settings: Settings | None = None, format_name: str | None = None,
-                  **options: Any) -> Sequence:
+def open_sequence(
+    ref: str | Path, *, settings: Settings | None = None, format_name: str | None = None, **options: Any
+) -> Sequence:
     """Open ``ref`` (world name, dataset name or path) as a streamed Sequence."""
     from albot1.data import catalog
     from albot1.data.loaders.registry import load
@@ -44,8 +45,9 @@ def open_sequence(ref: str | Path, *, settings: Settings | None = None, format_n
         return sequence
     name, has_query, query = text.partition("?")
     if has_query and not Path(text).expanduser().exists():
-        return open_sequence(name, settings=settings, format_name=format_name,
-                             **{**parse_options(query, text), **options})
+        return open_sequence(
+            name, settings=settings, format_name=format_name, **{**parse_options(query, text), **options}
+        )
     if text in worlds.WORLDS:
         if options:
             raise DatasetNotFoundError(f"synthetic world {text!r} takes no loader options, got {', '.join(options)}")

@@ -55,6 +55,16 @@ def write_relations(path: str | Path, relations: Relations) -> None:
     p = Path(path)
     n = len(relations)
     zeros = np.zeros(n)
-    rows = np.column_stack([relations.t1, relations.t2, relations.poses[:, 0], relations.poses[:, 1],
-                            zeros, zeros, zeros, relations.poses[:, 2]])
+    rows = np.column_stack(
+        [
+            relations.t1,
+            relations.t2,
+            relations.poses[:, 0],
+            relations.poses[:, 1],
+            zeros,
+            zeros,
+            zeros,
+            relations.poses[:, 2],
+        ]
+    )
     atomic_write(p, lambda tmp: np.savetxt(tmp, rows, fmt="%.9f"))

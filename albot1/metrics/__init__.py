@@ -1,8 +1,8 @@
 """Metrics: pure functions of trajectories, maps and the dataset's reference.
 
-Nothing in this package reads or writes files except :mod:`albot1.metrics.evaluate`,
+Nothing in this package reads or writes files except :mod:`albot1.runs.evaluate`,
 which turns a run folder into ``metrics.json``. Every metric states its units
 and its alignment, and a metric that cannot be computed is reported as
-``null`` with a reason (see :mod:`albot1.metrics.evaluate`), never as a number
+``null`` with a reason (see :mod:`albot1.runs.evaluate`), never as a number
 made up to fill the slot.
 """

@@ -47,8 +47,9 @@ def check_pair(estimate: ArrayLike, reference: ArrayLike, what: str = "trajector
             bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
             raise MetricsError(f"{what}: the {name} has a non-finite pose at scan {bad}")
     if len(est) != len(ref):
-        raise MetricsError(f"{what}: the estimate has {len(est)} poses and the reference {len(ref)}; "
-                           "expected one of each per scan")
+        raise MetricsError(
+            f"{what}: the estimate has {len(est)} poses and the reference {len(ref)}; expected one of each per scan"
+        )
     if len(est) == 0:
         raise MetricsError(f"{what}: no poses to compare")
     return est, ref

@@ -27,8 +27,10 @@ def cost(per_scan_ns: ArrayLike, timing: dict[str, Any] | None = None, *, bins: 
     if len(ns) == 0:
         raise MetricsError("cost: the run has no per-scan times")
     if np.any(ns < 0) or not np.isfinite(ns).all():
-        raise MetricsError(f"cost: per-scan times must be finite and non-negative (first bad at scan "
-                           f"{int(np.flatnonzero(~(np.isfinite(ns) & (ns >= 0)))[0])})")
+        raise MetricsError(
+            f"cost: per-scan times must be finite and non-negative (first bad at scan "
+            f"{int(np.flatnonzero(~(np.isfinite(ns) & (ns >= 0)))[0])})"
+        )
     ms = ns / 1e6
     timing = timing or {}
     edges = np.linspace(0, len(ms), min(bins, len(ms)) + 1).astype(int)

@@ -60,8 +60,14 @@ def route_gap(estimate: ArrayLike, reference: ArrayLike | None = None) -> dict[s
     }
 
 
-def loop_pairs(timestamps: ArrayLike, reference: ArrayLike, *, radius_m: float = RADIUS_M,
-               min_dt_s: float = MIN_DT_S, min_travel_m: float = MIN_TRAVEL_M) -> NDArray[np.int64]:
+def loop_pairs(
+    timestamps: ArrayLike,
+    reference: ArrayLike,
+    *,
+    radius_m: float = RADIUS_M,
+    min_dt_s: float = MIN_DT_S,
+    min_travel_m: float = MIN_TRAVEL_M,
+) -> NDArray[np.int64]:
     """``(K, 2)`` pairs ``(i, j)``, ``i < j``: revisits by the rule in the module docstring."""
     from scipy.spatial import cKDTree
 
@@ -93,8 +99,12 @@ def pair_gaps(timestamps: ArrayLike, estimate: ArrayLike, reference: ArrayLike, 
     """Errors of the estimated relative pose over every revisit pair (m, deg)."""
     est, ref = check_pair(estimate, reference, "loop pairs")
     pairs = loop_pairs(timestamps, ref, **rule)
-    block: dict[str, Any] = {"radius_m": rule.get("radius_m", RADIUS_M), "min_dt_s": rule.get("min_dt_s", MIN_DT_S),
-                             "min_travel_m": rule.get("min_travel_m", MIN_TRAVEL_M), "pairs": int(len(pairs))}
+    block: dict[str, Any] = {
+        "radius_m": rule.get("radius_m", RADIUS_M),
+        "min_dt_s": rule.get("min_dt_s", MIN_DT_S),
+        "min_travel_m": rule.get("min_travel_m", MIN_TRAVEL_M),
+        "pairs": int(len(pairs)),
+    }
     if len(pairs) == 0:
         block.update({"translation_m": None, "rotation_deg": None, "worst_pair": None})
         return block

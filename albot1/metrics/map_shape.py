@@ -56,8 +56,14 @@ def thin(points: ArrayLike, voxel_m: float = VOXEL_M, max_points: int = MAX_POIN
     return kept
 
 
-def map_agreement(map_points: ArrayLike, reference_points: ArrayLike, *, tol: float = TOLERANCE_M,
-                  voxel_m: float = VOXEL_M, max_points: int = MAX_POINTS) -> dict[str, Any]:
+def map_agreement(
+    map_points: ArrayLike,
+    reference_points: ArrayLike,
+    *,
+    tol: float = TOLERANCE_M,
+    voxel_m: float = VOXEL_M,
+    max_points: int = MAX_POINTS,
+) -> dict[str, Any]:
     """Precision, coverage and distances between two point sets in the same frame (m)."""
     from scipy.spatial import cKDTree
 
@@ -72,8 +78,10 @@ def map_agreement(map_points: ArrayLike, reference_points: ArrayLike, *, tol: fl
     map_to_ref, _ = cKDTree(rp).query(mp)
     ref_to_map, _ = cKDTree(mp).query(rp)
     return {
-        "tolerance_m": tol, "voxel_m": voxel_m,
-        "map_points": int(len(mp)), "reference_points": int(len(rp)),
+        "tolerance_m": tol,
+        "voxel_m": voxel_m,
+        "map_points": int(len(mp)),
+        "reference_points": int(len(rp)),
         "precision": float(np.mean(map_to_ref <= tol)),
         "coverage": float(np.mean(ref_to_map <= tol)),
         "map_to_reference_mean_m": float(np.mean(map_to_ref)),

@@ -47,8 +47,14 @@ def home_vector(poses: ArrayLike, index: int) -> tuple[float, float]:
     return float(np.degrees(np.arctan2(local[1], local[0]))), float(np.hypot(local[0], local[1]))
 
 
-def orientation_table(estimate: ArrayLike, reference: ArrayLike, timestamps: ArrayLike | None = None, *,
-                      every_m: float = EVERY_M, min_distance_m: float = MIN_DISTANCE_M) -> dict[str, Any]:
+def orientation_table(
+    estimate: ArrayLike,
+    reference: ArrayLike,
+    timestamps: ArrayLike | None = None,
+    *,
+    every_m: float = EVERY_M,
+    min_distance_m: float = MIN_DISTANCE_M,
+) -> dict[str, Any]:
     """The ``orientation`` block: Table-3.1 rows and mean/max absolute differences."""
     est, ref = check_pair(estimate, reference, "orientation")
     stamps = None if timestamps is None else np.asarray(timestamps, dtype=float)
@@ -63,14 +69,19 @@ def orientation_table(estimate: ArrayLike, reference: ArrayLike, timestamps: Arr
         b_ref, d_ref = home_vector(ref, int(k))
         defined = d_ref >= min_distance_m
         b_diff = float(np.degrees(se2.wrap(np.radians(b_est - b_ref)))) if defined else None
-        rows.append({
-            "scan": int(k),
-            "timestamp": float(stamps[k]) if stamps is not None else None,
-            "travel_m": float(travel[k]),
-            "estimate_bearing_deg": b_est, "estimate_distance_m": d_est,
-            "reference_bearing_deg": b_ref, "reference_distance_m": d_ref,
-            "bearing_error_deg": b_diff, "distance_error_m": d_est - d_ref,
-        })
+        rows.append(
+            {
+                "scan": int(k),
+                "timestamp": float(stamps[k]) if stamps is not None else None,
+                "travel_m": float(travel[k]),
+                "estimate_bearing_deg": b_est,
+                "estimate_distance_m": d_est,
+                "reference_bearing_deg": b_ref,
+                "reference_distance_m": d_ref,
+                "bearing_error_deg": b_diff,
+                "distance_error_m": d_est - d_ref,
+            }
+        )
         if b_diff is not None:
             bearing_err.append(abs(b_diff))
         distance_err.append(abs(d_est - d_ref))
@@ -83,9 +94,13 @@ def orientation_table(estimate: ArrayLike, reference: ArrayLike, timestamps: Arr
     return {
         "alignment": "none (bearing and distance are relative to the robot's own start)",
         "units": {"bearing": "deg, + = start is to the left", "distance": "m"},
-        "every_m": every_m, "min_distance_m": min_distance_m,
-        "stops": len(rows), "bearing_undefined": len(rows) - len(bearing_err),
-        "bearing_abs_error_mean_deg": b_mean, "bearing_abs_error_max_deg": b_max,
-        "distance_abs_error_mean_m": d_mean, "distance_abs_error_max_m": d_max,
+        "every_m": every_m,
+        "min_distance_m": min_distance_m,
+        "stops": len(rows),
+        "bearing_undefined": len(rows) - len(bearing_err),
+        "bearing_abs_error_mean_deg": b_mean,
+        "bearing_abs_error_max_deg": b_max,
+        "distance_abs_error_mean_m": d_mean,
+        "distance_abs_error_max_m": d_max,
         "rows": rows,
     }

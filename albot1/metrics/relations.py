@@ -56,9 +56,15 @@ def nearest_indices(timestamps: ArrayLike, query: ArrayLike) -> tuple[NDArray[np
     return pick.astype(np.int64), np.abs(t[pick] - q)
 
 
-def relation_errors(timestamps: ArrayLike, poses: ArrayLike, relations: Relations, *,
-                    max_gap_s: float = MAX_TIME_GAP_S, outside: OutsidePolicy = "error",
-                    source: str = "relations") -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+def relation_errors(
+    timestamps: ArrayLike,
+    poses: ArrayLike,
+    relations: Relations,
+    *,
+    max_gap_s: float = MAX_TIME_GAP_S,
+    outside: OutsidePolicy = "error",
+    source: str = "relations",
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """``(errors (K, 3), used mask (M,))``: the error pose of each used relation.
 
     A relation whose time lies within the trajectory's span but more than
@@ -84,7 +90,8 @@ def relation_errors(timestamps: ArrayLike, poses: ArrayLike, relations: Relation
         raise MetricsError(
             f"{source}:{k + 1}: no pose within {max_gap_s} s of time {stamp:.6f} (nearest is "
             f"{max(gap1[k], gap2[k]):.3f} s away); expected relation times to match scan timestamps"
-            f" ({len(bad)} relation(s) affected)")
+            f" ({len(bad)} relation(s) affected)"
+        )
     d_est = se2.between(est[i1[used]], est[i2[used]])
     return se2.between(relations.poses[used], d_est), used
 
@@ -100,12 +107,18 @@ def _block(errors: NDArray[np.float64]) -> dict[str, Any]:
     }
 
 
-def relation_metric(timestamps: ArrayLike, poses: ArrayLike, relations: Relations, *,
-                    max_gap_s: float = MAX_TIME_GAP_S, loop_min_dt_s: float = LOOP_MIN_DT_S,
-                    outside: OutsidePolicy = "error", source: str = "relations") -> dict[str, Any]:
+def relation_metric(
+    timestamps: ArrayLike,
+    poses: ArrayLike,
+    relations: Relations,
+    *,
+    max_gap_s: float = MAX_TIME_GAP_S,
+    loop_min_dt_s: float = LOOP_MIN_DT_S,
+    outside: OutsidePolicy = "error",
+    source: str = "relations",
+) -> dict[str, Any]:
     """The ``relations`` block of ``metrics.json`` (all relations, then ``loops``)."""
-    errors, used = relation_errors(timestamps, poses, relations, max_gap_s=max_gap_s, outside=outside,
-                                   source=source)
+    errors, used = relation_errors(timestamps, poses, relations, max_gap_s=max_gap_s, outside=outside, source=source)
     block: dict[str, Any] = {
         "alignment": "none (relative poses are invariant to a rigid motion of the estimate)",
         "error": "e = inv(d_ref) * inv(T(t1)) * T(t2); translation |trans(e)|, rotation |angle(e)|",

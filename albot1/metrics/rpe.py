@@ -77,12 +77,16 @@ def rpe(estimate: ArrayLike, reference: ArrayLike, delta: float = 1, unit: Delta
     }
 
 
-def rpe_set(estimate: ArrayLike, reference: ArrayLike,
-            deltas: tuple[tuple[float, DeltaUnit], ...] = DEFAULT_DELTAS) -> dict[str, Any]:
+def rpe_set(
+    estimate: ArrayLike, reference: ArrayLike, deltas: tuple[tuple[float, DeltaUnit], ...] = DEFAULT_DELTAS
+) -> dict[str, Any]:
     """The ``rpe`` block of ``metrics.json``: one entry per delta (the first is also at the top level)."""
     entries = [rpe(estimate, reference, d, u) for d, u in deltas]
-    block: dict[str, Any] = {"alignment": "none (relative errors are invariant to a rigid motion of the estimate)",
-                             "pairs_from": "reference", "units": {"translation": "m", "rotation": "deg"}}
+    block: dict[str, Any] = {
+        "alignment": "none (relative errors are invariant to a rigid motion of the estimate)",
+        "pairs_from": "reference",
+        "units": {"translation": "m", "rotation": "deg"},
+    }
     block.update(entries[0])
     block["deltas"] = entries
     return block

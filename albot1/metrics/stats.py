@@ -23,8 +23,7 @@ def summarize(values: ArrayLike, *, ddof: int = 1) -> dict[str, Any]:
     n = int(v.size)
     if n == 0:
         nan = float("nan")
-        return {"mean": nan, "std": nan, "median": nan, "min": nan, "max": nan, "rmse": nan, "n": 0,
-                "std_ddof": ddof}
+        return {"mean": nan, "std": nan, "median": nan, "min": nan, "max": nan, "rmse": nan, "n": 0, "std_ddof": ddof}
     return {
         "mean": float(np.mean(v)),
         "std": float(np.std(v, ddof=ddof)) if n > ddof else float("nan"),

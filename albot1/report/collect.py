@@ -85,8 +85,17 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
     for cell in plan.cells:
         run_dir = store.run_dir(cell.key)
         if store.is_complete(cell.key):
-            records.append(CellRecord(cell, "done", run_dir, store.read_json(cell.key, "result.json"),
-                                      store.read_json(cell.key, METRICS), None, store.read_json(cell.key, ATTEMPT)))
+            records.append(
+                CellRecord(
+                    cell,
+                    "done",
+                    run_dir,
+                    store.read_json(cell.key, "result.json"),
+                    store.read_json(cell.key, METRICS),
+                    None,
+                    store.read_json(cell.key, ATTEMPT),
+                )
+            )
             continue
         failure = store.failure(cell.key)
         records.append(CellRecord(cell, "failed" if failure else "not run", run_dir, None, None, failure))
@@ -98,9 +107,15 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
     rows = []
     for rec in records:
         c = rec.cell
-        row: dict[str, Any] = {"dataset": c.dataset_label, "method": c.method_label, "degradation": c.degradation,
-                               "seed": c.seed, "status": rec.status, "key": c.key,
-                               "scans": (rec.result or {}).get("scans")}
+        row: dict[str, Any] = {
+            "dataset": c.dataset_label,
+            "method": c.method_label,
+            "degradation": c.degradation,
+            "seed": c.seed,
+            "status": rec.status,
+            "key": c.key,
+            "scans": (rec.result or {}).get("scans"),
+        }
         sources = {"metrics": rec.metrics, "result": rec.result, "attempt": rec.attempt}
         for column, (source, path, _) in {**METRIC_COLUMNS, **COST_COLUMNS}.items():
             row[column] = dig(sources[source], path)

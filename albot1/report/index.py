@@ -16,8 +16,7 @@ from typing import Any
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
-from albot1.report.plots import (plot_maps, plot_robustness, plot_runtime, plot_scan_time, plot_trajectories,
-                                 slug)
+from albot1.report.plots import plot_maps, plot_robustness, plot_runtime, plot_scan_time, plot_trajectories, slug
 from albot1.report.tables import aggregate, cells_frame, write_tables
 
 REPORTS_ROOT = Path("reports")
@@ -48,10 +47,12 @@ def render_plots(records: list[CellRecord], out: Path) -> dict[str, list[Path]]:
         files = [
             plot_maps(recs, dataset, stem.with_name(f"{stem.name}-maps.png")),
             plot_trajectories(recs, dataset, stem.with_name(f"{stem.name}-trajectories.png")),
-            plot_robustness(metrics, dataset, "ate_rmse_m", "ATE RMSE (m)",
-                            stem.with_name(f"{stem.name}-robustness-ate.png")),
-            plot_robustness(metrics, dataset, "loop_gap_m", "loop gap (m)",
-                            stem.with_name(f"{stem.name}-robustness-loop-gap.png")),
+            plot_robustness(
+                metrics, dataset, "ate_rmse_m", "ATE RMSE (m)", stem.with_name(f"{stem.name}-robustness-ate.png")
+            ),
+            plot_robustness(
+                metrics, dataset, "loop_gap_m", "loop gap (m)", stem.with_name(f"{stem.name}-robustness-loop-gap.png")
+            ),
             plot_scan_time(recs, dataset, stem.with_name(f"{stem.name}-scan-time.png")),
         ]
         made[dataset] = [f for f in files if f is not None]
@@ -87,42 +88,65 @@ def _failure_lines(records: list[CellRecord], out: Path) -> list[str]:
     for rec in failed:
         kind = rec.failure.kind if rec.failure else "?"
         counts[(rec.cell.method_label, kind)] = counts.get((rec.cell.method_label, kind), 0) + 1
-    lines = [f"{len(failed)} cells failed: " + ", ".join(f"{m} {n} ({k})" for (m, k), n in counts.items()) + ".", "",
-             "| dataset | method | degradation | seed | kind | reason | log |", "|---|---|---|---|---|---|---|"]
+    lines = [
+        f"{len(failed)} cells failed: " + ", ".join(f"{m} {n} ({k})" for (m, k), n in counts.items()) + ".",
+        "",
+        "| dataset | method | degradation | seed | kind | reason | log |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for rec in failed:
         c, f = rec.cell, rec.failure
         assert f is not None
         log = f"[log]({_rel(rec.run_dir / f.log, out)})" if f.log else "–"
         reason = f.reason.replace("|", "\\|").replace("\n", " ")
-        lines.append(f"| {c.dataset_label} | {c.method_label} | {c.degradation} | {c.seed} | {f.kind} | "
-                     f"{reason} | {log} |")
+        lines.append(
+            f"| {c.dataset_label} | {c.method_label} | {c.degradation} | {c.seed} | {f.kind} | {reason} | {log} |"
+        )
     return [*lines, ""]
 
 
-def write_index(plan: GridPlan, records: list[CellRecord], tables: dict[str, Path],
-                plots: dict[str, list[Path]], out: Path, results_dir: Path) -> Path:
+def write_index(
+    plan: GridPlan,
+    records: list[CellRecord],
+    tables: dict[str, Path],
+    plots: dict[str, list[Path]],
+    out: Path,
+    results_dir: Path,
+) -> Path:
     counts = _status_counts(records)
     lines: list[str] = [
-        f"# Benchmark report: suite `{plan.suite}`", "",
-        plan.description.strip() or "", "",
+        f"# Benchmark report: suite `{plan.suite}`",
+        "",
+        plan.description.strip() or "",
+        "",
         f"Generated {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from `{results_dir}` "
-        f"(suite file `{plan.suite_path}`).", "",
+        f"(suite file `{plan.suite_path}`).",
+        "",
         f"Cells: {len(records)} planned, {counts['done']} complete, {counts['failed']} failed, "
-        f"{counts['not run']} not run.", "",
-        "## Machine and versions", "", *_machine_lines(plan), "",
-        "## Grid", "",
+        f"{counts['not run']} not run.",
+        "",
+        "## Machine and versions",
+        "",
+        *_machine_lines(plan),
+        "",
+        "## Grid",
+        "",
         f"- seeds: {', '.join(map(str, plan.seeds))}",
         f"- degradations: {', '.join(f'`{d}`' for d in plan.degradations)} "
         "(`none` = the dataset's own odometry; swept ones only on datasets with reference poses)",
         f"- datasets: {', '.join(dict.fromkeys(r.cell.dataset_label for r in records)) or '(none)'}",
-        f"- methods: {', '.join(dict.fromkeys(r.cell.method_label for r in records)) or '(none)'}", "",
-        "## Tables", "",
+        f"- methods: {', '.join(dict.fromkeys(r.cell.method_label for r in records)) or '(none)'}",
+        "",
+        "## Tables",
+        "",
         f"- [accuracy (Markdown)]({_rel(tables['metrics.md'], out)}) · [CSV]({_rel(tables['metrics.csv'], out)})",
         f"- [cost (Markdown)]({_rel(tables['cost.md'], out)}) · [CSV]({_rel(tables['cost.csv'], out)})",
         f"- [every cell, accuracy and status (CSV)]({_rel(tables['cells.csv'], out)}) · "
-        f"[every cell, cost (CSV)]({_rel(tables['cells-cost.csv'], out)})", "",
+        f"[every cell, cost (CSV)]({_rel(tables['cells-cost.csv'], out)})",
+        "",
         "Cost numbers were measured with the suite's parallelism on a possibly shared machine; "
-        "compare them within one report.", "",
+        "compare them within one report.",
+        "",
     ]
     if plots:
         lines += ["## Plots", ""]
@@ -135,13 +159,20 @@ def write_index(plan: GridPlan, records: list[CellRecord], tables: dict[str, Pat
     lines += ["## Failed cells", "", *_failure_lines(records, out)]
     not_run = [r for r in records if r.status == "not run"]
     if not_run:
-        lines += ["## Cells not run", "",
-                  "The runner stopped before these cells finished; run `albot1 bench` again to complete them.", "",
-                  *[f"- {r.cell.describe()}" for r in not_run], ""]
+        lines += [
+            "## Cells not run",
+            "",
+            "The runner stopped before these cells finished; run `albot1 bench` again to complete them.",
+            "",
+            *[f"- {r.cell.describe()}" for r in not_run],
+            "",
+        ]
     lines += ["## Skipped datasets", ""]
     if plan.skipped_datasets:
-        lines += [f"- `{s.name}`: {s.reason}" + (f" — fetch it with `{s.hint}`" if s.hint else "")
-                  for s in plan.skipped_datasets]
+        lines += [
+            f"- `{s.name}`: {s.reason}" + (f" — fetch it with `{s.hint}`" if s.hint else "")
+            for s in plan.skipped_datasets
+        ]
     else:
         lines.append("None: every dataset the suite selects was available.")
     lines += ["", "## Skipped methods", ""]

@@ -176,8 +176,9 @@ def plot_robustness(table: pd.DataFrame, dataset: str, column: str, label: str, 
         # mean - min can come out as -1e-17 when every seed agrees: clip the rounding away
         low = np.maximum(mean - group[f"{column}_min"].to_numpy(float), 0.0)
         high = np.maximum(group[f"{column}_max"].to_numpy(float) - mean, 0.0)
-        ax.errorbar(xs, mean, yerr=[low, high], marker="o", ms=4, capsize=3, lw=1,
-                    color=COLORS[i % len(COLORS)], label=method)
+        ax.errorbar(
+            xs, mean, yerr=[low, high], marker="o", ms=4, capsize=3, lw=1, color=COLORS[i % len(COLORS)], label=method
+        )
     ax.set_xticks(range(len(levels)), levels, rotation=20, fontsize=8)
     if (rows[f"{column}_min"].dropna() > 0).all():
         ax.set_yscale("log")
@@ -247,8 +248,9 @@ def plot_runtime(cost: pd.DataFrame, path: Path) -> Path | None:
                 med.append(float(sub.loc[dataset, "per_scan_ms_median_mean"]))
                 p95.append(float(sub.loc[dataset, "per_scan_ms_p95_mean"]))
         upper = np.maximum(np.asarray(p95) - np.asarray(med), 0.0)
-        ax.bar(xs, med, width, yerr=[np.zeros_like(upper), upper], capsize=2, color=COLORS[i % len(COLORS)],
-               label=method)
+        ax.bar(
+            xs, med, width, yerr=[np.zeros_like(upper), upper], capsize=2, color=COLORS[i % len(COLORS)], label=method
+        )
     ax.set_xticks(range(len(datasets)), datasets, rotation=35, ha="right", fontsize=7)
     ax.set_yscale("log")
     ax.set_ylabel("per-scan time (ms): median, whisker to p95")

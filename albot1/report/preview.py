@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from albot1.runs.protocol import RunResult
+from albot1.contract import RunResult
 
 
 def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> None:
@@ -39,8 +39,9 @@ def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> 
     ax.plot(result.poses[:, 0], result.poses[:, 1], color="tab:blue", lw=0.8, label=f"{result.method} estimate")
     ax.set_aspect("equal")
     ax.autoscale_view()
-    ax.set_title(f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]",
-                 fontsize=9)
+    ax.set_title(
+        f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]", fontsize=9
+    )
     ax.legend(loc="upper right", fontsize=7)  # "best" scans every map point: slow
     fig.savefig(path, format="png", bbox_inches="tight")
     plt.close(fig)

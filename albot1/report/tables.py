@@ -41,8 +41,12 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, tuple[str, str, str]]) -> 
     methods = {name: i for i, name in enumerate(dict.fromkeys(cells["method"]))}
     degradations = {name: i for i, name in enumerate(severity_order(list(dict.fromkeys(cells["degradation"]))))}
     for (dataset, method, degradation), group in done.groupby(list(KEY_COLUMNS), sort=False):
-        row: dict[str, Any] = {"dataset": dataset, "method": method, "degradation": degradation,
-                               "seeds": int(group["seed"].nunique())}
+        row: dict[str, Any] = {
+            "dataset": dataset,
+            "method": method,
+            "degradation": degradation,
+            "seeds": int(group["seed"].nunique()),
+        }
         for column in columns:
             values = group[column].dropna().astype(float)
             for stat in STATS:
@@ -73,25 +77,36 @@ def cell_text(row: pd.Series, column: str) -> str:
         return "–"
     if row["seeds"] <= 1 or row[f"{column}_min"] == row[f"{column}_max"]:
         return _fmt(mean)
-    return (f"{_fmt(mean)} / {_fmt(row[f'{column}_median'])} "
-            f"({_fmt(row[f'{column}_min'])}–{_fmt(row[f'{column}_max'])})")
+    return f"{_fmt(mean)} / {_fmt(row[f'{column}_median'])} ({_fmt(row[f'{column}_min'])}–{_fmt(row[f'{column}_max'])})"
 
 
 def markdown(table: pd.DataFrame, columns: dict[str, tuple[str, str, str]], title: str) -> str:
     """One Markdown table per dataset; columns that are empty for a dataset are left out."""
-    lines = [f"# {title}", "",
-             "Each number: mean over seeds, then median (min–max) when seeds differ. "
-             "`–`: not computable for this run (see the run's metrics.json for the reason).", ""]
+    lines = [
+        f"# {title}",
+        "",
+        "Each number: mean over seeds, then median (min–max) when seeds differ. "
+        "`–`: not computable for this run (see the run's metrics.json for the reason).",
+        "",
+    ]
     if table.empty:
         return "\n".join([*lines, "No completed cells.", ""])
     for dataset, group in table.groupby("dataset", sort=False):
         present = [c for c in columns if group[f"{c}_mean"].notna().any()]
         header = ["method", "degradation", "seeds", *[columns[c][2] for c in present]]
-        lines += [f"## {dataset}", "", "| " + " | ".join(header) + " |",
-                  "|" + "|".join(["---"] * 3 + ["---:"] * len(present)) + "|"]
+        lines += [
+            f"## {dataset}",
+            "",
+            "| " + " | ".join(header) + " |",
+            "|" + "|".join(["---"] * 3 + ["---:"] * len(present)) + "|",
+        ]
         for _, row in group.iterrows():
-            cells = [str(row["method"]), str(row["degradation"]), str(int(row["seeds"])),
-                     *[cell_text(row, c) for c in present]]
+            cells = [
+                str(row["method"]),
+                str(row["degradation"]),
+                str(int(row["seeds"])),
+                *[cell_text(row, c) for c in present],
+            ]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     return "\n".join(lines)
@@ -103,8 +118,10 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
     cells = cells_frame(records)
     written = {"cells.csv": out / "cells.csv"}
     cells.drop(columns=list(COST_COLUMNS)).to_csv(written["cells.csv"], index=False, float_format="%.9g")
-    for name, columns, title in (("metrics", METRIC_COLUMNS, "Accuracy per dataset, method and degradation"),
-                                 ("cost", COST_COLUMNS, "Cost per dataset, method and degradation")):
+    for name, columns, title in (
+        ("metrics", METRIC_COLUMNS, "Accuracy per dataset, method and degradation"),
+        ("cost", COST_COLUMNS, "Cost per dataset, method and degradation"),
+    ):
         table = aggregate(cells, columns)
         csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
         table.to_csv(csv_path, index=False, float_format="%.9g")
@@ -112,6 +129,7 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
         written[f"{name}.csv"], written[f"{name}.md"] = csv_path, md_path
     cost_cells = out / "cells-cost.csv"
     cells[["dataset", "method", "degradation", "seed", "status", *COST_COLUMNS]].to_csv(
-        cost_cells, index=False, float_format="%.9g")
+        cost_cells, index=False, float_format="%.9g"
+    )
     written["cells-cost.csv"] = cost_cells
     return written

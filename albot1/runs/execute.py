@@ -21,8 +21,8 @@ from albot1 import versions
 from albot1.data.model import Sequence
 from albot1.errors import Albot1Error
 from albot1.runs.errors import RunError
-from albot1.runs.methods import get_method, resolve_config
-from albot1.runs.protocol import MapperOutput, RunResult
+from albot1.methods.registry import get_method, resolve_config
+from albot1.contract import MapperOutput, RunResult
 
 
 def peak_rss_mb() -> float:

@@ -33,7 +33,7 @@ from albot1.atomic import atomic_write
 from albot1.data.model import Relations
 from albot1.data.relations import read_relations, write_relations
 from albot1.runs.errors import RunError
-from albot1.runs.protocol import MapData, RunResult
+from albot1.contract import MapData, RunResult
 from albot1.runs.tum import read_tum, write_tum
 
 DONE = "DONE"

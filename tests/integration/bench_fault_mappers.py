@@ -16,9 +16,9 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict
 
-from albot1.baselines.odometry import OdometryConfig, OdometryMapper
+from albot1.contract import MapperOutput
 from albot1.data.model import Frame
-from albot1.runs.protocol import MapperOutput
+from albot1.methods.baselines.odometry import OdometryConfig, OdometryMapper
 
 
 class FaultConfig(BaseModel):

@@ -15,7 +15,8 @@ from albot1.runs.execute import run_method
 def perfect_odometry(name: str) -> Sequence:
     """The world with its odometry replaced by the exact poses."""
     return load_world(name).with_frames(
-        lambda frames: (Frame(f.index, f.scan, np.asarray(f.reference, dtype=float), f.reference) for f in frames))
+        lambda frames: (Frame(f.index, f.scan, np.asarray(f.reference, dtype=float), f.reference) for f in frames)
+    )
 
 
 def distance_to_walls(points: np.ndarray, walls: np.ndarray) -> np.ndarray:

@@ -19,11 +19,18 @@ def test_dry_run_lists_the_planned_cells_without_running_them(tmp_path: Path) ->
 
 
 def test_errors_are_one_line_on_stderr_with_exit_1(tmp_path: Path) -> None:
-    for args, words in ((["report", str(tmp_path)], "no grid.json"),
-                        (["bench", "no-such-suite"], "no suite named 'no-such-suite'"),
-                        (["bench", "quick", "--executor", "ray"], "executor 'ray' not understood")):
-        done = subprocess.run([sys.executable, "-c", "from albot1.cli.app import main; main()", *args],
-                              capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    for args, words in (
+        (["report", str(tmp_path)], "no grid.json"),
+        (["bench", "no-such-suite"], "no suite named 'no-such-suite'"),
+        (["bench", "quick", "--executor", "ray"], "executor 'ray' not understood"),
+    ):
+        done = subprocess.run(
+            [sys.executable, "-c", "from albot1.cli.app import main; main()", *args],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+            timeout=120,
+        )
         assert done.returncode == 1, done.stderr
         assert done.stderr.startswith("albot1: error: ") and words in done.stderr
         assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1

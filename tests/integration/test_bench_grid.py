@@ -36,8 +36,9 @@ def suite_file(tmp_path: Path, body: str, name: str = "tiny") -> Path:
     return path
 
 
-def run(path: Path, results: Path, jobs: int = 2, executor: str = "local",
-        **executor_options: bool) -> tuple[GridPlan, GridSummary, ResultsStore]:
+def run(
+    path: Path, results: Path, jobs: int = 2, executor: str = "local", **executor_options: bool
+) -> tuple[GridPlan, GridSummary, ResultsStore]:
     suite = load_suite(path)
     plan = plan_suite(suite, get_settings())
     store = ResultsStore(results / suite.name)
@@ -160,8 +161,9 @@ def test_rerun_keeps_completed_cells_and_same_seeds_give_identical_tables(tmp_pa
 
 @pytest.mark.slow
 def test_dask_executor_runs_the_same_code_path(tmp_path: Path) -> None:
-    plan, summary, store = run(suite_file(tmp_path, TWO_ODOMETRY), tmp_path / "results", jobs=1,
-                               executor="dask", dask_processes=False)
+    plan, summary, store = run(
+        suite_file(tmp_path, TWO_ODOMETRY), tmp_path / "results", jobs=1, executor="dask", dask_processes=False
+    )
     assert summary.counts["done"] == 3
     assert all(store.is_complete(c.key) for c in plan.cells)
 
@@ -187,15 +189,28 @@ def test_sigkill_halfway_then_rerun_finishes_without_recomputing(tmp_path: Path)
     path = suite_file(tmp_path, SLOW, name="slow")
     results = tmp_path / "results"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent), *sys.path]))
-    command = [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(path), "-j", "2",
-               "--results", str(results), "--no-progress"]
+    command = [
+        sys.executable,
+        "-c",
+        "from albot1.cli.app import main; main()",
+        "bench",
+        str(path),
+        "-j",
+        "2",
+        "--results",
+        str(results),
+        "--no-progress",
+    ]
     runs = results / "slow" / "runs"
     store = ResultsStore(results / "slow")
 
     def complete() -> dict[str, int]:
         """key -> mtime of metrics.json, for the cells the store counts as complete."""
-        return {p.name: (p / "metrics.json").stat().st_mtime_ns
-                for p in (runs.iterdir() if runs.is_dir() else []) if store.is_complete(p.name)}
+        return {
+            p.name: (p / "metrics.json").stat().st_mtime_ns
+            for p in (runs.iterdir() if runs.is_dir() else [])
+            if store.is_complete(p.name)
+        }
 
     runner = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
@@ -226,7 +241,9 @@ def test_sigkill_halfway_then_rerun_finishes_without_recomputing(tmp_path: Path)
 
 @pytest.mark.slow
 def test_fresh_machine_skips_absent_datasets_and_says_how_to_fetch_them(tmp_path: Path) -> None:
-    path = suite_file(tmp_path, f"""
+    path = suite_file(
+        tmp_path,
+        f"""
 [[methods]]
 name = "odometry"
 
@@ -235,7 +252,8 @@ name = "{WORLD}"
 
 [[datasets]]
 name = "aces"
-""")
+""",
+    )
     settings = Settings(data_dir=None, cache_dir=tmp_path / "empty-cache")
     plan = plan_suite(load_suite(path), settings)
     assert [s.name for s in plan.skipped_datasets] == ["aces"]

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from albot1.data import catalog
 from albot1.data.errors import ParseError
-from albot1.data.loaders.carmen import CarmenLoader
+from albot1.data.loaders.carmen.loader import CarmenLoader
 from albot1.geometry import se2
 from albot1.settings import Settings
 
@@ -58,12 +58,28 @@ def test_fr_clinic_from_robotlaser1(data_file: DataFile) -> None:
     assert seq.metadata.sensor_offset[0] == pytest.approx(0.22, abs=1e-6)
 
 
-@pytest.mark.parametrize("site", ["acapulco", "aces", "belgioioso", "csail", "edmonton", "fhw", "freiburg-079",
-                                  "freiburg-101", "freiburg-campus", "infinite-corridor", "intel", "orebro",
-                                  "seattle"])
+@pytest.mark.parametrize(
+    "site",
+    [
+        "acapulco",
+        "aces",
+        "belgioioso",
+        "csail",
+        "edmonton",
+        "fhw",
+        "freiburg-079",
+        "freiburg-101",
+        "freiburg-campus",
+        "infinite-corridor",
+        "intel",
+        "orebro",
+        "seattle",
+    ],
+)
 def test_every_corrected_log_has_reference_poses(data_file: DataFile, site: str) -> None:
-    seq = catalog.open_dataset(f"{site}-corrected",
-                               settings_for(data_file, f"radish-corrected/{site}-corrected.log.gz"))
+    seq = catalog.open_dataset(
+        f"{site}-corrected", settings_for(data_file, f"radish-corrected/{site}-corrected.log.gz")
+    )
     frames = [f for _, f in zip(range(50), seq.frames())]
     assert len(frames) == 50 and all(f.reference is not None for f in frames)
 

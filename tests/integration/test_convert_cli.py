@@ -27,26 +27,41 @@ def run_cli(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
     return code, out, err
 
 
-def test_convert_chain_carmen_to_bag_to_albot_log(data_file: Callable[[str], Path], tmp_path: Path,
-                                                  monkeypatch: pytest.MonkeyPatch,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_convert_chain_carmen_to_bag_to_albot_log(
+    data_file: Callable[[str], Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     aces = data_file("radish/aces.clf.bz2")
     code, out, err = run_cli(monkeypatch, capsys, "convert", str(aces), str(tmp_path / "a.bag"), "--limit", "40")
     assert code == 0, err
     assert out.strip() == f"wrote 40 scans from {aces} to {tmp_path / 'a.bag'} (ros1)"
-    code, out, err = run_cli(monkeypatch, capsys, "convert", str(tmp_path / "a.bag"), str(tmp_path / "a.out"),
-                             "--format", "albot-log", "--scan-topic", "/scan")
+    code, out, err = run_cli(
+        monkeypatch,
+        capsys,
+        "convert",
+        str(tmp_path / "a.bag"),
+        str(tmp_path / "a.out"),
+        "--format",
+        "albot-log",
+        "--scan-topic",
+        "/scan",
+    )
     assert code == 0, err
     assert "(albot-log)" in out
     first = [f.scan.ranges for f in itertools.islice(load(aces).frames(), 40)]
     again = [f.scan.ranges for f in load(tmp_path / "a.out").frames()]
     assert len(again) == 40
-    assert all(np.array_equal(a.astype(np.float32), b.astype(np.float32), equal_nan=True)
-               for a, b in zip(first, again))
+    assert all(np.array_equal(a.astype(np.float32), b.astype(np.float32), equal_nan=True) for a, b in zip(first, again))
 
 
-def test_convert_errors_are_one_line(data_file: Callable[[str], Path], tmp_path: Path,
-                                     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+def test_convert_errors_are_one_line(
+    data_file: Callable[[str], Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     aces = str(data_file("radish/aces.clf.bz2"))
     code, _, err = run_cli(monkeypatch, capsys, "convert", aces, str(tmp_path / "out.xyz"), "--limit", "5")
     assert code == 1 and err.count("\n") == 1
@@ -58,8 +73,15 @@ def test_convert_errors_are_one_line(data_file: Callable[[str], Path], tmp_path:
     assert not (tmp_path / "x.albotlog").exists()
 
     assert run_cli(monkeypatch, capsys, "convert", aces, str(tmp_path / "b.bag"), "--limit", "3")[0] == 0
-    code, _, err = run_cli(monkeypatch, capsys, "convert", str(tmp_path / "b.bag"), str(tmp_path / "c.albotlog"),
-                           "--scan-topic", "/base_scan")
+    code, _, err = run_cli(
+        monkeypatch,
+        capsys,
+        "convert",
+        str(tmp_path / "b.bag"),
+        str(tmp_path / "c.albotlog"),
+        "--scan-topic",
+        "/base_scan",
+    )
     assert code == 1 and "'/base_scan' (scan_topic / --scan-topic) is not in the bag" in err
     assert "/scan (sensor_msgs/msg/LaserScan, 3 msgs)" in err and "/odom (nav_msgs/msg/Odometry, 3 msgs)" in err
 

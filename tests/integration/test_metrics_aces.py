@@ -24,8 +24,9 @@ def test_raw_aces_odometry_against_the_published_relation_numbers(data_file: Cal
     log = data_file("radish/aces.clf.bz2")
     relations_file = data_file("radish/aces.relations")
     sequence = load(log)
-    block = relation_metric(sequence.timestamps, sequence.odometry, read_relations(relations_file),
-                            source=str(relations_file))
+    block = relation_metric(
+        sequence.timestamps, sequence.odometry, read_relations(relations_file), source=str(relations_file)
+    )
     trans, rot = block["translation_m"], block["rotation_deg"]
     assert trans["n"] == rot["n"] == 1279
     assert round(trans["mean"], 3) == 0.549
@@ -39,8 +40,9 @@ def test_raw_aces_odometry_against_the_published_relation_numbers(data_file: Cal
 
 
 @pytest.mark.slow
-def test_the_pipeline_scores_a_prefix_run_like_the_direct_call(data_file: Callable[[str], Path], tmp_path: Path,
-                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_pipeline_scores_a_prefix_run_like_the_direct_call(
+    data_file: Callable[[str], Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """`albot1 run odometry aces --limit 2000` + `albot1 evaluate`: same numbers as on the log's first 2000 scans."""
     from typer.testing import CliRunner
 
@@ -51,8 +53,9 @@ def test_the_pipeline_scores_a_prefix_run_like_the_direct_call(data_file: Callab
     relations = read_relations(data_file("radish/aces.relations"))
     monkeypatch.setenv("ALBOT1_DATA_DIR", str(log.parent.parent))
     runner = CliRunner()
-    ran = runner.invoke(app, ["run", "odometry", "aces", "--limit", "2000", "--out", str(tmp_path), "--json"],
-                        catch_exceptions=False)
+    ran = runner.invoke(
+        app, ["run", "odometry", "aces", "--limit", "2000", "--out", str(tmp_path), "--json"], catch_exceptions=False
+    )
     assert ran.exit_code == 0, ran.output
     run_dir = json.loads(ran.stdout)["run_dir"]
     evaluated = runner.invoke(app, ["evaluate", run_dir, "--json"], catch_exceptions=False)

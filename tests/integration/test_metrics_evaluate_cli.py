@@ -13,7 +13,7 @@ from albot1.cli.app import app, main
 from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
 from albot1.data.transforms import head
 from albot1.geometry import se2
-from albot1.metrics.evaluate import METRIC_KEYS, evaluate_run
+from albot1.runs.evaluate import METRIC_KEYS, evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
 
@@ -82,7 +82,8 @@ def test_without_reference_metrics_are_null_with_reasons(tmp_path: Path) -> None
 
 
 def test_evaluate_on_a_folder_that_is_not_a_run_fails_with_one_line(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     monkeypatch.setattr("sys.argv", ["albot1", "evaluate", str(tmp_path)])
     with pytest.raises(SystemExit) as stop:
         main()
@@ -92,7 +93,8 @@ def test_evaluate_on_a_folder_that_is_not_a_run_fails_with_one_line(
 
 
 def test_a_declared_closed_route_gets_its_end_to_start_gap_without_reference(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     n = 41
     steps = np.tile([[np.pi / 2, 0.0, np.radians(9.0)]], (n - 1, 1))  # a full circle of 40 steps
     truth = se2.integrate_steps(np.zeros(3), steps)

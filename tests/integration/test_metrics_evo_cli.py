@@ -27,8 +27,14 @@ def evo_tool(name: str) -> Path:
 def run_evo(tool: str, *args: str, home: Path) -> dict[str, float]:
     """The statistics table evo prints (``max mean median min rmse sse std``)."""
     env = {**os.environ, "HOME": str(home), "MPLBACKEND": "Agg"}
-    out = subprocess.run([str(evo_tool(tool)), "tum", *args, "--no_warnings"], capture_output=True, text=True,
-                         env=env, check=True, timeout=120).stdout
+    out = subprocess.run(
+        [str(evo_tool(tool)), "tum", *args, "--no_warnings"],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=True,
+        timeout=120,
+    ).stdout
     stats = dict(re.findall(r"^\s*(max|mean|median|min|rmse|sse|std)\s+([-+0-9.eE]+)\s*$", out, re.MULTILINE))
     assert stats, f"no statistics in evo's output:\n{out}"
     return {k: float(v) for k, v in stats.items()}

@@ -32,8 +32,9 @@ def assert_round_trip(original: Sequence, path: Path, expected_format: str) -> N
     for a, b in zip(original.frames(), loaded.frames(), strict=True):
         count += 1
         assert np.array_equal(np.isnan(a.scan.ranges), np.isnan(b.scan.ranges)), f"scan {a.index}: NaN positions"
-        assert np.array_equal(a.scan.ranges.astype(np.float32), b.scan.ranges.astype(np.float32), equal_nan=True), \
+        assert np.array_equal(a.scan.ranges.astype(np.float32), b.scan.ranges.astype(np.float32), equal_nan=True), (
             f"scan {a.index}: ranges"
+        )
         assert np.max(np.abs(a.scan.angles - b.scan.angles)) < 1e-6
         assert abs(a.scan.timestamp - b.scan.timestamp) < 1e-6
         d = b.odometry - a.odometry
@@ -65,8 +66,9 @@ def test_full_aces_round_trips_through_every_format(data_file: Callable[[str], P
         ("old-rosbag-laser_scan_sparsifier-demo.bag", "unsupported ROS1 bag header b'#ROSRECORD V1.2'"),
     ],
 )
-def test_bags_rosbags_cannot_open_give_one_clear_error(data_file: Callable[[str], Path], name: str,
-                                                       reason: str) -> None:
+def test_bags_rosbags_cannot_open_give_one_clear_error(
+    data_file: Callable[[str], Path], name: str, reason: str
+) -> None:
     path = data_file(f"bad-inputs/{name}")
     with pytest.raises(ParseError) as info:
         load(path)

@@ -8,13 +8,15 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from albot1.perception.accel import get_kernels
-from albot1.perception.landmarks import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
-from albot1.perception.view import ViewParams, construct_view
+from albot1.methods.albot1.perception.accel import get_kernels
+from albot1.methods.albot1.perception.landmarks import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
+from albot1.methods.albot1.perception.view import ViewParams, construct_view
 
 ANGLES = np.radians(np.arange(-90.0, 91.0, 2.0))
 ranges_strategy = st.lists(
-    st.one_of(st.floats(0.05, 40.0), st.just(math.nan)), min_size=ANGLES.size, max_size=ANGLES.size,
+    st.one_of(st.floats(0.05, 40.0), st.just(math.nan)),
+    min_size=ANGLES.size,
+    max_size=ANGLES.size,
 ).map(np.array)
 
 
@@ -31,7 +33,7 @@ def test_view_invariants(ranges: np.ndarray) -> None:
         for e in (0, 1):
             r, a = rev_r[b[e]], rev_a[b[e]]
             assert r <= params.max_range
-            np.testing.assert_allclose(s[2 * e: 2 * e + 2], [-r * math.sin(a), r * math.cos(a)], atol=1e-9)
+            np.testing.assert_allclose(s[2 * e : 2 * e + 2], [-r * math.sin(a), r * math.cos(a)], atol=1e-9)
     # Left to right: beams never go backwards; a surface spans beams b1 <= b2.
     flat = view.beams.ravel()
     assert np.all(np.diff(flat) >= 0)

@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from albot1.baselines.point_map import ThinnedPointMap
+from albot1.methods.baselines.point_map import ThinnedPointMap
 
 coordinate = st.floats(min_value=-50.0, max_value=50.0, allow_nan=False, allow_infinity=False)
 scan = st.lists(st.tuples(coordinate, coordinate), min_size=0, max_size=30)
@@ -26,10 +26,14 @@ def _reference(chunks: list[np.ndarray], cell: float) -> np.ndarray:
 
 
 @settings(max_examples=150, deadline=None)
-@given(scans=st.lists(scan, min_size=1, max_size=8), cell=st.sampled_from([0.05, 0.5, 3.0]),
-       batch=st.integers(min_value=1, max_value=100))
-def test_batched_thinning_equals_first_point_per_cell(scans: list[list[tuple[float, float]]], cell: float,
-                                                      batch: int) -> None:
+@given(
+    scans=st.lists(scan, min_size=1, max_size=8),
+    cell=st.sampled_from([0.05, 0.5, 3.0]),
+    batch=st.integers(min_value=1, max_value=100),
+)
+def test_batched_thinning_equals_first_point_per_cell(
+    scans: list[list[tuple[float, float]]], cell: float, batch: int
+) -> None:
     chunks = [np.asarray(s, dtype=float).reshape(-1, 2) for s in scans]
     thinned = ThinnedPointMap(cell, batch_points=batch)
     for chunk in chunks:

@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from albot1.data.errors import DataError
-from albot1.data.loaders.carmen import CarmenLoader
+from albot1.data.loaders.carmen.loader import CarmenLoader
 
 VALID = [
     "PARAM robot_frontlaser_offset 0.1 0 host 0",
@@ -20,8 +20,31 @@ VALID = [
     "NEFF 12.3",
     "# comment",
 ]
-TOKENS = st.sampled_from(["FLASER", "ODOM", "ROBOTLASER1", "RAWLASER1", "TRUEPOS", "PARAM", "nan", "-1", "inf",
-                          "1e308", "0", "3", "180", "x", "#", "", "host", "1.5", "-0", "1_0", "١"])
+TOKENS = st.sampled_from(
+    [
+        "FLASER",
+        "ODOM",
+        "ROBOTLASER1",
+        "RAWLASER1",
+        "TRUEPOS",
+        "PARAM",
+        "nan",
+        "-1",
+        "inf",
+        "1e308",
+        "0",
+        "3",
+        "180",
+        "x",
+        "#",
+        "",
+        "host",
+        "1.5",
+        "-0",
+        "1_0",
+        "١",
+    ]
+)
 
 
 def base_lines(count: int) -> list[str]:
@@ -60,11 +83,16 @@ def test_random_bytes(lines: list[bytes]) -> None:
 
 
 @settings(max_examples=250, deadline=None)
-@given(st.integers(1, 14), st.integers(0, 13),
-       st.lists(st.tuples(st.integers(0, 2), st.integers(0, 40), TOKENS), min_size=1, max_size=4),
-       st.sampled_from(["laser-pose", "odom", "odom-segments"]), st.sampled_from(["auto", "none", "laser-pose"]))
-def test_mutated_valid_lines(count: int, target: int, ops: list[tuple[int, int, str]], odometry: str,
-                             reference: str) -> None:
+@given(
+    st.integers(1, 14),
+    st.integers(0, 13),
+    st.lists(st.tuples(st.integers(0, 2), st.integers(0, 40), TOKENS), min_size=1, max_size=4),
+    st.sampled_from(["laser-pose", "odom", "odom-segments"]),
+    st.sampled_from(["auto", "none", "laser-pose"]),
+)
+def test_mutated_valid_lines(
+    count: int, target: int, ops: list[tuple[int, int, str]], odometry: str, reference: str
+) -> None:
     lines = base_lines(count)
     lines[target % count] = mutate(lines[target % count], ops)
     parse(("\n".join(lines) + "\n").encode(), odometry=odometry, reference=reference)

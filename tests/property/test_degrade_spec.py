@@ -12,7 +12,7 @@ from albot1.data.degrade import EXPECTED_SPEC, DegradationSpecError, parse_spec
 KINDS = st.sampled_from(["none", "thesis", "gauss", "bias", "GAUSS", "Bias", "noise", "", " thesis "])
 NUMBERS = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True).map(repr),
-    st.integers(-10**6, 10**6).map(str),
+    st.integers(-(10**6), 10**6).map(str),
     st.text(alphabet="0123456789.-+eE_ naif", max_size=8),
 )
 

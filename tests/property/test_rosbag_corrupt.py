@@ -11,16 +11,23 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from albot1.data.errors import DataError
-from albot1.data.loaders.rosbag import Ros1BagLoader, Ros2BagLoader
-from albot1.data.loaders.rosbag_writer import Ros1BagWriter, Ros2McapWriter, Ros2Sqlite3Writer
+from albot1.data.loaders.rosbag.loader import Ros1BagLoader, Ros2BagLoader
+from albot1.data.loaders.rosbag.writer import Ros1BagWriter, Ros2McapWriter, Ros2Sqlite3Writer
 from albot1.data.model import Frame, Scan, Sequence
 
 ANGLES = np.deg2rad(np.arange(-90.0, 90.0, 10.0))
 
 
 def _bags() -> dict[str, tuple[bytes, str]]:
-    frames = [Frame(i, Scan(np.full(18, 2.0 + 0.1 * i), ANGLES, 1.0 + 0.1 * i, 30.0), np.array([0.1 * i, 0.0, 0.0]),
-                    np.array([0.0, 0.1 * i, 0.0])) for i in range(15)]
+    frames = [
+        Frame(
+            i,
+            Scan(np.full(18, 2.0 + 0.1 * i), ANGLES, 1.0 + 0.1 * i, 30.0),
+            np.array([0.1 * i, 0.0, 0.0]),
+            np.array([0.0, 0.1 * i, 0.0]),
+        )
+        for i in range(15)
+    ]
     seq = Sequence.from_frames("fuzz", frames)
     out: dict[str, tuple[bytes, str]] = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -35,8 +42,9 @@ def _bags() -> dict[str, tuple[bytes, str]]:
 
 
 BAGS = _bags()
-EDITS = st.lists(st.tuples(st.sampled_from(["flip", "truncate"]), st.floats(0.0, 1.0), st.integers(0, 255)),
-                 min_size=1, max_size=4)
+EDITS = st.lists(
+    st.tuples(st.sampled_from(["flip", "truncate"]), st.floats(0.0, 1.0), st.integers(0, 255)), min_size=1, max_size=4
+)
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

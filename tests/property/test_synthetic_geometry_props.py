@@ -36,10 +36,12 @@ def brute_force(walls: np.ndarray, pose: np.ndarray, angles: np.ndarray, slack: 
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(st.tuples(COORD, COORD, COORD, COORD), min_size=1, max_size=8), COORD, COORD,
-       st.floats(-math.pi, math.pi))
-def test_ranges_agree_with_brute_force(segments: list[tuple[float, float, float, float]], x: float, y: float,
-                                       heading: float) -> None:
+@given(
+    st.lists(st.tuples(COORD, COORD, COORD, COORD), min_size=1, max_size=8), COORD, COORD, st.floats(-math.pi, math.pi)
+)
+def test_ranges_agree_with_brute_force(
+    segments: list[tuple[float, float, float, float]], x: float, y: float, heading: float
+) -> None:
     walls = np.array(segments)
     pose = np.array([x, y, heading])
     got = cast(walls, pose, ANGLES, 30.0)
@@ -57,11 +59,24 @@ def test_ranges_agree_with_brute_force(segments: list[tuple[float, float, float,
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.lists(st.tuples(COORD, COORD, COORD, COORD), min_size=1, max_size=6), COORD, COORD,
-       st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi), COORD, COORD)
-def test_moving_the_world_with_the_robot_changes_nothing(segments: list[tuple[float, float, float, float]], x: float,
-                                                          y: float, heading: float, turn: float, dx: float,
-                                                          dy: float) -> None:
+@given(
+    st.lists(st.tuples(COORD, COORD, COORD, COORD), min_size=1, max_size=6),
+    COORD,
+    COORD,
+    st.floats(-math.pi, math.pi),
+    st.floats(-math.pi, math.pi),
+    COORD,
+    COORD,
+)
+def test_moving_the_world_with_the_robot_changes_nothing(
+    segments: list[tuple[float, float, float, float]],
+    x: float,
+    y: float,
+    heading: float,
+    turn: float,
+    dx: float,
+    dy: float,
+) -> None:
     walls = np.array(segments)
     # A ray running exactly along a zero-thickness wall is degenerate (a real wall's end face would be
     # hit); keep the sensor off every wall's line so no beam can be collinear with a wall.
@@ -83,10 +98,13 @@ GRID = st.integers(-10, 10).map(float)
 
 
 @settings(max_examples=80, deadline=None)
-@given(st.lists(st.tuples(GRID, GRID), min_size=2, max_size=6, unique=True),
-       st.sampled_from([(0.1, 1.0), (1.0, 45.0), (0.35, 7.0)]))
-def test_sampled_routes_step_exactly_and_end_at_the_last_waypoint(points: list[tuple[float, float]],
-                                                                   spacing: tuple[float, float]) -> None:
+@given(
+    st.lists(st.tuples(GRID, GRID), min_size=2, max_size=6, unique=True),
+    st.sampled_from([(0.1, 1.0), (1.0, 45.0), (0.35, 7.0)]),
+)
+def test_sampled_routes_step_exactly_and_end_at_the_last_waypoint(
+    points: list[tuple[float, float]], spacing: tuple[float, float]
+) -> None:
     route = Route(tuple(points))
     poses = sample(route, Sampling(*spacing))
     steps = se2.relative_steps(poses)

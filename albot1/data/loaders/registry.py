@@ -16,11 +16,20 @@ from albot1.data.model import Sequence
 
 #: format name -> (loader "module:Class", writer "module:Class" or None)
 FORMATS: dict[str, tuple[str, str | None]] = {
-    "carmen": ("albot1.data.loaders.carmen:CarmenLoader", "albot1.data.loaders.carmen_writer:CarmenWriter"),
-    "ros1": ("albot1.data.loaders.rosbag:Ros1BagLoader", "albot1.data.loaders.rosbag_writer:Ros1BagWriter"),
-    "ros2-sqlite3": ("albot1.data.loaders.rosbag:Ros2BagLoader", "albot1.data.loaders.rosbag_writer:Ros2Sqlite3Writer"),
-    "ros2-mcap": ("albot1.data.loaders.rosbag:Ros2BagLoader", "albot1.data.loaders.rosbag_writer:Ros2McapWriter"),
-    "albot-log": ("albot1.data.loaders.albot_log:AlbotLogLoader", "albot1.data.loaders.albot_log:AlbotLogWriter"),
+    "carmen": ("albot1.data.loaders.carmen.loader:CarmenLoader", "albot1.data.loaders.carmen.writer:CarmenWriter"),
+    "ros1": ("albot1.data.loaders.rosbag.loader:Ros1BagLoader", "albot1.data.loaders.rosbag.writer:Ros1BagWriter"),
+    "ros2-sqlite3": (
+        "albot1.data.loaders.rosbag.loader:Ros2BagLoader",
+        "albot1.data.loaders.rosbag.writer:Ros2Sqlite3Writer",
+    ),
+    "ros2-mcap": (
+        "albot1.data.loaders.rosbag.loader:Ros2BagLoader",
+        "albot1.data.loaders.rosbag.writer:Ros2McapWriter",
+    ),
+    "albot-log": (
+        "albot1.data.loaders.albot_log.loader:AlbotLogLoader",
+        "albot1.data.loaders.albot_log.loader:AlbotLogWriter",
+    ),
 }
 
 

@@ -83,8 +83,7 @@ class Doorway:
         return ((self.a[0] + self.b[0]) / 2.0, (self.a[1] + self.b[1]) / 2.0)
 
     def as_dict(self) -> dict[str, Any]:
-        return {"id": self.id, "a": list(self.a), "b": list(self.b), "width_m": self.width,
-                "spaces": list(self.spaces)}
+        return {"id": self.id, "a": list(self.a), "b": list(self.b), "width_m": self.width, "spaces": list(self.spaces)}
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,8 +101,9 @@ class FloorPlan:
         for door in self.doorways:
             if door.id == doorway_id:
                 return door
-        raise SyntheticWorldError(f"plan {self.name!r} has no doorway {doorway_id!r}; "
-                                  f"doorways: {', '.join(d.id for d in self.doorways)}")
+        raise SyntheticWorldError(
+            f"plan {self.name!r} has no doorway {doorway_id!r}; doorways: {', '.join(d.id for d in self.doorways)}"
+        )
 
     def space_at(self, x: float, y: float) -> str | None:
         """The name of the space containing a point (None in a wall or doorway gap)."""
@@ -117,24 +117,37 @@ class FloorPlan:
         return _free_space(self.spaces, [_passage(d, self.wall_thickness) for d in self.doorways], self.obstacles)
 
 
-def build_plan(name: str, spaces: Sequence[Space], doorways: Sequence[DoorwaySpec] = (),
-               obstacles: Sequence[Rect] = (), *, wall_thickness: float = 0.2) -> FloorPlan:
+def build_plan(
+    name: str,
+    spaces: Sequence[Space],
+    doorways: Sequence[DoorwaySpec] = (),
+    obstacles: Sequence[Rect] = (),
+    *,
+    wall_thickness: float = 0.2,
+) -> FloorPlan:
     """Build a :class:`FloorPlan` and check it: every doorway must join two different spaces."""
     if wall_thickness <= 0:
         raise SyntheticWorldError(f"plan {name!r}: expected a positive wall thickness, got {wall_thickness}")
     for space in spaces:
         x0, y0, x1, y1 = space.rect
         if not (x1 > x0 and y1 > y0):
-            raise SyntheticWorldError(f"plan {name!r}: space {space.name!r} rect {space.rect} must have "
-                                      "xmin < xmax and ymin < ymax")
+            raise SyntheticWorldError(
+                f"plan {name!r}: space {space.name!r} rect {space.rect} must have xmin < xmax and ymin < ymax"
+            )
     ids = [d.id for d in doorways]
     if len(set(ids)) != len(ids):
         raise SyntheticWorldError(f"plan {name!r}: doorway ids must be unique, got {ids}")
     built = tuple(_doorway(name, spec, spaces, wall_thickness) for spec in doorways)
     passages = [_passage(d, wall_thickness) for d in built]
     free = _free_space(spaces, passages, obstacles)
-    return FloorPlan(name=name, walls=boundary_segments(free), doorways=built, spaces=tuple(spaces),
-                     obstacles=tuple(obstacles), wall_thickness=wall_thickness)
+    return FloorPlan(
+        name=name,
+        walls=boundary_segments(free),
+        doorways=built,
+        spaces=tuple(spaces),
+        obstacles=tuple(obstacles),
+        wall_thickness=wall_thickness,
+    )
 
 
 def _doorway(plan: str, spec: DoorwaySpec, spaces: Sequence[Space], thickness: float) -> Doorway:
@@ -157,7 +170,8 @@ def _doorway(plan: str, spec: DoorwaySpec, spaces: Sequence[Space], thickness: f
         if not found:
             raise SyntheticWorldError(
                 f"plan {plan!r}: doorway {spec.id!r} at {spec.centre} does not open into a space at {point}; "
-                f"expected its centre on the mid-line of a {thickness} m wall between two spaces")
+                f"expected its centre on the mid-line of a {thickness} m wall between two spaces"
+            )
         names.append(found[0])
     if names[0] == names[1]:
         raise SyntheticWorldError(f"plan {plan!r}: doorway {spec.id!r} joins space {names[0]!r} to itself")
@@ -213,7 +227,8 @@ def check_route(plan: FloorPlan, waypoints: Sequence[tuple[float, float]], *, cl
             raise SyntheticWorldError(
                 f"plan {plan.name!r}: route leg {i} from {tuple(a)} to {tuple(b)} leaves the free floor"
                 + (f" or passes within {clearance} m of a wall" if clearance > 0 else "")
-                + "; expected legs through rooms, corridors and doorways only")
+                + "; expected legs through rooms, corridors and doorways only"
+            )
 
 
 @dataclass(frozen=True)
@@ -227,8 +242,14 @@ class DoorwayCrossing:
     to_space: str
 
     def as_dict(self) -> dict[str, Any]:
-        return {"scan": self.scan, "x": self.position[0], "y": self.position[1], "doorway": self.doorway,
-                "from": self.from_space, "to": self.to_space}
+        return {
+            "scan": self.scan,
+            "x": self.position[0],
+            "y": self.position[1],
+            "doorway": self.doorway,
+            "from": self.from_space,
+            "to": self.to_space,
+        }
 
 
 def doorway_crossings(plan: FloorPlan, poses: ArrayLike) -> list[DoorwayCrossing]:

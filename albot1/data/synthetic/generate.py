@@ -108,10 +108,8 @@ def stream_frames(data: WorldData) -> Iterator[Frame]:
         rng = np.random.default_rng([data.spec.seed, 1, start // NOISE_BLOCK])
         ranges = lidar.add_noise(data.lap_ranges[data.exact_row(index)], laser.range_sigma, laser.max_range, rng)
         for k, i in enumerate(index):
-            scan = Scan(ranges=ranges[k], angles=angles, timestamp=float(data.timestamps[i]),
-                        max_range=laser.max_range)
-            yield Frame(index=int(i), scan=scan, odometry=data.odometry[i].copy(),
-                        reference=data.reference[i].copy())
+            scan = Scan(ranges=ranges[k], angles=angles, timestamp=float(data.timestamps[i]), max_range=laser.max_range)
+            yield Frame(index=int(i), scan=scan, odometry=data.odometry[i].copy(), reference=data.reference[i].copy())
 
 
 def world_metadata(data: WorldData) -> SequenceMetadata:

@@ -93,8 +93,9 @@ def cast(walls: ArrayLike, pose: ArrayLike, angles: ArrayLike, max_range: float)
     return cast_many(walls, np.asarray(pose, dtype=float).reshape(1, 3), angles, max_range)[0]
 
 
-def cast_many(walls: ArrayLike, poses: ArrayLike, angles: ArrayLike, max_range: float, *,
-              batch: int = 16) -> FloatArray:
+def cast_many(
+    walls: ArrayLike, poses: ArrayLike, angles: ArrayLike, max_range: float, *, batch: int = 16
+) -> FloatArray:
     """Exact ranges ``(N, beams)`` for ``N`` poses (see :func:`cast`).
 
     Rather than intersecting every beam with every wall, each wall is only
@@ -113,13 +114,14 @@ def cast_many(walls: ArrayLike, poses: ArrayLike, angles: ArrayLike, max_range: 
     if len(seg) and len(beam):
         cos_b, sin_b = np.cos(beam), np.sin(beam)
         for start in range(0, len(p), batch):
-            _cast_batch(out[start:start + batch], seg, p[start:start + batch], beam, cos_b, sin_b)
+            _cast_batch(out[start : start + batch], seg, p[start : start + batch], beam, cos_b, sin_b)
     out[~(out <= max_range)] = np.nan
     return out
 
 
-def _cast_batch(out: FloatArray, seg: FloatArray, poses: FloatArray, beam: FloatArray, cos_b: FloatArray,
-                sin_b: FloatArray) -> None:
+def _cast_batch(
+    out: FloatArray, seg: FloatArray, poses: FloatArray, beam: FloatArray, cos_b: FloatArray, sin_b: FloatArray
+) -> None:
     """Fill ``out`` (n, beams), initialised to inf, with the nearest hit per beam for ``n`` poses."""
     m, beams = len(seg), len(beam)
     # Walls in each sensor frame, shape (n, m), so beam directions depend on the beam only.
@@ -141,8 +143,9 @@ def _cast_batch(out: FloatArray, seg: FloatArray, poses: FloatArray, beam: Float
     _nearest_hits(out.reshape(-1), cell, ax[wall], ay[wall], bx[wall], by[wall], cos_b[ray], sin_b[ray])
 
 
-def _angular_intervals(ax: FloatArray, ay: FloatArray, bx: FloatArray,
-                       by: FloatArray) -> tuple[NDArray[np.intp], FloatArray, FloatArray]:
+def _angular_intervals(
+    ax: FloatArray, ay: FloatArray, bx: FloatArray, by: FloatArray
+) -> tuple[NDArray[np.intp], FloatArray, FloatArray]:
     """``(wall index, lo, hi)`` bearing intervals in ``[-pi, pi]`` each wall covers.
 
     A wall not through the sensor subtends less than pi, so its interval is
@@ -165,8 +168,16 @@ def _angular_intervals(ax: FloatArray, ay: FloatArray, bx: FloatArray,
     return all_idx, all_lo, all_hi
 
 
-def _nearest_hits(out: FloatArray, cell: NDArray[np.intp], ax: FloatArray, ay: FloatArray, bx: FloatArray,
-                  by: FloatArray, dx: FloatArray, dy: FloatArray) -> None:
+def _nearest_hits(
+    out: FloatArray,
+    cell: NDArray[np.intp],
+    ax: FloatArray,
+    ay: FloatArray,
+    bx: FloatArray,
+    by: FloatArray,
+    dx: FloatArray,
+    dy: FloatArray,
+) -> None:
     """Lower ``out[cell]`` to the distance at which each (ray, wall) pair's ray (direction dx, dy) meets the wall."""
     ex, ey = bx - ax, by - ay
     den = dx * ey - dy * ex  # cross(d, e)

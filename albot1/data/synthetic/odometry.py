@@ -88,8 +88,12 @@ def perturb_steps(steps: ArrayLike, model: OdometryErrorModel, rng: np.random.Ge
     root_d = np.sqrt(dist)
     along = dist * model.distance_scale + model.sigma_distance * root_d * noise[:, 0]
     across = model.sigma_lateral * root_d * noise[:, 1]
-    dtheta = (s[:, 2] * model.turn_scale + model.heading_bias * dist
-              + model.sigma_turn * np.sqrt(turn) * noise[:, 2] + model.sigma_drift * root_d * noise[:, 3])
+    dtheta = (
+        s[:, 2] * model.turn_scale
+        + model.heading_bias * dist
+        + model.sigma_turn * np.sqrt(turn) * noise[:, 2]
+        + model.sigma_drift * root_d * noise[:, 3]
+    )
     return np.column_stack([ux * along - uy * across, uy * along + ux * across, dtheta])
 
 

@@ -48,8 +48,12 @@ class Sampling:
     dwell_s: float = 0.0
 
     def __post_init__(self) -> None:
-        for field, value in (("step_m", self.step_m), ("step_deg", self.step_deg), ("speed_mps", self.speed_mps),
-                             ("turn_rate_dps", self.turn_rate_dps)):
+        for field, value in (
+            ("step_m", self.step_m),
+            ("step_deg", self.step_deg),
+            ("speed_mps", self.speed_mps),
+            ("turn_rate_dps", self.turn_rate_dps),
+        ):
             if not (math.isfinite(value) and value > 0):
                 raise SyntheticWorldError(f"sampling: expected a positive finite {field}, got {value}")
         if not (math.isfinite(self.dwell_s) and self.dwell_s >= 0):
@@ -78,8 +82,8 @@ class Route:
             raise SyntheticWorldError(f"route: expected at least 2 waypoints, got {len(self.waypoints)}")
         if self.closed and self.waypoints[0] != self.waypoints[-1]:
             raise SyntheticWorldError(
-                f"route: a closed route must end at its first waypoint {self.waypoints[0]}, "
-                f"not {self.waypoints[-1]}")
+                f"route: a closed route must end at its first waypoint {self.waypoints[0]}, not {self.waypoints[-1]}"
+            )
         for i, (a, b) in enumerate(zip(self.waypoints[:-1], self.waypoints[1:], strict=True)):
             if math.hypot(b[0] - a[0], b[1] - a[1]) <= _TINY:
                 raise SyntheticWorldError(f"route: waypoints {i} and {i + 1} coincide at {a}; legs must have length")

@@ -32,8 +32,18 @@ from albot1.data.synthetic.generate import WorldData, WorldSpec, generate, strea
 from albot1.data.synthetic.odometry import OdometryErrorModel
 from albot1.data.synthetic.route import CONTINUOUS, START_STOP
 
-__all__ = ["OFFICE_ODOMETRY", "WORLDS", "WorldData", "WorldSpec", "doorway_crossings", "generate", "load_world",
-           "spec_for", "world_data", "world_geometry"]
+__all__ = [
+    "OFFICE_ODOMETRY",
+    "WORLDS",
+    "WorldData",
+    "WorldSpec",
+    "doorway_crossings",
+    "generate",
+    "load_world",
+    "spec_for",
+    "world_data",
+    "world_geometry",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -63,27 +73,43 @@ WORLDS: dict[str, WorldSpec] = {
         WorldSpec(
             name="synthetic-office-loop",
             description="closed loop of about 79 m through a corridor ring, two offices, a lab and a kitchen; "
-                        "a scan every 0.1 m or 1 deg (the thesis's Experiment 4 logger)",
-            plan=layouts.office_plan, route=layouts.office_loop, sampling=CONTINUOUS,
-            odometry=OFFICE_ODOMETRY, seed=105),
+            "a scan every 0.1 m or 1 deg (the thesis's Experiment 4 logger)",
+            plan=layouts.office_plan,
+            route=layouts.office_loop,
+            sampling=CONTINUOUS,
+            odometry=OFFICE_ODOMETRY,
+            seed=105,
+        ),
         WorldSpec(
             name="synthetic-office-startstop",
             description="the office loop driven start-stop: a view after every 1 m move or 45 deg turn "
-                        "(106 views, as the thesis's Experiment 3)",
-            plan=layouts.office_plan, route=layouts.office_loop, sampling=START_STOP,
-            odometry=OFFICE_ODOMETRY, seed=131),
+            "(106 views, as the thesis's Experiment 3)",
+            plan=layouts.office_plan,
+            route=layouts.office_loop,
+            sampling=START_STOP,
+            odometry=OFFICE_ODOMETRY,
+            seed=131,
+        ),
         WorldSpec(
             name="synthetic-corridor",
             description="a featureless straight corridor 60 m x 2 m driven 53 m at 0.1 m per scan: no corner or "
-                        "occluding edge in view until the end wall comes within 30 m (path integration)",
-            plan=layouts.corridor_plan, route=layouts.corridor_route, sampling=CONTINUOUS,
-            odometry=OFFICE_ODOMETRY, seed=117),
+            "occluding edge in view until the end wall comes within 30 m (path integration)",
+            plan=layouts.corridor_plan,
+            route=layouts.corridor_route,
+            sampling=CONTINUOUS,
+            odometry=OFFICE_ODOMETRY,
+            seed=117,
+        ),
         WorldSpec(
             name="synthetic-office-long",
-            description="20 laps of synthetic-office-loop (about 1.6 km), for per-scan cost against "
-                        "sequence length",
-            plan=layouts.office_plan, route=layouts.office_loop, sampling=CONTINUOUS,
-            odometry=OFFICE_ODOMETRY, seed=126, laps=20),
+            description="20 laps of synthetic-office-loop (about 1.6 km), for per-scan cost against sequence length",
+            plan=layouts.office_plan,
+            route=layouts.office_loop,
+            sampling=CONTINUOUS,
+            odometry=OFFICE_ODOMETRY,
+            seed=126,
+            laps=20,
+        ),
     )
 }
 
@@ -93,11 +119,12 @@ def spec_for(name: str) -> WorldSpec:
     try:
         return WORLDS[name]
     except KeyError:
-        raise UnknownWorldError(f"no synthetic world named {name!r}; expected one of: "
-                                f"{', '.join(sorted(WORLDS))}") from None
+        raise UnknownWorldError(
+            f"no synthetic world named {name!r}; expected one of: {', '.join(sorted(WORLDS))}"
+        ) from None
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def world_data(name: str) -> WorldData:
     """The generated world ``name`` (cached per process)."""
     return generate(spec_for(name))

@@ -1,1 +1,0 @@
-"""Wrapped baselines, each behind the mapper protocol of :mod:`albot1.runs.protocol`."""

@@ -1,0 +1,218 @@
+"""Lines of the albot log (format version 1): parsing and formatting, no file I/O.
+
+The specification is in ``docs/formats.md``; :mod:`.albot_log` opens files
+and streams their lines through :class:`ViewParser`. Keeping the line
+grammar apart lets the property tests and the writer share it exactly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from albot1.data.errors import DataError, ParseError
+from albot1.data.loaders.rosbag.msg import even_spacing
+from albot1.data.model import FloatArray, Frame, Scan
+from albot1.data.tokens import parse_floats
+
+MAGIC = "ALBOT1-LOG"
+VERSION = 1
+UNITS = "length=m angle=rad time=s"
+FRAME = "thesis"
+#: A point may sit at most this far (metres) off its beam's ray; more means
+#: the file mixes up frames or beam order, not rounding.
+POINT_TOLERANCE_M = 1e-3
+#: More beams than this is not a planar laser but a corrupt count (and would
+#: make the reader allocate the count before seeing a single point).
+MAX_BEAMS = 100_000
+#: Evenly spaced beams within this (radians) are written as one SENSOR line.
+_SPACING_EXACT = 1e-12
+
+
+class _Sensor:
+    """The active beam geometry; ``dirs`` are the unit beam directions in file (left-to-right) order."""
+
+    def __init__(self, angles: FloatArray, max_range: float) -> None:
+        self.angles = angles
+        self.max_range = max_range
+        rev = angles[::-1]
+        self.dirs = np.column_stack([-np.sin(rev), np.cos(rev)])
+
+
+def _numbers(path: Path, line: int, tokens: list[str], what: str) -> FloatArray:
+    return parse_floats(path, line, tokens, f"{what}:")
+
+
+def _is_count(token: str) -> bool:
+    """A plain non-negative integer: ASCII digits only (``str.isdigit`` accepts superscripts that
+    ``int`` rejects) and short enough for ``int`` (which refuses > 4300 digits)."""
+    return token.isascii() and token.isdigit() and len(token) <= 12
+
+
+class ViewParser:
+    """Turns the lines after the header into frames, checking every field."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.sensor: _Sensor | None = None
+        self.index = 0
+
+    def error(self, line: int, message: str) -> ParseError:
+        return ParseError(self.path, message, line=line)
+
+    def sensor_line(self, line: int, tokens: list[str]) -> None:
+        explicit = tokens[0] == "SENSOR-ANGLES"
+        if len(tokens) < 3 or not _is_count(tokens[1]) or not 1 <= int(tokens[1]) <= MAX_BEAMS:
+            raise self.error(
+                line, f"expected '{tokens[0]} <beams> <max_range> ...' with beams an integer from 1 to {MAX_BEAMS}"
+            )
+        beams = int(tokens[1])
+        expected = 3 + (beams if explicit else 2)
+        if len(tokens) != expected:
+            layout = "<a_1> ... <a_beams>" if explicit else "<angle_min> <angle_increment>"
+            raise self.error(
+                line, f"expected {expected} fields '{tokens[0]} <beams> <max_range> {layout}', got {len(tokens)}"
+            )
+        values = _numbers(self.path, line, tokens[2:], tokens[0])
+        if not np.all(np.isfinite(values)) or values[0] <= 0:
+            raise self.error(line, f"{tokens[0]}: expected finite numbers and a positive max range")
+        if explicit:
+            angles = values[1:]
+        else:
+            angles = values[1] + np.arange(beams, dtype=np.float64) * values[2]
+        if beams > 1 and not np.all(np.diff(angles) > 0):
+            raise self.error(line, f"{tokens[0]}: beam angles must be strictly increasing (counter-clockwise)")
+        self.sensor = _Sensor(angles, float(values[0]))
+
+    def view_line(self, line: int, tokens: list[str]) -> Frame:
+        if self.sensor is None:
+            raise self.error(line, "VIEW before any SENSOR line; the beam geometry must come first")
+        n = self.sensor.angles.shape[0]
+        has_ref = len(tokens) > 6 and tokens[6] != "-"
+        head = 9 if has_ref else 7
+        if len(tokens) != head + 2 * n:
+            raise self.error(
+                line,
+                f"expected 'VIEW <index> <t> <x> <y> <theta> <- | rx ry rtheta>' and {2 * n} "
+                f"point coordinates ({n} beams), got {len(tokens)} fields",
+            )
+        if not _is_count(tokens[1]) or int(tokens[1]) != self.index:
+            raise self.error(line, f"expected view index {self.index}, got {tokens[1]!r}")
+        poses = _numbers(self.path, line, tokens[2:6] + (tokens[6:9] if has_ref else []), "VIEW time/pose")
+        if not np.all(np.isfinite(poses)):
+            raise self.error(line, "the timestamp and poses must be finite numbers")
+        t = float(poses[0])
+        ranges = self._ranges(line, _numbers(self.path, line, tokens[head:], "VIEW points").reshape(n, 2))
+        frame = Frame(
+            self.index,
+            Scan(ranges, self.sensor.angles, t, self.sensor.max_range),
+            poses[1:4].copy(),
+            poses[4:7].copy() if has_ref else None,
+        )
+        self.index += 1
+        return frame
+
+    def _ranges(self, line: int, points: FloatArray) -> FloatArray:
+        assert self.sensor is not None
+        nan = np.isnan(points)
+        if np.any(nan[:, 0] != nan[:, 1]) or np.any(np.isinf(points)):
+            raise self.error(line, "a point must be two finite numbers, or 'nan nan' for a beam without return")
+        r = np.hypot(points[:, 0], points[:, 1])
+        along = np.einsum("ij,ij->i", points, self.sensor.dirs)
+        off = np.abs(points[:, 0] * self.sensor.dirs[:, 1] - points[:, 1] * self.sensor.dirs[:, 0])
+        with np.errstate(invalid="ignore"):
+            checks = (
+                (off > POINT_TOLERANCE_M, "is {off:.4g} m off its beam at {angle!r} rad"),
+                (along < -POINT_TOLERANCE_M, "lies behind the robot on its beam at {angle!r} rad"),
+                (r > self.sensor.max_range * (1 + 1e-12), "lies {r!r} m away, beyond the max range {max_range!r} m"),
+            )
+        for bad, template in checks:
+            if np.any(bad):
+                k = int(np.argmax(bad))
+                problem = template.format(
+                    off=float(off[k]),
+                    angle=float(self.sensor.angles[-1 - k]),
+                    r=float(r[k]),
+                    max_range=self.sensor.max_range,
+                )
+                raise self.error(
+                    line,
+                    f"point {k + 1} ({float(points[k, 0])!r}, {float(points[k, 1])!r}) {problem}; "
+                    f"expected thesis-frame points (x = -r sin a, y = r cos a) listed left to right "
+                    f"within the max range",
+                )
+        return r[::-1].copy()
+
+
+def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | None, list[tuple[int, str]]]:
+    """Checks magic, version, UNITS and FRAME; returns NAME and the lines read past the header."""
+    first = next(lines, None)
+    if first is None:
+        raise ParseError(path, f"empty file; expected the first line '{MAGIC} {VERSION}'", line=1)
+    tokens = first[1].split()
+    if len(tokens) != 2 or tokens[0] != MAGIC:
+        raise ParseError(path, f"expected the first line '{MAGIC} {VERSION}', got {first[1].strip()[:60]!r}", line=1)
+    if tokens[1] != str(VERSION):
+        raise ParseError(
+            path, f"unsupported {MAGIC} version {tokens[1]!r}; this reader knows version {VERSION}", line=1
+        )
+    seen: dict[str, str] = {}
+    for lineno, text in lines:
+        stripped = text.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        key, _, value = stripped.partition(" ")
+        if key in ("SENSOR", "SENSOR-ANGLES", "VIEW"):
+            missing = [k for k in ("UNITS", "FRAME") if k not in seen]
+            if missing:
+                raise ParseError(
+                    path,
+                    f"the header lacks {' and '.join(missing)} before the first {key} line "
+                    f"(expected 'UNITS {UNITS}' and 'FRAME {FRAME}')",
+                    line=lineno,
+                )
+            return seen.get("NAME"), [(lineno, text)]
+        if key not in ("UNITS", "FRAME", "NAME"):
+            raise ParseError(
+                path, f"unknown header line {key!r}; expected UNITS, FRAME, NAME, SENSOR or VIEW", line=lineno
+            )
+        value = " ".join(value.split())
+        if key == "UNITS" and value != UNITS:
+            raise ParseError(path, f"expected 'UNITS {UNITS}' (no other units are defined), got {value!r}", line=lineno)
+        if key == "FRAME" and value != FRAME:
+            raise ParseError(path, f"expected 'FRAME {FRAME}', got {value!r}", line=lineno)
+        seen[key] = value
+    raise ParseError(path, "the file has a header but no SENSOR or VIEW line")
+
+
+def _fmt(values: Any) -> str:
+    return " ".join(map(repr, np.asarray(values, dtype=np.float64).tolist()))
+
+
+def sensor_line(scan: Scan) -> str:
+    n = scan.beams
+    spacing = even_spacing(scan.angles, _SPACING_EXACT) if n > 1 else None
+    if spacing is not None:
+        return f"SENSOR {n} {float(scan.max_range)!r} {spacing[0]!r} {spacing[1]!r}"
+    return f"SENSOR-ANGLES {n} {float(scan.max_range)!r} {_fmt(scan.angles)}"
+
+
+def check_ranges(frame: Frame) -> None:
+    finite = frame.scan.ranges[np.isfinite(frame.scan.ranges)]
+    if finite.size and (finite.min() < 0 or finite.max() > frame.scan.max_range):
+        raise DataError(
+            f"scan #{frame.index}: ranges must lie in [0, max_range={frame.scan.max_range}] m, got "
+            f"[{finite.min()}, {finite.max()}]"
+        )
+
+
+def view_line(frame: Frame) -> str:
+    """One VIEW record (without newline) for a frame."""
+    scan = frame.scan
+    rev_r, rev_a = scan.ranges[::-1], scan.angles[::-1]
+    points = np.column_stack([-rev_r * np.sin(rev_a), rev_r * np.cos(rev_a)])
+    ref = _fmt(frame.reference) if frame.reference is not None else "-"
+    return f"VIEW {frame.index} {float(scan.timestamp)!r} {_fmt(frame.odometry)} {ref} {_fmt(points.ravel())}"

@@ -1,0 +1,129 @@
+"""Beam geometry and no-return rules of CARMEN scans (pure functions, no I/O).
+
+FLASER/RLASER lines carry only ranges, so their geometry comes from PARAM
+lines when the logger wrote them, else from documented defaults by beam count
+(the conventions of the Radish/Freiburg logs, which were recorded with SICK
+LMS 2xx scanners covering 180 degrees):
+
+=========  ===================  ====================================
+beams      angle step           beams at
+=========  ===================  ====================================
+180        1 deg                -90, -89, ..., +89 deg
+360        0.5 deg              -90, -89.5, ..., +89.5 deg
+181, 361   180/(n-1) deg        -90 ... +90 deg (both ends included)
+other n    180/(n-1) deg        -90 ... +90 deg
+=========  ===================  ====================================
+
+PARAM lines that override the defaults (front laser; ``rear`` for RLASER):
+``laser_front_laser_resolution`` / ``laser_frontlaser_resolution`` (degrees),
+``laser_front_laser_fov`` (degrees, or radians when <= 2*pi as in the CSAIL
+log), ``robot_front_laser_max`` (metres), ``robot_frontlaser_offset``
+(metres forward of the robot centre).
+
+No-return rule: a reading ``r >= max_range - 0.005`` (half the 1 cm
+resolution of the logs, so a value printed as the maximum counts) or
+``r == 0`` becomes NaN. Negative and non-finite readings are parse errors.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+#: SICK LMS 2xx maximum (8191 cm is its "no echo" code); used when a log states no maximum.
+DEFAULT_MAX_RANGE = 81.9
+NO_RETURN_MARGIN = 0.005
+
+
+@dataclass(frozen=True, slots=True)
+class BeamGeometry:
+    """First beam angle and step (radians, CCW, 0 = forward) and the sensor's max range (m)."""
+
+    start: float
+    step: float
+    max_range: float
+    source: str
+
+
+def default_geometry(beams: int) -> tuple[float, float]:
+    """``(start, step)`` in radians for a FLASER line of ``beams`` readings without PARAM hints."""
+    if beams in (180, 360):
+        return -math.pi / 2, math.pi / beams
+    return -math.pi / 2, math.pi / max(beams - 1, 1)
+
+
+def _number(params: dict[str, str], *names: str) -> float | None:
+    for name in names:
+        if name in params:
+            try:
+                value = float(params[name])
+            except ValueError:
+                continue
+            if math.isfinite(value) and value > 0:
+                return value
+    return None
+
+
+def param_geometry(beams: int, params: dict[str, str], rear: bool = False) -> BeamGeometry:
+    """Geometry of an old-style laser line from PARAM values seen so far, else the defaults."""
+    which = "rear" if rear else "front"
+    start, step = default_geometry(beams)
+    source = f"default for {beams} beams"
+    resolution = _number(params, f"laser_{which}_laser_resolution", f"laser_{which}laser_resolution")
+    fov = _number(params, f"laser_{which}_laser_fov", f"laser_{which}laser_fov")
+    if fov is not None:
+        fov_rad = fov if fov <= 2 * math.pi + 1e-6 else math.radians(fov)
+        start = -fov_rad / 2
+        step = fov_rad / max(beams - 1, 1) if resolution is None else step
+        source = "PARAM fov"
+    if resolution is not None:
+        step = math.radians(resolution)
+        source = "PARAM resolution" if fov is None else "PARAM fov+resolution"
+    max_range = _number(params, f"robot_{which}_laser_max")
+    return BeamGeometry(start, step, max_range if max_range is not None else DEFAULT_MAX_RANGE, source)
+
+
+def sensor_offset(params: dict[str, str], rear: bool = False) -> tuple[float, float, float]:
+    """Laser pose in the robot frame from PARAM ``robot_frontlaser_offset`` (and side/angular, if logged)."""
+    which = "rear" if rear else "front"
+
+    def get(name: str) -> float:
+        try:
+            return float(params.get(name, "0"))
+        except ValueError:
+            return 0.0
+
+    return (
+        get(f"robot_{which}laser_offset"),
+        get(f"robot_{which}laser_side_offset"),
+        get(f"robot_{which}laser_angular_offset"),
+    )
+
+
+_ANGLE_CACHE: dict[tuple[int, float, float], FloatArray] = {}
+
+
+def beam_angles(beams: int, start: float, step: float) -> FloatArray:
+    """Read-only angle array, shared between scans with the same geometry."""
+    key = (beams, start, step)
+    angles = _ANGLE_CACHE.get(key)
+    if angles is None:
+        if len(_ANGLE_CACHE) > 256:
+            _ANGLE_CACHE.clear()
+        angles = start + step * np.arange(beams, dtype=np.float64)
+        angles.flags.writeable = False
+        _ANGLE_CACHE[key] = angles
+    return angles
+
+
+def clean_block(ranges: FloatArray, max_range: FloatArray) -> FloatArray:
+    """A copy of a ``(k, n)`` block (one max range per row) with max-range and zero readings as NaN
+    (the no-return rule above), in one numpy pass."""
+    out = ranges.copy()
+    out[(out >= (max_range - NO_RETURN_MARGIN)[:, None]) | (out == 0.0)] = np.nan
+    return out

@@ -1,0 +1,234 @@
+"""ROS1 and ROS2 (sqlite3, MCAP) bags -> a streamed Sequence, through ``rosbags``.
+
+What is read:
+
+* scans: ``sensor_msgs/LaserScan`` of one topic, at their *header* stamps
+  (the time the scan was taken, not when the recorder received it);
+* odometry: ``nav_msgs/Odometry`` of one topic, or the ``odom_frame ->
+  base_frame`` transforms of ``/tf``, read in a first pass over that topic
+  only and SE(2)-interpolated to each scan stamp;
+* reference (optional): the ``nav_msgs/Odometry`` topic named by
+  ``reference_topic`` (e.g. simulator ground truth), else ``/ground_truth``
+  when present (the layout ``albot1 convert`` writes), interpolated the same
+  way. Topic choice rules live in :mod:`.rosbag_topics`.
+
+A scan outside the odometry (or reference) time span is an error by default
+because extrapolating a pose would invent data; ``outside_odometry="drop"``
+skips such scans and logs how many. Scans stream: the bag is not decoded
+before the first frame is yielded. ``rosbags`` is imported lazily.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from albot1.data.errors import DataError, ParseError
+from albot1.data.loaders.rosbag.msg import PoseTrack, scan_arrays
+from albot1.data.loaders.rosbag.reader import header_stamp, odometry_track, opened_bag, tf_track, topic_messages
+from albot1.data.loaders.rosbag.topics import LASER_SCAN, TopicChoice, TopicInfo, choose_topics, normalize_type
+from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
+
+log = logging.getLogger(__name__)
+
+ROS1_MAGIC = b"#ROSBAG V2.0"
+_OPTIONS = ("scan_topic", "odom_topic", "reference_topic", "odom_frame", "base_frame", "outside_odometry")
+_OUTSIDE = ("error", "drop")
+
+
+@dataclass
+class _BagSource:
+    """One bag with its chosen topics; reads the pose tracks once, streams the scans each pass."""
+
+    bag: Path
+    shown: Path
+    choice: TopicChoice
+    odom_frame: str
+    base_frame: str | None
+    outside: str
+
+    def __post_init__(self) -> None:
+        self._tracks: tuple[PoseTrack, PoseTrack | None] | None = None
+
+    def tracks(self) -> tuple[PoseTrack, PoseTrack | None]:
+        if self._tracks is None:
+            with opened_bag(self.bag, self.shown) as reader:
+                if self.choice.odom_is_tf:
+                    odom = tf_track(reader, self.choice.odom, self.odom_frame, self.base_frame, self.shown)
+                else:
+                    odom = odometry_track(reader, self.choice.odom, self.shown)
+                ref = odometry_track(reader, self.choice.reference, self.shown) if self.choice.reference else None
+            self._tracks = (odom, ref)
+        return self._tracks
+
+    def _outside(self, index: int, t: float, track: PoseTrack, topic: str) -> None:
+        if self.outside == "error":
+            raise ParseError(
+                self.shown,
+                f"topic {self.choice.scan}: scan stamp {t:.9f} s is outside the time span "
+                f"[{track.start:.9f}, {track.end:.9f}] s of {topic}; poses are never extrapolated "
+                f"(load with outside_odometry='drop' to skip such scans)",
+                index=index,
+            )
+
+    def frames(self) -> Iterator[Frame]:
+        odom, ref = self.tracks()
+        topic = self.choice.scan
+        out, dropped, last = 0, 0, -math.inf
+        with opened_bag(self.bag, self.shown) as reader:
+            for i, msg in topic_messages(reader, topic, self.shown):
+                t = header_stamp(msg)
+                if t < last:
+                    raise ParseError(
+                        self.shown,
+                        f"topic {topic}: scan stamp {t:.9f} s is earlier than the previous "
+                        f"scan's {last:.9f} s; scans must be in time order",
+                        index=i,
+                    )
+                last = t
+                pose = odom.at(t)
+                if pose is None:
+                    self._outside(i, t, odom, self.choice.odom)
+                    dropped += 1
+                    continue
+                reference = None
+                if ref is not None:
+                    reference = ref.at(t)
+                    if reference is None:
+                        self._outside(i, t, ref, str(self.choice.reference))
+                        dropped += 1
+                        continue
+                yield Frame(out, self._scan(msg, t, i), pose, reference)
+                out += 1
+        if dropped:
+            log.warning("%s: dropped %d scans of %s outside the pose time span", self.shown, dropped, topic)
+
+    def _scan(self, msg: Any, t: float, index: int) -> Scan:
+        geometry = (float(msg.angle_min), float(msg.angle_increment), float(msg.range_min), float(msg.range_max))
+        n = len(msg.ranges)
+        if not all(math.isfinite(v) for v in geometry) or geometry[3] <= 0 or n == 0 or (n > 1 and geometry[1] == 0):
+            raise ParseError(
+                self.shown,
+                f"topic {self.choice.scan}: expected a LaserScan with finite angle_min, "
+                f"non-zero angle_increment, range_min, positive range_max and at least one range; got "
+                f"angle_min/increment/range_min/range_max = {geometry}, {n} ranges",
+                index=index,
+            )
+        ranges, angles = scan_arrays(np.asarray(msg.ranges), *geometry)
+        return Scan(ranges=ranges, angles=angles, timestamp=t, max_range=geometry[3])
+
+
+def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
+    unknown = sorted(k for k, v in options.items() if k not in _OPTIONS and v is not None)
+    if unknown:
+        raise DataError(f"{shown}: unknown bag option(s) {', '.join(unknown)}; expected: {', '.join(_OPTIONS)}")
+    opts = {k: options.get(k) for k in _OPTIONS}
+    opts["outside_odometry"] = opts["outside_odometry"] or "error"
+    if opts["outside_odometry"] not in _OUTSIDE:
+        raise DataError(f"outside_odometry={opts['outside_odometry']!r}; expected one of {', '.join(_OUTSIDE)}")
+    opts["odom_frame"] = opts["odom_frame"] or "odom"
+    return opts
+
+
+def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict[str, Any]) -> Sequence:
+    opts = _options(options, shown)
+    with opened_bag(bag, shown) as reader:
+        topics = {
+            name_: TopicInfo(normalize_type(info.msgtype or "?"), int(info.msgcount))
+            for name_, info in reader.topics.items()
+        }
+    choice = choose_topics(shown, topics, opts["scan_topic"], opts["odom_topic"], opts["reference_topic"])
+    source = _BagSource(bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"])
+    odom_desc = (
+        f"{choice.odom} transforms {opts['odom_frame']} -> {opts['base_frame'] or '(its only child)'}"
+        if choice.odom_is_tf
+        else f"{choice.odom} ({topics[choice.odom].msgtype})"
+    )
+    metadata = SequenceMetadata(
+        source=str(shown),
+        format=format_name,
+        odometry_source=f"{odom_desc}, SE(2)-interpolated to the {LASER_SCAN} header stamps of {choice.scan}",
+        reference_source=(
+            f"{choice.reference} (nav_msgs/msg/Odometry), SE(2)-interpolated to the scan stamps"
+            if choice.reference
+            else ""
+        ),
+        extra={
+            "scan_topic": choice.scan,
+            "odom_topic": choice.odom,
+            "reference_topic": choice.reference,
+            "outside_odometry": opts["outside_odometry"],
+        },
+    )
+    return Sequence(name, source.frames, metadata)
+
+
+class Ros1BagLoader:
+    """ROS1 ``.bag`` files (format 2.0). Options: see :func:`Ros2BagLoader.load`."""
+
+    format_name: ClassVar[str] = "ros1"
+    suffixes: ClassVar[tuple[str, ...]] = (".bag",)
+
+    def sniff(self, path: Path) -> bool:
+        """Any ``#ROSBAG``/``#ROSRECORD`` file, so that old versions reach :meth:`load` and its clear error."""
+        if not path.is_file():
+            return False
+        with path.open("rb") as fh:
+            head = fh.read(16)
+        return head.startswith((b"#ROSBAG", b"#ROSRECORD"))
+
+    def load(self, path: Path, **options: Any) -> Sequence:
+        path = Path(path)
+        if not path.is_file():
+            raise DataError(f"{path}: no such ROS1 bag file")
+        with path.open("rb") as fh:
+            head = fh.readline(64).rstrip(b"\n")
+        if head != ROS1_MAGIC:
+            raise ParseError(
+                path,
+                f"unsupported ROS1 bag header {head[:32]!r}; expected {ROS1_MAGIC.decode()!r} "
+                f"(rosbags reads only bag format 2.0)",
+                line=1,
+            )
+        return _load_bag(path, path, path.stem, self.format_name, options)
+
+
+class Ros2BagLoader:
+    """ROS2 bags (a folder with ``metadata.yaml`` and sqlite3 ``.db3`` or ``.mcap`` storage).
+
+    ``format_name`` is ``"ros2"``; the loaded sequence's metadata says
+    ``ros2-sqlite3`` or ``ros2-mcap`` from the storage file found.
+    """
+
+    format_name: ClassVar[str] = "ros2"
+    suffixes: ClassVar[tuple[str, ...]] = (".db3", ".mcap")
+
+    @staticmethod
+    def bag_dir(path: Path) -> Path | None:
+        """The bag folder for a folder or one of its storage files, or None."""
+        folder = path if path.is_dir() else path.parent
+        return folder if (folder / "metadata.yaml").is_file() else None
+
+    def sniff(self, path: Path) -> bool:
+        return (path.is_dir() or path.suffix in self.suffixes) and self.bag_dir(path) is not None
+
+    def load(self, path: Path, **options: Any) -> Sequence:
+        """The bag as a Sequence.
+
+        Options: ``scan_topic``, ``odom_topic`` (Odometry or ``/tf``),
+        ``reference_topic`` (Odometry), ``odom_frame`` (default ``odom``) and
+        ``base_frame`` (default: the only child of ``odom_frame``) for ``/tf``,
+        ``outside_odometry`` (``error`` | ``drop``).
+        """
+        path = Path(path)
+        folder = self.bag_dir(path)
+        if folder is None:
+            raise DataError(f"{path}: not a ROS2 bag; expected a folder holding metadata.yaml and its .db3/.mcap file")
+        storage = "ros2-mcap" if any(folder.glob("*.mcap")) else "ros2-sqlite3"
+        return _load_bag(folder, folder, folder.name, storage, options)

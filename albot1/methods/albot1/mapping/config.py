@@ -1,0 +1,143 @@
+"""Every threshold and every reading of an ambiguous passage of thesis 3.1, typed.
+
+Defaults are the thesis's values; where the thesis gives none, the default
+is the resolution that worked in the prototype (``albot1-spec-notes.md``,
+item numbers in the descriptions) and ``docs/albot1-mapper.md`` lists each
+choice with the thesis text it resolves. Presets: ``thesis`` (= ``default``,
+the literal reading, including the distance/turn motion model of eqs
+3.1-3.2) and ``exact`` (the full SE(2) odometry increment).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from albot1.methods.albot1.perception.view import ViewParams
+
+
+class Albot1Config(BaseModel):
+    """Config of the Albot1 mapper (lengths in metres, angles in degrees)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    # 3.1.3 view construction
+    max_range_m: float = Field(30.0, gt=0, description="3.1.3 step 1: readings beyond this are deleted")
+    cluster_gap_m: float = Field(
+        0.6, gt=0, description="3.1.3 step 2: Euclidean gap between consecutive points that starts a new cluster"
+    )
+    cluster_size_m: float = Field(
+        0.2,
+        ge=0,
+        description="3.1.3 step 3: clusters whose first-to-last chord exceeds this get the split test (note 1)",
+    )
+    break_point_height_m: float = Field(
+        0.1,
+        gt=0,
+        description="3.1.3 step 3: split at the point farthest from the chord when farther than this (note 2)",
+    )
+    surface_length_m: float = Field(0.1, ge=0, description="3.1.3 step 5: shorter surfaces are deleted")
+    # 3.1.4 landmarks
+    landmark_min_length_m: float = Field(0.4, ge=0, description="3.1.4: landmark surfaces are at least this long")
+    corner_min_angle_deg: float = Field(
+        30.0,
+        gt=0,
+        lt=180,
+        description=(
+            "3.1.4: smallest turn between two pieces of a cluster that is a corner (thesis: none given; note 5)"
+        ),
+    )
+    occlusion_margin_m: float = Field(
+        0.0, ge=0, description="3.1.4: the next return outward must be this much farther for an occluding end (note 4)"
+    )
+    continuation_tolerance_m: float = Field(
+        0.1,
+        ge=0,
+        description="3.1.4: a cluster end whose next return outward lies within this of the surface's own line continued is a grazing-angle gap, not an occluding edge (0 = off; the thesis's 'obstructs' needs something else behind)",
+    )
+    # 3.1.5 recognition
+    motion_model: Literal["thesis", "exact"] = Field(
+        "thesis", description="eqs 3.1-3.2 distance+turn model, or the full SE(2) odometry increment (note 8)"
+    )
+    recognition_angle_deg: float = Field(
+        5.0, gt=0, description="Algorithm 1 line 6: directions (P1->P2) closer than this"
+    )
+    recognition_distance_m: float = Field(
+        0.4, gt=0, description="Algorithm 1 line 7: same-side stable endpoints closer than this (note 7)"
+    )
+    recognition_matching: Literal["greedy", "nested_loop"] = Field(
+        "greedy", description="one-to-one by smallest gap, or Algorithm 1's nested loop verbatim (note 7)"
+    )
+    # Algorithm 4
+    min_landmarks: int = Field(3, ge=1, description="Algorithm 4 line 12: update when fewer landmarks are recognised")
+    pose_between_updates: Literal["localise", "odometry"] = Field(
+        "localise",
+        description="per-scan pose between updates: localise on the tracked landmarks (note 13), or compose odometry",
+    )
+    # 3.1.6 localisation
+    outlier_min_candidates: int = Field(
+        3, ge=2, description="apply the standard-deviation outlier rule with at least this many candidates (note 10)"
+    )
+    goodness_gap_floor_m: float = Field(
+        0.01, gt=0, description="eq 3.5: floor of g_diff so a zero gap does not divide by zero (note 9)"
+    )
+    goodness_angle_floor_deg: float = Field(0.1, gt=0, description="eq 3.5: floor of a_diff (note 9)")
+    goodness_distance_view: Literal["previous", "current"] = Field(
+        "previous",
+        description="eq 3.5 d_R: distance of the previous endpoint from the robot in the previous view (literal) or predicted into the current view",
+    )
+    # 3.1.7 update
+    update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
+        "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
+    )
+    delete_margin_m: float = Field(
+        0.4,
+        ge=0,
+        description="Algorithm 3 line 9: endpoints within this of the polygon boundary count as inside (note 16)",
+    )
+    delete_margin_from: Literal["surfaces", "boundary"] = Field(
+        "surfaces",
+        description="Algorithm 3 line 9: measure the 40 cm from the view's surfaces (perpendicular, within their extent) or from every polygon edge, including the field-of-view sides through unperceived space (see docs: the latter erases walls behind the robot when updates come less than 40 cm apart)",
+    )
+    correspond_angle_deg: float = Field(
+        5.0, gt=0, description="Algorithm 3 line 12: a corresponding view surface is this parallel (note 17)"
+    )
+    correspond_distance_m: float = Field(
+        0.4, gt=0, description="Algorithm 3 line 12: ... and this close (segment distance; note 17)"
+    )
+    partial_without_match: Literal["clip", "keep"] = Field(
+        "clip",
+        description="a partly covered map surface with no corresponding view surface: clip it at the grown polygon, or keep it whole",
+    )
+    # degenerate input and implementation
+    odometry_jump_m: float = Field(5.0, gt=0, description="an odometry step longer than this is counted as a jump")
+    stationary_m: float = Field(
+        1e-6, ge=0, description="a step shorter than this and turning less than stationary_deg is stationary"
+    )
+    stationary_deg: float = Field(1e-6, ge=0, description="see stationary_m")
+    map_grid_cell_m: float = Field(2.0, gt=0, description="cell of the map's spatial grid index (speed only)")
+    accelerate: bool = Field(True, description="run the per-scan kernels with numba (results are identical)")
+
+    def view_params(self) -> ViewParams:
+        return ViewParams(
+            max_range=self.max_range_m,
+            cluster_gap=self.cluster_gap_m,
+            cluster_size=self.cluster_size_m,
+            break_point_height=self.break_point_height_m,
+            surface_length=self.surface_length_m,
+            corner_min_turn=math.radians(self.corner_min_angle_deg),
+            occlusion_margin=self.occlusion_margin_m,
+            continuation_tolerance=self.continuation_tolerance_m,
+        )
+
+
+PRESETS: dict[str, dict[str, Any]] = {
+    "default": {},
+    "thesis": {},
+    "exact": {"motion_model": "exact"},
+    # The bare text where our defaults read it otherwise (docs/albot1-mapper.md, "Presets"):
+    # the 40 cm delete margin from every polygon edge and no grazing-angle test.
+    "literal": {"delete_margin_from": "boundary", "continuation_tolerance_m": 0.0},
+}

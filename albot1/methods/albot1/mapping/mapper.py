@@ -1,0 +1,305 @@
+"""Albot1's perceptual mapping (thesis Algorithm 4) behind the Mapper protocol.
+
+Each scan becomes a view; its landmarks are recognised against the
+landmarks tracked since the last update. While at least three are
+recognised the robot only localises on them. With fewer, the map is
+updated: with the current view if the previous step was the update, else
+with the previous view (its landmarks are then tracked afresh and
+recognition re-runs on the current view, which can trigger a second update
+in the same step). When no landmark can place the robot, the odometry step
+is composed instead (the thesis's path integration in featureless
+corridors).
+
+Everything runs in the thesis frame; poses and map are handed out in a
+REP-103 map frame (the first view at the origin, heading 0).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from pydantic import BaseModel
+
+from albot1.contract import MapData, MapperOutput
+from albot1.data.model import Frame
+from albot1.methods.albot1.mapping.config import PRESETS, Albot1Config
+from albot1.methods.albot1.mapping.errors import MappingError
+from albot1.methods.albot1.mapping.localisation import Localisation, localise
+from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
+from albot1.methods.albot1.mapping.update import UpdateParams, update_map
+from albot1.methods.albot1.perception.accel import get_kernels
+from albot1.methods.albot1.perception.frames import (
+    Pose,
+    between,
+    compose,
+    thesis_to_rep_pose,
+    thesis_to_rep_segments,
+    transform_segments,
+)
+from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
+from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise
+from albot1.methods.albot1.perception.view import View, construct_view
+
+
+@dataclass(slots=True)
+class _Step:
+    """What Algorithm 4 keeps of the previous step."""
+
+    index: int
+    view: View
+    landmarks: Landmarks
+    tracked: Tracked
+    odometry: tuple[float, float, float]
+    pose: Pose
+
+
+@dataclass(slots=True)
+class _Counts:
+    views: int = 0
+    updates: int = 0
+    updates_current_view: int = 0
+    updates_previous_view: int = 0
+    double_updates: int = 0
+    path_integration: int = 0
+    odometry_pose_steps: int = 0
+    empty_views: int = 0
+    single_surface_views: int = 0
+    odometry_jumps: int = 0
+    stationary_steps: int = 0
+    surfaces_added: int = 0
+    surfaces_deleted: int = 0
+    surfaces_extended: int = 0
+    surfaces_trimmed: int = 0
+    recognised: list[int] = field(default_factory=list)
+
+
+class Albot1Mapper:
+    """The Albot1 perceptual mapper (thesis chapter 3, section 3.1)."""
+
+    name: ClassVar[str] = "albot1"
+    config_model: ClassVar[type[BaseModel]] = Albot1Config
+    presets: ClassVar[dict[str, dict[str, Any]]] = PRESETS
+
+    def __init__(self, config: Albot1Config, *, seed: int = 0) -> None:
+        # The method is deterministic; ``seed`` is accepted for the protocol.
+        self.config = config
+        self._k = get_kernels(config.accelerate)
+        self._view_params = config.view_params()
+        self._update_params = UpdateParams(
+            delete_margin=config.delete_margin_m,
+            correspond_angle=math.radians(config.correspond_angle_deg),
+            correspond_distance=config.correspond_distance_m,
+            partial_without_match=config.partial_without_match,
+            polygon=config.update_polygon,
+            margin_from=config.delete_margin_from,
+        )
+        self._rec_angle = math.radians(config.recognition_angle_deg)
+        self._angle_floor = math.radians(config.goodness_angle_floor_deg)
+        self._stationary_rad = math.radians(config.stationary_deg)
+        self.map = PerceptualMap(config.map_grid_cell_m, self._k)
+        self._landmark_map: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._poses: list[Pose] = []
+        self._prev: _Step | None = None
+        self._u_step = -1
+        self._n = 0
+        self._counts = _Counts()
+        self._trace: list[dict[str, Any]] = []
+
+    # -- Algorithm 4 -------------------------------------------------------
+    def process(self, frame: Frame) -> None:
+        n = self._n
+        scan = frame.scan
+        try:
+            view = construct_view(scan.ranges, scan.angles, self._view_params, self._k)
+        except (ValueError, TypeError) as exc:
+            raise MappingError(f"scan {frame.index}: cannot build a view: {exc}") from exc
+        lms = find_landmarks(view, self.config.landmark_min_length_m)
+        odo = (float(frame.odometry[0]), float(frame.odometry[1]), float(frame.odometry[2]))
+        if not all(map(math.isfinite, odo)):
+            raise MappingError(f"scan {frame.index}: odometry {odo} is not finite")
+        c = self._counts
+        c.views += 1
+        if len(view) == 0:
+            c.empty_views += 1
+        elif len(view) == 1:
+            c.single_surface_views += 1
+        prev = self._prev
+        if prev is None:
+            pose: Pose = (0.0, 0.0, 0.0)
+            tracked = self._update(view, lms, pose, n, trigger=n, which="initial", source="initial", reference=-1)
+            c.recognised.append(0)
+        else:
+            tracked, pose = self._step(n, view, lms, odo, prev)
+        self._poses.append(pose)
+        self._prev = _Step(n, view, lms, tracked, odo, pose)
+        self._n += 1
+
+    def _step(
+        self, n: int, view: View, lms: Landmarks, odo: tuple[float, float, float], prev: _Step
+    ) -> tuple[Tracked, Pose]:
+        c, cfg = self._counts, self.config
+        rel = between(prev.odometry, odo)
+        dist = math.hypot(rel[0], rel[1])
+        if dist > cfg.odometry_jump_m:
+            c.odometry_jumps += 1
+        if dist <= cfg.stationary_m and abs(rel[2]) <= self._stationary_rad:
+            c.stationary_steps += 1
+        step = motion_step(rel, cfg.motion_model)
+        rl = self._recognise(prev.tracked, lms, step)
+        c.recognised.append(len(rl))
+        if len(rl) >= cfg.min_landmarks:
+            return rl, self._pose_between_updates(rl, prev.pose, step)
+        if n - self._u_step != 1:
+            # Lines 18-23: update with the previous view at its own pose, track its landmarks afresh
+            # and recognise again (line 23, "go back to step 11").
+            prev.tracked = self._update(
+                prev.view,
+                prev.landmarks,
+                prev.pose,
+                prev.index,
+                trigger=n,
+                which="previous",
+                source="stored",
+                reference=-1,
+            )
+            rl = self._recognise(prev.tracked, lms, step)
+            if len(rl) >= cfg.min_landmarks:
+                return rl, self._pose_between_updates(rl, prev.pose, step)
+            c.double_updates += 1
+        # Lines 13-17: update with the current view.
+        loc = self._localise(rl)
+        if loc is None:
+            c.path_integration += 1
+            pose, source, ref = compose(prev.pose, step), "odometry", -1
+        else:
+            pose, source, ref = loc.pose, "landmark", loc.reference_id
+        tracked = self._update(
+            view, lms, pose, n, trigger=n, which="current", source=source, reference=ref, recognised=len(rl)
+        )
+        return tracked, pose
+
+    # -- stages ------------------------------------------------------------
+    def _recognise(self, previous: Tracked, lms: Landmarks, step: Pose) -> Tracked:
+        return recognise(
+            previous,
+            lms.surfaces,
+            lms.kinds,
+            step,
+            max_angle=self._rec_angle,
+            max_distance=self.config.recognition_distance_m,
+            matching=self.config.recognition_matching,
+            kernels=self._k,
+        )
+
+    def _localise(self, rl: Tracked) -> Localisation | None:
+        return localise(
+            rl,
+            self._landmark_map,
+            min_candidates=self.config.outlier_min_candidates,
+            gap_floor=self.config.goodness_gap_floor_m,
+            angle_floor=self._angle_floor,
+            distance_view=self.config.goodness_distance_view,
+        )
+
+    def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
+        """Spec note 13: localise on the tracked landmarks; compose the odometry step if that fails."""
+        if self.config.pose_between_updates == "localise":
+            loc = self._localise(rl)
+            if loc is not None:
+                return loc.pose
+        self._counts.odometry_pose_steps += 1
+        return compose(prev_pose, step)
+
+    def _update(
+        self,
+        view: View,
+        lms: Landmarks,
+        pose: Pose,
+        view_scan: int,
+        *,
+        trigger: int,
+        which: str,
+        source: str,
+        reference: int,
+        recognised: int | None = None,
+    ) -> Tracked:
+        """``updatePM`` with ``view`` placed at ``pose``; returns the landmark list reset to its landmarks."""
+        c = self._counts
+        view_map = transform_segments(pose, view.surfaces)
+        out = update_map(self.map, view_map, (pose[0], pose[1]), view_scan, self._update_params, self._k)
+        ids = out.view_ids[lms.index]
+        # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
+        lm_map = view_map[lms.index]
+        self._landmark_map = {int(i): (lm_map[r], lms.kinds[r]) for r, i in enumerate(ids.tolist())}
+        self._u_step = view_scan
+        c.surfaces_added += len(out.added)
+        c.surfaces_deleted += len(out.deleted)
+        c.surfaces_extended += len(out.extended)
+        c.surfaces_trimmed += len(out.trimmed)
+        if which != "initial":
+            c.updates += 1
+            if which == "current":
+                c.updates_current_view += 1
+            else:
+                c.updates_previous_view += 1
+        self._trace.append(
+            {
+                "scan": trigger,
+                "view": which,
+                "view_scan": view_scan,
+                "pose_source": source,
+                "reference_id": reference,
+                "recognised": recognised,
+                "surfaces": len(view),
+                "landmarks": len(lms),
+                "added": len(out.added),
+                "deleted": len(out.deleted),
+                "extended": len(out.extended),
+                "trimmed": len(out.trimmed),
+            }
+        )
+        return Tracked.fresh(lms.surfaces, lms.kinds, ids)
+
+    # -- output ------------------------------------------------------------
+    def finish(self) -> MapperOutput:
+        c = self._counts
+        ids = self.map.ids()
+        segments = thesis_to_rep_segments(self.map.segments(ids))
+        poses = np.asarray([thesis_to_rep_pose(p) for p in self._poses], dtype=float).reshape(-1, 3)
+        rec = np.asarray(c.recognised, dtype=float)
+        counters: dict[str, int | float] = {
+            name: getattr(c, name)
+            for name in (
+                "views",
+                "updates",
+                "updates_current_view",
+                "updates_previous_view",
+                "double_updates",
+                "path_integration",
+                "odometry_pose_steps",
+                "empty_views",
+                "single_surface_views",
+                "odometry_jumps",
+                "stationary_steps",
+                "surfaces_added",
+                "surfaces_deleted",
+                "surfaces_extended",
+                "surfaces_trimmed",
+            )
+        }
+        counters["map_surfaces"] = len(self.map)
+        counters["updates_per_view"] = c.updates / c.views if c.views else 0.0
+        counters["landmarks_recognised_mean"] = float(rec[1:].mean()) if len(rec) > 1 else 0.0
+        return MapperOutput(
+            poses=poses,
+            map=MapData(segments=segments, segment_properties=self.map.properties(ids)),
+            counters=counters,
+            extras={
+                "update_trace": self._trace,
+                "landmarks_recognised": c.recognised,
+                "frame": "REP-103 map frame: first view at the origin, heading 0 (x forward)",
+            },
+        )

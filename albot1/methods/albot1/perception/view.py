@@ -1,0 +1,95 @@
+"""View construction (thesis 3.1.3): from one laser scan to ordered line surfaces.
+
+The five steps of the thesis (point filtering, clustering, recursive
+segmenting, surface forming, surface filtering) run in one compiled pass
+(:func:`albot1.methods.albot1.perception.kernels.build_view`), which also labels each
+surface endpoint (occluding, corner, ...; 3.1.4) because that needs the raw
+beams the view itself no longer holds. Readings of "cluster size" and the
+split rule are documented on :class:`ViewParams`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.methods.albot1.perception.accel import Kernels, get_kernels
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+@dataclass(frozen=True, slots=True)
+class ViewParams:
+    """Thresholds of 3.1.3 and of the endpoint labels of 3.1.4 (metres, radians).
+
+    ``cluster_size`` is compared with the chord from a cluster's first to its
+    last point (a point count worked worse); a cluster longer than that is
+    split at its point farthest from the chord when that distance exceeds
+    ``break_point_height``, the split point ending one half and starting the
+    other, recursively (iterative end-point fit). ``corner_min_turn`` is the
+    smallest turn between two pieces of one cluster that makes their shared
+    point a corner (the thesis gives none); ``occlusion_margin`` is how much
+    farther the next return outward must be for a cluster end to occlude.
+    """
+
+    max_range: float = 30.0
+    cluster_gap: float = 0.6
+    cluster_size: float = 0.2
+    break_point_height: float = 0.1
+    surface_length: float = 0.1
+    corner_min_turn: float = math.radians(30.0)
+    occlusion_margin: float = 0.0
+    continuation_tolerance: float = 0.1
+
+
+@dataclass(frozen=True, slots=True)
+class View:
+    """Surfaces of one scan in the thesis frame, left to right.
+
+    ``surfaces`` ``(m, 4)``: P1 (x1, y1) is the surface's left end, P2 its
+    right end. ``kinds`` ``(m, 2)``: label of P1 and P2 (see
+    :mod:`albot1.methods.albot1.perception.landmarks`). ``beams`` ``(m, 2)``: index of the
+    endpoint's beam counted from the left. ``cluster`` ``(m,)``: the cluster
+    each surface was cut from.
+    """
+
+    surfaces: FloatArray
+    kinds: IntArray
+    beams: IntArray
+    cluster: IntArray
+
+    def __len__(self) -> int:
+        return int(self.surfaces.shape[0])
+
+    @property
+    def lengths(self) -> FloatArray:
+        s = self.surfaces
+        return np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
+
+
+def construct_view(ranges: FloatArray, angles: FloatArray, params: ViewParams, kernels: Kernels | None = None) -> View:
+    """``constructView`` of Algorithm 4 for a REP-103 scan (angles ascending, counter-clockwise).
+
+    The thesis orders surfaces left to right, i.e. by *descending* beam
+    angle, so the beams are reversed before the pass.
+    """
+    k = kernels or get_kernels()
+    r = np.ascontiguousarray(np.asarray(ranges, dtype=np.float64)[::-1])
+    a = np.ascontiguousarray(np.asarray(angles, dtype=np.float64)[::-1])
+    surfaces, kinds, beams, cluster = k.build_view(
+        r,
+        a,
+        params.max_range,
+        params.cluster_gap,
+        params.cluster_size,
+        params.break_point_height,
+        params.surface_length,
+        params.corner_min_turn,
+        params.occlusion_margin,
+        params.continuation_tolerance,
+    )
+    return View(surfaces, kinds, beams, cluster)

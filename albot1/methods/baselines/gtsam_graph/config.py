@@ -1,0 +1,164 @@
+"""The typed configuration of the GTSAM graph baseline.
+
+The model holds types, bounds and meaning; the values (with the reasons
+for them) live in ``baselines/gtsam-graph.toml`` and are loaded by
+:mod:`albot1.config.presets`. Angles are degrees in the config (what a
+person reads and edits) and radians everywhere inside.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from albot1.methods.baselines.gtsam_graph.registration import IcpParams
+
+
+class GtsamGraphConfig(BaseModel):
+    """Every knob of the graph SLAM baseline, with units in the field names."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    # Nodes (Grisetti et al. 2010: a node when the robot moved enough to see something new).
+    node_translation_m: float = Field(gt=0, description="odometry translation since the last node that creates a node")
+    node_rotation_deg: float = Field(
+        gt=0, description="odometry rotation (deg) since the last node that creates a node"
+    )
+
+    # Scan preprocessing.
+    min_range_m: float = Field(ge=0, description="beams shorter than this are dropped (robot body, dust)")
+    max_range_m: float = Field(gt=0, description="beams longer than this are dropped (sparse, noisy far points)")
+    scan_voxel_m: float = Field(ge=0, description="source scans keep one point per cell of this size (0 = all)")
+
+    # Registration (point-to-line ICP, albot1.methods.baselines.gtsam_graph.registration).
+    icp_max_iterations: int = Field(ge=1, description="Gauss-Newton iterations per registration")
+    icp_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate (annealed down)")
+    icp_min_correspondence_m: float = Field(
+        gt=0, description="final correspondence gate; inliers are counted within it"
+    )
+    point_sigma_m: float = Field(gt=0, description="std dev of one point-to-line residual (sets the match information)")
+    normal_neighbours: int = Field(ge=3, description="neighbours used to fit each target point's line")
+    normal_radius_m: float = Field(gt=0, description="neighbours farther than this are not used for the line fit")
+    max_planarity: float = Field(
+        gt=0, le=1, description="target points whose neighbourhood eigenvalue ratio exceeds this get no line"
+    )
+
+    # Sequential edges.
+    local_map_nodes: int = Field(
+        ge=1, description="the last k node scans form the local map the new node is matched against"
+    )
+    odometry_sigma_xy_m: float = Field(
+        gt=0, description="prior std dev of the odometry guess per node step (x, y), used inside ICP"
+    )
+    odometry_sigma_theta_deg: float = Field(
+        gt=0, description="prior std dev of the odometry guess per node step (theta)"
+    )
+    seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
+    seq_max_rmse_m: float = Field(
+        gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"
+    )
+    seq_max_correction_m: float = Field(
+        gt=0, description="a sequential match may move the odometry guess this far at most"
+    )
+    seq_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most")
+    seq_retries: int = Field(
+        ge=0, description="failed sequential matches are retried from the guess rotated by +-1..n steps"
+    )
+    seq_retry_rotation_deg: float = Field(gt=0, description="rotation step of those retries (deg)")
+    match_sigma_floor_xy_m: float = Field(
+        gt=0, description="added to every match's std dev (x, y): matches are never perfect"
+    )
+    match_sigma_floor_theta_deg: float = Field(gt=0, description="added to every match's std dev (theta)")
+    fallback_sigma_xy_m: float = Field(
+        gt=0, description="std dev (x, y) of an odometry edge used when the match is poor"
+    )
+    fallback_sigma_theta_deg: float = Field(gt=0, description="std dev (theta) of an odometry fallback edge")
+    max_consecutive_fallbacks: int = Field(
+        ge=1, description="this many poor matches in a row abort the run (registration diverged)"
+    )
+
+    # Loop closures.
+    loop_search_radius_m: float = Field(
+        gt=0, description="earlier nodes within this distance of the current estimate are candidates"
+    )
+    loop_radius_growth: float = Field(
+        ge=0, description="the search radius grows by this fraction of the path since the last closure"
+    )
+    loop_max_search_radius_m: float = Field(gt=0, description="upper bound of the grown search radius")
+    loop_min_node_gap: int = Field(
+        ge=1, description="nodes this recent are never loop candidates (they are sequential)"
+    )
+    loop_max_candidates: int = Field(
+        ge=1, description="at most this many candidates (nearest first, distinct places) per node"
+    )
+    loop_every_nodes: int = Field(ge=1, description="search for loop closures at every n-th node")
+    loop_submap_nodes: int = Field(
+        ge=0, description="a candidate's submap is its scan plus this many node scans either side"
+    )
+    loop_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of loop matches")
+    loop_coarse_max_half_width_m: float = Field(
+        ge=0, description="failed loop matches are retried from a correlative search this wide at most (0 = off)"
+    )
+    loop_coarse_min_half_width_m: float = Field(
+        gt=0, description="the search half-width is loop_radius_growth x path since the last closure, at least this"
+    )
+    loop_coarse_step_m: float = Field(gt=0, description="translation step of the correlative search grid")
+    loop_coarse_half_angle_deg: float = Field(
+        ge=0, description="the correlative search tries rotations within +-this of the guess"
+    )
+    loop_coarse_step_deg: float = Field(gt=0, description="rotation step of the correlative search")
+    loop_max_ambiguity: float = Field(
+        gt=0,
+        le=1,
+        description="a correlative match is refused when a pose >1 m away scores this fraction of the best or more",
+    )
+    loop_min_fitness: float = Field(ge=0, le=1, description="a loop match needs this inlier fraction")
+    loop_max_rmse_m: float = Field(gt=0, description="a loop match needs this inlier RMS distance or less")
+    loop_max_correction_m: float = Field(
+        gt=0, description="a loop match may disagree with the current estimate this much at most (m)"
+    )
+    loop_max_correction_deg: float = Field(gt=0, description="... and this much at most (deg)")
+    loop_min_sigma_ratio: float = Field(
+        gt=0,
+        le=1,
+        description=(
+            "reject matches whose weakest direction is this much less constrained than the strongest (corridors)"
+        ),
+    )
+    loop_confirmations: int = Field(
+        ge=1, description="consecutive nodes whose loop matches must agree before they are added"
+    )
+    loop_agreement_m: float = Field(
+        gt=0, description="two loop matches agree when their corrections differ by less than this (m)"
+    )
+    loop_agreement_deg: float = Field(gt=0, description="... and this (deg)")
+    loop_kernel: Literal["cauchy", "huber", "none"] = Field(description="robust kernel on loop-closure edges")
+    loop_kernel_scale: float = Field(
+        gt=0, description="kernel parameter on the whitened error (in standard deviations)"
+    )
+
+    # Optimisation.
+    isam_relinearize_threshold: float = Field(
+        gt=0, description="ISAM2 relinearises variables that moved more than this"
+    )
+    isam_extra_updates_on_loop: int = Field(ge=0, description="extra ISAM2 iterations after a loop closure is added")
+    final_lm: bool = Field(description="run Levenberg-Marquardt over the whole graph in finish()")
+    lm_max_iterations: int = Field(ge=1, description="iteration cap of the final Levenberg-Marquardt")
+
+    # Map.
+    map_voxel_m: float = Field(gt=0, description="grid cell for thinning the projected map points")
+    map_every: int = Field(ge=1, description="project every n-th scan into the map")
+
+    def icp(self, loop: bool = False) -> IcpParams:
+        """Registration parameters for sequential (``loop=False``) or loop matches."""
+        return IcpParams(
+            max_iterations=self.icp_max_iterations,
+            max_correspondence_m=self.loop_max_correspondence_m if loop else self.icp_max_correspondence_m,
+            min_correspondence_m=self.icp_min_correspondence_m,
+            point_sigma_m=self.point_sigma_m,
+            cauchy_scale_m=2.0 * self.point_sigma_m,
+            prior_sigma_xy_m=self.loop_max_correction_m if loop else self.odometry_sigma_xy_m,
+            prior_sigma_theta_rad=math.radians(self.loop_max_correction_deg if loop else self.odometry_sigma_theta_deg),
+        )

@@ -1,0 +1,401 @@
+"""``GtsamGraphMapper``: graph-based SLAM behind the mapper protocol.
+
+The method of Grisetti et al. (2010), the thesis's section 2.2.3:
+
+* a **node** whenever odometry says the robot moved 0.5 m or turned 0.5 rad
+  since the last node; its scan is stored in the node's frame;
+* a **sequential edge** from point-to-line ICP of the node's scan against a
+  local map (the last ``local_map_nodes`` node scans), the odometry
+  increment being the initial guess and a weak prior; when the match is poor
+  (not converged, low inlier fraction, large residual or an implausible
+  correction) the edge is the odometry increment with a larger covariance;
+* **loop-closure edges** from ICP against the submaps of earlier nodes near
+  the current estimate (:mod:`.loop_closure`), added only after strict tests
+  and with a robust kernel;
+* GTSAM **ISAM2** after every node, a final batch **Levenberg-Marquardt** in
+  :meth:`GtsamGraphMapper.finish`.
+
+The pose of a scan is the optimised pose of the node it belongs to composed
+with the odometry from that node to the scan; the map is every scan
+projected with those poses, thinned on a grid.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel
+
+from albot1.config.presets import TomlPresets
+from albot1.contract import MapData, MapperOutput
+from albot1.data.model import Frame, Scan
+from albot1.geometry import se2
+from albot1.methods.baselines.errors import BaselineError
+from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
+from albot1.methods.baselines.gtsam_graph.correlative import SearchWindow, correlative_search
+from albot1.methods.baselines.gtsam_graph.errors import GraphError, RegistrationError
+from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
+from albot1.methods.baselines.gtsam_graph.loop_closure import (
+    Confirmer,
+    LoopMatch,
+    LoopTests,
+    find_candidates,
+    search_radius,
+    verify,
+)
+from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, line_normals, register
+from albot1.methods.baselines.point_map import first_per_cell
+
+FloatArray = NDArray[np.float64]
+
+
+class GtsamGraphMapper:
+    """Pose-graph SLAM with scan-matching edges, verified loop closures, ISAM2 and a final LM."""
+
+    name: ClassVar[str] = "gtsam-graph"
+    config_model: ClassVar[type[BaseModel]] = GtsamGraphConfig
+    presets: ClassVar[dict[str, dict]] = TomlPresets()  # type: ignore[assignment]
+
+    def __init__(self, config: GtsamGraphConfig, *, seed: int = 0) -> None:
+        # Nothing here is random; the seed is kept for the protocol and the record.
+        self.config = config
+        self.seed = seed
+        self._graph = PoseGraph(config.isam_relinearize_threshold)
+        self._seq_icp = config.icp(loop=False)
+        self._loop_icp = config.icp(loop=True)
+        self._seq_prior = np.diag(
+            [config.odometry_sigma_xy_m**-2] * 2 + [math.radians(config.odometry_sigma_theta_deg) ** -2]
+        )
+        # A vanishing prior keeps a loop match's covariance invertible while letting directions the scans do not
+        # constrain show up as huge variances, which is what the degeneracy (corridor) test looks for.
+        self._loop_prior = 1e-6 * np.diag(
+            [config.loop_max_correction_m**-2] * 2 + [math.radians(config.loop_max_correction_deg) ** -2]
+        )
+        self._floor = np.diag(
+            [config.match_sigma_floor_xy_m**2] * 2 + [math.radians(config.match_sigma_floor_theta_deg) ** 2]
+        )
+        self._fallback = np.diag(
+            [config.fallback_sigma_xy_m**2] * 2 + [math.radians(config.fallback_sigma_theta_deg) ** 2]
+        )
+        self._tests = LoopTests(
+            min_fitness=config.loop_min_fitness,
+            max_rmse_m=config.loop_max_rmse_m,
+            max_correction_m=config.loop_max_correction_m,
+            max_correction_rad=math.radians(config.loop_max_correction_deg),
+            min_sigma_ratio=config.loop_min_sigma_ratio,
+            confirmations=config.loop_confirmations,
+            agreement_m=config.loop_agreement_m,
+            agreement_rad=math.radians(config.loop_agreement_deg),
+        )
+        self._confirmer = Confirmer(self._tests)
+        # Per node.
+        self._node_odometry: list[FloatArray] = []
+        self._node_scans: list[FloatArray] = []
+        self._node_lines: list[tuple[FloatArray, FloatArray]] = []  # line-like points and normals, node frame
+        self._node_frame: list[int] = []
+        self._estimates = np.empty((0, 3))
+        # Per scan.
+        self._scan_node: list[int] = []
+        self._scan_offset: list[FloatArray] = []
+        self._scan_points: list[FloatArray | None] = []
+        # Bookkeeping.
+        self._path_since_closure = 0.0
+        self._consecutive_fallbacks = 0
+        self._loop_edges: list[tuple[int, int]] = []
+        self._rejections: dict[str, int] = {}
+        self.counters: dict[str, int] = {
+            "views": 0,
+            "nodes": 0,
+            "sequential_matches": 0,
+            "sequential_retries_recovered": 0,
+            "odometry_fallbacks": 0,
+            "loop_candidates": 0,
+            "loop_coarse_searches": 0,
+            "loop_closures_accepted": 0,
+            "loop_closures_rejected": 0,
+        }
+
+    # ------------------------------------------------------------------ input
+    def process(self, frame: Frame) -> None:
+        """Add the frame's scan to its node, creating a node when the robot moved enough."""
+        odometry = np.asarray(frame.odometry, dtype=float)
+        if odometry.shape != (3,) or not np.isfinite(odometry).all():
+            raise BaselineError(
+                f"gtsam-graph: scan {frame.index}: expected a finite odometry pose (x, y, theta), "
+                f"got {odometry.tolist()}"
+            )
+        points = self._preprocess(frame.scan, frame.index)
+        self.counters["views"] += 1
+        try:
+            if not self._node_odometry:
+                self._start(odometry, points, frame.index)
+            else:
+                last = len(self._node_odometry) - 1
+                step = se2.between(self._node_odometry[last], odometry)
+                if math.hypot(step[0], step[1]) >= self.config.node_translation_m or abs(step[2]) >= math.radians(
+                    self.config.node_rotation_deg
+                ):
+                    self._add_node(odometry, step, points, frame.index)
+        except (
+            GraphError,
+            RegistrationError,
+        ) as exc:  # re-raised as the method's error so the runner names the dataset
+            raise BaselineError(f"gtsam-graph: scan {frame.index}: {exc}") from exc
+        node = len(self._node_odometry) - 1
+        self._scan_node.append(node)
+        self._scan_offset.append(se2.between(self._node_odometry[node], odometry))
+        keep = (frame.index % self.config.map_every) == 0
+        self._scan_points.append(points if keep else None)
+
+    def _preprocess(self, scan: Scan, index: int) -> FloatArray:
+        """Valid beams within the range limits, as points, thinned to one per ``scan_voxel_m`` cell."""
+        ranges = np.asarray(scan.ranges, dtype=float)
+        if np.isinf(ranges).any():
+            raise BaselineError(f"gtsam-graph: scan {index}: ranges must be finite or NaN (no return), found inf")
+        if not np.isfinite(np.asarray(scan.angles, dtype=float)).all():
+            raise BaselineError(f"gtsam-graph: scan {index}: beam angles must be finite")
+        ok = np.isfinite(ranges) & (ranges >= self.config.min_range_m) & (ranges <= self.config.max_range_m)
+        r, a = ranges[ok], scan.angles[ok]
+        pts = np.column_stack([r * np.cos(a), r * np.sin(a)])
+        cell = self.config.scan_voxel_m
+        if cell > 0 and len(pts):
+            pts = first_per_cell(pts, cell)
+        return pts
+
+    # ------------------------------------------------------------------ nodes and edges
+    def _start(self, odometry: FloatArray, points: FloatArray, index: int) -> None:
+        self._graph.add_node(np.zeros(3))
+        self._graph.update()
+        self._remember_node(odometry, points, index)
+        self._estimates = np.zeros((1, 3))
+
+    def _remember_node(self, odometry: FloatArray, points: FloatArray, index: int) -> None:
+        """Keep what later scan matching needs of a new node: its odometry, scan, line normals and frame."""
+        self._node_odometry.append(odometry)
+        self._node_scans.append(points)
+        self._node_lines.append(
+            line_normals(points, self.config.normal_neighbours, self.config.normal_radius_m, self.config.max_planarity)
+        )
+        self._node_frame.append(index)
+
+    def _add_node(self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int) -> None:
+        prev = len(self._node_odometry) - 1
+        key = self._graph.add_node(se2.compose(self._estimates[prev], step))
+        relative, covariance = self._sequential_edge(prev, step, points, index)
+        self._graph.add_edge(prev, key, relative, covariance)
+        self._graph.update()
+        self._remember_node(odometry, points, index)
+        self._estimates = np.vstack([self._estimates, se2.compose(self._estimates[prev], relative)])
+        self._refresh_estimates(range(max(0, key - self.config.local_map_nodes), key + 1))
+        self._path_since_closure += math.hypot(relative[0], relative[1])
+        if key % self.config.loop_every_nodes == 0:
+            self._close_loops(key, index)
+
+    def _sequential_edge(
+        self, prev: int, step: FloatArray, points: FloatArray, index: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """ICP against the local map in ``prev``'s frame, or the odometry step when the match is poor.
+
+        When the match from the odometry guess fails its tests, ICP is retried
+        from the guess rotated by +-k * ``seq_retry_rotation_deg``: odometry
+        heading errors (slipping wheels while turning) are what most often
+        put the guess outside ICP's basin, and a rotated start recovers them.
+        """
+        cfg = self.config
+        first = max(0, prev - cfg.local_map_nodes + 1)
+        target = self._target(range(first, prev + 1), prev)
+        reg = self._register(target, points, step, self._seq_icp)
+        good = self._sequential_ok(reg, step)
+        for k in range(1, cfg.seq_retries + 1):
+            if good:
+                break
+            for sign in (1.0, -1.0):
+                start = step + np.array([0.0, 0.0, sign * k * math.radians(cfg.seq_retry_rotation_deg)])
+                retry = self._register(target, points, start, self._seq_icp)
+                if self._sequential_ok(retry, step) and (not good or retry.fitness > reg.fitness):
+                    reg, good = retry, True
+            if good:
+                self.counters["sequential_retries_recovered"] += 1
+        if good:
+            self.counters["sequential_matches"] += 1
+            self._consecutive_fallbacks = 0
+            covariance = np.linalg.inv(reg.information + self._seq_prior) + self._floor
+            return reg.pose, covariance
+        self.counters["odometry_fallbacks"] += 1
+        self._consecutive_fallbacks += 1
+        if self._consecutive_fallbacks >= cfg.max_consecutive_fallbacks:
+            detail = (
+                "no usable points"
+                if reg is None
+                else (f"converged={reg.converged}, fitness={reg.fitness:.2f}, rmse={reg.rmse_m:.3f} m")
+            )
+            raise BaselineError(
+                f"gtsam-graph: scan {index}: scan registration failed on {self._consecutive_fallbacks} consecutive nodes "
+                f"(last: {detail}); the front-end has lost track (limit max_consecutive_fallbacks="
+                f"{cfg.max_consecutive_fallbacks})"
+            )
+        return step, self._fallback
+
+    def _sequential_ok(self, reg: Registration | None, step: FloatArray) -> bool:
+        cfg = self.config
+        if reg is None or not reg.converged or reg.fitness < cfg.seq_min_fitness or reg.rmse_m > cfg.seq_max_rmse_m:
+            return False
+        corr = se2.between(step, reg.pose)
+        return math.hypot(corr[0], corr[1]) <= cfg.seq_max_correction_m and abs(corr[2]) <= math.radians(
+            cfg.seq_max_correction_deg
+        )
+
+    def _target(self, nodes: range, frame_node: int) -> Target:
+        """The line-like points of ``nodes``' scans, expressed in ``frame_node``'s frame."""
+        origin = self._estimates[frame_node]
+        pts, nrm = [], []
+        for n in nodes:
+            rel = se2.between(origin, self._estimates[n])
+            c, s = math.cos(rel[2]), math.sin(rel[2])
+            pts.append(se2.transform_points(rel, self._node_lines[n][0]))
+            nrm.append(self._node_lines[n][1] @ np.array([[c, s], [-s, c]]))
+        return Target(np.concatenate(pts), np.concatenate(nrm))
+
+    @staticmethod
+    def _register(target: Target, points: FloatArray, guess: FloatArray, params: IcpParams) -> Registration | None:
+        """ICP, or None when either side has too few usable points to try."""
+        if len(points) < params.min_points or len(target) < params.min_points:
+            return None
+        return register(target, points, guess, params)
+
+    def _close_loops(self, key: int, index: int) -> None:
+        cfg = self.config
+        radius = search_radius(
+            cfg.loop_search_radius_m, cfg.loop_radius_growth, cfg.loop_max_search_radius_m, self._path_since_closure
+        )
+        candidates = find_candidates(
+            self._estimates[:, :2],
+            key,
+            radius,
+            cfg.loop_min_node_gap,
+            cfg.loop_max_candidates,
+            separation=2 * cfg.loop_submap_nodes + 1,
+        )
+        verified: list[LoopMatch] = []
+        for j in candidates:
+            self.counters["loop_candidates"] += 1
+            guess = se2.between(self._estimates[j], self._estimates[key])
+            nodes = range(
+                max(0, j - cfg.loop_submap_nodes), min(key - cfg.loop_min_node_gap, j + cfg.loop_submap_nodes) + 1
+            )
+            target = self._target(nodes, j)
+            reg = self._register(target, self._node_scans[key], guess, self._loop_icp)
+            if reg is None:
+                self._reject("too few points")
+                continue
+            covariance, reason = verify(reg, guess, self._tests, self._loop_prior)
+            if covariance is None and cfg.loop_coarse_max_half_width_m > 0:
+                # The estimate may have drifted beyond ICP's basin: seed ICP from a correlative search.
+                half = min(
+                    cfg.loop_coarse_max_half_width_m,
+                    max(cfg.loop_coarse_min_half_width_m, cfg.loop_radius_growth * self._path_since_closure),
+                )
+                window = SearchWindow(
+                    half_width_m=half,
+                    step_m=cfg.loop_coarse_step_m,
+                    half_angle_rad=math.radians(cfg.loop_coarse_half_angle_deg),
+                    step_rad=math.radians(cfg.loop_coarse_step_deg),
+                )
+                coarse = correlative_search(target.points, self._node_scans[key], guess, window)
+                self.counters["loop_coarse_searches"] += 1
+                retry = self._register(target, self._node_scans[key], coarse.pose, self._loop_icp)
+                if coarse.ambiguity > cfg.loop_max_ambiguity:
+                    reason = f"ambiguous ({coarse.ambiguity:.2f})"
+                elif retry is not None:
+                    cov, why = verify(retry, guess, self._tests, self._loop_prior)
+                    if cov is not None:
+                        covariance, reason, reg = cov, "", retry
+            if covariance is None:
+                self._reject(reason)
+                continue
+            implied = se2.compose(self._estimates[j], reg.pose)
+            correction = np.array(
+                [*(implied[:2] - self._estimates[key, :2]), se2.wrap(implied[2] - self._estimates[key, 2])]
+            )
+            verified.append(LoopMatch(key, j, reg.pose, covariance + self._floor, correction))
+        accepted, expired = self._confirmer.offer(key, verified, cfg.loop_every_nodes)
+        if expired:
+            self._reject("not confirmed", expired)
+        if not accepted:
+            return
+        for match in accepted:
+            self._graph.add_edge(
+                match.candidate,
+                match.current,
+                match.relative,
+                match.covariance,
+                kernel=cfg.loop_kernel,
+                kernel_scale=cfg.loop_kernel_scale,
+            )
+            self._loop_edges.append((match.candidate, match.current))
+        self.counters["loop_closures_accepted"] += len(accepted)
+        self._graph.update(cfg.isam_extra_updates_on_loop)
+        self._estimates = self._graph.estimates()
+        self._path_since_closure = 0.0
+
+    def _reject(self, reason: str, count: int = 1) -> None:
+        self.counters["loop_closures_rejected"] += count
+        kind = reason.split(" ")[0]
+        self._rejections[kind] = self._rejections.get(kind, 0) + count
+
+    def _refresh_estimates(self, keys: range) -> None:
+        for k in keys:
+            self._estimates[k] = self._graph.estimate(k)
+
+    # ------------------------------------------------------------------ output
+    def finish(self) -> MapperOutput:
+        """Final LM, per-scan poses (node pose composed with odometry since the node) and the map."""
+        if not self._scan_node:
+            return MapperOutput(
+                poses=np.empty((0, 3)),
+                map=MapData(points=np.empty((0, 2))),
+                counters={**self.counters, "updates": 0, "optimisations": 0, "map_points": 0},
+            )
+        unconfirmed = self._confirmer.flush()
+        if unconfirmed:
+            self._reject("not confirmed", unconfirmed)
+        try:
+            nodes = (
+                self._graph.optimise(self.config.lm_max_iterations) if self.config.final_lm else self._graph.estimates()
+            )
+        except GraphError as exc:
+            raise BaselineError(f"gtsam-graph: final optimisation: {exc}") from exc
+        if not np.isfinite(nodes).all():
+            raise BaselineError(
+                f"gtsam-graph: the optimised graph of {len(nodes)} nodes has non-finite poses (diverged)"
+            )
+        poses = se2.compose(nodes[np.asarray(self._scan_node)], np.asarray(self._scan_offset))
+        points = self._project_map(poses)
+        n_nodes = len(self._node_odometry)
+        counters = {
+            **self.counters,
+            "nodes": n_nodes,
+            "updates": n_nodes,
+            "optimisations": self._graph.optimisations,
+            "map_points": int(len(points)),
+        }
+        extras = {
+            "node_scans": [int(i) for i in self._node_frame],
+            "loop_edges": [[int(a), int(b)] for a, b in self._loop_edges],
+            "loop_rejections": dict(sorted(self._rejections.items())),
+        }
+        return MapperOutput(poses=poses, map=MapData(points=points), counters=counters, extras=extras)
+
+    def _project_map(self, poses: FloatArray) -> FloatArray:
+        """Every kept scan projected with its pose; the first point in each grid cell wins (deterministic)."""
+        parts = [
+            se2.transform_points(poses[i], pts)
+            for i, pts in enumerate(self._scan_points)
+            if pts is not None and len(pts)
+        ]
+        if not parts:
+            return np.empty((0, 2))
+        return first_per_cell(np.concatenate(parts), self.config.map_voxel_m)

@@ -1,0 +1,214 @@
+"""2D scan registration: point-to-line ICP with an odometry prior.
+
+Pure maths (numpy + scipy's cKDTree), no I/O. A :class:`Target` is a point
+set with one line normal per point (:func:`line_normals`: the principal axes
+of its nearest neighbours); :func:`register` finds the SE(2) pose that maps source points
+onto the target's local lines, Gauss-Newton with Cauchy weights, starting
+from an initial guess and annealing the correspondence gate from
+``max_correspondence_m`` down to ``min_correspondence_m``.
+
+Why point-to-line rather than point-to-point: laser scans of buildings are
+mostly walls; point-to-line converges in a handful of iterations and does not
+pull scans along a wall by sampling differences (Censi 2008). Why a weak
+prior on the initial guess: in a featureless corridor the along-corridor
+direction has no gradient; the prior keeps that direction at the odometry
+guess instead of letting a near-singular normal matrix send it anywhere, and
+the returned information matrix says how much the match actually knows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class IcpParams:
+    """Knobs of one registration (see :class:`~albot1.methods.baselines.gtsam_graph.config.GtsamGraphConfig`)."""
+
+    max_iterations: int = 30
+    max_correspondence_m: float = 1.0
+    min_correspondence_m: float = 0.2
+    point_sigma_m: float = 0.05
+    cauchy_scale_m: float = 0.1
+    prior_sigma_xy_m: float = 1.0
+    prior_sigma_theta_rad: float = 0.2
+    gate_decay: float = 0.7
+    tolerance_m: float = 5e-4
+    tolerance_rad: float = 1e-4
+    min_points: int = 10
+
+
+@dataclass(frozen=True)
+class Registration:
+    """The outcome of :func:`register`.
+
+    ``pose`` maps source points into the target frame. ``fitness`` is the
+    fraction of source points with a target line within the final gate,
+    ``rmse_m`` the RMS point-to-line distance of those inliers, and
+    ``information`` the 3x3 Gauss-Newton information of the scan terms alone
+    (``J^T W J / point_sigma^2``, order x, y, theta), without the prior.
+    """
+
+    pose: FloatArray
+    converged: bool
+    iterations: int
+    fitness: float
+    rmse_m: float
+    inliers: int
+    information: FloatArray
+
+
+def line_normals(
+    points: FloatArray, neighbours: int = 6, radius_m: float = 0.5, max_planarity: float = 0.2
+) -> tuple[FloatArray, FloatArray]:
+    """The line-like points of ``points`` and one unit normal each.
+
+    A point's normal is the minor principal axis of its ``neighbours``
+    nearest points within ``radius_m``; points whose neighbourhood is not
+    line-like (eigenvalue ratio above ``max_planarity``: clutter, isolated
+    returns) are dropped because they would only add noise. Computed once per
+    scan and rotated with it, so local maps are cheap to assemble.
+    """
+    from scipy.spatial import cKDTree
+
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    if not np.isfinite(pts).all():
+        raise RegistrationError(f"target points must be finite; {int((~np.isfinite(pts)).any(axis=1).sum())} are not")
+    if len(pts) < 3:
+        return np.empty((0, 2)), np.empty((0, 2))
+    k = min(neighbours, len(pts))
+    dist, idx = cKDTree(pts).query(pts, k=k, distance_upper_bound=radius_m)
+    ok = np.isfinite(dist)
+    counts = ok.sum(axis=1)
+    idx = np.where(ok, idx, np.arange(len(pts))[:, None])  # pad with the point itself, weight 0
+    w = ok[..., None].astype(float)
+    nb = pts[idx]
+    mean = (nb * w).sum(axis=1) / np.maximum(counts, 1)[:, None]
+    d = (nb - mean[:, None, :]) * w
+    cxx = (d[..., 0] ** 2).sum(axis=1)
+    cyy = (d[..., 1] ** 2).sum(axis=1)
+    cxy = (d[..., 0] * d[..., 1]).sum(axis=1)
+    root = np.sqrt((0.5 * (cxx - cyy)) ** 2 + cxy**2)
+    lam_max = 0.5 * (cxx + cyy) + root
+    lam_min = 0.5 * (cxx + cyy) - root
+    axis = 0.5 * np.arctan2(2.0 * cxy, cxx - cyy)  # direction of the major axis
+    keep = (counts >= 3) & (lam_max > 1e-12) & (lam_min <= max_planarity * np.maximum(lam_max, 1e-12))
+    normals = np.column_stack([-np.sin(axis[keep]), np.cos(axis[keep])])
+    return pts[keep], normals
+
+
+class Target:
+    """Points with line normals (from :func:`line_normals`), indexed by a k-d tree for matching."""
+
+    def __init__(self, points: FloatArray, normals: FloatArray) -> None:
+        from scipy.spatial import cKDTree
+
+        self.points: FloatArray = np.asarray(points, dtype=float).reshape(-1, 2)
+        self.normals: FloatArray = np.asarray(normals, dtype=float).reshape(-1, 2)
+        if self.points.shape != self.normals.shape:
+            raise RegistrationError(
+                f"expected one normal per target point, got {len(self.normals)} for {len(self.points)}"
+            )
+        if not (np.isfinite(self.points).all() and np.isfinite(self.normals).all()):
+            raise RegistrationError("target points and normals must be finite")
+        self.tree = cKDTree(self.points) if len(self.points) else None
+
+    @classmethod
+    def from_points(
+        cls, points: FloatArray, neighbours: int = 6, radius_m: float = 0.5, max_planarity: float = 0.2
+    ) -> Target:
+        """A target from raw points (normals estimated here)."""
+        return cls(*line_normals(points, neighbours, radius_m, max_planarity))
+
+    def __len__(self) -> int:
+        return int(len(self.points))
+
+
+def register(target: Target, source: FloatArray, initial: FloatArray, params: IcpParams = IcpParams()) -> Registration:
+    """Align ``source`` points (sensor frame) to ``target``, starting at ``initial``.
+
+    Raises :class:`RegistrationError` for unusable input (non-finite values,
+    too few points); a match that simply does not fit comes back with
+    ``converged=False`` or a low ``fitness`` for the caller to judge.
+    """
+    src = np.asarray(source, dtype=float).reshape(-1, 2)
+    init = np.asarray(initial, dtype=float).reshape(3)
+    if not np.isfinite(init).all():
+        raise RegistrationError(f"initial guess must be finite, got {init.tolist()}")
+    if not np.isfinite(src).all():
+        raise RegistrationError(f"source points must be finite; {int((~np.isfinite(src)).any(axis=1).sum())} are not")
+    if len(src) < params.min_points or len(target) < params.min_points or target.tree is None:
+        raise RegistrationError(
+            f"need at least {params.min_points} source points and line-like target points, "
+            f"got {len(src)} source and {len(target)} target"
+        )
+
+    prior_info = np.diag([params.prior_sigma_xy_m**-2, params.prior_sigma_xy_m**-2, params.prior_sigma_theta_rad**-2])
+    inv_var = params.point_sigma_m**-2
+    pose = init.copy()
+    gate = params.max_correspondence_m
+    converged = False
+    iterations = 0
+    for iterations in range(1, params.max_iterations + 1):
+        jac, res, w, _ = _linearise(target, src, pose, gate, params.cauchy_scale_m)
+        if len(res) < params.min_points:
+            break
+        wj = jac * (w * inv_var)[:, None]
+        offset = pose - init
+        offset[2] = math.remainder(offset[2], 2.0 * math.pi)
+        try:
+            step = -np.linalg.solve(wj.T @ jac + prior_info, wj.T @ res + prior_info @ offset)
+        except np.linalg.LinAlgError:
+            break
+        if not np.isfinite(step).all():
+            break
+        pose = pose + step
+        pose[2] = math.remainder(pose[2], 2.0 * math.pi)
+        small = math.hypot(step[0], step[1]) < params.tolerance_m and abs(step[2]) < params.tolerance_rad
+        if small and gate <= params.min_correspondence_m:
+            converged = True
+            break
+        # Anneal the gate: wide while the guess may be far off, then down to the inlier gate.
+        gate = max(params.min_correspondence_m, gate * params.gate_decay)
+
+    jac, res, w, _ = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m)
+    inliers = int(len(res))
+    information = (jac * (w * inv_var)[:, None]).T @ jac if inliers else np.zeros((3, 3))
+    rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")
+    return Registration(
+        pose=pose,
+        converged=converged,
+        iterations=iterations,
+        fitness=inliers / len(src),
+        rmse_m=rmse,
+        inliers=inliers,
+        information=information,
+    )
+
+
+def _linearise(
+    target: Target, src: FloatArray, pose: FloatArray, gate: float, cauchy_scale: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Jacobian rows, point-to-line residuals, Cauchy weights and distances of matches within ``gate``."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    rot = src @ np.array([[c, s], [-s, c]])  # R p for row vectors
+    dist, idx = target.tree.query(rot + pose[:2], k=1, distance_upper_bound=gate)
+    ok = dist < gate
+    rot, idx = rot[ok], idx[ok]
+    n = target.normals[idx]
+    diff = rot + pose[:2] - target.points[idx]
+    res = n[:, 0] * diff[:, 0] + n[:, 1] * diff[:, 1]
+    # d(R p + t)/d theta = (-(R p)_y, (R p)_x).
+    jac = np.empty((len(res), 3))
+    jac[:, :2] = n
+    jac[:, 2] = n[:, 1] * rot[:, 0] - n[:, 0] * rot[:, 1]
+    w = 1.0 / (1.0 + (res / cauchy_scale) ** 2)
+    return jac, res, w, dist[ok]

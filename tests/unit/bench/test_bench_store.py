@@ -1,0 +1,166 @@
+"""Results store and the verdict on a finished cell process (no processes started here)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from albot1.bench.cell_main import ERROR_FILE, EXIT_EXCEPTION, EXIT_MEMORY, limit_memory
+from albot1.bench.cells import restrict_relations
+from albot1.bench.errors import BenchError
+from albot1.bench.grid import Cell, GridPlan, Skipped
+from albot1.bench.job import judge
+from albot1.bench.limits import ChildExit
+from albot1.bench.store import ResultsStore
+from albot1.data.model import Relations
+
+
+def make_cell(**changes: object) -> Cell:
+    values: dict[str, object] = dict(
+        suite="t",
+        dataset="w",
+        dataset_label="w[:10]",
+        method="odometry",
+        method_label="odometry",
+        preset="default",
+        degradation="none",
+        seed=0,
+        key="k1",
+        code_version="v",
+        time_s=7,
+        memory_mb=123,
+        limit=10,
+    )
+    values.update(changes)
+    return Cell(**values)  # type: ignore[arg-type]
+
+
+def test_cell_and_plan_round_trip_through_json() -> None:
+    cell = make_cell(overrides={"a": 1}, config={"a": 1}, requires=("x",))
+    assert Cell.from_json(json.loads(json.dumps(cell.to_json()))) == cell
+    plan = GridPlan(
+        "t",
+        None,
+        "",
+        [cell],
+        [Skipped("intel", "absent", "albot1 datasets fetch intel")],
+        [],
+        {},
+        [0],
+        ["none"],
+        {"cpu_count": 2},
+    )
+    again = GridPlan.from_json(json.loads(json.dumps(plan.to_json())))
+    assert again.cells == [cell] and again.skipped_datasets == plan.skipped_datasets
+
+
+def test_complete_needs_done_and_parseable_metrics(tmp_path: Path) -> None:
+    store = ResultsStore(tmp_path)
+    run_dir = store.prepare(make_cell())
+    assert not store.is_complete("k1")
+    (run_dir / "DONE").write_text("k1\n")
+    assert not store.is_complete("k1")  # evaluation missing: the cell is re-evaluated, not kept
+    (run_dir / "metrics.json").write_text('{"ate": ')
+    assert not store.is_complete("k1")  # a torn file never counts
+    (run_dir / "metrics.json").write_text('{"ate": null}')
+    assert store.is_complete("k1")
+
+
+def test_failure_is_recorded_and_cleared_by_the_next_attempt(tmp_path: Path) -> None:
+    store = ResultsStore(tmp_path)
+    cell = make_cell()
+    store.record_failure(cell, "boom", "exception", exit_code=2, elapsed_s=1.5, traceback_text="Traceback ...")
+    failure = store.failure("k1")
+    assert failure is not None and (failure.reason, failure.kind, failure.exit_code) == ("boom", "exception", 2)
+    assert "Traceback" in (store.run_dir("k1") / "cell.log").read_text()
+    store.prepare(cell)
+    assert store.failure("k1") is None
+
+
+def test_lock_refuses_a_second_runner(tmp_path: Path) -> None:
+    first, second = ResultsStore(tmp_path), ResultsStore(tmp_path)
+    first.lock()
+    try:
+        with pytest.raises(BenchError, match="another `albot1 bench` is running"):
+            second.lock()
+    finally:
+        first.unlock()
+    second.lock()
+    second.unlock()
+
+
+def test_read_plan_of_a_folder_that_is_not_a_results_folder(tmp_path: Path) -> None:
+    with pytest.raises(BenchError, match="no grid.json"):
+        ResultsStore(tmp_path).read_plan()
+
+
+@pytest.mark.parametrize(
+    ("ended", "error", "kind", "words"),
+    [
+        (ChildExit(None, True, 7.1), None, "timeout", "time limit exceeded: no result after 7 s"),
+        (ChildExit(-11, False, 1.0), None, "crash", "SIGSEGV"),
+        (ChildExit(-9, False, 1.0), None, "crash", "out-of-memory killer"),
+        (
+            ChildExit(EXIT_MEMORY, False, 1.0),
+            {"kind": "memory", "type": "MemoryError", "message": ""},
+            "memory",
+            "memory limit exceeded (123 MB address space)",
+        ),
+        (
+            ChildExit(EXIT_EXCEPTION, False, 1.0),
+            {"kind": "exception", "type": "BaselineError", "message": "diverged"},
+            "exception",
+            "BaselineError: diverged",
+        ),
+        (ChildExit(1, False, 1.0), None, "crash", "exited with code 1 without an error report"),
+        (ChildExit(0, False, 1.0), None, "exception", "left no complete run"),
+    ],
+)
+def test_judge_names_every_way_a_cell_can_end(
+    tmp_path: Path, ended: ChildExit, error: dict | None, kind: str, words: str
+) -> None:
+    store = ResultsStore(tmp_path)
+    run_dir = store.prepare(make_cell())
+    if error is not None:
+        (run_dir / ERROR_FILE).write_text(json.dumps(error))
+    verdict = judge(make_cell(), store, ended)
+    assert verdict is not None
+    assert verdict[0] == kind and words in verdict[1]
+    assert not (run_dir / ERROR_FILE).exists()
+
+
+def test_judge_accepts_a_complete_cell(tmp_path: Path) -> None:
+    store = ResultsStore(tmp_path)
+    run_dir = store.prepare(make_cell())
+    (run_dir / "DONE").write_text("k1\n")
+    (run_dir / "metrics.json").write_text("{}")
+    assert judge(make_cell(), store, ChildExit(0, False, 1.0)) is None
+
+
+def test_restrict_relations_keeps_pairs_whose_both_ends_were_kept() -> None:
+    relations = Relations(
+        t1=np.array([0.0, 1.0, 2.0, 0.0]),
+        t2=np.array([1.0, 3.0, 4.0, 4.0]),
+        poses=np.arange(12, dtype=float).reshape(4, 3),
+    )
+    kept = restrict_relations(relations, np.array([0.0, 1.0, 2.0, 4.0]))
+    assert kept is not None
+    np.testing.assert_array_equal(kept.t1, [0.0, 2.0, 0.0])
+    np.testing.assert_array_equal(kept.poses[:, 0], [0.0, 6.0, 9.0])
+    assert restrict_relations(relations, np.array([10.0])) is None
+
+
+def test_limit_memory_caps_growth_above_the_current_size() -> None:
+    import resource
+
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    try:
+        cap = limit_memory(64)
+        assert cap is not None
+        with pytest.raises(MemoryError):
+            np.ones(16 * 2**20)  # 128 MiB > 64 MiB allowance
+    finally:
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))

@@ -1,0 +1,137 @@
+"""Suite files: parsing, validation errors that name file and key, option merging, shipped suites."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from albot1.bench.errors import BenchError, SuiteError
+from albot1.bench.executors import parse_executor
+from albot1.bench.suite import find_suite, load_suite, parse_suite
+from albot1.resources import project_dir
+
+MINIMAL = {"methods": [{"name": "odometry"}], "datasets": [{"name": "*"}]}
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    return path
+
+
+def test_minimal_suite_defaults() -> None:
+    suite = parse_suite(MINIMAL, name="s", source="s.toml")
+    assert suite.limits.time_s == 900 and suite.limits.memory_mb == 4096
+    assert suite.grid.degradations == () and suite.grid.undegraded_seeds == (0,)
+    assert suite.methods[0].display == "odometry"
+
+
+def test_later_entries_override_earlier_ones_field_by_field() -> None:
+    suite = parse_suite(
+        {
+            "methods": [{"name": "odometry"}],
+            "datasets": [
+                {"name": "*", "stride": 2, "time_s": 30},
+                {"name": "intel*", "limit": 100},
+                {"name": "intel-corrected", "stride": 1},
+                {"name": "aces", "skip": True},
+            ],
+        },
+        name="s",
+        source="s.toml",
+    )
+    intel = suite.options_for("intel-corrected")
+    assert intel is not None
+    assert (intel.limit, intel.stride, intel.time_s) == (100, 1, 30)
+    assert intel.label == "intel-corrected[:100:1]"
+    other = suite.options_for("fr079")
+    assert other is not None and other.label == "fr079[::2]"
+    assert suite.options_for("aces") is None
+    assert suite.literal_datasets() == ["intel-corrected"]
+
+
+def test_method_labels_include_non_default_presets_and_must_be_unique() -> None:
+    suite = parse_suite(
+        {
+            "methods": [{"name": "albot1", "preset": "thesis"}, {"name": "albot1", "preset": "exact"}],
+            "datasets": [{"name": "*"}],
+        },
+        name="s",
+        source="s.toml",
+    )
+    assert [m.display for m in suite.methods] == ["albot1:thesis", "albot1:exact"]
+    with pytest.raises(SuiteError, match="both labelled 'odometry'"):
+        parse_suite(
+            {"methods": [{"name": "odometry"}, {"name": "odometry"}], "datasets": [{"name": "*"}]},
+            name="s",
+            source="s.toml",
+        )
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", strde = 2}]\n', r"s\.toml: .*datasets\.0\.strde"),
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", limit = 0}]\n', r"datasets\.0\.limit"),
+        ('methods = []\ndatasets = [{name = "*"}]\n', r"methods"),
+        (
+            'methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n[grid]\ndegradations = ["gauss:1"]\n',
+            r"grid\.degradations.*gauss:SIGMA_XY_M",
+        ),
+        ('methods = [{name = "odometry", target = "nocolon"}]\ndatasets = [{name = "*"}]\n', r"module:Class"),
+        ('methods = [{name = "odometry"}]\nx = = 1\n', r"s\.toml: not valid TOML.*line 2"),
+    ],
+)
+def test_invalid_suites_name_file_and_key(tmp_path: Path, text: str, expected: str) -> None:
+    with pytest.raises(SuiteError, match=expected):
+        load_suite(write(tmp_path, text))
+
+
+def test_suite_name_defaults_to_file_stem(tmp_path: Path) -> None:
+    path = write(tmp_path, 'methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n')
+    assert load_suite(path).name == "s"
+
+
+def test_find_suite_by_name_and_path(tmp_path: Path) -> None:
+    assert find_suite("quick") == project_dir() / "benchmarks" / "quick.toml"
+    path = write(tmp_path, "")
+    assert find_suite(str(path)) == path
+    with pytest.raises(SuiteError, match="no suite named 'nope'.*quick"):
+        find_suite("nope")
+    with pytest.raises(SuiteError, match="suite file not found"):
+        find_suite(str(tmp_path / "missing.toml"))
+
+
+@pytest.mark.parametrize("name", ["default", "quick", "full"])
+def test_shipped_suites_are_valid(name: str) -> None:
+    suite = load_suite(find_suite(name))
+    assert suite.name == name
+    assert {"odometry", "albot1"} <= {m.name for m in suite.methods}
+
+
+def test_parse_executor() -> None:
+    assert parse_executor("local") == ("local", None)
+    assert parse_executor("dask") == ("dask", None)
+    assert parse_executor("dask://10.0.0.1:8786") == ("dask", "tcp://10.0.0.1:8786")
+    with pytest.raises(BenchError, match="expected local | dask"):
+        parse_executor("ray")
+
+
+def test_reference_with_loader_options_is_a_literal_entry() -> None:
+    suite = parse_suite(
+        {
+            "methods": [{"name": "odometry"}],
+            "datasets": [
+                {"name": "*", "sweep": False},
+                {"name": "intel-corrected?odometry=laser-pose", "sweep": True},
+            ],
+        },
+        name="s",
+        source="s.toml",
+    )
+    assert suite.literal_datasets() == ["intel-corrected?odometry=laser-pose"]
+    opts = suite.options_for("intel-corrected?odometry=laser-pose")
+    assert opts is not None and opts.sweep is True
+    plain = suite.options_for("intel-corrected")
+    assert plain is not None and plain.sweep is False

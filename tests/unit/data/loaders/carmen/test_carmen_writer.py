@@ -1,0 +1,59 @@
+"""CarmenWriter -> CarmenLoader round trip: ranges, NaN beams, geometry, max range, both pose sets."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from albot1.data.errors import DataError
+from albot1.data.loaders.carmen.loader import CarmenLoader
+from albot1.data.loaders.carmen.writer import CarmenWriter
+from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
+
+
+def sequence(with_reference: bool, stamps: list[float]) -> Sequence:
+    rng = np.random.default_rng(7)
+    angles = np.linspace(-2.0, 2.0, 91)
+    frames = []
+    for i, t in enumerate(stamps):
+        ranges = rng.uniform(0.2, 25.0, size=91)
+        ranges[rng.integers(0, 91, size=5)] = np.nan
+        odom = np.array([0.1 * i, -0.05 * i, math.remainder(0.3 * i, 2 * math.pi)])
+        ref = odom + np.array([0.01, 0.02, 0.003]) if with_reference else None
+        frames.append(Frame(i, Scan(ranges, angles, t, 25.5), odom, ref))
+    meta = SequenceMetadata(sensor_offset=(0.15, -0.02, 0.01))
+    return Sequence.from_frames("synthetic", frames, meta)
+
+
+@pytest.mark.parametrize("name", ["out.clf", "out.clf.gz", "out.log.bz2"])
+@pytest.mark.parametrize("stamps", [[0.1 * k for k in range(20)], [7.0] * 20])
+def test_round_trip(tmp_path: Path, name: str, stamps: list[float]) -> None:
+    original = sequence(True, stamps)
+    CarmenWriter().write(original, tmp_path / name)
+    back = CarmenLoader().load(tmp_path / name)
+    assert back.metadata.sensor_offset == pytest.approx((0.15, -0.02, 0.01), abs=1e-8)
+    pairs = list(zip(original.frames(), back.frames(), strict=True))
+    for a, b in pairs:
+        np.testing.assert_array_equal(np.isnan(a.scan.ranges), np.isnan(b.scan.ranges))
+        np.testing.assert_allclose(a.scan.ranges, b.scan.ranges, atol=5e-7, equal_nan=True)
+        np.testing.assert_allclose(a.scan.angles, b.scan.angles, atol=1e-12)
+        assert b.scan.max_range == 25.5 and b.scan.timestamp == pytest.approx(a.scan.timestamp, abs=1e-6)
+        np.testing.assert_allclose(a.odometry, b.odometry, atol=1e-8)
+        np.testing.assert_allclose(a.reference, b.reference, atol=1e-8)
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_without_reference_loads_without_reference(tmp_path: Path) -> None:
+    CarmenWriter().write(sequence(False, [0.1 * k for k in range(3)]), tmp_path / "o.clf")
+    assert CarmenLoader().load(tmp_path / "o.clf").reference is None
+
+
+def test_uneven_beams_are_rejected_and_nothing_is_left(tmp_path: Path) -> None:
+    scan = Scan(np.ones(3), np.array([0.0, 0.1, 0.3]), 0.0, 10.0)
+    seq = Sequence.from_frames("u", [Frame(0, scan, np.zeros(3))])
+    with pytest.raises(DataError, match="frame 0: beam angles are not evenly spaced"):
+        CarmenWriter().write(seq, tmp_path / "u.clf")
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,88 @@
+"""Exact checks of the pure ROS message conversions (no bag, no rosbags)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from albot1.data.loaders.rosbag.msg import (
+    PoseTrack,
+    even_spacing,
+    quaternion_from_yaw,
+    scan_arrays,
+    seconds_to_ns,
+    split_ns,
+    stamp_seconds,
+    yaw_from_quaternion,
+)
+
+
+def test_scan_arrays_marks_out_of_range_inf_and_nan_as_no_return() -> None:
+    ranges, angles = scan_arrays(
+        np.array([0.05, 1.0, np.inf, np.nan, 30.0, 30.5, -np.inf], dtype=np.float32),
+        angle_min=-0.5,
+        angle_increment=0.25,
+        range_min=0.1,
+        range_max=30.0,
+    )
+    assert np.array_equal(np.isnan(ranges), [True, False, True, True, False, True, True])
+    assert ranges[1] == 1.0 and ranges[4] == 30.0
+    assert np.allclose(angles, [-0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 1.0], atol=0, rtol=0)
+
+
+def test_a_clockwise_scan_is_reversed_so_angles_ascend() -> None:
+    ranges, angles = scan_arrays(
+        np.array([1.0, 2.0, 3.0]), angle_min=0.5, angle_increment=-0.5, range_min=0.0, range_max=10.0
+    )
+    assert angles.tolist() == [-0.5, 0.0, 0.5]
+    assert ranges.tolist() == [3.0, 2.0, 1.0]
+
+
+@pytest.mark.parametrize("theta", [0.0, 0.3, -2.0, math.pi - 1e-9, -math.pi + 1e-9, 1.5])
+def test_yaw_quaternion_round_trip(theta: float) -> None:
+    assert yaw_from_quaternion(*quaternion_from_yaw(theta)) == pytest.approx(theta, abs=1e-12)
+
+
+def test_yaw_of_an_unwrapped_heading_comes_back_wrapped() -> None:
+    assert yaw_from_quaternion(*quaternion_from_yaw(2 * math.pi + 0.25)) == pytest.approx(0.25, abs=1e-12)
+
+
+def test_stamp_conversions() -> None:
+    ns = seconds_to_ns(70.2899)
+    assert ns == 70_289_900_000
+    assert split_ns(ns) == (70, 289_900_000)
+    assert stamp_seconds(*split_ns(ns)) == pytest.approx(70.2899, abs=1e-12)
+
+
+def test_even_spacing_accepts_uniform_and_rejects_irregular_beams() -> None:
+    uniform = np.deg2rad(np.arange(-90.0, 90.0, 1.0))
+    first, step = even_spacing(uniform)  # type: ignore[misc]
+    assert first == uniform[0] and step == pytest.approx(math.radians(1.0), rel=1e-14)
+    irregular = uniform.copy()
+    irregular[10] += 1e-3
+    assert even_spacing(irregular) is None
+    assert even_spacing(np.array([0.3])) == (0.3, 0.0)
+
+
+def test_pose_track_returns_stored_poses_exactly_at_their_stamps() -> None:
+    poses = np.array([[0.0, 0.0, 3.0], [1.0, 2.0, 3.1], [2.0, 2.0, -3.1]])
+    track = PoseTrack.build([1.0, 2.0, 3.0], poses)
+    for t, pose in zip([1.0, 2.0, 3.0], poses):
+        assert np.array_equal(track.at(t), pose)  # type: ignore[arg-type]
+
+
+def test_pose_track_interpolates_heading_across_the_wrap() -> None:
+    track = PoseTrack.build([0.0, 1.0], [[0.0, 0.0, math.pi - 0.1], [2.0, 4.0, -math.pi + 0.1]])
+    mid = track.at(0.5)
+    assert mid is not None
+    assert mid[:2] == pytest.approx([1.0, 2.0])
+    assert abs(abs(mid[2]) - math.pi) < 1e-12  # through pi, not through 0
+
+
+def test_pose_track_never_extrapolates() -> None:
+    track = PoseTrack.build([5.0, 1.0], [[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])  # unsorted input is sorted
+    assert track.start == 1.0 and track.end == 5.0
+    assert track.at(0.999) is None and track.at(5.001) is None
+    assert track.at(3.0) == pytest.approx([0.5, 0.0, 0.0])

@@ -1,0 +1,71 @@
+"""The shipped manifests: every public dataset is registered, pinned, checksummed and loadable by name."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from albot1.data import catalog
+from albot1.data.errors import DatasetNotFoundError
+from albot1.settings import Settings
+
+SITES = [
+    "acapulco",
+    "aces",
+    "belgioioso",
+    "csail",
+    "edmonton",
+    "fhw",
+    "freiburg-079",
+    "freiburg-101",
+    "freiburg-campus",
+    "infinite-corridor",
+    "intel",
+    "orebro",
+    "seattle",
+]
+RAW = ["intel", "aces", "fr079", "mit-csail", "fr-clinic"]
+PINNED = re.compile(
+    r"^https://raw\.githubusercontent\.com/("
+    r"MOLAorg/mola_test_datasets/13a2ed141116bc654e14ffca1d88fb740b3d1253/datasets/radish/"
+    r"|acschaefer/ple/cfcb5a7f12a793b616357381a688cfcc26eed347/data/carmen/)"
+)
+
+
+def test_every_dataset_of_the_readme_is_registered() -> None:
+    expected = set(RAW) | {"mit-killian"} | {f"{s}-corrected" for s in SITES}
+    assert expected <= set(catalog.names())
+
+
+@pytest.mark.parametrize("name", catalog.names())
+def test_manifest_fields(name: str) -> None:
+    m = catalog.get(name)
+    assert m.name == name and m.description and m.license and m.citation and m.format == "carmen"
+    for f in m.files:
+        assert re.fullmatch(r"[0-9a-f]{64}", f.sha256)
+        assert not f.path.startswith("/")
+        if not m.local_only:
+            assert f.urls and all(PINNED.match(u) and u.endswith(f.path.split("/")[-1]) for u in f.urls)
+
+
+def test_corrected_logs_take_reference_from_the_flaser_pose() -> None:
+    for site in SITES:
+        loader = catalog.get(f"{site}-corrected").loader
+        assert loader["reference"] == "laser-pose"
+        assert loader["odometry"] == ("laser-pose" if site == "orebro" else "odom-segments")
+
+
+def test_mit_killian_is_local_only_and_aces_has_relations() -> None:
+    assert catalog.get("mit-killian").local_only and not catalog.get("mit-killian").file("log").urls
+    assert catalog.get("aces").file("relations").path == "radish/aces.relations"
+
+
+def test_unknown_and_missing_datasets(tmp_path) -> None:
+    with pytest.raises(DatasetNotFoundError, match="unknown dataset 'nope'; known datasets: .*intel"):
+        catalog.get("nope")
+    settings = Settings(data_dir=tmp_path / "empty", cache_dir=tmp_path / "cache")
+    with pytest.raises(DatasetNotFoundError, match=r"radish/intel\.clf\.bz2 not found under .*datasets fetch intel"):
+        catalog.locate("intel", settings)
+    with pytest.raises(DatasetNotFoundError, match="derived locally and cannot be downloaded"):
+        catalog.open_dataset("mit-killian", settings)

@@ -1,0 +1,45 @@
+"""Dataset references: names, loader options and slices in one string."""
+
+from __future__ import annotations
+
+import pytest
+
+from albot1.data.errors import DatasetNotFoundError
+from albot1.data.open import open_sequence, parse_options
+
+
+def test_parse_options_converts_numbers() -> None:
+    assert parse_options("odometry=laser-pose&max_range=80&tol=0.5", "x") == {
+        "odometry": "laser-pose",
+        "max_range": 80,
+        "tol": 0.5,
+    }
+
+
+def test_bad_option_names_the_ref() -> None:
+    with pytest.raises(DatasetNotFoundError, match="'x': loader option 'novalue' is not of the form KEY=VALUE"):
+        parse_options("novalue", "x")
+
+
+def test_slice_of_a_world() -> None:
+    full = open_sequence("synthetic-office-startstop")
+    part = open_sequence("synthetic-office-startstop[:20:2]")
+    assert len(part) == 10
+    assert part.timestamps[1] == full.timestamps[2]
+
+
+def test_world_rejects_loader_options() -> None:
+    with pytest.raises(DatasetNotFoundError, match="takes no loader options, got odometry"):
+        open_sequence("synthetic-office-startstop?odometry=laser-pose")
+
+
+def test_unknown_name_lists_known_ones() -> None:
+    with pytest.raises(DatasetNotFoundError, match="synthetic-office-loop"):
+        open_sequence("no-such-dataset")
+
+
+def test_corrected_log_with_clean_odometry(data_file) -> None:  # type: ignore[no-untyped-def]
+    data_file("radish-corrected/intel-corrected.log.gz")
+    seq = open_sequence("intel-corrected?odometry=laser-pose[:50]")
+    assert len(seq) == 50 and seq.reference is not None
+    assert (seq.odometry == seq.reference).all()

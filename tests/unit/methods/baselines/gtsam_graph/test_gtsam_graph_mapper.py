@@ -1,0 +1,174 @@
+"""GtsamGraphMapper on a small ray-cast room: nodes, determinism, presets and the documented errors."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from albot1.data.model import Frame, Scan, Sequence
+from albot1.data.synthetic.lidar import cast
+from albot1.geometry import se2
+from albot1.methods.baselines.errors import BaselineError
+from albot1.methods.baselines.gtsam_graph import GtsamGraphConfig, GtsamGraphMapper
+from albot1.methods.registry import resolve_config
+from albot1.runs.execute import run_method
+
+pytest.importorskip("gtsam")
+
+WALLS = np.array(
+    [
+        [0, 0, 12, 0],
+        [12, 0, 12, 8],
+        [12, 8, 7, 8],
+        [7, 8, 7, 9],
+        [7, 9, 4, 9],
+        [4, 9, 4, 8],
+        [4, 8, 0, 8],
+        [0, 8, 0, 0],
+        [5, 3, 6, 3],
+        [6, 3, 6, 4],
+        [6, 4, 5, 4],
+        [5, 4, 5, 3],
+        [9, 1, 10, 2],
+    ],
+    dtype=float,
+)
+ANGLES = np.radians(np.linspace(-90.0, 90.0, 181))
+
+
+def room_sequence(scans: int = 60, odometry_bias_deg: float = 0.5) -> Sequence:
+    """A 0.1 m-per-scan drive along the room with a slowly turning heading; odometry over-turns a little."""
+    t = np.arange(scans)
+    truth = np.column_stack([2.0 + 0.1 * t, 2.0 + 0.02 * t, 0.2 * np.sin(t / 15.0)])
+    steps = se2.relative_steps(truth)
+    steps[:, 2] += math.radians(odometry_bias_deg)
+    odometry = se2.integrate_steps(truth[0], steps)
+    frames = []
+    for i in range(scans):
+        ranges = cast(WALLS, truth[i], ANGLES, 30.0)
+        frames.append(Frame(i, Scan(ranges, ANGLES, float(i) * 0.1, 30.0), odometry[i], truth[i]))
+    return Sequence.from_frames("room", frames)
+
+
+def config(**overrides: object) -> GtsamGraphConfig:
+    return resolve_config("gtsam-graph", "default", dict(overrides))  # type: ignore[return-value]
+
+
+def run(seq: Sequence, **overrides: object) -> tuple[GtsamGraphMapper, object]:
+    mapper = GtsamGraphMapper(config(**overrides))
+    for frame in seq.frames():
+        mapper.process(frame)
+    return mapper, mapper.finish()
+
+
+def test_presets_come_from_the_toml_and_validate() -> None:
+    presets = GtsamGraphMapper.presets
+    assert "default" in presets
+    cfg = config()
+    assert cfg.node_translation_m == 0.5
+    assert math.isclose(math.radians(cfg.node_rotation_deg), 0.5, rel_tol=1e-4)
+
+
+def test_nodes_every_half_metre_and_scan_poses_follow_odometry_between_nodes() -> None:
+    seq = room_sequence()
+    mapper, out = run(seq)
+    nodes = out.extras["node_scans"]
+    odo = seq.odometry
+    # A node opens when the odometry moved >= 0.5 m (or 0.5 rad) from the previous node.
+    for a, b in zip(nodes, nodes[1:]):
+        step = se2.between(odo[a], odo[b])
+        before = se2.between(odo[a], odo[b - 1])
+        assert math.hypot(step[0], step[1]) >= 0.5 or abs(step[2]) >= 0.5
+        assert math.hypot(before[0], before[1]) < 0.5 and abs(before[2]) < 0.5
+    assert out.counters["nodes"] == out.counters["updates"] == len(nodes)
+    assert out.counters["views"] == len(seq)
+    # Between nodes the scan pose is the node pose composed with odometry since the node.
+    k = nodes[1] + 1
+    np.testing.assert_allclose(
+        se2.between(out.poses[nodes[1]], out.poses[k]), se2.between(odo[nodes[1]], odo[k]), atol=1e-9
+    )
+
+
+def test_scan_matching_beats_biased_odometry_on_the_room() -> None:
+    seq = room_sequence()
+    _, out = run(seq)
+    ref = seq.reference
+    est = se2.compose(ref[0], out.poses)  # the mapper's frame starts at the origin
+    err = np.hypot(*(est[:, :2] - ref[:, :2]).T)
+    odo_err = np.hypot(*(seq.odometry[:, :2] - ref[:, :2]).T)
+    assert err.max() < 0.05
+    assert err.max() < 0.5 * odo_err.max()
+    assert out.counters["odometry_fallbacks"] == 0
+    for key in (
+        "views",
+        "updates",
+        "nodes",
+        "loop_closures_accepted",
+        "loop_closures_rejected",
+        "optimisations",
+        "odometry_fallbacks",
+        "map_points",
+    ):
+        assert key in out.counters
+    assert out.map.points is not None and len(out.map.points) == out.counters["map_points"] > 100
+
+
+def test_same_input_gives_identical_output() -> None:
+    seq = room_sequence(40)
+    a = run_method("gtsam-graph", seq, degradation="gauss:0.02:0.5", seed=7)
+    b = run_method("gtsam-graph", seq, degradation="gauss:0.02:0.5", seed=7)
+    np.testing.assert_array_equal(a.poses, b.poses)
+    np.testing.assert_array_equal(a.map.points, b.map.points)
+    assert a.counters == b.counters
+
+
+def test_non_finite_odometry_names_the_scan() -> None:
+    seq = room_sequence(10)
+    frames = list(seq.frames())
+    frames[4] = replace(frames[4], odometry=np.array([np.nan, 0.0, 0.0]))
+    with pytest.raises(BaselineError, match=r"^gtsam-graph on room-nan: scan 4: expected a finite odometry pose"):
+        run_method("gtsam-graph", Sequence.from_frames("room-nan", frames))
+
+
+def test_registration_that_never_converges_aborts_with_baseline_error() -> None:
+    """Scans without returns cannot be registered: after the configured number of fallbacks the run stops."""
+    seq = room_sequence(40)
+    frames = [
+        replace(f, scan=replace(f.scan, ranges=np.full_like(f.scan.ranges, np.nan))) if f.index > 3 else f
+        for f in seq.frames()
+    ]
+    with pytest.raises(
+        BaselineError, match=r"^gtsam-graph on room-blind: scan \d+: scan registration failed on 3 consecutive nodes"
+    ):
+        run_method(
+            "gtsam-graph", Sequence.from_frames("room-blind", frames), overrides={"max_consecutive_fallbacks": 3}
+        )
+
+
+def test_infinite_ranges_are_refused() -> None:
+    seq = room_sequence(5)
+    frames = list(seq.frames())
+    ranges = frames[2].scan.ranges.copy()
+    ranges[10] = np.inf
+    frames[2] = replace(frames[2], scan=replace(frames[2].scan, ranges=ranges))
+    with pytest.raises(BaselineError, match=r"^gtsam-graph on room-inf: scan 2: ranges must be finite or NaN"):
+        run_method("gtsam-graph", Sequence.from_frames("room-inf", frames))
+
+
+def test_back_end_failure_is_a_baseline_error_naming_the_scan(monkeypatch: pytest.MonkeyPatch) -> None:
+    from albot1.methods.baselines.gtsam_graph.errors import GraphError
+    from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
+
+    original = PoseGraph.update
+
+    def fail(self: PoseGraph, extra_iterations: int = 0) -> None:
+        if len(self) > 2:
+            raise GraphError(f"ISAM2 update with {len(self)} nodes failed: Indeterminant linear system")
+        original(self, extra_iterations)
+
+    monkeypatch.setattr(PoseGraph, "update", fail)
+    with pytest.raises(BaselineError, match=r"^gtsam-graph on room: scan \d+: ISAM2 update with 3 nodes failed"):
+        run_method("gtsam-graph", room_sequence(40))

@@ -1,0 +1,110 @@
+"""The relation metric (Kuemmerle et al. 2009) and RPE on constructed cases."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from albot1.data.model import Relations
+from albot1.geometry import se2
+from albot1.metrics.errors import MetricsError
+from albot1.metrics.relations import nearest_indices, relation_metric
+from albot1.metrics.rpe import pair_indices, rpe, rpe_set
+
+
+def straight(n: int = 21) -> tuple[np.ndarray, np.ndarray]:
+    stamps = np.arange(n) * 2.0  # one scan every 2 s, 1 m apart
+    return stamps, np.column_stack([np.arange(n, dtype=float), np.zeros(n), np.zeros(n)])
+
+
+def relations_from(stamps: np.ndarray, poses: np.ndarray, pairs: list[tuple[int, int]]) -> Relations:
+    i = np.array([p[0] for p in pairs])
+    j = np.array([p[1] for p in pairs])
+    return Relations(t1=stamps[i], t2=stamps[j], poses=se2.between(poses[i], poses[j]))
+
+
+def test_a_perfect_estimate_has_zero_relation_error_even_in_another_frame() -> None:
+    stamps, ref = straight()
+    rel = relations_from(stamps, ref, [(0, 1), (3, 9), (0, 20)])
+    est = se2.compose(np.array([5.0, -2.0, 1.0]), ref)
+    block = relation_metric(stamps, est, rel)
+    assert block["translation_m"]["max"] == pytest.approx(0.0, abs=1e-12)
+    assert block["rotation_deg"]["max"] == pytest.approx(0.0, abs=1e-9)
+    assert block["translation_m"]["n"] == 3
+
+
+def test_a_known_error_gives_known_statistics_with_sample_std() -> None:
+    stamps, ref = straight()
+    est = ref.copy()
+    est[10:, 0] += 0.5  # a 0.5 m jump forward between scans 9 and 10
+    est[15:, 2] += np.radians(3.0)  # and a 3 deg turn between 14 and 15
+    rel = relations_from(stamps, ref, [(0, 5), (8, 12), (13, 17), (16, 20)])
+    block = relation_metric(stamps, est, rel)
+    # (13, 17): est rel = (4, 0, 3 deg) vs (4, 0, 0): rotation 3 deg only.
+    # (16, 20): both ends turned 3 deg, positions not: the 4 m step is seen 3 deg off,
+    # a chord error of 2 * 4 * sin(1.5 deg).
+    trans = np.array([0.0, 0.5, 0.0, 8.0 * np.sin(np.radians(1.5))])
+    rot = np.array([0.0, 0.0, 3.0, 0.0])
+    assert block["translation_m"]["mean"] == pytest.approx(trans.mean())
+    assert block["translation_m"]["std"] == pytest.approx(trans.std(ddof=1))
+    assert block["translation_m"]["max"] == pytest.approx(0.5)
+    assert block["translation_m"]["min"] == pytest.approx(0.0, abs=1e-12)
+    assert block["rotation_deg"]["mean"] == pytest.approx(rot.mean())
+    assert block["rotation_deg"]["std"] == pytest.approx(rot.std(ddof=1))
+    assert block["translation_squared_m2"]["mean"] == pytest.approx(np.mean(trans**2))
+    assert block["rotation_squared_deg2"]["max"] == pytest.approx(9.0)
+
+
+def test_loop_relations_are_those_spanning_more_than_30_s() -> None:
+    stamps, ref = straight()
+    est = ref.copy()
+    est[:, 1] = 0.01 * np.arange(21)  # sideways drift
+    rel = relations_from(stamps, ref, [(0, 1), (0, 15), (0, 20), (5, 19)])  # spans 2, 30, 40, 28 s
+    block = relation_metric(stamps, est, rel)
+    assert block["loops"]["translation_m"]["n"] == 1
+    assert block["loops"]["translation_m"]["max"] == pytest.approx(0.2)  # (0, 20): 0.2 m sideways
+
+
+def test_a_relation_time_without_a_scan_names_the_relation_line() -> None:
+    stamps, ref = straight()
+    rel = relations_from(stamps, ref, [(0, 1), (2, 3), (4, 5)])
+    bad = Relations(t1=rel.t1.copy(), t2=rel.t2.copy(), poses=rel.poses)
+    bad.t2[2] += 0.5
+    with pytest.raises(MetricsError, match=r"rel\.txt:3: no pose within 0\.1 s of time 10\.5"):
+        relation_metric(stamps, ref, bad, source="rel.txt")
+
+
+def test_relations_outside_a_prefix_run_are_excluded_and_counted_when_asked() -> None:
+    stamps, ref = straight()
+    rel = relations_from(stamps, ref, [(0, 1), (2, 3), (15, 18)])
+    block = relation_metric(stamps[:10], ref[:10], rel, outside="exclude")
+    assert (block["relations_used"], block["relations_outside_run"]) == (2, 1)
+    with pytest.raises(MetricsError, match=":3: no pose within"):
+        relation_metric(stamps[:10], ref[:10], rel)
+
+
+def test_nearest_indices_picks_the_closer_neighbour() -> None:
+    idx, gap = nearest_indices([0.0, 1.0, 2.0], [0.4, 0.6, 2.05, -0.01])
+    assert idx.tolist() == [0, 1, 2, 0]
+    np.testing.assert_allclose(gap, [0.4, 0.4, 0.05, 0.01])
+
+
+def test_rpe_pairs_by_frames_and_by_reference_travel() -> None:
+    _, ref = straight(11)
+    assert pair_indices(ref, 3, "frames").tolist() == [[0, 3], [3, 6], [6, 9]]
+    assert pair_indices(ref, 2.5, "m").tolist() == [[0, 3], [3, 6], [6, 9]]
+
+
+def test_rpe_of_a_constant_per_step_heading_bias() -> None:
+    _, ref = straight(11)
+    est = se2.integrate_steps(ref[0], se2.relative_steps(ref) + np.array([0.0, 0.0, np.radians(1.0)]))
+    one = rpe(est, ref, 1, "frames")
+    assert one["rotation_deg"]["mean"] == pytest.approx(1.0)
+    # Over one step the translation of the step is unchanged (the turn happens after it).
+    assert one["translation_m"]["max"] == pytest.approx(0.0, abs=1e-12)
+    two = rpe(est, ref, 2, "frames")
+    # inv(Q) P for P = step(1 m) turned 1 deg then 1 m: error |(cos1 - 1, sin1)| m.
+    assert two["translation_m"]["mean"] == pytest.approx(np.hypot(np.cos(np.radians(1)) - 1, np.sin(np.radians(1))))
+    block = rpe_set(est, ref)
+    assert [d["delta_unit"] for d in block["deltas"]] == ["frames", "m", "m"]
+    assert block["translation_m"] == block["deltas"][0]["translation_m"]

@@ -1,0 +1,116 @@
+"""The runner's contract: config resolution, timing, result checks, error wrapping."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+import pytest
+from pydantic import BaseModel, ConfigDict
+
+from albot1.methods.baselines.errors import BaselineError
+from albot1.data.model import Frame, Scan, Sequence
+from albot1.errors import ConfigError
+from albot1.methods import registry as methods
+from albot1.runs.errors import RunError, UnknownMethodError
+from albot1.runs.execute import run_method
+from albot1.methods.registry import MethodSpec, parse_overrides, resolve_config
+from albot1.contract import MapData, MapperOutput
+
+ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
+
+
+def _sequence(n: int = 6) -> Sequence:
+    frames = [Frame(i, Scan(np.full(9, 2.0), ANGLES, float(i), 30.0), np.array([0.5 * i, 0.0, 0.0]),
+                    np.array([0.5 * i, 0.0, 0.0])) for i in range(n)]
+    return Sequence.from_frames("toy", frames)
+
+
+class FakeConfig(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    mode: str = "ok"
+    gain: float = 1.0
+
+
+class FakeMapper:
+    """Misbehaves on request, to exercise the runner's checks."""
+
+    name: ClassVar[str] = "fake"
+    config_model: ClassVar[type[BaseModel]] = FakeConfig
+    presets: ClassVar[dict[str, dict[str, Any]]] = {"default": {}, "double": {"gain": 2.0}}
+
+    def __init__(self, config: FakeConfig, *, seed: int = 0) -> None:
+        self.config = config
+        self.n = 0
+
+    def process(self, frame: Frame) -> None:
+        if self.config.mode == "raise" and frame.index == 3:
+            raise ZeroDivisionError("boom")
+        self.n += 1
+
+    def finish(self) -> MapperOutput:
+        n = self.n - 1 if self.config.mode == "short" else self.n
+        poses = np.zeros((n, 3)) * self.config.gain
+        if self.config.mode == "nan":
+            poses[2, 0] = np.nan
+        counters = {"views": self.n} if self.config.mode == "nocount" else {"views": self.n, "updates": 1}
+        return MapperOutput(poses=poses, map=MapData(points=np.zeros((1, 2))), counters=counters)
+
+
+@pytest.fixture
+def fake_method(monkeypatch: pytest.MonkeyPatch) -> str:
+    monkeypatch.setitem(methods.METHODS, "fake", MethodSpec("fake", f"{__name__}:FakeMapper"))
+    return "fake"
+
+
+def test_config_precedence(fake_method: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    assert resolve_config(fake_method).gain == 1.0
+    assert resolve_config(fake_method, "double").gain == 2.0
+    monkeypatch.setenv("ALBOT1_FAKE_GAIN", "3.5")
+    assert resolve_config(fake_method, "double").gain == 3.5
+    assert resolve_config(fake_method, "double", {"gain": "4"}).gain == 4.0
+
+
+def test_config_errors_say_what_was_expected(fake_method: str) -> None:
+    with pytest.raises(ConfigError, match="no preset 'nope'; expected one of: default, double"):
+        resolve_config(fake_method, "nope")
+    with pytest.raises(ConfigError, match="gain"):
+        resolve_config(fake_method, overrides={"gain": "abc"})
+    with pytest.raises(ConfigError, match="unknown|extra|not permitted"):
+        resolve_config(fake_method, overrides={"typo": 1})
+    with pytest.raises(ConfigError, match="FIELD=VALUE"):
+        parse_overrides(["gain"])
+
+
+def test_unknown_method() -> None:
+    with pytest.raises(UnknownMethodError, match="expected one of"):
+        methods.get_method("nope")
+
+
+def test_missing_dependency_is_named(monkeypatch: pytest.MonkeyPatch) -> None:
+    spec = MethodSpec("ghost", "x:Y", requires=("no_such_module_xyz",))
+    monkeypatch.setitem(methods.METHODS, "ghost", spec)
+    assert not spec.available()
+    with pytest.raises(UnknownMethodError, match="no_such_module_xyz"):
+        spec.load_class()
+
+
+def test_successful_run_records_everything(fake_method: str) -> None:
+    result = run_method(fake_method, _sequence(), degradation="gauss:0.1:1", seed=4)
+    assert result.poses.shape == (6, 3) and result.per_scan_ns.shape == (6,)
+    assert result.reference is not None and result.reference.shape == (6, 3)
+    assert result.config == {"mode": "ok", "gain": 1.0}
+    assert result.versions["code"].startswith("0.1.0+")
+    assert result.timing()["per_scan_ms_median"] >= 0.0
+    assert not np.allclose(result.odometry, _sequence().odometry)  # degraded before the method saw it
+
+
+@pytest.mark.parametrize(("mode", "error", "match"), [
+    ("raise", BaselineError, r"fake on toy failed at scan 3: ZeroDivisionError: boom"),
+    ("short", BaselineError, r"expected 6 poses"),
+    ("nan", BaselineError, r"non-finite poses, first at scan 2"),
+    ("nocount", RunError, r"counters lack the required key 'updates'"),
+])
+def test_contract_violations(fake_method: str, mode: str, error: type[Exception], match: str) -> None:
+    with pytest.raises(error, match=match):
+        run_method(fake_method, _sequence(), overrides={"mode": mode})
