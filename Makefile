@@ -17,7 +17,7 @@ endif
 endif
 export MPLBACKEND := Agg
 
-.PHONY: venv test test-fast bench bench-timing clean
+.PHONY: venv test test-fast bench bench-timing lint wheel-check clean
 
 venv: $(STAMP)
 
@@ -39,5 +39,18 @@ bench: $(STAMP)
 bench-timing: $(STAMP)
 	$(BIN)/python -m pytest benchmarks -q --benchmark-only --benchmark-json=reports/timing.json
 
+# Static checks: style (ruff), types (mypy, config in pyproject.toml) and the
+# import layers of docs/architecture.md (import-linter).
+lint: $(STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+	$(BIN)/mypy
+	$(BIN)/lint-imports
+
+# Build the wheel, install it with its dependencies into a fresh venv outside
+# the clone and run the CLI from there (.ci/wheel-check).
+wheel-check:
+	PYTHON=$(PYTHON) .ci/wheel-check
+
 clean:
-	rm -rf $(VENV) .pytest_cache .benchmarks
+	rm -rf $(VENV) .pytest_cache .benchmarks build dist

@@ -13,8 +13,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 
-def atomic_write(path: str | Path, writer: Callable[[Path], None]) -> None:
-    """Call ``writer(tmp_path)`` and rename the result to ``path``.
+def atomic_write(path: str | Path, writer: Callable[[Path], object]) -> None:
+    """Call ``writer(tmp_path)`` and rename the result to ``path`` (``writer``'s return value is ignored).
 
     The temporary name keeps ``path``'s suffix, so writers that choose a
     compression or format by suffix (``.gz``, ``.npz``) behave as for ``path``.

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from albot1.data.model import Frame, Relations
+from albot1.records import Timing
 
 FloatArray = NDArray[np.float64]
 
@@ -73,6 +74,10 @@ class Mapper(Protocol):
     #: preset name -> field overrides on top of the config model's defaults; has "default".
     presets: ClassVar[dict[str, dict[str, Any]]]
 
+    def __init__(self, config: Any, *, seed: int = 0) -> None:
+        """Build from a validated ``config_model`` instance; ``seed`` drives any random choice."""
+        ...
+
     def process(self, frame: Frame) -> None:
         """Consume one frame (the only call that is timed per scan)."""
         ...
@@ -84,7 +89,11 @@ class Mapper(Protocol):
 
 @dataclass
 class RunResult:
-    """One method run on one (possibly degraded) sequence, ready to store."""
+    """One method run on one (possibly degraded) sequence, ready to store.
+
+    :func:`albot1.runs.folder.write_run` turns it into a run folder; its
+    ``result.json`` is an :class:`albot1.records.ResultRecord`.
+    """
 
     method: str
     dataset: str
@@ -108,15 +117,15 @@ class RunResult:
     versions: dict[str, Any]
     dataset_info: dict[str, Any] = field(default_factory=dict)
 
-    def timing(self) -> dict[str, float]:
-        """The timing block of ``result.json`` (DESIGN.md 4b)."""
+    def timing(self) -> Timing:
+        """The ``timing`` block of ``result.json`` (per-scan statistics are None for a run of no scans)."""
         ms = self.per_scan_ns.astype(float) / 1e6
-        return {
-            "per_scan_ms_median": float(np.median(ms)) if len(ms) else float("nan"),
-            "per_scan_ms_p95": float(np.percentile(ms, 95)) if len(ms) else float("nan"),
-            "per_scan_ms_mean": float(np.mean(ms)) if len(ms) else float("nan"),
-            "finish_s": self.finish_s,
-            "total_s": self.total_s,
-            "wall_s": self.wall_s,
-            "peak_mb": self.peak_mb,
-        }
+        return Timing(
+            per_scan_ms_median=float(np.median(ms)) if len(ms) else None,
+            per_scan_ms_p95=float(np.percentile(ms, 95)) if len(ms) else None,
+            per_scan_ms_mean=float(np.mean(ms)) if len(ms) else None,
+            finish_s=self.finish_s,
+            total_s=self.total_s,
+            wall_s=self.wall_s,
+            peak_mb=self.peak_mb,
+        )

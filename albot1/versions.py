@@ -11,6 +11,8 @@ from pathlib import Path
 from albot1 import __version__
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
+#: ``albot1.resources.BUNDLE_DIR_NAME`` (same layer: the two modules may not import each other).
+_BUNDLE_DIR_NAME = "_bundled"
 
 
 @lru_cache(maxsize=1)
@@ -19,11 +21,17 @@ def code_version() -> str:
 
     A digest of the sources (rather than only a git hash) changes whenever the
     code that computes a result changes, committed or not, and works outside a
-    git checkout (an installed wheel, a CI tarball).
+    git checkout (an installed wheel, a CI tarball). The copies of the project's
+    TOML folders bundled into a wheel (``albot1/_bundled``, see
+    :mod:`albot1.resources`) are left out, so a wheel and the checkout it was
+    built from name the same code; the configs a run used are recorded with it.
     """
     digest = hashlib.sha256()
     for path in sorted(_PACKAGE_DIR.rglob("*")):
-        if path.is_file() and path.suffix in {".py", ".toml", ".json"} and "__pycache__" not in path.parts:
+        relative = path.relative_to(_PACKAGE_DIR).parts
+        if relative[0] == _BUNDLE_DIR_NAME or "__pycache__" in relative:
+            continue
+        if path.is_file() and path.suffix in {".py", ".toml", ".json"}:
             digest.update(path.relative_to(_PACKAGE_DIR).as_posix().encode())
             digest.update(path.read_bytes())
     return f"{__version__}+{digest.hexdigest()[:12]}"

@@ -28,14 +28,14 @@ from albot1.data.loaders.registry import load
 from albot1.data.model import Frame
 from albot1.data.synthetic.worlds import load_world
 from albot1.data.transforms import head
-from albot1.methods.albot1.mapping.config import PRESETS, Albot1Config
+from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 
 
 def _per_scan_ns(
     frames: list[Frame], preset: str = "thesis", clock: Callable[[], int] = time.perf_counter_ns
 ) -> np.ndarray:
-    mapper = Albot1Mapper(Albot1Config(**PRESETS[preset]))
+    mapper = Albot1Mapper(Albot1Config(**Albot1Mapper.presets[preset]))
     out = np.empty(len(frames), dtype=np.int64)
     for i, frame in enumerate(frames):
         t0 = clock()

@@ -15,12 +15,14 @@ from typing import Any
 
 import pytest
 
+from albot1.bench.cells import renderer_target
 from albot1.bench.grid import Cell
 from albot1.bench.job import run_cell_job
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
 from albot1.bench.suite import parse_suite
 from albot1.report.index import build_report
+from albot1.report.preview import render_preview
 from albot1.settings import get_settings
 
 SUITE = {
@@ -28,6 +30,7 @@ SUITE = {
     "methods": [{"name": "odometry"}],
     "datasets": [{"name": "synthetic-office-startstop"}],
 }
+PREVIEW = renderer_target(render_preview)  # as `albot1 bench` draws it
 
 
 @pytest.fixture(scope="module")
@@ -41,11 +44,11 @@ def planned(tmp_path_factory: pytest.TempPathFactory) -> tuple[ResultsStore, lis
 def test_per_cell_overhead(benchmark: Any, planned: tuple[ResultsStore, list[Cell]]) -> None:
     store, cells = planned
     cell = cells[0]
-    run_cell_job(cell, str(store.root))  # starts the forkserver once, as a grid does
+    run_cell_job(cell, str(store.root), PREVIEW)  # starts the forkserver once, as a grid does
 
-    def fresh() -> tuple[tuple[Cell, str], dict[str, Any]]:
+    def fresh() -> tuple[tuple[Cell, str, str], dict[str, Any]]:
         shutil.rmtree(store.run_dir(cell.key), ignore_errors=True)
-        return (cell, str(store.root)), {}
+        return (cell, str(store.root), PREVIEW), {}
 
     outcome = benchmark.pedantic(run_cell_job, setup=fresh, rounds=5, iterations=1)
     assert outcome.status == "done", outcome.reason
@@ -55,6 +58,6 @@ def test_report_build(benchmark: Any, planned: tuple[ResultsStore, list[Cell]], 
     store, cells = planned
     for cell in cells:
         if not store.is_complete(cell.key):
-            assert run_cell_job(cell, str(store.root)).status == "done"
+            assert run_cell_job(cell, str(store.root), PREVIEW).status == "done"
     index = benchmark.pedantic(build_report, args=(store.root, tmp_path / "report"), rounds=2, iterations=1)
     assert index.is_file()

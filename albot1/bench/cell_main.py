@@ -109,10 +109,12 @@ def child_main(args: dict[str, Any]) -> int:
     _apply_environment(dict(args.get("env", {})))
     try:
         limit_memory(float(args["cell"]["memory_mb"]))
-        from albot1.bench.cells import execute_cell
+        # Imported here, inside the try: an import failure is this cell's recorded failure.
+        from albot1.bench.cells import execute_cell, renderer_from_target
         from albot1.bench.grid import Cell
 
-        execute_cell(Cell.from_json(args["cell"]), Path(args["runs_root"]))
+        preview = renderer_from_target(args.get("preview"))
+        execute_cell(Cell.from_json(args["cell"]), Path(args["runs_root"]), preview=preview)
     except MemoryError as exc:
         _write_error(run_dir, "memory", exc)
         return EXIT_MEMORY

@@ -10,28 +10,37 @@ killed last time) is only re-evaluated, not re-run.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import Any, cast
 
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell
-from albot1.data.model import Relations, Sequence
-from albot1.runs.folder import is_complete
+from albot1.bench.plan import register_plugin
+from albot1.config.targets import resolve_target
+from albot1.data.model import Sequence
+from albot1.data.open import open_sequence
+from albot1.data.relations import restrict_relations
+from albot1.runs.evaluate import evaluate_run
+from albot1.runs.execute import run_method
+from albot1.runs.folder import PreviewRenderer, is_complete, write_run
 from albot1.settings import Settings, get_settings
 
-#: a relation end counts as inside the slice when a kept scan is this close in time (s)
-RELATION_TOLERANCE_S = 1e-3
+__all__ = [
+    "config_difference",
+    "execute_cell",
+    "open_cell_sequence",
+    "renderer_from_target",
+    "renderer_target",
+    "restrict_relations",
+]
 
 
 def open_cell_sequence(cell: Cell, settings: Settings) -> Sequence:
     """The dataset slice of ``cell`` (its label, e.g. ``intel[:4000:2]``, is what ``open_sequence`` reopens).
 
-    The relations of a slice are restricted to the kept scans, so the
-    relation metric scores exactly the scans the method saw.
+    The relations of a slice are restricted to the kept scans
+    (:func:`albot1.data.relations.restrict_relations`, the same stamp matching
+    as the relation metric), so the metric scores exactly the scans the method saw.
     """
-    from albot1.data.open import open_sequence
-
     sequence = open_sequence(cell.dataset_label, settings=settings)
     if (cell.limit is None and cell.stride is None) or sequence.relations is None:
         return sequence
@@ -40,21 +49,26 @@ def open_cell_sequence(cell: Cell, settings: Settings) -> Sequence:
     )
 
 
-def restrict_relations(relations: Relations, timestamps: np.ndarray) -> Relations | None:
-    """The relations whose two ends are both kept scans (a slice must not be scored on scans it lacks)."""
-    if len(timestamps) == 0:
-        return None
-    stamps = np.sort(np.asarray(timestamps, dtype=float))
+def renderer_target(renderer: PreviewRenderer) -> str:
+    """``module:function`` naming ``renderer``: how a preview renderer reaches the cell processes.
 
-    def kept(t: np.ndarray) -> np.ndarray:
-        idx = np.clip(np.searchsorted(stamps, t), 1, len(stamps) - 1) if len(stamps) > 1 else np.zeros(len(t), int)
-        nearest = np.minimum(np.abs(stamps[idx] - t), np.abs(stamps[np.maximum(idx - 1, 0)] - t))
-        return nearest <= RELATION_TOLERANCE_S
+    A cell runs in a child process started from JSON arguments (and possibly
+    on a Dask worker), so the renderer travels by name and is imported there.
+    """
+    target = f"{renderer.__module__}:{renderer.__qualname__}"
+    if resolve_target(target) is not renderer:
+        raise BenchError(f"{target}: a preview renderer must be a module-level function importable by that name")
+    return target
 
-    mask = kept(relations.t1) & kept(relations.t2)
-    if not mask.any():
+
+def renderer_from_target(target: str | None) -> PreviewRenderer | None:
+    """The renderer named by :func:`renderer_target` (None: no previews)."""
+    if target is None:
         return None
-    return Relations(t1=relations.t1[mask], t2=relations.t2[mask], poses=relations.poses[mask])
+    renderer = resolve_target(target)
+    if not callable(renderer):
+        raise BenchError(f"{target}: expected a preview renderer function, found {type(renderer).__name__}")
+    return cast(PreviewRenderer, renderer)
 
 
 def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
@@ -67,15 +81,14 @@ def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
     )
 
 
-def execute_cell(cell: Cell, runs_root: Path, settings: Settings | None = None) -> Path:
-    """Run, store and evaluate ``cell`` under ``runs_root/<key>``; returns the run folder."""
-    from albot1.runs.evaluate import evaluate_run
-    from albot1.runs.execute import run_method
-    from albot1.runs.folder import write_run
+def execute_cell(
+    cell: Cell, runs_root: Path, settings: Settings | None = None, preview: PreviewRenderer | None = None
+) -> Path:
+    """Run, store and evaluate ``cell`` under ``runs_root/<key>``; returns the run folder.
 
+    ``preview`` draws the run's ``preview.png`` (see :func:`albot1.runs.folder.write_run`).
+    """
     if cell.target is not None:
-        from albot1.bench.plan import register_plugin
-
         register_plugin(cell.method, cell.target, cell.error_class, cell.requires)
     settings = settings or get_settings()
     run_dir = runs_root / cell.key
@@ -96,7 +109,7 @@ def execute_cell(cell: Cell, runs_root: Path, settings: Settings | None = None) 
                 f"planned one ({config_difference(cell.config or {}, result.config)}); did a "
                 "baselines/*.toml file or an ALBOT1_* variable change during the run?"
             )
-        written = write_run(result, runs_root)
+        written = write_run(result, runs_root, preview=preview)
         if written.name != cell.key:
             raise BenchError(
                 f"{cell.describe()}: stored under {written.name}, expected key {cell.key} "

@@ -18,7 +18,8 @@ from albot1.bench.cell_main import ERROR_FILE, EXIT_OK
 from albot1.bench.grid import Cell, CellOutcome, FailureKind
 from albot1.bench.limits import ChildExit, run_limited
 from albot1.bench.store import ATTEMPT, LOG, ResultsStore
-from albot1.runs.folder import write_json
+from albot1.records import AttemptRecord
+from albot1.runs.folder import write_record
 
 
 def _signal_name(number: int) -> str:
@@ -63,20 +64,23 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
     return None
 
 
-def run_cell_job(cell: Cell, results_root: str) -> CellOutcome:
-    """Run ``cell`` into the store at ``results_root`` and record how it ended."""
+def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> CellOutcome:
+    """Run ``cell`` into the store at ``results_root`` and record how it ended.
+
+    ``preview``: the ``module:function`` that draws each run's preview (None: no preview).
+    """
     store = ResultsStore(results_root)
     run_dir = store.prepare(cell)
-    ended = run_limited(cell, store.runs, run_dir / LOG)
+    ended = run_limited(cell, store.runs, run_dir / LOG, preview=preview)
     verdict = judge(cell, store, ended)
     if verdict is None:
-        write_json(
+        write_record(
             run_dir / ATTEMPT,
-            {
-                "elapsed_s": ended.elapsed_s,
-                "host": socket.gethostname(),
-                "finished": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-            },
+            AttemptRecord(
+                elapsed_s=ended.elapsed_s,
+                host=socket.gethostname(),
+                finished=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            ),
         )
         return CellOutcome.of(cell, "done", ended.elapsed_s)
     kind, reason = verdict

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from albot1.bench.cell_main import process_entry
 from albot1.bench.grid import Cell
 from albot1.runs.folder import write_json
 
@@ -73,24 +74,28 @@ def launcher() -> str:
     return "subprocess"
 
 
-def child_args(cell: Cell, runs_root: Path, log_path: Path) -> dict[str, Any]:
+def child_args(cell: Cell, runs_root: Path, log_path: Path, preview: str | None = None) -> dict[str, Any]:
     env = {k: v for k, v in os.environ.items() if k.startswith("ALBOT1_")}
     return {
         "cell": cell.to_json(),
         "runs_root": str(runs_root),
         "log_path": str(log_path),
+        "preview": preview,
         "parent_pid": os.getpid(),
         "env": env,
     }
 
 
-def run_limited(cell: Cell, runs_root: Path, log_path: Path, *, how: str | None = None) -> ChildExit:
-    """Run ``cell`` in a child; kill it after ``cell.time_s`` seconds."""
-    args = child_args(cell, runs_root, log_path)
+def run_limited(
+    cell: Cell, runs_root: Path, log_path: Path, *, how: str | None = None, preview: str | None = None
+) -> ChildExit:
+    """Run ``cell`` in a child; kill it after ``cell.time_s`` seconds.
+
+    ``preview`` is the ``module:function`` of the run preview renderer (``bench.cells.renderer_target``).
+    """
+    args = child_args(cell, runs_root, log_path, preview)
     start = time.monotonic()
     if (how or launcher()) == "forkserver":
-        from albot1.bench.cell_main import process_entry
-
         # The forkserver, not this process, is the child's parent; it exits when this process dies.
         args["parent_pid"] = None
         proc = _forkserver().Process(target=process_entry, args=(args,), name=f"cell-{cell.key}", daemon=False)

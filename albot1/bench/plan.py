@@ -20,7 +20,12 @@ from albot1 import versions
 from albot1.bench.errors import SuiteError
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
+from albot1.data import catalog
+from albot1.data.errors import DatasetNotFoundError
+from albot1.data.open import open_sequence
+from albot1.data.synthetic import worlds
 from albot1.errors import Albot1Error
+from albot1.methods.registry import METHODS, MethodSpec, resolve_config
 from albot1.runs.folder import run_key
 from albot1.settings import Settings
 
@@ -48,8 +53,6 @@ def register_plugin(name: str, target: str, error_class: str | None, requires: I
     Called by the planner and again inside each cell's child process, which
     starts from a fresh registry.
     """
-    from albot1.methods.registry import METHODS, MethodSpec
-
     spec = MethodSpec(
         name,
         target,
@@ -67,8 +70,6 @@ def register_plugin(name: str, target: str, error_class: str | None, requires: I
 
 def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
     """(resolved config as JSON, None) or (None, reason it does not resolve)."""
-    from albot1.methods.registry import resolve_config
-
     try:
         config = resolve_config(entry.name, entry.preset, dict(entry.set))
     except Albot1Error as exc:
@@ -79,8 +80,6 @@ def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
 
 
 def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
-    from albot1.methods.registry import METHODS
-
     entries = list(suite.methods)
     for entry in entries:
         if entry.target is not None:
@@ -117,9 +116,6 @@ def _importable(module: str) -> bool:
 
 
 def _candidate_datasets(suite: Suite) -> list[str]:
-    from albot1.data import catalog
-    from albot1.data.synthetic import worlds
-
     known = list(worlds.WORLDS) + sorted(catalog.names())
     out = [n for n in known if suite.options_for(n) is not None]
     for literal in suite.literal_datasets():
@@ -130,10 +126,6 @@ def _candidate_datasets(suite: Suite) -> list[str]:
 
 def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None]:
     """(has reference poses, None) when the dataset can be opened, else (None, why skipped)."""
-    from albot1.data import catalog
-    from albot1.data.errors import DatasetNotFoundError
-    from albot1.data.open import open_sequence
-
     base = name.partition("?")[0]  # a reference with loader options needs its catalog file all the same
     if base in catalog.names():
         try:

@@ -52,12 +52,13 @@ def _warm() -> None:
             importlib.import_module(name)
         except Exception:  # noqa: BLE001 -- reported by the cell that needs the module
             continue
+    from albot1.config.targets import resolve_target
     from albot1.data.loaders.registry import FORMATS
     from albot1.methods.registry import METHODS
 
     for loader_target, _ in FORMATS.values():
         try:
-            importlib.import_module(loader_target.partition(":")[0])
+            resolve_target(loader_target)
         except Exception:  # noqa: BLE001 -- reported by the cell that reads this format
             continue
 

@@ -14,13 +14,20 @@ import traceback
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Protocol
 
+from albot1.bench.cells import renderer_target
+from albot1.bench.executors import open_executor, parse_executor
 from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.job import results_path, run_cell_job
+from albot1.bench.limits import start_forkserver
+from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
-from albot1.settings import Settings
+from albot1.bench.suite import find_suite, load_suite
+from albot1.runs.folder import PreviewRenderer
+from albot1.settings import Settings, get_settings
 
 
 class GridObserver(Protocol):
@@ -116,15 +123,16 @@ def run_suite(
     observer: GridObserver | None = None,
     settings: Settings | None = None,
     dask_processes: bool = True,
+    preview: PreviewRenderer | None = None,
 ) -> tuple[GridPlan, GridSummary, ResultsStore]:
-    """Load, plan and run a suite into ``results/<suite>``: what `albot1 bench` does."""
-    from albot1.bench.executors import open_executor, parse_executor
-    from albot1.bench.limits import start_forkserver
-    from albot1.bench.plan import plan_suite
-    from albot1.bench.suite import find_suite, load_suite
-    from albot1.settings import get_settings
+    """Load, plan and run a suite into ``results/<suite>``: what `albot1 bench` does.
 
+    ``preview`` draws each run's ``preview.png`` (the CLI passes
+    ``albot1.report.preview.render_preview``); it must be a module-level function,
+    as the cell processes import it by name.
+    """
     kind, _ = parse_executor(executor)  # a typo fails before any planning work
+    job = partial(run_cell_job, preview=renderer_target(preview) if preview is not None else None)
     suite_file = find_suite(suite_ref)
     suite = load_suite(suite_file)
     if kind == "local":
@@ -135,7 +143,7 @@ def run_suite(
     try:
         store.write_plan(plan, suite_file)
         with open_executor(executor, jobs, dask_processes=dask_processes) as pool:
-            summary = run_grid(plan, store, pool, observer)
+            summary = run_grid(plan, store, pool, observer, job=job)
     finally:
         store.unlock()
     return plan, summary, store

@@ -49,6 +49,10 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from albot1.bench.errors import SuiteError
+from albot1.config.targets import TargetError, check_target
+from albot1.config.validation import describe_errors
+from albot1.data.degrade import DegradationSpecError, parse_spec
+from albot1.resources import list_resources, resource_dirs
 
 # "?" is not a glob character here: in a dataset reference it introduces loader options
 # (``intel-corrected?odometry=laser-pose``, see albot1.data.open), so such an entry is a literal.
@@ -95,8 +99,11 @@ class MethodEntry(_Strict):
     @field_validator("target", "error_class")
     @classmethod
     def _module_class(cls, value: str | None) -> str | None:
-        if value is not None and (value.count(":") != 1 or not all(value.split(":"))):
-            raise ValueError(f"expected 'module:Class', got {value!r}")
+        if value is not None:
+            try:
+                check_target(value)
+            except TargetError as exc:
+                raise ValueError(str(exc)) from None
         return value
 
     @property
@@ -202,8 +209,6 @@ class Suite(_Strict):
 
 
 def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
-    from albot1.data.degrade import DegradationSpecError, parse_spec
-
     for spec in specs:
         try:
             parse_spec(spec)
@@ -217,10 +222,7 @@ def parse_suite(data: dict[str, Any], *, name: str, source: str, path: Path | No
     try:
         return Suite.model_validate({"name": name, **data, "path": path})
     except ValidationError as exc:
-        problems = "; ".join(
-            f"{'.'.join(str(p) for p in err['loc']) or '(top level)'}: {err['msg']}" for err in exc.errors()
-        )
-        raise SuiteError(f"{source}: invalid suite: {problems}") from None
+        raise SuiteError(f"{source}: invalid suite: {describe_errors(exc)}") from None
 
 
 def load_suite(path: str | Path) -> Suite:
@@ -237,20 +239,22 @@ def load_suite(path: str | Path) -> Suite:
 
 
 def find_suite(ref: str) -> Path:
-    """A suite argument -> its file: an existing path, else ``benchmarks/<ref>.toml`` of the project."""
+    """A suite argument -> its file: an existing path, else the project's ``benchmarks/<ref>.toml``.
+
+    Suites by name are found with :func:`albot1.resources.list_resources`
+    (a user's ``ALBOT1_CONFIG_DIR/benchmarks/`` first, then the checkout's
+    or the installed package's copy).
+    """
     candidate = Path(ref).expanduser()
     if candidate.suffix == ".toml" or candidate.is_file():
         if not candidate.is_file():
             raise SuiteError(f"{candidate}: suite file not found")
         return candidate
-    from albot1.resources import project_dir
-
-    folder = project_dir() / "benchmarks"
-    path = folder / f"{ref}.toml"
-    if not path.is_file():
-        known = sorted(p.stem for p in folder.glob("*.toml"))
+    suites = {path.stem: path for path in list_resources("benchmarks")}
+    if ref not in suites:
+        searched = " or ".join(str(folder) for folder in resource_dirs("benchmarks"))
         raise SuiteError(
-            f"no suite named {ref!r} in {folder}; expected one of: {', '.join(known) or '(none)'} "
+            f"no suite named {ref!r} in {searched}; expected one of: {', '.join(suites) or '(none)'} "
             "or a path to a .toml file"
         )
-    return path
+    return suites[ref]

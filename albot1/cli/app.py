@@ -27,6 +27,7 @@ _COMMANDS: tuple[tuple[str, str, str | None], ...] = (
     ("albot1.cli.datasets", "app", "datasets"),
     ("albot1.cli.convert", "register", None),
     ("albot1.cli.run", "register", None),
+    ("albot1.cli.methods", "register", None),
     ("albot1.cli.evaluate", "register", None),
     ("albot1.cli.bench", "register", None),
 )

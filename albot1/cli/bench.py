@@ -44,6 +44,7 @@ def bench(
 
     from albot1.bench.progress import TqdmProgress, plan_table, summary_table
     from albot1.bench.runner import run_suite
+    from albot1.report.preview import render_preview
     from albot1.settings import get_settings
 
     if dry_run:
@@ -62,6 +63,7 @@ def bench(
             executor=executor,
             observer=view,
             settings=get_settings(data_dir=data_dir),
+            preview=render_preview,
         )
     finally:
         view.close()

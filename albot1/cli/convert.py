@@ -7,6 +7,11 @@ from typing import Annotated
 
 import typer
 
+from albot1.data.convert import convert as run_conversion
+from albot1.data.open import open_sequence
+from albot1.data.transforms import head
+from albot1.settings import get_settings
+
 FORMAT_HELP = "carmen | ros1 | ros2-sqlite3 | ros2-mcap | albot-log (default: from OUT's name)"
 
 
@@ -50,11 +55,6 @@ def convert(
       albot1 convert radish/aces.clf.bz2 aces.mcap\n
       albot1 convert run1/ aces.albotlog --scan-topic /base_scan --odom-topic /odom_raw
     """
-    from albot1.data.convert import convert as run_conversion
-    from albot1.data.open import open_sequence
-    from albot1.data.transforms import head
-    from albot1.settings import get_settings
-
     options = {
         "scan_topic": scan_topic,
         "odom_topic": odom_topic,

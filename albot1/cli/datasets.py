@@ -1,18 +1,21 @@
 """``albot1 datasets list | fetch NAME | info NAME|PATH``: the dataset registry from the shell.
 
 Thin: every fact comes from :mod:`albot1.data.catalog` and
-:meth:`albot1.data.model.Sequence.summary`; heavy imports happen inside the
-commands so ``albot1 --help`` stays instant.
+:meth:`albot1.data.model.Sequence.summary`.
 """
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+
+from albot1.data import catalog
+from albot1.data.open import open_sequence
+from albot1.data.synthetic import worlds
+from albot1.settings import get_settings
 
 app = typer.Typer(
     help="Public datasets: what is registered, what is here, download, inspect.",
@@ -23,15 +26,7 @@ DataDir = Annotated[Path | None, typer.Option(help="dataset folder (default: $AL
 
 
 def _synthetic_worlds() -> dict[str, str]:
-    """Embedded synthetic worlds (name -> description), if that module is installed.
-
-    Only a *missing* module is tolerated; an existing module that fails to
-    import raises, so a broken world generator is never silently hidden.
-    """
-    if importlib.util.find_spec("albot1.data.synthetic.worlds") is None:
-        return {}
-    from albot1.data.synthetic import worlds
-
+    """Embedded synthetic worlds (name -> description)."""
     return {name: getattr(spec, "description", "") for name, spec in worlds.WORLDS.items()}
 
 
@@ -45,9 +40,6 @@ def list_(
       albot1 datasets list\n
       ALBOT1_DATA_DIR=/data/albot1 albot1 datasets list --json
     """
-    from albot1.data import catalog
-    from albot1.settings import get_settings
-
     settings = get_settings(data_dir=data_dir)
     rows: list[dict[str, Any]] = []
     for name in catalog.names():
@@ -106,9 +98,6 @@ def fetch(
       albot1 datasets fetch intel\n
       ALBOT1_CACHE_DIR=/data/cache albot1 datasets fetch aces
     """
-    from albot1.data import catalog
-    from albot1.settings import get_settings
-
     path = catalog.fetch(name, get_settings(data_dir=data_dir), base_url=base_url)
     typer.echo(f"{name}: {path}")
 
@@ -128,9 +117,6 @@ def info(
       albot1 datasets info intel --json\n
       albot1 datasets info recording.bag --scan-topic /base_scan --odom-topic /odom_raw
     """
-    from albot1.data.open import open_sequence
-    from albot1.settings import get_settings
-
     options = {
         key: value
         for key, value in (("scan_topic", scan_topic), ("odom_topic", odom_topic), ("reference_topic", reference_topic))

@@ -11,7 +11,6 @@ import typer
 
 def register(app: typer.Typer) -> None:
     app.command("run")(run)
-    app.command("methods")(methods)
 
 
 def run(
@@ -35,10 +34,13 @@ def run(
     from albot1.data.open import open_sequence
     from albot1.data.transforms import head
     from albot1.methods.registry import parse_overrides
+    from albot1.records import dump_record
+    from albot1.report.preview import render_preview
     from albot1.runs.execute import run_method
-    from albot1.runs.folder import write_run
+    from albot1.runs.folder import read_result, write_run
     from albot1.settings import get_settings
 
+    overrides = parse_overrides(set_ or [])  # a malformed --set fails before the log is opened
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
     if preset == "default" and method == "albot1":
         preset = "thesis"
@@ -48,38 +50,30 @@ def run(
         method,
         sequence,
         preset=preset,
-        overrides=parse_overrides(set_ or []),
+        overrides=overrides,
         degradation=degrade,
         seed=seed,
         dataset_name=dataset,
     )
-    run_dir = write_run(result, out)
-    summary = {
-        "run_dir": str(run_dir),
-        "method": method,
-        "dataset": dataset,
-        "preset": preset,
-        "degradation": degrade,
-        "seed": seed,
-        "scans": int(len(result.poses)),
-        "status": "done",
-        "counters": result.counters,
-        "timing": result.timing(),
-    }
+    run_dir = write_run(result, out, preview=render_preview)
+    record = read_result(run_dir)  # the headline says what result.json says
     if as_json:
-        typer.echo(json.dumps(summary, default=float))
+        summary = {
+            "run_dir": str(run_dir),
+            "method": record.method,
+            "dataset": record.dataset,
+            "preset": record.preset,
+            "degradation": record.degradation,
+            "seed": record.seed,
+            "scans": record.scans,
+            "status": "done",
+            "counters": record.counters,
+            "timing": dump_record(record.timing),
+        }
+        typer.echo(json.dumps(summary))
     else:
-        t = result.timing()
+        median = record.timing.per_scan_ms_median
         typer.echo(
-            f"{method} on {dataset}: {summary['scans']} scans, {result.counters.get('updates')} updates, "
-            f"{t['per_scan_ms_median']:.3f} ms/scan median -> {run_dir}"
+            f"{record.method} on {record.dataset}: {record.scans} scans, {record.counters.get('updates')} updates, "
+            f"{'n/a' if median is None else format(median, '.3f')} ms/scan median -> {run_dir}"
         )
-
-
-def methods() -> None:
-    """List the registered methods and whether their dependencies are installed."""
-    from albot1.methods.registry import METHODS
-
-    for spec in METHODS.values():
-        state = "available" if spec.available() else "missing: " + ", ".join(spec.requires)
-        typer.echo(f"{spec.name:12s} {state:12s} {spec.description}")

@@ -1,47 +1,59 @@
-"""Baseline presets read from the project's ``baselines/<method>.toml``.
+"""Every method's presets, read from a TOML file by one mechanism.
 
-Why a TOML file and not a dict in the code: the numbers a baseline runs with
+Why a TOML file and not a dict in the code: the numbers a method runs with
 (voxel sizes, thresholds, ...) are what a researcher reads, questions and
-edits, and each carries a measured justification that belongs beside it.
-The split is therefore
+edits, and each carries a justification that belongs beside it. The split
+is therefore
 
 * the pydantic config model holds the *types, bounds and meaning* of every
-  field (and no tuned values; a model may keep plain defaults so it can be
-  built directly in code, but runs never rely on them);
-* ``baselines/<method>.toml`` holds the *values*: a ``[presets.default]``
-  table that must set every field of the model (checked), and optional
-  further ``[presets.NAME]`` tables, each listing only what it changes
-  relative to ``default``.
+  field (a model may keep plain defaults so it can be built directly in
+  code, but runs never rely on them);
+* a TOML file holds the *values*: a ``[presets.default]`` table that must
+  set every field of the model (checked), and optional further
+  ``[presets.NAME]`` tables, each listing only what it changes relative to
+  ``default``.
 
-A mapper class opts in with ``presets: ClassVar[...] = TomlPresets()``. The
-descriptor reads ``baselines/<cls.name>.toml`` the first time ``cls.presets``
-is used (not at import, so importing a mapper never touches the disk), merges
-every preset onto ``default`` and validates each merged preset against
+Where the file lives depends on who owns the values. A wrapped baseline's
+file is ``baselines/<method>.toml`` (the project's editable config folder,
+found by :func:`albot1.resources.find_resource`); a method that is part of
+this package ships its file beside its code as package data
+(``albot1/methods/albot1/presets.toml``, the thesis's values).
+
+A mapper class opts in with ``presets: ClassVar[...] = TomlPresets()`` (a
+baseline) or ``TomlPresets(package="its.package")`` (package data). The
+descriptor reads the file the first time ``cls.presets`` is used (not at
+import, so importing a mapper never touches the disk), merges every preset
+onto ``default`` and validates each merged preset against
 ``cls.config_model``: a typo or out-of-range value in the file is a
 :class:`~albot1.errors.ConfigError` naming the file, preset and field,
 raised before any run starts.
 
-The precedence applied later by :func:`albot1.methods.registry.resolve_config`
-is unchanged: model < preset < env ``ALBOT1_<METHOD>_<FIELD>`` < ``--set``.
+The precedence applied later by :func:`albot1.config.resolve.resolve`
+is: model < preset < env ``ALBOT1_<METHOD>_<FIELD>`` < ``--set``.
 """
 
 from __future__ import annotations
 
 import tomllib
+from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
+from albot1.config.validation import describe_errors
 from albot1.errors import ConfigError
-from albot1.resources import project_file
+from albot1.resources import find_resource
 
 PresetTable = dict[str, dict[str, Any]]
 
+#: The file name of a package's own presets (``TomlPresets(package=...)``).
+PACKAGE_PRESETS = "presets.toml"
+
 
 def preset_file(method: str) -> Path:
-    """The config file of a baseline: ``baselines/<method>.toml`` in the project."""
-    return project_file("baselines", f"{method}.toml")
+    """The config file of a baseline: ``baselines/<method>.toml`` (the one place that looks it up)."""
+    return find_resource("baselines", f"{method}.toml")
 
 
 def parse_presets(data: dict[str, Any], model: type[BaseModel], source: str) -> PresetTable:
@@ -73,37 +85,63 @@ def parse_presets(data: dict[str, Any], model: type[BaseModel], source: str) -> 
         try:
             model.model_validate(preset)
         except ValidationError as exc:
-            problems = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors())
-            raise ConfigError(f"{source}: preset {name!r} is not a valid {model.__name__}: {problems}") from None
+            raise ConfigError(
+                f"{source}: preset {name!r} is not a valid {model.__name__}: {describe_errors(exc)}"
+            ) from None
         merged[name] = preset
     return merged
 
 
-def load_presets(method: str, model: type[BaseModel]) -> PresetTable:
-    """Read and validate ``baselines/<method>.toml`` (see :func:`parse_presets`)."""
-    path = preset_file(method)
+def parse_preset_text(text: str, model: type[BaseModel], source: str) -> PresetTable:
+    """:func:`parse_presets` of TOML text; invalid TOML is a ConfigError naming ``source``."""
     try:
-        with path.open("rb") as handle:
-            data = tomllib.load(handle)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
-    return parse_presets(data, model, str(path))
+        raise ConfigError(f"{source}: not valid TOML: {exc}") from None
+    return parse_presets(data, model, source)
+
+
+def load_presets(method: str, model: type[BaseModel]) -> PresetTable:
+    """Read and validate ``baselines/<method>.toml``."""
+    path = preset_file(method)
+    return parse_preset_text(path.read_text(encoding="utf-8"), model, str(path))
+
+
+def load_package_presets(package: str, model: type[BaseModel]) -> PresetTable:
+    """Read and validate ``presets.toml`` shipped inside ``package``."""
+    resource = files(package).joinpath(PACKAGE_PRESETS)
+    if not resource.is_file():
+        raise ConfigError(f"{resource}: the presets of package {package} are missing (package data not installed?)")
+    return parse_preset_text(resource.read_text(encoding="utf-8"), model, str(resource))
 
 
 class TomlPresets:
-    """Class attribute that loads ``presets`` lazily from ``baselines/<owner.name>.toml``.
+    """Class attribute that loads ``presets`` lazily from the owner's TOML file.
 
+    ``TomlPresets()`` reads ``baselines/<owner.name>.toml``;
+    ``TomlPresets(package="a.b")`` reads ``presets.toml`` of package ``a.b``.
     The owner class must define ``name`` and ``config_model`` (as every
-    :class:`~albot1.contract.Mapper` does). The table is read once per
-    owner class and process.
+    :class:`~albot1.contract.Mapper` does). The table is read once per owner
+    class and process.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, package: str | None = None) -> None:
+        self.package = package
         self._cache: dict[type, PresetTable] = {}
 
     def __get__(self, instance: object, owner: type) -> PresetTable:
         table = self._cache.get(owner)
         if table is None:
-            table = load_presets(owner.name, owner.config_model)  # type: ignore[attr-defined]
+            model: type[BaseModel] = owner.config_model  # type: ignore[attr-defined]
+            if self.package is None:
+                table = load_presets(owner.name, model)  # type: ignore[attr-defined]
+            else:
+                table = load_package_presets(self.package, model)
             self._cache[owner] = table
         return table
+
+    def location(self, owner: type) -> str:
+        """Where the owner's presets are read from (for listings and messages)."""
+        if self.package is None:
+            return str(preset_file(owner.name))  # type: ignore[attr-defined]
+        return str(files(self.package).joinpath(PACKAGE_PRESETS))

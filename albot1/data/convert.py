@@ -15,7 +15,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from albot1.data.errors import DataError, UnknownFormatError
+from albot1.data.loaders.registry import writer_for
 from albot1.data.model import Frame, Sequence
+from albot1.data.open import open_sequence
 
 if TYPE_CHECKING:
     from albot1.settings import Settings
@@ -104,8 +106,6 @@ def convert(
     this changes data it is never done unless asked for, and the count is
     returned.
     """
-    from albot1.data.loaders.registry import writer_for
-
     target = format_name or guess_format(dst)
     writer = writer_for(target)
     if Path(dst).exists():  # one policy for every writer, checked before the (maybe long) load
@@ -113,8 +113,6 @@ def convert(
     if isinstance(src, Sequence):
         sequence = src
     else:
-        from albot1.data.open import open_sequence
-
         options = {k: v for k, v in load_options.items() if v is not None}
         sequence = open_sequence(src, settings=settings, format_name=source_format, **options)
     count, shifted = [0], [0]

@@ -3,7 +3,7 @@
 Degradation acts on the *relative* motion between consecutive scans (the
 odometry increment ``inv(o[i-1]) * o[i]``), then re-integrates from the first
 pose, which is how odometry error arises physically. SPEC strings
-(DESIGN.md 4b):
+(the README, "Running methods", lists the same):
 
 ``none``
     unchanged.
@@ -116,4 +116,4 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
 
     source = sequence.metadata.odometry_source or "odometry"
     meta = replace(sequence.metadata, odometry_source=f"{source} degraded {deg.spec} seed {seed}")
-    return sequence.with_frames(frames, metadata=meta)
+    return sequence.with_frames(frames, metadata=meta, scan_count=sequence.known_scan_count)

@@ -45,3 +45,16 @@ class TopicError(DataError):
 
 class FetchError(DataError):
     """A download failed or its checksum did not match."""
+
+
+class ReferenceOptionError(DataError):
+    """A dataset reference option (``odometry=reference``, ``views=D_M:A_DEG``) cannot be applied."""
+
+
+class WriteError(DataError):
+    """An output cannot be written: it exists, its folder is missing, not a folder or not writable,
+    the file system is read-only or full. The message names the path."""
+
+
+class SliceError(DataError):
+    """A slice of a dataset reference (``NAME[:STOP:STEP]``) or a scan limit is not a positive count."""

@@ -16,13 +16,10 @@ import tempfile
 import urllib.error
 import urllib.request
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from albot1.data.errors import FetchError
-
-if TYPE_CHECKING:
-    from albot1.data.catalog import DataFile
-    from albot1.settings import Settings
+from albot1.data.manifest import DataFile
+from albot1.settings import Settings
 
 _BLOCK = 1 << 20
 TIMEOUT_S = 60.0

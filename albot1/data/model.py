@@ -8,6 +8,13 @@ A :class:`Sequence` is *streamed*: iterating it yields :class:`Frame` objects
 decoded on demand, so a mapper can start on a 100k-scan log before the rest
 of the file is read. Whole-sequence arrays (timestamps, odometry, reference)
 are computed by one full pass the first time they are asked for and cached.
+
+The number of scans is known up front only for some sequences (in memory,
+synthetic worlds, prefixes and strides of those); for a streamed log it
+takes decoding the whole file. So ``len(sequence)`` answers only when the
+count is known without decoding (:attr:`Sequence.known_scan_count`) and is
+a ``TypeError`` otherwise, while :meth:`Sequence.count_scans` always answers
+and says in its name that it may cost a full pass.
 """
 
 from __future__ import annotations
@@ -22,6 +29,31 @@ from numpy.typing import NDArray
 from albot1.geometry import se2
 
 FloatArray = NDArray[np.float64]
+
+
+class _BeamDirections:
+    """cos and sin of the last read-only beam-angle array seen.
+
+    Loaders share one read-only angle array across all scans of a log, so
+    :meth:`Scan.points` computes its trigonometry once per log instead of
+    once per scan (half the cost of the conversion). A writeable array is
+    never cached: its values could change under the same identity.
+    """
+
+    def __init__(self) -> None:
+        self._last: tuple[FloatArray, FloatArray, FloatArray] | None = None
+
+    def __call__(self, angles: FloatArray) -> tuple[FloatArray, FloatArray]:
+        last = self._last
+        if last is not None and last[0] is angles:
+            return last[1], last[2]
+        cos, sin = np.cos(angles), np.sin(angles)
+        if not angles.flags.writeable:
+            self._last = (angles, cos, sin)
+        return cos, sin
+
+
+_beam_directions = _BeamDirections()
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -50,11 +82,27 @@ class Scan:
         """Mask of beams with a return."""
         return np.isfinite(self.ranges)
 
-    def points(self) -> FloatArray:
-        """Cartesian points ``(k, 2)`` of the valid beams, sensor frame, in beam order."""
+    def points(self, min_range_m: float | None = None, max_range_m: float | None = None) -> FloatArray:
+        """Cartesian points ``(k, 2)`` of the beams with a return, in the sensor frame, in beam order.
+
+        The one scan-to-points conversion of the package. Beams without a
+        return (NaN) are always dropped; ``min_range_m`` / ``max_range_m``
+        also drop beams shorter / longer than the limit (a beam exactly at a
+        limit is kept). Moving the points into the robot or map frame (the
+        laser's mounting offset, a pose) is the caller's, with
+        :func:`albot1.geometry.se2.transform_points`.
+        """
         mask = self.valid()
-        r, a = self.ranges[mask], self.angles[mask]
-        return np.column_stack([r * np.cos(a), r * np.sin(a)])
+        if min_range_m is not None:
+            mask &= self.ranges >= min_range_m
+        if max_range_m is not None:
+            mask &= self.ranges <= max_range_m
+        cos, sin = _beam_directions(self.angles)
+        r = self.ranges[mask]
+        out = np.empty((len(r), 2))
+        np.multiply(r, cos[mask], out=out[:, 0])
+        np.multiply(r, sin[mask], out=out[:, 1])
+        return out
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -114,6 +162,8 @@ class Sequence:
     ``frames_factory`` must return a *new* iterator each call, yielding frames
     with consecutive indices from 0; it is how streaming loaders, transforms
     (odometry degradation) and in-memory sequences share one type.
+    ``scan_count`` is the number of frames when the creator knows it without
+    decoding (a list in memory, an index, a generated world); None = unknown.
     """
 
     def __init__(
@@ -122,11 +172,16 @@ class Sequence:
         frames_factory: Callable[[], Iterator[Frame]],
         metadata: SequenceMetadata | None = None,
         relations: Relations | None = None,
+        *,
+        scan_count: int | None = None,
     ) -> None:
+        if scan_count is not None and scan_count < 0:
+            raise ValueError(f"scan_count must be >= 0 or None (unknown), got {scan_count}")
         self.name = name
         self._frames_factory = frames_factory
         self.metadata = metadata or SequenceMetadata()
         self.relations = relations
+        self._scan_count = scan_count
         self._arrays: SequenceArrays | None = None
 
     @classmethod
@@ -142,7 +197,7 @@ class Sequence:
         for i, frame in enumerate(frame_list):
             if frame.index != i:
                 raise ValueError(f"frame {i} has index {frame.index}; frames must be numbered 0..N-1")
-        return cls(name, lambda: iter(frame_list), metadata, relations)
+        return cls(name, lambda: iter(frame_list), metadata, relations, scan_count=len(frame_list))
 
     def __iter__(self) -> Iterator[Frame]:
         return self._frames_factory()
@@ -162,9 +217,22 @@ class Sequence:
         transform: Callable[[Iterator[Frame]], Iterator[Frame]],
         name: str | None = None,
         metadata: SequenceMetadata | None = None,
+        *,
+        scan_count: int | None = None,
     ) -> Sequence:
-        """A new sequence whose frames are ``transform(self.frames())``, still streamed."""
-        return Sequence(name or self.name, lambda: transform(self.frames()), metadata or self.metadata, self.relations)
+        """A new sequence whose frames are ``transform(self.frames())``, still streamed.
+
+        ``scan_count``: how many frames the transform yields, when that is
+        known without decoding (e.g. a count-preserving transform of a
+        sequence whose count is known); None leaves it unknown.
+        """
+        return Sequence(
+            name or self.name,
+            lambda: transform(self.frames()),
+            metadata or self.metadata,
+            self.relations,
+            scan_count=scan_count,
+        )
 
     @property
     def arrays(self) -> SequenceArrays:
@@ -188,8 +256,39 @@ class Sequence:
             )
         return self._arrays
 
+    @property
+    def known_scan_count(self) -> int | None:
+        """The number of frames if known without decoding (given at creation, or counted already), else None."""
+        if self._scan_count is not None:
+            return self._scan_count
+        return int(self._arrays.timestamps.shape[0]) if self._arrays is not None else None
+
+    def count_scans(self) -> int:
+        """The number of frames: free when :attr:`known_scan_count` knows it, else one full decoding pass.
+
+        The pass fills :attr:`arrays` (cached), so later counts are free.
+        """
+        known = self.known_scan_count
+        return known if known is not None else int(self.arrays.timestamps.shape[0])
+
     def __len__(self) -> int:
-        return int(self.arrays.timestamps.shape[0])
+        """The number of frames when known without decoding; TypeError otherwise (see :meth:`count_scans`).
+
+        ``len()`` must be cheap: a streamed log's length takes decoding the
+        whole file, which ``len()`` must not do silently. (``list(sequence)``
+        still works: Python's size hint treats the TypeError as "unknown".)
+        """
+        known = self.known_scan_count
+        if known is None:
+            raise TypeError(
+                f"len() of sequence {self.name!r} is unknown without decoding it; "
+                "use sequence.count_scans() (one full pass) instead"
+            )
+        return known
+
+    def __bool__(self) -> bool:
+        """Always true, like any object: emptiness needs :meth:`count_scans` (``len()`` may be unknown)."""
+        return True
 
     @property
     def timestamps(self) -> FloatArray:
@@ -204,7 +303,7 @@ class Sequence:
         return self.arrays.reference
 
     def summary(self) -> dict[str, Any]:
-        """The facts ``albot1 datasets info --json`` prints (DESIGN.md 4b)."""
+        """The facts ``albot1 datasets info --json`` prints (one full pass, cached; see ``docs/datasets.md``)."""
         arr = self.arrays
         beams = np.unique(arr.beams).tolist() if len(arr.beams) else []
         return {

@@ -7,19 +7,36 @@ of any known format, optionally followed by loader options and a slice::
     intel-corrected?odometry=laser-pose      loader options (key=value&key=value)
     intel[:1000]   intel[:5000:5]   intel[::2]   the first STOP scans, every STEP-th
 
+Two options apply to every dataset and are handled here, not by a loader
+(the inputs of the thesis's experiments; ``docs/datasets.md``, "Reference
+options"):
+
+    NAME?odometry=reference     the reference poses as odometry (perfect odometry)
+    NAME?views=D_M:A_DEG        keep a scan once the odometry moved D_M metres or turned A_DEG degrees
+
+``odometry=reference`` is applied first, so ``views`` then spaces the views
+by the reference poses; a degradation (applied by the runner) acts on the
+kept views' steps.
+
 The whole string names what a run used, so a stored run reopens its data
 exactly (``albot1 evaluate`` relies on this).
 """
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 from typing import Any
 
-from albot1.data.errors import DatasetNotFoundError
+from albot1.config.keyvalue import KeyValueError, parse_query
+from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError
 from albot1.data.model import Sequence
+from albot1.data.tokens import parse_scalar
 from albot1.settings import Settings, get_settings
+
+#: ``odometry=reference``: the value that selects the reference poses as odometry on any dataset.
+REFERENCE = "reference"
 
 
 def open_sequence(
@@ -48,6 +65,8 @@ def open_sequence(
         return open_sequence(
             name, settings=settings, format_name=format_name, **{**parse_options(query, text), **options}
         )
+    if options.get("odometry") == REFERENCE or "views" in options:
+        return _with_reference_options(text, settings, format_name, options)
     if text in worlds.WORLDS:
         if options:
             raise DatasetNotFoundError(f"synthetic world {text!r} takes no loader options, got {', '.join(options)}")
@@ -65,18 +84,50 @@ def open_sequence(
 
 
 def parse_options(query: str, ref: str) -> dict[str, Any]:
-    """``"a=1&b=x"`` -> ``{"a": 1, "b": "x"}`` (numbers become int/float)."""
-    options: dict[str, Any] = {}
-    for pair in filter(None, query.split("&")):
-        key, sep, value = pair.partition("=")
-        if not sep or not key:
-            raise DatasetNotFoundError(f"{ref!r}: loader option {pair!r} is not of the form KEY=VALUE")
-        for convert in (int, float):
-            try:
-                options[key] = convert(value)
-                break
-            except ValueError:
-                continue
-        else:
-            options[key] = value
-    return options
+    """``"a=1&b=x"`` -> ``{"a": 1, "b": "x"}`` (numbers become int/float).
+
+    The split is :func:`albot1.config.keyvalue.parse_query`, the project's one ``KEY=VALUE`` parser.
+    """
+    try:
+        pairs = parse_query(query, what="loader option")
+    except KeyValueError as exc:
+        raise DatasetNotFoundError(f"{ref!r}: {exc}") from None
+    return {key: parse_scalar(value) for key, value in pairs.items()}
+
+
+def _with_reference_options(
+    text: str, settings: Settings | None, format_name: str | None, options: dict[str, Any]
+) -> Sequence:
+    """Open ``text`` without the reference options, then apply ``odometry=reference`` and ``views``."""
+    from albot1.data.transforms import reference_odometry, view_spacing
+
+    rest = dict(options)
+    use_reference = rest.get("odometry") == REFERENCE
+    if use_reference:
+        del rest["odometry"]
+    views = rest.pop("views", None)
+    sequence = open_sequence(text, settings=settings, format_name=format_name, **rest)
+    if use_reference:
+        first = next(iter(sequence), None)
+        if first is not None and first.reference is None:
+            raise ReferenceOptionError(f"{text!r}: odometry=reference, but the dataset has no reference poses")
+        sequence = reference_odometry(sequence)
+    if views is not None:
+        distance_m, angle_deg = parse_views(views, text)
+        sequence = view_spacing(sequence, distance_m, angle_deg)
+    return sequence
+
+
+def parse_views(value: Any, ref: str) -> tuple[float, float]:
+    """``"1:10"`` -> ``(1.0, 10.0)``: the ``views=D_M:A_DEG`` option (metres, degrees, both positive)."""
+    parts = str(value).split(":")
+    try:
+        distance_m, angle_deg = (float(p) for p in parts) if len(parts) == 2 else (math.nan, math.nan)
+    except ValueError:
+        distance_m = angle_deg = math.nan
+    if not (math.isfinite(distance_m) and distance_m > 0 and math.isfinite(angle_deg) and angle_deg > 0):
+        raise ReferenceOptionError(
+            f"{ref!r}: views={value}; expected views=D_M:A_DEG with a positive distance in metres and angle in "
+            f"degrees, e.g. views=1:10"
+        )
+    return distance_m, angle_deg

@@ -7,6 +7,17 @@ is kept: z, roll and pitch are zero in every published 2D relations file,
 and a non-zero value is reported rather than silently dropped. Blank lines
 and ``#`` comments are allowed; a file without relations gives zero relations
 (a run folder of a dataset with an empty relation set round-trips).
+
+A relation names its two poses by timestamp, and those are the timestamps
+of scans, so :func:`match_stamps` is the one place where a relation end is
+turned into a scan index: the nearest scan stamp, accepted within
+:data:`STAMP_TOLERANCE_S`. Scan stamps need not be sorted: the Intel log's
+ipc stamps go back by up to 0.9 s at 631 places, which is also why 6 of
+``intel.relations``' lines have ``t2 < t1`` -- the scan stamped ``t1``
+comes *first* in the log and the relation, read as written
+(``inv(T(t1)) * T(t2)``), agrees with the odometry between those two scans
+(docs/metrics.md has the check). Such pairs are therefore used as written:
+neither swapped nor inverted.
 """
 
 from __future__ import annotations
@@ -15,6 +26,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from albot1.atomic import atomic_write
 from albot1.data.errors import ParseError
@@ -23,6 +35,12 @@ from albot1.data.tokens import parse_floats
 
 _FIELDS = "t1 t2 x y z roll pitch yaw"
 _PLANAR_TOLERANCE = 1e-6
+
+#: Largest accepted gap (s) between a relation's timestamp and the scan stamp it names. The published
+#: relations files copy the scans' ipc stamps, except that ``mit-csail.relations`` prints 5 decimals where
+#: its log prints 6 (8 stamps differ by up to 5 us); the closest two scans of the five logs are 0.51 ms
+#: apart (Intel), so 0.1 ms accepts the rounding with a 20x margin and can never accept a neighbour scan.
+STAMP_TOLERANCE_S = 1e-4
 
 
 def read_relations(path: str | Path) -> Relations:
@@ -68,3 +86,42 @@ def write_relations(path: str | Path, relations: Relations) -> None:
         ]
     )
     atomic_write(p, lambda tmp: np.savetxt(tmp, rows, fmt="%.9f"))
+
+
+def match_stamps(timestamps: ArrayLike, query: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """For each ``query`` time: the index of the nearest of ``timestamps`` and the absolute gap (s).
+
+    ``timestamps`` may be in any order (indices refer to the given order); among equal stamps the first
+    in that order wins. Accepting or refusing a gap is the caller's decision (see
+    :data:`STAMP_TOLERANCE_S`).
+    """
+    t = np.asarray(timestamps, dtype=float).reshape(-1)
+    q = np.asarray(query, dtype=float).reshape(-1)
+    if len(t) == 0:
+        raise ValueError("match_stamps: no timestamps to match against")
+    order = np.argsort(t, kind="stable")
+    ts = t[order]
+    right = np.clip(np.searchsorted(ts, q, side="left"), 0, len(ts) - 1)
+    left = np.clip(right - 1, 0, len(ts) - 1)
+    # searchsorted(side="left") lands on the first of equal stamps; the left neighbour wins ties of distance
+    # only when it is strictly closer, so an exact match is always the first stamp of its run.
+    pick = np.where(np.abs(ts[left] - q) < np.abs(ts[right] - q), left, right)
+    return order[pick].astype(np.int64), np.abs(ts[pick] - q)
+
+
+def restrict_relations(
+    relations: Relations, timestamps: ArrayLike, tolerance_s: float = STAMP_TOLERANCE_S
+) -> Relations | None:
+    """The relations whose two ends are both among ``timestamps`` (None when none are).
+
+    A run on a slice of a log (a prefix, every n-th scan) must be scored only on the scans it saw.
+    """
+    t = np.asarray(timestamps, dtype=float)
+    if len(t) == 0 or len(relations) == 0:
+        return None
+    _, gap1 = match_stamps(t, relations.t1)
+    _, gap2 = match_stamps(t, relations.t2)
+    mask = (gap1 <= tolerance_s) & (gap2 <= tolerance_s)
+    if not mask.any():
+        return None
+    return Relations(t1=relations.t1[mask], t2=relations.t2[mask], poses=relations.poses[mask])

@@ -1,5 +1,6 @@
-"""Turning whitespace-separated text fields into numbers with errors that
-name the offending token (shared by the line-oriented parsers)."""
+"""Turning text fields into numbers: whitespace-separated fields of the
+line-oriented parsers (errors name the offending token), and the values of
+dataset reference options (``NAME?key=value``)."""
 
 from __future__ import annotations
 
@@ -27,3 +28,18 @@ def _is_float(token: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def parse_scalar(token: str) -> int | float | str:
+    """``"80"`` -> 80, ``"0.5"`` -> 0.5, anything else (``"laser-pose"``) unchanged.
+
+    A dataset reference option is passed to its loader as a keyword, so a
+    number typed in the reference must arrive as a number; an int is tried
+    first so counts stay ints.
+    """
+    for convert in (int, float):
+        try:
+            return convert(token)
+        except ValueError:
+            continue
+    return token

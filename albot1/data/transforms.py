@@ -1,23 +1,33 @@
-"""Small streamed transforms of a Sequence (prefix, stride)."""
+"""Small streamed transforms of a Sequence (prefix, stride, reference odometry, view spacing)."""
 
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Iterator
 from dataclasses import replace
 
+import numpy as np
+
+from albot1.data.errors import ReferenceOptionError
 from albot1.data.model import Frame, Sequence
+
+#: Slack of the view-spacing rule, so ten 0.1 m steps (0.9999999... m in floating point) make 1 m.
+SPACING_SLACK = 1e-9
 
 
 def head(sequence: Sequence, count: int) -> Sequence:
-    """The first ``count`` frames (still streamed)."""
+    """The first ``count`` frames (still streamed; the scan count stays known if it was)."""
     if count < 1:
         raise ValueError(f"expected a positive scan count, got {count}")
-    return sequence.with_frames(lambda frames: itertools.islice(frames, count))
+    known = sequence.known_scan_count
+    return sequence.with_frames(
+        lambda frames: itertools.islice(frames, count), scan_count=None if known is None else min(count, known)
+    )
 
 
 def stride(sequence: Sequence, step: int) -> Sequence:
-    """Every ``step``-th frame, renumbered from 0."""
+    """Every ``step``-th frame, renumbered from 0 (the scan count stays known if it was)."""
     if step < 1:
         raise ValueError(f"expected a positive stride, got {step}")
 
@@ -25,4 +35,62 @@ def stride(sequence: Sequence, step: int) -> Sequence:
         for i, frame in enumerate(itertools.islice(frames, 0, None, step)):
             yield replace(frame, index=i)
 
-    return sequence.with_frames(pick)
+    known = sequence.known_scan_count
+    return sequence.with_frames(pick, scan_count=None if known is None else -(-known // step))
+
+
+def reference_odometry(sequence: Sequence) -> Sequence:
+    """The odometry of every frame replaced by its reference pose (the thesis's perfect-odometry runs).
+
+    A frame without a reference pose is a :class:`ReferenceOptionError`
+    naming it: no pose is invented for it.
+    """
+    name = sequence.name
+
+    def swap(frames: Iterator[Frame]) -> Iterator[Frame]:
+        for frame in frames:
+            if frame.reference is None:
+                raise ReferenceOptionError(
+                    f"{name}: odometry=reference needs a reference pose for every scan; scan {frame.index} has none"
+                )
+            yield replace(frame, odometry=np.array(frame.reference, dtype=float))
+
+    source = sequence.metadata.reference_source or "reference poses"
+    metadata = replace(sequence.metadata, odometry_source=f"reference poses as odometry ({source})")
+    return sequence.with_frames(swap, metadata=metadata)
+
+
+def view_spacing(sequence: Sequence, distance_m: float, angle_deg: float) -> Sequence:
+    """Keep a frame only once the odometry has moved ``distance_m`` or turned ``angle_deg`` since the last kept one.
+
+    The rule of the thesis's data logger (Experiments 4 and 5: a view every
+    10 cm or 1 degree, or every 1 m or 10 degrees): the first frame is kept;
+    a later frame is kept when the straight-line distance between its
+    odometry position and the last kept one's is at least ``distance_m``, or
+    the absolute heading change is at least ``angle_deg`` (both within
+    :data:`SPACING_SLACK`). Kept frames are renumbered from 0; their
+    odometry, reference and timestamps are unchanged, so a degradation
+    applied afterwards acts on the kept views' steps.
+    """
+    if not (math.isfinite(distance_m) and distance_m > 0 and math.isfinite(angle_deg) and angle_deg > 0):
+        raise ReferenceOptionError(
+            f"{sequence.name}: views={distance_m:g}:{angle_deg:g}; expected a positive distance (m) and angle (deg)"
+        )
+    angle = math.radians(angle_deg)
+
+    def keep(frames: Iterator[Frame]) -> Iterator[Frame]:
+        last: np.ndarray | None = None
+        kept = 0
+        for frame in frames:
+            odo = frame.odometry
+            if last is not None:
+                moved = math.hypot(float(odo[0] - last[0]), float(odo[1] - last[1]))
+                turned = abs(math.remainder(float(odo[2] - last[2]), 2.0 * math.pi))
+                if moved < distance_m - SPACING_SLACK and turned < angle - SPACING_SLACK:
+                    continue
+            last = np.asarray(odo, dtype=float)
+            yield replace(frame, index=kept)
+            kept += 1
+
+    extra = {**sequence.metadata.extra, "view_spacing": {"distance_m": distance_m, "angle_deg": angle_deg}}
+    return sequence.with_frames(keep, metadata=replace(sequence.metadata, extra=extra))

@@ -1,22 +1,92 @@
-"""SE(2) poses as ``(x, y, theta)`` arrays, vectorised over leading axes.
+"""SE(2) poses ``(x, y, theta)``: one implementation, in a scalar and a vectorised form.
 
 A pose ``a`` maps points from its own frame into the parent frame:
 ``p_parent = R(theta) @ p + (x, y)``. ``compose(a, b)`` is ``a * b`` (``b``
 expressed in ``a``'s frame), ``between(a, b)`` is ``inv(a) * b``, the motion
 from ``a`` to ``b`` seen from ``a``, which is what odometry increments and
 ground-truth relations are. Angles are radians, counter-clockwise positive.
+
+**Angle wrap convention** (every heading this package computes): an angle is
+wrapped to ``[-pi, pi)`` by ``(a + pi) mod 2 pi - pi`` with the floored
+(Python/numpy) modulo. The formula is not exact for an angle already in range
+(``a + pi - pi`` can differ from ``a`` by one rounding, at most 4.4e-16 rad);
+it is kept because every recorded result was computed with it.
+:func:`wrap_angle` (scalar) and :func:`wrap` (vectorised) give the same bits.
+
+Two forms of the same maths:
+
+* **scalar** (:data:`Pose`, :func:`wrap_angle`, :func:`compose_pose`,
+  :func:`between_pose`): single poses as plain floats, for the per-scan path
+  of the mappers, where numpy's per-call overhead (tens of microseconds)
+  would dominate the arithmetic. :func:`wrap_angle` is also compiled into the
+  numba kernels, so it uses only Python scalars and :mod:`math`;
+* **vectorised** (everything else): arrays of poses ``(..., 3)``, for whole
+  trajectories (metrics, data preparation).
+
+:func:`pose_to_se3` and :func:`pose_from_se3` bridge to 4x4 SE(3) matrices,
+which 3-D registration libraries (KISS-ICP) work with.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
 
+#: A single pose ``(x, y, theta)`` as plain floats (the scalar API).
+Pose = tuple[float, float, float]
+#: What the scalar API accepts: a :data:`Pose` or a length-3 array.
+PoseLike = Pose | FloatArray
+
+
+# -- scalar: single poses as plain floats -------------------------------------------------------------------------
+
+
+def wrap_angle(a: float) -> float:
+    """``a`` wrapped to ``[-pi, pi)`` (the module's convention; compiled into the numba kernels)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def compose_pose(a: PoseLike, b: PoseLike) -> Pose:
+    """``a * b`` for single poses: pose ``b`` (given in ``a``'s frame) in ``a``'s parent frame."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap_angle(a[2] + b[2]))
+
+
+def between_pose(a: PoseLike, b: PoseLike) -> Pose:
+    """``inv(a) * b`` for single poses: the pose of ``b`` seen from ``a`` (e.g. an odometry increment)."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return (c * dx + s * dy, -s * dx + c * dy, wrap_angle(b[2] - a[2]))
+
+
+def pose_to_se3(pose: PoseLike) -> FloatArray:
+    """A pose as the 4x4 homogeneous SE(3) matrix of the motion in the z = 0 plane."""
+    x, y, theta = (float(v) for v in pose)
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, 0.0, x], [s, c, 0.0, y], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+
+
+def pose_from_se3(matrix: FloatArray) -> tuple[FloatArray, float]:
+    """Project a 4x4 SE(3) matrix to a pose; also return the out-of-plane part dropped.
+
+    The dropped part is ``max(|z| in m, tilt of the z axis in rad)``: zero
+    for an exactly planar motion. The heading is read by atan2, so it lies
+    in ``[-pi, pi]`` without a wrap.
+    """
+    yaw = math.atan2(matrix[1, 0], matrix[0, 0])
+    tilt = math.acos(min(1.0, max(-1.0, float(matrix[2, 2]))))
+    return np.array([matrix[0, 3], matrix[1, 3], yaw]), max(abs(float(matrix[2, 3])), tilt)
+
+
+# -- vectorised: arrays of poses (..., 3) -------------------------------------------------------------------------
+
 
 def wrap(angle: ArrayLike) -> FloatArray:
-    """Angles wrapped to ``[-pi, pi)``."""
+    """Angles wrapped to ``[-pi, pi)``, elementwise the same bits as :func:`wrap_angle`."""
     a = np.asarray(angle, dtype=float)
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 

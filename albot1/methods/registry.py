@@ -1,24 +1,54 @@
 """The method registry: names -> mapper classes (imported lazily) and the
-resolution of a typed config from preset, config file and overrides.
+resolution of a typed config from preset, environment and overrides.
 
-Config precedence (lowest first): the config model's defaults, the preset,
-environment variables ``ALBOT1_<METHOD>_<FIELD>`` (method and field upper-case,
-dashes as underscores; e.g. ``ALBOT1_KISS_ICP_VOXEL_SIZE=0.2``), then
-explicit overrides (CLI ``--set FIELD=VALUE`` or a bench suite).
+Config precedence (lowest first; :mod:`albot1.config.resolve`): the config
+model's defaults, the preset (every method's presets are a TOML file read by
+:class:`albot1.config.presets.TomlPresets`), environment variables
+``ALBOT1_<METHOD>_<FIELD>`` (method and field upper-case, dashes as
+underscores; e.g. ``ALBOT1_KISS_ICP_VOXEL_SIZE_M=0.2``; a variable under a
+method's prefix that names no field is an error), then explicit overrides
+(CLI ``--set FIELD=VALUE`` or a bench suite's ``set``).
 """
 
 from __future__ import annotations
 
-import importlib
 import importlib.util
-import os
+import inspect
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel
 
-from albot1.errors import ConfigError
-from albot1.runs.errors import UnknownMethodError
+from albot1.config.env import method_prefix
+from albot1.config.keyvalue import parse_key_values
+from albot1.config.resolve import ResolvedConfig, resolve
+from albot1.config.targets import TargetError, check_target, resolve_class
+from albot1.contract import Mapper
+from albot1.methods.errors import UnknownMethodError
+
+#: What a class must define to be run as a mapper (:class:`albot1.contract.Mapper`).
+MAPPER_ATTRIBUTES = ("name", "config_model", "presets", "process", "finish")
+
+
+def load_mapper_class(target: str) -> type[Mapper]:
+    """The mapper class named by ``"module:Class"``; TargetError when it is none.
+
+    The check looks the attributes up statically, so a class whose presets
+    are read lazily from a file (:class:`~albot1.config.presets.TomlPresets`)
+    is not made to read it here.
+    """
+    cls = resolve_class(target)
+    missing = [name for name in MAPPER_ATTRIBUTES if _static_attr(cls, name) is None]
+    if missing:
+        raise TargetError(f"{target}: not a mapper class, it lacks {', '.join(missing)} (see albot1.contract.Mapper)")
+    return cast(type[Mapper], cls)
+
+
+def _static_attr(cls: type, name: str) -> object | None:
+    try:
+        return inspect.getattr_static(cls, name)
+    except AttributeError:
+        return None
 
 
 @dataclass(frozen=True)
@@ -31,20 +61,30 @@ class MethodSpec:
     error_class: str = "albot1.methods.baselines.errors:BaselineError"
     description: str = ""
 
+    def __post_init__(self) -> None:
+        check_target(self.target)
+        check_target(self.error_class)
+
     def available(self) -> bool:
         """True when every required import can be found (without importing it)."""
         return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
 
-    def load_class(self) -> Any:
+    def load_class(self) -> type[Mapper]:
         if not self.available():
             missing = [m for m in self.requires if importlib.util.find_spec(m) is None]
             raise UnknownMethodError(f"method {self.name!r} needs {', '.join(missing)}, which is not installed")
-        module_name, _, attr = self.target.partition(":")
-        return getattr(importlib.import_module(module_name), attr)
+        return load_mapper_class(self.target)
 
     def load_error_class(self) -> type[Exception]:
-        module_name, _, attr = self.error_class.partition(":")
-        return getattr(importlib.import_module(module_name), attr)
+        cls = resolve_class(self.error_class)
+        if not issubclass(cls, Exception):
+            raise TargetError(f"{self.error_class}: expected an exception class for method {self.name!r}")
+        return cls
+
+    @property
+    def env_prefix(self) -> str:
+        """``ALBOT1_<METHOD>_``: the prefix of this method's environment variables."""
+        return method_prefix(self.name)
 
 
 METHODS: dict[str, MethodSpec] = {
@@ -84,36 +124,33 @@ def get_method(name: str) -> MethodSpec:
         raise UnknownMethodError(f"unknown method {name!r}; expected one of: {', '.join(METHODS)}") from None
 
 
-def _env_overrides(method: str, model: type[BaseModel]) -> dict[str, str]:
-    prefix = "ALBOT1_" + method.upper().replace("-", "_") + "_"
-    found = {}
-    for field_name in model.model_fields:
-        value = os.environ.get(prefix + field_name.upper())
-        if value is not None:
-            found[field_name] = value
-    return found
+def resolve_method_config(
+    method: str, preset: str = "default", overrides: dict[str, Any] | None = None
+) -> ResolvedConfig[BaseModel]:
+    """The validated config of ``method`` for ``preset`` plus env and explicit overrides, with each value's origin.
+
+    Environment variables of the other registered methods are left to them:
+    with nested prefixes (``albot1`` and a method ``albot1-places``) a
+    variable belongs to the longest prefix it starts with.
+    """
+    spec = get_method(method)
+    cls = spec.load_class()
+    return resolve(
+        cls.config_model,
+        cls.presets,
+        preset,
+        env_prefix=spec.env_prefix,
+        other_prefixes=[other.env_prefix for other in METHODS.values() if other.name != method],
+        overrides=overrides,
+        owner=method,
+    )
 
 
 def resolve_config(method: str, preset: str = "default", overrides: dict[str, Any] | None = None) -> BaseModel:
-    """The validated config of ``method`` for ``preset`` plus env and explicit overrides."""
-    cls = get_method(method).load_class()
-    presets: dict[str, dict[str, Any]] = cls.presets
-    if preset not in presets:
-        raise ConfigError(f"method {method!r} has no preset {preset!r}; expected one of: {', '.join(presets)}")
-    values = {**presets[preset], **_env_overrides(method, cls.config_model), **(overrides or {})}
-    try:
-        return cls.config_model.model_validate(values)
-    except ValidationError as exc:
-        problems = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors())
-        raise ConfigError(f"invalid config for method {method!r} (preset {preset!r}): {problems}") from None
+    """The validated config of ``method`` (see :func:`resolve_method_config`)."""
+    return resolve_method_config(method, preset, overrides).config
 
 
-def parse_overrides(pairs: list[str]) -> dict[str, Any]:
+def parse_overrides(pairs: list[str]) -> dict[str, str]:
     """``["a=1", "b=x"]`` -> ``{"a": "1", "b": "x"}`` (pydantic converts the strings)."""
-    out: dict[str, Any] = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep or not key.strip():
-            raise ConfigError(f"override {pair!r} is not of the form FIELD=VALUE")
-        out[key.strip()] = value.strip()
-    return out
+    return parse_key_values(pairs, what="override", key="FIELD")

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 
 from albot1.geometry import se2
 from albot1.metrics.alignment import ALIGNMENTS, Alignment, align, check_pair, describe
+from albot1.metrics.errors import MetricsError
 from albot1.metrics.stats import suffixed, summarize
 
 
@@ -52,3 +53,54 @@ def ate(estimate: ArrayLike, reference: ArrayLike, alignment: Alignment = "rigid
             others[other] = {"rmse_m": s["rmse"], "mean_m": s["mean"], "max_m": s["max"]}
     block["other_alignments"] = others
     return block
+
+
+#: Reference travel per window of :func:`windowed_ate`.
+WINDOW_M = 50.0
+
+
+def windowed_ate(
+    estimate: ArrayLike, reference: ArrayLike, window_m: float = WINDOW_M, alignment: Alignment = "rigid"
+) -> dict[str, Any]:
+    """The ``ate_windows`` block: ATE of consecutive windows of ``window_m`` reference travel, each aligned alone.
+
+    ``mean_rmse_m`` (the headline) is the mean of the windows' RMSE;
+    ``window_rmse`` their full summary, ``per_window`` each window's scans,
+    RMSE and maximum.
+
+    One ATE over a whole long log is dominated by where the first large
+    heading error happens (everything after it is rotated away from the
+    reference); the mean over windows measures the accuracy a user of any
+    50 m of the map sees, and is far less sensitive to one event. Window
+    ``k`` holds the scans from the first at or beyond ``k * window_m`` of
+    reference travel up to the first at or beyond ``(k + 1) * window_m``;
+    the tail shorter than a window is left out (``uncovered_m``). At least
+    two windows are needed (a MetricsError otherwise).
+    """
+    est, ref = check_pair(estimate, reference, "windowed ATE")
+    if not window_m > 0:
+        raise MetricsError(f"windowed ATE: expected a positive window length, got {window_m} m")
+    travel = se2.cumulative_length(ref)
+    total = float(travel[-1])
+    count = int(np.floor(total / window_m + 1e-9))
+    if count < 2:
+        raise MetricsError(
+            f"windowed ATE: the route ({total:.1f} m of reference travel) is shorter than two {window_m:g} m windows"
+        )
+    bounds = np.searchsorted(travel, np.arange(count + 1) * window_m - 1e-9, side="left")
+    windows: list[dict[str, Any]] = []
+    for k in range(count):
+        first, last = int(bounds[k]), int(bounds[k + 1])
+        s = summarize(position_errors(est[first : last + 1], ref[first : last + 1], alignment), ddof=0)
+        windows.append({"first_scan": first, "last_scan": last, "rmse_m": s["rmse"], "max_m": s["max"]})
+    rmse = [w["rmse_m"] for w in windows]
+    return {
+        "alignment": f"{alignment}, each window on its own",
+        "window_m": window_m,
+        "windows": count,
+        "uncovered_m": total - count * window_m,
+        "units": {"translation": "m"},
+        "mean_rmse_m": float(np.mean(rmse)),
+        "window_rmse": suffixed(summarize(rmse, ddof=0), "m"),
+        "per_window": windows,
+    }

@@ -29,31 +29,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from albot1.data.model import Relations
+from albot1.data.relations import STAMP_TOLERANCE_S, match_stamps
 from albot1.geometry import se2
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.stats import summarize
 
-#: Largest accepted gap between a relation's timestamp and the nearest scan.
-MAX_TIME_GAP_S = 0.1
+#: Largest accepted gap between a relation's timestamp and the scan it names (see albot1.data.relations).
+MAX_TIME_GAP_S = STAMP_TOLERANCE_S
 #: Relations spanning more than this are loop relations.
 LOOP_MIN_DT_S = 30.0
 
 OutsidePolicy = Literal["error", "exclude"]
-
-
-def nearest_indices(timestamps: ArrayLike, query: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Index of the nearest timestamp for each query, and the absolute gap (s)."""
-    t = np.asarray(timestamps, dtype=float)
-    q = np.asarray(query, dtype=float)
-    if len(t) == 0:
-        raise MetricsError("relations: the trajectory has no poses to look relations up in")
-    if np.any(np.diff(t) < 0):
-        bad = int(np.flatnonzero(np.diff(t) < 0)[0]) + 1
-        raise MetricsError(f"relations: trajectory timestamps must not decrease (scan {bad}: {t[bad]} < {t[bad - 1]})")
-    right = np.clip(np.searchsorted(t, q), 0, len(t) - 1)
-    left = np.clip(right - 1, 0, len(t) - 1)
-    pick = np.where(np.abs(t[left] - q) <= np.abs(t[right] - q), left, right)
-    return pick.astype(np.int64), np.abs(t[pick] - q)
 
 
 def relation_errors(
@@ -77,19 +63,21 @@ def relation_errors(
     est = np.asarray(poses, dtype=float)
     if est.shape != (len(t), 3):
         raise MetricsError(f"relations: expected {len(t)} poses (x, y, theta), one per timestamp, got {est.shape}")
+    if len(t) == 0:
+        raise MetricsError("relations: the trajectory has no poses to look relations up in")
     used = np.ones(len(relations), dtype=bool)
-    if outside == "exclude" and len(t):
-        lo, hi = t[0] - max_gap_s, t[-1] + max_gap_s
+    if outside == "exclude":
+        lo, hi = t.min() - max_gap_s, t.max() + max_gap_s
         used = (relations.t1 >= lo) & (relations.t1 <= hi) & (relations.t2 >= lo) & (relations.t2 <= hi)
-    i1, gap1 = nearest_indices(t, relations.t1)
-    i2, gap2 = nearest_indices(t, relations.t2)
+    i1, gap1 = match_stamps(t, relations.t1)
+    i2, gap2 = match_stamps(t, relations.t2)
     bad = np.flatnonzero(used & ((gap1 > max_gap_s) | (gap2 > max_gap_s)))
     if len(bad):
         k = int(bad[0])
         stamp = relations.t1[k] if gap1[k] > max_gap_s else relations.t2[k]
         raise MetricsError(
-            f"{source}:{k + 1}: no pose within {max_gap_s} s of time {stamp:.6f} (nearest is "
-            f"{max(gap1[k], gap2[k]):.3f} s away); expected relation times to match scan timestamps"
+            f"{source}:{k + 1}: no pose within {max_gap_s:g} s of time {stamp:.6f} (nearest is "
+            f"{max(gap1[k], gap2[k]):.6f} s away); expected relation times to match scan timestamps"
             f" ({len(bad)} relation(s) affected)"
         )
     d_est = se2.between(est[i1[used]], est[i2[used]])

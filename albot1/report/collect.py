@@ -4,41 +4,95 @@ Only the cells of the folder's ``grid.json`` (the last `albot1 bench` plan)
 are read: run folders left from older code versions stay on disk but never
 mix into a report. Each row carries the cell's coordinates, its status
 (done, failed, or not run -- the runner was stopped before it), and the
-numbers the tables use, taken from ``metrics.json`` and ``result.json`` by
-the dotted paths in :data:`METRIC_COLUMNS` and :data:`COST_COLUMNS`.
+numbers the tables use, taken from ``metrics.json``, ``result.json`` and
+``attempt.json`` by the dotted paths in :data:`METRIC_COLUMNS` and
+:data:`COST_COLUMNS`.
+
+The files are read through their models (:mod:`albot1.records`), and every
+column's path is checked against its model when the column is defined: a
+column naming a field that does not exist fails at import (and in the unit
+tests), instead of silently becoming an empty column. A cell is empty only
+when its run has no number there (a metric that does not apply, ``null``).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ATTEMPT, METRICS, Failure, ResultsStore
+from albot1.records import (
+    AttemptRecord,
+    MetricsRecord,
+    Record,
+    ResultRecord,
+    check_number_path,
+    number_at,
+    read_record,
+)
 
 if TYPE_CHECKING:
     from albot1.runs.folder import StoredRun
 
-#: column -> (source file, dotted path, header text); accuracy numbers, identical for identical inputs
-METRIC_COLUMNS: dict[str, tuple[str, str, str]] = {
-    "ate_rmse_m": ("metrics", "ate.rmse_m", "ATE RMSE (m)"),
-    "loop_gap_m": ("metrics", "loop_gap.route.gap_m", "loop gap (m)"),
-    "revisit_gap_m": ("metrics", "loop_gap.translation_m.mean", "revisit gap mean (m)"),
-    "orientation_deg": ("metrics", "orientation.bearing_abs_error_mean_deg", "bearing error mean (deg)"),
-    "relation_m": ("metrics", "relations.translation_m.mean", "relation trans. (m)"),
-    "relation_deg": ("metrics", "relations.rotation_deg.mean", "relation rot. (deg)"),
-    "map_precision": ("metrics", "map_shape.precision", "map precision"),
-    "map_coverage": ("metrics", "map_shape.coverage", "map coverage"),
-    "updates_per_view": ("metrics", "updates.updates_per_view", "updates/view"),
+Source = Literal["metrics", "result", "attempt"]
+#: the record model behind each column source (``metrics.json``, ``result.json``, ``attempt.json``)
+SOURCE_MODELS: dict[Source, type[Record]] = {
+    "metrics": MetricsRecord,
+    "result": ResultRecord,
+    "attempt": AttemptRecord,
+}
+
+
+@dataclass(frozen=True)
+class Column:
+    """One table column: the number at ``path`` in the ``source`` record, shown under ``header``.
+
+    The path is checked against the source's model on creation (KeyError
+    when it names no numeric field), so a typo cannot become an empty column.
+    """
+
+    source: Source
+    path: str
+    header: str
+
+    def __post_init__(self) -> None:
+        check_number_path(SOURCE_MODELS[self.source], self.path)
+
+    def value(self, record: CellRecord) -> float | None:
+        """The cell's number (None: the run has none there, e.g. a metric that does not apply)."""
+        sources: dict[Source, Record | None] = {
+            "metrics": record.metrics,
+            "result": record.result,
+            "attempt": record.attempt,
+        }
+        return number_at(sources[self.source], self.path)
+
+
+#: accuracy numbers, identical for identical inputs
+METRIC_COLUMNS: dict[str, Column] = {
+    "ate_rmse_m": Column("metrics", "ate.rmse_m", "ATE RMSE (m)"),
+    "ate_windows_m": Column("metrics", "ate_windows.mean_rmse_m", "ATE per 50 m window, mean (m)"),
+    "drift_10m_m": Column("metrics", "drift.at_10m.translation_m", "RPE@10 m trans. (m)"),
+    "drift_10m_deg": Column("metrics", "drift.at_10m.rotation_deg", "RPE@10 m rot. (deg)"),
+    "loop_gap_m": Column("metrics", "loop_gap.route.gap_m", "loop gap (m)"),
+    "revisit_gap_m": Column("metrics", "loop_gap.translation_m.mean", "revisit gap mean (m)"),
+    "orientation_deg": Column("metrics", "orientation.bearing_abs_error_mean_deg", "bearing error mean (deg)"),
+    "relation_m": Column("metrics", "relations.translation_m.mean", "relation trans. (m)"),
+    "relation_deg": Column("metrics", "relations.rotation_deg.mean", "relation rot. (deg)"),
+    "map_precision": Column("metrics", "map_shape.precision", "map precision"),
+    "map_coverage": Column("metrics", "map_shape.coverage", "map coverage"),
+    "updates_per_view": Column("metrics", "updates.updates_per_view", "updates/view"),
 }
 #: cost numbers: they vary from run to run and machine to machine, so they live in their own table
-COST_COLUMNS: dict[str, tuple[str, str, str]] = {
-    "per_scan_ms_median": ("result", "timing.per_scan_ms_median", "per-scan median (ms)"),
-    "per_scan_ms_p95": ("result", "timing.per_scan_ms_p95", "per-scan p95 (ms)"),
-    "total_s": ("result", "timing.total_s", "total (s)"),
-    "peak_mb": ("result", "timing.peak_mb", "peak (MB)"),
-    "cell_s": ("attempt", "elapsed_s", "cell wall (s)"),
+COST_COLUMNS: dict[str, Column] = {
+    "per_scan_ms_median": Column("result", "timing.per_scan_ms_median", "per-scan median (ms)"),
+    "per_scan_ms_mean": Column("result", "timing.per_scan_ms_mean", "per-scan mean (ms)"),
+    "per_scan_ms_p95": Column("result", "timing.per_scan_ms_p95", "per-scan p95 (ms)"),
+    "total_s": Column("result", "timing.total_s", "total (s)"),
+    "peak_mb": Column("result", "timing.peak_mb", "peak (MB)"),
+    "cell_s": Column("attempt", "elapsed_s", "cell wall (s)"),
 }
 KEY_COLUMNS = ("dataset", "method", "degradation")
 
@@ -50,10 +104,10 @@ class CellRecord:
     cell: Cell
     status: str  # done | failed | not run
     run_dir: Path
-    result: dict[str, Any] | None
-    metrics: dict[str, Any] | None
+    result: ResultRecord | None
+    metrics: MetricsRecord | None
     failure: Failure | None
-    attempt: dict[str, Any] | None = None
+    attempt: AttemptRecord | None = None
     _stored: StoredRun | None = field(default=None, repr=False, compare=False)
 
     def stored_run(self) -> StoredRun:
@@ -65,35 +119,31 @@ class CellRecord:
         return self._stored
 
 
-def dig(data: dict[str, Any] | None, path: str) -> float | None:
-    """``data["a"]["b"]`` for ``"a.b"``; None when absent or not a number."""
-    current: Any = data
-    for part in path.split("."):
-        if not isinstance(current, dict) or part not in current:
-            return None
-        current = current[part]
-    if isinstance(current, bool) or not isinstance(current, (int, float)):
-        return None
-    return float(current)
-
-
 def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
-    """The plan of ``results_dir`` and a record per planned cell (suite order)."""
+    """The plan of ``results_dir`` and a record per planned cell (suite order).
+
+    A completed cell whose ``result.json`` or ``metrics.json`` does not fit
+    its model is a RecordError naming the file and the field (e.g. a results
+    folder made by an older version: run ``albot1 bench`` again).
+    """
+    from albot1.runs.folder import RESULT_FILE
+
     store = ResultsStore(results_dir)
     plan = store.read_plan()
     records: list[CellRecord] = []
     for cell in plan.cells:
         run_dir = store.run_dir(cell.key)
         if store.is_complete(cell.key):
+            attempt = run_dir / ATTEMPT  # absent when the runner stopped right after the evaluation
             records.append(
                 CellRecord(
                     cell,
                     "done",
                     run_dir,
-                    store.read_json(cell.key, "result.json"),
-                    store.read_json(cell.key, METRICS),
+                    read_record(ResultRecord, run_dir / RESULT_FILE),
+                    read_record(MetricsRecord, run_dir / METRICS),
                     None,
-                    store.read_json(cell.key, ATTEMPT),
+                    read_record(AttemptRecord, attempt) if attempt.is_file() else None,
                 )
             )
             continue
@@ -114,11 +164,10 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
             "seed": c.seed,
             "status": rec.status,
             "key": c.key,
-            "scans": (rec.result or {}).get("scans"),
+            "scans": rec.result.scans if rec.result is not None else None,
         }
-        sources = {"metrics": rec.metrics, "result": rec.result, "attempt": rec.attempt}
-        for column, (source, path, _) in {**METRIC_COLUMNS, **COST_COLUMNS}.items():
-            row[column] = dig(sources[source], path)
+        for name, column in {**METRIC_COLUMNS, **COST_COLUMNS}.items():
+            row[name] = column.value(rec)
         row["reason"] = rec.failure.reason if rec.failure else None
         rows.append(row)
     return rows

@@ -19,6 +19,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from albot1.geometry import se2
+from albot1.metrics.alignment import align, rigid_transform
 from albot1.report.collect import CellRecord, severity_order
 
 if TYPE_CHECKING:
@@ -60,8 +62,6 @@ def representative(records: Iterable[CellRecord]) -> dict[str, CellRecord]:
 def _aligned_xy(poses: np.ndarray, reference: np.ndarray | None) -> np.ndarray:
     if reference is None or len(reference) != len(poses) or len(poses) < 2:
         return poses[:, :2]
-    from albot1.metrics.alignment import align
-
     try:
         aligned, _ = align(poses, reference, "rigid")
     except Exception:  # noqa: BLE001 -- a picture is still useful unaligned; the metrics say why
@@ -73,9 +73,6 @@ def _transform_points(points: np.ndarray, poses: np.ndarray, reference: np.ndarr
     """Apply to map points the same rigid motion that aligns ``poses`` onto ``reference``."""
     if reference is None or len(reference) != len(poses) or len(poses) < 2 or not len(points):
         return points
-    from albot1.geometry import se2
-    from albot1.metrics.alignment import rigid_transform
-
     try:
         transform = rigid_transform(poses, reference)
     except Exception:  # noqa: BLE001 -- see _aligned_xy
@@ -96,9 +93,9 @@ def _draw_run(ax: Axes, rec: CellRecord, color: str) -> None:
         pts = _transform_points(pts, run.poses, ref)
         ax.scatter(pts[:, 0], pts[:, 1], s=0.15, c="0.45", linewidths=0, rasterized=True)
     if data.segments is not None and len(data.segments):
-        seg = np.asarray(data.segments, dtype=float).reshape(-1, 2)
-        seg = _transform_points(seg, run.poses, ref).reshape(-1, 2, 2)
-        ax.add_collection(LineCollection(seg, colors="0.2", linewidths=0.7))
+        ends = np.asarray(data.segments, dtype=float).reshape(-1, 2)
+        seg = _transform_points(ends, run.poses, ref).reshape(-1, 2, 2)
+        ax.add_collection(LineCollection(list(seg), colors="0.2", linewidths=0.7))
     if ref is not None:
         ax.plot(ref[:, 0], ref[:, 1], color="tab:orange", lw=0.8, label="reference")
     xy = _aligned_xy(run.poses, ref)

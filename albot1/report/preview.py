@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from albot1.contract import RunResult
+from albot1.metrics.alignment import align
 
 
 def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> None:
@@ -30,10 +31,8 @@ def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> 
         ax.scatter(pts[:, 0], pts[:, 1], s=0.2, c="0.35", linewidths=0, label="map points")
     if data.segments is not None and len(data.segments):
         seg = np.asarray(data.segments).reshape(-1, 2, 2)
-        ax.add_collection(LineCollection(seg, colors="tab:green", linewidths=0.8, label="map surfaces"))
+        ax.add_collection(LineCollection(list(seg), colors="tab:green", linewidths=0.8, label="map surfaces"))
     if result.reference is not None and len(result.reference) > 2:
-        from albot1.metrics.alignment import align
-
         ref, _ = align(result.reference, result.poses, "rigid")
         ax.plot(ref[:, 0], ref[:, 1], color="tab:orange", lw=0.8, label="reference (aligned)")
     ax.plot(result.poses[:, 0], result.poses[:, 1], color="tab:blue", lw=0.8, label=f"{result.method} estimate")

@@ -14,7 +14,15 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from albot1.report.collect import COST_COLUMNS, KEY_COLUMNS, METRIC_COLUMNS, CellRecord, cell_rows, severity_order
+from albot1.report.collect import (
+    COST_COLUMNS,
+    KEY_COLUMNS,
+    METRIC_COLUMNS,
+    CellRecord,
+    Column,
+    cell_rows,
+    severity_order,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -29,7 +37,7 @@ def cells_frame(records: list[CellRecord]) -> pd.DataFrame:
     return pd.DataFrame(cell_rows(records))
 
 
-def aggregate(cells: pd.DataFrame, columns: dict[str, tuple[str, str, str]]) -> pd.DataFrame:
+def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
     """Completed cells grouped by dataset x method x degradation: n seeds and mean/median/min/max per column."""
     import pandas as pd
 
@@ -80,7 +88,7 @@ def cell_text(row: pd.Series, column: str) -> str:
     return f"{_fmt(mean)} / {_fmt(row[f'{column}_median'])} ({_fmt(row[f'{column}_min'])}–{_fmt(row[f'{column}_max'])})"
 
 
-def markdown(table: pd.DataFrame, columns: dict[str, tuple[str, str, str]], title: str) -> str:
+def markdown(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str:
     """One Markdown table per dataset; columns that are empty for a dataset are left out."""
     lines = [
         f"# {title}",
@@ -93,7 +101,7 @@ def markdown(table: pd.DataFrame, columns: dict[str, tuple[str, str, str]], titl
         return "\n".join([*lines, "No completed cells.", ""])
     for dataset, group in table.groupby("dataset", sort=False):
         present = [c for c in columns if group[f"{c}_mean"].notna().any()]
-        header = ["method", "degradation", "seeds", *[columns[c][2] for c in present]]
+        header = ["method", "degradation", "seeds", *[columns[c].header for c in present]]
         lines += [
             f"## {dataset}",
             "",

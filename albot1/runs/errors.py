@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 from albot1.errors import Albot1Error
+from albot1.methods.errors import UnknownMethodError
+
+__all__ = ["RunError", "UnknownMethodError"]
 
 
 class RunError(Albot1Error):
     """A run could not be made or its result breaks the result contract."""
-
-
-class UnknownMethodError(RunError):
-    """A method name is not registered, or its dependencies are missing."""

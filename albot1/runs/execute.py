@@ -18,11 +18,12 @@ from typing import Any
 import numpy as np
 
 from albot1 import versions
+from albot1.contract import MapperOutput, RunResult
+from albot1.data.degrade import degrade
 from albot1.data.model import Sequence
 from albot1.errors import Albot1Error
-from albot1.runs.errors import RunError
 from albot1.methods.registry import get_method, resolve_config
-from albot1.contract import MapperOutput, RunResult
+from albot1.runs.errors import RunError
 
 
 def peak_rss_mb() -> float:
@@ -43,8 +44,6 @@ def run_method(
     on_frame: Callable[[int], None] | None = None,
 ) -> RunResult:
     """Degrade (seeded), run and check one method; raises the method's error class on failure."""
-    from albot1.data.degrade import degrade
-
     spec = get_method(method)
     config = resolve_config(method, preset, overrides)
     error_class = spec.load_error_class()
@@ -82,7 +81,7 @@ def run_method(
             raise
         # A mapper never sees the dataset's name: add it ("kiss-icp diverged ..." -> "kiss-icp on intel diverged ...").
         text = str(exc)
-        rest = text[len(method):] if text.startswith(method) else f": {text}"
+        rest = text[len(method) :] if text.startswith(method) else f": {text}"
         raise error_class(f"{method} on {dataset}{rest}") from exc
     except Exception as exc:  # a library failed deep inside: name method, dataset and scan
         raise error_class(f"{method} on {dataset} failed at scan {index}: {type(exc).__name__}: {exc}") from exc
@@ -110,16 +109,21 @@ def run_method(
         wall_s=time.perf_counter() - wall_start,
         peak_mb=peak_rss_mb(),
         versions={"code": versions.code_version(), "git": versions.git_commit(), **versions.library_versions()},
-        dataset_info={"source": seq.metadata.source, "format": seq.metadata.format,
-                      "odometry_source": seq.metadata.odometry_source,
-                      "reference_source": seq.metadata.reference_source},
+        dataset_info={
+            "source": seq.metadata.source,
+            "format": seq.metadata.format,
+            "odometry_source": seq.metadata.odometry_source,
+            "reference_source": seq.metadata.reference_source,
+        },
     )
 
 
 def _check_output(output: MapperOutput, n: int, method: str, dataset: str, error_class: type[Exception]) -> None:
     poses = np.asarray(output.poses, dtype=float)
     if poses.shape != (n, 3):
-        raise error_class(f"{method} on {dataset}: expected {n} poses (one per scan) of (x, y, theta), got shape {poses.shape}")
+        raise error_class(
+            f"{method} on {dataset}: expected {n} poses (one per scan) of (x, y, theta), got shape {poses.shape}"
+        )
     bad = np.flatnonzero(~np.isfinite(poses).all(axis=1))
     if len(bad):
         raise error_class(f"{method} on {dataset}: {len(bad)} non-finite poses, first at scan {bad[0]} (diverged)")

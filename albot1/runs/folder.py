@@ -1,4 +1,4 @@
-"""The run-folder contract (DESIGN.md 4 and 4b).
+"""The run-folder contract (``docs/architecture.md``, "Contracts").
 
 One folder per run, named by a content hash of (dataset, method, config,
 degradation, seed, code version)::
@@ -7,10 +7,10 @@ degradation, seed, code version)::
     odometry.tum     the odometry the method was given (after degradation)
     reference.tum    reference poses, when the dataset has them
     relations.txt    ground-truth relations, when the dataset has them
-    result.json      method, dataset, config, versions, counters, timing
+    result.json      method, dataset, config, versions, counters, timing (albot1.records.ResultRecord)
     map.geojson      line surfaces (Albot1) -- or map.npz (points) for baselines
     extras.json      method-specific records (update trace, ...)
-    preview.png      the map with the trajectory
+    preview.png      the map with the trajectory (drawn by the caller's renderer, if given)
     DONE             written last, by atomic rename: the run is complete
 
 Every file is written to a temporary name and renamed, so a killed process
@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,64 +31,74 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.atomic import atomic_write
+from albot1.contract import MapData, RunResult
 from albot1.data.model import Relations
 from albot1.data.relations import read_relations, write_relations
+from albot1.records import Record, ResultRecord, dump_record, json_value, parse_record, read_record
 from albot1.runs.errors import RunError
-from albot1.contract import MapData, RunResult
 from albot1.runs.tum import read_tum, write_tum
 
 DONE = "DONE"
+RESULT_FILE = "result.json"
+
+#: Draws a run's ``preview.png`` (``albot1.report.preview.render_preview``). The caller passes it in:
+#: storing a run must not depend on the plotting layer above it (docs/architecture.md, layers).
+PreviewRenderer = Callable[[RunResult, Path], None]
 
 
 def run_key(dataset: str, method: str, config: dict[str, Any], degradation: str, seed: int, code_version: str) -> str:
     """Content hash naming a run folder (16 hex digits)."""
-    payload = json.dumps({"dataset": dataset, "method": method, "config": config, "degradation": degradation,
-                          "seed": seed, "code": code_version}, sort_keys=True, default=str)
+    payload = json.dumps(
+        {
+            "dataset": dataset,
+            "method": method,
+            "config": config,
+            "degradation": degradation,
+            "seed": seed,
+            "code": code_version,
+        },
+        sort_keys=True,
+        default=str,
+    )
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
 
 def write_json(path: Path, data: Any) -> None:
-    """Atomically write JSON (NaN/inf are written as null)."""
-    atomic_write(path, lambda p: p.write_text(json.dumps(_jsonable(data), indent=2, sort_keys=False) + "\n"))
+    """Atomically write JSON (numpy values as Python ones, NaN/inf as null; key order kept)."""
+    atomic_write(path, lambda p: p.write_text(json.dumps(json_value(data), indent=2, sort_keys=False) + "\n"))
 
 
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, (np.floating, float)):
-        return float(value) if np.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    return value
+def write_record(path: Path, record: Record) -> None:
+    """Atomically write one record (``result.json``, ``metrics.json``, ...) in its fields' order."""
+    write_json(path, dump_record(record))
 
 
 def is_complete(run_dir: Path) -> bool:
     return (run_dir / DONE).is_file()
 
 
-def write_run(result: RunResult, root: Path, *, preview: bool = True) -> Path:
-    """Store ``result`` under ``root/<key>`` and mark it DONE; returns the folder."""
-    key = run_key(result.dataset, result.method, result.config, result.degradation, result.seed,
-                  str(result.versions.get("code")))
+def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None = None) -> Path:
+    """Store ``result`` under ``root/<key>`` and mark it DONE; returns the folder.
+
+    ``preview`` draws ``preview.png`` before DONE is written; without it the folder has no preview.
+    """
+    key = run_key(
+        result.dataset, result.method, result.config, result.degradation, result.seed, str(result.versions.get("code"))
+    )
     run_dir = root / key
     run_dir.mkdir(parents=True, exist_ok=True)
     (run_dir / DONE).unlink(missing_ok=True)
 
     atomic_write(run_dir / "trajectory.tum", lambda p: write_tum(p, result.timestamps, result.poses))
     atomic_write(run_dir / "odometry.tum", lambda p: write_tum(p, result.timestamps, result.odometry))
-    if result.reference is not None:
-        atomic_write(run_dir / "reference.tum", lambda p: write_tum(p, result.timestamps, result.reference))
+    reference = result.reference
+    if reference is not None:
+        atomic_write(run_dir / "reference.tum", lambda p: write_tum(p, result.timestamps, reference))
     if result.relations is not None:
         write_relations(run_dir / "relations.txt", result.relations)  # atomic itself
     map_file = _write_map(run_dir, result.map)
     write_json(run_dir / "extras.json", result.extras)
-    write_json(run_dir / "result.json", {
+    info = {
         "key": key,
         "method": result.method,
         "dataset": result.dataset,
@@ -99,16 +110,15 @@ def write_run(result: RunResult, root: Path, *, preview: bool = True) -> Path:
         "versions": result.versions,
         "dataset_info": result.dataset_info,
         "counters": result.counters,
-        "timing": result.timing(),
+        "timing": dump_record(result.timing()),
         "map_file": map_file,
         "has_reference": result.reference is not None,
         "relations": len(result.relations) if result.relations is not None else 0,
-    })
+    }
+    write_record(run_dir / RESULT_FILE, parse_record(ResultRecord, info, f"{run_dir / RESULT_FILE} (being written)"))
     np.save(run_dir / "per_scan_ns.npy", result.per_scan_ns)
-    if preview:
-        from albot1.report.preview import render_preview
-
-        atomic_write(run_dir / "preview.png", lambda p: render_preview(result, p))
+    if preview is not None:
+        atomic_write(run_dir / "preview.png", lambda p: preview(result, p))
     atomic_write(run_dir / DONE, lambda p: p.write_text(key + "\n"))
     return run_dir
 
@@ -118,11 +128,21 @@ def _write_map(run_dir: Path, data: MapData) -> str:
         features = []
         props = data.segment_properties or [{} for _ in range(len(data.segments))]
         for seg, prop in zip(np.asarray(data.segments, dtype=float), props):
-            features.append({"type": "Feature", "properties": prop,
-                             "geometry": {"type": "LineString", "coordinates": [[seg[0], seg[1]], [seg[2], seg[3]]]}})
+            features.append(
+                {
+                    "type": "Feature",
+                    "properties": prop,
+                    "geometry": {"type": "LineString", "coordinates": [[seg[0], seg[1]], [seg[2], seg[3]]]},
+                }
+            )
         if data.points is not None and len(data.points):
-            features.append({"type": "Feature", "properties": {"kind": "points"},
-                             "geometry": {"type": "MultiPoint", "coordinates": np.asarray(data.points).tolist()}})
+            features.append(
+                {
+                    "type": "Feature",
+                    "properties": {"kind": "points"},
+                    "geometry": {"type": "MultiPoint", "coordinates": np.asarray(data.points).tolist()},
+                }
+            )
         write_json(run_dir / "map.geojson", {"type": "FeatureCollection", "features": features})
         return "map.geojson"
     points = np.asarray(data.points if data.points is not None else np.empty((0, 2)), dtype=np.float32)
@@ -132,10 +152,10 @@ def _write_map(run_dir: Path, data: MapData) -> str:
 
 @dataclass
 class StoredRun:
-    """A run folder read back (what ``evaluate`` and the report consume)."""
+    """A run folder read back (what ``evaluate`` and the report consume); ``info`` is its ``result.json``."""
 
     path: Path
-    info: dict[str, Any]
+    info: ResultRecord
     timestamps: NDArray[np.float64]
     poses: NDArray[np.float64]
     odometry: NDArray[np.float64]
@@ -144,7 +164,7 @@ class StoredRun:
     per_scan_ns: NDArray[np.int64]
 
     def load_map(self) -> MapData:
-        map_file = self.path / self.info["map_file"]
+        map_file = self.path / self.info.map_file
         if map_file.suffix == ".npz":
             with np.load(map_file) as npz:
                 return MapData(points=npz["points"].astype(float))
@@ -158,21 +178,31 @@ class StoredRun:
                 props.append(feature.get("properties") or {})
             elif geom["type"] == "MultiPoint":
                 points = np.asarray(geom["coordinates"], dtype=float).reshape(-1, 2)
-        return MapData(segments=np.asarray(segments, dtype=float).reshape(-1, 4), points=points,
-                       segment_properties=props)
+        return MapData(
+            segments=np.asarray(segments, dtype=float).reshape(-1, 4), points=points, segment_properties=props
+        )
 
 
 def read_run(run_dir: str | Path) -> StoredRun:
-    """Read a complete run folder; RunError if it is missing or incomplete."""
+    """Read a complete run folder; RunError if it is missing or incomplete (see :func:`read_result`)."""
     path = Path(run_dir)
-    if not (path / "result.json").is_file():
-        raise RunError(f"{path}: not a run folder (no result.json)")
-    if not is_complete(path):
-        raise RunError(f"{path}: the run is incomplete (no {DONE} marker); run it again")
-    info = json.loads((path / "result.json").read_text())
+    info = read_result(path)
     stamps, poses = read_tum(path / "trajectory.tum")
     _, odom = read_tum(path / "odometry.tum")
     reference = read_tum(path / "reference.tum")[1] if (path / "reference.tum").is_file() else None
     relations = read_relations(path / "relations.txt") if (path / "relations.txt").is_file() else None
     per_scan = np.load(path / "per_scan_ns.npy")
     return StoredRun(path, info, stamps, poses, odom, reference, relations, per_scan)
+
+
+def read_result(run_dir: str | Path) -> ResultRecord:
+    """The ``result.json`` of a complete run folder.
+
+    RunError when the folder is not a run or is incomplete; RecordError when the file does not fit its model.
+    """
+    path = Path(run_dir)
+    if not (path / RESULT_FILE).is_file():
+        raise RunError(f"{path}: not a run folder (no {RESULT_FILE})")
+    if not is_complete(path):
+        raise RunError(f"{path}: the run is incomplete (no {DONE} marker); run it again")
+    return read_record(ResultRecord, path / RESULT_FILE)

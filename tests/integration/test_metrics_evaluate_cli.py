@@ -13,6 +13,7 @@ from albot1.cli.app import app, main
 from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
 from albot1.data.transforms import head
 from albot1.geometry import se2
+from albot1.records import ClosedRouteGapBlock, dump_record
 from albot1.runs.evaluate import METRIC_KEYS, evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
@@ -52,8 +53,8 @@ def test_an_estimate_equal_to_the_reference_scores_zero(tmp_path: Path) -> None:
     angles = np.linspace(-np.pi / 2, np.pi / 2, 31)
     frames = [Frame(i, Scan(np.full(31, 2.0), angles, i * 1.0, 8.0), ref[i], ref[i]) for i in range(n)]
     result = run_method("odometry", Sequence.from_frames("circle", frames), dataset_name="circle-in-memory")
-    run_dir = write_run(result, tmp_path, preview=False)
-    metrics = evaluate_run(run_dir)
+    run_dir = write_run(result, tmp_path)
+    metrics = dump_record(evaluate_run(run_dir))  # the metrics.json object
     assert metrics["ate"]["rmse_m"] == pytest.approx(0.0, abs=1e-6)
     assert metrics["rpe"]["translation_m"]["max"] == pytest.approx(0.0, abs=1e-6)
     assert metrics["orientation"]["bearing_abs_error_max_deg"] == pytest.approx(0.0, abs=1e-4)
@@ -71,7 +72,7 @@ def test_without_reference_metrics_are_null_with_reasons(tmp_path: Path) -> None
     angles = np.linspace(-np.pi / 2, np.pi / 2, 31)
     frames = [Frame(i, Scan(np.full(31, 2.0), angles, 10.0 + i * 0.5, 8.0), poses[i], None) for i in range(n)]
     result = run_method("odometry", Sequence.from_frames("in-memory", frames), dataset_name="in-memory-test")
-    run_dir = write_run(result, tmp_path, preview=False)
+    run_dir = write_run(result, tmp_path)
     metrics = cli("evaluate", str(run_dir), "--json")
     for key in ("ate", "rpe", "orientation", "map_shape", "loop_gap", "relations"):
         assert metrics[key] is None, key
@@ -102,14 +103,15 @@ def test_a_declared_closed_route_gets_its_end_to_start_gap_without_reference(
     angles = np.linspace(-np.pi / 2, np.pi / 2, 31)
     frames = [Frame(i, Scan(np.full(31, 2.0), angles, float(i), 8.0), odometry[i], None) for i in range(n)]
     closed = Sequence.from_frames("ring", frames, metadata=SequenceMetadata(extra={"closed_loop": True}))
-    run_dir = write_run(run_method("odometry", closed, dataset_name="ring"), tmp_path, preview=False)
+    run_dir = write_run(run_method("odometry", closed, dataset_name="ring"), tmp_path)
     monkeypatch.setattr("albot1.data.open.open_sequence", lambda ref, **_: closed)
-    block = evaluate_run(run_dir)["loop_gap"]
+    block = evaluate_run(run_dir).loop_gap
+    assert isinstance(block, ClosedRouteGapBlock)
     assert np.allclose(truth[-1, :2], 0.0, atol=1e-9)
-    assert block["route"]["gap_m"] == pytest.approx(np.hypot(*odometry[-1, :2]))
-    assert block["route"]["gap_m"] > 0.5
-    assert block["pairs"] is None and block["pairs_reason"] == "the dataset has no reference poses"
+    assert block.route.gap_m == pytest.approx(np.hypot(*odometry[-1, :2]))
+    assert block.route.gap_m > 0.5
+    assert block.pairs is None and block.pairs_reason == "the dataset has no reference poses"
     # A prefix of the same route does not end at its start: no gap without a reference.
-    prefix = write_run(run_method("odometry", head(closed, 30), dataset_name="ring"), tmp_path / "p", preview=False)
-    metrics = evaluate_run(prefix)
-    assert metrics["loop_gap"] is None and "not known to be closed" in metrics["loop_gap_reason"]
+    prefix = write_run(run_method("odometry", head(closed, 30), dataset_name="ring"), tmp_path / "p")
+    record = evaluate_run(prefix)
+    assert record.loop_gap is None and "not known to be closed" in str(record.loop_gap_reason)

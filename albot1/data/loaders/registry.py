@@ -6,12 +6,13 @@ only when a bag is actually opened.
 
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
 from typing import Any
 
+from albot1.config.targets import TargetError, resolve_class
 from albot1.data.errors import DataError, UnknownFormatError
 from albot1.data.loaders.base import SequenceLoader, SequenceWriter
+from albot1.data.loaders.diagnose import unrecognised
 from albot1.data.model import Sequence
 
 #: format name -> (loader "module:Class", writer "module:Class" or None)
@@ -34,12 +35,10 @@ FORMATS: dict[str, tuple[str, str | None]] = {
 
 
 def _import(target: str) -> Any:
-    module_name, _, attr = target.partition(":")
     try:
-        module = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise UnknownFormatError(f"the loader module {module_name} cannot be imported: {exc}") from exc
-    return getattr(module, attr)
+        return resolve_class(target)
+    except TargetError as exc:
+        raise UnknownFormatError(f"a format's loader or writer cannot be loaded: {exc}") from exc
 
 
 def _check_format(name: str) -> tuple[str, str | None]:
@@ -64,10 +63,7 @@ def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoad
         loader: SequenceLoader = _import(loader_target)()
         if loader.sniff(p):
             return loader
-    raise UnknownFormatError(
-        f"{p}: not a recognised log; expected a CARMEN log (.clf/.log, optionally .gz/.bz2), "
-        f"a ROS1 .bag, a ROS2 bag folder (sqlite3 or MCAP) or an albot log"
-    )
+    raise unrecognised(p)
 
 
 def writer_for(format_name: str) -> SequenceWriter:

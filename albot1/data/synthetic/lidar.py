@@ -8,7 +8,7 @@ of poses are solved as flat numpy arrays. A 181-beam scan against a few
 hundred segments takes a fraction of a millisecond, which is what lets the
 embedded worlds be generated on first use instead of being shipped as files.
 
-Conventions (DESIGN.md section 3, ROS REP-103): beam angles are radians,
+Conventions (the data model of ``docs/architecture.md``, ROS REP-103): beam angles are radians,
 counter-clockwise, 0 = straight ahead, ascending; a 180-degree, 181-beam
 scanner (the thesis's SICK LMS-200 at 1 degree) has beam 0 at -90 degrees
 (the robot's right). A beam that hits nothing within ``max_range`` reads NaN

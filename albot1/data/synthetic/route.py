@@ -11,7 +11,8 @@ A :class:`Sampling` says when a scan is taken:
 - continuous motion, as the thesis's Experiment 4 logger: a scan every
   0.1 m of translation or 1 degree of rotation (``CONTINUOUS``);
 - start-stop, as Experiments 1-3: a scan after every 1 m move or 45 degree
-  turn (``START_STOP``), with a dwell while the robot stands still to scan.
+  turn (``START_STOP``), with a dwell while the robot stands still to scan;
+  at Experiment 5's spacing, 1 m or 10 degrees (``START_STOP_10DEG``).
 
 Each move or turn is cut into full steps plus one shorter remainder step, so
 the steps are exactly the commanded size (a straight 5.5 m leg in start-stop
@@ -62,6 +63,8 @@ class Sampling:
 
 CONTINUOUS = Sampling(step_m=0.1, step_deg=1.0)
 START_STOP = Sampling(step_m=1.0, step_deg=45.0, dwell_s=1.0)
+#: Experiment 5's view spacing (a view every 1 m or 10 deg), driven start-stop.
+START_STOP_10DEG = Sampling(step_m=1.0, step_deg=10.0, dwell_s=1.0)
 
 
 @dataclass(frozen=True)

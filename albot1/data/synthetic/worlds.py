@@ -30,7 +30,7 @@ from albot1.data.synthetic.errors import UnknownWorldError
 from albot1.data.synthetic.floorplan import DoorwayCrossing
 from albot1.data.synthetic.generate import WorldData, WorldSpec, generate, stream_frames, world_metadata
 from albot1.data.synthetic.odometry import OdometryErrorModel
-from albot1.data.synthetic.route import CONTINUOUS, START_STOP
+from albot1.data.synthetic.route import CONTINUOUS, START_STOP, START_STOP_10DEG
 
 __all__ = [
     "OFFICE_ODOMETRY",
@@ -91,6 +91,17 @@ WORLDS: dict[str, WorldSpec] = {
             seed=131,
         ),
         WorldSpec(
+            name="synthetic-office-startstop-10deg",
+            description="the office loop driven start-stop at the thesis's Experiment 5 spacing: a view after every "
+            "1 m move or 10 deg turn (190 views); with synthetic-office-loop (0.1 m / 1 deg) Experiments 4 and 5 "
+            "run on one route",
+            plan=layouts.office_plan,
+            route=layouts.office_loop,
+            sampling=START_STOP_10DEG,
+            odometry=OFFICE_ODOMETRY,
+            seed=113,
+        ),
+        WorldSpec(
             name="synthetic-corridor",
             description="a featureless straight corridor 60 m x 2 m driven 53 m at 0.1 m per scan: no corner or "
             "occluding edge in view until the end wall comes within 30 m (path integration)",
@@ -133,7 +144,7 @@ def world_data(name: str) -> WorldData:
 def load_world(name: str) -> Sequence:
     """The embedded world ``name`` as a streamed Sequence (reference = exact poses)."""
     data = world_data(name)
-    return Sequence(name, functools.partial(stream_frames, data), world_metadata(data))
+    return Sequence(name, functools.partial(stream_frames, data), world_metadata(data), scan_count=data.scans)
 
 
 def world_geometry(name: str) -> FloatArray:

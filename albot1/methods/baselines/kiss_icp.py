@@ -69,9 +69,7 @@ from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry import se2
-from albot1.methods.baselines import planar
 from albot1.methods.baselines.errors import BaselineError
-from albot1.methods.baselines.planar import planar_pose, pose_matrix
 from albot1.methods.baselines.point_map import ThinnedPointMap
 
 if TYPE_CHECKING:
@@ -101,7 +99,9 @@ class KissIcpConfig(BaseModel):
     )
     map_point_spacing_m: float = Field(
         gt=0,
-        description="scans are thinned to one point per cell of this size before insertion into the map (KISS-ICP: 0.5 x voxel)",
+        description=(
+            "scans are thinned to one point per cell of this size before insertion into the map (KISS-ICP: 0.5 x voxel)"
+        ),
     )
     source_point_spacing_m: float = Field(
         gt=0,
@@ -109,13 +109,18 @@ class KissIcpConfig(BaseModel):
     )
     map_update_distance_m: float = Field(
         ge=0,
-        description="insert a scan into the voxel map only after moving this far from the last insertion (or turning map_update_angle_deg); 0 and 0 = every scan, as KISS-ICP",
+        description=(
+            "insert a scan into the voxel map only after moving this far from the last insertion "
+            "(or turning map_update_angle_deg); 0 and 0 = every scan, as KISS-ICP"
+        ),
     )
     map_update_angle_deg: float = Field(ge=0, description="see map_update_distance_m")
     min_range_m: float = Field(ge=0, description="beams shorter than this are dropped")
     max_range_m: float = Field(
         gt=0,
-        description="beams longer than this are dropped; also the local map radius and the threshold's rotation lever arm",
+        description=(
+            "beams longer than this are dropped; also the local map radius and the threshold's rotation lever arm"
+        ),
     )
     max_points_per_voxel: int = Field(ge=1, description="points kept per map voxel")
     initial_threshold_m: float = Field(gt=0, description="adaptive threshold before any motion sample exists")
@@ -180,8 +185,6 @@ class KissIcpMapper:
         self._max_correction_rad = math.radians(config.max_correction_deg)
         self._map_update_angle_rad = math.radians(config.map_update_angle_deg)
         self._last_inserted: FloatArray | None = None
-        self._angles: FloatArray | None = None
-        self._cos = self._sin = np.empty(0)
         self._map = ThinnedPointMap(config.map_voxel_m)
         self._poses: list[FloatArray] = []
         self._last_odometry: FloatArray | None = None
@@ -218,11 +221,11 @@ class KissIcpMapper:
             pose = np.zeros(3)
         else:
             pose = self._register(frame, odometry, frame_down, voxel_down_sample)
-            self._last_delta = planar.between(self._poses[-1], pose)
+            self._last_delta = np.array(se2.between_pose(self._poses[-1], pose))
         self._last_odometry = odometry
         self._poses.append(pose)
         if len(frame_down) and self._moved_since_insertion(pose):
-            self._local_map.update(frame_down, pose_matrix(pose))
+            self._local_map.update(frame_down, se2.pose_to_se3(pose))
             self._last_inserted = pose
             self._counters["updates"] += 1
         c, s = math.cos(pose[2]), math.sin(pose[2])
@@ -232,40 +235,32 @@ class KissIcpMapper:
         """Whether the pose is far enough from the last one inserted into the voxel map."""
         if self._last_inserted is None:
             return True
-        step = planar.between(self._last_inserted, pose)
+        step = se2.between_pose(self._last_inserted, pose)
         return (
             math.hypot(step[0], step[1]) >= self.config.map_update_distance_m
             or abs(float(step[2])) >= self._map_update_angle_rad
         )
 
     def _base_cloud(self, frame: Frame) -> FloatArray:
-        """Valid beams within the range limits as 3D points (z = 0) in the base frame, ``(k, 3)``."""
-        scan = frame.scan
-        if scan.angles is not self._angles or scan.angles.flags.writeable:
-            # Loaders share one read-only angle array across a log's scans: compute its cos/sin once.
-            self._angles, self._cos, self._sin = scan.angles, np.cos(scan.angles), np.sin(scan.angles)
-        ranges = scan.ranges
-        with np.errstate(invalid="ignore"):  # NaN (no return) compares False: dropped
-            keep = (ranges >= self.config.min_range_m) & (ranges <= self.config.max_range_m)
-        r = ranges[keep]
-        cloud = np.zeros((len(r), 3))
-        cloud[:, 0] = r * self._cos[keep]
-        cloud[:, 1] = r * self._sin[keep]
+        """Beams with a return within the range limits as 3D points (z = 0) in the base frame, ``(k, 3)``."""
+        points = frame.scan.points(self.config.min_range_m, self.config.max_range_m)
         if self._sensor.any():
-            cloud[:, :2] = se2.transform_points(self._sensor, cloud[:, :2])
+            points = se2.transform_points(self._sensor, points)
+        cloud = np.zeros((len(points), 3))
+        cloud[:, :2] = points
         return cloud
 
     def _register(self, frame: Frame, odometry: FloatArray, frame_down: FloatArray, down_sample: Any) -> FloatArray:
         """The pose of this scan: ICP from the predicted pose, or the prediction when ICP cannot be trusted."""
         assert self._last_odometry is not None
-        step = planar.between(self._last_odometry, odometry) if self.config.odometry_prior else self._last_delta
-        guess = planar.compose(self._poses[-1], step)
+        step = se2.between_pose(self._last_odometry, odometry) if self.config.odometry_prior else self._last_delta
+        guess = np.array(se2.compose_pose(self._poses[-1], step))
         source = down_sample(frame_down, self.config.source_point_spacing_m)
         if len(source) < self.config.min_points:
             return self._fallback(frame.index, guess)
 
         sigma = float(self._threshold.get_threshold())
-        guess_matrix = pose_matrix(guess)
+        guess_matrix = se2.pose_to_se3(guess)
         result = self._align(source, guess_matrix, sigma)
         if self.config.refine_threshold_m > 0 and np.isfinite(result).all():
             result = self._align(source, result, self.config.refine_threshold_m)
@@ -275,10 +270,10 @@ class KissIcpMapper:
                 f"kiss-icp diverged at scan {frame.index}: registration of {len(source)} points returned a "
                 f"non-finite pose from the initial guess {np.round(guess, 4).tolist()} (threshold {sigma:.3g} m)"
             )
-        pose, out_of_plane = planar_pose(result)
+        pose, out_of_plane = se2.pose_from_se3(result)
         self._out_of_plane = max(self._out_of_plane, out_of_plane)
 
-        correction = planar.between(guess, pose)
+        correction = se2.between_pose(guess, pose)
         shift, turn = math.hypot(correction[0], correction[1]), abs(float(correction[2]))
         if shift > self.config.max_correction_m or turn > self._max_correction_rad:
             self._counters["registration_failures"] += 1
@@ -294,7 +289,7 @@ class KissIcpMapper:
 
         self._consecutive_failures = 0
         self._corrections.append((shift, turn))
-        self._threshold.update_model_deviation(pose_matrix(correction))
+        self._threshold.update_model_deviation(se2.pose_to_se3(correction))
         return pose
 
     def _align(self, source: FloatArray, initial: FloatArray, sigma: float) -> FloatArray:

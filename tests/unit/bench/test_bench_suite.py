@@ -9,7 +9,7 @@ import pytest
 from albot1.bench.errors import BenchError, SuiteError
 from albot1.bench.executors import parse_executor
 from albot1.bench.suite import find_suite, load_suite, parse_suite
-from albot1.resources import project_dir
+from albot1.resources import shipped_dir
 
 MINIMAL = {"methods": [{"name": "odometry"}], "datasets": [{"name": "*"}]}
 
@@ -94,7 +94,7 @@ def test_suite_name_defaults_to_file_stem(tmp_path: Path) -> None:
 
 
 def test_find_suite_by_name_and_path(tmp_path: Path) -> None:
-    assert find_suite("quick") == project_dir() / "benchmarks" / "quick.toml"
+    assert find_suite("quick") == shipped_dir("benchmarks") / "quick.toml"
     path = write(tmp_path, "")
     assert find_suite(str(path)) == path
     with pytest.raises(SuiteError, match="no suite named 'nope'.*quick"):

@@ -1,4 +1,4 @@
-"""Baseline presets read from baselines/<method>.toml (albot1.config.presets)."""
+"""Presets read from TOML (albot1.config.presets): baselines/<method>.toml and a package's presets.toml."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import Any, ClassVar
 import pytest
 from pydantic import BaseModel, ConfigDict, Field
 
-from albot1.config.presets import TomlPresets, load_presets, parse_presets, preset_file
+from albot1.config.presets import TomlPresets, load_package_presets, load_presets, parse_presets, preset_file
 from albot1.errors import ConfigError
 from albot1.methods.baselines.kiss_icp import KissIcpConfig, KissIcpMapper
 from albot1.methods.registry import resolve_config
@@ -58,7 +58,7 @@ def test_descriptor_reads_the_file_named_after_the_class(monkeypatch: pytest.Mon
     (tmp_path / "baselines" / "toy.toml").write_text(
         "[presets.default]\nsize = 0.5\ncount = 3\n[presets.more]\ncount = 9\n"
     )
-    monkeypatch.setenv("ALBOT1_PROJECT_DIR", str(tmp_path))
+    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path))
 
     class Toy:
         name: ClassVar[str] = "toy"
@@ -73,7 +73,7 @@ def test_broken_toml_is_a_config_error(monkeypatch: pytest.MonkeyPatch, tmp_path
     (tmp_path / "baselines").mkdir()
     (tmp_path / "datasets").mkdir()
     (tmp_path / "baselines" / "toy.toml").write_text("[presets.default\n")
-    monkeypatch.setenv("ALBOT1_PROJECT_DIR", str(tmp_path))
+    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path))
     with pytest.raises(ConfigError, match=r"toy.toml: not valid TOML"):
         load_presets("toy", _Model)
 
@@ -95,3 +95,37 @@ def test_kiss_icp_precedence_preset_env_override(monkeypatch: pytest.MonkeyPatch
     assert resolve_config("kiss-icp", overrides={"voxel_size_m": "0.6"}).voxel_size_m == 0.6  # type: ignore[attr-defined]
     with pytest.raises(ConfigError, match=r"voxel_size_m: Input should be greater than 0"):
         resolve_config("kiss-icp", overrides={"voxel_size_m": "-1"})
+
+
+def _package(tmp_path: Any, monkeypatch: pytest.MonkeyPatch, name: str, presets: str | None) -> None:
+    folder = tmp_path / name
+    folder.mkdir()
+    (folder / "__init__.py").write_text("")
+    if presets is not None:
+        (folder / "presets.toml").write_text(presets)
+    monkeypatch.syspath_prepend(str(tmp_path))
+
+
+def test_package_presets_use_the_same_mechanism(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
+    _package(
+        tmp_path, monkeypatch, "toy_presets_pkg", "[presets.default]\nsize = 0.5\ncount = 3\n[presets.x]\nsize = 2.0\n"
+    )
+
+    class Toy:
+        name: ClassVar[str] = "toy"
+        config_model: ClassVar[type[BaseModel]] = _Model
+        presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets(package="toy_presets_pkg")  # type: ignore[assignment]
+
+    assert Toy.presets == {"default": {"size": 0.5, "count": 3}, "x": {"size": 2.0, "count": 3}}
+    assert Toy.__dict__["presets"].location(Toy) == str(tmp_path / "toy_presets_pkg" / "presets.toml")
+
+
+def test_package_presets_errors_name_the_file(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
+    _package(tmp_path, monkeypatch, "toy_bad_pkg", "[presets.default]\nsize = 0.5\n")
+    _package(tmp_path, monkeypatch, "toy_empty_pkg", None)
+    with pytest.raises(ConfigError, match=r"toy_bad_pkg/presets.toml: \[presets.default\] must set every field"):
+        load_package_presets("toy_bad_pkg", _Model)
+    with pytest.raises(
+        ConfigError, match=r"toy_empty_pkg/presets.toml: the presets of package toy_empty_pkg are missing"
+    ):
+        load_package_presets("toy_empty_pkg", _Model)

@@ -59,7 +59,7 @@ def _manifest(tmp_path: Path, url: str, sha: str) -> None:
 
 @pytest.fixture
 def project(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
-    monkeypatch.setenv("ALBOT1_PROJECT_DIR", str(tmp_path / "project"))
+    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path / "project"))
     catalog._manifests.cache_clear()
     yield tmp_path / "project"
     catalog._manifests.cache_clear()

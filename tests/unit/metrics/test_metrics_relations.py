@@ -8,7 +8,7 @@ import pytest
 from albot1.data.model import Relations
 from albot1.geometry import se2
 from albot1.metrics.errors import MetricsError
-from albot1.metrics.relations import nearest_indices, relation_metric
+from albot1.metrics.relations import relation_metric
 from albot1.metrics.rpe import pair_indices, rpe, rpe_set
 
 
@@ -70,7 +70,7 @@ def test_a_relation_time_without_a_scan_names_the_relation_line() -> None:
     rel = relations_from(stamps, ref, [(0, 1), (2, 3), (4, 5)])
     bad = Relations(t1=rel.t1.copy(), t2=rel.t2.copy(), poses=rel.poses)
     bad.t2[2] += 0.5
-    with pytest.raises(MetricsError, match=r"rel\.txt:3: no pose within 0\.1 s of time 10\.5"):
+    with pytest.raises(MetricsError, match=r"rel\.txt:3: no pose within 0\.0001 s of time 10\.5"):
         relation_metric(stamps, ref, bad, source="rel.txt")
 
 
@@ -83,10 +83,31 @@ def test_relations_outside_a_prefix_run_are_excluded_and_counted_when_asked() ->
         relation_metric(stamps[:10], ref[:10], rel)
 
 
-def test_nearest_indices_picks_the_closer_neighbour() -> None:
-    idx, gap = nearest_indices([0.0, 1.0, 2.0], [0.4, 0.6, 2.05, -0.01])
-    assert idx.tolist() == [0, 1, 2, 0]
-    np.testing.assert_allclose(gap, [0.4, 0.4, 0.05, 0.01])
+def test_relations_are_looked_up_by_stamp_in_a_log_whose_stamps_go_back() -> None:
+    # The Intel log: a scan stamped earlier than its predecessor. Relations name scans by stamp,
+    # so (t1, t2) with t2 < t1 is the pose of the later-logged scan seen from the earlier-logged one.
+    stamps = np.array([0.0, 2.0, 1.5, 3.0])
+    ref = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [2.0, 0.5, 0.2], [3.0, 0.5, 0.3]])
+    rel = Relations(t1=np.array([2.0, 0.0]), t2=np.array([1.5, 3.0]), poses=se2.between(ref[[1, 0]], ref[[2, 3]]))
+    block = relation_metric(stamps, ref, rel)
+    assert block["translation_m"]["max"] == pytest.approx(0.0, abs=1e-12)
+    assert block["relations_used"] == 2
+    swapped = relation_metric(stamps, ref, Relations(rel.t2, rel.t1, rel.poses))
+    assert swapped["translation_m"]["max"] > 2.0  # reading it the other way round is wrong
+
+
+def test_five_decimal_relation_stamps_match_six_decimal_scan_stamps() -> None:
+    # mit-csail: the log prints 1134864645.903214, the relations file 1134864645.90321.
+    stamps = np.array([1134864645.903214, 1134864646.324196, 1134864646.532199])
+    ref = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.2], [0.5, 0.1, 0.3]])
+    rel = Relations(
+        t1=np.array([1134864645.90321, 1134864646.32420]),
+        t2=np.array([1134864646.32420, 1134864646.53220]),
+        poses=se2.between(ref[[0, 1]], ref[[1, 2]]),
+    )
+    block = relation_metric(stamps, ref, rel)
+    assert block["relations_used"] == 2
+    assert block["translation_m"]["max"] == pytest.approx(0.0, abs=1e-12)
 
 
 def test_rpe_pairs_by_frames_and_by_reference_travel() -> None:

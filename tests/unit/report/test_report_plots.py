@@ -34,7 +34,7 @@ def _record(method: str, degradation: str, seed: int, status: str = "done") -> C
         time_s=1,
         memory_mb=1,
     )
-    return CellRecord(cell, status, Path("/x"), {}, {}, None)
+    return CellRecord(cell, status, Path("/x"), None, None, None)
 
 
 def test_representative_run_is_the_undegraded_lowest_seed_that_completed() -> None:

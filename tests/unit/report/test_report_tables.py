@@ -3,13 +3,66 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pandas as pd
+import pytest
 
 from albot1.bench.grid import Cell
 from albot1.bench.store import Failure
-from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, dig
+from albot1.metrics.ate import ate as ate_block
+from albot1.metrics.updates import update_counts
+from albot1.records import METRIC_NAMES, MetricsRecord, ResultRecord, check_number_path, parse_record
+from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, SOURCE_MODELS, CellRecord, Column
 from albot1.report.tables import aggregate, cell_text, cells_frame, markdown, write_tables
+
+RUN = {
+    "key": "k",
+    "method": "odometry",
+    "dataset": "w",
+    "preset": "default",
+    "degradation": "none",
+    "seed": 0,
+    "scans": 10,
+    "has_reference": True,
+}
+
+
+def metrics_record(ate_rmse_m: float | None) -> MetricsRecord:
+    """A valid metrics.json: an ATE block with the given RMSE (or none), 1 update per 2 views, the rest absent."""
+    data: dict[str, Any] = {"run": RUN}
+    for name in METRIC_NAMES:
+        data[name], data[f"{name}_reason"] = None, "not computed in this test"
+    if ate_rmse_m is not None:
+        poses = np.column_stack([np.arange(5.0), np.zeros(5), np.zeros(5)])
+        data["ate"], data["ate_reason"] = {**ate_block(poses, poses), "rmse_m": ate_rmse_m}, None
+    data["updates"], data["updates_reason"] = update_counts({"views": 2, "updates": 1}), None
+    return parse_record(MetricsRecord, data, "test metrics")
+
+
+def result_record(ms: float) -> ResultRecord:
+    timing = {
+        "per_scan_ms_median": ms,
+        "per_scan_ms_p95": 2 * ms,
+        "per_scan_ms_mean": ms,
+        "finish_s": 0.0,
+        "total_s": 0.01,
+        "wall_s": 0.02,
+        "peak_mb": 100.0,
+    }
+    data = {
+        **{k: v for k, v in RUN.items() if k != "has_reference"},
+        "config": {},
+        "versions": {"code": "v"},
+        "dataset_info": {"source": "", "format": "", "odometry_source": "", "reference_source": ""},
+        "counters": {"views": 10, "updates": 5},
+        "timing": timing,
+        "map_file": "map.npz",
+        "has_reference": True,
+        "relations": 0,
+    }
+    return parse_record(ResultRecord, data, "test result")
 
 
 def record(
@@ -38,19 +91,41 @@ def record(
             None,
             Failure("RuntimeError: boom", "exception", 2, 0.1, None) if status == "failed" else None,
         )
-    metrics = {"ate": {"rmse_m": ate} if ate is not None else None, "updates": {"updates_per_view": 0.5}}
-    result = {
-        "scans": 10,
-        "timing": {"per_scan_ms_median": ms, "per_scan_ms_p95": 2 * ms, "total_s": 0.01, "peak_mb": 100.0},
-    }
-    return CellRecord(cell, "done", Path("/nonexistent"), result, metrics, None)
+    return CellRecord(cell, "done", Path("/nonexistent"), result_record(ms), metrics_record(ate), None)
 
 
-def test_dig_follows_dotted_paths_and_rejects_non_numbers() -> None:
-    data = {"a": {"b": 2, "c": None, "d": "x", "e": True}}
-    assert dig(data, "a.b") == 2.0
-    assert dig(data, "a.c") is None and dig(data, "a.d") is None and dig(data, "a.e") is None
-    assert dig(data, "a.z.y") is None and dig(None, "a") is None
+def test_every_report_column_names_a_numeric_field_of_its_record() -> None:
+    for name, column in {**METRIC_COLUMNS, **COST_COLUMNS}.items():
+        check_number_path(SOURCE_MODELS[column.source], column.path)  # raises KeyError naming the path
+        assert column.header, name
+
+
+@pytest.mark.parametrize(
+    ("source", "path", "problem"),
+    [
+        ("metrics", "ate.rmse", "no field 'ate.rmse'"),  # a typo
+        ("metrics", "ate_rmse_m", "no field 'ate_rmse_m'"),
+        ("result", "timing.per_scan_median_ms", "no field 'timing.per_scan_median_ms'"),
+        ("metrics", "ate.alignment", "not a number"),  # a field, but text
+        ("metrics", "ate.rotation", "not a number"),  # a block, not a number
+        ("attempt", "host", "not a number"),
+    ],
+)
+def test_a_column_naming_no_numeric_field_fails_when_defined(source: Any, path: str, problem: str) -> None:
+    with pytest.raises(KeyError, match=problem):
+        Column(source, path, "header")
+
+
+def test_columns_read_numbers_and_leave_not_applicable_cells_empty() -> None:
+    rec = record("w", "odometry", "none", 0, 0.25, ms=3.0)
+    assert METRIC_COLUMNS["ate_rmse_m"].value(rec) == 0.25
+    assert METRIC_COLUMNS["updates_per_view"].value(rec) == 0.5
+    assert COST_COLUMNS["per_scan_ms_p95"].value(rec) == 6.0
+    assert METRIC_COLUMNS["relation_m"].value(rec) is None  # relations: null with a reason
+    assert COST_COLUMNS["cell_s"].value(rec) is None  # no attempt.json
+    assert Column("result", "counters.views", "views").value(rec) == 10.0  # method counters: any key
+    assert Column("result", "counters.nodes", "nodes").value(rec) is None
+    assert METRIC_COLUMNS["ate_rmse_m"].value(record("w", "odometry", "none", 0, None)) is None
 
 
 def test_aggregate_over_seeds_mean_median_min_max() -> None:

@@ -8,21 +8,28 @@ import numpy as np
 import pytest
 from pydantic import BaseModel, ConfigDict
 
-from albot1.methods.baselines.errors import BaselineError
+from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame, Scan, Sequence
 from albot1.errors import ConfigError
 from albot1.methods import registry as methods
+from albot1.methods.baselines.errors import BaselineError
+from albot1.methods.registry import MethodSpec, parse_overrides, resolve_config
 from albot1.runs.errors import RunError, UnknownMethodError
 from albot1.runs.execute import run_method
-from albot1.methods.registry import MethodSpec, parse_overrides, resolve_config
-from albot1.contract import MapData, MapperOutput
 
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
 
 
 def _sequence(n: int = 6) -> Sequence:
-    frames = [Frame(i, Scan(np.full(9, 2.0), ANGLES, float(i), 30.0), np.array([0.5 * i, 0.0, 0.0]),
-                    np.array([0.5 * i, 0.0, 0.0])) for i in range(n)]
+    frames = [
+        Frame(
+            i,
+            Scan(np.full(9, 2.0), ANGLES, float(i), 30.0),
+            np.array([0.5 * i, 0.0, 0.0]),
+            np.array([0.5 * i, 0.0, 0.0]),
+        )
+        for i in range(n)
+    ]
     return Sequence.from_frames("toy", frames)
 
 
@@ -101,16 +108,20 @@ def test_successful_run_records_everything(fake_method: str) -> None:
     assert result.reference is not None and result.reference.shape == (6, 3)
     assert result.config == {"mode": "ok", "gain": 1.0}
     assert result.versions["code"].startswith("0.1.0+")
-    assert result.timing()["per_scan_ms_median"] >= 0.0
+    median = result.timing().per_scan_ms_median
+    assert median is not None and median >= 0.0
     assert not np.allclose(result.odometry, _sequence().odometry)  # degraded before the method saw it
 
 
-@pytest.mark.parametrize(("mode", "error", "match"), [
-    ("raise", BaselineError, r"fake on toy failed at scan 3: ZeroDivisionError: boom"),
-    ("short", BaselineError, r"expected 6 poses"),
-    ("nan", BaselineError, r"non-finite poses, first at scan 2"),
-    ("nocount", RunError, r"counters lack the required key 'updates'"),
-])
+@pytest.mark.parametrize(
+    ("mode", "error", "match"),
+    [
+        ("raise", BaselineError, r"fake on toy failed at scan 3: ZeroDivisionError: boom"),
+        ("short", BaselineError, r"expected 6 poses"),
+        ("nan", BaselineError, r"non-finite poses, first at scan 2"),
+        ("nocount", RunError, r"counters lack the required key 'updates'"),
+    ],
+)
 def test_contract_violations(fake_method: str, mode: str, error: type[Exception], match: str) -> None:
     with pytest.raises(error, match=match):
         run_method(fake_method, _sequence(), overrides={"mode": mode})

@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from albot1.contract import MapData, RunResult
 from albot1.data.model import Frame, Relations, Scan, Sequence
 from albot1.runs.errors import RunError
 from albot1.runs.execute import run_method
 from albot1.runs.folder import DONE, is_complete, read_run, run_key, write_run
-from albot1.contract import MapData
 from albot1.runs.tum import read_tum, write_tum
 
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 7)
@@ -37,7 +37,7 @@ def test_tum_round_trip_keeps_micrometres(tmp_path: Path) -> None:
 
 def test_write_and_read_back(tmp_path: Path) -> None:
     result = run_method("odometry", _sequence(), seed=1)
-    run_dir = write_run(result, tmp_path, preview=False)
+    run_dir = write_run(result, tmp_path)
     assert is_complete(run_dir)
     stored = read_run(run_dir)
     np.testing.assert_allclose(stored.poses, result.poses, atol=1e-8)
@@ -53,14 +53,14 @@ def test_segments_map_round_trip(tmp_path: Path) -> None:
     result = run_method("odometry", _sequence())
     result.map = MapData(segments=np.array([[0, 0, 1, 0], [1, 0, 1, 2.5]], dtype=float),
                          segment_properties=[{"id": 1}, {"id": 2}])
-    stored = read_run(write_run(result, tmp_path, preview=False))
+    stored = read_run(write_run(result, tmp_path))
     loaded = stored.load_map()
     np.testing.assert_allclose(loaded.segments, result.map.segments)
     assert loaded.segment_properties == [{"id": 1}, {"id": 2}]
 
 
 def test_incomplete_folder_is_refused(tmp_path: Path) -> None:
-    run_dir = write_run(run_method("odometry", _sequence()), tmp_path, preview=False)
+    run_dir = write_run(run_method("odometry", _sequence()), tmp_path)
     (run_dir / DONE).unlink()
     with pytest.raises(RunError, match="incomplete"):
         read_run(run_dir)
@@ -68,6 +68,14 @@ def test_incomplete_folder_is_refused(tmp_path: Path) -> None:
         read_run(tmp_path / "nothing")
 
 
-def test_preview_png_is_written(tmp_path: Path) -> None:
-    run_dir = write_run(run_method("odometry", _sequence()), tmp_path)
-    assert (run_dir / "preview.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+def test_preview_is_drawn_by_the_callers_renderer_before_done(tmp_path: Path) -> None:
+    seen: list[tuple[str, bool]] = []
+
+    def renderer(result: RunResult, path: Path) -> None:
+        seen.append((result.method, (path.parent / DONE).exists()))
+        path.write_bytes(b"picture")
+
+    run_dir = write_run(run_method("odometry", _sequence()), tmp_path, preview=renderer)
+    assert seen == [("odometry", False)]
+    assert (run_dir / "preview.png").read_bytes() == b"picture" and is_complete(run_dir)
+    assert not (write_run(run_method("odometry", _sequence(), seed=3), tmp_path) / "preview.png").exists()

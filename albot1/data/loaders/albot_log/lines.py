@@ -1,8 +1,11 @@
 """Lines of the albot log (format version 1): parsing and formatting, no file I/O.
 
-The specification is in ``docs/formats.md``; :mod:`.albot_log` opens files
+The specification is in ``docs/formats.md``; :mod:`.loader` opens files
 and streams their lines through :class:`ViewParser`. Keeping the line
-grammar apart lets the property tests and the writer share it exactly.
+grammar apart lets the property tests and the writer share it exactly: the
+writer checks each SENSOR and VIEW with the reader's own rules
+(:func:`sensor_problem`, :func:`view_problem`), so it never writes a log the
+reader refuses.
 """
 
 from __future__ import annotations
@@ -46,6 +49,41 @@ def _numbers(path: Path, line: int, tokens: list[str], what: str) -> FloatArray:
     return parse_floats(path, line, tokens, f"{what}:")
 
 
+def sensor_problem(beams: int, max_range: float, angles: FloatArray) -> str | None:
+    """Why a beam geometry cannot be written or read as a SENSOR line (None if it can)."""
+    if not 1 <= beams <= MAX_BEAMS:
+        return f"{beams} beams, expected 1 to {MAX_BEAMS}"
+    if not (np.isfinite(max_range) and max_range > 0):
+        return f"max range is {max_range!r}, expected a finite, positive max range in metres"
+    if not np.all(np.isfinite(angles)):
+        return "beam angles must be finite numbers (radians)"
+    if beams > 1 and not np.all(np.diff(angles) > 0):
+        k = int(np.argmax(~(np.diff(angles) > 0)))
+        return (
+            f"beam angles must be strictly increasing (counter-clockwise), but beam {k + 2} at "
+            f"{float(angles[k + 1])!r} rad does not follow beam {k + 1} at {float(angles[k])!r} rad"
+        )
+    return None
+
+
+def view_problem(frame: Frame) -> str | None:
+    """Why a frame cannot be written or read as a VIEW line under its scan's SENSOR (None if it can)."""
+    poses = [frame.scan.timestamp, *np.asarray(frame.odometry, dtype=np.float64).tolist()]
+    if frame.reference is not None:
+        poses += np.asarray(frame.reference, dtype=np.float64).tolist()
+    if not all(np.isfinite(poses)):
+        return f"the timestamp and poses must be finite numbers, got {poses}"
+    ranges = frame.scan.ranges
+    bad = np.isinf(ranges) | (ranges < 0) | (ranges > frame.scan.max_range)
+    if bad.any():
+        k = int(np.argmax(bad))
+        return (
+            f"range {k + 1} is {float(ranges[k])!r}, expected ranges in [0, max_range={frame.scan.max_range}] m "
+            f"or NaN (no return)"
+        )
+    return None
+
+
 def _is_count(token: str) -> bool:
     """A plain non-negative integer: ASCII digits only (``str.isdigit`` accepts superscripts that
     ``int`` rejects) and short enough for ``int`` (which refuses > 4300 digits)."""
@@ -77,14 +115,15 @@ class ViewParser:
                 line, f"expected {expected} fields '{tokens[0]} <beams> <max_range> {layout}', got {len(tokens)}"
             )
         values = _numbers(self.path, line, tokens[2:], tokens[0])
-        if not np.all(np.isfinite(values)) or values[0] <= 0:
-            raise self.error(line, f"{tokens[0]}: expected finite numbers and a positive max range")
         if explicit:
             angles = values[1:]
         else:
-            angles = values[1] + np.arange(beams, dtype=np.float64) * values[2]
-        if beams > 1 and not np.all(np.diff(angles) > 0):
-            raise self.error(line, f"{tokens[0]}: beam angles must be strictly increasing (counter-clockwise)")
+            with np.errstate(invalid="ignore", over="ignore"):
+                angles = values[1] + np.arange(beams, dtype=np.float64) * values[2]
+        with np.errstate(invalid="ignore", over="ignore"):
+            problem = sensor_problem(beams, float(values[0]), angles)
+        if problem is not None:
+            raise self.error(line, f"{tokens[0]}: {problem}")
         self.sensor = _Sensor(angles, float(values[0]))
 
     def view_line(self, line: int, tokens: list[str]) -> Frame:
@@ -200,13 +239,15 @@ def sensor_line(scan: Scan) -> str:
     return f"SENSOR-ANGLES {n} {float(scan.max_range)!r} {_fmt(scan.angles)}"
 
 
-def check_ranges(frame: Frame) -> None:
-    finite = frame.scan.ranges[np.isfinite(frame.scan.ranges)]
-    if finite.size and (finite.min() < 0 or finite.max() > frame.scan.max_range):
-        raise DataError(
-            f"scan #{frame.index}: ranges must lie in [0, max_range={frame.scan.max_range}] m, got "
-            f"[{finite.min()}, {finite.max()}]"
-        )
+def check_frame(frame: Frame) -> None:
+    """A DataError naming the frame if the reader would refuse its SENSOR or VIEW line."""
+    scan = frame.scan
+    problem = sensor_problem(scan.beams, float(scan.max_range), scan.angles)
+    where = "SENSOR"
+    if problem is None:
+        problem, where = view_problem(frame), "VIEW"
+    if problem is not None:
+        raise DataError(f"scan #{frame.index}: {where} {problem}; the albot-log reader would refuse it")
 
 
 def view_line(frame: Frame) -> str:

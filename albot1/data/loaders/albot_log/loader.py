@@ -20,13 +20,17 @@ and ranges survive a round trip: the range is ``hypot(x, y)`` and the angle
 comes from the SENSOR line, never from the point. Numbers are written with
 Python's shortest round-trip ``repr``, so poses, timestamps and angles come
 back bit-identical and ranges to within 2 ulp.
+
+A log must hold at least one VIEW: ``load`` reads up to the first one and
+refuses a log without, naming the file, so an empty log never becomes an
+empty run. The writer refuses what the reader refuses (see :mod:`.lines`),
+an empty sequence included.
 """
 
 from __future__ import annotations
 
 import gzip
 import itertools
-import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, ClassVar
@@ -40,11 +44,13 @@ from albot1.data.loaders.albot_log.lines import (
     UNITS,
     VERSION,
     ViewParser,
-    check_ranges,
+    check_frame,
     read_header,
     sensor_line,
     view_line,
 )
+from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
+from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.model import FloatArray, Frame, Sequence, SequenceMetadata
 
 __all__ = ["AlbotLogLoader", "AlbotLogWriter"]
@@ -58,22 +64,21 @@ def _create_text(path: Path) -> IO[str]:
 
 
 def _lines(path: Path) -> Iterator[tuple[int, str]]:
-    """``(1-based line number, text)``; bad UTF-8 names its line, bad gzip the last good line."""
+    """``(1-based line number, text)``; bad UTF-8 names its line, damaged gzip data the last complete line."""
     lineno = 0
     try:
-        with gzip.open(path, "rb") if path.suffix == ".gz" else path.open("rb") as fh:
-            for lineno, raw in enumerate(fh, start=1):
-                try:
-                    text = raw.decode("utf-8")
-                except UnicodeDecodeError as exc:
-                    raise ParseError(
-                        path, f"not UTF-8 text ({exc.reason} at byte {exc.start} of the line)", line=lineno
-                    ) from exc
-                yield lineno, text
-    except (EOFError, zlib.error, gzip.BadGzipFile) as exc:
-        raise ParseError(
-            path, f"cannot decompress past line {lineno} (truncated or corrupt gzip file?): {exc}", line=lineno + 1
-        ) from exc
+        for lineno, raw in enumerate(iter_lines(path), start=1):
+            try:
+                text = raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                raise ParseError(
+                    path, f"not UTF-8 text ({exc.reason} at byte {exc.start} of the line)", line=lineno
+                ) from exc
+            yield lineno, text
+    except DamagedStream as damage:
+        if lineno == 0:
+            raise ParseError(path, damage.describe(" before its first line could be decompressed")) from None
+        raise ParseError(path, damage.describe(" after this line (the last complete one)"), line=lineno) from None
 
 
 def _frames(path: Path) -> Iterator[Frame]:
@@ -102,13 +107,7 @@ class AlbotLogLoader:
     suffixes: ClassVar[tuple[str, ...]] = (".albotlog",)
 
     def sniff(self, path: Path) -> bool:
-        if not path.is_file():
-            return False
-        try:
-            with gzip.open(path, "rb") if path.suffix == ".gz" else path.open("rb") as fh:
-                return fh.read(len(MAGIC)) == MAGIC.encode()
-        except (OSError, EOFError, zlib.error):
-            return False
+        return path.is_file() and read_head(path, len(MAGIC)) == MAGIC.encode()
 
     def load(self, path: Path, **options: Any) -> Sequence:
         path = Path(path)
@@ -118,6 +117,13 @@ class AlbotLogLoader:
         if not path.is_file():
             raise DataError(f"{path}: no such file")
         name, _ = read_header(path, _lines(path))
+        if next(_frames(path), None) is None:  # reads up to the first VIEW only
+            last = sum(1 for _ in _lines(path))
+            raise ParseError(
+                path,
+                "the log holds no VIEW line, so no scans; expected at least one VIEW after a SENSOR line",
+                line=last,
+            )
         stem = path.name.removesuffix(".gz").removesuffix(".albotlog")
         metadata = SequenceMetadata(
             source=str(path),
@@ -134,11 +140,9 @@ class AlbotLogWriter:
     format_name: ClassVar[str] = "albot-log"
 
     def write(self, sequence: Sequence, path: Path) -> None:
-        path = Path(path)
-        if path.exists():
-            raise DataError(f"{path} exists already; remove it or choose another output path")
+        path = prepare_output(path)
         try:
-            with _create_text(path) as fh:
+            with writing(path), _create_text(path) as fh:
                 fh.write(f"{MAGIC} {VERSION}\n# written by albot1; format: docs/formats.md\n")
                 if sequence.metadata.source:
                     fh.write(f"# source: {' '.join(sequence.metadata.source.split())}\n")
@@ -148,13 +152,17 @@ class AlbotLogWriter:
                     if frame.index != i:
                         raise DataError(f"frame {i} has index {frame.index}; expected consecutive indices from 0")
                     scan = frame.scan
-                    check_ranges(frame)
+                    check_frame(frame)
                     if geometry is None or not (
                         scan.max_range == geometry[1] and np.array_equal(scan.angles, geometry[0])
                     ):
                         fh.write(sensor_line(scan) + "\n")
                         geometry = (scan.angles, scan.max_range)
                     fh.write(view_line(frame) + "\n")
+                if geometry is None:
+                    raise DataError(
+                        f"{path}: the sequence has no scans; the albot-log reader refuses a log without VIEW"
+                    )
         except BaseException:
             path.unlink(missing_ok=True)
             raise

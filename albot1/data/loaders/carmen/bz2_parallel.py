@@ -15,7 +15,9 @@ is the combined CRC of a one-block stream); ``bz2`` then checks every CRC.
 A 48-bit magic can in principle occur inside compressed data; if a cut block
 fails to decompress, the generator falls back to the sequential decoder and
 resumes after the bytes already produced, so the output is always identical to
-``bz2.open(path).read()`` and genuine corruption still raises the codec's error.
+``bz2.open(path).read()`` and genuine damage is reported by the sequential
+decoder (:class:`~albot1.data.loaders.compressed.DamagedStream`, with its
+offset).
 """
 
 from __future__ import annotations
@@ -27,35 +29,17 @@ from collections.abc import Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
-BLOCK_MAGIC = 0x314159265359
-END_MAGIC = 0x177245385090
+from albot1.data.loaders.compressed import BZ2_BLOCK_MAGIC as BLOCK_MAGIC
+from albot1.data.loaders.compressed import BZ2_END_MAGIC as END_MAGIC
+from albot1.data.loaders.compressed import find_bit_pattern, iter_decompressed
+
+__all__ = ["BLOCK_MAGIC", "END_MAGIC", "find_bit_pattern", "iter_bz2_parallel"]
+
 _MAGIC_BITS = 48
 
 
 class _BlockFailed(Exception):
     """A cut-out block did not decompress (corrupt data or a false magic match)."""
-
-
-def find_bit_pattern(data: bytes, pattern: int) -> list[int]:
-    """Sorted bit offsets (MSB-first) at which the 48-bit ``pattern`` occurs in ``data``."""
-    found: set[int] = set()
-    for shift in range(8):
-        window = (pattern << (8 - shift)).to_bytes(7, "big")
-        needle = window[1:6]  # the five bytes fully covered by the pattern at this shift
-        start = 0
-        while True:
-            idx = data.find(needle, start)
-            if idx < 0:
-                break
-            start = idx + 1
-            bit = (idx - 1) * 8 + shift
-            if bit < 0 or (bit + _MAGIC_BITS + 7) // 8 > len(data):
-                continue
-            first = bit // 8
-            chunk = int.from_bytes(data[first : first + 7].ljust(7, b"\0"), "big")
-            if (chunk >> (56 - _MAGIC_BITS - bit % 8)) & ((1 << _MAGIC_BITS) - 1) == pattern:
-                found.add(bit)
-    return sorted(found)
 
 
 def _bits(data: bytes, start: int, stop: int) -> int:
@@ -117,16 +101,10 @@ def iter_bz2_parallel(path: Path, workers: int | None = None) -> Iterator[bytes]
             except _BlockFailed:
                 for fut in in_flight:
                     fut.cancel()
-    decoder = bz2.BZ2File(path, "rb")
-    with decoder:
-        skip = produced
-        while skip > 0:
-            skipped = len(decoder.read(min(skip, 1 << 22)))
-            if skipped == 0:
-                break
-            skip -= skipped
-        while True:
-            block = decoder.read(1 << 21)
-            if not block:
-                return
-            yield block
+    skip = produced  # resume the sequential decoder after the bytes already handed out
+    for block in iter_decompressed(path, "bzip2"):
+        if skip >= len(block):
+            skip -= len(block)
+            continue
+        yield block[skip:] if skip else block
+        skip = 0

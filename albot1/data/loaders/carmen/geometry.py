@@ -18,7 +18,9 @@ PARAM lines that override the defaults (front laser; ``rear`` for RLASER):
 ``laser_front_laser_resolution`` / ``laser_frontlaser_resolution`` (degrees),
 ``laser_front_laser_fov`` (degrees, or radians when <= 2*pi as in the CSAIL
 log), ``robot_front_laser_max`` (metres), ``robot_frontlaser_offset``
-(metres forward of the robot centre).
+(metres forward of the robot centre). Their values must be numbers in range
+(:func:`param_problem`, checked by the parser at the PARAM line): a value
+that cannot be used is an error, never silently replaced by a default.
 
 No-return rule: a reading ``r >= max_range - 0.005`` (half the 1 cm
 resolution of the logs, so a value printed as the maximum counts) or
@@ -28,6 +30,7 @@ resolution of the logs, so a value printed as the maximum counts) or
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,15 +60,44 @@ def default_geometry(beams: int) -> tuple[float, float]:
     return -math.pi / 2, math.pi / max(beams - 1, 1)
 
 
+def _param_rules() -> dict[str, tuple[str, Callable[[float], bool]]]:
+    """PARAM names this module interprets -> (what the value must be, its test). Other PARAMs are free text."""
+    angle = ("an angle between beams in degrees, > 0 and <= 360", lambda v: 0 < v <= 360)
+    fov = ("a field of view > 0 and <= 360 degrees (or <= 2 pi radians)", lambda v: 0 < v <= 360)
+    rules: dict[str, tuple[str, Callable[[float], bool]]] = {}
+    for which in ("front", "rear"):
+        rules[f"laser_{which}_laser_resolution"] = rules[f"laser_{which}laser_resolution"] = angle
+        rules[f"laser_{which}_laser_fov"] = rules[f"laser_{which}laser_fov"] = fov
+        rules[f"robot_{which}_laser_max"] = ("a maximum range in metres, > 0", lambda v: v > 0)
+        rules[f"robot_{which}laser_offset"] = ("an offset in metres", lambda v: True)
+        rules[f"robot_{which}laser_side_offset"] = ("an offset in metres", lambda v: True)
+        rules[f"robot_{which}laser_angular_offset"] = ("an angle in radians", lambda v: True)
+    return rules
+
+
+_PARAM_RULES = _param_rules()
+
+
+def param_problem(name: str, value: str) -> str | None:
+    """Why a PARAM value this loader interprets cannot be used (None if it can, or if the name is free text)."""
+    rule = _PARAM_RULES.get(name)
+    if rule is None:
+        return None
+    meaning, accept = rule
+    try:
+        number = float(value)
+    except ValueError:
+        number = math.nan
+    if math.isfinite(number) and accept(number):
+        return None
+    return f"PARAM {name} is {value[:40]!r}, expected {meaning}"
+
+
 def _number(params: dict[str, str], *names: str) -> float | None:
+    """The first of ``names`` that is set (values were checked by :func:`param_problem` when parsed)."""
     for name in names:
         if name in params:
-            try:
-                value = float(params[name])
-            except ValueError:
-                continue
-            if math.isfinite(value) and value > 0:
-                return value
+            return float(params[name])
     return None
 
 
@@ -93,10 +125,7 @@ def sensor_offset(params: dict[str, str], rear: bool = False) -> tuple[float, fl
     which = "rear" if rear else "front"
 
     def get(name: str) -> float:
-        try:
-            return float(params.get(name, "0"))
-        except ValueError:
-            return 0.0
+        return float(params.get(name, "0"))  # checked by param_problem when parsed
 
     return (
         get(f"robot_{which}laser_offset"),

@@ -39,9 +39,16 @@ ODOM and TRUEPOS lines are only decoded when a pose source uses them.
 Streaming: the log is decoded chunk by chunk (2 MiB of text); only scans
 waiting for a later ODOM/TRUEPOS line and the ODOM lines that can still
 bracket them are buffered. Message types other than the chosen laser, ODOM,
-TRUEPOS and PARAM (SYNC, NEFF, NMEA-GGA, a second laser, ...) are skipped
+TRUEPOS and PARAM (SYNC, NEFF, NMEA-GGA, a rear laser, ...) are skipped
 by design; the names seen at the start of the log are listed in
 ``metadata.extra["ignored_messages"]``.
+
+Old and new front-laser messages (FLASER, ROBOTLASER1, RAWLASER1) in one
+log are refused unless the ``laser`` option names the kind to read: they may
+be the same scans written twice (CARMEN's logger writes RAWLASER1 beside
+ROBOTLASER1) or two recordings run together, and the loader cannot tell
+which, so it neither merges them nor drops one kind without a word. The
+error names the count and first line of each kind.
 """
 
 from __future__ import annotations
@@ -57,32 +64,32 @@ import numpy as np
 
 from albot1.data.errors import DataError, ParseError
 from albot1.data.loaders.carmen import geometry as geom
+from albot1.data.loaders.carmen.checks import span_problem, time_problem
 from albot1.data.loaders.carmen.interp import PoseBuffer
 from albot1.data.loaders.carmen.parse import (
+    FRONT_LASERS,
     LASER_MESSAGES,
     OLD_LASERS,
     LaserBlock,
     ParsedChunk,
     parse_chunk,
     probe_chunk,
+    split_messages,
 )
 from albot1.data.loaders.carmen.source import CHUNK_BYTES, iter_line_chunks, read_head
 from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
+from albot1.data.relations import read_relations
 from albot1.geometry import se2
 
 ODOMETRY_SOURCES = ("laser-pose", "odom", "odom-segments")
 REFERENCE_SOURCES = ("none", "laser-pose", "truepos", "auto")
-_SNIFF_NAMES = (
-    b"FLASER ",
-    b"RLASER ",
-    b"ROBOTLASER1 ",
-    b"RAWLASER",
-    b"ODOM ",
-    b"PARAM ",
-    b"TRUEPOS ",
-    b"SYNC ",
-    b"# CARMEN",
+#: A file is taken for a CARMEN log if a line of its first 64 KiB starts with one of these messages
+#: (or the "# CARMEN" comment the logger writes first).
+_SNIFF_NAMES = frozenset(
+    (b"FLASER", b"RLASER", b"ROBOTLASER1", b"RAWLASER1", b"RAWLASER2", b"RAWLASER3", b"RAWLASER4")
+    + (b"ODOM", b"PARAM", b"TRUEPOS", b"SYNC")
 )
+_SNIFF_BYTES = 1 << 16
 #: The corrected logs print anchors with the same digits as the scan pose; this only absorbs float noise.
 _ANCHOR_TOLERANCE = 1e-5
 
@@ -138,16 +145,13 @@ class CarmenLoader:
     def sniff(self, path: Path) -> bool:
         if path.is_dir():
             return False
-        head = read_head(path)
-        for line in head.split(b"\n")[:64]:
-            stripped = line.strip()
-            if stripped and any(stripped.startswith(n) for n in _SNIFF_NAMES):
+        for line in read_head(path, _SNIFF_BYTES).split(b"\n"):
+            words = line.split(None, 1)
+            if words and (words[0] in _SNIFF_NAMES or line.lstrip().startswith(b"# CARMEN")):
                 return True
         return False
 
     def load(self, path: Path, **options: Any) -> Sequence:
-        from albot1.data.relations import read_relations
-
         path = Path(path)
         relations_path = options.pop("relations", None)
         license_text = str(options.pop("license", ""))
@@ -158,11 +162,21 @@ class CarmenLoader:
         probe = _probe(path, opts)
         laser = opts.laser or probe.first_laser
         if laser is None:
+            others = sorted(name for name in probe.ignored if name in LASER_MESSAGES)
+            hint = (
+                f"; the log has {', '.join(f'{probe.ignored[n]} {n}' for n in others)} lines: read them with "
+                f"the loader option laser={others[0]} (e.g. 'FILE?laser={others[0]}')"
+                if others
+                else ""
+            )
             raise ParseError(
                 path,
-                "no scans in the first 2 MiB of the log; expected FLASER, RLASER, ROBOTLASER1 or RAWLASER1-4 lines",
+                f"no front-laser scans in the first 2 MiB of the log; expected FLASER, ROBOTLASER1 or "
+                f"RAWLASER1 lines{hint}",
                 line=1,
             )
+        if opts.laser is None:
+            _refuse_mixed(path, laser, probe)
         if opts.odometry == "laser-pose" and laser.startswith("RAWLASER"):
             raise DataError(f"{path}: {laser} lines carry no pose; use odometry='odom' (ODOM lines)")
         if opts.reference == "laser-pose" and laser.startswith("RAWLASER"):
@@ -233,12 +247,16 @@ def _probe(path: Path, opts: CarmenOptions) -> ParsedChunk:
     """Read the head of the log until the first scan (at most 2 MiB): laser type, PARAM values,
     TRUEPOS presence, skipped message names. Small reads keep this cheap on compressed logs."""
     merged = ParsedChunk()
-    seen = 0
+    seen = lines = 0
     with closing(iter_line_chunks(path, chunk_bytes=_PROBE_BYTES, parallel_bz2=False)) as chunks:
         for chunk in chunks:
             part = probe_chunk(path, chunk.first_line, chunk.lines, opts.laser)
             merged.params.extend(part.params)
             merged.ignored.update(part.ignored)
+            for name, line in part.ignored_first.items():
+                merged.ignored_first.setdefault(name, line)
+            merged.message_lines += part.message_lines
+            lines = chunk.first_line + len(chunk.lines) - 1
             if not len(merged.truepos.lines):
                 merged.truepos = part.truepos
             seen += sum(len(line) + 1 for line in chunk.lines)
@@ -247,7 +265,44 @@ def _probe(path: Path, opts: CarmenOptions) -> ParsedChunk:
                 return merged
     if seen == 0:
         raise ParseError(path, "the file is empty; expected a CARMEN log (one message per line)")
+    if merged.message_lines == 0:
+        raise ParseError(
+            path, f"the log holds only comments and blank lines ({lines} lines); expected CARMEN messages", line=lines
+        )
     return merged
+
+
+def _refuse_mixed(path: Path, laser: str, parsed: ParsedChunk) -> None:
+    """A ParseError if ``parsed`` holds front-laser messages of another kind than ``laser``."""
+    other = next((name for name in FRONT_LASERS if name != laser and parsed.ignored.get(name)), None)
+    if other is None:
+        return
+    counts, first = _count_messages(path, FRONT_LASERS)
+    kinds = [name for name in FRONT_LASERS if counts.get(name)]
+    listed = " and ".join(f"{counts[name]} {name} lines (first at line {first[name]})" for name in kinds)
+    choices = " or ".join(f"laser={name}" for name in kinds)
+    raise ParseError(
+        path,
+        f"the log mixes front-laser message kinds: {listed}; expected one kind (they may be the same scans "
+        f"written twice or two recordings, so none is merged or dropped silently); choose with the loader "
+        f"option {choices} (e.g. 'FILE?laser={kinds[0]}'), the other kind is then skipped",
+        line=parsed.ignored_first.get(other, first.get(other)),
+    )
+
+
+def _count_messages(path: Path, names: tuple[str, ...]) -> tuple[dict[str, int], dict[str, int]]:
+    """Count and first line of each message in ``names`` over the whole log (only on the error path)."""
+    counts: dict[str, int] = {}
+    first: dict[str, int] = {}
+    try:
+        for chunk in iter_line_chunks(path):
+            for name, rows in split_messages(path, chunk.first_line, chunk.lines).items():
+                if name in names:
+                    counts[name] = counts.get(name, 0) + len(rows)
+                    first.setdefault(name, rows[0][0])
+    except ParseError:
+        pass  # a damaged tail: the counts so far still describe the mix
+    return counts, first
 
 
 @dataclass(slots=True)
@@ -333,10 +388,17 @@ class _FrameIterator:
             g = cache.get(n)
             if g is None:
                 g = cache[n] = geom.param_geometry(n, state, rear=rear)
+                problem = span_problem(n, g.step)
+                if problem is not None:
+                    raise ParseError(
+                        self.path, f"{self.s.laser}: {problem}; the spacing comes from the {g.source}", line=line
+                    )
             start[i], step[i], max_range[i] = g.start, g.step, g.max_range
         return start, step, max_range
 
     def _consume(self, parsed: ParsedChunk) -> Iterator[Frame]:
+        if self.opts.laser is None:
+            _refuse_mixed(self.path, self.s.laser, parsed)
         params = sorted(parsed.params)
         rows: list[tuple[int, int, int]] = []  # (line, block, row) in file order
         decoded = []
@@ -390,17 +452,11 @@ class _FrameIterator:
         last = self.last_stamp
         if last is not None:
             prev, prev_line = last
-            if stamp <= prev and stamp >= prev - self.opts.time_tolerance:
+            problem = time_problem(prev, stamp, self.opts.time_tolerance, f" from line {prev_line}")
+            if problem is not None:
+                raise ParseError(self.path, f"{self.s.laser} {problem}", line=line)
+            if stamp <= prev:
                 return
-            if stamp < prev:
-                raise ParseError(
-                    self.path,
-                    f"{self.s.laser} timestamp {stamp:.6f} goes back "
-                    f"{prev - stamp:.3f} s from line {prev_line}; expected "
-                    f"non-decreasing ipc timestamps (tolerance "
-                    f"{self.opts.time_tolerance} s)",
-                    line=line,
-                )
         self.last_stamp = (stamp, line)
 
     def _ready(self, stamp: float) -> bool:

@@ -22,7 +22,10 @@ Message layouts (after the name; every message ends with
     PARAM          name value
 
 The timestamp used everywhere is ``ipc_timestamp`` (the ground-truth
-relations of Kuemmerle et al. are keyed by it).
+relations of Kuemmerle et al. are keyed by it). Fields are separated by any
+run of spaces or tabs (CARMEN is whitespace-separated); the common
+single-space layout takes the fastest path. What a line may hold is in
+:mod:`.checks`, shared with the writer.
 """
 
 from __future__ import annotations
@@ -36,12 +39,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.data.errors import ParseError
+from albot1.data.loaders.carmen.checks import MAX_BEAMS, geometry_problem, ranges_problem
+from albot1.data.loaders.carmen.geometry import param_problem
 
 FloatArray = NDArray[np.float64]
 
 OLD_LASERS = ("FLASER", "RLASER")
 NEW_LASERS = ("ROBOTLASER1", "RAWLASER1", "RAWLASER2", "RAWLASER3", "RAWLASER4")
 LASER_MESSAGES = OLD_LASERS + NEW_LASERS
+#: The message kinds of the *front* laser, old and new; a log mixing them is refused unless one is chosen.
+FRONT_LASERS = ("FLASER", "ROBOTLASER1", "RAWLASER1")
 POSE_MESSAGES = ("ODOM", "TRUEPOS")
 #: Message names are upper-case words; anything else is not a CARMEN line.
 _NAME = re.compile(rb"^[A-Z][A-Z0-9_-]*$")
@@ -107,16 +114,32 @@ class ParsedChunk:
     truepos: PoseRecords = field(default_factory=PoseRecords.empty)
     params: list[tuple[int, str, str]] = field(default_factory=list)
     ignored: Counter[str] = field(default_factory=Counter)
+    #: first line of each ignored message name in this chunk
+    ignored_first: dict[str, int] = field(default_factory=dict)
     first_laser: str | None = None
+    #: lines holding a message (not blank, not a comment) in this chunk
+    message_lines: int = 0
 
 
 _KNOWN = frozenset(LASER_MESSAGES + POSE_MESSAGES + ("PARAM",))
 
 
+def _irregular_spacing(lines: list[bytes]) -> bool:
+    """True if any line holds a tab or a run of spaces (one memchr pass over the chunk)."""
+    joined = b"\n".join(lines)
+    return b"\t" in joined or b"  " in joined
+
+
 def split_messages(path: Path, first_line: int, lines: list[bytes]) -> dict[str, list[tuple[int, bytes]]]:
-    """Lines grouped by message name -> ``(line number, rest of line)``; comments and blanks dropped."""
+    """Lines grouped by message name -> ``(line number, rest of line)``; comments and blanks dropped.
+
+    The rest of every line comes back with its fields single-space separated,
+    whatever whitespace the file used between them.
+    """
     groups: dict[bytes, list[tuple[int, bytes]]] = {}
     known = {name.encode(): name for name in _KNOWN}
+    if _irregular_spacing(lines):
+        lines = [b" ".join(raw.split()) if b"\t" in raw or b"  " in raw else raw for raw in lines]
     for offset, raw in enumerate(lines):
         head, _, rest = raw.partition(b" ")
         if head in known:  # fast path: a well-formed known message
@@ -206,7 +229,8 @@ class _Lines:
         return iter(self._text.split("\n"))
 
 
-def _first_int(path: Path, name: str, line: int, token: bytes | None, what: str) -> int:
+def _first_int(path: Path, name: str, line: int, token: bytes | None, what: str, *, beams: bool = True) -> int:
+    """A count field: the beam count (1..MAX_BEAMS) or, with ``beams=False``, a remission count (>= 0)."""
     try:
         if token is None:
             raise ValueError
@@ -219,22 +243,17 @@ def _first_int(path: Path, name: str, line: int, token: bytes | None, what: str)
             f"({_LAYOUT['RAWLASER' if name.startswith('RAWLASER') else name]})",
             line=line,
         ) from None
-    if value < 0 or value > 100_000:
-        raise ParseError(path, f"{name} {what} is {value}, expected a beam count in 0..100000", line=line)
+    low = 1 if beams else 0
+    if not low <= value <= MAX_BEAMS:
+        raise ParseError(path, f"{name} {what} is {value}, expected {low} to {MAX_BEAMS}", line=line)
     return value
 
 
 def _check_values(path: Path, name: str, lines: NDArray[np.int64], ranges: FloatArray, finite: FloatArray) -> None:
-    """Ranges must be finite and >= 0; poses and timestamps finite."""
-    bad = ~np.isfinite(ranges) | (ranges < 0)
-    if bad.any():
-        row, beam = (int(v) for v in np.argwhere(bad)[0])
-        raise ParseError(
-            path,
-            f"{name} range {beam + 1} is {float(ranges[row, beam])!r}, expected a finite "
-            f"non-negative distance in metres",
-            line=int(lines[row]),
-        )
+    """The rules of :func:`.checks.ranges_problem`; poses and timestamps finite."""
+    found = ranges_problem(ranges)
+    if found is not None:
+        raise ParseError(path, f"{name} {found[1]}", line=int(lines[found[0]]))
     bad_rows = ~np.isfinite(finite).all(axis=1)
     if bad_rows.any():
         row = int(np.argmax(bad_rows))
@@ -282,7 +301,12 @@ def parse_new_lasers(path: Path, name: str, rows: list[tuple[int, bytes]]) -> li
         n = _first_int(path, name, line, tokens[7] if len(tokens) > 7 else None, "beam count (field 8)")
         m_at = 8 + n
         m = _first_int(
-            path, name, line, tokens[m_at] if len(tokens) > m_at else None, f"remission count (field {m_at + 1})"
+            path,
+            name,
+            line,
+            tokens[m_at] if len(tokens) > m_at else None,
+            f"remission count (field {m_at + 1})",
+            beams=False,
         )
         by_shape.setdefault((n, m), []).append((line, rest))
     out: list[LaserBlock] = []
@@ -295,6 +319,9 @@ def parse_new_lasers(path: Path, name: str, rows: list[tuple[int, bytes]]) -> li
         stamps = v[:, -2]
         poses = v[:, pose_at : pose_at + 6] if with_pose else np.zeros((len(group), 0))
         _check_values(path, name, lines, ranges, np.column_stack([head[:, 1:5], poses, stamps]))
+        found = geometry_problem(n, head[:, 1], head[:, 2], head[:, 3], head[:, 4])
+        if found is not None:
+            raise ParseError(path, f"{name} {found[1]}", line=int(lines[found[0]]))
         out.append(
             LaserBlock(
                 lines,
@@ -327,7 +354,11 @@ def parse_params(path: Path, rows: list[tuple[int, bytes]]) -> list[tuple[int, s
         parts = rest.split()
         if len(parts) < 2:
             raise ParseError(path, "PARAM needs a name and a value (PARAM name value " + _TRAILER + ")", line=line)
-        out.append((line, parts[0].decode("utf-8", "replace"), parts[1].decode("utf-8", "replace")))
+        name, value = parts[0].decode("utf-8", "replace"), parts[1].decode("utf-8", "replace")
+        problem = param_problem(name, value)
+        if problem is not None:
+            raise ParseError(path, problem, line=line)
+        out.append((line, name, value))
     return out
 
 
@@ -341,12 +372,15 @@ def probe_chunk(path: Path, first_line: int, lines: list[bytes], laser: str | No
     """What ``load()`` needs before streaming, cheaply: the laser message and its first line only,
     PARAM values, TRUEPOS lines and the names of skipped messages (ODOM is left to the stream)."""
     groups = split_messages(path, first_line, lines)
+    message_lines = sum(len(rows) for rows in groups.values())
     if laser is None:
         laser = _first_front_laser(groups)
     groups.pop("ODOM", None)
     if laser is not None and laser in groups:
         groups[laser] = groups[laser][:1]
-    return _parse_groups(path, groups, laser)
+    chunk = _parse_groups(path, groups, laser)
+    chunk.message_lines = message_lines
+    return chunk
 
 
 def parse_chunk(
@@ -380,4 +414,5 @@ def _parse_groups(path: Path, groups: dict[str, list[tuple[int, bytes]]], laser:
             chunk.params = parse_params(path, rows)
         else:
             chunk.ignored[name] += len(rows)
+            chunk.ignored_first[name] = rows[0][0]
     return chunk

@@ -6,26 +6,23 @@ chunks of whole lines with their 1-based line numbers, which is what lets the
 parser work on many lines at once with numpy while a 100k-scan log is never
 decompressed as a whole before the first scan is yielded.
 
-Decompression failures (truncated or corrupt ``.gz``/``.bz2``) become a
-:class:`~albot1.data.errors.ParseError` naming the last complete line, instead
-of the ``EOFError``/``OSError``/``zlib.error`` the codecs raise.
+Damaged compressed data (a truncated or corrupt ``.gz``/``.bz2``, see
+:mod:`albot1.data.loaders.compressed`) becomes a
+:class:`~albot1.data.errors.ParseError` naming the last complete line and the
+compressed byte offset, after every complete line before it was handed out.
 """
 
 from __future__ import annotations
 
-import bz2
-import gzip
-import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO
 
 from albot1.data.errors import ParseError
 from albot1.data.loaders.carmen.bz2_parallel import iter_bz2_parallel
+from albot1.data.loaders.compressed import DamagedStream, compression_of, iter_decompressed, read_head
 
-GZIP_MAGIC = b"\x1f\x8b"
-BZ2_MAGIC = b"BZh"
+__all__ = ["CHUNK_BYTES", "LineChunk", "compression_of", "damaged_error", "iter_line_chunks", "read_head"]
 
 #: Decompressed bytes handed to the parser at a time. Large enough that numpy's
 #: per-call overhead vanishes, small enough that the first scans come quickly.
@@ -40,44 +37,11 @@ class LineChunk:
     lines: list[bytes]
 
 
-def compression_of(path: Path) -> str:
-    """``"gzip"``, ``"bzip2"`` or ``"none"``, from the first bytes of the file."""
-    with path.open("rb") as fh:
-        head = fh.read(3)
-    if head.startswith(GZIP_MAGIC):
-        return "gzip"
-    if head.startswith(BZ2_MAGIC):
-        return "bzip2"
-    return "none"
-
-
-def _open(path: Path, compression: str) -> BinaryIO:
-    if compression == "gzip":
-        return gzip.open(path, "rb")  # type: ignore[return-value]
-    if compression == "bzip2":
-        return bz2.open(path, "rb")  # type: ignore[return-value]
-    return path.open("rb")
-
-
-def read_head(path: Path, size: int = 4096) -> bytes:
-    """The first ``size`` decompressed bytes (for sniffing); empty on any decoding problem."""
-    try:
-        with _open(path, compression_of(path)) as fh:
-            return fh.read(size)
-    except (OSError, EOFError, zlib.error):
-        return b""
-
-
-def _raw_blocks(path: Path, compression: str, chunk_bytes: int, parallel: bool) -> Iterator[bytes]:
-    if compression == "bzip2" and parallel:
-        yield from iter_bz2_parallel(path)
-        return
-    with _open(path, compression) as fh:
-        while True:
-            block = fh.read(chunk_bytes)
-            if not block:
-                return
-            yield block
+def damaged_error(path: Path, damage: DamagedStream, complete_lines: int) -> ParseError:
+    """The ParseError of damaged compressed data after ``complete_lines`` good lines."""
+    if complete_lines == 0:
+        return ParseError(path, damage.describe(" before its first line could be decompressed"))
+    return ParseError(path, damage.describe(" after this line (the last complete one)"), line=complete_lines)
 
 
 def iter_line_chunks(path: Path, *, chunk_bytes: int = CHUNK_BYTES, parallel_bz2: bool = True) -> Iterator[LineChunk]:
@@ -88,21 +52,24 @@ def iter_line_chunks(path: Path, *, chunk_bytes: int = CHUNK_BYTES, parallel_bz2
     is byte-identical to sequential decompression.
     """
     compression = compression_of(path)
+    if compression == "bzip2" and parallel_bz2:
+        blocks = iter_bz2_parallel(path)
+    else:
+        blocks = iter_decompressed(path, compression)
     next_line = 1
     carry = b""
-    blocks = _raw_blocks(path, compression, chunk_bytes, parallel_bz2)
     pending: list[bytes] = []
     pending_size = 0
     while True:
         try:
             block = next(blocks, None)
-        except (OSError, EOFError, zlib.error, ValueError) as exc:
-            raise ParseError(
-                path,
-                f"the {compression} data is truncated or corrupt after this line ({exc}); "
-                f"expected a complete {compression} stream",
-                line=max(next_line - 1, 1),
-            ) from None
+        except DamagedStream as damage:
+            data = carry + b"".join(pending)
+            lines = data.split(b"\n")[:-1]  # the last piece is the cut-off line
+            if lines:
+                yield LineChunk(next_line, lines)
+                next_line += len(lines)
+            raise damaged_error(path, damage, next_line - 1) from None
         if block is not None:
             pending.append(block)
             pending_size += len(block)

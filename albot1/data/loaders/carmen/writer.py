@@ -13,9 +13,15 @@ the max range, which the loader's no-return rule turns back into NaN. Ranges
 are written with 6 decimals (1 um), poses with 9, timestamps with 6, the beam
 geometry with 17 significant digits (so angles come back to 1e-15 rad).
 
+Every frame is checked with the reader's own rules (:mod:`.checks`: beam
+count, ranges, beam geometry, finite poses and stamps, stamps not going back
+more than the loader's default tolerance) before it is written, so the writer
+never produces a log its reader refuses. A range above the max range is
+refused too: it would come back as "no return".
+
 The output is compressed when the name ends in ``.gz`` or ``.bz2`` and is
 written to a temporary file renamed into place, so a failed conversion
-leaves no partial log behind.
+leaves no partial log behind (output rules: :mod:`albot1.data.loaders.output`).
 """
 
 from __future__ import annotations
@@ -30,6 +36,8 @@ import numpy as np
 
 from albot1.atomic import atomic_write
 from albot1.data.errors import DataError
+from albot1.data.loaders.carmen.checks import beam_count_problem, geometry_problem, ranges_problem, time_problem
+from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
@@ -46,6 +54,8 @@ _HEADER = """# CARMEN Logfile written by albot1-bench (albot1.data.loaders.carme
 """
 #: Relative tolerance on beam spacing: ROBOTLASER1 can only describe evenly spaced beams.
 _SPACING_TOLERANCE = 1e-6
+#: The loader's default ``time_tolerance`` (seconds a scan stamp may go back): what the writer allows.
+DEFAULT_TIME_TOLERANCE = 1.0
 
 
 def _open(path: Path) -> IO[str]:
@@ -60,19 +70,46 @@ def _pose(p: np.ndarray) -> str:
     return f"{p[0]:.9f} {p[1]:.9f} {p[2]:.9f}"
 
 
+def _frame_problem(frame: Frame, step: float) -> str | None:
+    """Why the reader would refuse (or change) this frame as a ROBOTLASER1 line; None if it would not."""
+    scan = frame.scan
+    n = scan.beams
+    problem = beam_count_problem(n)
+    if problem is not None:
+        return problem
+    if n > 2 and not np.allclose(np.diff(scan.angles), step, rtol=_SPACING_TOLERANCE, atol=1e-9):
+        return (
+            "beam angles are not evenly spaced; a CARMEN ROBOTLASER1 line needs a start angle and one angular "
+            "resolution"
+        )
+    max_range = float(scan.max_range)
+    if not (math.isfinite(max_range) and max_range > 0):
+        return f"max_range {max_range!r}; expected a positive number of metres"
+    found = geometry_problem(n, *(np.array([float(v)]) for v in (scan.angles[0], step * (n - 1), step, max_range)))
+    if found is None:
+        found = ranges_problem(np.where(np.isnan(scan.ranges), max_range, scan.ranges)[None, :])
+    if found is not None:
+        return found[1]
+    longest = float(np.nanmax(scan.ranges)) if not np.isnan(scan.ranges).all() else 0.0
+    if longest > max_range:
+        return f"a range of {longest!r} m exceeds max_range {max_range!r} m (it would come back as no return)"
+    values = [scan.timestamp, *np.asarray(frame.odometry, dtype=np.float64).tolist()]
+    if frame.reference is not None:
+        values += np.asarray(frame.reference, dtype=np.float64).tolist()
+    if not all(math.isfinite(v) for v in values):
+        return f"the timestamp and poses must be finite numbers, got {values}"
+    return None
+
+
 def _laser_line(frame: Frame, offset: np.ndarray) -> str:
     scan = frame.scan
     n = scan.beams
     angles = scan.angles
     step = float(angles[1] - angles[0]) if n > 1 else 0.0
-    if n > 2 and not np.allclose(np.diff(angles), step, rtol=_SPACING_TOLERANCE, atol=1e-9):
-        raise DataError(
-            f"frame {frame.index}: beam angles are not evenly spaced; a CARMEN ROBOTLASER1 line "
-            f"needs a start angle and one angular resolution"
-        )
+    problem = _frame_problem(frame, step)
+    if problem is not None:
+        raise DataError(f"frame {frame.index}: {problem}; the CARMEN reader would refuse it, so it is not written")
     max_range = float(scan.max_range)
-    if not (math.isfinite(max_range) and max_range > 0):
-        raise DataError(f"frame {frame.index}: max_range {max_range!r}; expected a positive number of metres")
     ranges = np.where(np.isfinite(scan.ranges), scan.ranges, max_range)
     robot = np.asarray(frame.odometry, dtype=np.float64)
     laser = se2.compose(robot, offset)
@@ -92,9 +129,11 @@ class CarmenWriter:
     format_name: ClassVar[str] = "carmen"
 
     def write(self, sequence: Sequence, path: Path) -> None:
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
+        path = prepare_output(path)
         offset = np.asarray(sequence.metadata.sensor_offset, dtype=np.float64)
+        if not np.isfinite(offset).all():
+            raise DataError(f"{path}: sensor offset {offset.tolist()} is not finite; expected metres and radians")
+        latest = -math.inf
 
         def write_lines(tmp: Path) -> None:
             with _open(tmp) as out:
@@ -102,11 +141,19 @@ class CarmenWriter:
                 out.write(f"PARAM robot_frontlaser_offset {offset[0]:.9f} 0.000000 {HOST} 0.000000\n")
                 out.write(f"PARAM robot_frontlaser_side_offset {offset[1]:.9f} 0.000000 {HOST} 0.000000\n")
                 out.write(f"PARAM robot_frontlaser_angular_offset {offset[2]:.9f} 0.000000 {HOST} 0.000000\n")
+                nonlocal latest
                 for frame in sequence.frames():
+                    back = time_problem(latest, frame.scan.timestamp, DEFAULT_TIME_TOLERANCE)
+                    if back is not None:
+                        raise DataError(f"frame {frame.index}: scan {back}; the CARMEN reader would refuse it")
+                    latest = max(latest, frame.scan.timestamp)
                     stamp = f"{frame.scan.timestamp:.6f}"
                     out.write(f"ODOM {_pose(frame.odometry)} 0 0 0 {stamp} {HOST} {stamp}\n")
                     if frame.reference is not None:
                         out.write(f"TRUEPOS {_pose(frame.reference)} {_pose(frame.odometry)} {stamp} {HOST} {stamp}\n")
                     out.write(_laser_line(frame, offset))
+                if latest == -math.inf:
+                    raise DataError(f"{path}: the sequence has no scans; the CARMEN reader refuses a log without scans")
 
-        atomic_write(path, write_lines)
+        with writing(path):
+            atomic_write(path, write_lines)

@@ -29,15 +29,15 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from albot1.data.errors import DataError, ParseError
-from albot1.data.loaders.rosbag.msg import PoseTrack, scan_arrays
+from albot1.data.errors import DataError, ParseError, TopicError
+from albot1.data.loaders.rosbag.bag1_check import version_problem
+from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, scan_arrays
 from albot1.data.loaders.rosbag.reader import header_stamp, odometry_track, opened_bag, tf_track, topic_messages
 from albot1.data.loaders.rosbag.topics import LASER_SCAN, TopicChoice, TopicInfo, choose_topics, normalize_type
 from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
 
 log = logging.getLogger(__name__)
 
-ROS1_MAGIC = b"#ROSBAG V2.0"
 _OPTIONS = ("scan_topic", "odom_topic", "reference_topic", "odom_frame", "base_frame", "outside_odometry")
 _OUTSIDE = ("error", "drop")
 
@@ -108,18 +108,19 @@ class _BagSource:
                 out += 1
         if dropped:
             log.warning("%s: dropped %d scans of %s outside the pose time span", self.shown, dropped, topic)
+        if out == 0 and dropped:
+            raise DataError(
+                f"{self.shown}: all {dropped} scans of {topic} lie outside the pose time span "
+                f"(outside_odometry='drop' left none); expected scans stamped within the odometry"
+                f"{' and reference' if ref is not None else ''} messages"
+            )
 
     def _scan(self, msg: Any, t: float, index: int) -> Scan:
         geometry = (float(msg.angle_min), float(msg.angle_increment), float(msg.range_min), float(msg.range_max))
         n = len(msg.ranges)
-        if not all(math.isfinite(v) for v in geometry) or geometry[3] <= 0 or n == 0 or (n > 1 and geometry[1] == 0):
-            raise ParseError(
-                self.shown,
-                f"topic {self.choice.scan}: expected a LaserScan with finite angle_min, "
-                f"non-zero angle_increment, range_min, positive range_max and at least one range; got "
-                f"angle_min/increment/range_min/range_max = {geometry}, {n} ranges",
-                index=index,
-            )
+        problem = laserscan_problem(n, geometry[0], float(msg.angle_max), *geometry[1:])
+        if problem is not None:
+            raise ParseError(self.shown, f"topic {self.choice.scan}: LaserScan {problem}", index=index)
         ranges, angles = scan_arrays(np.asarray(msg.ranges), *geometry)
         return Scan(ranges=ranges, angles=angles, timestamp=t, max_range=geometry[3])
 
@@ -144,6 +145,9 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
             for name_, info in reader.topics.items()
         }
     choice = choose_topics(shown, topics, opts["scan_topic"], opts["odom_topic"], opts["reference_topic"])
+    for topic, role in ((choice.scan, "scans"), (choice.odom, "odometry"), (choice.reference, "reference poses")):
+        if topic is not None and topics[topic].count == 0:
+            raise TopicError(f"{shown}: topic {topic} ({role}) has no messages; expected at least one")
     source = _BagSource(bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"])
     odom_desc = (
         f"{choice.odom} transforms {opts['odom_frame']} -> {opts['base_frame'] or '(its only child)'}"
@@ -181,7 +185,7 @@ class Ros1BagLoader:
             return False
         with path.open("rb") as fh:
             head = fh.read(16)
-        return head.startswith((b"#ROSBAG", b"#ROSRECORD"))
+        return head.startswith((b"#ROSBAG", b"#ROSRECORD", b"#ROSLOG"))
 
     def load(self, path: Path, **options: Any) -> Sequence:
         path = Path(path)
@@ -189,13 +193,9 @@ class Ros1BagLoader:
             raise DataError(f"{path}: no such ROS1 bag file")
         with path.open("rb") as fh:
             head = fh.readline(64).rstrip(b"\n")
-        if head != ROS1_MAGIC:
-            raise ParseError(
-                path,
-                f"unsupported ROS1 bag header {head[:32]!r}; expected {ROS1_MAGIC.decode()!r} "
-                f"(rosbags reads only bag format 2.0)",
-                line=1,
-            )
+        problem = version_problem(head)
+        if problem is not None:
+            raise ParseError(path, problem, line=1)
         return _load_bag(path, path, path.stem, self.format_name, options)
 
 
@@ -215,8 +215,16 @@ class Ros2BagLoader:
         folder = path if path.is_dir() else path.parent
         return folder if (folder / "metadata.yaml").is_file() else None
 
+    @classmethod
+    def storage_files(cls, folder: Path) -> list[Path]:
+        """The ``.db3`` / ``.mcap`` files of a (would-be) bag folder."""
+        return sorted(p for p in folder.iterdir() if p.suffix in cls.suffixes and p.is_file())
+
     def sniff(self, path: Path) -> bool:
-        return (path.is_dir() or path.suffix in self.suffixes) and self.bag_dir(path) is not None
+        """A bag folder (or a storage file in one), also when its metadata.yaml is missing (see :meth:`load`)."""
+        if path.is_dir():
+            return self.bag_dir(path) is not None or bool(self.storage_files(path))
+        return path.suffix in self.suffixes
 
     def load(self, path: Path, **options: Any) -> Sequence:
         """The bag as a Sequence.
@@ -227,8 +235,15 @@ class Ros2BagLoader:
         ``outside_odometry`` (``error`` | ``drop``).
         """
         path = Path(path)
+        if not path.exists():
+            raise DataError(f"{path}: no such ROS2 bag folder")
         folder = self.bag_dir(path)
         if folder is None:
-            raise DataError(f"{path}: not a ROS2 bag; expected a folder holding metadata.yaml and its .db3/.mcap file")
+            where = path if path.is_dir() else path.parent
+            found = ", ".join(p.name for p in self.storage_files(where)) or "no .db3/.mcap file either"
+            raise DataError(
+                f"{where / 'metadata.yaml'}: missing; a ROS2 bag folder holds metadata.yaml beside its storage "
+                f"files (found: {found}); ROS 2's `ros2 bag reindex FOLDER` can recreate it"
+            )
         storage = "ros2-mcap" if any(folder.glob("*.mcap")) else "ros2-sqlite3"
         return _load_bag(folder, folder, folder.name, storage, options)

@@ -2,7 +2,10 @@
 
 Kept apart from the bag readers and writers so the maths (LaserScan beam
 geometry, quaternion yaw, odometry interpolation without extrapolation) can
-be unit-tested exactly, without ``rosbags`` or a file.
+be unit-tested exactly, without ``rosbags`` or a file. The ``*_problem``
+functions are the one statement of which field values the reader accepts;
+the writer checks what it is about to write with the same functions, so it
+never writes a bag the reader refuses.
 """
 
 from __future__ import annotations
@@ -20,6 +23,15 @@ FloatArray = NDArray[np.float64]
 #: Beam angles that differ from ``angle_min + i * angle_increment`` by more
 #: than this cannot be written as a LaserScan (which only knows even spacing).
 ANGLE_SPACING_TOLERANCE = 1e-6
+#: How far ``len(ranges)`` may be from the beam count that ``angle_min``, ``angle_max`` and
+#: ``angle_increment`` describe. One beam: drivers disagree on whether ``angle_max`` is the last
+#: beam or one increment past it (pointcloud_to_laserscan, several 360-degree scanners), and the
+#: loader places beams by ``angle_min + i * angle_increment`` either way. The 0.01 absorbs float32.
+BEAM_COUNT_SLACK = 1.01
+#: Quaternions whose norm is further than this from 1 are refused (a zero quaternion is no rotation);
+#: closer ones are normalised before the yaw is taken.
+QUATERNION_NORM_TOLERANCE = 0.1
+FULL_TURN = 2 * math.pi
 
 
 def stamp_seconds(sec: int, nanosec: int) -> float:
@@ -37,13 +49,77 @@ def split_ns(ns: int) -> tuple[int, int]:
     return ns // 1_000_000_000, ns % 1_000_000_000
 
 
+def quaternion_problem(x: float, y: float, z: float, w: float) -> str | None:
+    """Why ``(x, y, z, w)`` is not a rotation: non-finite, or a norm far from 1 (e.g. all zeros)."""
+    norm = math.sqrt(x * x + y * y + z * z + w * w) if all(map(math.isfinite, (x, y, z, w))) else math.nan
+    if math.isfinite(norm) and abs(norm - 1.0) <= QUATERNION_NORM_TOLERANCE:
+        return None
+    return (
+        f"orientation quaternion (x, y, z, w) = ({x!r}, {y!r}, {z!r}, {w!r}) has norm {norm:.6g}, expected a "
+        f"unit quaternion (norm 1 +/- {QUATERNION_NORM_TOLERANCE}; all zeros is no rotation, not yaw 0)"
+    )
+
+
 def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
     """The heading (rotation about z) of a quaternion, in ``(-pi, pi]``.
 
     Roll and pitch are ignored: a 2D robot's odometry quaternion is a pure
     yaw, and a tilted one would still be projected sensibly onto the plane.
+    A quaternion that is not quite unit is normalised first (the formula
+    assumes norm 1); callers refuse far-off ones with :func:`quaternion_problem`.
     """
+    n2 = x * x + y * y + z * z + w * w
+    if abs(n2 - 1.0) > 1e-9 and n2 > 0:
+        scale = 1.0 / math.sqrt(n2)
+        x, y, z, w = x * scale, y * scale, z * scale, w * scale
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def pose_problem(pose: ArrayLike) -> str | None:
+    """A planar pose ``(x, y, theta)`` must be finite."""
+    values = np.asarray(pose, dtype=np.float64)
+    if values.shape == (3,) and bool(np.isfinite(values).all()):
+        return None
+    return f"pose {values.tolist()} is not three finite numbers (x, y, theta)"
+
+
+def laserscan_problem(
+    beams: int, angle_min: float, angle_max: float, angle_increment: float, range_min: float, range_max: float
+) -> str | None:
+    """Why LaserScan fields cannot describe a scan of ``beams`` ranges (None if they can).
+
+    Finite fields; at least one range; ``0 <= range_min < range_max``; a
+    non-zero increment when there are several beams, spanning at most a full
+    turn; and ``beams`` agreeing with ``(angle_max - angle_min) / angle_increment + 1``
+    to within :data:`BEAM_COUNT_SLACK`.
+    """
+    fields = (angle_min, angle_max, angle_increment, range_min, range_max)
+    shown = (
+        f"angle_min {angle_min!r}, angle_max {angle_max!r}, angle_increment {angle_increment!r} rad, "
+        f"range_min {range_min!r}, range_max {range_max!r} m"
+    )
+    if not all(map(math.isfinite, fields)):
+        return f"{shown}: expected finite numbers"
+    if beams < 1:
+        return "no ranges, expected at least one beam"
+    if not 0 <= range_min < range_max:
+        return f"range_min {range_min!r} m and range_max {range_max!r} m, expected 0 <= range_min < range_max"
+    if beams == 1:
+        return None
+    if angle_increment == 0:
+        return f"{beams} ranges all at angle {angle_min!r} (angle_increment 0), expected a non-zero angle_increment"
+    if (beams - 1) * abs(angle_increment) > FULL_TURN + 1e-6:
+        return (
+            f"{beams} ranges {angle_increment!r} rad apart span {math.degrees((beams - 1) * abs(angle_increment)):.6g} "
+            f"deg, expected at most a full turn"
+        )
+    described = (angle_max - angle_min) / angle_increment + 1.0
+    if abs(beams - described) > BEAM_COUNT_SLACK:
+        return (
+            f"{beams} ranges, but {shown[: shown.index(', range_min')]} describe {described:.6g} beams; expected "
+            f"the count to agree with the angles (to within one beam)"
+        )
+    return None
 
 
 def quaternion_from_yaw(theta: float) -> tuple[float, float, float, float]:

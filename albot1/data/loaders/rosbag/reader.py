@@ -18,7 +18,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from albot1.data.errors import DataError, ParseError, TopicError
-from albot1.data.loaders.rosbag.msg import PoseTrack, stamp_seconds, yaw_from_quaternion
+from albot1.data.loaders.rosbag.bag1_check import describe_failure
+from albot1.data.loaders.rosbag.msg import PoseTrack, quaternion_problem, stamp_seconds, yaw_from_quaternion
 
 if TYPE_CHECKING:
     from rosbags.highlevel import AnyReader
@@ -59,6 +60,8 @@ def opened_bag(bag: Path, shown: Path) -> Iterator[AnyReader]:
         reader = AnyReader([bag], default_typestore=_ros2_default_typestore())
         reader.open()
     except Exception as exc:  # noqa: BLE001 - see docstring: rosbags fails in many ways on bad files
+        if bag.is_file():  # a ROS1 bag: say what is wrong with the file rather than where rosbags stopped
+            raise ParseError(shown, describe_failure(bag, _reason(exc))) from exc
         raise ParseError(shown, f"rosbags cannot open this bag: {_reason(exc)}") from exc
     try:
         yield reader
@@ -100,13 +103,22 @@ def header_stamp(msg: Any) -> float:
     return stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
 
 
+def _planar_pose(shown: Path, topic: str, index: int, p: Any, q: Any) -> tuple[float, float, float]:
+    """``(x, y, yaw)`` of a position and orientation; a ParseError for a non-finite position or a bad quaternion."""
+    x, y = float(p.x), float(p.y)
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ParseError(shown, f"topic {topic}: position ({x!r}, {y!r}), expected finite numbers", index=index)
+    quaternion = (float(q.x), float(q.y), float(q.z), float(q.w))
+    problem = quaternion_problem(*quaternion)
+    if problem is not None:
+        raise ParseError(shown, f"topic {topic}: {problem}", index=index)
+    return x, y, yaw_from_quaternion(*quaternion)
+
+
 def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
     times, poses = [], []
     for i, msg in topic_messages(reader, topic, shown):
-        p, q = msg.pose.pose.position, msg.pose.pose.orientation
-        pose = (float(p.x), float(p.y), yaw_from_quaternion(q.x, q.y, q.z, q.w))
-        if not all(math.isfinite(v) for v in pose):
-            raise ParseError(shown, f"topic {topic}: non-finite pose {pose}", index=i)
+        pose = _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation)
         times.append(header_stamp(msg))
         poses.append(pose)
     if not times:
@@ -122,16 +134,18 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
     """
     by_child: dict[str, tuple[list[float], list[tuple[float, float, float]]]] = {}
     pairs: set[tuple[str, str]] = set()
-    for _, msg in topic_messages(reader, topic, shown):
+    for i, msg in topic_messages(reader, topic, shown):
         for tf in msg.transforms:
             parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
             pairs.add((parent, child))
             if parent != odom_frame or (base_frame is not None and child != base_frame):
                 continue
-            tr, q = tf.transform.translation, tf.transform.rotation
+            pose = _planar_pose(
+                shown, f"{topic} ({parent} -> {child})", i, tf.transform.translation, tf.transform.rotation
+            )
             times, poses = by_child.setdefault(child, ([], []))
             times.append(header_stamp(tf))
-            poses.append((float(tr.x), float(tr.y), yaw_from_quaternion(q.x, q.y, q.z, q.w)))
+            poses.append(pose)
     seen = ", ".join(f"{p} -> {c}" for p, c in sorted(pairs)) or "none"
     if len(by_child) != 1:
         wanted = f"{odom_frame} -> {base_frame}" if base_frame else f"{odom_frame} -> <one child frame>"

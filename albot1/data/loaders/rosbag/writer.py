@@ -16,8 +16,12 @@ bag time alike):
 Because odometry is written at exactly the scan stamps, the loader's
 interpolation returns the written poses unchanged; this needs strictly
 increasing scan stamps, which the writer checks (see ``convert(retime=)``
-for logs whose stamps jitter or repeat). The output must not
-exist; a failed write removes what it created.
+for logs whose stamps jitter or repeat). Each LaserScan and pose is checked
+with the reader's own rules (:func:`.msg.laserscan_problem`, on the float32
+values as stored; :func:`.msg.pose_problem`) before it is written, so the
+writer never produces a bag its reader refuses. The output must not exist;
+a failed write removes what it created (output rules:
+:mod:`albot1.data.loaders.output`).
 """
 
 from __future__ import annotations
@@ -30,8 +34,16 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from albot1.data.errors import DataError
-from albot1.data.loaders.rosbag.msg import even_spacing, quaternion_from_yaw, seconds_to_ns, split_ns
+from albot1.data.errors import DataError, WriteError
+from albot1.data.loaders.output import prepare_output, writing
+from albot1.data.loaders.rosbag.msg import (
+    even_spacing,
+    laserscan_problem,
+    pose_problem,
+    quaternion_from_yaw,
+    seconds_to_ns,
+    split_ns,
+)
 from albot1.data.loaders.rosbag.topics import LASER_SCAN, ODOMETRY, WRITTEN_REFERENCE
 from albot1.data.model import Frame, Sequence
 
@@ -78,6 +90,10 @@ class RosMessages:
             )
         ranges = np.where(np.isfinite(scan.ranges), scan.ranges, np.inf).astype(np.float32)
         angle_min, step = spacing
+        fields = [float(np.float32(v)) for v in (angle_min, scan.angles[-1], step, 0.0, scan.max_range)]
+        problem = laserscan_problem(scan.beams, *fields)
+        if problem is not None:
+            raise DataError(f"scan #{frame.index}: LaserScan {problem}; the bag reader would refuse it")
         return self.LaserScan(
             header=self.header(ns, "laser", frame.index),
             angle_min=angle_min,
@@ -92,6 +108,9 @@ class RosMessages:
         )
 
     def odometry(self, pose: np.ndarray, ns: int, parent: str, seq: int) -> Any:
+        problem = pose_problem(pose)
+        if problem is not None:
+            raise DataError(f"scan #{seq}: {parent} {problem}; the bag reader would refuse it")
         x, y, theta = (float(v) for v in pose)
         qx, qy, qz, qw = quaternion_from_yaw(theta)
         zero = self.Vector3(x=0.0, y=0.0, z=0.0)
@@ -120,9 +139,9 @@ def _frame_ns(frame: Frame) -> int:
 def _write_frames(
     sequence: Sequence,
     msgs: RosMessages,
-    serialize: Callable[[Any, str], bytes],
+    serialize: Callable[[Any, str], bytes | memoryview],
     add: Callable[[str, str], Any],
-    write: Callable[[Any, int, bytes], None],
+    write: Callable[[Any, int, bytes | memoryview], None],
 ) -> None:
     """The shared loop; the reference connection is added on the first frame that has one.
 
@@ -147,11 +166,8 @@ def _write_frames(
         if frame.reference is not None:
             ref_conn = ref_conn or add(REFERENCE_TOPIC, ODOMETRY)
             write(ref_conn, ns, serialize(msgs.odometry(frame.reference, ns, "map", frame.index), ODOMETRY))
-
-
-def _refuse_existing(path: Path) -> None:
-    if path.exists():
-        raise DataError(f"{path} exists already; remove it or choose another output path")
+    if previous < 0:
+        raise DataError("the sequence has no scans; the bag reader refuses a bag whose scan topic is empty")
 
 
 def _cleanup(path: Path) -> None:
@@ -163,9 +179,13 @@ def _cleanup(path: Path) -> None:
 
 def _write_bag(sequence: Sequence, path: Path, open_bag: Callable[[], Any], ts: Typestore, *, ros1: bool) -> None:
     """Write every frame through a ``rosbags`` writer; a failed write removes what it created."""
+    from rosbags.rosbag1 import WriterError as Ros1WriterError
+    from rosbags.rosbag2 import WriterError as Ros2WriterError
+
     serialize = ts.serialize_ros1 if ros1 else ts.serialize_cdr
+    prepare_output(path)
     try:
-        with open_bag() as bag:
+        with writing(path), open_bag() as bag:
             _write_frames(
                 sequence,
                 RosMessages(ts, ros1=ros1),
@@ -173,6 +193,9 @@ def _write_bag(sequence: Sequence, path: Path, open_bag: Callable[[], Any], ts: 
                 lambda topic, msgtype: bag.add_connection(topic, msgtype, typestore=ts),
                 bag.write,
             )
+    except (Ros1WriterError, Ros2WriterError) as exc:
+        _cleanup(path)
+        raise WriteError(f"{path}: cannot be written: {' '.join(str(exc).split())}") from exc
     except BaseException:
         _cleanup(path)
         raise
@@ -188,7 +211,6 @@ class Ros1BagWriter:
         from rosbags.typesys import Stores, get_typestore
 
         path = Path(path)
-        _refuse_existing(path)
         _write_bag(sequence, path, lambda: Writer(path), get_typestore(Stores.ROS1_NOETIC), ros1=True)
 
 
@@ -203,7 +225,6 @@ class _Ros2Writer:
         from rosbags.typesys import Stores, get_typestore
 
         path = Path(path)
-        _refuse_existing(path)
         plugin = StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3
         _write_bag(
             sequence,

@@ -1,17 +1,19 @@
 """Every threshold and every reading of an ambiguous passage of thesis 3.1, typed.
 
 Defaults are the thesis's values; where the thesis gives none, the default
-is the resolution that worked in the prototype (``albot1-spec-notes.md``,
-item numbers in the descriptions) and ``docs/albot1-mapper.md`` lists each
-choice with the thesis text it resolves. Presets: ``thesis`` (= ``default``,
-the literal reading, including the distance/turn motion model of eqs
-3.1-3.2) and ``exact`` (the full SE(2) odometry increment).
+is the resolution that worked in a prototype; ``docs/albot1-mapper.md``
+lists each choice with the thesis text it resolves, and the "note N" in a
+field's description is the number that page gives the resolution. The values a run uses come from
+the presets file ``albot1/methods/albot1/presets.toml`` (``default`` =
+``thesis``, ``exact``, ``literal``; read by
+:class:`albot1.config.presets.TomlPresets`); the defaults here equal its
+``[presets.default]`` so the model can also be built directly in code.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -55,7 +57,11 @@ class Albot1Config(BaseModel):
     continuation_tolerance_m: float = Field(
         0.1,
         ge=0,
-        description="3.1.4: a cluster end whose next return outward lies within this of the surface's own line continued is a grazing-angle gap, not an occluding edge (0 = off; the thesis's 'obstructs' needs something else behind)",
+        description=(
+            "3.1.4: a cluster end whose next return outward lies within this of the surface's own line continued "
+            "is a grazing-angle gap, not an occluding edge (0 = off; the thesis's 'obstructs' needs something "
+            "else behind)"
+        ),
     )
     # 3.1.5 recognition
     motion_model: Literal["thesis", "exact"] = Field(
@@ -86,7 +92,10 @@ class Albot1Config(BaseModel):
     goodness_angle_floor_deg: float = Field(0.1, gt=0, description="eq 3.5: floor of a_diff (note 9)")
     goodness_distance_view: Literal["previous", "current"] = Field(
         "previous",
-        description="eq 3.5 d_R: distance of the previous endpoint from the robot in the previous view (literal) or predicted into the current view",
+        description=(
+            "eq 3.5 d_R: distance of the previous endpoint from the robot in the previous view (literal) "
+            "or predicted into the current view"
+        ),
     )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
@@ -99,7 +108,11 @@ class Albot1Config(BaseModel):
     )
     delete_margin_from: Literal["surfaces", "boundary"] = Field(
         "surfaces",
-        description="Algorithm 3 line 9: measure the 40 cm from the view's surfaces (perpendicular, within their extent) or from every polygon edge, including the field-of-view sides through unperceived space (see docs: the latter erases walls behind the robot when updates come less than 40 cm apart)",
+        description=(
+            "Algorithm 3 line 9: measure the 40 cm from the view's surfaces (perpendicular, within their extent) "
+            "or from every polygon edge, including the field-of-view sides through unperceived space (see docs: "
+            "the latter erases walls behind the robot when updates come less than 40 cm apart)"
+        ),
     )
     correspond_angle_deg: float = Field(
         5.0, gt=0, description="Algorithm 3 line 12: a corresponding view surface is this parallel (note 17)"
@@ -109,7 +122,10 @@ class Albot1Config(BaseModel):
     )
     partial_without_match: Literal["clip", "keep"] = Field(
         "clip",
-        description="a partly covered map surface with no corresponding view surface: clip it at the grown polygon, or keep it whole",
+        description=(
+            "a partly covered map surface with no corresponding view surface: clip it at the grown polygon, "
+            "or keep it whole"
+        ),
     )
     # degenerate input and implementation
     odometry_jump_m: float = Field(5.0, gt=0, description="an odometry step longer than this is counted as a jump")
@@ -132,12 +148,3 @@ class Albot1Config(BaseModel):
             continuation_tolerance=self.continuation_tolerance_m,
         )
 
-
-PRESETS: dict[str, dict[str, Any]] = {
-    "default": {},
-    "thesis": {},
-    "exact": {"motion_model": "exact"},
-    # The bare text where our defaults read it otherwise (docs/albot1-mapper.md, "Presets"):
-    # the 40 cm delete margin from every polygon edge and no grazing-angle test.
-    "literal": {"delete_margin_from": "boundary", "continuation_tolerance_m": 0.0},
-}

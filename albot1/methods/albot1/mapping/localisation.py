@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1.perception.frames import Pose, wrap
-from albot1.methods.albot1.perception.kernels import CORNER, OCCLUDING
+from albot1.geometry.se2 import Pose, wrap_angle
+from albot1.methods.albot1.perception.endpoints import is_stable
 from albot1.methods.albot1.perception.recognition import Tracked
 
 FloatArray = NDArray[np.float64]
@@ -58,7 +58,7 @@ def dp_theta(view_seg: FloatArray, side: int, point: tuple[float, float]) -> tup
     """Figure 3.10a: distance from the reference point to ``point`` and its angle from the surface direction."""
     rx, ry = _reference(view_seg, side)
     dx, dy = point[0] - rx, point[1] - ry
-    return math.hypot(dx, dy), wrap(math.atan2(dy, dx) - _direction(view_seg))
+    return math.hypot(dx, dy), wrap_angle(math.atan2(dy, dx) - _direction(view_seg))
 
 
 def algorithm2_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pose:
@@ -77,12 +77,12 @@ def algorithm2_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pos
         d_p, theta = dp_theta(view_seg, side, point)
         p.append(eq_3_6_3_7(mx1, my1, mx2, my2, d_p, theta))
     heading = math.atan2(p[1][1] - p[0][1], p[1][0] - p[0][0]) - math.pi / 2.0
-    return (p[0][0], p[0][1], wrap(heading))
+    return (p[0][0], p[0][1], wrap_angle(heading))
 
 
 def landmark_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pose:
     """The view's pose in the map that lays ``view_seg`` onto ``map_seg`` at the reference point ``side``."""
-    phi = wrap(_direction(map_seg) - _direction(view_seg))
+    phi = wrap_angle(_direction(map_seg) - _direction(view_seg))
     c, s = math.cos(phi), math.sin(phi)
     mx, my = _reference(map_seg, side)
     vx, vy = _reference(view_seg, side)
@@ -123,10 +123,6 @@ class Localisation:
     goodness: FloatArray
 
 
-def _is_stable(kind: int) -> bool:
-    return kind == OCCLUDING or kind == CORNER
-
-
 def localise(
     tracked: Tracked,
     landmark_map: Mapping[int, tuple[FloatArray, IntArray]],
@@ -164,7 +160,7 @@ def localise(
         matched = sides[k]
         side = -1
         for s in (matched, 1 - matched) if matched >= 0 else (0, 1):
-            if _is_stable(kinds[k][s]) and _is_stable(int(map_kinds[s])):
+            if is_stable(kinds[k][s]) and is_stable(int(map_kinds[s])):
                 side = s
                 break
         if side < 0:

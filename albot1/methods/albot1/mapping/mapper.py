@@ -23,22 +23,19 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import BaseModel
 
+from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
-from albot1.methods.albot1.mapping.config import PRESETS, Albot1Config
+from albot1.geometry.se2 import Pose, between_pose, compose_pose
+from albot1.geometry.segments import transform_segments
+from albot1.methods.albot1.mapping.accel import mapping_kernels
+from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.update import UpdateParams, update_map
-from albot1.methods.albot1.perception.accel import get_kernels
-from albot1.methods.albot1.perception.frames import (
-    Pose,
-    between,
-    compose,
-    thesis_to_rep_pose,
-    thesis_to_rep_segments,
-    transform_segments,
-)
+from albot1.methods.albot1.perception.accel import perception_kernels
+from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
 from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
 from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise
 from albot1.methods.albot1.perception.view import View, construct_view
@@ -81,12 +78,13 @@ class Albot1Mapper:
 
     name: ClassVar[str] = "albot1"
     config_model: ClassVar[type[BaseModel]] = Albot1Config
-    presets: ClassVar[dict[str, dict[str, Any]]] = PRESETS
+    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets(package="albot1.methods.albot1")  # type: ignore[assignment]
 
     def __init__(self, config: Albot1Config, *, seed: int = 0) -> None:
         # The method is deterministic; ``seed`` is accepted for the protocol.
         self.config = config
-        self._k = get_kernels(config.accelerate)
+        self._pk = perception_kernels(config.accelerate)
+        self._mk = mapping_kernels(config.accelerate)
         self._view_params = config.view_params()
         self._update_params = UpdateParams(
             delete_margin=config.delete_margin_m,
@@ -99,7 +97,7 @@ class Albot1Mapper:
         self._rec_angle = math.radians(config.recognition_angle_deg)
         self._angle_floor = math.radians(config.goodness_angle_floor_deg)
         self._stationary_rad = math.radians(config.stationary_deg)
-        self.map = PerceptualMap(config.map_grid_cell_m, self._k)
+        self.map = PerceptualMap(config.map_grid_cell_m, self._mk)
         self._landmark_map: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._poses: list[Pose] = []
         self._prev: _Step | None = None
@@ -113,7 +111,7 @@ class Albot1Mapper:
         n = self._n
         scan = frame.scan
         try:
-            view = construct_view(scan.ranges, scan.angles, self._view_params, self._k)
+            view = construct_view(scan.ranges, scan.angles, self._view_params, self._pk)
         except (ValueError, TypeError) as exc:
             raise MappingError(f"scan {frame.index}: cannot build a view: {exc}") from exc
         lms = find_landmarks(view, self.config.landmark_min_length_m)
@@ -141,7 +139,7 @@ class Albot1Mapper:
         self, n: int, view: View, lms: Landmarks, odo: tuple[float, float, float], prev: _Step
     ) -> tuple[Tracked, Pose]:
         c, cfg = self._counts, self.config
-        rel = between(prev.odometry, odo)
+        rel = between_pose(prev.odometry, odo)
         dist = math.hypot(rel[0], rel[1])
         if dist > cfg.odometry_jump_m:
             c.odometry_jumps += 1
@@ -173,7 +171,7 @@ class Albot1Mapper:
         loc = self._localise(rl)
         if loc is None:
             c.path_integration += 1
-            pose, source, ref = compose(prev.pose, step), "odometry", -1
+            pose, source, ref = compose_pose(prev.pose, step), "odometry", -1
         else:
             pose, source, ref = loc.pose, "landmark", loc.reference_id
         tracked = self._update(
@@ -191,7 +189,7 @@ class Albot1Mapper:
             max_angle=self._rec_angle,
             max_distance=self.config.recognition_distance_m,
             matching=self.config.recognition_matching,
-            kernels=self._k,
+            kernels=self._pk,
         )
 
     def _localise(self, rl: Tracked) -> Localisation | None:
@@ -205,13 +203,13 @@ class Albot1Mapper:
         )
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
-        """Spec note 13: localise on the tracked landmarks; compose the odometry step if that fails."""
+        """Note 13 (``docs/albot1-mapper.md``): localise on the tracked landmarks; compose the odometry step if that fails."""
         if self.config.pose_between_updates == "localise":
             loc = self._localise(rl)
             if loc is not None:
                 return loc.pose
         self._counts.odometry_pose_steps += 1
-        return compose(prev_pose, step)
+        return compose_pose(prev_pose, step)
 
     def _update(
         self,
@@ -229,7 +227,7 @@ class Albot1Mapper:
         """``updatePM`` with ``view`` placed at ``pose``; returns the landmark list reset to its landmarks."""
         c = self._counts
         view_map = transform_segments(pose, view.surfaces)
-        out = update_map(self.map, view_map, (pose[0], pose[1]), view_scan, self._update_params, self._k)
+        out = update_map(self.map, view_map, (pose[0], pose[1]), view_scan, self._update_params, self._mk)
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1.perception.accel import Kernels, get_kernels
+from albot1.methods.albot1.mapping.accel import MappingKernels, mapping_kernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -26,9 +26,9 @@ Cell = tuple[int, int]
 class PerceptualMap:
     """Editable surfaces ``(x1, y1, x2, y2)`` in the map (thesis) frame."""
 
-    def __init__(self, cell_size: float = 2.0, kernels: Kernels | None = None) -> None:
+    def __init__(self, cell_size: float = 2.0, kernels: MappingKernels | None = None) -> None:
         self.cell_size = float(cell_size)
-        self._k = kernels or get_kernels()
+        self._k = kernels or mapping_kernels()
         self._seg = np.empty((256, 4))
         self._alive = np.zeros(256, dtype=bool)
         self._added_at = np.zeros(256, dtype=np.int64)
@@ -126,9 +126,9 @@ class PerceptualMap:
         else:
             for i in range(i0, i1 + 1):
                 for j in range(j0, j1 + 1):
-                    bucket = grid.get((i, j))
-                    if bucket:
-                        found.update(bucket)
+                    cell = grid.get((i, j))
+                    if cell:
+                        found.update(cell)
         return np.fromiter(sorted(found), dtype=np.int64, count=len(found))
 
     def segments(self, ids: IntArray | None = None) -> FloatArray:

@@ -17,8 +17,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.methods.albot1.mapping.accel import MappingKernels, mapping_kernels
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
-from albot1.methods.albot1.perception.accel import Kernels, get_kernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -67,14 +67,14 @@ def update_map(
     robot_xy: tuple[float, float],
     scan: int,
     params: UpdateParams,
-    kernels: Kernels | None = None,
+    kernels: MappingKernels | None = None,
 ) -> UpdateOutcome:
     """``updatePM`` for a view already transformed into the map (``view_map``, left to right).
 
     Lines 1-6 (placing the view with the reference landmark) are the
     caller's: that is the localisation pose applied to every surface.
     """
-    k = kernels or get_kernels()
+    k = kernels or mapping_kernels()
     view_map = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
     m = view_map.shape[0]
     view_ids = np.full(m, -1, dtype=np.int64)
@@ -140,7 +140,7 @@ def _extend_or_trim(
     poly: FloatArray,
     scan: int,
     params: UpdateParams,
-    k: Kernels,
+    k: MappingKernels,
     deleted: list[int],
     extended: list[int],
     trimmed: list[int],
@@ -149,8 +149,9 @@ def _extend_or_trim(
 
     The corresponding view surface is the closest one (segment distance)
     that is parallel (either direction) within the angle and near within
-    the distance, and not already taken by another map surface (note 17). The surface then runs from its outside end to the far end of that
-    view surface (seen from the outside end): longer is "extended", shorter
+    the distance, and not already taken by another map surface (note 17).
+    The surface then runs from its outside end to the far end of that view
+    surface (seen from the outside end): longer is "extended", shorter
     "trimmed" (Figure 3.13's S_e and S_r). With no corresponding surface it
     is clipped where it enters the grown polygon, or kept whole.
     """

@@ -1,62 +1,38 @@
-"""The kernels of :mod:`albot1.methods.albot1.perception.kernels`, jitted with numba or as written.
+"""The perception kernels to run: jitted with numba or as written, in one typed set.
 
-Acceleration never changes results: both variants run the same source. The
-jitted set is built once per process (numba's on-disk cache makes later
-processes start in well under a second); when numba cannot be imported the
-interpreted kernels are used, which is slow but exact.
+Acceleration never changes results: both variants run the same source
+(:mod:`albot1.methods.albot1.jit`). A set is built once per process and flag;
+when numba cannot be imported the interpreted kernels are used, which is slow
+but exact.
 """
 
 from __future__ import annotations
 
-import types
+from collections.abc import Callable
 from functools import lru_cache
-from typing import Any
+from typing import NamedTuple
 
+from albot1.methods.albot1.jit import kernel_compiler
 from albot1.methods.albot1.perception import kernels
-
-#: every kernel function; helpers are jitted too because jitted code can only call jitted code.
-_NAMES = (
-    "build_view",
-    "_occlusion",
-    "_corner",
-    "wrap_angle",
-    "recognise_landmarks",
-    "classify_endpoints",
-    "best_correspondence",
-    "segment_distance",
-    "_point_segment",
-    "_segments_cross",
-    "_orient",
-    "clip_parameter",
-    "segment_cells",
-)
+from albot1.methods.albot1.perception.kernels import FloatArray, IntArray
 
 
-class Kernels:
-    """Attribute access to one consistent set of kernels (all jitted or none)."""
+class PerceptionKernels(NamedTuple):
+    """One consistent set of perception kernels (all jitted or none); see :mod:`.kernels` for each."""
 
-    def __init__(self, functions: dict[str, Any], jitted: bool) -> None:
-        self.jitted = jitted
-        for name, fn in functions.items():
-            setattr(self, name.lstrip("_"), fn)
+    jitted: bool
+    build_view: Callable[
+        [FloatArray, FloatArray, float, float, float, float, float, float, float, float],
+        tuple[FloatArray, IntArray, IntArray, IntArray],
+    ]
+    recognise_landmarks: Callable[
+        [FloatArray, IntArray, FloatArray, IntArray, float, float, float, float, float, bool],
+        tuple[IntArray, IntArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray],
+    ]
 
 
 @lru_cache(maxsize=2)
-def get_kernels(accelerate: bool = True) -> Kernels:
+def perception_kernels(accelerate: bool = True) -> PerceptionKernels:
     """The jitted kernels when ``accelerate`` and numba is importable, else the plain ones."""
-    plain = {name: getattr(kernels, name) for name in _NAMES}
-    if not accelerate:
-        return Kernels(plain, jitted=False)
-    try:
-        import numba
-    except ImportError:
-        return Kernels(plain, jitted=False)
-    # Clones share one globals dict in which every helper is replaced by its jitted
-    # version, so jitted callers resolve jitted callees when they compile.
-    shared = dict(vars(kernels))
-    for name, fn in plain.items():
-        clone = types.FunctionType(fn.__code__, shared, fn.__name__, fn.__defaults__, fn.__closure__)
-        clone.__qualname__ = fn.__qualname__
-        clone.__module__ = fn.__module__
-        shared[name] = numba.njit(cache=True, nogil=True)(clone)
-    return Kernels({name: shared[name] for name in _NAMES}, jitted=True)
+    jit = kernel_compiler(accelerate, (kernels.build_view, kernels.recognise_landmarks))
+    return PerceptionKernels(jit.jitted, jit(kernels.build_view), jit(kernels.recognise_landmarks))

@@ -1,11 +1,17 @@
-"""Per-scan loops of the perceptual pipeline, written once for numba and CPython.
+"""The per-scan loops of Albot1's perception: view construction and landmark recognition.
 
 Every function here is plain Python over numpy arrays and scalars in the
-subset numba compiles. :mod:`albot1.methods.albot1.perception.accel` hands out either the
-jitted or the interpreted version of the same source, so the accelerated path
-can never drift from the readable one (tests run both on the same inputs).
-Geometry is in the thesis frame (robot at the origin facing +y); endpoint
-kinds use the codes of :mod:`albot1.methods.albot1.perception.landmarks`.
+subset numba compiles. :mod:`albot1.methods.albot1.perception.accel` hands out
+either the jitted or the interpreted version of the same source, so the
+accelerated path can never drift from the readable one (tests run both on
+the same inputs). Geometry is in the thesis frame (robot at the origin facing
++y); endpoint labels are those of
+:mod:`albot1.methods.albot1.perception.endpoints`.
+
+Distances use ``np.hypot``, not ``math.hypot``: numba compiles both to C's
+``hypot``, while CPython's ``math.hypot`` is its own, more accurate routine
+that differs in the last bit for about 0.6 % of inputs, which would make the
+interpreted kernels disagree with the compiled ones.
 """
 
 from __future__ import annotations
@@ -13,16 +19,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import NDArray
 
-UNSTABLE = 0
-OCCLUDING = 1
-CORNER = 2
-OCCLUDED = 3
+from albot1.geometry.se2 import wrap_angle
+from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, UNSTABLE, is_stable
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 
 def build_view(
-    ranges: np.ndarray,
-    angles: np.ndarray,
+    ranges: FloatArray,
+    angles: FloatArray,
     max_range: float,
     cluster_gap: float,
     cluster_size: float,
@@ -31,7 +39,7 @@ def build_view(
     corner_min_turn: float,
     occlusion_margin: float,
     continuation_tolerance: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[FloatArray, IntArray, IntArray, IntArray]:
     """Thesis 3.1.3 steps 1-5 plus endpoint classification (3.1.4) for one scan.
 
     ``ranges``/``angles`` are in *thesis order* (left to right, i.e. beam
@@ -64,7 +72,7 @@ def build_view(
     starts[nc] = 0
     nc += 1
     for i in range(1, k):
-        if math.hypot(px[i] - px[i - 1], py[i] - py[i - 1]) > cluster_gap:
+        if np.hypot(px[i] - px[i - 1], py[i] - py[i - 1]) > cluster_gap:
             starts[nc] = i
             nc += 1
     starts[nc] = k
@@ -85,7 +93,7 @@ def build_view(
             i1 = stack_b[top]
             dx = px[i1] - px[i0]
             dy = py[i1] - py[i0]
-            chord = math.hypot(dx, dy)
+            chord = np.hypot(dx, dy)
             split = -1
             if chord > cluster_size and i1 - i0 >= 2:
                 best = break_point_height
@@ -112,7 +120,7 @@ def build_view(
     for p in range(npieces):
         i0 = piece_a[p]
         i1 = piece_b[p]
-        length = math.hypot(px[i1] - px[i0], py[i1] - py[i0])
+        length = np.hypot(px[i1] - px[i0], py[i1] - py[i0])
         if length < surface_length:
             continue
         c = piece_c[p]
@@ -143,7 +151,7 @@ def build_view(
 
 
 def _occlusion(
-    ranges: np.ndarray, angles: np.ndarray, b: int, step: int, margin: float, ox: float, oy: float, tolerance: float
+    ranges: FloatArray, angles: FloatArray, b: int, step: int, margin: float, ox: float, oy: float, tolerance: float
 ) -> int:
     """Kind of a cluster-boundary endpoint on beam ``b`` looking outward by ``step``.
 
@@ -170,7 +178,7 @@ def _occlusion(
                 qy = r * math.cos(angles[j])
                 lx = ex - ox
                 ly = ey - oy
-                ll = math.hypot(lx, ly)
+                ll = np.hypot(lx, ly)
                 if ll > 0.0 and abs(lx * (qy - oy) - ly * (qx - ox)) / ll <= tolerance:
                     return UNSTABLE
             return OCCLUDING
@@ -178,7 +186,7 @@ def _occlusion(
     return UNSTABLE
 
 
-def _corner(px: np.ndarray, py: np.ndarray, a: int, b: int, c: int, min_turn: float) -> int:
+def _corner(px: FloatArray, py: FloatArray, a: int, b: int, c: int, min_turn: float) -> int:
     """CORNER when the pieces a->b and b->c turn by at least ``min_turn`` radians at b."""
     ux = px[b] - px[a]
     uy = py[b] - py[a]
@@ -192,23 +200,18 @@ def _corner(px: np.ndarray, py: np.ndarray, a: int, b: int, c: int, min_turn: fl
     return UNSTABLE
 
 
-def wrap_angle(a: float) -> float:
-    """``a`` wrapped to ``[-pi, pi)``."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
 def recognise_landmarks(
-    prev: np.ndarray,
-    prev_kinds: np.ndarray,
-    cur: np.ndarray,
-    cur_kinds: np.ndarray,
+    prev: FloatArray,
+    prev_kinds: IntArray,
+    cur: FloatArray,
+    cur_kinds: IntArray,
     xr: float,
     yr: float,
     theta: float,
     max_angle: float,
     max_distance: float,
     greedy: bool,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[IntArray, IntArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """Algorithm 1 on arrays: predict (eqs 3.3-3.4), test every pair, pick the matches.
 
     ``(xr, yr, theta)`` is the current robot in the previous view (eqs
@@ -251,8 +254,8 @@ def recognise_landmarks(
             best = max_distance
             side = -1
             for e in range(2):
-                if 1 <= prev_kinds[i, e] <= 2 and 1 <= cur_kinds[j, e] <= 2:
-                    g = math.hypot(pred[i, 2 * e] - cur[j, 2 * e], pred[i, 2 * e + 1] - cur[j, 2 * e + 1])
+                if is_stable(prev_kinds[i, e]) and is_stable(cur_kinds[j, e]):
+                    g = np.hypot(pred[i, 2 * e] - cur[j, 2 * e], pred[i, 2 * e + 1] - cur[j, 2 * e + 1])
                     if g < best:
                         best = g
                         side = e
@@ -299,177 +302,7 @@ def recognise_landmarks(
         os_[k] = e
         og[k] = gg[o]
         oa[k] = aa[o]
-        od[k] = math.hypot(prev[i, 2 * e], prev[i, 2 * e + 1])
-        odc[k] = math.hypot(pred[i, 2 * e], pred[i, 2 * e + 1])
+        od[k] = np.hypot(prev[i, 2 * e], prev[i, 2 * e + 1])
+        odc[k] = np.hypot(pred[i, 2 * e], pred[i, 2 * e + 1])
         k += 1
     return oi, oj, os_, og, oa, od, odc
-
-
-def classify_endpoints(
-    poly: np.ndarray, view: np.ndarray, pts: np.ndarray, margin: float, surfaces_only: bool
-) -> np.ndarray:
-    """For each point: inside the closed polygon (even-odd) or within ``margin`` of it.
-
-    ``poly`` is ``(v, 2)`` (implicitly closed); the view polygon is
-    star-shaped around the robot, so even-odd is its exact interior. With
-    ``surfaces_only`` the margin is measured from the view's surfaces
-    (``view`` ``(m, 4)``), perpendicular to each and within its extent, not
-    from the polygon's sides through unperceived space (field-of-view edges,
-    gaps); otherwise from every polygon edge.
-    """
-    v = poly.shape[0]
-    out = np.zeros(pts.shape[0], dtype=np.bool_)
-    m2 = margin * margin
-    for k in range(pts.shape[0]):
-        x = pts[k, 0]
-        y = pts[k, 1]
-        inside = False
-        near = False
-        for e in range(v):
-            ax = poly[e, 0]
-            ay = poly[e, 1]
-            bx = poly[(e + 1) % v, 0]
-            by = poly[(e + 1) % v, 1]
-            if (ay > y) != (by > y):
-                xc = ax + (y - ay) * (bx - ax) / (by - ay)
-                if x < xc:
-                    inside = not inside
-            if not near and not surfaces_only:
-                ex = bx - ax
-                ey = by - ay
-                l2 = ex * ex + ey * ey
-                t = 0.0
-                if l2 > 0.0:
-                    t = ((x - ax) * ex + (y - ay) * ey) / l2
-                    t = min(1.0, max(0.0, t))
-                dx = ax + t * ex - x
-                dy = ay + t * ey - y
-                if dx * dx + dy * dy < m2:
-                    near = True
-        if surfaces_only and not inside:
-            for j in range(view.shape[0]):
-                ex = view[j, 2] - view[j, 0]
-                ey = view[j, 3] - view[j, 1]
-                l2 = ex * ex + ey * ey
-                if l2 <= 0.0:
-                    continue
-                t = ((x - view[j, 0]) * ex + (y - view[j, 1]) * ey) / l2
-                if t < 0.0 or t > 1.0:
-                    continue
-                dx = view[j, 0] + t * ex - x
-                dy = view[j, 1] + t * ey - y
-                if dx * dx + dy * dy < m2:
-                    near = True
-                    break
-        out[k] = inside or near
-    return out
-
-
-def best_correspondence(
-    seg: np.ndarray, view: np.ndarray, taken: np.ndarray, max_angle: float, max_distance: float
-) -> int:
-    """Index of the free view surface closest to ``seg`` (segment distance) among those parallel
-    to it within ``max_angle`` (undirected) and nearer than ``max_distance``; -1 if none."""
-    best = -1
-    best_d = max_distance
-    a0 = math.atan2(seg[3] - seg[1], seg[2] - seg[0])
-    for j in range(view.shape[0]):
-        if taken[j]:
-            continue
-        da = math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0]) - a0
-        da = abs((da + 0.5 * math.pi) % math.pi - 0.5 * math.pi)
-        if da >= max_angle:
-            continue
-        d = segment_distance(seg, view[j])
-        if d < best_d:
-            best = j
-            best_d = d
-    return best
-
-
-def segment_distance(a: np.ndarray, b: np.ndarray) -> float:
-    """Smallest distance between segments ``a`` and ``b`` (each x1, y1, x2, y2); 0 if they cross."""
-    if _segments_cross(a, b):
-        return 0.0
-    d = _point_segment(a[0], a[1], b)
-    d = min(d, _point_segment(a[2], a[3], b))
-    d = min(d, _point_segment(b[0], b[1], a))
-    return min(d, _point_segment(b[2], b[3], a))
-
-
-def _point_segment(x: float, y: float, s: np.ndarray) -> float:
-    ex = s[2] - s[0]
-    ey = s[3] - s[1]
-    l2 = ex * ex + ey * ey
-    t = 0.0
-    if l2 > 0.0:
-        t = min(1.0, max(0.0, ((x - s[0]) * ex + (y - s[1]) * ey) / l2))
-    return math.hypot(s[0] + t * ex - x, s[1] + t * ey - y)
-
-
-def _segments_cross(a: np.ndarray, b: np.ndarray) -> bool:
-    d1 = _orient(b[0], b[1], b[2], b[3], a[0], a[1])
-    d2 = _orient(b[0], b[1], b[2], b[3], a[2], a[3])
-    d3 = _orient(a[0], a[1], a[2], a[3], b[0], b[1])
-    d4 = _orient(a[0], a[1], a[2], a[3], b[2], b[3])
-    return ((d1 > 0.0) != (d2 > 0.0)) and ((d3 > 0.0) != (d4 > 0.0)) and d1 != 0.0 and d2 != 0.0
-
-
-def _orient(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-
-
-def clip_parameter(
-    poly: np.ndarray, view: np.ndarray, x0: float, y0: float, x1: float, y1: float, margin: float, surfaces_only: bool
-) -> float:
-    """Fraction ``t`` along (x0, y0)->(x1, y1) where the segment first enters the covered region.
-
-    (x0, y0) is outside, (x1, y1) covered (:func:`classify_endpoints`);
-    bisection on that predicate (the grown region has no closed form without
-    a buffer operation), to 1e-4 of the segment.
-    """
-    lo = 0.0
-    hi = 1.0
-    probe = np.empty((1, 2))
-    for _ in range(14):
-        mid = 0.5 * (lo + hi)
-        probe[0, 0] = x0 + mid * (x1 - x0)
-        probe[0, 1] = y0 + mid * (y1 - y0)
-        if classify_endpoints(poly, view, probe, margin, surfaces_only)[0]:
-            hi = mid
-        else:
-            lo = mid
-    return lo
-
-
-def segment_cells(segs: np.ndarray, inv_cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Grid cells each segment passes through: ``(row, i, j)`` arrays, rows ascending.
-
-    Samples every half cell along the segment (so every cell it crosses by
-    more than a corner is hit; queries pad by one cell) and drops repeats;
-    along a straight segment the cells visited are contiguous, so comparing
-    with the previous sample suffices.
-    """
-    total = 0
-    m = segs.shape[0]
-    counts = np.empty(m, dtype=np.int64)
-    for r in range(m):
-        counts[r] = int(math.hypot(segs[r, 2] - segs[r, 0], segs[r, 3] - segs[r, 1]) * 2.0 * inv_cell) + 2
-        total += counts[r]
-    rows = np.empty(total, dtype=np.int64)
-    ci = np.empty(total, dtype=np.int64)
-    cj = np.empty(total, dtype=np.int64)
-    k = 0
-    for r in range(m):
-        n = counts[r]
-        for q in range(n):
-            t = q / (n - 1)
-            i = math.floor((segs[r, 0] + t * (segs[r, 2] - segs[r, 0])) * inv_cell)
-            j = math.floor((segs[r, 1] + t * (segs[r, 3] - segs[r, 1])) * inv_cell)
-            if q > 0 and ci[k - 1] == i and cj[k - 1] == j:
-                continue
-            rows[k] = r
-            ci[k] = i
-            cj[k] = j
-            k += 1
-    return rows[:k], ci[:k], cj[:k]

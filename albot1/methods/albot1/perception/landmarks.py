@@ -1,20 +1,8 @@
 """Landmark surfaces (thesis 3.1.4): long enough and with a stable endpoint.
 
-Endpoint labels (set during view construction, which sees the raw beams):
-
-* ``OCCLUDING``: a cluster end whose next beam with a return, looking
-  outward, is farther away: the surface is in front and its end is a real
-  edge (Figure 3.7's p3, p6).
-* ``CORNER``: a point shared by two pieces of one cluster that turn by at
-  least the corner angle (p1, p2).
-* ``OCCLUDED``: a cluster end with a nearer return beside it: the end is
-  where something else hides the surface, and moves as the robot moves.
-* ``UNSTABLE``: anything else: an end on the outermost beam or followed by
-  no-return beams only up to the edge of the field of view, or a bend
-  smaller than the corner angle.
-
-Only occluding and corner endpoints are *stable*: they are the reference
-points for recognition and localisation.
+The endpoint labels and the rule for which are stable live in
+:mod:`albot1.methods.albot1.perception.endpoints` (set during view
+construction, which sees the raw beams); they are re-exported here.
 """
 
 from __future__ import annotations
@@ -24,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1.perception.kernels import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
+from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, STABLE, UNSTABLE
 from albot1.methods.albot1.perception.view import View
 
 FloatArray = NDArray[np.float64]
@@ -35,7 +23,7 @@ __all__ = ["CORNER", "OCCLUDED", "OCCLUDING", "UNSTABLE", "Landmarks", "find_lan
 
 def stable(kinds: IntArray) -> NDArray[np.bool_]:
     """Mask of endpoint labels that can serve as reference points."""
-    return (kinds == OCCLUDING) | (kinds == CORNER)
+    return STABLE[kinds]
 
 
 @dataclass(frozen=True, slots=True)

@@ -16,8 +16,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1.perception.accel import Kernels, get_kernels
-from albot1.methods.albot1.perception.frames import Pose
+from albot1.geometry.se2 import Pose, PoseLike
+from albot1.methods.albot1.perception.accel import PerceptionKernels, perception_kernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -35,7 +35,7 @@ def thesis_motion(d: float, theta: float) -> Pose:
     return (d * math.sin(-theta), d * math.cos(-theta), theta)
 
 
-def motion_step(step_rep: FloatArray | tuple[float, float, float], model: MotionModel) -> Pose:
+def motion_step(step_rep: PoseLike, model: MotionModel) -> Pose:
     """The current view's pose in the previous view's thesis frame, from a REP-103 odometry increment.
 
     ``"thesis"`` keeps only ``d = |(dx, dy)|`` and ``theta = dtheta`` (eqs
@@ -46,20 +46,6 @@ def motion_step(step_rep: FloatArray | tuple[float, float, float], model: Motion
     if model == "thesis":
         return thesis_motion(math.hypot(dx, dy), dth)
     return (-dy, dx, dth)
-
-
-def predict(surfaces: FloatArray, step: Pose) -> FloatArray:
-    """Eqs 3.3-3.4: previous-view surfaces seen from the current robot (subtract, rotate by -theta)."""
-    xr, yr, th = step
-    c, s = math.cos(th), math.sin(th)
-    seg = np.asarray(surfaces, dtype=float).reshape(-1, 4)
-    out = np.empty_like(seg)
-    for k in (0, 2):
-        dx = seg[:, k] - xr
-        dy = seg[:, k + 1] - yr
-        out[:, k] = dx * c + dy * s
-        out[:, k + 1] = dy * c - dx * s
-    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,7 +87,7 @@ def recognise(
     max_angle: float,
     max_distance: float,
     matching: Matching = "greedy",
-    kernels: Kernels | None = None,
+    kernels: PerceptionKernels | None = None,
 ) -> Tracked:
     """``recognizeLandmark``: the current landmarks (``surfaces``, ``kinds``) matched to ``previous``.
 
@@ -111,7 +97,7 @@ def recognise(
     id onto the current surface (the last pair wins) and each current
     surface is saved once.
     """
-    k = kernels or get_kernels()
+    k = kernels or perception_kernels()
     if len(previous) == 0 or len(surfaces) == 0:
         return Tracked.fresh(np.empty((0, 4)), np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.int64))
     i, j, side, gap, angle_diff, d_prev, d_prev_cur = k.recognise_landmarks(

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1.perception.accel import Kernels, get_kernels
+from albot1.methods.albot1.perception.accel import PerceptionKernels, perception_kernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -52,7 +52,7 @@ class View:
 
     ``surfaces`` ``(m, 4)``: P1 (x1, y1) is the surface's left end, P2 its
     right end. ``kinds`` ``(m, 2)``: label of P1 and P2 (see
-    :mod:`albot1.methods.albot1.perception.landmarks`). ``beams`` ``(m, 2)``: index of the
+    :mod:`albot1.methods.albot1.perception.endpoints`). ``beams`` ``(m, 2)``: index of the
     endpoint's beam counted from the left. ``cluster`` ``(m,)``: the cluster
     each surface was cut from.
     """
@@ -71,13 +71,15 @@ class View:
         return np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
 
 
-def construct_view(ranges: FloatArray, angles: FloatArray, params: ViewParams, kernels: Kernels | None = None) -> View:
+def construct_view(
+    ranges: FloatArray, angles: FloatArray, params: ViewParams, kernels: PerceptionKernels | None = None
+) -> View:
     """``constructView`` of Algorithm 4 for a REP-103 scan (angles ascending, counter-clockwise).
 
     The thesis orders surfaces left to right, i.e. by *descending* beam
     angle, so the beams are reversed before the pass.
     """
-    k = kernels or get_kernels()
+    k = kernels or perception_kernels()
     r = np.ascontiguousarray(np.asarray(ranges, dtype=np.float64)[::-1])
     a = np.ascontiguousarray(np.asarray(angles, dtype=np.float64)[::-1])
     surfaces, kinds, beams, cluster = k.build_view(

@@ -46,6 +46,9 @@ class GtsamGraphConfig(BaseModel):
     )
 
     # Sequential edges.
+    track_scans: bool = Field(
+        description="register every scan against the local map to carry the next node's guess (else: odometry)"
+    )
     local_map_nodes: int = Field(
         ge=1, description="the last k node scans form the local map the new node is matched against"
     )
@@ -67,6 +70,15 @@ class GtsamGraphConfig(BaseModel):
         ge=0, description="failed sequential matches are retried from the guess rotated by +-1..n steps"
     )
     seq_retry_rotation_deg: float = Field(gt=0, description="rotation step of those retries (deg)")
+    seq_reversed_guess: bool = Field(
+        description="also try the odometry step with its translation reversed when the match disagrees with it"
+    )
+    seq_reversed_min_correction_m: float = Field(
+        ge=0, description="... when the match moved the odometry guess at least this far (or failed)"
+    )
+    seq_reversed_min_gain: float = Field(
+        ge=0, le=1, description="... and keep the reversed match only if its inlier fraction is this much higher"
+    )
     match_sigma_floor_xy_m: float = Field(
         gt=0, description="added to every match's std dev (x, y): matches are never perfect"
     )
@@ -147,9 +159,34 @@ class GtsamGraphConfig(BaseModel):
     final_lm: bool = Field(description="run Levenberg-Marquardt over the whole graph in finish()")
     lm_max_iterations: int = Field(ge=1, description="iteration cap of the final Levenberg-Marquardt")
 
+    # Per-scan poses (albot1.methods.baselines.gtsam_graph.refine).
+    refine_scans: bool = Field(
+        description="register every scan that is not a node against the optimised map around it in finish()"
+    )
+    refine_nodes_either_side: int = Field(
+        ge=0, description="the refinement's local map: the scan's node and this many node scans either side"
+    )
+    refine_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of the refinement")
+    refine_min_fitness: float = Field(ge=0, le=1, description="a refined pose needs this inlier fraction")
+    refine_max_rmse_m: float = Field(gt=0, description="... and this inlier RMS point-to-line distance or less")
+    refine_max_correction_m: float = Field(gt=0, description="... and may move its seed this far at most (m)")
+    refine_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most (deg)")
+
     # Map.
     map_voxel_m: float = Field(gt=0, description="grid cell for thinning the projected map points")
     map_every: int = Field(ge=1, description="project every n-th scan into the map")
+
+    def refine_icp(self) -> IcpParams:
+        """Registration parameters of the per-scan refinement (the seed is close: a narrower starting gate)."""
+        return IcpParams(
+            max_iterations=self.icp_max_iterations,
+            max_correspondence_m=self.refine_max_correspondence_m,
+            min_correspondence_m=self.icp_min_correspondence_m,
+            point_sigma_m=self.point_sigma_m,
+            cauchy_scale_m=2.0 * self.point_sigma_m,
+            prior_sigma_xy_m=self.refine_max_correction_m,
+            prior_sigma_theta_rad=math.radians(self.refine_max_correction_deg),
+        )
 
     def icp(self, loop: bool = False) -> IcpParams:
         """Registration parameters for sequential (``loop=False``) or loop matches."""

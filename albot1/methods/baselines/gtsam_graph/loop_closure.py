@@ -102,7 +102,7 @@ def verify(
     if math.hypot(corr[0], corr[1]) > tests.max_correction_m or abs(corr[2]) > tests.max_correction_rad:
         return None, "inconsistent with the current estimate"
     try:
-        cov = np.linalg.inv(reg.information + prior_information)
+        cov = np.asarray(np.linalg.inv(reg.information + prior_information), dtype=np.float64)
     except np.linalg.LinAlgError:
         return None, "singular information"
     eig = np.linalg.eigvalsh(0.5 * (cov[:2, :2] + cov[:2, :2].T))
@@ -144,4 +144,4 @@ class Confirmer:
 
     def _agree(self, a: LoopMatch, b: LoopMatch) -> bool:
         d = a.correction - b.correction
-        return math.hypot(d[0], d[1]) < self.tests.agreement_m and abs(se2.wrap(d[2])) < self.tests.agreement_rad
+        return bool(math.hypot(d[0], d[1]) < self.tests.agreement_m and abs(se2.wrap(d[2])) < self.tests.agreement_rad)

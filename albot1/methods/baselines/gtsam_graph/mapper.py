@@ -47,6 +47,7 @@ from albot1.methods.baselines.gtsam_graph.loop_closure import (
     verify,
 )
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, line_normals, register
+from albot1.methods.baselines.gtsam_graph.refine import RefineTests, accept, seed_poses
 from albot1.methods.baselines.point_map import first_per_cell
 
 FloatArray = NDArray[np.float64]
@@ -91,8 +92,20 @@ class GtsamGraphMapper:
             agreement_rad=math.radians(config.loop_agreement_deg),
         )
         self._confirmer = Confirmer(self._tests)
+        self._refine_icp = config.refine_icp()
+        self._refine_tests = RefineTests(
+            min_fitness=config.refine_min_fitness,
+            max_rmse_m=config.refine_max_rmse_m,
+            max_correction_m=config.refine_max_correction_m,
+            max_correction_rad=math.radians(config.refine_max_correction_deg),
+        )
+        # Tracking: the latest scan's pose in the frame of the newest node, and the local map it is matched against.
+        self._track = np.zeros(3)
+        self._last_odometry: FloatArray | None = None
+        self._local: Target | None = None
         # Per node.
         self._node_odometry: list[FloatArray] = []
+        self._node_steps: list[FloatArray] = []  # measured pose of node k in node k-1's frame (node 0: zeros)
         self._node_scans: list[FloatArray] = []
         self._node_lines: list[tuple[FloatArray, FloatArray]] = []  # line-like points and normals, node frame
         self._node_frame: list[int] = []
@@ -100,7 +113,7 @@ class GtsamGraphMapper:
         # Per scan.
         self._scan_node: list[int] = []
         self._scan_offset: list[FloatArray] = []
-        self._scan_points: list[FloatArray | None] = []
+        self._scan_points: list[FloatArray] = []
         # Bookkeeping.
         self._path_since_closure = 0.0
         self._consecutive_fallbacks = 0
@@ -111,11 +124,15 @@ class GtsamGraphMapper:
             "nodes": 0,
             "sequential_matches": 0,
             "sequential_retries_recovered": 0,
+            "sequential_reversed": 0,
+            "scans_tracked": 0,
+            "tracking_failures": 0,
             "odometry_fallbacks": 0,
             "loop_candidates": 0,
             "loop_coarse_searches": 0,
             "loop_closures_accepted": 0,
             "loop_closures_rejected": 0,
+            "scans_refined": 0,
         }
 
     # ------------------------------------------------------------------ input
@@ -130,25 +147,56 @@ class GtsamGraphMapper:
         points = self._preprocess(frame.scan, frame.index)
         self.counters["views"] += 1
         try:
-            if not self._node_odometry:
+            if self._last_odometry is None:
                 self._start(odometry, points, frame.index)
             else:
-                last = len(self._node_odometry) - 1
-                step = se2.between(self._node_odometry[last], odometry)
-                if math.hypot(step[0], step[1]) >= self.config.node_translation_m or abs(step[2]) >= math.radians(
-                    self.config.node_rotation_deg
-                ):
-                    self._add_node(odometry, step, points, frame.index)
+                guess = se2.compose(self._track, se2.between(self._last_odometry, odometry))
+                if self._moved_enough(guess):
+                    self._add_node(odometry, guess, points, frame.index)
+                else:
+                    self._track = self._follow(guess, points)
+                    if self._moved_enough(self._track):
+                        self._add_node(odometry, self._track, points, frame.index)
         except (
             GraphError,
             RegistrationError,
         ) as exc:  # re-raised as the method's error so the runner names the dataset
             raise BaselineError(f"gtsam-graph: scan {frame.index}: {exc}") from exc
-        node = len(self._node_odometry) - 1
-        self._scan_node.append(node)
-        self._scan_offset.append(se2.between(self._node_odometry[node], odometry))
-        keep = (frame.index % self.config.map_every) == 0
-        self._scan_points.append(points if keep else None)
+        self._last_odometry = odometry
+        self._scan_node.append(len(self._node_odometry) - 1)
+        self._scan_offset.append(self._track.copy())
+        self._scan_points.append(points)
+
+    def _moved_enough(self, relative: FloatArray) -> bool:
+        """Whether a pose relative to the newest node is far enough from it to become a node."""
+        return math.hypot(relative[0], relative[1]) >= self.config.node_translation_m or abs(
+            relative[2]
+        ) >= math.radians(self.config.node_rotation_deg)
+
+    def _local_map(self) -> Target:
+        """The last ``local_map_nodes`` node scans in the newest node's frame (built once per node)."""
+        if self._local is None:
+            last = len(self._node_odometry) - 1
+            self._local = self._target(range(max(0, last - self.config.local_map_nodes + 1), last + 1), last)
+        return self._local
+
+    def _follow(self, guess: FloatArray, points: FloatArray) -> FloatArray:
+        """Track a scan that makes no node: one ICP against the local map from ``guess``, else the guess itself.
+
+        Chaining scan-to-map matches keeps the guess of the next node's
+        sequential match within a scan period of odometry error, instead of
+        the whole node step (up to 28.6 deg of raw odometry, or a reversed
+        step on fr079, see :meth:`_try_reversed`).
+        """
+        if not self.config.track_scans:
+            return guess
+        reg = self._register(self._local_map(), points, guess, self._seq_icp)
+        if self._sequential_ok(reg, guess):
+            assert reg is not None
+            self.counters["scans_tracked"] += 1
+            return reg.pose
+        self.counters["tracking_failures"] += 1
+        return guess
 
     def _preprocess(self, scan: Scan, index: int) -> FloatArray:
         """Valid beams within the range limits, as points, thinned to one per ``scan_voxel_m`` cell."""
@@ -157,9 +205,7 @@ class GtsamGraphMapper:
             raise BaselineError(f"gtsam-graph: scan {index}: ranges must be finite or NaN (no return), found inf")
         if not np.isfinite(np.asarray(scan.angles, dtype=float)).all():
             raise BaselineError(f"gtsam-graph: scan {index}: beam angles must be finite")
-        ok = np.isfinite(ranges) & (ranges >= self.config.min_range_m) & (ranges <= self.config.max_range_m)
-        r, a = ranges[ok], scan.angles[ok]
-        pts = np.column_stack([r * np.cos(a), r * np.sin(a)])
+        pts = scan.points(self.config.min_range_m, self.config.max_range_m)
         cell = self.config.scan_voxel_m
         if cell > 0 and len(pts):
             pts = first_per_cell(pts, cell)
@@ -169,12 +215,15 @@ class GtsamGraphMapper:
     def _start(self, odometry: FloatArray, points: FloatArray, index: int) -> None:
         self._graph.add_node(np.zeros(3))
         self._graph.update()
-        self._remember_node(odometry, points, index)
+        self._remember_node(odometry, np.zeros(3), points, index)
         self._estimates = np.zeros((1, 3))
 
-    def _remember_node(self, odometry: FloatArray, points: FloatArray, index: int) -> None:
-        """Keep what later scan matching needs of a new node: its odometry, scan, line normals and frame."""
+    def _remember_node(self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int) -> None:
+        """Keep what later scan matching needs of a new node: its odometry, measured step, scan, lines, frame."""
         self._node_odometry.append(odometry)
+        self._node_steps.append(np.asarray(step, dtype=float))
+        self._track = np.zeros(3)
+        self._local = None
         self._node_scans.append(points)
         self._node_lines.append(
             line_normals(points, self.config.normal_neighbours, self.config.normal_radius_m, self.config.max_planarity)
@@ -187,7 +236,7 @@ class GtsamGraphMapper:
         relative, covariance = self._sequential_edge(prev, step, points, index)
         self._graph.add_edge(prev, key, relative, covariance)
         self._graph.update()
-        self._remember_node(odometry, points, index)
+        self._remember_node(odometry, relative, points, index)
         self._estimates = np.vstack([self._estimates, se2.compose(self._estimates[prev], relative)])
         self._refresh_estimates(range(max(0, key - self.config.local_map_nodes), key + 1))
         self._path_since_closure += math.hypot(relative[0], relative[1])
@@ -205,8 +254,7 @@ class GtsamGraphMapper:
         put the guess outside ICP's basin, and a rotated start recovers them.
         """
         cfg = self.config
-        first = max(0, prev - cfg.local_map_nodes + 1)
-        target = self._target(range(first, prev + 1), prev)
+        target = self._local_map()
         reg = self._register(target, points, step, self._seq_icp)
         good = self._sequential_ok(reg, step)
         for k in range(1, cfg.seq_retries + 1):
@@ -219,6 +267,8 @@ class GtsamGraphMapper:
                     reg, good = retry, True
             if good:
                 self.counters["sequential_retries_recovered"] += 1
+        if cfg.seq_reversed_guess:
+            reg, good = self._try_reversed(target, points, step, reg, good)
         if good:
             self.counters["sequential_matches"] += 1
             self._consecutive_fallbacks = 0
@@ -233,11 +283,40 @@ class GtsamGraphMapper:
                 else (f"converged={reg.converged}, fitness={reg.fitness:.2f}, rmse={reg.rmse_m:.3f} m")
             )
             raise BaselineError(
-                f"gtsam-graph: scan {index}: scan registration failed on {self._consecutive_fallbacks} consecutive nodes "
-                f"(last: {detail}); the front-end has lost track (limit max_consecutive_fallbacks="
+                f"gtsam-graph: scan {index}: scan registration failed on {self._consecutive_fallbacks} "
+                f"consecutive nodes (last: {detail}); the front-end has lost track (limit max_consecutive_fallbacks="
                 f"{cfg.max_consecutive_fallbacks})"
             )
         return step, self._fallback
+
+    def _try_reversed(
+        self, target: Target, points: FloatArray, step: FloatArray, reg: Registration | None, good: bool
+    ) -> tuple[Registration | None, bool]:
+        """The match from the odometry step with its translation reversed, when it explains the scan clearly better.
+
+        Some logs' odometry ignores the sign of the velocity (fr079's ODOM
+        lines report tv < 0 while x, y advance): while the robot reverses the
+        guess is then twice the step away from the truth, and ICP either fails
+        or stops half-way with a large correction. Only such matches (failed,
+        or moved at least ``seq_reversed_min_correction_m``) are retried, so a
+        correct odometry step in a corridor, where forward and backward
+        alignments can look alike, keeps its small-correction match.
+        """
+        cfg = self.config
+        if good:
+            assert reg is not None
+            corr = se2.between(step, reg.pose)
+            if math.hypot(corr[0], corr[1]) < cfg.seq_reversed_min_correction_m:
+                return reg, good
+        back = np.array([-step[0], -step[1], step[2]])
+        alt = self._register(target, points, back, self._seq_icp)
+        if not self._sequential_ok(alt, back):
+            return reg, good
+        assert alt is not None
+        if good and reg is not None and alt.fitness < reg.fitness + cfg.seq_reversed_min_gain:
+            return reg, good
+        self.counters["sequential_reversed"] += 1
+        return alt, True
 
     def _sequential_ok(self, reg: Registration | None, step: FloatArray) -> bool:
         cfg = self.config
@@ -248,12 +327,16 @@ class GtsamGraphMapper:
             cfg.seq_max_correction_deg
         )
 
-    def _target(self, nodes: range, frame_node: int) -> Target:
-        """The line-like points of ``nodes``' scans, expressed in ``frame_node``'s frame."""
-        origin = self._estimates[frame_node]
+    def _target(self, nodes: range, frame_node: int, poses: FloatArray | None = None) -> Target:
+        """The line-like points of ``nodes``' scans, expressed in ``frame_node``'s frame.
+
+        Nodes are placed with ``poses`` (default: the current estimates).
+        """
+        at = self._estimates if poses is None else poses
+        origin = at[frame_node]
         pts, nrm = [], []
         for n in nodes:
-            rel = se2.between(origin, self._estimates[n])
+            rel = se2.between(origin, at[n])
             c, s = math.cos(rel[2]), math.sin(rel[2])
             pts.append(se2.transform_points(rel, self._node_lines[n][0]))
             nrm.append(self._node_lines[n][1] @ np.array([[c, s], [-s, c]]))
@@ -339,6 +422,7 @@ class GtsamGraphMapper:
         self.counters["loop_closures_accepted"] += len(accepted)
         self._graph.update(cfg.isam_extra_updates_on_loop)
         self._estimates = self._graph.estimates()
+        self._local = None
         self._path_since_closure = 0.0
 
     def _reject(self, reason: str, count: int = 1) -> None:
@@ -372,7 +456,7 @@ class GtsamGraphMapper:
             raise BaselineError(
                 f"gtsam-graph: the optimised graph of {len(nodes)} nodes has non-finite poses (diverged)"
             )
-        poses = se2.compose(nodes[np.asarray(self._scan_node)], np.asarray(self._scan_offset))
+        poses = self._scan_poses(nodes)
         points = self._project_map(poses)
         n_nodes = len(self._node_odometry)
         counters = {
@@ -389,12 +473,39 @@ class GtsamGraphMapper:
         }
         return MapperOutput(poses=poses, map=MapData(points=points), counters=counters, extras=extras)
 
+    def _scan_poses(self, nodes: FloatArray) -> FloatArray:
+        """Every scan's pose: node scans take their node's, the others are seeded and refined (:mod:`.refine`)."""
+        scan_node = np.asarray(self._scan_node, dtype=np.int64)
+        offsets = np.asarray(self._scan_offset, dtype=float)
+        if not self.config.refine_scans:
+            return se2.compose(nodes[scan_node], offsets)
+        poses = seed_poses(nodes, np.asarray(self._node_steps), scan_node, offsets)
+        is_node = np.zeros(len(scan_node), dtype=bool)
+        is_node[np.asarray(self._node_frame, dtype=np.int64)] = True
+        poses[is_node] = nodes[scan_node[is_node]]
+        width = self.config.refine_nodes_either_side
+        target: Target | None = None
+        target_node = -1
+        for i in np.flatnonzero(~is_node):
+            k = int(scan_node[i])
+            if k != target_node:
+                around = range(max(0, k - width), min(len(nodes), k + width + 2))
+                target, target_node = self._target(around, k, nodes), k
+            assert target is not None
+            seed = se2.between(nodes[k], poses[i])
+            reg = self._register(target, self._scan_points[i], seed, self._refine_icp)
+            if reg is not None and accept(self._refine_tests, seed, reg.pose, reg.converged, reg.fitness, reg.rmse_m):
+                poses[i] = se2.compose(nodes[k], reg.pose)
+                self.counters["scans_refined"] += 1
+        return poses
+
     def _project_map(self, poses: FloatArray) -> FloatArray:
-        """Every kept scan projected with its pose; the first point in each grid cell wins (deterministic)."""
+        """Every ``map_every``-th scan projected with its pose; the first point in each grid cell wins."""
+        every = self.config.map_every
         parts = [
             se2.transform_points(poses[i], pts)
             for i, pts in enumerate(self._scan_points)
-            if pts is not None and len(pts)
+            if i % every == 0 and len(pts)
         ]
         if not parts:
             return np.empty((0, 2))

@@ -157,7 +157,7 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
     gate = params.max_correspondence_m
     converged = False
     iterations = 0
-    for iterations in range(1, params.max_iterations + 1):
+    for iterations in range(1, params.max_iterations + 1):  # noqa: B007 -- read after the loop (the count run)
         jac, res, w, _ = _linearise(target, src, pose, gate, params.cauchy_scale_m)
         if len(res) < params.min_points:
             break

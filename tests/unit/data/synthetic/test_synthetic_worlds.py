@@ -10,13 +10,19 @@ import numpy as np
 import pytest
 
 from albot1.data.errors import DatasetNotFoundError
-from albot1.data.synthetic import worlds
+from albot1.data.synthetic import layouts, worlds
 from albot1.data.synthetic.errors import SyntheticWorldError, UnknownWorldError
 from albot1.data.synthetic.route import Route, repeat_laps, sample
 from albot1.geometry import se2
 
-NAMES = ["synthetic-office-loop", "synthetic-office-startstop", "synthetic-corridor", "synthetic-office-long"]
-QUICK = NAMES[:3]
+NAMES = [
+    "synthetic-office-loop",
+    "synthetic-office-startstop",
+    "synthetic-corridor",
+    "synthetic-office-long",
+    "synthetic-office-startstop-10deg",
+]
+QUICK = [*NAMES[:3], NAMES[4]]
 
 
 def point_to_walls(points: np.ndarray, walls: np.ndarray) -> np.ndarray:
@@ -103,11 +109,34 @@ def test_office_startstop_is_about_a_hundred_views_in_metre_and_45_degree_steps(
     np.testing.assert_array_equal(data.reference[0], data.reference[-1])
 
 
+def test_office_startstop_10deg_views_are_metre_moves_and_10_degree_turns() -> None:
+    """Experiment 5's spacing: every step is a full 1 m move or 10 deg turn, or the one remainder of a leg."""
+    data = worlds.world_data("synthetic-office-startstop-10deg")
+    assert data.scans == 190
+    steps = se2.relative_steps(data.reference)
+    dist = np.hypot(steps[:, 0], steps[:, 1])
+    turn = np.abs(steps[:, 2])
+    moves = dist > 1e-12
+    assert np.all(turn[moves] < 1e-12) and np.all(dist[~moves] < 1e-12)
+    assert np.all(dist[moves] <= 1.0 + 1e-9) and np.all(turn[~moves] <= math.radians(10.0) + 1e-9)
+    # Legs are cut into whole metres plus one remainder; the route turns by multiples of 90 deg only.
+    legs = np.hypot(*np.diff(np.asarray(layouts.office_loop().waypoints), axis=0).T)
+    assert np.count_nonzero(np.abs(dist[moves] - 1.0) < 1e-9) == int(np.floor(legs + 1e-9).sum()) == 77
+    np.testing.assert_allclose(turn[~moves], math.radians(10.0), atol=1e-9)
+    np.testing.assert_array_equal(data.reference[0], data.reference[-1])
+    # Every pose of this world is a pose of the 0.1 m / 1 deg world: one route, two spacings.
+    loop = worlds.world_data("synthetic-office-loop").reference
+    nearest = np.min(np.linalg.norm(data.reference[:, None, :2] - loop[None, :, :2], axis=2), axis=1)
+    assert float(nearest.max()) < 1e-9
+
+
 def test_both_office_worlds_share_plan_and_route() -> None:
-    loop, startstop = worlds.world_data("synthetic-office-loop"), worlds.world_data("synthetic-office-startstop")
-    np.testing.assert_array_equal(loop.plan.walls, startstop.plan.walls)
-    assert loop.route_length == pytest.approx(startstop.route_length, abs=1e-9)
-    assert [c.doorway for c in loop.crossings] == [c.doorway for c in startstop.crossings]
+    loop = worlds.world_data("synthetic-office-loop")
+    for name in ("synthetic-office-startstop", "synthetic-office-startstop-10deg"):
+        startstop = worlds.world_data(name)
+        np.testing.assert_array_equal(loop.plan.walls, startstop.plan.walls)
+        assert loop.route_length == pytest.approx(startstop.route_length, abs=1e-9)
+        assert [c.doorway for c in loop.crossings] == [c.doorway for c in startstop.crossings]
 
 
 def test_corridor_shows_no_end_wall_until_it_comes_within_range() -> None:
@@ -172,7 +201,7 @@ def test_different_seeds_give_different_noise() -> None:
 
 
 def test_office_odometry_drifts_like_a_real_robot() -> None:
-    for name in ("synthetic-office-loop", "synthetic-office-startstop"):
+    for name in ("synthetic-office-loop", "synthetic-office-startstop", "synthetic-office-startstop-10deg"):
         data = worlds.world_data(name)
         gap = float(np.hypot(*(data.odometry[-1, :2] - data.reference[-1, :2])))
         assert 0.5 < gap < 5.0, name

@@ -149,7 +149,7 @@ def test_truncated_gzip_and_binary_garbage(tmp_path: Path) -> None:
     AlbotLogWriter().write(synthetic(), tmp_path / "full.albotlog.gz")
     data = (tmp_path / "full.albotlog.gz").read_bytes()
     (tmp_path / "cut.albotlog.gz").write_bytes(data[: len(data) // 2])
-    with pytest.raises(ParseError, match=r"cut.albotlog.gz:\d+: cannot decompress past line \d+"):
+    with pytest.raises(ParseError, match=r"cut.albotlog.gz:\d+: the gzip data is truncated after this line"):
         list(AlbotLogLoader().load(tmp_path / "cut.albotlog.gz").frames())
     (tmp_path / "bin.albotlog").write_bytes(b"ALBOT1-LOG 1\n\xff\xfe\x00")
     with pytest.raises(ParseError, match=r"bin.albotlog:2: not UTF-8 text"):
@@ -174,7 +174,7 @@ def test_writer_checks(tmp_path: Path) -> None:
         (tmp_path / "x.albotlog").write_text("")
         AlbotLogWriter().write(synthetic(2), tmp_path / "x.albotlog")
     frame = Frame(0, Scan(np.array([1.0, -0.5]), np.array([0.0, 0.1]), 0.0, 10.0), np.zeros(3))
-    with pytest.raises(DataError, match=r"scan #0: ranges must lie in \[0, max_range=10.0\]"):
+    with pytest.raises(DataError, match=r"scan #0: VIEW range 2 is -0.5, expected ranges in \[0, max_range=10.0\]"):
         AlbotLogWriter().write(Sequence.from_frames("neg", [frame]), tmp_path / "neg.albotlog")
     assert not (tmp_path / "neg.albotlog").exists()
     with pytest.raises(DataError, match="takes no loading options"):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from albot1.data.loaders.carmen.bz2_parallel import BLOCK_MAGIC, _block_streams, find_bit_pattern, iter_bz2_parallel
+from albot1.data.loaders.compressed import DamagedStream
 
 
 def sample(seed: int = 3) -> bytes:
@@ -39,5 +40,5 @@ def test_corrupt_block_falls_back_to_the_sequential_error(tmp_path: Path) -> Non
     data[len(data) * 3 // 4] ^= 0x55
     path = tmp_path / "c.bz2"
     path.write_bytes(bytes(data))
-    with pytest.raises(OSError):
+    with pytest.raises(DamagedStream, match="corrupt"):
         b"".join(iter_bz2_parallel(path, workers=2))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import bz2
 import gzip
+import zlib
 from pathlib import Path
 
 import pytest
@@ -58,23 +59,47 @@ def test_empty_file(tmp_path: Path) -> None:
         run(tmp_path, "", "empty.clf")
 
 
-def test_comments_only_means_no_scans(tmp_path: Path) -> None:
-    with pytest.raises(ParseError, match=r"c\.clf:1: no scans in the first 2 MiB"):
+def test_no_scans_only_odometry(tmp_path: Path) -> None:
+    with pytest.raises(ParseError, match=r"c\.clf:1: no front-laser scans in the first 2 MiB"):
         run(tmp_path, "# nothing\n# here\nODOM 0 0 0 0 0 0 1 host 1\n", "c.clf")
 
 
-def test_truncated_gzip(tmp_path: Path) -> None:
-    data = gzip.compress(("\n".join(GOOD.format(t=k) for k in range(2000)) + "\n").encode())
-    with pytest.raises(ParseError, match=r"t\.clf\.gz:\d+: the gzip data is truncated or corrupt"):
-        run(tmp_path, data[: len(data) // 2], "t.clf.gz")
+def test_comments_only_says_so(tmp_path: Path) -> None:
+    with pytest.raises(ParseError, match=r"c\.clf:3: the log holds only comments and blank lines \(3 lines\)"):
+        run(tmp_path, "# nothing\n\n# here\n", "c.clf")
+
+
+def test_truncated_gzip_names_the_last_complete_line(tmp_path: Path) -> None:
+    text = "\n".join(GOOD.format(t=k) for k in range(2000)) + "\n"
+    data = gzip.compress(text.encode())
+    cut = data[: len(data) // 2]
+    # what zlib can decode from the cut stream: its complete lines are the ones the error must name
+    decoded = zlib.decompressobj(wbits=31).decompress(cut)
+    last = decoded.count(b"\n")
+    assert last > 100
+    with pytest.raises(ParseError, match=rf"t\.clf\.gz:{last}: the gzip data is truncated after this line"):
+        run(tmp_path, cut, "t.clf.gz")
 
 
 @pytest.mark.parametrize("parallel", [True, False])
-def test_truncated_bzip2(tmp_path: Path, parallel: bool) -> None:
+def test_truncated_single_block_bzip2(tmp_path: Path, parallel: bool) -> None:
     data = bz2.compress(("\n".join(GOOD.format(t=k) for k in range(2000)) + "\n").encode())
     path = tmp_path / "t.clf.bz2"
     path.write_bytes(data[: len(data) // 2])
-    with pytest.raises(ParseError, match=r"t\.clf\.bz2:\d+: the bzip2 data is truncated or corrupt"):
+    message = rf"t\.clf\.bz2: the bzip2 data is truncated before its first line .*ends at byte {len(data) // 2} "
+    with pytest.raises(ParseError, match=message):
+        for _ in CarmenLoader().load(path, parallel_bz2=parallel).frames():
+            pass
+
+
+@pytest.mark.parametrize("parallel", [True, False])
+def test_truncated_multi_block_bzip2_names_the_last_good_line(tmp_path: Path, parallel: bool) -> None:
+    first = ("\n".join(GOOD.format(t=k) for k in range(3000)) + "\n").encode()
+    second = ("\n".join(GOOD.format(t=3000 + k) for k in range(3000)) + "\n").encode()
+    data = bz2.compress(first) + bz2.compress(second)  # two streams, as pbzip2 writes
+    path = tmp_path / "m.clf.bz2"
+    path.write_bytes(data[: len(data) - 200])
+    with pytest.raises(ParseError, match=r"m\.clf\.bz2:3000: the bzip2 data is truncated after this line"):
         for _ in CarmenLoader().load(path, parallel_bz2=parallel).frames():
             pass
 
@@ -82,5 +107,5 @@ def test_truncated_bzip2(tmp_path: Path, parallel: bool) -> None:
 def test_corrupt_bzip2(tmp_path: Path) -> None:
     data = bytearray(bz2.compress(("\n".join(GOOD.format(t=k) for k in range(2000)) + "\n").encode()))
     data[len(data) // 2] ^= 0xFF
-    with pytest.raises(ParseError, match=r"c\.clf\.bz2:\d+: the bzip2 data is truncated or corrupt"):
+    with pytest.raises(ParseError, match=r"c\.clf\.bz2: the bzip2 data is corrupt before its first line .* rejects"):
         run(tmp_path, bytes(data), "c.clf.bz2")

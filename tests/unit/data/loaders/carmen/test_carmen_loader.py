@@ -287,4 +287,4 @@ def test_small_chunks_give_the_same_frames(
     chunked = CarmenLoader().load(path, odometry=odometry, reference=reference)
     np.testing.assert_array_equal(chunked.odometry, expected_odom)
     np.testing.assert_array_equal(chunked.reference, expected_ref)
-    assert len(chunked) == 300
+    assert chunked.count_scans() == 300

@@ -9,9 +9,10 @@ import pytest
 
 from albot1.data.synthetic.lidar import cast
 from albot1.geometry import se2
+from albot1.methods.albot1.perception.accel import perception_kernels
 from albot1.methods.albot1.perception.frames import rep_to_thesis_pose
 from albot1.methods.albot1.perception.landmarks import CORNER, OCCLUDING, UNSTABLE, find_landmarks
-from albot1.methods.albot1.perception.recognition import Tracked, motion_step, predict, recognise, thesis_motion
+from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise, thesis_motion
 from albot1.methods.albot1.perception.view import ViewParams, construct_view
 
 ANGLES = np.radians(np.arange(-90.0, 91.0, 0.5))
@@ -57,13 +58,25 @@ def test_eqs_3_1_3_2_place_the_robot_along_its_turned_heading() -> None:
     )
 
 
-def test_eqs_3_3_3_4_equal_the_inverse_rigid_motion() -> None:
+@pytest.mark.parametrize("accelerate", [True, False])
+def test_eqs_3_3_3_4_in_the_kernel_equal_the_inverse_rigid_motion(accelerate: bool) -> None:
+    # The kernel predicts the previous surface into the current view (eqs 3.3-3.4); a current
+    # surface placed exactly where the inverse rigid motion puts it is matched with zero gap,
+    # and its predicted endpoint's distance from the robot is reported.
     step = (0.4, 1.2, math.radians(25.0))
     seg = np.array([[1.0, 2.0, -0.5, 3.0]])
-    got = predict(seg, step)
-    inv = se2.inverse(np.array(step))
-    want = se2.transform_points(inv, seg.reshape(2, 2)).reshape(1, 4)
-    np.testing.assert_allclose(got, want, atol=1e-12)
+    want = se2.transform_points(se2.inverse(np.array(step)), seg.reshape(2, 2)).reshape(1, 4)
+    kinds = np.array([[OCCLUDING, CORNER]])
+    kernel = perception_kernels(accelerate).recognise_landmarks
+    i, j, side, gap, angle_diff, d_prev, d_pred = kernel(seg, kinds, want, kinds, *step, MAX_ANGLE, MAX_DISTANCE, True)
+    assert (i.tolist(), j.tolist(), side.tolist()) == ([0], [0], [0])
+    assert gap[0] == pytest.approx(0.0, abs=1e-12) and angle_diff[0] == pytest.approx(0.0, abs=1e-12)
+    assert d_prev[0] == pytest.approx(math.hypot(1.0, 2.0))
+    assert d_pred[0] == pytest.approx(math.hypot(want[0, 0], want[0, 1]))
+    # Moved by 0.3 m along x in the current view: the gap is that shift.
+    shifted = want + [0.3, 0.0, 0.3, 0.0]
+    gap_shifted = kernel(seg, kinds, shifted, kinds, *step, MAX_ANGLE, MAX_DISTANCE, True)[3]
+    assert gap_shifted[0] == pytest.approx(0.3)
 
 
 @pytest.mark.parametrize("motion", [(0.25, 0.0, 3.0), (0.3, 0.05, -4.0), (0.0, 0.0, 0.0), (0.0, 0.0, 2.5)])

@@ -1,0 +1,100 @@
+"""A method's effective config: model defaults < preset < environment < explicit overrides.
+
+The order is the one a user expects from the most general to the most
+specific statement: the model says what a field means (and may carry a
+plain default), the preset file says what the method runs with, an
+environment variable changes it for a whole shell session or job, and
+``--set FIELD=VALUE`` (or a benchmark suite's ``set``) for one run.
+
+Besides the validated config, :func:`resolve` says where each field's value
+came from, so a result can be traced to the file, variable or flag that set
+it, and an invalid value's message names its origin.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any, Generic, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from albot1.config.env import env_values
+from albot1.config.validation import describe_errors
+from albot1.errors import ConfigError
+
+ModelT = TypeVar("ModelT", bound=BaseModel)
+
+#: Origin of a value that only the config model sets (a preset given as a partial dict).
+FROM_MODEL = "model default"
+#: Origin of an explicit override (``--set`` or a suite's ``set``).
+FROM_OVERRIDE = "--set"
+
+
+@dataclass(frozen=True)
+class ResolvedConfig(Generic[ModelT]):
+    """The validated config and, per field, where its value came from.
+
+    ``sources`` values: ``"model default"``, ``"preset NAME"`` (the preset's
+    own value), ``"preset default"`` (inherited from the default preset),
+    ``"env VARIABLE"`` or ``"--set"``.
+    """
+
+    config: ModelT
+    sources: dict[str, str]
+
+
+def preset_sources(presets: Mapping[str, Mapping[str, Any]], preset: str, fields: Iterable[str]) -> dict[str, str]:
+    """Where each field of ``presets[preset]`` comes from: the preset itself, ``default``, or the model.
+
+    A preset "sets" a field when its value differs from the ``default``
+    preset's (TOML presets are stored merged onto ``default``, so presence
+    alone would say nothing).
+    """
+    chosen = presets[preset]
+    default = presets.get("default", {})
+    out = {}
+    for name in fields:
+        if name in chosen and (preset == "default" or name not in default or chosen[name] != default[name]):
+            out[name] = f"preset {preset}"
+        elif name in default:
+            out[name] = "preset default"
+        else:
+            out[name] = FROM_MODEL
+    return out
+
+
+def resolve(
+    model: type[ModelT],
+    presets: Mapping[str, Mapping[str, Any]],
+    preset: str,
+    *,
+    env_prefix: str,
+    other_prefixes: Iterable[str] = (),
+    overrides: Mapping[str, Any] | None = None,
+    owner: str = "",
+) -> ResolvedConfig[ModelT]:
+    """Validate ``model`` from ``presets[preset]``, the environment and ``overrides`` (highest last).
+
+    ``owner`` names the method in messages. Raises ConfigError for an
+    unknown preset, an environment variable that names no field, or a value
+    the model rejects (the message names the field and where its value came from).
+    """
+    label = owner or model.__name__
+    if preset not in presets:
+        raise ConfigError(f"method {label!r} has no preset {preset!r}; expected one of: {', '.join(presets)}")
+    sources = preset_sources(presets, preset, model.model_fields)
+    values: dict[str, Any] = dict(presets[preset])
+    for name, (variable, value) in env_values(model, env_prefix, other_prefixes=other_prefixes, owner=label).items():
+        values[name] = value
+        sources[name] = f"env {variable}"
+    for name, value in (overrides or {}).items():
+        values[name] = value
+        sources[name] = FROM_OVERRIDE
+    try:
+        config = model.model_validate(values)
+    except ValidationError as exc:
+        raise ConfigError(
+            f"invalid config for method {label!r} (preset {preset!r}): {describe_errors(exc, sources)}"
+        ) from None
+    return ResolvedConfig(config, {name: sources[name] for name in model.model_fields})

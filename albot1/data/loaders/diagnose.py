@@ -1,0 +1,76 @@
+"""Why no loader recognises a file: one specific sentence instead of "not a recognised log".
+
+Reached only after every loader's ``sniff`` said no, so it may read the
+whole file: an empty file, a file of comments only, a folder, damaged
+compressed data (truncated or corrupt ``.gz``/``.bz2``, with the byte offset
+and the last complete line), binary data, or the first line that starts no
+known format, shown as found.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from albot1.data.errors import DataError, ParseError, UnknownFormatError
+from albot1.data.loaders.compressed import DamagedStream, compression_of, iter_lines, read_head
+
+EXPECTED = (
+    "expected a CARMEN log (messages such as FLASER, ROBOTLASER1, ODOM, PARAM; .clf/.log, optionally .gz/.bz2), "
+    "an albot log (first line 'ALBOT1-LOG 1'), a ROS1 bag ('#ROSBAG V2.0') or a ROS2 bag folder "
+    "(metadata.yaml beside .db3/.mcap files)"
+)
+#: Decompressed lines looked at before giving up on finding a first message (the rest is not needed to
+#: describe the file, except when it is damaged, which only a full pass can show).
+_MAX_LINES = 1_000_000
+_SHOWN = 40
+
+
+def _shown(line: bytes) -> str:
+    return repr(line.strip()[:_SHOWN].decode("utf-8", "replace"))
+
+
+def _is_binary(line: bytes) -> bool:
+    sample = line[:256]
+    return b"\0" in sample or sum(b < 9 or 13 < b < 32 for b in sample) > len(sample) // 10
+
+
+def unrecognised(path: Path) -> DataError:
+    """The error for a path that no loader sniffed as its format."""
+    if path.is_dir():
+        return UnknownFormatError(f"{path}: a folder without metadata.yaml, not a ROS2 bag; {EXPECTED}")
+    if path.stat().st_size == 0:
+        return UnknownFormatError(f"{path}: the file is empty (0 bytes); {EXPECTED}")
+    compression = compression_of(path)
+    packed = "" if compression == "none" else f"{compression}-compressed "
+    head = read_head(path)
+    if _is_binary(head):
+        return UnknownFormatError(f"{path}: binary {packed}data of no known format (starts {head[:16]!r}); {EXPECTED}")
+    count = 0
+    first: tuple[int, bytes] | None = None
+    try:
+        for count, line in enumerate(iter_lines(path), start=1):
+            stripped = line.strip()
+            if first is None and stripped and not stripped.startswith(b"#"):
+                first = (count, line)
+                if compression == "none":
+                    break  # plain data cannot be damaged: the first line says it all
+            if count >= _MAX_LINES and first is not None:
+                break
+    except DamagedStream as damage:
+        if count == 0:
+            return ParseError(path, damage.describe(" before its first line could be decompressed"))
+        return ParseError(path, damage.describe(" after this line (the last complete one)"), line=count)
+    except OSError as exc:
+        return DataError(f"{path}: cannot be read ({exc.strerror or exc})")
+    if first is None:
+        if count == 0:
+            return UnknownFormatError(f"{path}: the {packed}file holds no data (0 bytes decompressed); {EXPECTED}")
+        return UnknownFormatError(
+            f"{path}: the {packed}file holds only comments and blank lines ({count} lines); {EXPECTED}"
+        )
+    line_no, line = first
+    return ParseError(
+        path,
+        f"the first line that is not a comment is {_shown(line)}, which begins no known format; {EXPECTED}",
+        line=line_no,
+    )

@@ -1,0 +1,1 @@
+"""MRPT rawlog files (write only): the input of MRPT's SLAM applications."""

@@ -1,0 +1,134 @@
+"""The dataset manifest: the types of ``datasets/<name>.toml`` and their parser.
+
+A manifest says where a dataset's files live relative to a data root
+(``radish/intel.clf.bz2``), where they can be downloaded (raw GitHub URLs at
+pinned commits, so the bytes never change), their sha256, licence and
+citation, and how to load them (odometry source, max range, reference
+poses, relations file). The schema is documented in ``datasets/README.md``.
+
+The types live apart from the registry (:mod:`albot1.data.catalog`) and the
+downloader (:mod:`albot1.data.fetch`) because both use them and neither
+should import the other.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from albot1.data.errors import DataError
+
+#: The roles a file of a dataset may have.
+ROLES = ("log", "relations")
+
+
+@dataclass(frozen=True)
+class DataFile:
+    """One file of a dataset: where it sits under a data root, where to get it, its checksum."""
+
+    role: str
+    path: str
+    sha256: str
+    size: int | None = None
+    urls: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class DatasetManifest:
+    """A parsed ``datasets/<name>.toml``."""
+
+    name: str
+    description: str
+    format: str
+    files: tuple[DataFile, ...]
+    license: str = ""
+    citation: str = ""
+    source: str = ""
+    local_only: bool = False
+    reference: str = ""
+    notes: str = ""
+    loader: dict[str, Any] = field(default_factory=dict)
+    manifest_path: Path | None = None
+
+    def file(self, role: str) -> DataFile | None:
+        """The first file with ``role`` (``"log"`` or ``"relations"``)."""
+        return next((f for f in self.files if f.role == role), None)
+
+    @property
+    def log(self) -> DataFile:
+        found = self.file("log")
+        assert found is not None  # parse_manifest guarantees one log file
+        return found
+
+
+#: TOML's names of the Python types a manifest value may have (for error messages).
+_TOML_TYPES = {str: "string", int: "integer", bool: "boolean", list: "array", dict: "table"}
+
+
+def _require(data: dict[str, Any], key: str, kind: type, where: Path) -> Any:
+    value = data.get(key)
+    if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
+        found = "nothing" if key not in data else f"a {_TOML_TYPES.get(type(value), type(value).__name__)}"
+        raise DataError(f"{where}: key {key!r} must be a {_TOML_TYPES[kind]}, found {found} (see datasets/README.md)")
+    return value
+
+
+def _optional(data: dict[str, Any], key: str, kind: type, where: Path, default: Any) -> Any:
+    """``data[key]`` checked against ``kind`` when present, else ``default``."""
+    return _require(data, key, kind, where) if key in data else default
+
+
+def _strings(data: dict[str, Any], key: str, where: Path) -> tuple[str, ...]:
+    values = _optional(data, key, list, where, [])
+    if not all(isinstance(v, str) for v in values):
+        raise DataError(f"{where}: key {key!r} must be a list of strings (see datasets/README.md)")
+    return tuple(values)
+
+
+def parse_manifest(path: Path) -> DatasetManifest:
+    """Read and check one manifest; DataError naming the file (and file entry) on bad input."""
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise DataError(f"{path}: not a readable TOML manifest ({exc})") from None
+    name = _require(data, "name", str, path)
+    if name != path.stem:
+        raise DataError(f"{path}: name {name!r} must equal the file name {path.stem!r}")
+    files = []
+    for i, entry in enumerate(_require(data, "files", list, path)):
+        where = Path(f"{path} files[{i}]")
+        if not isinstance(entry, dict):
+            raise DataError(f"{where}: expected a [[files]] table, got {type(entry).__name__}")
+        role = _require(entry, "role", str, where)
+        if role not in ROLES:
+            raise DataError(f"{where}: role {role!r}; expected one of {', '.join(ROLES)}")
+        sha = _require(entry, "sha256", str, where).lower()
+        if len(sha) != 64 or any(c not in "0123456789abcdef" for c in sha):
+            raise DataError(f"{where}: sha256 must be 64 hex digits")
+        files.append(
+            DataFile(
+                role=role,
+                path=_require(entry, "path", str, where),
+                sha256=sha,
+                size=_optional(entry, "size", int, where, None),
+                urls=_strings(entry, "urls", where),
+            )
+        )
+    if sum(f.role == "log" for f in files) != 1:
+        raise DataError(f'{path}: expected exactly one file with role = "log"')
+    return DatasetManifest(
+        name=name,
+        description=_optional(data, "description", str, path, ""),
+        format=_optional(data, "format", str, path, "carmen"),
+        files=tuple(files),
+        license=_optional(data, "license", str, path, ""),
+        citation=_optional(data, "citation", str, path, ""),
+        source=_optional(data, "source", str, path, ""),
+        local_only=_optional(data, "local_only", bool, path, False),
+        reference=_optional(data, "reference", str, path, ""),
+        notes=_optional(data, "notes", str, path, ""),
+        loader=dict(_optional(data, "loader", dict, path, {})),
+        manifest_path=path,
+    )

@@ -1,0 +1,158 @@
+"""The per-scan loops of Albot1's map update and of the perceptual map's grid index.
+
+Plain Python over numpy arrays and scalars in the subset numba compiles;
+:mod:`albot1.methods.albot1.mapping.accel` hands out either the jitted or the
+interpreted version of the same source (tests run both on the same inputs).
+Segment geometry comes from :mod:`albot1.geometry.segments`, compiled
+together with these loops.
+
+Distances use ``np.hypot``, not ``math.hypot``: numba compiles both to C's
+``hypot``, while CPython's ``math.hypot`` is its own, more accurate routine
+that differs in the last bit for about 0.6 % of inputs, which would make the
+interpreted kernels disagree with the compiled ones.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.geometry.segments import closest_parameter, segment_distance
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+
+def classify_endpoints(
+    poly: FloatArray, view: FloatArray, pts: FloatArray, margin: float, surfaces_only: bool
+) -> BoolArray:
+    """For each point: inside the closed polygon (even-odd) or within ``margin`` of it.
+
+    ``poly`` is ``(v, 2)`` (implicitly closed); the view polygon is
+    star-shaped around the robot, so even-odd is its exact interior. With
+    ``surfaces_only`` the margin is measured from the view's surfaces
+    (``view`` ``(m, 4)``), perpendicular to each and within its extent, not
+    from the polygon's sides through unperceived space (field-of-view edges,
+    gaps); otherwise from every polygon edge.
+    """
+    v = poly.shape[0]
+    out = np.zeros(pts.shape[0], dtype=np.bool_)
+    m2 = margin * margin
+    for k in range(pts.shape[0]):
+        x = pts[k, 0]
+        y = pts[k, 1]
+        inside = False
+        near = False
+        for e in range(v):
+            ax = poly[e, 0]
+            ay = poly[e, 1]
+            bx = poly[(e + 1) % v, 0]
+            by = poly[(e + 1) % v, 1]
+            if (ay > y) != (by > y):
+                xc = ax + (y - ay) * (bx - ax) / (by - ay)
+                if x < xc:
+                    inside = not inside
+            if not near and not surfaces_only:
+                t = closest_parameter(x, y, ax, ay, bx, by)
+                dx = ax + t * (bx - ax) - x
+                dy = ay + t * (by - ay) - y
+                if dx * dx + dy * dy < m2:
+                    near = True
+        if surfaces_only and not inside:
+            for j in range(view.shape[0]):
+                ex = view[j, 2] - view[j, 0]
+                ey = view[j, 3] - view[j, 1]
+                l2 = ex * ex + ey * ey
+                if l2 <= 0.0:
+                    continue
+                t = ((x - view[j, 0]) * ex + (y - view[j, 1]) * ey) / l2
+                if t < 0.0 or t > 1.0:
+                    continue
+                dx = view[j, 0] + t * ex - x
+                dy = view[j, 1] + t * ey - y
+                if dx * dx + dy * dy < m2:
+                    near = True
+                    break
+        out[k] = inside or near
+    return out
+
+
+def best_correspondence(
+    seg: FloatArray, view: FloatArray, taken: BoolArray, max_angle: float, max_distance: float
+) -> int:
+    """Index of the free view surface closest to ``seg`` (segment distance) among those parallel
+    to it within ``max_angle`` (undirected) and nearer than ``max_distance``; -1 if none."""
+    best = -1
+    best_d = max_distance
+    a0 = math.atan2(seg[3] - seg[1], seg[2] - seg[0])
+    for j in range(view.shape[0]):
+        if taken[j]:
+            continue
+        da = math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0]) - a0
+        da = abs((da + 0.5 * math.pi) % math.pi - 0.5 * math.pi)
+        if da >= max_angle:
+            continue
+        d = segment_distance(seg, view[j])
+        if d < best_d:
+            best = j
+            best_d = d
+    return best
+
+
+def clip_parameter(
+    poly: FloatArray, view: FloatArray, x0: float, y0: float, x1: float, y1: float, margin: float, surfaces_only: bool
+) -> float:
+    """Fraction ``t`` along (x0, y0)->(x1, y1) where the segment first enters the covered region.
+
+    (x0, y0) is outside, (x1, y1) covered (:func:`classify_endpoints`);
+    bisection on that predicate (the grown region has no closed form without
+    a buffer operation), to 1e-4 of the segment.
+    """
+    lo = 0.0
+    hi = 1.0
+    probe = np.empty((1, 2))
+    for _ in range(14):
+        mid = 0.5 * (lo + hi)
+        probe[0, 0] = x0 + mid * (x1 - x0)
+        probe[0, 1] = y0 + mid * (y1 - y0)
+        if classify_endpoints(poly, view, probe, margin, surfaces_only)[0]:
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+def segment_cells(segs: FloatArray, inv_cell: float) -> tuple[IntArray, IntArray, IntArray]:
+    """Grid cells each segment passes through: ``(row, i, j)`` arrays, rows ascending.
+
+    Samples every half cell along the segment (so every cell it crosses by
+    more than a corner is hit; queries pad by one cell) and drops repeats;
+    along a straight segment the cells visited are contiguous, so comparing
+    with the previous sample suffices.
+    """
+    total = 0
+    m = segs.shape[0]
+    counts = np.empty(m, dtype=np.int64)
+    for r in range(m):
+        counts[r] = int(np.hypot(segs[r, 2] - segs[r, 0], segs[r, 3] - segs[r, 1]) * 2.0 * inv_cell) + 2
+        total += counts[r]
+    rows = np.empty(total, dtype=np.int64)
+    ci = np.empty(total, dtype=np.int64)
+    cj = np.empty(total, dtype=np.int64)
+    k = 0
+    for r in range(m):
+        n = counts[r]
+        for q in range(n):
+            t = q / (n - 1)
+            i = math.floor((segs[r, 0] + t * (segs[r, 2] - segs[r, 0])) * inv_cell)
+            j = math.floor((segs[r, 1] + t * (segs[r, 3] - segs[r, 1])) * inv_cell)
+            if q > 0 and ci[k - 1] == i and cj[k - 1] == j:
+                continue
+            rows[k] = r
+            ci[k] = i
+            cj[k] = j
+            k += 1
+    return rows[:k], ci[:k], cj[:k]

@@ -1,0 +1,85 @@
+"""`albot1 methods [--presets] [METHOD] [--json]`."""
+
+from __future__ import annotations
+
+import json
+
+from typer.testing import CliRunner
+
+from albot1.cli.app import app
+from albot1.methods.registry import METHODS
+
+runner = CliRunner()
+
+
+def test_plain_listing_is_one_line_per_method() -> None:
+    result = runner.invoke(app, ["methods"])
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert [line.split()[0] for line in lines] == list(METHODS)
+    assert lines[1].startswith("albot1       available    the Albot1 perceptual mapper")
+
+
+def test_presets_table_of_one_method() -> None:
+    result = runner.invoke(app, ["methods", "--presets", "albot1"])
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert lines[0] == "albot1: the Albot1 perceptual mapper (thesis chapter 3)"
+    assert "environment prefix ALBOT1_ALBOT1_" in lines[1]
+    assert lines[2].startswith("  presets file ") and lines[2].endswith("albot1/methods/albot1/presets.toml")
+    header = next(line for line in lines if line.lstrip().startswith("field"))
+    assert header.split() == ["field", "unit", "type", "default", "meaning"]
+    row = next(line for line in lines if line.strip().startswith("corner_min_angle_deg"))
+    assert row.split()[:4] == ["corner_min_angle_deg", "deg", "float", "30.0"]
+    row = next(line for line in lines if line.strip().startswith("motion_model"))
+    assert row.split()[:4] == ["motion_model", "-", "thesis|exact", "thesis"]
+    row = next(line for line in lines if line.strip().startswith("accelerate"))
+    assert row.split()[:4] == ["accelerate", "-", "bool", "true"]
+    tail = lines[lines.index("  presets (fields that differ from default):") + 1 :]
+    assert tail == [
+        "    default  the default column above",
+        "    thesis   (same as default)",
+        "    exact    motion_model = exact",
+        "    literal  continuation_tolerance_m = 0.0 m, delete_margin_from = boundary",
+    ]
+
+
+def test_presets_json_of_every_method() -> None:
+    result = runner.invoke(app, ["methods", "--presets", "--json"])
+    assert result.exit_code == 0, result.output
+    records = {record["name"]: record for record in json.loads(result.output)["methods"]}
+    assert list(records) == list(METHODS)
+    albot1 = records["albot1"]
+    assert albot1["config_model"] == "albot1.methods.albot1.mapping.config.Albot1Config"
+    assert albot1["presets"] == {
+        "default": {},
+        "thesis": {},
+        "exact": {"motion_model": "exact"},
+        "literal": {"continuation_tolerance_m": 0.0, "delete_margin_from": "boundary"},
+    }
+    field = next(f for f in albot1["fields"] if f["name"] == "delete_margin_m")
+    assert field["unit"] == "m" and field["default"] == 0.4 and field["type"] == "float"
+    assert field["description"].startswith("Algorithm 3 line 9")
+    odometry = records["odometry"]
+    assert odometry["presets_file"].endswith("baselines/odometry.toml")
+    assert odometry["presets"]["sparse-map"] == {"map_every": 10}
+    assert [f["name"] for f in odometry["fields"]] == ["map_voxel_m", "map_every"]
+
+
+def test_json_without_presets_has_no_fields() -> None:
+    result = runner.invoke(app, ["methods", "--json"])
+    assert result.exit_code == 0, result.output
+    record = json.loads(result.output)["methods"][0]
+    assert record == {
+        "name": "odometry",
+        "available": True,
+        "requires": [],
+        "description": METHODS["odometry"].description,
+        "env_prefix": "ALBOT1_ODOMETRY_",
+    }
+
+
+def test_unknown_method_is_a_config_error() -> None:
+    result = runner.invoke(app, ["methods", "nope"])
+    assert result.exit_code != 0
+    assert "unknown method 'nope'" in str(result.exception)

@@ -1,0 +1,50 @@
+"""The manifest parser: each kind of bad input is one DataError naming the file, the entry and the key."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from albot1.data.errors import DataError
+from albot1.data.manifest import parse_manifest
+
+SHA = "ab" * 32
+GOOD = f'name = "lab"\nformat = "carmen"\n\n[[files]]\nrole = "log"\npath = "mine/lab.clf"\nsha256 = "{SHA}"\n'
+
+
+def write(tmp_path: Path, text: str, name: str = "lab") -> Path:
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_minimal_manifest_gets_the_documented_defaults(tmp_path: Path) -> None:
+    path = write(tmp_path, GOOD)
+    manifest = parse_manifest(path)
+    assert (manifest.name, manifest.format, manifest.local_only, manifest.loader) == ("lab", "carmen", False, {})
+    assert manifest.log.path == "mine/lab.clf" and manifest.log.urls == () and manifest.log.size is None
+    assert manifest.file("relations") is None and manifest.manifest_path == path
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("name = [", r"lab.toml: not a readable TOML manifest"),
+        ('name = "other"\nfiles = []', r"lab.toml: name 'other' must equal the file name 'lab'"),
+        ('name = "lab"', r"lab.toml: key 'files' must be a array, found nothing"),
+        ('name = "lab"\nfiles = [1]', r"lab.toml files\[0\]: expected a \[\[files\]\] table, got int"),
+        ('name = "lab"\nfiles = []', r'lab.toml: expected exactly one file with role = "log"'),
+        (GOOD.replace('role = "log"', 'role = "map"'), r"files\[0\]: role 'map'; expected one of log, relations"),
+        (GOOD.replace(SHA, "xyz"), r"files\[0\]: sha256 must be 64 hex digits"),
+        (GOOD + 'urls = "https://x"\n', r"files\[0\]: key 'urls' must be a array, found a string"),
+        (GOOD + "urls = [1]\n", r"files\[0\]: key 'urls' must be a list of strings"),
+        (GOOD + "size = true\n", r"files\[0\]: key 'size' must be a integer, found a boolean"),
+        ('local_only = "yes"\n' + GOOD, r"lab.toml: key 'local_only' must be a boolean, found a string"),
+        ('loader = "carmen"\n' + GOOD, r"lab.toml: key 'loader' must be a table, found a string"),
+        ("description = 3\n" + GOOD, r"lab.toml: key 'description' must be a string, found a integer"),
+    ],
+)
+def test_bad_manifests_name_file_entry_and_key(tmp_path: Path, text: str, message: str) -> None:
+    with pytest.raises(DataError, match=message):
+        parse_manifest(write(tmp_path, text))

@@ -1,0 +1,88 @@
+"""Albot1's presets, read from albot1/methods/albot1/presets.toml, are exactly the values of before.
+
+The expected values below are a literal copy of what the presets resolved to
+when they were a dict in the mapping config module (every field of the model
+at its default, plus each preset's changes): the move to a TOML file must not
+change a single number, type or string.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import pytest
+
+from albot1.methods.albot1.mapping.config import Albot1Config
+from albot1.methods.albot1.mapping.mapper import Albot1Mapper
+from albot1.methods.registry import resolve_config
+
+#: Albot1Config() before the move, field by field.
+OLD_DEFAULT: dict[str, Any] = {
+    "max_range_m": 30.0,
+    "cluster_gap_m": 0.6,
+    "cluster_size_m": 0.2,
+    "break_point_height_m": 0.1,
+    "surface_length_m": 0.1,
+    "landmark_min_length_m": 0.4,
+    "corner_min_angle_deg": 30.0,
+    "occlusion_margin_m": 0.0,
+    "continuation_tolerance_m": 0.1,
+    "motion_model": "thesis",
+    "recognition_angle_deg": 5.0,
+    "recognition_distance_m": 0.4,
+    "recognition_matching": "greedy",
+    "min_landmarks": 3,
+    "pose_between_updates": "localise",
+    "outlier_min_candidates": 3,
+    "goodness_gap_floor_m": 0.01,
+    "goodness_angle_floor_deg": 0.1,
+    "goodness_distance_view": "previous",
+    "update_polygon": "robot_and_endpoints",
+    "delete_margin_m": 0.4,
+    "delete_margin_from": "surfaces",
+    "correspond_angle_deg": 5.0,
+    "correspond_distance_m": 0.4,
+    "partial_without_match": "clip",
+    "odometry_jump_m": 5.0,
+    "stationary_m": 1e-06,
+    "stationary_deg": 1e-06,
+    "map_grid_cell_m": 2.0,
+    "accelerate": True,
+}
+
+#: The old ``PRESETS`` dict: each preset's changes relative to the model defaults.
+OLD_PRESETS: dict[str, dict[str, Any]] = {
+    "default": {},
+    "thesis": {},
+    "exact": {"motion_model": "exact"},
+    "literal": {"delete_margin_from": "boundary", "continuation_tolerance_m": 0.0},
+}
+
+
+def _typed(values: dict[str, Any]) -> dict[str, tuple[type, Any]]:
+    """Values with their types, so 3 and 3.0 (or True and 1) do not compare equal."""
+    return {name: (type(value), value) for name, value in values.items()}
+
+
+def test_the_model_defaults_are_unchanged() -> None:
+    assert _typed(Albot1Config().model_dump()) == _typed(OLD_DEFAULT)
+
+
+def test_the_same_preset_names() -> None:
+    assert list(Albot1Mapper.presets) == list(OLD_PRESETS)
+
+
+@pytest.mark.parametrize("name", list(OLD_PRESETS))
+def test_each_preset_resolves_to_the_old_values(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    for variable in [v for v in os.environ if v.upper().startswith("ALBOT1_ALBOT1_")]:
+        monkeypatch.delenv(variable)
+    expected = {**OLD_DEFAULT, **OLD_PRESETS[name]}
+    assert _typed(Albot1Config.model_validate(Albot1Mapper.presets[name]).model_dump()) == _typed(expected)
+    assert _typed(resolve_config("albot1", name).model_dump()) == _typed(expected)
+
+
+@pytest.mark.parametrize("name", list(OLD_PRESETS))
+def test_each_preset_table_is_complete(name: str) -> None:
+    """The TOML mechanism merges ``default`` into every preset: each table sets every field."""
+    assert _typed(Albot1Mapper.presets[name]) == _typed({**OLD_DEFAULT, **OLD_PRESETS[name]})

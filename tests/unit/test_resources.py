@@ -1,0 +1,101 @@
+"""The project's TOML folders: found in the checkout, in the wheel's bundle, or under ALBOT1_CONFIG_DIR."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from albot1 import resources, versions
+from albot1.errors import ConfigError
+from albot1.resources import FOLDERS, find_resource, list_resources, resource_dirs, shipped_dir
+
+CHECKOUT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(autouse=True)
+def _no_user_folder(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(resources.CONFIG_DIR_ENV, raising=False)
+
+
+def test_a_checkout_uses_its_own_top_level_folders() -> None:
+    for folder in FOLDERS:
+        assert shipped_dir(folder) == CHECKOUT / folder
+        assert resource_dirs(folder) == [CHECKOUT / folder]
+    assert find_resource("baselines", "kiss-icp.toml") == CHECKOUT / "baselines" / "kiss-icp.toml"
+    assert [p.name for p in list_resources("benchmarks")] == sorted(p.name for p in CHECKOUT.glob("benchmarks/*.toml"))
+
+
+def test_missing_file_and_unknown_folder_are_config_errors() -> None:
+    with pytest.raises(ConfigError, match=r"no baselines/nope.toml in .*baselines"):
+        find_resource("baselines", "nope.toml")
+    with pytest.raises(ConfigError, match="unknown resource folder 'presets'; expected one of: datasets, baselines"):
+        list_resources("presets")  # type: ignore[arg-type]
+
+
+def test_user_folder_adds_and_replaces_files(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "benchmarks").mkdir()
+    (tmp_path / "benchmarks" / "quick.toml").write_text("# mine\n")
+    (tmp_path / "benchmarks" / "lab.toml").write_text("# mine too\n")
+    monkeypatch.setenv(resources.CONFIG_DIR_ENV, str(tmp_path))
+    found = {p.name: p for p in list_resources("benchmarks")}
+    assert found["quick.toml"] == tmp_path / "benchmarks" / "quick.toml"
+    assert found["lab.toml"] == tmp_path / "benchmarks" / "lab.toml"
+    assert found["default.toml"] == CHECKOUT / "benchmarks" / "default.toml"
+    assert find_resource("benchmarks", "quick.toml") == tmp_path / "benchmarks" / "quick.toml"
+    assert resource_dirs("datasets") == [CHECKOUT / "datasets"]  # no datasets/ in the user's folder
+
+
+def test_user_folder_that_is_not_a_folder_is_one_clear_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(resources.CONFIG_DIR_ENV, str(tmp_path / "missing"))
+    with pytest.raises(ConfigError, match=r"ALBOT1_CONFIG_DIR=.*missing: not a folder"):
+        list_resources("datasets")
+
+
+def test_installed_package_uses_the_bundle(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    package = tmp_path / "site-packages" / "albot1"
+    (package / "_bundled" / "datasets").mkdir(parents=True)
+    (package / "_bundled" / "datasets" / "intel.toml").write_text("")
+    (tmp_path / "site-packages" / "datasets").mkdir()  # another distribution's package named "datasets"
+    monkeypatch.setattr(resources, "_PACKAGE_DIR", package)
+    assert shipped_dir("datasets") == package / "_bundled" / "datasets"
+    assert [p.name for p in list_resources("datasets")] == ["intel.toml"]
+    with pytest.raises(ConfigError, match="neither .*baselines \\(a checkout\\) nor .*_bundled/baselines"):
+        shipped_dir("baselines")
+
+
+@pytest.mark.slow
+def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
+    """setup.py's build_py copies the top-level folders into the package tree of the build."""
+    build = tmp_path / "build"
+    subprocess.run(
+        [sys.executable, "setup.py", "-q", "build_py", "--build-lib", str(build)],
+        cwd=CHECKOUT,
+        check=True,
+        capture_output=True,
+    )
+    for folder in FOLDERS:
+        bundled = sorted(p.name for p in (build / "albot1" / "_bundled" / folder).iterdir())
+        assert bundled == sorted(p.name for p in (CHECKOUT / folder).glob("*.toml")), folder
+        for name in bundled:
+            assert (build / "albot1" / "_bundled" / folder / name).read_bytes() == (
+                CHECKOUT / folder / name
+            ).read_bytes()
+    assert not (CHECKOUT / "albot1" / "_bundled").exists()  # never into the source tree
+
+
+def test_the_code_version_ignores_the_bundle(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A wheel and its checkout name the same code: the bundled copies are not part of the digest."""
+    package = tmp_path / "albot1"
+    (package / "methods").mkdir(parents=True)
+    (package / "methods" / "m.py").write_text("X = 1\n")
+    (package / "methods" / "presets.toml").write_text("[presets.default]\n")
+    monkeypatch.setattr(versions, "_PACKAGE_DIR", package)
+    checkout = versions.code_version.__wrapped__()
+    (package / resources.BUNDLE_DIR_NAME / "baselines").mkdir(parents=True)
+    (package / resources.BUNDLE_DIR_NAME / "baselines" / "kiss-icp.toml").write_text("[presets.default]\n")
+    assert versions.code_version.__wrapped__() == checkout
+    (package / "methods" / "presets.toml").write_text("[presets.default]\nx = 1\n")
+    assert versions.code_version.__wrapped__() != checkout  # package data does count
