@@ -7,10 +7,30 @@ destination; on any error the temporary file is removed.
 
 from __future__ import annotations
 
+import functools
 import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
+
+
+@functools.cache
+def _umask() -> int:
+    """The process's umask, read once (``/proc/self/status`` where it exists: no window with another mask)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def normal_mode() -> int:
+    """The mode ``open()`` would give a new file (0o666 less the umask), for files made by ``mkstemp`` (0o600)."""
+    return 0o666 & ~_umask()
 
 
 def atomic_write(path: str | Path, writer: Callable[[Path], object]) -> None:
@@ -18,6 +38,8 @@ def atomic_write(path: str | Path, writer: Callable[[Path], object]) -> None:
 
     The temporary name keeps ``path``'s suffix, so writers that choose a
     compression or format by suffix (``.gz``, ``.npz``) behave as for ``path``.
+    The file gets the permissions of a file made with ``open()`` (the
+    temporary file of ``mkstemp`` is private to its owner).
     """
     dest = Path(path)
     fd, tmp = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=f".tmp{''.join(dest.suffixes)}")
@@ -25,6 +47,8 @@ def atomic_write(path: str | Path, writer: Callable[[Path], object]) -> None:
     tmp_path = Path(tmp)
     try:
         writer(tmp_path)
+        if tmp_path.is_file():
+            os.chmod(tmp_path, normal_mode())
         os.replace(tmp_path, dest)
     finally:
         tmp_path.unlink(missing_ok=True)

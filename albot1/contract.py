@@ -56,13 +56,17 @@ class MapperOutput:
 
     ``counters`` must hold at least ``views`` (scans processed) and
     ``updates`` (map updates for Albot1; insertions/keyframes for baselines);
-    ``extras`` holds JSON-able, method-specific records (update trace, ...).
+    ``extras`` holds JSON-able, method-specific records (update trace, ...);
+    ``files`` extra files of the run folder by name (``places.json``, ...): a
+    str is written as text, anything else as JSON (see
+    :func:`albot1.runs.folder.write_run`).
     """
 
     poses: FloatArray
     map: MapData
     counters: dict[str, int | float]
     extras: dict[str, Any] = field(default_factory=dict)
+    files: dict[str, Any] = field(default_factory=dict)
 
 
 @runtime_checkable
@@ -116,6 +120,8 @@ class RunResult:
     peak_mb: float
     versions: dict[str, Any]
     dataset_info: dict[str, Any] = field(default_factory=dict)
+    #: the mapper's extra files (``MapperOutput.files``), written beside the standard ones
+    files: dict[str, Any] = field(default_factory=dict)
 
     def timing(self) -> Timing:
         """The ``timing`` block of ``result.json`` (per-scan statistics are None for a run of no scans)."""

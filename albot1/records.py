@@ -39,7 +39,7 @@ import math
 import types
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Annotated, Any, Literal, TypeAlias, TypeVar, Union, get_args, get_origin
+from typing import Annotated, Any, ClassVar, Literal, TypeAlias, TypeVar, Union, get_args, get_origin
 
 from pydantic import (
     BaseModel,
@@ -106,12 +106,19 @@ class Record(BaseModel):
 
 
 class OmitsAbsentReasons(Record):
-    """A record whose ``<name>_reason`` keys are written only when they hold a reason (never as null)."""
+    """A record whose ``<name>_reason`` keys (and :attr:`OMITTED_WHEN_NULL` keys) are written only when set.
+
+    So a file never holds ``"x_reason": null``, and an optional block that most
+    files lack (``trajectory`` of ``metrics.json``) does not appear in them as null.
+    """
+
+    OMITTED_WHEN_NULL: ClassVar[frozenset[str]] = frozenset()
 
     @model_serializer(mode="wrap")
     def _omit_absent_reasons(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
         data: dict[str, Any] = handler(self)
-        return {k: v for k, v in data.items() if not (k.endswith("_reason") and v is None)}
+        omitted = self.OMITTED_WHEN_NULL
+        return {k: v for k, v in data.items() if not ((k.endswith("_reason") or k in omitted) and v is None)}
 
 
 def parse_record(model: type[RecordT], data: object, source: str) -> RecordT:
@@ -524,16 +531,43 @@ class CostBlock(Record):
 
 
 class RunHeader(Record):
-    """``metrics.json`` ``run``: which run the metrics belong to."""
+    """``metrics.json`` ``run``: which run the metrics belong to.
+
+    For an external trajectory (``albot1 evaluate --trajectory``) ``method``
+    is its label, ``preset`` is ``external``, ``seed`` is null (unknown) and
+    ``scans`` counts the poses matched to the dataset's scans.
+    """
 
     key: str
     method: str
     dataset: str
     preset: str
     degradation: str
-    seed: int
+    seed: int | None
     scans: int
     has_reference: bool
+
+
+class TrajectorySource(Record):
+    """``metrics.json`` ``trajectory``: the external trajectory file an evaluation scored (absent for a run folder).
+
+    Its poses are matched to the dataset's scans by time (the nearest scan
+    within ``max_dt_s``; one pose per scan, the nearest) or, for a format
+    without timestamps (KITTI), by order (``max_dt_s`` null). Poses left
+    out are counted, never dropped silently: ``unmatched`` found no scan
+    within ``max_dt_s``, ``duplicates`` lost their scan to a nearer pose.
+    ``versions`` names the code that scored it.
+    """
+
+    file: str
+    format: Literal["tum", "kitti", "carmen"]
+    sha256: str
+    poses: int
+    matched: int
+    unmatched: int
+    duplicates: int
+    max_dt_s: float | None
+    versions: dict[str, str | None]
 
 
 #: Any computed block of ``metrics.json``.
@@ -553,9 +587,16 @@ MetricBlock: TypeAlias = (
 
 
 class MetricsRecord(OmitsAbsentReasons):
-    """``metrics.json``: every metric of a run, each a block or null with ``<metric>_reason``."""
+    """``metrics.json``: every metric of a run, each a block or null with ``<metric>_reason``.
+
+    ``trajectory`` describes the scored file of an external trajectory and is
+    absent from a run folder's metrics.
+    """
+
+    OMITTED_WHEN_NULL: ClassVar[frozenset[str]] = frozenset({"trajectory"})
 
     run: RunHeader
+    trajectory: TrajectorySource | None = None
     missing: str = MISSING_NOTE
     ate: AteBlock | None = None
     ate_reason: str | None = None

@@ -31,7 +31,7 @@ def code_version() -> str:
         relative = path.relative_to(_PACKAGE_DIR).parts
         if relative[0] == _BUNDLE_DIR_NAME or "__pycache__" in relative:
             continue
-        if path.is_file() and path.suffix in {".py", ".toml", ".json"}:
+        if path.is_file() and path.suffix in {".py", ".toml", ".json", ".ini"}:
             digest.update(path.relative_to(_PACKAGE_DIR).as_posix().encode())
             digest.update(path.read_bytes())
     return f"{__version__}+{digest.hexdigest()[:12]}"

@@ -21,6 +21,7 @@ from albot1.bench.errors import SuiteError
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
 from albot1.data import catalog
+from albot1.data.degrade import parse_spec
 from albot1.data.errors import DatasetNotFoundError
 from albot1.data.open import open_sequence
 from albot1.data.synthetic import worlds
@@ -98,21 +99,8 @@ def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
         if spec.available():
             usable.append(entry)
         else:
-            missing = [m for m in spec.requires if not _importable(m)]
-            skipped.append(
-                Skipped(
-                    entry.display,
-                    f"needs {', '.join(missing)}, which is not installed",
-                    f"pip install {' '.join(missing)}",
-                )
-            )
+            skipped.append(Skipped(entry.display, f"unavailable: {spec.unavailable_reason()}", spec.install_command()))
     return usable, skipped
-
-
-def _importable(module: str) -> bool:
-    import importlib.util
-
-    return importlib.util.find_spec(module) is not None
 
 
 def _candidate_datasets(suite: Suite) -> list[str]:
@@ -124,8 +112,14 @@ def _candidate_datasets(suite: Suite) -> list[str]:
     return out
 
 
-def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None]:
-    """(has reference poses, None) when the dataset can be opened, else (None, why skipped)."""
+def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None, bool]:
+    """(has reference poses, None, True) when the dataset can be opened, else (None, why skipped, known).
+
+    ``known`` is False when ``name`` names nothing that exists (no world, no
+    registered dataset, no file, or options its loader rejects): for a
+    literal suite entry that is an error unless the entry is ``optional``.
+    A registered dataset that is merely not downloaded is known.
+    """
     base = name.partition("?")[0]  # a reference with loader options needs its catalog file all the same
     if base in catalog.names():
         try:
@@ -133,27 +127,37 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
         except DatasetNotFoundError as exc:
             manifest = catalog.get(base)
             fetchable = not manifest.local_only and bool(manifest.log.urls)
-            return None, Skipped(name, f"not downloaded: {exc}", f"albot1 datasets fetch {base}" if fetchable else "")
+            hint = f"albot1 datasets fetch {base}" if fetchable else ""
+            return None, Skipped(name, f"not downloaded: {exc}", hint), True
     try:
         sequence = open_sequence(name, settings=settings)
         first = next(iter(sequence.frames()), None)
     except DatasetNotFoundError as exc:
-        return None, Skipped(name, str(exc))
+        return None, Skipped(name, str(exc)), False
     if first is None:
-        return None, Skipped(name, "the dataset holds no scans")
-    return first.reference is not None, None
+        return None, Skipped(name, "the dataset holds no scans"), True
+    return first.reference is not None, None, True
+
+
+def _seeds_of(degradation: str, seeds: tuple[int, ...]) -> tuple[int, ...]:
+    """``seeds``, or only the first of them for a deterministic degradation (every seed would repeat one run).
+
+    The first seed keeps the run key such a cell always had, so stored results stay found.
+    """
+    spec = parse_spec(degradation)
+    deterministic = spec.kind in ("none", "thesis", "bias") or (spec.kind == "gauss" and spec.a == spec.b == 0.0)
+    return seeds[:1] if deterministic else seeds
 
 
 def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tuple[str, int]]:
     grid = suite.grid
-    runs = [
-        ("none", s) for s in (opts.undegraded_seeds if opts.undegraded_seeds is not None else grid.undegraded_seeds)
-    ]
+    undegraded = opts.undegraded_seeds if opts.undegraded_seeds is not None else grid.undegraded_seeds
+    runs = [("none", s) for s in _seeds_of("none", undegraded)]
     sweep = has_reference if opts.sweep == "auto" else bool(opts.sweep)
     if sweep:
         degradations = opts.degradations if opts.degradations is not None else grid.degradations
         seeds = opts.seeds if opts.seeds is not None else grid.seeds
-        runs += [(d, s) for d in degradations if d != "none" for s in seeds]
+        runs += [(d, s) for d in degradations if d != "none" for s in _seeds_of(d, seeds)]
     return runs
 
 
@@ -170,10 +174,16 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
     cells: list[Cell] = []
     skipped_datasets: list[Skipped] = []
     config_failures: dict[str, str] = {}
+    literals = set(suite.literal_datasets())
     for name in _candidate_datasets(suite):
         opts = suite.options_for(name)
         assert opts is not None  # _candidate_datasets keeps selected names only
-        has_reference, skipped = _availability(name, settings)
+        has_reference, skipped, known = _availability(name, settings)
+        if skipped is not None and not known and name in literals and not opts.optional:
+            raise SuiteError(
+                f"{suite.path or suite.name}: dataset entry {name!r}: {skipped.reason}; "
+                "fix the name, or mark the entry `optional = true` to skip it when it is absent"
+            )
         if skipped is not None:
             skipped_datasets.append(skipped)
             continue

@@ -37,6 +37,14 @@ Format (every key optional except ``methods`` and ``datasets``)::
     stride = 2                       # ... every 2nd of them
     sweep = false                    # true | false | "auto" (= when the dataset has reference poses)
     # degradations / seeds / undegraded_seeds / time_s / memory_mb / skip = true
+    # optional = true                # a literal name or path that does not exist is skipped, not an error
+
+A literal dataset entry (not a glob) that names no synthetic world, no
+registered dataset and no existing file is an error of the suite unless it
+says ``optional = true``; a registered dataset that is not downloaded is
+skipped with the command that fetches it. The deterministic degradations
+(``none``, ``thesis``, ``bias:...``) run with the first seed of their list
+only: every other seed would repeat the same run.
 """
 
 from __future__ import annotations
@@ -119,6 +127,9 @@ class DatasetEntry(_Strict):
 
     name: str = Field(min_length=1)
     skip: bool = False
+    optional: bool = Field(
+        False, description="a literal name or path that cannot be found is skipped, not an error of the suite"
+    )
     limit: int | None = Field(None, ge=1, description="use the first LIMIT scans of the log")
     stride: int | None = Field(None, ge=1, description="then every STRIDE-th of them")
     sweep: bool | Literal["auto"] = "auto"
@@ -145,6 +156,7 @@ class DatasetOptions(_Strict):
     """The merged options of one concrete dataset (all entries that match it, in order)."""
 
     name: str
+    optional: bool = False
     limit: int | None = None
     stride: int | None = None
     sweep: bool | Literal["auto"] = "auto"

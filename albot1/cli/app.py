@@ -1,26 +1,58 @@
 """The ``albot1`` entry point: assembles the command groups and turns the
 project's known errors into one line on stderr with a non-zero exit.
 
-Each command module imports only typer at module level; heavy libraries are
-imported inside the commands, so ``albot1 --help`` is instant.
+The command modules import the package at module level; the heavy optional
+libraries (gtsam, kiss-icp, rosbags, matplotlib, dask, ...) are imported only
+by the code that uses them, so ``albot1 --help`` loads none of them.
 """
 
 from __future__ import annotations
 
 import importlib
 import sys
+from typing import Annotated
 
 import typer
 
+from albot1 import __version__
 from albot1.errors import Albot1Error
+from albot1.versions import code_version
+
+HELP = """Albot1 perceptual mapping vs SLAM baselines on 2D laser datasets.
+
+Every command names a dataset the same way (run, evaluate, convert, datasets info, suites):\n
+NAME: a registered dataset (`albot1 datasets list`) or a synthetic world;\n
+NAME[:N]: its first N scans (NAME[:N:S] every S-th of them, NAME[::S]);\n
+NAME?key=value: loader options joined by &, e.g. intel-corrected?odometry=laser-pose;
+on any dataset odometry=reference (perfect odometry) and views=D_M:A_DEG;\n
+PATH: a log file (CARMEN, ROS1/ROS2 bag, Albot1 log; the format is sniffed).\n
+Quote references in a shell: albot1 run odometry 'aces[:2500]'.
+"""
 
 app = typer.Typer(
     name="albot1",
-    help="Albot1 perceptual mapping vs SLAM baselines on 2D laser datasets.",
+    help=HELP,
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
 )
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"albot1 {__version__} (code {code_version()})")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option("--version", callback=_version, is_eager=True, help="print the version and the code digest, exit"),
+    ] = False,
+) -> None:
+    """The options of ``albot1`` itself (the commands are added below)."""
+
 
 #: (module, attribute, group name or None to add its commands at top level)
 _COMMANDS: tuple[tuple[str, str, str | None], ...] = (
@@ -29,6 +61,7 @@ _COMMANDS: tuple[tuple[str, str, str | None], ...] = (
     ("albot1.cli.run", "register", None),
     ("albot1.cli.methods", "register", None),
     ("albot1.cli.evaluate", "register", None),
+    ("albot1.cli.runs", "register", None),
     ("albot1.cli.bench", "register", None),
 )
 

@@ -2,10 +2,20 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
+from tqdm import tqdm
+
+from albot1.bench.plan import plan_suite
+from albot1.bench.progress import TqdmProgress, plan_table, summary_table
+from albot1.bench.runner import run_suite
+from albot1.bench.suite import find_suite, load_suite
+from albot1.report.index import build_report
+from albot1.report.preview import render_preview
+from albot1.settings import get_settings
 
 
 def register(app: typer.Typer) -> None:
@@ -30,7 +40,12 @@ def bench(
     process under the suite's time and memory limits.
 
     Completed cells are kept and skipped on the next run; failed cells are recorded with their
-    reason and retried. Then build the report with `albot1 report results/SUITE`.
+    reason and retried. Then build the report with `albot1 report results/SUITE`. The exit status
+    is 1 when any cell failed (after the whole grid ran and the summary was printed).
+
+    Datasets are named as in `albot1 run`: NAME, NAME[:N] (first N scans), NAME?key=value
+    (loader options), or a path; a suite entry naming none of these is an error unless it
+    says `optional = true`.
 
     Examples:\n
       albot1 bench                       # the default suite, 2 cells at a time\n
@@ -38,19 +53,7 @@ def bench(
       albot1 bench default --executor dask -j 4\n
       albot1 bench benchmarks/full.toml --executor dask://scheduler:8786
     """
-    import sys
-
-    from tqdm import tqdm
-
-    from albot1.bench.progress import TqdmProgress, plan_table, summary_table
-    from albot1.bench.runner import run_suite
-    from albot1.report.preview import render_preview
-    from albot1.settings import get_settings
-
     if dry_run:
-        from albot1.bench.plan import plan_suite
-        from albot1.bench.suite import find_suite, load_suite
-
         plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))
         return
@@ -77,6 +80,11 @@ def bench(
         typer.echo(f"skipped method {skipped.name}: {skipped.reason}", err=True)
     typer.echo(summary_table(summary))
     typer.echo(f"results: {store.root}  (report: albot1 report {store.root})")
+    failed = summary.counts["failed"]
+    if failed:
+        # The whole grid ran and the summary is printed; the exit status tells scripts (make, CI) it is not clean.
+        typer.echo(f"{failed} of {len(summary.outcomes)} cells failed (reasons above and in the report)", err=True)
+        raise typer.Exit(1)
 
 
 def report(
@@ -90,7 +98,5 @@ def report(
       albot1 report results/default          # -> reports/default/README.md\n
       albot1 report results/quick --out /tmp/quick-report
     """
-    from albot1.report.index import build_report
-
     index = build_report(results_dir, out, plots=plots)
     typer.echo(f"report: {index}")

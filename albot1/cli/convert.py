@@ -7,7 +7,9 @@ from typing import Annotated
 
 import typer
 
+from albot1.cli.progress import with_progress
 from albot1.data.convert import convert as run_conversion
+from albot1.data.loaders.output import check_output
 from albot1.data.open import open_sequence
 from albot1.data.transforms import head
 from albot1.settings import get_settings
@@ -20,7 +22,10 @@ def register(app: typer.Typer) -> None:
 
 
 def convert(
-    source: Annotated[str, typer.Argument(metavar="IN", help="a dataset name (`albot1 datasets list`) or a log path")],
+    source: Annotated[
+        str,
+        typer.Argument(metavar="IN", help="NAME, NAME[:N], NAME?key=value (see `albot1 --help`) or a log path"),
+    ],
     output: Annotated[Path, typer.Argument(metavar="OUT", help="the file (or ROS2 bag folder) to create")],
     format_name: Annotated[str | None, typer.Option("--format", help=FORMAT_HELP)] = None,
     source_format: Annotated[
@@ -64,14 +69,12 @@ def convert(
         "outside_odometry": outside_odometry,
     }
     settings = get_settings(data_dir=data_dir)
-    if limit is None:
-        done = run_conversion(
-            source, output, format_name, source_format=source_format, settings=settings, retime=retime, **options
-        )
-    else:
-        sequence = open_sequence(
-            source, settings=settings, format_name=source_format, **{k: v for k, v in options.items() if v is not None}
-        )
-        done = run_conversion(head(sequence, limit), output, format_name, retime=retime)
+    check_output(output)  # refused before the (maybe long) load, as for every writer
+    sequence = open_sequence(
+        source, settings=settings, format_name=source_format, **{k: v for k, v in options.items() if v is not None}
+    )
+    if limit is not None:
+        sequence = head(sequence, limit)
+    done = run_conversion(with_progress(sequence, f"converting {source}"), output, format_name, retime=retime)
     shifted = f"; {done.retimed} timestamps shifted by --retime" if done.retimed else ""
     typer.echo(f"wrote {done.scans} scans from {done.source} to {done.output} ({done.format_name}){shifted}")

@@ -12,6 +12,7 @@ from typing import Annotated, Any
 
 import typer
 
+from albot1.cli.progress import with_progress
 from albot1.data import catalog
 from albot1.data.open import open_sequence
 from albot1.data.synthetic import worlds
@@ -104,7 +105,10 @@ def fetch(
 
 @app.command("info")
 def info(
-    ref: Annotated[str, typer.Argument(help="a dataset name, a synthetic world or a log file path")],
+    ref: Annotated[
+        str,
+        typer.Argument(help="NAME, NAME[:N], NAME?key=value (see `albot1 --help`), a synthetic world or a log path"),
+    ],
     as_json: Annotated[bool, typer.Option("--json", help="print Sequence.summary() as one JSON object")] = False,
     scan_topic: Annotated[str | None, typer.Option(help="bag: the sensor_msgs/LaserScan topic")] = None,
     odom_topic: Annotated[str | None, typer.Option(help="bag: the nav_msgs/Odometry topic")] = None,
@@ -122,7 +126,8 @@ def info(
         for key, value in (("scan_topic", scan_topic), ("odom_topic", odom_topic), ("reference_topic", reference_topic))
         if value is not None
     }
-    summary = open_sequence(ref, settings=get_settings(data_dir=data_dir), **options).summary()
+    sequence = open_sequence(ref, settings=get_settings(data_dir=data_dir), **options)
+    summary = with_progress(sequence, f"reading {ref}").summary()
     if as_json:
         typer.echo(json.dumps(summary))
         return

@@ -1,15 +1,43 @@
-"""``albot1 evaluate RUN_DIR``: compute a run's metrics into ``metrics.json``."""
+"""``albot1 evaluate``: score a run folder, or any trajectory file, into ``metrics.json``."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 import typer
 
-if TYPE_CHECKING:
-    from albot1.records import MetricBlock
+from albot1.cli.progress import with_progress
+from albot1.errors import Albot1Error
+from albot1.records import (
+    METRIC_NAMES,
+    AteBlock,
+    AteWindowsBlock,
+    ClosedRouteGapBlock,
+    DriftBlock,
+    LoopGapBlock,
+    MapShapeBlock,
+    MetricBlock,
+    MetricsRecord,
+    OrientationBlock,
+    RelationsBlock,
+    RpeBlock,
+    UpdatesBlock,
+    dump_record,
+)
+from albot1.runs.evaluate import METRICS_FILE, evaluate_run, evaluate_trajectory
+from albot1.runs.evo_results import write_evo_results
+from albot1.runs.external import MAX_DT_S
+from albot1.runs.folder import read_run
+from albot1.runs.scored import Scored, scored_run
+from albot1.settings import get_settings
+
+DATASET_HELP = (
+    "the dataset the trajectory was made on: NAME, NAME[:N] (its first N scans), NAME?key=value "
+    "(loader options) or a log path (see `albot1 datasets list`)"
+)
 
 
 def register(app: typer.Typer) -> None:
@@ -17,36 +45,126 @@ def register(app: typer.Typer) -> None:
 
 
 def evaluate(
-    run_dir: Annotated[Path, typer.Argument(help="a run folder written by `albot1 run` (holds result.json, DONE)")],
-    data_dir: Annotated[
-        Path | None, typer.Option(help="dataset folder for the reference map (default: $ALBOT1_DATA_DIR)")
+    run_dir: Annotated[
+        Path | None,
+        typer.Argument(help="a run folder written by `albot1 run` (holds result.json, DONE); or use --trajectory"),
     ] = None,
-    as_json: Annotated[bool, typer.Option("--json", help="print metrics.json as one JSON object")] = False,
+    trajectory: Annotated[
+        Path | None,
+        typer.Option(help="score this trajectory file of another tool instead of a run folder (needs --dataset)"),
+    ] = None,
+    dataset: Annotated[str | None, typer.Option(help=DATASET_HELP)] = None,
+    format_name: Annotated[
+        str | None,
+        typer.Option(
+            "--format",
+            help="tum (t x y z qx qy qz qw) | kitti (3x4 [R|t] per line, one per scan) | carmen (corrected log); "
+            "default: from the file",
+        ),
+    ] = None,
+    label: Annotated[
+        str | None, typer.Option(help="the method's name in the metrics (default: the file's stem)")
+    ] = None,
+    max_dt: Annotated[
+        float | None, typer.Option(help=f"largest pose-to-scan time difference (s; default {MAX_DT_S:g})")
+    ] = None,
+    out: Annotated[Path | None, typer.Option(help="with --trajectory: write the metrics JSON to this file")] = None,
+    evo: Annotated[
+        Path | None,
+        typer.Option(help="also write evo result files (NAME.ape.zip, NAME.rpe.zip) into this folder, for evo_res"),
+    ] = None,
+    data_dir: Annotated[
+        Path | None, typer.Option(help="dataset folder for the reference (default: $ALBOT1_DATA_DIR)")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print the metrics as one JSON object")] = False,
 ) -> None:
-    """Score the run against the dataset's reference and write RUN_DIR/metrics.json.
+    """Score a run, or any trajectory, against the dataset's reference poses and relations.
 
-    Metrics that cannot be computed (no reference poses, no relations) are
-    null with a reason beside them.
+    With RUN_DIR: write RUN_DIR/metrics.json. With --trajectory FILE --dataset NAME: score a
+    trajectory made by another tool (Cartographer, slam_toolbox, GMapping, ...) with the same
+    metrics; its poses are matched to the dataset's scans by time (TUM, CARMEN) or by order
+    (KITTI), and poses left out are counted and reported. Metrics that cannot be computed (no
+    reference poses, no relations; map, counters and timing for a trajectory file) are null
+    with a reason beside them.
 
     Examples:\n
       albot1 evaluate runs/3f2a9c0d11e4b7a2\n
-      albot1 evaluate runs/3f2a9c0d11e4b7a2 --json | jq .ate.rmse_m
+      albot1 evaluate runs/3f2a9c0d11e4b7a2 --json | jq .ate.rmse_m\n
+      albot1 evaluate --trajectory cartographer.tum --dataset intel-corrected --out carto.json\n
+      albot1 evaluate --trajectory intel.gfs.log --format carmen --dataset aces --evo evo-results/
     """
-    from albot1.records import METRIC_NAMES
-    from albot1.runs.evaluate import METRICS_FILE, evaluate_run
-    from albot1.settings import get_settings
-
-    metrics = evaluate_run(run_dir, settings=get_settings(data_dir=data_dir))
-    written = run_dir / METRICS_FILE
-    if as_json:
-        # Re-read what was written, so stdout and the file agree exactly (NaN -> null included).
-        typer.echo(json.dumps(json.loads(written.read_text())))
+    settings = get_settings(data_dir=data_dir)
+    if (run_dir is None) == (trajectory is None):
+        raise typer.BadParameter("give either RUN_DIR or --trajectory FILE (with --dataset NAME), not both")
+    if trajectory is None:
+        assert run_dir is not None
+        for flag, value in (("--dataset", dataset), ("--format", format_name), ("--label", label), ("--out", out)):
+            if value is not None:
+                raise typer.BadParameter(f"{flag} goes with --trajectory; a run folder names its own dataset")
+        metrics = evaluate_run(run_dir, settings=settings)
+        written = run_dir / METRICS_FILE
+        if evo is not None:
+            _evo(scored_run(read_run(run_dir)), evo, f"{metrics.run.method}_{metrics.run.key}")
+        if as_json:
+            # Re-read what was written, so stdout and the file agree exactly (NaN -> null included).
+            typer.echo(json.dumps(json.loads(written.read_text())))
+            return
+        typer.echo(str(written))
+        _print_headlines(metrics)
         return
-    typer.echo(str(written))
+    if dataset is None:
+        raise typer.BadParameter("--trajectory needs --dataset NAME: the dataset whose reference scores it")
+    metrics, scored = evaluate_trajectory(
+        trajectory,
+        dataset,
+        format_name=format_name,
+        label=label,
+        max_dt_s=max_dt,
+        settings=settings,
+        out=out,
+        wrap=lambda sequence: with_progress(sequence, f"reading {dataset}"),
+    )
+    _note_left_out(metrics)
+    if evo is not None:
+        _evo(scored, evo, _file_name(metrics.run.method))
+    if as_json:
+        typer.echo(json.dumps(dump_record(metrics)))
+        return
+    typer.echo(f"{trajectory} on {dataset}" + (f" -> {out}" if out is not None else ""))
+    _print_headlines(metrics)
+
+
+def _print_headlines(metrics: MetricsRecord) -> None:
     for name in METRIC_NAMES:
         block = metrics.block(name)
         line = _headline(block) if block is not None else f"null: {metrics.reason(name)}"
         typer.echo(f"  {name:12s} {line}")
+
+
+def _note_left_out(metrics: MetricsRecord) -> None:
+    """One line on stderr when poses of the file were not scored (the counts are in the JSON too)."""
+    source = metrics.trajectory
+    if source is None or not (source.unmatched or source.duplicates):
+        return
+    typer.echo(
+        f"note: {source.matched} of {source.poses} poses of {source.file} matched a scan within "
+        f"{source.max_dt_s:g} s and were scored; left out: {source.unmatched} with no scan that near, "
+        f"{source.duplicates} whose scan had a nearer pose",
+        err=True,
+    )
+
+
+def _evo(scored: Scored, folder: Path, name: str) -> None:
+    try:
+        written = write_evo_results(scored, folder, prefix=f"{name}.")
+    except Albot1Error as exc:
+        typer.echo(f"note: no evo result files: {exc}", err=True)
+        return
+    typer.echo(f"evo results: {', '.join(str(p) for p in written)}", err=True)
+
+
+def _file_name(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "trajectory"
 
 
 def _f(value: float | None, fmt: str = ".3f") -> str:
@@ -55,19 +173,6 @@ def _f(value: float | None, fmt: str = ".3f") -> str:
 
 def _headline(block: MetricBlock) -> str:
     """One line per metric for people; the JSON has everything."""
-    from albot1.records import (
-        AteBlock,
-        AteWindowsBlock,
-        ClosedRouteGapBlock,
-        DriftBlock,
-        LoopGapBlock,
-        MapShapeBlock,
-        OrientationBlock,
-        RelationsBlock,
-        RpeBlock,
-        UpdatesBlock,
-    )
-
     f = _f
     if isinstance(block, AteBlock):
         return f"rmse {f(block.rmse_m)} m, max {f(block.max_m)} m ({block.alignment} alignment)"

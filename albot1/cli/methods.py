@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import inspect
 import json
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import Annotated, Any
 
 import typer
 
-if TYPE_CHECKING:
-    from albot1.methods.registry import MethodSpec
+from albot1.config.describe import describe_presets
+from albot1.config.presets import TomlPresets
+from albot1.methods.registry import METHODS, MethodSpec, get_method
 
 
 def register(app: typer.Typer) -> None:
@@ -38,8 +40,6 @@ def methods(
       albot1 methods --presets\n
       albot1 methods kiss-icp --json
     """
-    from albot1.methods.registry import METHODS, get_method
-
     specs = [get_method(method)] if method is not None else list(METHODS.values())
     detail = presets or method is not None
     records = [_record(spec, detail) for spec in specs]
@@ -48,19 +48,16 @@ def methods(
         return
     if not detail:
         for record in records:
-            state = "available" if record["available"] else "missing: " + ", ".join(record["requires"])
+            state = "available" if record["available"] else "unavailable"
             typer.echo(f"{record['name']:12s} {state:12s} {record['description']}")
+            if not record["available"]:
+                typer.echo(f"{'':12s} {'':12s} -> {record['unavailable']}")
         return
     typer.echo("\n\n".join(_human(record) for record in records))
 
 
 def _record(spec: MethodSpec, detail: bool) -> dict[str, Any]:
     """One method as JSON-able data; with ``detail`` its fields and presets (when installed)."""
-    import inspect
-
-    from albot1.config.describe import describe_presets
-    from albot1.config.presets import TomlPresets
-
     record: dict[str, Any] = {
         "name": spec.name,
         "available": spec.available(),
@@ -68,6 +65,11 @@ def _record(spec: MethodSpec, detail: bool) -> dict[str, Any]:
         "description": spec.description,
         "env_prefix": spec.env_prefix,
     }
+    if spec.executables:
+        record["executables"] = list(spec.executables)
+    if not record["available"]:
+        hint = spec.install_command()
+        record["unavailable"] = f"{spec.unavailable_reason()}" + (f" (install: {hint})" if hint else "")
     if not detail or not record["available"]:
         return record
     cls = spec.load_class()
@@ -100,7 +102,7 @@ def _value(value: Any) -> str:
 def _human(record: dict[str, Any]) -> str:
     head = f"{record['name']}: {record['description']}"
     if not record["available"]:
-        return f"{head}\n  not installed (needs {', '.join(record['requires'])}); its presets cannot be listed"
+        return f"{head}\n  unavailable: {record['unavailable']}; its presets cannot be listed"
     lines = [head, f"  config model {record['config_model']}; environment prefix {record['env_prefix']}"]
     if record["presets_file"]:
         lines.append(f"  presets file {record['presets_file']}")

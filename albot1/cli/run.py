@@ -8,6 +8,16 @@ from typing import Annotated
 
 import typer
 
+from albot1.cli.progress import with_progress
+from albot1.data.open import open_sequence
+from albot1.data.transforms import head
+from albot1.methods.registry import parse_overrides
+from albot1.records import dump_record
+from albot1.report.preview import render_preview
+from albot1.runs.execute import run_method
+from albot1.runs.folder import mark_latest, read_result, write_run
+from albot1.settings import get_settings
+
 
 def register(app: typer.Typer) -> None:
     app.command("run")(run)
@@ -15,11 +25,19 @@ def register(app: typer.Typer) -> None:
 
 def run(
     method: Annotated[str, typer.Argument(help="odometry | albot1 | kiss-icp | gtsam-graph (see `albot1 methods`)")],
-    dataset: Annotated[str, typer.Argument(help="a dataset name (`albot1 datasets list`) or a log file path")],
+    dataset: Annotated[
+        str,
+        typer.Argument(
+            help="NAME (`albot1 datasets list`), NAME[:N] (first N scans), NAME?key=value (loader options) "
+            "or a log file path; see `albot1 --help`"
+        ),
+    ],
     preset: Annotated[str, typer.Option(help="config preset, e.g. albot1: thesis | exact")] = "default",
     degrade: Annotated[str, typer.Option(help="none | thesis | gauss:SXY_M:STH_DEG | bias:DX_M:DTH_DEG")] = "none",
     seed: Annotated[int, typer.Option(help="seed of the degradation and of any random choice")] = 0,
-    out: Annotated[Path, typer.Option(help="results root; the run folder is OUT/<hash>")] = Path("runs"),
+    out: Annotated[
+        Path, typer.Option(help="results root; the run folder is OUT/<hash>, OUT/latest links it (`albot1 runs`)")
+    ] = Path("runs"),
     set_: Annotated[list[str] | None, typer.Option("--set", help="config override FIELD=VALUE (repeatable)")] = None,
     data_dir: Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
     limit: Annotated[int | None, typer.Option(help="use only the first N scans")] = None,
@@ -27,25 +45,20 @@ def run(
 ) -> None:
     """Run METHOD on DATASET and write the run folder (trajectory, map, counters, preview).
 
+    The folder is named by a hash of its inputs; OUT/latest points at the last one written and
+    `albot1 runs OUT` lists them all. A progress bar shows on stderr when it is a terminal.
+
     Examples:\n
       albot1 run albot1 aces --preset thesis --out runs\n
       albot1 run gtsam-graph intel-corrected --degrade gauss:0.1:1 --seed 1
     """
-    from albot1.data.open import open_sequence
-    from albot1.data.transforms import head
-    from albot1.methods.registry import parse_overrides
-    from albot1.records import dump_record
-    from albot1.report.preview import render_preview
-    from albot1.runs.execute import run_method
-    from albot1.runs.folder import read_result, write_run
-    from albot1.settings import get_settings
-
     overrides = parse_overrides(set_ or [])  # a malformed --set fails before the log is opened
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
     if preset == "default" and method == "albot1":
         preset = "thesis"
     if limit is not None:
         sequence = head(sequence, limit)
+    sequence = with_progress(sequence, f"{method} on {dataset}")
     result = run_method(
         method,
         sequence,
@@ -56,6 +69,7 @@ def run(
         dataset_name=dataset,
     )
     run_dir = write_run(result, out, preview=render_preview)
+    mark_latest(out, run_dir)
     record = read_result(run_dir)  # the headline says what result.json says
     if as_json:
         summary = {

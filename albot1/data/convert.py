@@ -14,7 +14,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from albot1.data.errors import DataError, UnknownFormatError
+from albot1.data.errors import UnknownFormatError
+from albot1.data.loaders.output import check_output
 from albot1.data.loaders.registry import writer_for
 from albot1.data.model import Frame, Sequence
 from albot1.data.open import open_sequence
@@ -36,6 +37,8 @@ SUFFIX_FORMATS: tuple[tuple[str, str], ...] = (
     (".log.bz2", "carmen"),
     (".clf", "carmen"),
     (".log", "carmen"),
+    (".rawlog.gz", "rawlog"),
+    (".rawlog", "rawlog"),
 )
 
 
@@ -98,7 +101,10 @@ def convert(
     ``source_format`` overrides sniffing the input; ``settings`` locate
     dataset names; ``load_options`` (e.g. ``scan_topic``) go to the
     source's loader, dropping those that are None so CLI defaults pass
-    through. The output must not exist (writers never overwrite).
+    through. The output must not exist (writers never overwrite); an output
+    that cannot be created (a parent that is a file, a folder that is not
+    writable, a read-only file system) is refused before the input is read
+    (:mod:`albot1.data.loaders.output`); missing parent folders are created.
 
     ``retime`` shifts scans whose timestamp repeats or goes backwards to
     ``RETIME_STEP_S`` after the previous scan. Bags need strictly increasing
@@ -108,8 +114,7 @@ def convert(
     """
     target = format_name or guess_format(dst)
     writer = writer_for(target)
-    if Path(dst).exists():  # one policy for every writer, checked before the (maybe long) load
-        raise DataError(f"{dst} exists already; remove it or choose another output path")
+    check_output(dst)  # one policy for every writer, checked before the (maybe long) load
     if isinstance(src, Sequence):
         sequence = src
     else:

@@ -58,3 +58,8 @@ class WriteError(DataError):
 
 class SliceError(DataError):
     """A slice of a dataset reference (``NAME[:STOP:STEP]``) or a scan limit is not a positive count."""
+
+
+class UnwritableError(DataError):
+    """A sequence holds what the target format's reader would refuse, so the writer does not write it
+    (the message names the output and the frame)."""

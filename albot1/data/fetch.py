@@ -17,6 +17,7 @@ import urllib.error
 import urllib.request
 from pathlib import Path
 
+from albot1.atomic import normal_mode
 from albot1.data.errors import FetchError
 from albot1.data.manifest import DataFile
 from albot1.settings import Settings
@@ -54,6 +55,7 @@ def download_verified(url: str, dest: Path, sha256: str, *, timeout: float = TIM
         got = digest.hexdigest()
         if got != sha256:
             raise FetchError(f"{url}: sha256 {got} does not match the manifest's {sha256}; file discarded")
+        os.chmod(tmp, normal_mode())  # mkstemp's file is private (0o600); a dataset file is not
         os.replace(tmp, dest)
         return dest
     finally:

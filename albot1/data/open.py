@@ -30,9 +30,13 @@ from pathlib import Path
 from typing import Any
 
 from albot1.config.keyvalue import KeyValueError, parse_query
-from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError
+from albot1.data import catalog
+from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
+from albot1.data.loaders.registry import load
 from albot1.data.model import Sequence
+from albot1.data.synthetic import worlds
 from albot1.data.tokens import parse_scalar
+from albot1.data.transforms import head, reference_odometry, stride, view_spacing
 from albot1.settings import Settings, get_settings
 
 #: ``odometry=reference``: the value that selects the reference poses as odometry on any dataset.
@@ -43,44 +47,64 @@ def open_sequence(
     ref: str | Path, *, settings: Settings | None = None, format_name: str | None = None, **options: Any
 ) -> Sequence:
     """Open ``ref`` (world name, dataset name or path) as a streamed Sequence."""
-    from albot1.data import catalog
-    from albot1.data.loaders.registry import load
-    from albot1.data.synthetic import worlds
-
     text = str(ref)
     # "NAME[:STOP]" / "NAME[:STOP:STEP]" / "NAME[::STEP]": the first STOP scans, every STEP-th of them
     # (the benchmark suites name their slices of long logs this way, so a run's dataset reopens as run).
-    sliced = re.fullmatch(r"(?P<ref>.+)\[:(?P<stop>\d*)(?::(?P<step>\d+))?\]", text)
-    if sliced is not None and not Path(text).expanduser().exists():
-        from albot1.data.transforms import head, stride
-
+    sliced = re.fullmatch(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]", text)
+    if sliced is not None and not _exists(text):
+        stop, step = parse_slice(sliced["body"], text)
         sequence = open_sequence(sliced["ref"], settings=settings, format_name=format_name, **options)
-        if sliced["stop"]:
-            sequence = head(sequence, int(sliced["stop"]))
-        if sliced["step"]:
-            sequence = stride(sequence, int(sliced["step"]))
+        if stop is not None:
+            sequence = head(sequence, stop)
+        if step is not None:
+            sequence = stride(sequence, step)
         return sequence
     name, has_query, query = text.partition("?")
-    if has_query and not Path(text).expanduser().exists():
+    if has_query and not _exists(text):
         return open_sequence(
             name, settings=settings, format_name=format_name, **{**parse_options(query, text), **options}
         )
     if options.get("odometry") == REFERENCE or "views" in options:
         return _with_reference_options(text, settings, format_name, options)
     if text in worlds.WORLDS:
-        if options:
-            raise DatasetNotFoundError(f"synthetic world {text!r} takes no loader options, got {', '.join(options)}")
-        return worlds.load_world(text)
+        return worlds.load_world(text, **options)  # a world's own options (start=, laps=) or SyntheticWorldError
     settings = settings or get_settings()
     if text in catalog.names():
         return catalog.open_dataset(text, settings, **options)
     path = Path(text).expanduser()
-    if path.exists():
+    if _exists(text):
         return load(path, format_name, **options)
     raise DatasetNotFoundError(
         f"{text!r} is neither a dataset name nor an existing file; known datasets: "
         f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
     )
+
+
+def _exists(text: str) -> bool:
+    """Whether ``text`` names an existing path; False for strings no file system accepts (too long, NUL)."""
+    try:
+        return Path(text).expanduser().exists()
+    except (OSError, ValueError):
+        return False
+
+
+def parse_slice(body: str, ref: str) -> tuple[int | None, int | None]:
+    """``":100:5"`` -> ``(100, 5)``: the STOP and STEP of a reference's ``[:STOP:STEP]`` (None = not given).
+
+    Only prefixes and strides exist (a run must reopen exactly the scans it
+    used); both must be positive integers. Anything else is a SliceError
+    naming the reference.
+    """
+    forms = "[:STOP], [:STOP:STEP] or [::STEP] with positive integers (the first STOP scans, every STEP-th of them)"
+    found = re.fullmatch(r":(?P<stop>\d*)(?::(?P<step>\d*))?", body)
+    if found is None or len(body) > 40:
+        raise SliceError(f"{ref!r}: slice [{body[:40]}] is not understood; expected {forms}")
+    stop = int(found["stop"]) if found["stop"] else None
+    step = int(found["step"]) if found["step"] else None
+    for what, value in (("STOP", stop), ("STEP", step)):
+        if value is not None and value < 1:
+            raise SliceError(f"{ref!r}: slice {what} is {value}, expected a positive integer; use {forms}")
+    return stop, step
 
 
 def parse_options(query: str, ref: str) -> dict[str, Any]:
@@ -99,8 +123,6 @@ def _with_reference_options(
     text: str, settings: Settings | None, format_name: str | None, options: dict[str, Any]
 ) -> Sequence:
     """Open ``text`` without the reference options, then apply ``odometry=reference`` and ``views``."""
-    from albot1.data.transforms import reference_odometry, view_spacing
-
     rest = dict(options)
     use_reference = rest.get("odometry") == REFERENCE
     if use_reference:

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from albot1.data.errors import ReferenceOptionError
+from albot1.data.errors import ReferenceOptionError, SliceError
 from albot1.data.model import Frame, Sequence
 
 #: Slack of the view-spacing rule, so ten 0.1 m steps (0.9999999... m in floating point) make 1 m.
@@ -19,7 +19,7 @@ SPACING_SLACK = 1e-9
 def head(sequence: Sequence, count: int) -> Sequence:
     """The first ``count`` frames (still streamed; the scan count stays known if it was)."""
     if count < 1:
-        raise ValueError(f"expected a positive scan count, got {count}")
+        raise SliceError(f"expected a positive number of scans (a limit or slice stop of at least 1), got {count}")
     known = sequence.known_scan_count
     return sequence.with_frames(
         lambda frames: itertools.islice(frames, count), scan_count=None if known is None else min(count, known)
@@ -29,7 +29,7 @@ def head(sequence: Sequence, count: int) -> Sequence:
 def stride(sequence: Sequence, step: int) -> Sequence:
     """Every ``step``-th frame, renumbered from 0 (the scan count stays known if it was)."""
     if step < 1:
-        raise ValueError(f"expected a positive stride, got {step}")
+        raise SliceError(f"expected a positive stride (every STEP-th scan, STEP >= 1), got {step}")
 
     def pick(frames: Iterator[Frame]) -> Iterator[Frame]:
         for i, frame in enumerate(itertools.islice(frames, 0, None, step)):

@@ -48,6 +48,14 @@ def point_segment_distance(x: float, y: float, s: FloatArray) -> float:
     return np.hypot(s[0] + t * (s[2] - s[0]) - x, s[1] + t * (s[3] - s[1]) - y)
 
 
+def line_angle(direction_difference: float) -> float:
+    """The angle between two undirected lines whose directions differ by ``direction_difference``, in [0, pi/2].
+
+    Folds by the floored modulo of :func:`albot1.geometry.se2.wrap_angle`, on half turns.
+    """
+    return abs((direction_difference + 0.5 * math.pi) % math.pi - 0.5 * math.pi)
+
+
 def segments_cross(a: FloatArray, b: FloatArray) -> bool:
     """Whether segments ``a`` and ``b`` cross.
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import importlib.util
 import inspect
+import shutil
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -53,26 +54,67 @@ def _static_attr(cls: type, name: str) -> object | None:
 
 @dataclass(frozen=True)
 class MethodSpec:
-    """How to find a method: its class, the imports it needs, its error class."""
+    """How to find a method: its class, the imports and programs it needs, its error class.
+
+    ``executables`` are external programs the method runs (looked up on
+    ``PATH``); ``install_hint`` is the command that installs them, shown
+    when they are missing.
+    """
 
     name: str
     target: str  # "module:Class"
     requires: tuple[str, ...] = ()
     error_class: str = "albot1.methods.baselines.errors:BaselineError"
     description: str = ""
+    executables: tuple[str, ...] = ()
+    install_hint: str = ""
+    #: ``"module:function"`` the runner calls after a run on a dataset with reference poses, to score the
+    #: method's own claims against them (evaluation only: the mapper never sees the reference); see
+    #: :func:`albot1.runs.execute.run_method`.
+    judge: str | None = None
 
     def __post_init__(self) -> None:
         check_target(self.target)
         check_target(self.error_class)
+        if self.judge is not None:
+            check_target(self.judge)
+
+    def missing_modules(self) -> list[str]:
+        """Required imports that cannot be found (without importing them)."""
+        return [mod for mod in self.requires if importlib.util.find_spec(mod) is None]
+
+    def missing_executables(self) -> list[str]:
+        """Required programs that are not on ``PATH``."""
+        return [exe for exe in self.executables if shutil.which(exe) is None]
 
     def available(self) -> bool:
-        """True when every required import can be found (without importing it)."""
-        return all(importlib.util.find_spec(mod) is not None for mod in self.requires)
+        """True when every required import and program can be found."""
+        return not self.missing_modules() and not self.missing_executables()
+
+    def unavailable_reason(self) -> str | None:
+        """Why the method cannot run here (one line), or None when it can."""
+        parts = []
+        modules, programs = self.missing_modules(), self.missing_executables()
+        if modules:
+            parts.append(f"needs {', '.join(modules)}, which is not installed")
+        if programs:
+            parts.append(f"needs the program(s) {', '.join(programs)}, not found on PATH")
+        return "; ".join(parts) if parts else None
+
+    def install_command(self) -> str:
+        """The command that installs what is missing (``install_hint``, else ``pip install`` of the modules)."""
+        if self.install_hint:
+            return self.install_hint
+        modules = self.missing_modules()
+        return f"pip install {' '.join(modules)}" if modules else ""
 
     def load_class(self) -> type[Mapper]:
-        if not self.available():
-            missing = [m for m in self.requires if importlib.util.find_spec(m) is None]
-            raise UnknownMethodError(f"method {self.name!r} needs {', '.join(missing)}, which is not installed")
+        reason = self.unavailable_reason()
+        if reason is not None:
+            hint = self.install_command()
+            raise UnknownMethodError(
+                f"method {self.name!r} is unavailable: {reason}" + (f" (install: {hint})" if hint else "")
+            )
         return load_mapper_class(self.target)
 
     def load_error_class(self) -> type[Exception]:
@@ -102,6 +144,14 @@ METHODS: dict[str, MethodSpec] = {
             description="the Albot1 perceptual mapper (thesis chapter 3)",
         ),
         MethodSpec(
+            "albot1-places",
+            "albot1.methods.albot1.places.mapper:Albot1PlacesMapper",
+            requires=("networkx",),
+            error_class="albot1.methods.albot1.mapping.errors:MappingError",
+            description="Albot1 with its network of places (thesis chapter 4: exits, places, re-visits, exit aid)",
+            judge="albot1.metrics.places:judge_places",
+        ),
+        MethodSpec(
             "kiss-icp",
             "albot1.methods.baselines.kiss_icp:KissIcpMapper",
             requires=("kiss_icp",),
@@ -112,6 +162,20 @@ METHODS: dict[str, MethodSpec] = {
             "albot1.methods.baselines.gtsam_graph:GtsamGraphMapper",
             requires=("gtsam",),
             description="graph SLAM: scan-matching edges, loop closures, ISAM2 + final LM (GTSAM)",
+        ),
+        MethodSpec(
+            "mrpt-icp",
+            "albot1.methods.baselines.mrpt:MrptIcpMapper",
+            executables=("icp-slam",),
+            install_hint="apt-get install mrpt-apps (or: make mrpt)",
+            description="MRPT icp-slam: incremental ICP scan matching against a point map, no loop closing",
+        ),
+        MethodSpec(
+            "mrpt-rbpf",
+            "albot1.methods.baselines.mrpt:MrptRbpfMapper",
+            executables=("rbpf-slam",),
+            install_hint="apt-get install mrpt-apps (or: make mrpt)",
+            description="MRPT rbpf-slam: Rao-Blackwellized particle filter grid SLAM (GMapping family)",
         ),
     )
 }

@@ -19,10 +19,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
 
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ATTEMPT, METRICS, Failure, ResultsStore
+from albot1.data.degrade import parse_spec
 from albot1.records import (
     AttemptRecord,
     MetricsRecord,
@@ -32,9 +33,7 @@ from albot1.records import (
     number_at,
     read_record,
 )
-
-if TYPE_CHECKING:
-    from albot1.runs.folder import StoredRun
+from albot1.runs.folder import RESULT_FILE, StoredRun, read_run
 
 Source = Literal["metrics", "result", "attempt"]
 #: the record model behind each column source (``metrics.json``, ``result.json``, ``attempt.json``)
@@ -113,8 +112,6 @@ class CellRecord:
     def stored_run(self) -> StoredRun:
         """The run folder read back, once per record (several plots draw the same run)."""
         if self._stored is None:
-            from albot1.runs.folder import read_run
-
             self._stored = read_run(self.run_dir)
         return self._stored
 
@@ -126,8 +123,6 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
     its model is a RecordError naming the file and the field (e.g. a results
     folder made by an older version: run ``albot1 bench`` again).
     """
-    from albot1.runs.folder import RESULT_FILE
-
     store = ResultsStore(results_dir)
     plan = store.read_plan()
     records: list[CellRecord] = []
@@ -175,8 +170,6 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
 
 def severity_order(levels: list[str]) -> list[str]:
     """none, then Gaussian levels by sigma, then biases, then the thesis's systematic degradation."""
-    from albot1.data.degrade import parse_spec
-
     rank = {"none": 0, "gauss": 1, "bias": 2, "thesis": 3}
 
     def key(level: str) -> tuple[int, float, float]:

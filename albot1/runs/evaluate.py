@@ -1,9 +1,17 @@
-"""``evaluate_run``: a run folder in, ``metrics.json`` out.
+"""Evaluation: a trajectory scored against its dataset's reference, into ``metrics.json``.
 
-This is the only module of :mod:`albot1.metrics` that touches files: it
-reads the run with :func:`albot1.runs.folder.read_run`, reopens the dataset
-when the map-shape metric needs the scans, calls the pure metric functions
-and writes ``metrics.json`` atomically.
+Two sources, one scoring function (:func:`score`), so a run folder and an
+external trajectory holding the same poses get the same numbers digit for
+digit:
+
+* :func:`evaluate_run`: a run folder in, ``metrics.json`` written there. It
+  reads the run with :func:`albot1.runs.folder.read_run` and reopens the
+  dataset when the map-shape metric needs the scans.
+* :func:`evaluate_trajectory`: a trajectory file from another tool (TUM,
+  KITTI or a corrected CARMEN log; :mod:`albot1.data.trajectory`) scored
+  against the reference poses and relations of a dataset
+  (:mod:`albot1.runs.external` matches its poses to the scans). It has no
+  map, no counters and no timing: those metrics are null with that reason.
 
 Missing metrics. Every metric has one top-level key (``ate``,
 ``ate_windows``, ``rpe``, ``drift``, ``loop_gap``, ``orientation``,
@@ -23,24 +31,39 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
+from albot1.data.open import open_sequence
+from albot1.data.transforms import head
 from albot1.errors import Albot1Error
+from albot1.geometry import se2
+from albot1.metrics.alignment import describe, rigid_transform
+from albot1.metrics.ate import ate, windowed_ate
+from albot1.metrics.cost import cost
+from albot1.metrics.drift import drift
 from albot1.metrics.errors import MetricsError
+from albot1.metrics.loop_gap import pair_gaps, route_gap
+from albot1.metrics.map_shape import map_agreement
+from albot1.metrics.orientation import orientation_table
+from albot1.metrics.relations import relation_metric
+from albot1.metrics.rpe import rpe_set
+from albot1.metrics.updates import update_counts
 from albot1.records import (
     METRIC_NAMES,
     MISSING_NOTE,
     MetricName,
     MetricsRecord,
-    ResultRecord,
     dump_record,
     parse_record,
 )
+from albot1.runs.external import load_external
+from albot1.runs.folder import METRICS_FILE, read_run, write_record
+from albot1.runs.scored import Scored, scored_run
 from albot1.settings import Settings
 
 if TYPE_CHECKING:
-    from albot1.runs.folder import StoredRun
+    from albot1.data.model import Sequence
 
-METRICS_FILE = "metrics.json"
 #: The metrics of ``metrics.json`` in file order (defined once, by the record model).
 METRIC_KEYS: tuple[MetricName, ...] = METRIC_NAMES
 
@@ -49,26 +72,45 @@ NO_REFERENCE = "the dataset has no reference poses"
 
 def evaluate_run(run_dir: Path, *, settings: Settings | None = None) -> MetricsRecord:
     """Compute every metric of the run in ``run_dir``, write ``metrics.json`` there, return it."""
-    from albot1.runs.folder import read_run, write_record
-
     run = read_run(run_dir)
-    info = run.info
-    ref = run.reference
-    metrics: dict[str, Any] = {
-        "run": {
-            "key": info.key,
-            "method": info.method,
-            "dataset": info.dataset,
-            "preset": info.preset,
-            "degradation": info.degradation,
-            "seed": info.seed,
-            "scans": int(len(run.poses)),
-            "has_reference": ref is not None,
-        },
-        "missing": MISSING_NOTE,
-    }
+    record = score(scored_run(run), settings=settings, source=f"{run.path / METRICS_FILE} (being written)")
+    write_record(run.path / METRICS_FILE, record)
+    return record
+
+
+def evaluate_trajectory(
+    path: Path,
+    dataset: str,
+    *,
+    format_name: str | None = None,
+    label: str | None = None,
+    max_dt_s: float | None = None,
+    settings: Settings | None = None,
+    out: Path | None = None,
+    wrap: Callable[[Sequence], Sequence] | None = None,
+) -> tuple[MetricsRecord, Scored]:
+    """Score an external trajectory file against ``dataset``; write the metrics to ``out`` when given.
+
+    Returns the record and what was scored (for evo result files and the
+    CLI's note on poses left out).
+    """
+    scored = load_external(
+        path, dataset, format_name=format_name, label=label, max_dt_s=max_dt_s, settings=settings, wrap=wrap
+    )
+    record = score(scored, settings=settings, source=f"{out or path} (metrics being written)")
+    if out is not None:
+        write_record(out, record)
+    return record, scored
+
+
+def score(scored: Scored, *, settings: Settings | None = None, source: str = "metrics") -> MetricsRecord:
+    """Every metric of ``scored`` as a validated :class:`MetricsRecord` (``source`` names it in errors)."""
+    ref = scored.reference
+    poses = scored.poses
+    metrics: dict[str, Any] = {"run": scored.header, **scored.extra, "missing": MISSING_NOTE}
 
     def put(key: str, compute: Callable[[], dict[str, Any]], missing: str | None = None) -> None:
+        missing = scored.absent.get(key, missing)
         if missing is not None:
             metrics[key], metrics[f"{key}_reason"] = None, missing
             return
@@ -77,74 +119,67 @@ def evaluate_run(run_dir: Path, *, settings: Settings | None = None) -> MetricsR
         except Albot1Error as exc:
             metrics[key], metrics[f"{key}_reason"] = None, str(exc)
 
-    from albot1.metrics.ate import ate, windowed_ate
-    from albot1.metrics.cost import cost
-    from albot1.metrics.drift import drift
-    from albot1.metrics.loop_gap import pair_gaps, route_gap
-    from albot1.metrics.orientation import orientation_table
-    from albot1.metrics.relations import relation_metric
-    from albot1.metrics.rpe import rpe_set
-    from albot1.metrics.updates import update_counts
-
-    put("ate", lambda: ate(run.poses, ref), None if ref is not None else NO_REFERENCE)
-    put("ate_windows", lambda: windowed_ate(run.poses, ref), None if ref is not None else NO_REFERENCE)
-    put("rpe", lambda: rpe_set(run.poses, ref), None if ref is not None else NO_REFERENCE)
-    put("drift", lambda: drift(run.poses, ref), None if ref is not None else NO_REFERENCE)
-
-    if ref is not None:
-        put(
-            "loop_gap",
-            lambda: {
-                "units": {"gap": "m", "heading": "deg"},
-                "alignment": "none (relative poses)",
-                "route": route_gap(run.poses, ref),
-                **pair_gaps(run.timestamps, run.poses, ref),
-            },
-        )
-    elif _known_closed(info, len(run.poses), settings):
-        put(
-            "loop_gap",
-            lambda: {
-                "units": {"gap": "m", "heading": "deg"},
-                "alignment": "none (relative poses)",
-                "route": route_gap(run.poses, None),
-                "pairs": None,
-                "pairs_reason": NO_REFERENCE,
-            },
-        )
+    if ref is None:
+        for name in ("ate", "ate_windows", "rpe", "drift", "orientation"):
+            put(name, dict, NO_REFERENCE)
+        if _known_closed(scored.dataset, len(poses), settings):
+            put(
+                "loop_gap",
+                lambda: {
+                    "units": {"gap": "m", "heading": "deg"},
+                    "alignment": "none (relative poses)",
+                    "route": route_gap(poses, None),
+                    "pairs": None,
+                    "pairs_reason": NO_REFERENCE,
+                },
+            )
+        else:
+            put("loop_gap", dict, f"{NO_REFERENCE}, and the route is not known to be closed")
     else:
-        put("loop_gap", lambda: {}, f"{NO_REFERENCE}, and the route is not known to be closed")
+        reference: NDArray[np.float64] = ref
+        put("ate", lambda: ate(poses, reference))
+        put("ate_windows", lambda: windowed_ate(poses, reference))
+        put("rpe", lambda: rpe_set(poses, reference))
+        put("drift", lambda: drift(poses, reference))
+        put(
+            "loop_gap",
+            lambda: {
+                "units": {"gap": "m", "heading": "deg"},
+                "alignment": "none (relative poses)",
+                "route": route_gap(poses, reference),
+                **pair_gaps(scored.timestamps, poses, reference),
+            },
+        )
+        put("orientation", lambda: orientation_table(poses, reference, scored.timestamps))
 
-    put(
-        "orientation",
-        lambda: orientation_table(run.poses, ref, run.timestamps),
-        None if ref is not None else NO_REFERENCE,
-    )
-
-    relations_file = run.path / "relations.txt"
+    relations = scored.relations
     put(
         "relations",
         lambda: relation_metric(
-            run.timestamps,
-            run.poses,
-            run.relations,  # type: ignore[arg-type]
+            scored.relation_timestamps,
+            scored.relation_poses,
+            relations,  # type: ignore[arg-type]
             outside="exclude",
-            source=str(relations_file),
+            source=scored.relations_source,
         ),
-        None if run.relations is not None else "the dataset has no ground-truth relations",
+        None if relations is not None else "the dataset has no ground-truth relations",
     )
 
-    put("map_shape", lambda: _map_shape(run, settings), None if ref is not None else NO_REFERENCE)
-    put("updates", lambda: update_counts(dict(info.counters)))
-    put("cost", lambda: cost(run.per_scan_ns, dump_record(info.timing)))
+    put("map_shape", lambda: _map_shape(scored, settings), None if ref is not None else NO_REFERENCE)
+    counters = scored.counters
+    put("updates", lambda: update_counts(dict(counters or {})))
+    per_scan_ns, timing = scored.per_scan_ns, scored.timing
+    put(
+        "cost",
+        lambda: cost(per_scan_ns, dump_record(timing) if timing is not None else {}),  # type: ignore[arg-type]
+        None if per_scan_ns is not None else "no per-scan timings",
+    )
 
-    record = parse_record(MetricsRecord, metrics, f"{run.path / METRICS_FILE} (being written)")
-    write_record(run.path / METRICS_FILE, record)
-    return record
+    return parse_record(MetricsRecord, metrics, source)
 
 
-def _known_closed(info: ResultRecord, scans: int, settings: Settings | None) -> bool:
-    """Whether the run covers a whole route its dataset declares closed (``closed_loop`` metadata).
+def _known_closed(dataset: str, scans: int, settings: Settings | None) -> bool:
+    """Whether ``scans`` poses cover a whole route ``dataset`` declares closed (``closed_loop`` metadata).
 
     Only then may the end-to-start gap be reported without reference poses:
     the reference offset is zero by declaration, not by assumption. A run
@@ -152,31 +187,25 @@ def _known_closed(info: ResultRecord, scans: int, settings: Settings | None) -> 
     dataset's scans is free for the synthetic worlds (the ones that declare
     closed routes) and a full pass for a streamed log.
     """
-    from albot1.data.open import open_sequence
-
     try:
-        sequence = open_sequence(info.dataset, settings=settings)
+        sequence = open_sequence(dataset, settings=settings)
     except Albot1Error:
         return False
     return bool(sequence.metadata.extra.get("closed_loop", False)) and sequence.count_scans() == scans
 
 
-def _map_shape(run: StoredRun, settings: Settings | None) -> dict[str, Any]:
-    """Reopen the dataset, project its scans with the reference poses and compare with the run's map."""
-    from albot1.data.open import open_sequence
-    from albot1.data.transforms import head
-    from albot1.geometry import se2
-    from albot1.metrics.alignment import describe, rigid_transform
-    from albot1.metrics.map_shape import map_agreement
-
-    info, reference = run.info, run.reference
+def _map_shape(scored: Scored, settings: Settings | None) -> dict[str, Any]:
+    """Reopen the dataset, project its scans with the reference poses and compare with the map."""
+    reference, dataset = scored.reference, scored.dataset
     if reference is None:
         raise MetricsError(NO_REFERENCE)
-    n = int(len(run.poses))
+    if scored.load_map is None:
+        raise MetricsError("no map to compare")
+    n = int(len(scored.poses))
     try:
-        sequence = head(open_sequence(info.dataset, settings=settings), n)
+        sequence = head(open_sequence(dataset, settings=settings), n)
     except Albot1Error as exc:
-        raise MetricsError(f"cannot reopen dataset {info.dataset!r} for the reference map: {exc}") from exc
+        raise MetricsError(f"cannot reopen dataset {dataset!r} for the reference map: {exc}") from exc
     offset = np.asarray(sequence.metadata.sensor_offset, dtype=float)
     parts: list[np.ndarray] = []
     count = 0
@@ -184,18 +213,18 @@ def _map_shape(run: StoredRun, settings: Settings | None) -> dict[str, Any]:
         k = frame.index
         if k >= n:
             break
-        if abs(frame.scan.timestamp - run.timestamps[k]) > 1e-3:
+        if abs(frame.scan.timestamp - scored.timestamps[k]) > 1e-3:
             raise MetricsError(
-                f"dataset {info.dataset!r} scan {k} has time {frame.scan.timestamp:.6f} but the "
-                f"run's trajectory has {run.timestamps[k]:.6f}; the dataset changed since the run"
+                f"dataset {dataset!r} scan {k} has time {frame.scan.timestamp:.6f} but the "
+                f"run's trajectory has {scored.timestamps[k]:.6f}; the dataset changed since the run"
             )
         sensor = se2.compose(reference[k], offset)
         parts.append(se2.transform_points(sensor, frame.scan.points()))
         count += 1
     if count != n:
-        raise MetricsError(f"dataset {info.dataset!r} has {count} scans, the run has {n}")
-    transform = rigid_transform(run.poses, reference)
-    map_points = se2.transform_points(transform, run.load_map().geometry_points())
+        raise MetricsError(f"dataset {dataset!r} has {count} scans, the run has {n}")
+    transform = rigid_transform(scored.poses, reference)
+    map_points = se2.transform_points(transform, scored.load_map().geometry_points())
     block = map_agreement(map_points, np.concatenate(parts) if parts else np.empty((0, 2)))
     return {
         "units": {"distance": "m", "precision": "fraction", "coverage": "fraction"},

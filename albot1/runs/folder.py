@@ -10,6 +10,7 @@ degradation, seed, code version)::
     result.json      method, dataset, config, versions, counters, timing (albot1.records.ResultRecord)
     map.geojson      line surfaces (Albot1) -- or map.npz (points) for baselines
     extras.json      method-specific records (update trace, ...)
+    <extra files>    a mapper's own files (``MapperOutput.files``: places.json, places.graphml, ...)
     preview.png      the map with the trajectory (drawn by the caller's renderer, if given)
     DONE             written last, by atomic rename: the run is complete
 
@@ -22,6 +23,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,12 +36,39 @@ from albot1.atomic import atomic_write
 from albot1.contract import MapData, RunResult
 from albot1.data.model import Relations
 from albot1.data.relations import read_relations, write_relations
+from albot1.data.trajectory import read_tum, write_tum
+from albot1.errors import Albot1Error
 from albot1.records import Record, ResultRecord, dump_record, json_value, parse_record, read_record
 from albot1.runs.errors import RunError
-from albot1.runs.tum import read_tum, write_tum
 
 DONE = "DONE"
 RESULT_FILE = "result.json"
+METRICS_FILE = "metrics.json"
+LATEST = "latest"
+#: Files of a run that a new write of the same folder may not produce again (the metrics above all:
+#: they belong to the older run); :func:`write_run` removes them first.
+REWRITTEN_FILES = (METRICS_FILE, "reference.tum", "relations.txt", "map.geojson", "map.npz", "preview.png")
+#: The files a run folder may hold (the bench's cell files included); a mapper's extra file must not take one.
+STANDARD_FILES = frozenset(
+    {
+        "trajectory.tum",
+        "odometry.tum",
+        "reference.tum",
+        "relations.txt",
+        RESULT_FILE,
+        "map.geojson",
+        "map.npz",
+        "extras.json",
+        "preview.png",
+        "per_scan_ns.npy",
+        METRICS_FILE,
+        DONE,
+        "cell.json",
+        "cell.log",
+        "attempt.json",
+        "FAILED.json",
+    }
+)
 
 #: Draws a run's ``preview.png`` (``albot1.report.preview.render_preview``). The caller passes it in:
 #: storing a run must not depend on the plotting layer above it (docs/architecture.md, layers).
@@ -88,6 +117,8 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
     run_dir = root / key
     run_dir.mkdir(parents=True, exist_ok=True)
     (run_dir / DONE).unlink(missing_ok=True)
+    for name in REWRITTEN_FILES:  # a re-run never leaves an older run's metrics, map or preview behind
+        (run_dir / name).unlink(missing_ok=True)
 
     atomic_write(run_dir / "trajectory.tum", lambda p: write_tum(p, result.timestamps, result.poses))
     atomic_write(run_dir / "odometry.tum", lambda p: write_tum(p, result.timestamps, result.odometry))
@@ -98,6 +129,7 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
         write_relations(run_dir / "relations.txt", result.relations)  # atomic itself
     map_file = _write_map(run_dir, result.map)
     write_json(run_dir / "extras.json", result.extras)
+    _write_files(run_dir, result.files)
     info = {
         "key": key,
         "method": result.method,
@@ -121,6 +153,22 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
         atomic_write(run_dir / "preview.png", lambda p: preview(result, p))
     atomic_write(run_dir / DONE, lambda p: p.write_text(key + "\n"))
     return run_dir
+
+
+def _write_files(run_dir: Path, files: dict[str, Any]) -> None:
+    """A mapper's extra files: text for a str, bytes as they are, anything else as JSON; names are checked."""
+    for name, content in files.items():
+        if not name or Path(name).name != name or name.startswith(".") or name in STANDARD_FILES:
+            raise RunError(
+                f"{run_dir}: extra file name {name!r} from the mapper; expected a plain file name that is not one "
+                f"of the run folder's own ({', '.join(sorted(STANDARD_FILES))})"
+            )
+        if isinstance(content, str):
+            atomic_write(run_dir / name, lambda p, text=content: p.write_text(text, encoding="utf-8"))
+        elif isinstance(content, bytes):
+            atomic_write(run_dir / name, lambda p, data=content: p.write_bytes(data))
+        else:
+            write_json(run_dir / name, content)
 
 
 def _write_map(run_dir: Path, data: MapData) -> str:
@@ -206,3 +254,63 @@ def read_result(run_dir: str | Path) -> ResultRecord:
     if not is_complete(path):
         raise RunError(f"{path}: the run is incomplete (no {DONE} marker); run it again")
     return read_record(ResultRecord, path / RESULT_FILE)
+
+
+def mark_latest(root: Path, run_dir: Path) -> Path:
+    """Point ``root/latest`` at ``run_dir`` (a relative symbolic link, replaced atomically); returns the link.
+
+    Run folders are named by a content hash; ``runs/latest`` is the one a
+    person just made. RunError when ``root/latest`` exists and is not a link.
+    """
+    link = root / LATEST
+    if link.exists() and not link.is_symlink():
+        raise RunError(f"{link}: exists and is not a symbolic link; cannot mark the latest run there")
+    tmp = root / f".{LATEST}.{os.getpid()}"
+    tmp.unlink(missing_ok=True)
+    os.symlink(os.path.relpath(run_dir, root), tmp)
+    os.replace(tmp, link)
+    return link
+
+
+@dataclass(frozen=True)
+class RunListing:
+    """One folder under a runs root, as ``albot1 runs`` lists it."""
+
+    path: Path
+    status: str  # done | evaluated | incomplete | failed | unreadable
+    info: ResultRecord | None
+    modified: float
+    problem: str | None = None
+
+
+def list_runs(root: Path) -> list[RunListing]:
+    """Every run folder directly under ``root`` (oldest first); folders that are not runs are left out.
+
+    A folder is a run when it holds ``result.json``, ``DONE`` or the bench's
+    ``FAILED.json``; one whose ``result.json`` does not read is listed as
+    unreadable with the reason, never skipped.
+    """
+    if not root.is_dir():
+        raise RunError(f"{root}: not a folder of runs")
+    out: list[RunListing] = []
+    for folder in sorted(p for p in root.iterdir() if p.is_dir() and not p.is_symlink()):
+        markers = [folder / name for name in (RESULT_FILE, DONE, "FAILED.json")]
+        present = [m for m in markers if m.exists()]
+        if not present:
+            continue
+        modified = max(m.stat().st_mtime for m in present)
+        if not (folder / RESULT_FILE).is_file():
+            failed = (folder / "FAILED.json").is_file()
+            out.append(RunListing(folder, "failed" if failed else "incomplete", None, modified))
+            continue
+        try:
+            info = read_record(ResultRecord, folder / RESULT_FILE)
+        except Albot1Error as exc:
+            out.append(RunListing(folder, "unreadable", None, modified, str(exc)))
+            continue
+        if not is_complete(folder):
+            status = "incomplete"
+        else:
+            status = "evaluated" if (folder / METRICS_FILE).is_file() else "done"
+        out.append(RunListing(folder, status, info, modified))
+    return sorted(out, key=lambda r: (r.modified, r.path.name))

@@ -34,3 +34,25 @@ def test_errors_are_one_line_on_stderr_with_exit_1(tmp_path: Path) -> None:
         assert done.returncode == 1, done.stderr
         assert done.stderr.startswith("albot1: error: ") and words in done.stderr
         assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
+
+
+def test_bench_exits_1_after_the_whole_grid_when_a_cell_failed(tmp_path: Path) -> None:
+    suite = tmp_path / "onefails.toml"
+    suite.write_text(
+        '[[methods]]\nname = "odometry"\n\n'
+        '[[methods]]\nname = "odometry"\nlabel = "odometry:bad-config"\nset = { map_voxel_m = -1 }\n\n'
+        '[[datasets]]\nname = "synthetic-office-startstop"\n'
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+        + ["--results", str(tmp_path / "results"), "--no-progress"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+    )
+    assert done.returncode == 1, done.stderr
+    assert "total" in done.stdout and "albot1 report" in done.stdout  # the summary was printed first
+    assert done.stderr.strip().splitlines()[-1] == "1 of 2 cells failed (reasons above and in the report)"
+    assert "Traceback" not in done.stderr
+    assert (tmp_path / "results" / "onefails" / "grid.json").is_file()

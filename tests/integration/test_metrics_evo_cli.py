@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from albot1.data.trajectory import read_tum, write_tum
 from albot1.geometry import se2
 from albot1.metrics.ate import ate
 from albot1.metrics.rpe import rpe
-from albot1.runs.tum import read_tum, write_tum
 
 
 def evo_tool(name: str) -> Path:

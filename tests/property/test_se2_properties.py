@@ -32,3 +32,17 @@ def test_between_recovers(a: np.ndarray, b: np.ndarray) -> None:
 def test_relative_pose_invariant_under_common_transform(a: np.ndarray, b: np.ndarray) -> None:
     g = np.array([3.0, -7.0, 1.2])
     _close(se2.between(se2.compose(g, a), se2.compose(g, b)), se2.between(a, b))
+
+
+@given(pose, pose)
+def test_scalar_and_vectorised_forms_agree(a: np.ndarray, b: np.ndarray) -> None:
+    for scalar, vectorised in ((se2.compose_pose, se2.compose), (se2.between_pose, se2.between)):
+        got, want = np.array(scalar(tuple(a.tolist()), tuple(b.tolist()))), vectorised(a, b)
+        np.testing.assert_allclose(got[:2], want[:2], rtol=1e-12, atol=1e-9)
+        assert got[2] == want[2]  # one wrap: the same bits
+
+
+@given(angle)
+def test_wrap_angle_is_the_vectorised_wrap(a: float) -> None:
+    assert se2.wrap_angle(a) == float(se2.wrap(a))
+    assert -np.pi <= se2.wrap_angle(a) < np.pi

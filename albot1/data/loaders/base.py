@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
-from albot1.data.model import Sequence
+from albot1.data.model import Frame, Sequence
 
 
 @runtime_checkable
@@ -39,3 +39,21 @@ class SequenceWriter(Protocol):
     def write(self, sequence: Sequence, path: Path) -> None:
         """Write every frame (scan, odometry, reference when present) to ``path``."""
         ...
+
+
+def reference_presence_problem(first: Frame, frame: Frame, reader: str) -> str | None:
+    """Why ``frame`` cannot follow ``first`` in a format that keeps reference poses for all scans or none.
+
+    CARMEN (TRUEPOS lines) and bags (a reference topic) interpolate the
+    reference poses to every scan's time, so a sequence where only some frames
+    have one would come back with invented poses (or be refused): the writers
+    refuse it instead. The albot log stores a reference per view and needs no
+    such rule.
+    """
+    if (first.reference is None) == (frame.reference is None):
+        return None
+    has, lacks = (frame, first) if frame.reference is not None else (first, frame)
+    return (
+        f"frame {has.index} has a reference pose but frame {lacks.index} has none; {reader} holds reference "
+        f"poses for every scan or for none (it interpolates them to each scan's time)"
+    )

@@ -31,10 +31,10 @@ BZ2_MAGIC = b"BZh"
 BZ2_BLOCK_MAGIC = 0x314159265359
 BZ2_END_MAGIC = 0x177245385090
 _BZ2_MAGIC_BITS = 48
-#: Compressed bytes fed to the decompressor at a time. A failing call loses its own output, so gzip
-#: gets small pieces (the lines decoded before a corrupt spot still count, and the spot is located to
-#: within 8 KiB); bzip2 only checks whole blocks of up to 900 kB, which smaller pieces would not refine.
-PIECE_BYTES = {"gzip": 1 << 13, "bzip2": 1 << 16}
+#: Compressed bytes fed to the decompressor at a time. A failing call loses its own output, so the
+#: pieces are small: the lines decoded before a damaged spot still count, and a gzip failure is
+#: located to within 8 KiB (bzip2 checks whole blocks of up to 900 kB; its block is named instead).
+PIECE_BYTES = 1 << 13
 #: Uncompressed files are read this much at a time.
 PLAIN_BYTES = 1 << 21
 
@@ -144,8 +144,7 @@ def iter_decompressed(path: Path, compression: str | None = None) -> Iterator[by
         fed = False  # whether the current stream has received bytes
         streams = 0  # streams completed
         offset = 0  # compressed bytes before the current piece
-        piece_bytes = PIECE_BYTES[compression]
-        while piece := fh.read(piece_bytes):
+        while piece := fh.read(PIECE_BYTES):
             pos = 0
             while pos < len(piece):
                 data = piece[pos:] if pos else piece

@@ -33,6 +33,12 @@ FORMATS: dict[str, tuple[str, str | None]] = {
     ),
 }
 
+#: formats that can be written but not read: format name -> writer "module:Class".
+#: An MRPT rawlog is only ever an input of MRPT's applications (albot1.methods.baselines.mrpt).
+WRITE_ONLY_FORMATS: dict[str, str] = {
+    "rawlog": "albot1.data.loaders.rawlog.writer:RawlogWriter",
+}
+
 
 def _import(target: str) -> Any:
     try:
@@ -42,10 +48,13 @@ def _import(target: str) -> Any:
 
 
 def _check_format(name: str) -> tuple[str, str | None]:
+    if name in WRITE_ONLY_FORMATS:
+        raise UnknownFormatError(f"format {name!r} can be written but not read")
     try:
         return FORMATS[name]
     except KeyError:
-        raise UnknownFormatError(f"unknown format {name!r}; expected one of: {', '.join(FORMATS)}") from None
+        known = [*FORMATS, *WRITE_ONLY_FORMATS]
+        raise UnknownFormatError(f"unknown format {name!r}; expected one of: {', '.join(known)}") from None
 
 
 def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoader:
@@ -53,7 +62,11 @@ def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoad
     p = Path(path)
     if format_name is not None:
         return _import(_check_format(format_name)[0])()
-    if not p.exists():
+    try:
+        found = p.exists()
+    except (OSError, ValueError) as exc:  # a name too long for the file system, an embedded NUL
+        raise DataError(f"{str(p)[:80]}...: not a usable path ({exc.__class__.__name__})") from None
+    if not found:
         raise DataError(f"{p}: no such file or directory")
     seen: set[str] = set()
     for loader_target, _ in FORMATS.values():
@@ -67,7 +80,9 @@ def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoad
 
 
 def writer_for(format_name: str) -> SequenceWriter:
-    """The writer of a format name (see :data:`FORMATS`)."""
+    """The writer of a format name (see :data:`FORMATS` and :data:`WRITE_ONLY_FORMATS`)."""
+    if format_name in WRITE_ONLY_FORMATS:
+        return _import(WRITE_ONLY_FORMATS[format_name])()
     writer_target = _check_format(format_name)[1]
     if writer_target is None:
         raise UnknownFormatError(f"format {format_name!r} can be read but not written")

@@ -16,3 +16,7 @@ class SyntheticWorldError(DataError):
 
 class UnknownWorldError(SyntheticWorldError, DatasetNotFoundError):
     """No embedded synthetic world has the requested name."""
+
+
+class WorldOptionError(SyntheticWorldError, DatasetNotFoundError):
+    """A loader option a synthetic world does not take (``start=``, ``laps=`` are the ones some take)."""

@@ -50,6 +50,9 @@ class WorldSpec:
     odometry: OdometryErrorModel = field(default_factory=OdometryErrorModel)
     seed: int = 0
     laps: int = 1
+    #: Waypoints of the closed route the world may also be driven from: loader option ``start=K`` picks
+    #: ``starts[K]`` (empty: the world takes no ``start`` option).
+    starts: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)

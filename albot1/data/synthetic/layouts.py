@@ -100,3 +100,108 @@ def corridor_plan() -> FloorPlan:
 
 def corridor_route() -> Route:
     return Route(waypoints=((2.0, 0.0), (55.0, 0.0)))
+
+
+# --- Six rooms joined by doorways (thesis chapter 4, Experiments 4.2.1-4.2.3) -------------------------------------
+#
+# Six rooms of different sizes (4.8-7 m deep, 5-8 m wide) and furniture, in two rows, joined in a ring by six
+# 1 m doorways: room-1 (north-west) -> room-2 -> room-3 (north-east) -> room-4 (south-east) -> room-5 ->
+# room-6 (south-west) -> room-1. No two rooms have the same shape: a room is told from another by its
+# structure (4.1.2), as the rooms of the thesis's lab floor are. The double-loop plan adds a seventh doorway
+# between room-2 and room-5, so a second loop can enter room-5 from the north, a direction the first loop
+# never saw it from (4.2.2).
+
+PLACES_SPACES: tuple[Space, ...] = (
+    Space("room-1", (0.0, 6.2, 6.0, 12.2)),
+    Space("room-2", (6.2, 6.2, 14.2, 11.0)),
+    Space("room-3", (14.4, 6.2, 20.0, 13.0)),
+    Space("room-4", (12.2, -1.0, 20.0, 6.0)),
+    Space("room-5", (5.2, 1.0, 12.0, 6.0)),
+    Space("room-6", (0.0, 0.0, 5.0, 6.0)),
+)
+
+PLACES_DOORWAYS: tuple[DoorwaySpec, ...] = (
+    DoorwaySpec("door-1-2", (6.1, 9.0), "y", 1.0),
+    DoorwaySpec("door-2-3", (14.3, 8.0), "y", 1.0),
+    DoorwaySpec("door-3-4", (18.0, 6.1), "x", 1.0),
+    DoorwaySpec("door-4-5", (12.1, 3.0), "y", 1.0),
+    DoorwaySpec("door-5-6", (5.1, 4.0), "y", 1.0),
+    DoorwaySpec("door-6-1", (2.5, 6.1), "x", 1.0),
+)
+
+#: The double loop's extra doorway: room-2 to room-5 through their shared wall.
+PLACES_DOOR_2_5 = DoorwaySpec("door-2-5", (9.3, 6.1), "x", 1.0)
+
+PLACES_FURNITURE: tuple[Rect, ...] = (
+    (0.8, 10.8, 2.8, 11.6),  # room-1: desk, cabinet, pillar
+    (4.6, 7.0, 5.6, 7.6),
+    (3.6, 7.9, 4.1, 8.4),
+    (7.5, 10.0, 11.5, 10.5),  # room-2: long bench and two boxes
+    (8.0, 6.8, 8.6, 7.4),
+    (12.2, 8.6, 13.4, 9.2),
+    (15.0, 11.6, 16.8, 12.5),  # room-3: cabinet, shelf, pillar
+    (18.6, 9.0, 19.5, 12.0),
+    (16.5, 7.4, 17.0, 7.9),
+    (14.5, 1.0, 17.0, 2.5),  # room-4: table, cabinet, box
+    (19.2, -0.6, 19.7, 1.6),
+    (12.8, -0.5, 13.6, 0.2),
+    (6.0, 1.5, 7.5, 2.2),  # room-5: two desks and a pillar
+    (9.8, 4.6, 11.3, 5.3),
+    (8.8, 2.0, 9.3, 2.5),
+    (0.5, 0.5, 2.5, 1.5),  # room-6: desk and shelf
+    (3.3, 1.5, 4.0, 3.3),
+)
+
+#: One lap of the single loop, from S in room-1 clockwise through the six doorways back to S.
+PLACES_LOOP: tuple[tuple[float, float], ...] = (
+    (2.5, 8.2),  # S, room-1
+    (2.5, 9.0),
+    (7.0, 9.0),  # through door-1-2
+    (10.0, 9.0),
+    (10.0, 8.0),
+    (15.2, 8.0),  # through door-2-3
+    (16.0, 10.0),  # A, room-3
+    (18.0, 9.0),
+    (18.0, 5.0),  # through door-3-4
+    (18.0, 0.3),
+    (14.0, 0.4),
+    (13.2, 3.0),
+    (11.2, 3.0),  # through door-4-5
+    (10.0, 3.2),  # B, room-5
+    (8.0, 3.5),
+    (8.0, 4.0),
+    (4.3, 4.0),  # through door-5-6
+    (2.5, 4.0),
+    (2.5, 8.2),  # through door-6-1, back at S
+)
+
+#: The waypoints the loop may start from (``synthetic-places-loop?start=K``): S (room-1), A (room-3), B (room-5).
+PLACES_LOOP_STARTS: tuple[int, ...] = (0, 6, 13)
+
+#: After the first lap, a second loop that leaves room-2 south through door-2-5 into room-5 (a new direction).
+PLACES_SECOND_LOOP: tuple[tuple[float, float], ...] = (
+    (2.5, 9.0),
+    (7.0, 9.0),  # through door-1-2
+    (9.3, 9.0),
+    (9.3, 5.0),  # through door-2-5: room-5 entered from the north
+    (8.0, 4.0),
+    (4.3, 4.0),  # through door-5-6
+    (2.5, 4.0),
+    (2.5, 8.2),  # through door-6-1, back at S
+)
+
+
+def places_plan() -> FloorPlan:
+    return build_plan("six-rooms", PLACES_SPACES, PLACES_DOORWAYS, PLACES_FURNITURE)
+
+
+def places_double_plan() -> FloorPlan:
+    return build_plan("six-rooms-double", PLACES_SPACES, (*PLACES_DOORWAYS, PLACES_DOOR_2_5), PLACES_FURNITURE)
+
+
+def places_loop() -> Route:
+    return Route(waypoints=PLACES_LOOP, closed=True)
+
+
+def places_double_loop() -> Route:
+    return Route(waypoints=PLACES_LOOP + PLACES_SECOND_LOOP, closed=True)

@@ -97,6 +97,23 @@ class Route:
         return float(np.sum(np.hypot(np.diff(w[:, 0]), np.diff(w[:, 1]))))
 
 
+def start_at(route: Route, waypoint: int) -> Route:
+    """The same closed loop driven from ``route.waypoints[waypoint]`` (facing the waypoint after it).
+
+    Chapter 4's first experiment repeats one loop from three start points; the
+    loop is the same, only where it is cut open changes.
+    """
+    if not route.closed:
+        raise SyntheticWorldError("route: only a closed route can start at another waypoint")
+    last = len(route.waypoints) - 1
+    if not 0 <= waypoint < last:
+        raise SyntheticWorldError(f"route: start waypoint {waypoint} is not one of the loop's 0..{last - 1}")
+    if waypoint == 0:
+        return route
+    w = route.waypoints
+    return Route(waypoints=(*w[waypoint:], *w[1 : waypoint + 1]), closed=True)
+
+
 def sample(route: Route, sampling: Sampling) -> FloatArray:
     """The scan poses ``(N, 3)`` along ``route``: the start pose, then one per step."""
     w = np.asarray(route.waypoints, dtype=float)

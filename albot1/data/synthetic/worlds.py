@@ -18,19 +18,21 @@ to them): keep them stable.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
-from albot1.data.synthetic.errors import UnknownWorldError
+from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError
 from albot1.data.synthetic.floorplan import DoorwayCrossing
 from albot1.data.synthetic.generate import WorldData, WorldSpec, generate, stream_frames, world_metadata
 from albot1.data.synthetic.odometry import OdometryErrorModel
-from albot1.data.synthetic.route import CONTINUOUS, START_STOP, START_STOP_10DEG
+from albot1.data.synthetic.route import CONTINUOUS, START_STOP, START_STOP_10DEG, Route, start_at
 
 __all__ = [
     "OFFICE_ODOMETRY",
@@ -121,8 +123,33 @@ WORLDS: dict[str, WorldSpec] = {
             seed=126,
             laps=20,
         ),
+        WorldSpec(
+            name="synthetic-places-loop",
+            description="a single loop of about 50 m through six furnished rooms joined by 1 m doorways (thesis "
+            "chapter 4, Experiment 4.2.1); start=0|1|2 drives it from S (room-1), A (room-3) or B (room-5); "
+            "laps=2 drives it twice (4.2.3)",
+            plan=layouts.places_plan,
+            route=layouts.places_loop,
+            sampling=CONTINUOUS,
+            odometry=OFFICE_ODOMETRY,
+            seed=141,
+            starts=layouts.PLACES_LOOP_STARTS,
+        ),
+        WorldSpec(
+            name="synthetic-places-double-loop",
+            description="the six rooms with a seventh doorway (room-2 to room-5): the single loop, then a second "
+            "loop that enters room-5 from the north, a direction never seen before (thesis Experiment 4.2.2)",
+            plan=layouts.places_double_plan,
+            route=layouts.places_double_loop,
+            sampling=CONTINUOUS,
+            odometry=OFFICE_ODOMETRY,
+            seed=142,
+        ),
     )
 }
+
+#: Loader options a world may take (``synthetic-places-loop?start=1&laps=2``); see :func:`variant`.
+WORLD_OPTIONS = ("start", "laps")
 
 
 def spec_for(name: str) -> WorldSpec:
@@ -135,16 +162,65 @@ def spec_for(name: str) -> WorldSpec:
         ) from None
 
 
+def variant(name: str, options: dict[str, Any]) -> WorldSpec:
+    """The spec of world ``name`` under loader options; WorldOptionError naming a bad one.
+
+    ``start=K`` (worlds that list start points) drives the closed route from
+    its K-th start point; ``laps=N`` (closed routes) drives it N times. The
+    variant's name is the reference that selects it, e.g.
+    ``synthetic-places-loop?start=2``, so a run names exactly what it ran.
+    An option the world does not take is a :class:`WorldOptionError` (also a
+    ``DatasetNotFoundError``: that world-with-options does not exist).
+    """
+    spec = spec_for(name)
+    unknown = sorted(set(options) - set(WORLD_OPTIONS))
+    if unknown:
+        raise WorldOptionError(
+            f"synthetic world {name!r}: unknown loader option(s) {', '.join(unknown)}; "
+            f"expected {' or '.join(WORLD_OPTIONS)}"
+        )
+    if not options:
+        return spec
+    start, laps = options.get("start", 0), options.get("laps", spec.laps)
+    if "start" in options:
+        if not spec.starts:
+            raise WorldOptionError(f"synthetic world {name!r} has one start point; it takes no start option")
+        if not (type(start) is int and 0 <= start < len(spec.starts)):
+            raise WorldOptionError(
+                f"synthetic world {name!r}: start={start}; expected an integer 0..{len(spec.starts) - 1}"
+            )
+    if not (type(laps) is int and laps >= 1):
+        raise WorldOptionError(f"synthetic world {name!r}: laps={laps}; expected a positive integer")
+    if laps != 1 and not spec.route().closed:
+        raise WorldOptionError(f"synthetic world {name!r}: laps={laps}, but its route is not a closed loop")
+    waypoint = spec.starts[start] if spec.starts else 0
+    query = "&".join(f"{key}={options[key]}" for key in WORLD_OPTIONS if key in options)
+    return dataclasses.replace(
+        spec,
+        name=f"{name}?{query}",
+        route=functools.partial(_route_from, spec, waypoint),
+        laps=laps,
+    )
+
+
+def _route_from(spec: WorldSpec, waypoint: int) -> Route:
+    return start_at(spec.route(), waypoint)
+
+
 @functools.cache
-def world_data(name: str) -> WorldData:
-    """The generated world ``name`` (cached per process)."""
-    return generate(spec_for(name))
+def _generated(name: str, options: tuple[tuple[str, Any], ...]) -> WorldData:
+    return generate(variant(name, dict(options)))
 
 
-def load_world(name: str) -> Sequence:
-    """The embedded world ``name`` as a streamed Sequence (reference = exact poses)."""
-    data = world_data(name)
-    return Sequence(name, functools.partial(stream_frames, data), world_metadata(data), scan_count=data.scans)
+def world_data(name: str, **options: Any) -> WorldData:
+    """The generated world ``name`` (with loader options; cached per process)."""
+    return _generated(name, tuple(sorted(options.items())))
+
+
+def load_world(name: str, **options: Any) -> Sequence:
+    """The embedded world ``name`` (with loader options) as a streamed Sequence (reference = exact poses)."""
+    data = world_data(name, **options)
+    return Sequence(data.spec.name, functools.partial(stream_frames, data), world_metadata(data), scan_count=data.scans)
 
 
 def world_geometry(name: str) -> FloatArray:

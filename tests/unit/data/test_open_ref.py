@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from albot1.data.errors import DatasetNotFoundError
+from albot1.data.errors import DatasetNotFoundError, SliceError
 from albot1.data.open import open_sequence, parse_options
+from albot1.data.transforms import head, stride
 
 
 def test_parse_options_converts_numbers() -> None:
@@ -29,7 +30,7 @@ def test_slice_of_a_world() -> None:
 
 
 def test_world_rejects_loader_options() -> None:
-    with pytest.raises(DatasetNotFoundError, match="takes no loader options, got odometry"):
+    with pytest.raises(DatasetNotFoundError, match="unknown loader option.s. odometry; expected start or laps"):
         open_sequence("synthetic-office-startstop?odometry=laser-pose")
 
 
@@ -43,3 +44,29 @@ def test_corrected_log_with_clean_odometry(data_file) -> None:  # type: ignore[n
     seq = open_sequence("intel-corrected?odometry=laser-pose[:50]")
     assert seq.count_scans() == 50 and seq.reference is not None
     assert (seq.odometry == seq.reference).all()
+
+
+@pytest.mark.parametrize(
+    ("ref", "message"),
+    [
+        ("synthetic-office-startstop[:0]", r"'synthetic-office-startstop\[:0\]': slice STOP is 0, expected a positive"),
+        ("synthetic-office-startstop[::0]", r"slice STEP is 0, expected a positive integer"),
+        ("synthetic-office-startstop[:5:0]", r"slice STEP is 0"),
+        ("synthetic-office-startstop[5]", r"slice \[5\] is not understood; expected \[:STOP\], \[:STOP:STEP\]"),
+        ("synthetic-office-startstop[-5:]", r"slice \[-5:\] is not understood"),
+        ("synthetic-office-startstop[:-5]", r"slice \[:-5\] is not understood"),
+        ("synthetic-office-startstop[:" + "9" * 5000 + "]", r"is not understood"),
+    ],
+)
+def test_bad_slices_are_one_line_errors_naming_the_reference(ref: str, message: str) -> None:
+    with pytest.raises(SliceError, match=message):
+        open_sequence(ref)
+
+
+def test_zero_limits_and_strides_are_data_errors() -> None:
+    seq = open_sequence("synthetic-office-startstop")
+    with pytest.raises(SliceError, match="expected a positive number of scans .* got 0"):
+        head(seq, 0)
+    with pytest.raises(SliceError, match="expected a positive stride .* got -1"):
+        stride(seq, -1)
+    assert sum(1 for _ in open_sequence("synthetic-office-startstop[:]").frames()) == seq.count_scans()

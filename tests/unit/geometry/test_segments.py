@@ -10,6 +10,7 @@ import pytest
 from albot1.geometry import se2
 from albot1.geometry.segments import (
     closest_parameter,
+    line_angle,
     orientation,
     point_segment_distance,
     segment_distance,
@@ -35,6 +36,14 @@ def test_closest_parameter_is_clipped_to_the_segment(point: tuple[float, float],
 
 def test_closest_parameter_of_a_degenerate_segment_is_zero() -> None:
     assert closest_parameter(5.0, 5.0, 1.0, 1.0, 1.0, 1.0) == 0.0
+
+
+def test_line_angle_ignores_direction() -> None:
+    assert line_angle(0.0) == 0.0
+    assert line_angle(math.pi) == pytest.approx(0.0, abs=1e-15)
+    assert line_angle(-math.pi / 2) == pytest.approx(math.pi / 2)
+    assert line_angle(math.radians(175.0)) == pytest.approx(math.radians(5.0))
+    assert line_angle(math.radians(-365.0)) == pytest.approx(math.radians(5.0))
 
 
 def test_point_segment_distance_perpendicular_and_beyond_the_ends() -> None:

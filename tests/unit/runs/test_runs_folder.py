@@ -10,18 +10,24 @@ import pytest
 
 from albot1.contract import MapData, RunResult
 from albot1.data.model import Frame, Relations, Scan, Sequence
+from albot1.data.trajectory import read_tum, write_tum
 from albot1.runs.errors import RunError
 from albot1.runs.execute import run_method
 from albot1.runs.folder import DONE, is_complete, read_run, run_key, write_run
-from albot1.runs.tum import read_tum, write_tum
 
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 7)
 
 
 def _sequence() -> Sequence:
-    frames = [Frame(i, Scan(np.array([1, 2, np.nan, 3, 2, 1, 1], dtype=float), ANGLES, 100.0 + 0.5 * i, 30.0),
-                    np.array([0.3 * i, 0.1 * i, 0.05 * i]), np.array([0.3 * i, 0.1 * i, 0.05 * i]))
-              for i in range(8)]
+    frames = [
+        Frame(
+            i,
+            Scan(np.array([1, 2, np.nan, 3, 2, 1, 1], dtype=float), ANGLES, 100.0 + 0.5 * i, 30.0),
+            np.array([0.3 * i, 0.1 * i, 0.05 * i]),
+            np.array([0.3 * i, 0.1 * i, 0.05 * i]),
+        )
+        for i in range(8)
+    ]
     relations = Relations(np.array([100.0]), np.array([101.0]), np.array([[0.6, 0.2, 0.1]]))
     return Sequence.from_frames("toy", frames, relations=relations)
 
@@ -51,8 +57,9 @@ def test_write_and_read_back(tmp_path: Path) -> None:
 
 def test_segments_map_round_trip(tmp_path: Path) -> None:
     result = run_method("odometry", _sequence())
-    result.map = MapData(segments=np.array([[0, 0, 1, 0], [1, 0, 1, 2.5]], dtype=float),
-                         segment_properties=[{"id": 1}, {"id": 2}])
+    result.map = MapData(
+        segments=np.array([[0, 0, 1, 0], [1, 0, 1, 2.5]], dtype=float), segment_properties=[{"id": 1}, {"id": 2}]
+    )
     stored = read_run(write_run(result, tmp_path))
     loaded = stored.load_map()
     np.testing.assert_allclose(loaded.segments, result.map.segments)

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from albot1.data.errors import DataError, ParseError
+from albot1.data.errors import ParseError, UnwritableError
 from albot1.data.loaders.rosbag.msg import even_spacing
 from albot1.data.model import FloatArray, Frame, Scan
 from albot1.data.tokens import parse_floats
@@ -247,7 +247,7 @@ def check_frame(frame: Frame) -> None:
     if problem is None:
         problem, where = view_problem(frame), "VIEW"
     if problem is not None:
-        raise DataError(f"scan #{frame.index}: {where} {problem}; the albot-log reader would refuse it")
+        raise UnwritableError(f"scan #{frame.index}: {where} {problem}; the albot-log reader would refuse it")
 
 
 def view_line(frame: Frame) -> str:

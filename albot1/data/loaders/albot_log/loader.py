@@ -37,7 +37,7 @@ from typing import IO, Any, ClassVar
 
 import numpy as np
 
-from albot1.data.errors import DataError, ParseError
+from albot1.data.errors import DataError, ParseError, UnwritableError
 from albot1.data.loaders.albot_log.lines import (
     FRAME,
     MAGIC,
@@ -150,7 +150,7 @@ class AlbotLogWriter:
                 geometry: tuple[FloatArray, float] | None = None
                 for i, frame in enumerate(sequence.frames()):
                     if frame.index != i:
-                        raise DataError(f"frame {i} has index {frame.index}; expected consecutive indices from 0")
+                        raise UnwritableError(f"frame {i} has index {frame.index}; expected consecutive indices from 0")
                     scan = frame.scan
                     check_frame(frame)
                     if geometry is None or not (
@@ -160,9 +160,10 @@ class AlbotLogWriter:
                         geometry = (scan.angles, scan.max_range)
                     fh.write(view_line(frame) + "\n")
                 if geometry is None:
-                    raise DataError(
-                        f"{path}: the sequence has no scans; the albot-log reader refuses a log without VIEW"
-                    )
+                    raise UnwritableError("the sequence has no scans; the albot-log reader refuses a log without VIEW")
+        except UnwritableError as exc:
+            path.unlink(missing_ok=True)
+            raise UnwritableError(f"{path}: {exc}") from None
         except BaseException:
             path.unlink(missing_ok=True)
             raise

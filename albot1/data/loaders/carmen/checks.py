@@ -126,7 +126,10 @@ def time_problem(previous: float, stamp: float, tolerance: float, since: str = "
     """A scan stamp going back more than ``tolerance`` seconds from the latest one (``since`` says where that was)."""
     if stamp >= previous - tolerance:
         return None
+    back = previous - stamp
+    shown = f"{stamp:.6f}" if abs(stamp) < 1e12 else f"{stamp:.6g}"
+    back_shown = f"{back:.3f}" if back < 1e12 else f"{back:.6g}"
     return (
-        f"timestamp {stamp:.6f} goes back {previous - stamp:.3f} s{since}; expected non-decreasing ipc "
-        f"timestamps (tolerance {tolerance} s)"
+        f"timestamp {shown} goes back {back_shown} s{since}; expected "
+        f"non-decreasing ipc timestamps (tolerance {tolerance} s)"
     )

@@ -14,7 +14,7 @@ compressed byte offset, after every complete line before it was handed out.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Generator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,7 +44,9 @@ def damaged_error(path: Path, damage: DamagedStream, complete_lines: int) -> Par
     return ParseError(path, damage.describe(" after this line (the last complete one)"), line=complete_lines)
 
 
-def iter_line_chunks(path: Path, *, chunk_bytes: int = CHUNK_BYTES, parallel_bz2: bool = True) -> Iterator[LineChunk]:
+def iter_line_chunks(
+    path: Path, *, chunk_bytes: int = CHUNK_BYTES, parallel_bz2: bool = True
+) -> Generator[LineChunk, None, None]:
     """The log's lines in chunks; a final line without newline is included.
 
     ``parallel_bz2`` decompresses the independent blocks of a bzip2 file on

@@ -35,7 +35,8 @@ from typing import IO, ClassVar
 import numpy as np
 
 from albot1.atomic import atomic_write
-from albot1.data.errors import DataError
+from albot1.data.errors import UnwritableError
+from albot1.data.loaders.base import reference_presence_problem
 from albot1.data.loaders.carmen.checks import beam_count_problem, geometry_problem, ranges_problem, time_problem
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.model import Frame, Sequence
@@ -77,6 +78,8 @@ def _frame_problem(frame: Frame, step: float) -> str | None:
     problem = beam_count_problem(n)
     if problem is not None:
         return problem
+    if not np.isfinite(scan.angles).all():
+        return "beam angles must be finite numbers (radians)"
     if n > 2 and not np.allclose(np.diff(scan.angles), step, rtol=_SPACING_TOLERANCE, atol=1e-9):
         return (
             "beam angles are not evenly spaced; a CARMEN ROBOTLASER1 line needs a start angle and one angular "
@@ -85,9 +88,11 @@ def _frame_problem(frame: Frame, step: float) -> str | None:
     max_range = float(scan.max_range)
     if not (math.isfinite(max_range) and max_range > 0):
         return f"max_range {max_range!r}; expected a positive number of metres"
+    if float(f"{max_range:.6f}") <= 0:
+        return f"max_range {max_range!r} rounds to 0 in the log's 6 decimals (which means 'not stated')"
     found = geometry_problem(n, *(np.array([float(v)]) for v in (scan.angles[0], step * (n - 1), step, max_range)))
-    if found is None:
-        found = ranges_problem(np.where(np.isnan(scan.ranges), max_range, scan.ranges)[None, :])
+    if found is None:  # the ranges as written: 6 decimals, no return as the max range
+        found = ranges_problem(np.round(np.where(np.isnan(scan.ranges), max_range, scan.ranges), 6)[None, :])
     if found is not None:
         return found[1]
     longest = float(np.nanmax(scan.ranges)) if not np.isnan(scan.ranges).all() else 0.0
@@ -108,7 +113,7 @@ def _laser_line(frame: Frame, offset: np.ndarray) -> str:
     step = float(angles[1] - angles[0]) if n > 1 else 0.0
     problem = _frame_problem(frame, step)
     if problem is not None:
-        raise DataError(f"frame {frame.index}: {problem}; the CARMEN reader would refuse it, so it is not written")
+        raise UnwritableError(f"frame {frame.index}: {problem}; the CARMEN reader would refuse it")
     max_range = float(scan.max_range)
     ranges = np.where(np.isfinite(scan.ranges), scan.ranges, max_range)
     robot = np.asarray(frame.odometry, dtype=np.float64)
@@ -132,7 +137,7 @@ class CarmenWriter:
         path = prepare_output(path)
         offset = np.asarray(sequence.metadata.sensor_offset, dtype=np.float64)
         if not np.isfinite(offset).all():
-            raise DataError(f"{path}: sensor offset {offset.tolist()} is not finite; expected metres and radians")
+            raise UnwritableError(f"{path}: sensor offset {offset.tolist()} is not finite; expected metres and radians")
         latest = -math.inf
 
         def write_lines(tmp: Path) -> None:
@@ -142,10 +147,15 @@ class CarmenWriter:
                 out.write(f"PARAM robot_frontlaser_side_offset {offset[1]:.9f} 0.000000 {HOST} 0.000000\n")
                 out.write(f"PARAM robot_frontlaser_angular_offset {offset[2]:.9f} 0.000000 {HOST} 0.000000\n")
                 nonlocal latest
+                first: Frame | None = None
                 for frame in sequence.frames():
+                    first = first or frame
                     back = time_problem(latest, frame.scan.timestamp, DEFAULT_TIME_TOLERANCE)
                     if back is not None:
-                        raise DataError(f"frame {frame.index}: scan {back}; the CARMEN reader would refuse it")
+                        raise UnwritableError(f"frame {frame.index}: scan {back}; the CARMEN reader would refuse it")
+                    gap = reference_presence_problem(first, frame, "a CARMEN log (TRUEPOS lines)")
+                    if gap is not None:
+                        raise UnwritableError(gap)
                     latest = max(latest, frame.scan.timestamp)
                     stamp = f"{frame.scan.timestamp:.6f}"
                     out.write(f"ODOM {_pose(frame.odometry)} 0 0 0 {stamp} {HOST} {stamp}\n")
@@ -153,7 +163,10 @@ class CarmenWriter:
                         out.write(f"TRUEPOS {_pose(frame.reference)} {_pose(frame.odometry)} {stamp} {HOST} {stamp}\n")
                     out.write(_laser_line(frame, offset))
                 if latest == -math.inf:
-                    raise DataError(f"{path}: the sequence has no scans; the CARMEN reader refuses a log without scans")
+                    raise UnwritableError("the sequence has no scans; the CARMEN reader refuses a log without scans")
 
-        with writing(path):
-            atomic_write(path, write_lines)
+        try:
+            with writing(path):
+                atomic_write(path, write_lines)
+        except UnwritableError as exc:
+            raise UnwritableError(f"{path}: {exc}") from None

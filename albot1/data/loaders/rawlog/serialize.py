@@ -79,7 +79,10 @@ def mrpt_timestamp(unix_s: float) -> int:
     """``mrpt::Clock`` ticks (100 ns since 1601-01-01) of a Unix time in seconds."""
     if not math.isfinite(unix_s):
         raise ValueError(f"timestamp {unix_s!r} is not finite")
-    ticks = round((unix_s + FILETIME_EPOCH_OFFSET_S) * TICKS_PER_S)
+    # Whole seconds and the offset are added as integers and only the (exact) fraction is scaled:
+    # scaling 1.1e9 s or adding 1.2e10 s in float64 would round away the last 100 ns ticks.
+    whole = math.floor(unix_s)
+    ticks = (whole + FILETIME_EPOCH_OFFSET_S) * TICKS_PER_S + round((unix_s - whole) * TICKS_PER_S)
     if not 0 <= ticks < 2**64:
         raise ValueError(f"timestamp {unix_s!r} s is outside the range of mrpt::Clock")
     return ticks

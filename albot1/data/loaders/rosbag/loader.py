@@ -240,7 +240,12 @@ class Ros2BagLoader:
         folder = self.bag_dir(path)
         if folder is None:
             where = path if path.is_dir() else path.parent
-            found = ", ".join(p.name for p in self.storage_files(where)) or "no .db3/.mcap file either"
+            found = ", ".join(p.name for p in self.storage_files(where))
+            if not found:
+                raise DataError(
+                    f"{where}: not a ROS2 bag folder; expected metadata.yaml beside .db3/.mcap storage files, "
+                    f"found neither"
+                )
             raise DataError(
                 f"{where / 'metadata.yaml'}: missing; a ROS2 bag folder holds metadata.yaml beside its storage "
                 f"files (found: {found}); ROS 2's `ros2 bag reindex FOLDER` can recreate it"

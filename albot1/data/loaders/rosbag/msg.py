@@ -152,13 +152,14 @@ def scan_arrays(
 def even_spacing(angles: FloatArray, tolerance: float = ANGLE_SPACING_TOLERANCE) -> tuple[float, float] | None:
     """``(angle_min, angle_increment)`` if the beams are evenly spaced (within ``tolerance`` rad), else None."""
     n = angles.shape[0]
-    if n == 0:
+    if n == 0 or not np.isfinite(angles).all():
         return None
     first = float(angles[0])
     step = float(angles[-1] - angles[0]) / (n - 1) if n > 1 else 0.0
     rebuilt = first + np.arange(n, dtype=np.float64) * step
-    if float(np.max(np.abs(rebuilt - angles))) > tolerance:
-        return None
+    with np.errstate(invalid="ignore", over="ignore"):
+        if not float(np.max(np.abs(rebuilt - angles))) <= tolerance:
+            return None
     return first, step
 
 

@@ -34,7 +34,8 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from albot1.data.errors import DataError, WriteError
+from albot1.data.errors import UnwritableError, WriteError
+from albot1.data.loaders.base import reference_presence_problem
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.loaders.rosbag.msg import (
     even_spacing,
@@ -77,23 +78,26 @@ class RosMessages:
 
     def scan(self, frame: Frame, ns: int) -> Any:
         scan = frame.scan
+        if not np.isfinite(scan.angles).all():
+            raise UnwritableError(f"scan #{frame.index}: beam angles must be finite numbers (radians)")
         spacing = even_spacing(scan.angles)
         if spacing is None:
-            raise DataError(
+            raise UnwritableError(
                 f"scan #{frame.index}: beam angles are not evenly spaced, which a LaserScan message cannot represent"
             )
         finite = scan.ranges[np.isfinite(scan.ranges)]
         if finite.size and (finite.min() < 0 or finite.max() > scan.max_range):
-            raise DataError(
+            raise UnwritableError(
                 f"scan #{frame.index}: ranges must lie in [0, max_range={scan.max_range}] m, got "
                 f"[{finite.min()}, {finite.max()}]; they would be read back as no-return"
             )
-        ranges = np.where(np.isfinite(scan.ranges), scan.ranges, np.inf).astype(np.float32)
-        angle_min, step = spacing
-        fields = [float(np.float32(v)) for v in (angle_min, scan.angles[-1], step, 0.0, scan.max_range)]
+        with np.errstate(over="ignore"):  # beyond float32: inf, refused below or read as no return
+            ranges = np.where(np.isfinite(scan.ranges), scan.ranges, np.inf).astype(np.float32)
+            angle_min, step = spacing
+            fields = [float(np.float32(v)) for v in (angle_min, scan.angles[-1], step, 0.0, scan.max_range)]
         problem = laserscan_problem(scan.beams, *fields)
         if problem is not None:
-            raise DataError(f"scan #{frame.index}: LaserScan {problem}; the bag reader would refuse it")
+            raise UnwritableError(f"scan #{frame.index}: LaserScan {problem}; the bag reader would refuse it")
         return self.LaserScan(
             header=self.header(ns, "laser", frame.index),
             angle_min=angle_min,
@@ -110,7 +114,7 @@ class RosMessages:
     def odometry(self, pose: np.ndarray, ns: int, parent: str, seq: int) -> Any:
         problem = pose_problem(pose)
         if problem is not None:
-            raise DataError(f"scan #{seq}: {parent} {problem}; the bag reader would refuse it")
+            raise UnwritableError(f"scan #{seq}: {parent} {problem}; the bag reader would refuse it")
         x, y, theta = (float(v) for v in pose)
         qx, qy, qz, qw = quaternion_from_yaw(theta)
         zero = self.Vector3(x=0.0, y=0.0, z=0.0)
@@ -129,10 +133,16 @@ class RosMessages:
         )
 
 
+#: ROS 2 stores the seconds of a time stamp as int32 (ROS 1 as uint32): the common range.
+_MAX_ROS_SECONDS = 2**31 - 1
+
+
 def _frame_ns(frame: Frame) -> int:
     t = frame.scan.timestamp
-    if not math.isfinite(t) or t < 0:
-        raise DataError(f"scan #{frame.index}: timestamp {t} s cannot be a ROS time (expected finite and >= 0)")
+    if not (math.isfinite(t) and 0 <= t < _MAX_ROS_SECONDS):
+        raise UnwritableError(
+            f"scan #{frame.index}: timestamp {t} s cannot be a ROS time (expected 0 <= t < {_MAX_ROS_SECONDS} s)"
+        )
     return seconds_to_ns(t)
 
 
@@ -152,10 +162,15 @@ def _write_frames(
     scan_conn, odom_conn = add(SCAN_TOPIC, LASER_SCAN), add(ODOM_TOPIC, ODOMETRY)
     ref_conn = None
     previous = -1
+    first: Frame | None = None
     for frame in sequence.frames():
+        first = first or frame
+        gap = reference_presence_problem(first, frame, f"a bag ({REFERENCE_TOPIC})")
+        if gap is not None:
+            raise UnwritableError(gap)
         ns = _frame_ns(frame)
         if ns <= previous:
-            raise DataError(
+            raise UnwritableError(
                 f"scan #{frame.index}: timestamp {frame.scan.timestamp!r} s is not after the previous "
                 f"scan's ({previous * 1e-9!r} s); a bag orders scans and matches poses by time, so "
                 f"stamps must strictly increase (convert with --retime to shift such scans forward)"
@@ -167,7 +182,7 @@ def _write_frames(
             ref_conn = ref_conn or add(REFERENCE_TOPIC, ODOMETRY)
             write(ref_conn, ns, serialize(msgs.odometry(frame.reference, ns, "map", frame.index), ODOMETRY))
     if previous < 0:
-        raise DataError("the sequence has no scans; the bag reader refuses a bag whose scan topic is empty")
+        raise UnwritableError("the sequence has no scans; the bag reader refuses a bag whose scan topic is empty")
 
 
 def _cleanup(path: Path) -> None:
@@ -196,6 +211,9 @@ def _write_bag(sequence: Sequence, path: Path, open_bag: Callable[[], Any], ts: 
     except (Ros1WriterError, Ros2WriterError) as exc:
         _cleanup(path)
         raise WriteError(f"{path}: cannot be written: {' '.join(str(exc).split())}") from exc
+    except UnwritableError as exc:
+        _cleanup(path)
+        raise UnwritableError(f"{path}: {exc}") from None
     except BaseException:
         _cleanup(path)
         raise

@@ -19,7 +19,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.geometry.segments import closest_parameter, segment_distance
+from albot1.geometry.segments import closest_parameter, line_angle, segment_distance
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -91,8 +91,7 @@ def best_correspondence(
     for j in range(view.shape[0]):
         if taken[j]:
             continue
-        da = math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0]) - a0
-        da = abs((da + 0.5 * math.pi) % math.pi - 0.5 * math.pi)
+        da = line_angle(math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0]) - a0)
         if da >= max_angle:
             continue
         d = segment_distance(seg, view[j])

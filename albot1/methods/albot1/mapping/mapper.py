@@ -17,6 +17,7 @@ REP-103 map frame (the first view at the origin, heading 0).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -33,7 +34,7 @@ from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
-from albot1.methods.albot1.mapping.update import UpdateParams, update_map
+from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.accel import perception_kernels
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
 from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
@@ -51,6 +52,23 @@ class _Step:
     tracked: Tracked
     odometry: tuple[float, float, float]
     pose: Pose
+
+
+@dataclass(frozen=True, slots=True)
+class UpdateEvent:
+    """One map update as an observer (:attr:`Albot1Mapper.on_update`) sees it.
+
+    Chapter 4's places layer marks the surfaces entering the map with the
+    current place and counts the map surfaces the view co-locates with
+    (deleted, extended or trimmed) before they go. ``view`` is ``initial``,
+    ``current``, ``previous`` or ``forced`` (:meth:`Albot1Mapper.force_update`).
+    """
+
+    scan: int
+    view: str
+    view_scan: int
+    pose: Pose
+    outcome: UpdateOutcome
 
 
 @dataclass(slots=True)
@@ -105,6 +123,40 @@ class Albot1Mapper:
         self._n = 0
         self._counts = _Counts()
         self._trace: list[dict[str, Any]] = []
+        #: Called after every map update (chapter 4's places observe the map through it); None: nobody listens.
+        self.on_update: Callable[[UpdateEvent], None] | None = None
+
+    @property
+    def last_view(self) -> View | None:
+        """The view of the last processed scan (thesis frame; None before the first)."""
+        return None if self._prev is None else self._prev.view
+
+    @property
+    def last_pose(self) -> Pose | None:
+        """The pose of the last processed scan in the map (thesis frame; None before the first)."""
+        return None if self._prev is None else self._prev.pose
+
+    def force_update(self) -> None:
+        """Update the map with the last scan's view at its pose now, as if Algorithm 4 had decided to.
+
+        Chapter 4's Algorithm 5 (line 16) forces this after an exit is
+        crossed, so the surfaces in view re-enter the map marked with the new
+        place. Landmark tracking restarts from that view, as after any update.
+        Counted in ``updates`` (not in the current/previous-view counts).
+        """
+        prev = self._prev
+        if prev is None:
+            raise MappingError("force_update before the first scan")
+        prev.tracked = self._update(
+            prev.view,
+            prev.landmarks,
+            prev.pose,
+            prev.index,
+            trigger=prev.index,
+            which="forced",
+            source="current",
+            reference=-1,
+        )
 
     # -- Algorithm 4 -------------------------------------------------------
     def process(self, frame: Frame) -> None:
@@ -203,7 +255,7 @@ class Albot1Mapper:
         )
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
-        """Note 13 (``docs/albot1-mapper.md``): localise on the tracked landmarks; compose the odometry step if that fails."""
+        """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md)."""
         if self.config.pose_between_updates == "localise":
             loc = self._localise(rl)
             if loc is not None:
@@ -228,6 +280,8 @@ class Albot1Mapper:
         c = self._counts
         view_map = transform_segments(pose, view.surfaces)
         out = update_map(self.map, view_map, (pose[0], pose[1]), view_scan, self._update_params, self._mk)
+        if self.on_update is not None:
+            self.on_update(UpdateEvent(trigger, which, view_scan, pose, out))
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]
@@ -241,7 +295,7 @@ class Albot1Mapper:
             c.updates += 1
             if which == "current":
                 c.updates_current_view += 1
-            else:
+            elif which == "previous":
                 c.updates_previous_view += 1
         self._trace.append(
             {

@@ -49,6 +49,12 @@ class GtsamGraphConfig(BaseModel):
     track_scans: bool = Field(
         description="register every scan against the local map to carry the next node's guess (else: odometry)"
     )
+    track_prior_sigma_xy_m: float = Field(
+        gt=0, description="prior std dev of the odometry guess over one scan period (x, y), used inside tracking ICP"
+    )
+    track_prior_sigma_theta_deg: float = Field(gt=0, description="... (theta)")
+    track_max_correction_m: float = Field(gt=0, description="a tracking match may move its guess this far at most")
+    track_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most")
     local_map_nodes: int = Field(
         ge=1, description="the last k node scans form the local map the new node is matched against"
     )
@@ -175,6 +181,18 @@ class GtsamGraphConfig(BaseModel):
     # Map.
     map_voxel_m: float = Field(gt=0, description="grid cell for thinning the projected map points")
     map_every: int = Field(ge=1, description="project every n-th scan into the map")
+
+    def track_icp(self) -> IcpParams:
+        """Registration parameters of per-scan tracking (a guess one scan period of odometry away)."""
+        return IcpParams(
+            max_iterations=self.icp_max_iterations,
+            max_correspondence_m=self.icp_max_correspondence_m,
+            min_correspondence_m=self.icp_min_correspondence_m,
+            point_sigma_m=self.point_sigma_m,
+            cauchy_scale_m=2.0 * self.point_sigma_m,
+            prior_sigma_xy_m=self.track_prior_sigma_xy_m,
+            prior_sigma_theta_rad=math.radians(self.track_prior_sigma_theta_deg),
+        )
 
     def refine_icp(self) -> IcpParams:
         """Registration parameters of the per-scan refinement (the seed is close: a narrower starting gate)."""

@@ -46,8 +46,8 @@ from albot1.methods.baselines.gtsam_graph.loop_closure import (
     search_radius,
     verify,
 )
-from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, line_normals, register
 from albot1.methods.baselines.gtsam_graph.refine import RefineTests, accept, seed_poses
+from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, line_normals, register
 from albot1.methods.baselines.point_map import first_per_cell
 
 FloatArray = NDArray[np.float64]
@@ -93,6 +93,7 @@ class GtsamGraphMapper:
         )
         self._confirmer = Confirmer(self._tests)
         self._refine_icp = config.refine_icp()
+        self._track_icp = config.track_icp()
         self._refine_tests = RefineTests(
             min_fitness=config.refine_min_fitness,
             max_rmse_m=config.refine_max_rmse_m,
@@ -190,13 +191,40 @@ class GtsamGraphMapper:
         """
         if not self.config.track_scans:
             return guess
-        reg = self._register(self._local_map(), points, guess, self._seq_icp)
-        if self._sequential_ok(reg, guess):
+        cfg = self.config
+        reg, good, _ = self._attempt(
+            self._local_map(), points, guess, self._track_icp, cfg.track_max_correction_m, cfg.track_max_correction_deg
+        )
+        if good:
             assert reg is not None
             self.counters["scans_tracked"] += 1
             return reg.pose
         self.counters["tracking_failures"] += 1
         return guess
+
+    def _attempt(
+        self, target: Target, points: FloatArray, guess: FloatArray, params: IcpParams, max_m: float, max_deg: float
+    ) -> tuple[Registration | None, bool, bool]:
+        """ICP from ``guess``; if it fails its tests, from the guess rotated by +-k * ``seq_retry_rotation_deg``.
+
+        Odometry heading errors (slipping wheels while turning, a robot
+        spinning at 2 rad/s on mit-csail) are what most often put the guess
+        outside ICP's basin, and a rotated start recovers them. Returns
+        ``(registration, passed, recovered by a retry)``.
+        """
+        reg = self._register(target, points, guess, params)
+        if self._match_ok(reg, guess, max_m, max_deg):
+            return reg, True, False
+        step_rad = math.radians(self.config.seq_retry_rotation_deg)
+        for k in range(1, self.config.seq_retries + 1):
+            best: Registration | None = None
+            for sign in (1.0, -1.0):
+                retry = self._register(target, points, guess + np.array([0.0, 0.0, sign * k * step_rad]), params)
+                if self._match_ok(retry, guess, max_m, max_deg) and (best is None or retry.fitness > best.fitness):
+                    best = retry
+            if best is not None:
+                return best, True, True
+        return reg, False, False
 
     def _preprocess(self, scan: Scan, index: int) -> FloatArray:
         """Valid beams within the range limits, as points, thinned to one per ``scan_voxel_m`` cell."""
@@ -255,18 +283,11 @@ class GtsamGraphMapper:
         """
         cfg = self.config
         target = self._local_map()
-        reg = self._register(target, points, step, self._seq_icp)
-        good = self._sequential_ok(reg, step)
-        for k in range(1, cfg.seq_retries + 1):
-            if good:
-                break
-            for sign in (1.0, -1.0):
-                start = step + np.array([0.0, 0.0, sign * k * math.radians(cfg.seq_retry_rotation_deg)])
-                retry = self._register(target, points, start, self._seq_icp)
-                if self._sequential_ok(retry, step) and (not good or retry.fitness > reg.fitness):
-                    reg, good = retry, True
-            if good:
-                self.counters["sequential_retries_recovered"] += 1
+        reg, good, recovered = self._attempt(
+            target, points, step, self._seq_icp, cfg.seq_max_correction_m, cfg.seq_max_correction_deg
+        )
+        if recovered:
+            self.counters["sequential_retries_recovered"] += 1
         if cfg.seq_reversed_guess:
             reg, good = self._try_reversed(target, points, step, reg, good)
         if good:
@@ -319,13 +340,15 @@ class GtsamGraphMapper:
         return alt, True
 
     def _sequential_ok(self, reg: Registration | None, step: FloatArray) -> bool:
+        return self._match_ok(reg, step, self.config.seq_max_correction_m, self.config.seq_max_correction_deg)
+
+    def _match_ok(self, reg: Registration | None, guess: FloatArray, max_m: float, max_deg: float) -> bool:
+        """Converged, fits (inlier fraction, RMS) and moved ``guess`` by at most ``max_m`` / ``max_deg``."""
         cfg = self.config
         if reg is None or not reg.converged or reg.fitness < cfg.seq_min_fitness or reg.rmse_m > cfg.seq_max_rmse_m:
             return False
-        corr = se2.between(step, reg.pose)
-        return math.hypot(corr[0], corr[1]) <= cfg.seq_max_correction_m and abs(corr[2]) <= math.radians(
-            cfg.seq_max_correction_deg
-        )
+        corr = se2.between(guess, reg.pose)
+        return math.hypot(corr[0], corr[1]) <= max_m and abs(corr[2]) <= math.radians(max_deg)
 
     def _target(self, nodes: range, frame_node: int, poses: FloatArray | None = None) -> Target:
         """The line-like points of ``nodes``' scans, expressed in ``frame_node``'s frame.

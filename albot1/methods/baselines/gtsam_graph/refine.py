@@ -93,7 +93,9 @@ def seed_poses(
     return seeds
 
 
-def accept(tests: RefineTests, seed: FloatArray, pose: FloatArray, converged: bool, fitness: float, rmse_m: float) -> bool:
+def accept(
+    tests: RefineTests, seed: FloatArray, pose: FloatArray, converged: bool, fitness: float, rmse_m: float
+) -> bool:
     """Whether a refined pose may replace its seed."""
     if not converged or fitness < tests.min_fitness or rmse_m > tests.max_rmse_m:
         return False

@@ -200,6 +200,7 @@ def _linearise(
     """Jacobian rows, point-to-line residuals, Cauchy weights and distances of matches within ``gate``."""
     c, s = math.cos(pose[2]), math.sin(pose[2])
     rot = src @ np.array([[c, s], [-s, c]])  # R p for row vectors
+    assert target.tree is not None  # register() raises before linearising against an empty target
     dist, idx = target.tree.query(rot + pose[:2], k=1, distance_upper_bound=gate)
     ok = dist < gate
     rot, idx = rot[ok], idx[ok]

@@ -179,6 +179,7 @@ def test_segment_geometry_gives_the_same_bits_jitted_and_interpreted() -> None:
         segments.point_segment_distance,
         segments.closest_parameter,
         segments.orientation,
+        segments.line_angle,
     )
     jit = kernel_compiler(True, functions)
     for a, b in _segment_pairs():
@@ -188,6 +189,7 @@ def test_segment_geometry_gives_the_same_bits_jitted_and_interpreted() -> None:
             (segments.point_segment_distance, (a[0], a[1], b)),
             (segments.closest_parameter, (a[0], a[1], b[0], b[1], b[2], b[3])),
             (segments.orientation, (a[0], a[1], a[2], a[3], b[0], b[1])),
+            (segments.line_angle, (a[0] * 3.0 - b[1] * 5.0,)),
         ):
             assert_same_bits(jit(fn)(*args), fn(*args))
 
@@ -211,6 +213,9 @@ def test_callees_are_found_transitively_and_compiled_with_their_caller() -> None
     dispatcher: Any = mapping.best_correspondence  # a numba CPUDispatcher behind the typed field
     namespace = dispatcher.py_func.__globals__
     assert isinstance(namespace["segment_distance"], numba.core.registry.CPUDispatcher)
+    # Each cache entry carries the digest of its callees' source files (numba's internals: see jit.py).
+    stamp = dispatcher._cache._cache_file._source_stamp
+    assert isinstance(stamp, tuple) and len(stamp[1]) == 64
     # The source modules keep their plain functions.
     assert segments.segment_distance.__module__ == "albot1.geometry.segments"
     assert not hasattr(segments.segment_distance, "py_func")

@@ -121,11 +121,11 @@ def test_poses_and_map_come_out_in_a_rep103_map_frame() -> None:
 
 
 def test_degenerate_input_never_crashes_and_is_counted() -> None:
-    poses = [np.array([0.1 * k, 0.0, 0.0]) for k in range(5)]
-    poses += [poses[-1].copy() for _ in range(30)]  # 30 stationary steps
-    poses += [poses[-1] + np.array([6.0, 0.0, 0.0])]  # a 6 m odometry jump
-    poses += [poses[-1] + np.array([0.1 * k, 0.0, 0.0]) for k in range(1, 4)]
-    poses = np.array(poses)
+    steps = [np.array([0.1 * k, 0.0, 0.0]) for k in range(5)]
+    steps += [steps[-1].copy() for _ in range(30)]  # 30 stationary steps
+    steps += [steps[-1] + np.array([6.0, 0.0, 0.0])]  # a 6 m odometry jump
+    steps += [steps[-1] + np.array([0.1 * k, 0.0, 0.0]) for k in range(1, 4)]
+    poses = np.array(steps)
     frames = room_frames(np.minimum(poses, [0.4, 0.0, 0.0]))
     frames = [Frame(f.index, f.scan, poses[f.index]) for f in frames]
     # Scans with no returns, then a view of a single wall.

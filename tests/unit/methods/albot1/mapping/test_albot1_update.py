@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 import pytest
 
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.update import UpdateParams, update_map, view_polygon
+
+MarginFrom = Literal["surfaces", "boundary"]
 
 # A view (thesis frame, robot at the origin facing +y): a wall 3 m ahead with a gap.
 VIEW = np.array([[-2.0, 3.0, 0.0, 3.0], [0.5, 3.0, 2.0, 3.0]])
@@ -36,7 +39,9 @@ def test_view_polygon_is_the_robot_then_the_endpoints_left_to_right() -> None:
 
 
 @pytest.mark.parametrize("margin_from", ["surfaces", "boundary"])
-def test_update_deletes_exactly_the_covered_surfaces_and_extends_or_trims_as_in_figure_3_13(margin_from: str) -> None:
+def test_update_deletes_exactly_the_covered_surfaces_and_extends_or_trims_as_in_figure_3_13(
+    margin_from: MarginFrom,
+) -> None:
     pmap, ids = build_map()
     out = update_map(pmap, VIEW, (0.0, 0.0), scan=7, params=UpdateParams(margin_from=margin_from))
     assert sorted(out.deleted.tolist()) == sorted([ids["inside"], ids["near_boundary"]])
@@ -61,7 +66,7 @@ def test_update_deletes_exactly_the_covered_surfaces_and_extends_or_trims_as_in_
 
 
 @pytest.mark.parametrize("margin_from", ["surfaces", "boundary"])
-def test_a_wall_running_on_behind_the_field_of_view_edge(margin_from: str) -> None:
+def test_a_wall_running_on_behind_the_field_of_view_edge(margin_from: MarginFrom) -> None:
     # The map's wall starts 20 cm behind the robot (the previous update); the view sees it
     # from beside the robot (x = -1 in the thesis frame) forwards.
     pmap = PerceptualMap()

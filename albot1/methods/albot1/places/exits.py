@@ -1,0 +1,239 @@
+"""Exits: doorway-like gaps detected in views, tracked into the perceptual map, and crossed.
+
+Thesis 4.1.1 assumes "an office-like environment with well-defined exits
+(i.e. doorway, a gap whose typical size is about 1 meter)" and computes a
+place "whenever an exit is crossed", without saying how exits are found.
+Our detector (:func:`albot1.methods.albot1.places.kernels.detect_exits`)
+takes a gap between two surface ends of one view, both occluding (real
+edges with something farther beside them), 0.6-1.2 m wide, with everything
+seen through it lying beyond it: the view of a doorway from the room.
+
+Each detection is placed in the map with the pose of its scan and joins the
+tracked exit whose midpoint is within ``track_distance`` and whose direction
+is within ``track_angle`` (the latest sighting replaces the segment: the map
+drifts, the newest placement agrees best with the robot's current pose);
+otherwise it starts a new track. A track seen in ``min_sightings`` views can
+be crossed.
+
+The crossing test has hysteresis: the robot is on a side of an exit only
+when farther than ``crossing_band`` from its line; a crossing is a change of
+side whose straight path (from where the old side was last confirmed to
+here) passes between the exit's ends (with ``crossing_margin`` of slack).
+Jitter on the line is therefore not a crossing, and neither is walking past
+the end of a doorway's wall.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.geometry.se2 import Pose
+from albot1.geometry.segments import segments_cross, transform_segments
+from albot1.methods.albot1.perception.view import View
+from albot1.methods.albot1.places.accel import PlacesKernels
+from albot1.methods.albot1.places.config import ExitParams
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: How often (scans) unconfirmed tracks that have not been seen for ``_STALE_SCANS`` are dropped.
+_PRUNE_EVERY = 200
+_STALE_SCANS = 200
+
+
+def view_exits(view: View, params: ExitParams, kernels: PlacesKernels) -> FloatArray:
+    """Exits of one view ``(k, 4)`` in its own (thesis) frame, each from the left surface's end to the right one's."""
+    if len(view) < 2:
+        return np.empty((0, 4))
+    i, j = kernels.detect_exits(
+        view.surfaces,
+        view.kinds,
+        params.min_width,
+        params.max_width,
+        params.min_depth,
+        params.max_distance,
+        params.both_occluding,
+    )
+    s = view.surfaces
+    return np.column_stack([s[i, 2], s[i, 3], s[j, 0], s[j, 1]]).reshape(-1, 4)
+
+
+@dataclass(frozen=True, slots=True)
+class Crossing:
+    """An exit crossed at ``scan``: ``segment`` (map frame) runs so that the side left behind is on its left."""
+
+    track: int
+    scan: int
+    segment: FloatArray
+    before: tuple[float, float]
+    after: tuple[float, float]
+
+
+def orient_left(segment: FloatArray, point: tuple[float, float]) -> FloatArray:
+    """``segment`` reversed if needed so that ``point`` lies on its left (counter-clockwise side)."""
+    a, b = segment[:2], segment[2:]
+    side = (b[0] - a[0]) * (point[1] - a[1]) - (b[1] - a[1]) * (point[0] - a[0])
+    return segment.copy() if side >= 0 else np.concatenate([b, a])
+
+
+class ExitTracker:
+    """Exits tracked in the map frame, with each one's side of the robot for the crossing test."""
+
+    def __init__(self, params: ExitParams, kernels: PlacesKernels) -> None:
+        self.params = params
+        self._k = kernels
+        self._seg = np.empty((0, 4))
+        self._ids = np.empty(0, dtype=np.int64)
+        self._sightings = np.empty(0, dtype=np.int64)
+        self._last_seen = np.empty(0, dtype=np.int64)
+        self._side = np.empty(0, dtype=np.int64)  # +1 left of the segment, -1 right, 0 not yet known
+        self._side_at = np.empty((0, 2))  # where the robot last was clearly on that side
+        self._next_id = 0
+        self.detections = 0
+
+    def __len__(self) -> int:
+        return int(self._ids.shape[0])
+
+    @property
+    def confirmed(self) -> int:
+        """How many tracked exits have been seen often enough to be crossed."""
+        return int(np.count_nonzero(self._sightings >= self.params.min_sightings))
+
+    def segments(self, confirmed_only: bool = True) -> FloatArray:
+        """Tracked exits ``(k, 4)`` in the map frame."""
+        keep = self._sightings >= self.params.min_sightings if confirmed_only else slice(None)
+        return self._seg[keep].copy()
+
+    def beyond(self, origin: tuple[float, float], points: FloatArray) -> NDArray[np.bool_]:
+        """For each point ``(J, 2)``: whether the straight line from ``origin`` to it passes through a tracked exit.
+
+        Such a point was seen *through* an exit: it belongs to the place beyond.
+        """
+        out = np.zeros(len(points), dtype=bool)
+        keep = self._sightings >= self.params.min_sightings
+        if not keep.any() or len(points) == 0:
+            return out
+        seg = self._seg[keep]
+        ax, ay, bx, by = (seg[:, c][:, None] for c in range(4))
+        ox, oy = origin
+        px, py = points[None, :, 0], points[None, :, 1]
+        d1 = (bx - ax) * (oy - ay) - (by - ay) * (ox - ax)
+        d2 = (bx - ax) * (py - ay) - (by - ay) * (px - ax)
+        d3 = (px - ox) * (ay - oy) - (py - oy) * (ax - ox)
+        d4 = (px - ox) * (by - oy) - (py - oy) * (bx - ox)
+        through = (d1 * d2 < 0) & (d3 * d4 < 0)
+        return np.asarray(through.any(axis=0))
+
+    def near(self, position: tuple[float, float], distance: float) -> bool:
+        """Whether ``position`` is within ``distance`` of a tracked exit (standing in a doorway)."""
+        keep = self._sightings >= self.params.min_sightings
+        if not keep.any():
+            return False
+        seg = self._seg[keep]
+        a, e = seg[:, :2], seg[:, 2:] - seg[:, :2]
+        rel = np.asarray(position, dtype=float)[None, :] - a
+        t = np.clip((rel * e).sum(axis=1) / np.maximum((e * e).sum(axis=1), 1e-12), 0.0, 1.0)
+        gap = rel - t[:, None] * e
+        return bool((np.hypot(gap[:, 0], gap[:, 1]) <= distance).any())
+
+    def observe(self, view: View, pose: Pose, scan: int) -> FloatArray:
+        """Detect the exits of ``view`` (taken at ``pose``) and track them; returns them in the map frame."""
+        found = transform_segments(pose, view_exits(view, self.params, self._k))
+        for seg in found:
+            self._track(seg, scan)
+        self.detections += len(found)
+        if scan % _PRUNE_EVERY == 0:
+            self._prune(scan)
+        return found
+
+    def _track(self, seg: FloatArray, scan: int) -> None:
+        p = self.params
+        mid = 0.5 * (seg[:2] + seg[2:])
+        if len(self._ids):
+            mids = 0.5 * (self._seg[:, :2] + self._seg[:, 2:])
+            dist = np.hypot(mids[:, 0] - mid[0], mids[:, 1] - mid[1])
+            r = int(np.argmin(dist))
+            if dist[r] <= p.track_distance and _undirected_angle(self._seg[r], seg) <= p.track_angle:
+                self._seg[r] = seg
+                self._sightings[r] += 1
+                self._last_seen[r] = scan
+                return
+        self._seg = np.vstack([self._seg, seg[None]])
+        self._ids = np.append(self._ids, self._next_id)
+        self._sightings = np.append(self._sightings, 1)
+        self._last_seen = np.append(self._last_seen, scan)
+        self._side = np.append(self._side, 0)
+        self._side_at = np.vstack([self._side_at, np.zeros((1, 2))])
+        self._next_id += 1
+
+    def _prune(self, scan: int) -> None:
+        keep = (self._sightings >= self.params.min_sightings) | (scan - self._last_seen <= _STALE_SCANS)
+        if keep.all():
+            return
+        self._seg, self._ids, self._sightings = self._seg[keep], self._ids[keep], self._sightings[keep]
+        self._last_seen, self._side, self._side_at = self._last_seen[keep], self._side[keep], self._side_at[keep]
+
+    def crossing(self, position: tuple[float, float], scan: int) -> Crossing | None:
+        """Update every exit's side of the robot at ``position``; the exit crossed since the last call, if any.
+
+        With several crossed at once (a pose jump), the one whose line is
+        nearest the robot is returned; the others only change side.
+        """
+        n = len(self._ids)
+        if n == 0:
+            return None
+        p = self.params
+        seg = self._seg
+        ex, ey = seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]
+        width = np.hypot(ex, ey)
+        signed = (ex * (position[1] - seg[:, 1]) - ey * (position[0] - seg[:, 0])) / width
+        clear = np.abs(signed) > p.crossing_band
+        side = np.where(signed > 0, 1, -1)
+        changed = clear & (self._side != 0) & (side != self._side)
+        best: Crossing | None = None
+        best_distance = math.inf
+        for r in np.flatnonzero(changed & (self._sightings >= p.min_sightings)).tolist():
+            before = (float(self._side_at[r, 0]), float(self._side_at[r, 1]))
+            if not _passes_between(before, position, seg[r], p.crossing_margin):
+                continue
+            if abs(signed[r]) < best_distance:
+                best_distance = abs(signed[r])
+                best = Crossing(int(self._ids[r]), scan, orient_left(seg[r], before), before, position)
+        self._side[clear] = side[clear]
+        self._side_at[clear] = position
+        if best is not None:
+            # Another track of the same doorway (placed apart by map drift) is the exit just crossed too:
+            # it is put on the side the robot is heading for, so passing its line is not a second crossing.
+            mids = 0.5 * (seg[:, :2] + seg[:, 2:])
+            here = 0.5 * (best.segment[:2] + best.segment[2:])
+            twins = np.hypot(mids[:, 0] - here[0], mids[:, 1] - here[1]) <= p.twin_distance
+            twins[self._ids == best.track] = False
+            for r in np.flatnonzero(twins).tolist():
+                ax, ay, bx, by = seg[r]
+                before_side = (bx - ax) * (best.before[1] - ay) - (by - ay) * (best.before[0] - ax)
+                self._side[r] = -1 if before_side > 0 else 1
+                self._side_at[r] = position
+        return best
+
+
+def _undirected_angle(a: FloatArray, b: FloatArray) -> float:
+    da = math.atan2(a[3] - a[1], a[2] - a[0])
+    db = math.atan2(b[3] - b[1], b[2] - b[0])
+    d = abs(da - db) % math.pi
+    return min(d, math.pi - d)
+
+
+def _passes_between(p: tuple[float, float], q: tuple[float, float], seg: FloatArray, margin: float) -> bool:
+    """Whether the path p -> q meets ``seg`` lengthened by ``margin`` at both ends."""
+    a, b = seg[:2], seg[2:]
+    e = b - a
+    length = float(np.hypot(e[0], e[1]))
+    if length <= 0.0:
+        return False
+    u = e / length
+    grown = np.concatenate([a - margin * u, b + margin * u])
+    return bool(segments_cross(np.array([p[0], p[1], q[0], q[1]]), grown))

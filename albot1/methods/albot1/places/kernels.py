@@ -1,0 +1,312 @@
+"""The per-scan loops of the places layer: exit detection in a view and the structural matcher.
+
+Plain Python over numpy arrays and scalars in the subset numba compiles;
+:mod:`albot1.methods.albot1.places.accel` hands out the jitted or the
+interpreted version of the same source (the tests run both). Geometry is in
+the thesis frame (robot at the origin facing +y, surfaces left to right);
+endpoint labels are those of :mod:`albot1.methods.albot1.perception.endpoints`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.geometry.se2 import wrap_angle
+from albot1.geometry.segments import orientation, segment_distance
+from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDING
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+def detect_exits(
+    surfaces: FloatArray,
+    kinds: IntArray,
+    min_width: float,
+    max_width: float,
+    min_depth: float,
+    max_distance: float,
+    both_occluding: bool,
+) -> tuple[IntArray, IntArray]:
+    """Exit-like gaps of one view: pairs ``(i, j)``, the gap running from surface i's P2 to surface j's P1.
+
+    A pair is a candidate when ``i < j`` (j to the right of i), both ends are
+    occluding (or, without ``both_occluding``, one occluding and the other a
+    corner), the gap is ``min_width``-``max_width`` wide with its midpoint
+    within ``max_distance`` of the robot, and every surface between them in
+    the view (what is seen *through* the gap) lies beyond the gap's line, on
+    the far side from the robot, by at least ``min_depth``. Each end takes
+    part in one exit at most: candidates are accepted narrowest first (the
+    shortest gap is the exit, as in Yeap's exits).
+    """
+    m = surfaces.shape[0]
+    ci = np.empty(m * m, dtype=np.int64)
+    cj = np.empty(m * m, dtype=np.int64)
+    cw = np.empty(m * m)
+    n = 0
+    for i in range(m):
+        ka = kinds[i, 1]
+        if ka != OCCLUDING and ka != CORNER:
+            continue
+        ax = surfaces[i, 2]
+        ay = surfaces[i, 3]
+        for j in range(i + 1, m):
+            kb = kinds[j, 0]
+            if kb != OCCLUDING and kb != CORNER:
+                continue
+            if both_occluding:
+                if ka != OCCLUDING or kb != OCCLUDING:
+                    continue
+            elif ka != OCCLUDING and kb != OCCLUDING:
+                continue
+            bx = surfaces[j, 0]
+            by = surfaces[j, 1]
+            w = np.hypot(bx - ax, by - ay)
+            if w < min_width or w > max_width:
+                continue
+            if np.hypot(0.5 * (ax + bx), 0.5 * (ay + by)) > max_distance:
+                continue
+            robot_side = orientation(ax, ay, bx, by, 0.0, 0.0)
+            if robot_side == 0.0:
+                continue
+            ok = True
+            for k in range(i + 1, j):
+                for e in range(2):
+                    side = orientation(ax, ay, bx, by, surfaces[k, 2 * e], surfaces[k, 2 * e + 1])
+                    # beyond the line: the other side from the robot, by at least min_depth
+                    if side * robot_side >= 0.0 or abs(side) / w < min_depth:
+                        ok = False
+                        break
+                if not ok:
+                    break
+            if ok:
+                ci[n] = i
+                cj[n] = j
+                cw[n] = w
+                n += 1
+    order = np.argsort(cw[:n], kind="mergesort")
+    used_left = np.zeros(m, dtype=np.bool_)
+    used_right = np.zeros(m, dtype=np.bool_)
+    out_i = np.empty(n, dtype=np.int64)
+    out_j = np.empty(n, dtype=np.int64)
+    k = 0
+    for r in range(n):
+        c = order[r]
+        if used_left[ci[c]] or used_right[cj[c]]:
+            continue
+        used_left[ci[c]] = True
+        used_right[cj[c]] = True
+        out_i[k] = ci[c]
+        out_j[k] = cj[c]
+        k += 1
+    return out_i[:k], out_j[:k]
+
+
+def _count_matches(
+    current: FloatArray,
+    dir_j: FloatArray,
+    current_side: IntArray,
+    remembered: FloatArray,
+    dir_k: FloatArray,
+    theta: float,
+    tx: float,
+    ty: float,
+    max_angle: float,
+    max_gap: float,
+    partner: IntArray,
+) -> tuple[int, bool, bool]:
+    """Matches of the remembered surfaces moved by (theta, tx, ty) onto current ones, one-to-one.
+
+    ``partner[k]`` is set to the current surface remembered surface k matched (-1: none). Returns the
+    count and whether matched current surfaces lie left and right of the robot.
+    """
+    nj = current.shape[0]
+    nk = remembered.shape[0]
+    c = math.cos(theta)
+    s = math.sin(theta)
+    seg = np.empty(4)
+    used = np.zeros(nj, dtype=np.bool_)
+    count = 0
+    left = False
+    right = False
+    for kk in range(nk):
+        partner[kk] = -1
+        d = dir_k[kk] + theta
+        seg[0] = tx + c * remembered[kk, 0] - s * remembered[kk, 1]
+        seg[1] = ty + s * remembered[kk, 0] + c * remembered[kk, 1]
+        seg[2] = tx + c * remembered[kk, 2] - s * remembered[kk, 3]
+        seg[3] = ty + s * remembered[kk, 2] + c * remembered[kk, 3]
+        for jj in range(nj):
+            if used[jj] or abs(wrap_angle(dir_j[jj] - d)) >= max_angle:
+                continue
+            if segment_distance(current[jj], seg) <= max_gap:
+                used[jj] = True
+                partner[kk] = jj
+                count += 1
+                if current_side[jj] < 0:
+                    left = True
+                elif current_side[jj] > 0:
+                    right = True
+                break
+    return count, left, right
+
+
+def _refine(
+    current: FloatArray,
+    dir_j: FloatArray,
+    remembered: FloatArray,
+    dir_k: FloatArray,
+    theta: float,
+    tx: float,
+    ty: float,
+    partner: IntArray,
+) -> tuple[float, float, float]:
+    """The motion re-estimated from matched pairs: rotation from their directions, translation by least squares.
+
+    Rotation: the length-weighted mean of the direction differences. Translation: the remembered
+    endpoints' distances to the matched current lines squared and summed (a 2 x 2 system); a small
+    weight on the midpoints' offsets fixes the direction the lines leave free (all parallel).
+    """
+    nk = remembered.shape[0]
+    sw = 0.0
+    sa = 0.0
+    for kk in range(nk):
+        jj = partner[kk]
+        if jj < 0:
+            continue
+        w = np.hypot(remembered[kk, 2] - remembered[kk, 0], remembered[kk, 3] - remembered[kk, 1])
+        sa += w * wrap_angle(dir_j[jj] - (dir_k[kk] + theta))
+        sw += w
+    if sw <= 0.0:
+        return theta, tx, ty
+    theta = wrap_angle(theta + sa / sw)
+    c = math.cos(theta)
+    s = math.sin(theta)
+    a11 = 0.0
+    a12 = 0.0
+    a22 = 0.0
+    b1 = 0.0
+    b2 = 0.0
+    for kk in range(nk):
+        jj = partner[kk]
+        if jj < 0:
+            continue
+        nx = -math.sin(dir_j[jj])
+        ny = math.cos(dir_j[jj])
+        offset = nx * current[jj, 0] + ny * current[jj, 1]
+        for e in range(3):
+            if e < 2:
+                px = remembered[kk, 2 * e]
+                py = remembered[kk, 2 * e + 1]
+                wx = 1.0
+            else:
+                px = 0.5 * (remembered[kk, 0] + remembered[kk, 2])
+                py = 0.5 * (remembered[kk, 1] + remembered[kk, 3])
+                wx = 0.0
+            qx = c * px - s * py
+            qy = s * px + c * py
+            if wx > 0.0:
+                r = offset - (nx * qx + ny * qy)
+                a11 += nx * nx
+                a12 += nx * ny
+                a22 += ny * ny
+                b1 += nx * r
+                b2 += ny * r
+            else:  # weak pull of the midpoints together, along and across
+                mx = 0.5 * (current[jj, 0] + current[jj, 2]) - qx
+                my = 0.5 * (current[jj, 1] + current[jj, 3]) - qy
+                a11 += 1e-3
+                a22 += 1e-3
+                b1 += 1e-3 * mx
+                b2 += 1e-3 * my
+    det = a11 * a22 - a12 * a12
+    if det <= 1e-12:
+        return theta, tx, ty
+    return theta, (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+
+
+def match_structure(
+    current: FloatArray,
+    current_side: IntArray,
+    remembered: FloatArray,
+    max_angle: float,
+    max_gap: float,
+    min_matches: int,
+    anchors: int,
+) -> tuple[bool, int, float, float, float]:
+    """Algorithm 6: does a hypothesis ``S_j = S_k`` bring more than 4 remembered surfaces onto current ones?
+
+    ``current`` ``(J, 4)`` are the current place's surfaces (map frame),
+    ``current_side`` ``(J,)`` the side of the robot each lies on (-1 left,
+    +1 right, 0 neither), ``remembered`` ``(K, 4)`` the remembered place's
+    surfaces in its own frame. For every pair (j, k) in order, and for each
+    of ``anchors`` anchorings (1: midpoint on midpoint; 3: also left end on
+    left end and right end on right end), the rigid motion turning S_k's
+    direction onto S_j's and putting the anchor of S_k on that of S_j is
+    applied to every remembered surface; a transformed surface matches when
+    a current surface not yet matched (pairs are one-to-one, so pieces of
+    one wall cannot all count against one long surface) differs in
+    direction by less than ``max_angle`` and lies within ``max_gap`` of it.
+    A hypothesis with at least two matches is refined once from its matched
+    pairs (:func:`_refine`: one surface fixes a direction badly, so a small
+    angle error would push far surfaces out of the 40 cm) and counted again.
+    The first hypothesis with at least ``min_matches`` matches whose matched
+    current surfaces lie on both sides of the robot confirms (line 11's
+    break). Returns ``(confirmed, best count, theta, tx, ty)``: the motion of
+    the confirming hypothesis (or of the best one) mapping the remembered
+    frame into the map frame.
+    """
+    nj = current.shape[0]
+    nk = remembered.shape[0]
+    dir_j = np.empty(nj)
+    for j in range(nj):
+        dir_j[j] = math.atan2(current[j, 3] - current[j, 1], current[j, 2] - current[j, 0])
+    dir_k = np.empty(nk)
+    for k in range(nk):
+        dir_k[k] = math.atan2(remembered[k, 3] - remembered[k, 1], remembered[k, 2] - remembered[k, 0])
+    partner = np.empty(nk, dtype=np.int64)
+    best = -1
+    best_theta = 0.0
+    best_tx = 0.0
+    best_ty = 0.0
+    for j in range(nj):
+        for k in range(nk):
+            theta0 = wrap_angle(dir_j[j] - dir_k[k])
+            c = math.cos(theta0)
+            s = math.sin(theta0)
+            for a in range(anchors):
+                theta = theta0
+                if a == 0:
+                    jx = 0.5 * (current[j, 0] + current[j, 2])
+                    jy = 0.5 * (current[j, 1] + current[j, 3])
+                    kx = 0.5 * (remembered[k, 0] + remembered[k, 2])
+                    ky = 0.5 * (remembered[k, 1] + remembered[k, 3])
+                else:
+                    e = 2 * (a - 1)
+                    jx = current[j, e]
+                    jy = current[j, e + 1]
+                    kx = remembered[k, e]
+                    ky = remembered[k, e + 1]
+                tx = jx - (c * kx - s * ky)
+                ty = jy - (s * kx + c * ky)
+                count, left, right = _count_matches(
+                    current, dir_j, current_side, remembered, dir_k, theta, tx, ty, max_angle, max_gap, partner
+                )
+                if 2 <= count and not (count >= min_matches and left and right):
+                    rt, rx, ry = _refine(current, dir_j, remembered, dir_k, theta, tx, ty, partner)
+                    count2, left2, right2 = _count_matches(
+                        current, dir_j, current_side, remembered, dir_k, rt, rx, ry, max_angle, max_gap, partner
+                    )
+                    if count2 > count:
+                        count, left, right, theta, tx, ty = count2, left2, right2, rt, rx, ry
+                if count > best:
+                    best = count
+                    best_theta = theta
+                    best_tx = tx
+                    best_ty = ty
+                if count >= min_matches and left and right:
+                    return True, count, theta, tx, ty
+    return False, max(best, 0), best_theta, best_tx, best_ty

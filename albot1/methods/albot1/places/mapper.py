@@ -1,0 +1,319 @@
+"""``albot1-places``: the chapter-3 perceptual mapper with chapter 4's network of places on top.
+
+The chapter-3 :class:`~albot1.methods.albot1.mapping.mapper.Albot1Mapper`
+runs unchanged inside; this class listens to its map updates
+(:attr:`~albot1.methods.albot1.mapping.mapper.Albot1Mapper.on_update`) and,
+after each scan:
+
+1. marks every surface the update brought into the map with the current
+   visit, and counts the map surfaces the view co-locates with per
+   remembered place (4.1.2);
+2. detects exits in the view and tracks them into the map; when one is
+   crossed, closes the current place and opens the next (Algorithm 5), checks
+   whether the exit leads to a known place (line 13) and, if so, brings that
+   place's exits into the map aligned at the exit (Algorithm 7), then forces
+   a map update so the surfaces in view start the new place (line 16);
+3. when more than n surfaces of a remembered place co-located in an update,
+   matches the current place's structure with it (Algorithm 6) and, on
+   confirmation, merges and predicts its exits (Algorithm 8).
+
+Poses, map and counters are the chapter-3 mapper's (the forced updates
+change them a little: they are updates); the network leaves as the run
+folder's ``places.json`` and ``places.graphml`` (``MapperOutput.files``).
+Everything runs in the thesis frame and is handed out in the REP-103 map
+frame, as chapter 3's output.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel
+
+from albot1.config.presets import TomlPresets
+from albot1.contract import MapperOutput
+from albot1.data.model import Frame
+from albot1.geometry.se2 import Pose
+from albot1.geometry.segments import transform_segments
+from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
+from albot1.methods.albot1.places.accel import places_kernels
+from albot1.methods.albot1.places.config import Albot1PlacesConfig
+from albot1.methods.albot1.places.exits import Crossing, ExitTracker
+from albot1.methods.albot1.places.matcher import confirm, structural, trigger_threshold
+from albot1.methods.albot1.places.memory import PlaceNetwork, Visit, invert, same_surfaces
+from albot1.methods.albot1.places.navigation import Prediction, align_at_exit, nearest_prediction, predict
+from albot1.methods.albot1.places.network import network_files
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+@dataclass
+class _Counts:
+    exits_crossed: int = 0
+    revisits_by_structure: int = 0
+    revisits_by_exit: int = 0
+    match_attempts: int = 0
+    updates_forced: int = 0
+
+
+class Albot1PlacesMapper:
+    """Albot1 with its network of places (thesis chapter 4, Algorithms 5-8)."""
+
+    name: ClassVar[str] = "albot1-places"
+    config_model: ClassVar[type[BaseModel]] = Albot1PlacesConfig
+    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets(package="albot1.methods.albot1.places")  # type: ignore[assignment]
+
+    def __init__(self, config: Albot1PlacesConfig, *, seed: int = 0) -> None:
+        self.config = config
+        self.inner = Albot1Mapper(config, seed=seed)
+        self.inner.on_update = self._on_update
+        self._k = places_kernels(config.accelerate)
+        self._match = config.match_params()
+        self.exits = ExitTracker(config.exit_params(), self._k)
+        self._same_angle = math.radians(config.match_angle_deg)
+        self._same_gap = config.match_gap_m
+        self.network = PlaceNetwork(
+            same_angle=self._same_angle, same_gap=self._same_gap, link_distance=config.exit_link_distance_m
+        )
+        self._labels: list[set[int]] = []  # map surface id -> the visits it belongs to (see _on_update)
+        self._members: dict[int, set[int]] = {}  # visit -> the map surface ids marked with it
+        self._colocated: dict[int, int] = {}  # place -> most co-locating surfaces in one update, not yet checked
+        self._attempts: dict[tuple[int, int], int] = {}  # (visit, place) -> current surfaces at the failed attempt
+        self._predicted: list[Prediction] = []
+        self._predictions: list[dict[str, Any]] = []
+        self._revisits: list[dict[str, Any]] = []
+        self._crossings: list[dict[str, Any]] = []
+        self._counts = _Counts()
+        self._n = 0
+
+    # -- per scan ----------------------------------------------------------------------------------------------
+    def process(self, frame: Frame) -> None:
+        n = self._n
+        if n == 0:
+            self.network.start_visit(0, (0.0, 0.0, 0.0))
+        self.inner.process(frame)
+        view, pose = self.inner.last_view, self.inner.last_pose
+        assert view is not None and pose is not None
+        self.exits.observe(view, pose, n)
+        crossing = self.exits.crossing((pose[0], pose[1]), n)
+        if crossing is not None:
+            self._cross(crossing, pose, n)
+        if self._colocated and not self.exits.near((pose[0], pose[1]), self.config.recognition_exit_clearance_m):
+            # In a doorway the check waits until the robot is clear of it: what a view from a doorway
+            # co-locates with is mostly the place beyond, the place the robot is about to enter.
+            self._recognise(pose, n)
+            self._colocated.clear()
+        self._n += 1
+
+    def _on_update(self, event: UpdateEvent) -> None:
+        """Count co-locating surfaces per remembered place, then mark the view's surfaces with the current visit.
+
+        A surface belongs to every visit that brought it into the map, and a
+        surface an update adds in place of one it deleted (the same within 5
+        degrees and 40 cm: the same wall seen again) inherits that one's
+        visits: the perceptual map replaces surfaces rather than editing
+        them, and without the inheritance a room's surfaces would lose their
+        place as soon as a neighbour's view through the doorway replaced them.
+        """
+        out = event.outcome
+        network = self.network
+        current = network.current
+        labels = self._labels
+        top = int(max(out.view_ids.max(initial=-1), out.added.max(initial=-1))) + 1
+        while len(labels) < top:
+            labels.append(set())
+        touched = np.concatenate([out.deleted, out.extended, out.trimmed]).tolist()
+        if touched:
+            excluded = {network.find(v.place) for v in network.visits[-2:] if v.place is not None}
+            per_place: Counter[int] = Counter()
+            for sid in touched:
+                places = {network.find(p) for p in (network.visits[v].place for v in labels[sid]) if p is not None}
+                per_place.update(places - excluded)
+            for place, count in per_place.items():
+                self._colocated[place] = max(self._colocated.get(place, 0), count)
+        if len(out.added) and len(out.deleted):
+            pmap = self.inner.map
+            same = same_surfaces(pmap.segments(out.added), pmap.segments(out.deleted), self._same_angle, self._same_gap)
+            deleted = out.deleted.tolist()
+            for row, col in zip(*np.nonzero(same)):
+                labels[int(out.added[row])] |= labels[deleted[col]]
+        members = self._members.setdefault(current.id, set())
+        for sid in out.view_ids.tolist():
+            labels[sid].add(current.id)
+            members.add(sid)
+
+    def _visit_surfaces(self, visit: Visit) -> FloatArray:
+        """The map surfaces (thesis map frame) marked with ``visit`` (Algorithm 5 lines 2-6)."""
+        pmap = self.inner.map
+        alive = pmap.ids()
+        ids = np.fromiter(sorted(self._members.get(visit.id, ())), dtype=np.int64)
+        return pmap.segments(ids[np.isin(ids, alive, assume_unique=True)])
+
+    # -- Algorithms 5 and 7: an exit crossed ---------------------------------------------------------------------
+    def _cross(self, crossing: Crossing, pose: Pose, n: int) -> None:
+        network, counts = self.network, self._counts
+        counts.exits_crossed += 1
+        visit = network.current
+        compared = nearest_prediction(self._predicted, crossing.segment)
+        place, exit_id = network.close(visit, self._visit_surfaces(visit), crossing.segment, n)
+        entry = np.concatenate([crossing.segment[2:], crossing.segment[:2]])  # the place entered on its left
+        target = network.leads(place, exit_id)
+        nxt = network.start_visit(n, pose, entry, (place, exit_id))
+        record: dict[str, Any] = {
+            "scan": n,
+            "exit": exit_id,
+            "from_visit": visit.id,
+            "from_place": place,
+            "to_visit": nxt.id,
+            "segment": entry,
+            "robot": pose,
+            "prediction": None,
+        }
+        if compared is not None:
+            prediction, aligned_m, not_aligned_m = compared
+            record["prediction"] = {
+                "exit": prediction.exit,
+                "place": prediction.place,
+                "predicted_at_scan": prediction.scan,
+                "aligned": prediction.aligned,
+                "not_aligned": prediction.not_aligned,
+                "aligned_distance_m": aligned_m,
+                "not_aligned_distance_m": not_aligned_m,
+            }
+        self._predicted = []
+        if target is not None:
+            known, known_exit = target
+            landing = network.exit(known, known_exit)
+            assert landing is not None
+            place_in_map = align_at_exit(landing.segment, entry)
+            known = network.assign(nxt, known, place_in_map, n)
+            counts.revisits_by_exit += 1
+            self._revisits.append(
+                {"scan": n, "visit": nxt.id, "place": known, "how": "exit", "exit": exit_id, "matches": None}
+            )
+            self._predict(nxt, n)
+        record["to_place"] = nxt.place
+        self._crossings.append(record)
+        counts.updates_forced += 1
+        self.inner.force_update()  # line 16: the surfaces in view re-enter the map, marked with the new visit
+
+    def _predict(self, visit: Visit, n: int) -> None:
+        """Algorithms 7-8 step 13: the exits of the visit's place, in the map where the place now lies."""
+        assert visit.place is not None and visit.place_in_map is not None
+        place = self.network.places[self.network.find(visit.place)]
+        skip = None if visit.entry_exit is None else self.network.exit_id(visit.entry_exit)
+        self._predicted = predict(place.exits, place.id, visit.place_in_map, n, skip)
+        for p in self._predicted:
+            self._predictions.append(
+                {"scan": n, "visit": visit.id, "place": p.place, "exit": p.exit, "aligned": p.aligned,
+                 "not_aligned": p.not_aligned}
+            )
+
+    # -- Algorithms 6 and 8: a place re-visited -----------------------------------------------------------------
+    def _recognise(self, pose: Pose, n: int) -> None:
+        network, params = self.network, self._match
+        visit = network.current
+        excluded = {network.find(v.place) for v in network.visits[-2:] if v.place is not None}
+        current_all: FloatArray | None = None
+        current: FloatArray | None = None
+        for place_id, count in sorted(self._colocated.items(), key=lambda item: (-item[1], item[0])):
+            place_id = network.find(place_id)
+            if place_id in excluded:
+                continue
+            remembered = structural(network.places[place_id].surfaces, params)
+            if count <= trigger_threshold(len(remembered), params):
+                continue
+            if current_all is None:
+                current_all = self._visit_surfaces(visit)
+                current = self._this_side(structural(current_all, params), pose)
+            assert current is not None
+            key = (visit.id, place_id)
+            last = self._attempts.get(key)
+            if last is not None and len(current_all) < last + params.retry_growth:
+                continue
+            self._counts.match_attempts += 1
+            match = confirm(current, remembered, pose, params, self._k)
+            if not match.confirmed:
+                self._attempts[key] = len(current_all)
+                continue
+            place_in_map = self._align_at_entry(visit, place_id, match.place_in_map)
+            before = None if visit.place is None else network.find(visit.place)
+            now = network.assign(visit, place_id, place_in_map, n)
+            self._counts.revisits_by_structure += 1
+            self._revisits.append(
+                {
+                    "scan": n,
+                    "visit": visit.id,
+                    "place": place_id,
+                    "how": "structure",
+                    "exit": None,
+                    "matches": match.matches,
+                    "merged": None if before is None else sorted({before, place_id}),
+                    "kept": now,
+                }
+            )
+            self._predict(visit, n)
+            return
+
+    def _this_side(self, surfaces: FloatArray, pose: Pose) -> FloatArray:
+        """The surfaces not seen through an exit: the current place's own structure (see docs/places.md)."""
+        mid = 0.5 * (surfaces[:, :2] + surfaces[:, 2:])
+        return np.ascontiguousarray(surfaces[~self.exits.beyond((pose[0], pose[1]), mid)])
+
+    def _align_at_entry(self, visit: Visit, place_id: int, place_in_map: Pose) -> Pose:
+        """Re-align a matched place at the exit the visit came in by, when the place has that exit (Algorithm 8)."""
+        if visit.entry is None:
+            return place_in_map
+        own = transform_segments(invert(place_in_map), visit.entry)[0]
+        place = self.network.places[place_id]
+        same = self.network.same_exit(place, own)
+        if same is None:
+            return place_in_map
+        record = self.network.exit(place_id, same)
+        assert record is not None
+        return align_at_exit(record.segment, visit.entry)
+
+    # -- output ------------------------------------------------------------------------------------------------
+    def finish(self) -> MapperOutput:
+        out = self.inner.finish()
+        network, c = self.network, self._counts
+        counters = dict(out.counters)
+        counters.update(
+            places_created=len(network.places),
+            places=len(network.live_places()),
+            places_merged=len(network.places) - len(network.live_places()),
+            visits=len(network.visits),
+            exits_tracked=self.exits.confirmed,
+            exit_detections=self.exits.detections,
+            exits_crossed=c.exits_crossed,
+            revisits_confirmed=c.revisits_by_structure + c.revisits_by_exit,
+            revisits_by_structure=c.revisits_by_structure,
+            revisits_by_exit=c.revisits_by_exit,
+            match_attempts=c.match_attempts,
+            updates_forced=c.updates_forced,
+        )
+        compared = [r["prediction"] for r in self._crossings if r["prediction"] is not None]
+        if compared:
+            counters["exit_predictions_compared"] = len(compared)
+            counters["exit_prediction_aligned_mean_m"] = float(np.mean([p["aligned_distance_m"] for p in compared]))
+            counters["exit_prediction_not_aligned_mean_m"] = float(
+                np.mean([p["not_aligned_distance_m"] for p in compared])
+            )
+        files = network_files(
+            network,
+            crossings=self._crossings,
+            revisits=self._revisits,
+            predictions=self._predictions,
+            scans=self._n,
+            config=self.config,
+        )
+        extras = dict(out.extras)
+        extras["places"] = {"file": "places.json", "graph": "places.graphml"}
+        return MapperOutput(poses=out.poses, map=out.map, counters=counters, extras=extras, files=files)
+

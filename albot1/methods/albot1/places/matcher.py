@@ -1,0 +1,123 @@
+"""Recognising a place re-visited (thesis 4.1.2, Algorithm 6): the trigger and the structural match.
+
+The trigger: "whenever Albot1 updates its map with the incoming view and
+finds there are more than n co-locating surfaces in the map, it will attempt
+to confirm if it is in a familiar place. n is a function of the size of the
+place being re-visited; a smaller place requires a lesser number of surfaces."
+Co-locating surfaces are the map surfaces an update deletes, extends or
+trims (those the view covers), counted per remembered place through the
+place each was marked with. We take the size of a place as its number of
+structural surfaces (longer than 40 cm): ``n = max(trigger_min,
+ceil(trigger_fraction * size))``.
+
+The confirmation compares "the structural description of the current place
+with the remembered place": the current place's surfaces (map frame) and
+the remembered place's (its own frame), only those longer than 40 cm, the
+``max_surfaces`` longest of each, longest first (long surfaces make the
+steadiest hypotheses, and the first confirming hypothesis ends the search).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.geometry.se2 import Pose
+from albot1.methods.albot1.places.accel import PlacesKernels
+from albot1.methods.albot1.places.config import MatchParams
+
+FloatArray = NDArray[np.float64]
+
+
+def trigger_threshold(size: int, params: MatchParams) -> int:
+    """n of 4.1.2 for a remembered place with ``size`` structural surfaces: more than n co-locating triggers."""
+    return max(params.trigger_min, math.ceil(params.trigger_fraction * size))
+
+
+def merge_collinear(surfaces: FloatArray, max_angle: float, max_offset: float, max_gap: float) -> FloatArray:
+    """Pieces of one straight structure as one surface, longest pieces first.
+
+    A surface joins a longer one when their directions differ by less than
+    ``max_angle``, its midpoint is within ``max_offset`` of the longer one's
+    line, and along that line it overlaps it or leaves a gap of at most
+    ``max_gap``; the joined surface spans both along the longer one's line.
+    The perceptual map holds a wall as several pieces (cut where furniture
+    hid it, re-added a little apart by later views); counted piece by piece,
+    two walls alone would make "more than 4" matches in any two rooms.
+    """
+    s = np.asarray(surfaces, dtype=float).reshape(-1, 4)
+    if len(s) < 2:
+        return s.copy()
+    length = np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
+    groups: list[list[float]] = []  # ax, ay, ux, uy, tmin, tmax
+    for i in np.argsort(-length, kind="stable").tolist():
+        x1, y1, x2, y2 = s[i]
+        if length[i] <= 0.0:
+            continue
+        ux, uy = (x2 - x1) / length[i], (y2 - y1) / length[i]
+        mx, my = 0.5 * (x1 + x2), 0.5 * (y1 + y2)
+        for g in groups:
+            if ux * g[2] + uy * g[3] < math.cos(max_angle):
+                continue
+            if abs(-g[3] * (mx - g[0]) + g[2] * (my - g[1])) > max_offset:
+                continue
+            t1 = (x1 - g[0]) * g[2] + (y1 - g[1]) * g[3]
+            t2 = (x2 - g[0]) * g[2] + (y2 - g[1]) * g[3]
+            lo, hi = min(t1, t2), max(t1, t2)
+            if lo <= g[5] + max_gap and hi >= g[4] - max_gap:
+                g[4], g[5] = min(g[4], lo), max(g[5], hi)
+                break
+        else:
+            groups.append([x1, y1, ux, uy, 0.0, float(length[i])])
+    return np.array([[g[0] + g[4] * g[2], g[1] + g[4] * g[3], g[0] + g[5] * g[2], g[1] + g[5] * g[3]] for g in groups])
+
+
+def structural(surfaces: FloatArray, params: MatchParams) -> FloatArray:
+    """A place's structure: its surfaces merged where collinear, the longer than the minimum, longest first, capped."""
+    s = merge_collinear(surfaces, params.angle, 0.5 * params.gap, params.gap)
+    length = np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
+    keep = np.flatnonzero(length > params.min_surface)
+    order = keep[np.argsort(-length[keep], kind="stable")]
+    return np.ascontiguousarray(s[order[: params.max_surfaces]])
+
+
+def robot_sides(surfaces: FloatArray, pose: Pose) -> NDArray[np.int64]:
+    """Which side of the robot (thesis frame: facing +y at ``pose``) each surface's midpoint is on: -1 left, +1 right.
+
+    Left is counter-clockwise from the heading; a midpoint exactly on the heading line is 0.
+    """
+    mid_x = 0.5 * (surfaces[:, 0] + surfaces[:, 2]) - pose[0]
+    mid_y = 0.5 * (surfaces[:, 1] + surfaces[:, 3]) - pose[1]
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    lateral = c * mid_x + s * mid_y  # x in the robot's thesis frame: negative = left
+    return np.sign(lateral).astype(np.int64)
+
+
+@dataclass(frozen=True, slots=True)
+class Match:
+    """The outcome of one confirmation: whether it confirmed, the best count, and the remembered place's frame."""
+
+    confirmed: bool
+    matches: int
+    place_in_map: Pose
+
+
+def confirm(
+    current_map: FloatArray, remembered_own: FloatArray, pose: Pose, params: MatchParams, kernels: PlacesKernels
+) -> Match:
+    """Algorithm 6 on already selected surfaces (:func:`structural`); ``pose`` is the robot's, thesis frame."""
+    if len(current_map) == 0 or len(remembered_own) == 0:
+        return Match(False, 0, (0.0, 0.0, 0.0))
+    found, count, theta, tx, ty = kernels.match_structure(
+        current_map,
+        robot_sides(current_map, pose),
+        remembered_own,
+        params.angle,
+        params.gap,
+        params.min_matches,
+        params.anchors,
+    )
+    return Match(bool(found), int(count), (float(tx), float(ty), float(theta)))

@@ -1,0 +1,349 @@
+"""MRPT's ``icp-slam`` and ``rbpf-slam`` applications behind the mapper protocol.
+
+The applications are batch programs: they read a whole rawlog and write
+their results to a folder. The mapper therefore only *keeps* each frame in
+:meth:`process` (the per-scan time the runner measures is that bookkeeping)
+and does the work in :meth:`finish`: write the rawlog, render the INI file
+from its template, run the application as a subprocess with a wall-clock
+and a resident-memory limit, and read its output back. Where the time goes
+is recorded in the counters: ``rawlog_write_s``, ``mrpt_wall_s`` (the
+subprocess, start to exit), ``mrpt_cpu_s``, ``mrpt_total_s`` (MRPT's own
+timing of its mapping loop) and ``mrpt_peak_rss_mb``; the runner's
+``finish_s`` holds all of it.
+
+Each run gets a fresh temporary folder (the applications delete everything
+in their output folder first), removed afterwards; the INI text, MRPT's
+version and its per-step timing statistics go into ``extras.mrpt``.
+
+Success is checked, never assumed from the exit status: one pose per scan,
+finite, and a path whose length is within ``[min_path_ratio,
+max_path_ratio]`` of the odometry's. A failure is a :class:`BaselineError`
+with the reason (timeout, memory limit, MRPT's exception message, a short or
+frozen path).
+
+Frames: rbpf-slam's poses are relative to the first scan (its filter starts
+at the origin); icp-slam's are re-expressed relative to its first pose, with
+its map, so both start at the origin like the other baselines.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel
+
+from albot1.config.presets import TomlPresets
+from albot1.contract import MapData, MapperOutput
+from albot1.data.errors import DataError
+from albot1.data.loaders.rawlog.serialize import GaussianMotionModel
+from albot1.data.loaders.rawlog.writer import RawlogLayout, RawlogStats, write_frames
+from albot1.data.model import Frame
+from albot1.geometry import se2
+from albot1.methods.baselines.errors import BaselineError
+from albot1.methods.baselines.mrpt import outputs
+from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig, MrptRunConfig
+from albot1.methods.baselines.mrpt.process import ProcessOutcome, run_limited
+from albot1.methods.baselines.mrpt.templates import render
+
+FloatArray = NDArray[np.float64]
+
+#: The Debian package that provides the applications (``make mrpt`` installs it).
+APT_PACKAGE = "mrpt-apps"
+#: The odometry must move at least this far before the path-length check applies (m).
+MIN_CHECKED_PATH_M = 1.0
+
+RAWLOG_NAME = "input.rawlog"
+INI_NAME = "config.ini"
+OUTPUT_DIR = "out"
+
+
+def find_app(app: str) -> str | None:
+    """Absolute path of an MRPT application on ``PATH`` (None when absent)."""
+    return shutil.which(app)
+
+
+def _stats_ms(values: FloatArray) -> dict[str, float | int] | None:
+    if not len(values):
+        return None
+    return {
+        "median_ms": float(np.median(values)),
+        "mean_ms": float(np.mean(values)),
+        "p95_ms": float(np.percentile(values, 95)),
+        "max_ms": float(np.max(values)),
+        "sum_s": float(np.sum(values) / 1000.0),
+        "n": int(len(values)),
+    }
+
+
+def _mrpt_version(stdout_text: str) -> str | None:
+    for line in stdout_text.splitlines()[:20]:
+        marker = "MRPT C++ Library: MRPT "
+        if marker in line:
+            return line.split(marker, 1)[1].split()[0]
+    return None
+
+
+class _MrptMapper:
+    """Shared bookkeeping of the two applications (see the module doc)."""
+
+    name: ClassVar[str]
+    app: ClassVar[str]
+    layout: ClassVar[RawlogLayout]
+    config_model: ClassVar[type[BaseModel]]
+    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+
+    def __init__(self, config: MrptRunConfig, *, seed: int = 0) -> None:
+        self.config = config
+        self.seed = seed
+        self._frames: list[Frame] = []
+
+    # -- per scan --------------------------------------------------------------------------------------------
+
+    def process(self, frame: Frame) -> None:
+        """Keep the frame; the application runs on all of them in :meth:`finish`."""
+        odometry = np.asarray(frame.odometry, dtype=float)
+        if odometry.shape != (3,) or not np.isfinite(odometry).all():
+            raise BaselineError(
+                f"{self.name}: scan {frame.index}: odometry {odometry.tolist()} is not a finite (x, y, theta); "
+                f"expected finite odometry at every scan"
+            )
+        self._frames.append(frame)
+
+    # -- end of run ------------------------------------------------------------------------------------------
+
+    def _sensor_offset(self) -> tuple[float, float, float]:
+        c = self.config
+        return (c.sensor_offset_x_m, c.sensor_offset_y_m, math.radians(c.sensor_offset_theta_deg))
+
+    def _motion_model(self) -> GaussianMotionModel | None:
+        return None
+
+    def _run_values(self) -> dict[str, Any]:
+        return {}
+
+    def finish(self) -> MapperOutput:
+        """Write the rawlog and INI, run the application, read and check its output (module doc)."""
+        scans = len(self._frames)
+        if scans == 0:
+            raise BaselineError(f"{self.name}: no scans were given; {self.app} needs at least one")
+        executable = find_app(self.app)
+        if executable is None:
+            raise BaselineError(
+                f"{self.name}: MRPT's {self.app} is not on PATH; install the Debian package {APT_PACKAGE} "
+                f"(`make mrpt`)"
+            )
+        odometry = np.asarray([f.odometry for f in self._frames], dtype=float)
+        with tempfile.TemporaryDirectory(prefix=f"albot1-{self.name}-") as tmp:
+            work = Path(tmp)
+            start = time.perf_counter()
+            try:
+                with (work / RAWLOG_NAME).open("wb") as out:
+                    rawlog = write_frames(
+                        self._frames, out, layout=self.layout, sensor_offset=self._sensor_offset(),
+                        motion_model=self._motion_model(),
+                    )
+            except DataError as exc:
+                raise BaselineError(f"{self.name}: cannot write the rawlog: {exc}") from None
+            rawlog_s = time.perf_counter() - start
+            ini = render(
+                self.app, self.config, rawlog_file=RAWLOG_NAME, output_dir=OUTPUT_DIR, **self._run_values()
+            )
+            (work / INI_NAME).write_text(ini, encoding="ascii")
+            env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+            # One thread: MRPT's OpenMP loops draw from one global random generator, so more
+            # threads would make a seeded run irreproducible; the cost is measured single-threaded.
+            env["OMP_NUM_THREADS"] = "1"
+            outcome = run_limited(
+                [executable, INI_NAME, RAWLOG_NAME],
+                cwd=work,
+                timeout_s=self.config.timeout_s,
+                memory_limit_mb=self.config.memory_limit_mb,
+                stdout_path=work / "stdout.txt",
+                stderr_path=work / "stderr.txt",
+                env=env,
+            )
+            stdout_text = (work / "stdout.txt").read_text(encoding="utf-8", errors="replace")
+            stderr_text = (work / "stderr.txt").read_text(encoding="utf-8", errors="replace")
+            out_dir = work / OUTPUT_DIR
+            self._check_outcome(outcome, out_dir, stdout_text, stderr_text, scans)
+            poses, points, counters, extras = self._read(out_dir, odometry)
+
+        self._check_path(poses, odometry)
+        mrpt_block = {
+            "app": self.app,
+            "executable": executable,
+            "version": _mrpt_version(stdout_text),
+            "rawlog_layout": self.layout,
+            "rawlog_bytes": rawlog.bytes_written,
+            "rawlog_invalid_beams": rawlog.invalid_beams,
+            "seed": self.seed,
+            "threads": 1,
+            "ini": ini,
+            **extras,
+        }
+        all_counters: dict[str, int | float] = {
+            "views": scans,
+            **counters,
+            "map_points": int(len(points)),
+            "rawlog_write_s": rawlog_s,
+            "mrpt_wall_s": outcome.wall_s,
+            "mrpt_cpu_s": outcome.user_s + outcome.system_s,
+            "mrpt_peak_rss_mb": outcome.peak_rss_mb,
+        }
+        total = outputs.total_time_s(stdout_text)
+        if total is not None:
+            all_counters["mrpt_total_s"] = total
+        return MapperOutput(
+            poses=poses, map=MapData(points=points), counters=all_counters, extras={"mrpt": mrpt_block}
+        )
+
+    def _check_outcome(
+        self, outcome: ProcessOutcome, out_dir: Path, stdout_text: str, stderr_text: str, scans: int
+    ) -> None:
+        """A BaselineError saying why the application did not finish (limits, crash, exit status)."""
+        progress = self._progress(out_dir, scans)
+        if outcome.stopped == "timeout":
+            raise BaselineError(
+                f"{self.name}: {self.app} stopped by its time limit (timeout_s = {self.config.timeout_s:g}) after "
+                f"{outcome.wall_s:.1f} s, {progress}"
+            )
+        if outcome.stopped == "memory":
+            raise BaselineError(
+                f"{self.name}: {self.app} stopped by its memory limit (memory_limit_mb = "
+                f"{self.config.memory_limit_mb:g}; resident {outcome.peak_rss_mb:.0f} MB) after "
+                f"{outcome.wall_s:.1f} s, {progress}"
+            )
+        if outcome.returncode != 0:
+            if outcome.returncode is not None and outcome.returncode < 0:
+                how = f"was killed by signal {-outcome.returncode}"
+            else:
+                how = f"exited with status {outcome.returncode}"
+            reason = outputs.last_error_line(stderr_text + "\n" + stdout_text)
+            raise BaselineError(f"{self.name}: {self.app} {how}, {progress}: {reason}")
+
+    def _progress(self, out_dir: Path, scans: int) -> str:
+        """How far the application got, from its step log (written as it goes, possibly buffered)."""
+        path = out_dir / "log_estimated_path.txt"
+        try:
+            with path.open("rb") as handle:
+                lines = sum(1 for line in handle if line.strip() and not line.startswith(b"%"))
+        except OSError:
+            return f"before logging any of {scans} scans"
+        done = lines // 2 if self.layout == "observations" else lines
+        return f"about {done} of {scans} scans logged"
+
+    def _check_path(self, poses: FloatArray, odometry: FloatArray) -> None:
+        """The path must be finite and neither frozen nor wildly longer than the odometry's."""
+        if poses.shape != odometry.shape:
+            raise BaselineError(f"{self.name}: {len(poses)} poses for {len(odometry)} scans; expected one per scan")
+        bad = np.flatnonzero(~np.isfinite(poses).all(axis=1))
+        if len(bad):
+            raise BaselineError(f"{self.name}: {len(bad)} non-finite poses from {self.app}, first at scan {bad[0]}")
+        odometry_m = se2.path_length(odometry)
+        if odometry_m < MIN_CHECKED_PATH_M:
+            return
+        estimate_m = se2.path_length(poses)
+        ratio = estimate_m / odometry_m
+        if ratio < self.config.min_path_ratio:
+            raise BaselineError(
+                f"{self.name}: the estimated path is {estimate_m:.2f} m long for {odometry_m:.2f} m of odometry "
+                f"(ratio {ratio:.3f} < min_path_ratio {self.config.min_path_ratio:g}): {self.app} did not track "
+                f"the robot"
+            )
+        if ratio > self.config.max_path_ratio:
+            raise BaselineError(
+                f"{self.name}: the estimated path is {estimate_m:.2f} m long for {odometry_m:.2f} m of odometry "
+                f"(ratio {ratio:.3f} > max_path_ratio {self.config.max_path_ratio:g}): {self.app} diverged"
+            )
+
+    def _read(
+        self, out_dir: Path, odometry: FloatArray
+    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any]]:
+        raise NotImplementedError
+
+
+class MrptIcpMapper(_MrptMapper):
+    """MRPT ``icp-slam``: each scan matched by ICP against a growing point map (no loop closing)."""
+
+    name: ClassVar[str] = "mrpt-icp"
+    app: ClassVar[str] = "icp-slam"
+    layout: ClassVar[RawlogLayout] = "observations"
+    config_model: ClassVar[type[BaseModel]] = MrptIcpConfig
+
+    def __init__(self, config: MrptIcpConfig, *, seed: int = 0) -> None:
+        # icp-slam draws no random numbers; ``seed`` is accepted for the protocol.
+        super().__init__(config, seed=seed)
+
+    def _read(
+        self, out_dir: Path, odometry: FloatArray
+    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any]]:
+        scans = len(odometry)
+        raw = outputs.icp_poses(out_dir, scans)
+        origin_inverse = se2.inverse(raw[0])
+        poses = se2.compose(origin_inverse, raw)
+        points = se2.transform_points(origin_inverse, outputs.icp_point_map(out_dir))
+        times = outputs.icp_step_times_ms(out_dir, 2 * scans)
+        map_sizes = np.loadtxt(out_dir / "log_times.txt", ndmin=2)[:, 1]
+        counters: dict[str, int | float] = {"updates": int(map_sizes[-1]) if len(map_sizes) else 0}
+        extras = {"step_times": _stats_ms(times), "scan_step_times": _stats_ms(times[1::2])}
+        return poses, points, counters, extras
+
+
+class MrptRbpfMapper(_MrptMapper):
+    """MRPT ``rbpf-slam``: a Rao-Blackwellized particle filter of occupancy-grid maps (GMapping family)."""
+
+    name: ClassVar[str] = "mrpt-rbpf"
+    app: ClassVar[str] = "rbpf-slam"
+    layout: ClassVar[RawlogLayout] = "actions"
+    config_model: ClassVar[type[BaseModel]] = MrptRbpfConfig
+
+    def __init__(self, config: MrptRbpfConfig, *, seed: int = 0) -> None:
+        if seed < 0:
+            raise BaselineError(f"{self.name}: seed {seed}; expected >= 0 (a negative RANDOM_SEED means 'random')")
+        super().__init__(config, seed=seed)
+        self.rbpf: MrptRbpfConfig = config
+
+    def _run_values(self) -> dict[str, Any]:
+        return {"seed": self.seed}
+
+    def _motion_model(self) -> GaussianMotionModel:
+        c = self.rbpf
+        return GaussianMotionModel(
+            a1=c.motion_a1, a2=c.motion_a2, a3=c.motion_a3, a4=c.motion_a4,
+            min_std_xy=c.motion_min_std_xy_m, min_std_phi=math.radians(c.motion_min_std_theta_deg),
+        )
+
+    def _read(
+        self, out_dir: Path, odometry: FloatArray
+    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any]]:
+        scans = len(odometry)
+        steps = outputs.rbpf_steps(out_dir, scans)
+        updates = int(np.count_nonzero(steps.updated))
+        best = outputs.rbpf_best_path(out_dir, updates)
+        # Between updates MRPT predicts with the odometry increments the rawlog carried: the frames' odometry.
+        poses = outputs.poses_between_updates(best, steps.updated, odometry)
+        mean = outputs.rbpf_mean_poses(out_dir, scans)
+        grid = outputs.grid_map(out_dir, self.rbpf.grid_resolution_m)
+        points = grid.occupied_points(self.rbpf.map_occupied_probability)
+        ess = outputs._rows(out_dir / "log_ParticlesStats.txt", 3, "particle statistics")
+        gap = np.linalg.norm(poses[:, :2] - mean[:, :2], axis=1)
+        counters: dict[str, int | float] = {"updates": updates, "particles": self.rbpf.particles}
+        extras = {
+            "step_times": _stats_ms(steps.time_ms),
+            "update_step_times": _stats_ms(steps.time_ms[steps.updated]),
+            "grid": grid.summary(),
+            "ess_min": float(ess[:, 2].min()) if len(ess) else None,
+            "ess_mean": float(ess[:, 2].mean()) if len(ess) else None,
+            # How far the reported path (the most likely particle's, smoothed by later updates) lies from
+            # the online particle mean MRPT logged at each scan.
+            "best_vs_mean_m": {"median": float(np.median(gap)), "max": float(np.max(gap))},
+        }
+        return poses, points, counters, extras

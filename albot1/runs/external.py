@@ -1,0 +1,172 @@
+"""An external trajectory (Cartographer, slam_toolbox, GMapping, ...) prepared for scoring against a dataset.
+
+The file's poses (:func:`albot1.data.trajectory.read_trajectory`) are
+matched to the dataset's scans, whose reference poses they are scored
+against:
+
+* **by time** (TUM, CARMEN): each pose goes to the scan nearest in time
+  (:func:`albot1.data.relations.match_stamps`, the lookup the relation
+  metric uses) when that scan is at most ``max_dt_s`` away (default
+  :data:`MAX_DT_S`, evo's default ``t_max_diff``); when several poses go
+  to one scan the nearest keeps it (the earlier on a tie). Every pose left
+  out is counted in the ``trajectory`` block of ``metrics.json`` and by
+  the CLI, never dropped silently;
+* **by order** (KITTI, no timestamps): the file must hold exactly one pose
+  per scan of the dataset (``NAME[:N]`` selects a prefix).
+
+The relation metric needs only times, so it looks relations up in every
+pose of the file (matched or not). Map shape, update counts and cost need
+a map, counters and timings that a trajectory file does not hold: those
+metrics are null with that reason.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1 import versions
+from albot1.data.model import Sequence
+from albot1.data.open import open_sequence
+from albot1.data.relations import match_stamps
+from albot1.data.trajectory import PoseFile, as_stored, read_trajectory
+from albot1.runs.errors import RunError
+from albot1.runs.scored import Scored
+from albot1.settings import Settings
+
+#: Largest time between a pose and the scan it is matched to (s): evo's default ``t_max_diff``.
+MAX_DT_S = 0.01
+EXTERNAL_PRESET = "external"
+NO_MAP = "an external trajectory comes without a map"
+NO_COUNTERS = "an external trajectory comes without the method's counters (views, updates)"
+NO_TIMING = "an external trajectory comes without per-scan timings"
+
+
+@dataclass(frozen=True)
+class Matching:
+    """Which pose of the file went to which scan, and how many poses were left out (and why)."""
+
+    pose_index: NDArray[np.int64]
+    scan_index: NDArray[np.int64]
+    unmatched: int
+    duplicates: int
+
+
+def match_by_time(pose_times: NDArray[np.float64], scan_times: NDArray[np.float64], max_dt_s: float) -> Matching:
+    """Each pose to its nearest scan within ``max_dt_s``; one pose per scan (the nearest; ties: the earlier pose).
+
+    The result is ordered by scan index.
+    """
+    if not len(pose_times) or not len(scan_times):
+        return Matching(np.empty(0, np.int64), np.empty(0, np.int64), int(len(pose_times)), 0)
+    scan, gap = match_stamps(scan_times, pose_times)
+    close = np.flatnonzero(gap <= max_dt_s)
+    # nearest pose per scan: sort by (scan, gap, pose index) and keep the first of each scan
+    order = np.lexsort((close, gap[close], scan[close]))
+    chosen = close[order]
+    first = np.concatenate([[True], scan[chosen][1:] != scan[chosen][:-1]]) if len(chosen) else np.empty(0, bool)
+    keep = chosen[first]
+    return Matching(
+        pose_index=keep.astype(np.int64),
+        scan_index=scan[keep].astype(np.int64),
+        unmatched=int(len(pose_times) - len(close)),
+        duplicates=int(len(close) - len(keep)),
+    )
+
+
+def load_external(
+    path: Path,
+    dataset: str,
+    *,
+    format_name: str | None = None,
+    label: str | None = None,
+    max_dt_s: float | None = None,
+    settings: Settings | None = None,
+    wrap: Callable[[Sequence], Sequence] | None = None,
+) -> Scored:
+    """The trajectory in ``path`` matched to ``dataset``'s scans, ready for :func:`albot1.runs.evaluate.score`.
+
+    ``wrap`` may wrap the opened dataset before its one decoding pass (the CLI's progress bar).
+    """
+    file = read_trajectory(path, format_name)
+    if max_dt_s is not None and not max_dt_s > 0:
+        raise RunError(f"--max-dt is {max_dt_s} s; expected a positive number of seconds")
+    if not len(file.poses):
+        raise RunError(f"{file.path}: the trajectory holds no poses")
+    sequence = open_sequence(dataset, settings=settings)
+    if wrap is not None:
+        sequence = wrap(sequence)
+    arrays = sequence.arrays  # one decoding pass: scan times and reference poses
+    scan_times, reference = arrays.timestamps, arrays.reference
+    if reference is not None:
+        reference = as_stored(scan_times, reference)  # as a run folder's reference.tum holds it
+    if file.timestamps is None:
+        if len(file.poses) != len(scan_times):
+            raise RunError(
+                f"{file.path}: {len(file.poses)} poses without timestamps ({file.format}), but dataset {dataset!r} "
+                f"has {len(scan_times)} scans; expected one pose per scan in order (select a prefix with NAME[:N])"
+            )
+        dt = None
+        matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
+        pose_times = scan_times
+    else:
+        dt = MAX_DT_S if max_dt_s is None else max_dt_s
+        matching = match_by_time(file.timestamps, scan_times, dt)
+        pose_times = file.timestamps
+        if not len(matching.pose_index):
+            raise RunError(
+                f"{file.path}: none of its {len(file.poses)} poses (times {pose_times.min():.3f}-"
+                f"{pose_times.max():.3f} s) lies within {dt:g} s of a scan of {dataset!r} (times "
+                f"{scan_times.min():.3f}-{scan_times.max():.3f} s); expected the log's own timestamps"
+            )
+    poses = file.poses[matching.pose_index]
+    scans = matching.scan_index
+    key, digest = _key(file, dataset)
+    name = label or file.path.stem
+    order = np.argsort(pose_times, kind="stable")
+    return Scored(
+        header={
+            "key": key,
+            "method": name,
+            "dataset": dataset,
+            "preset": EXTERNAL_PRESET,
+            "degradation": "none",
+            "seed": None,
+            "scans": int(len(poses)),
+            "has_reference": reference is not None,
+        },
+        dataset=dataset,
+        timestamps=pose_times[matching.pose_index],
+        poses=poses,
+        reference=reference[scans] if reference is not None else None,
+        relations=sequence.relations,
+        relations_source=f"the relations of {dataset}",
+        relation_timestamps=pose_times[order],
+        relation_poses=file.poses[order],
+        absent={"map_shape": NO_MAP, "updates": NO_COUNTERS, "cost": NO_TIMING},
+        extra={
+            "trajectory": {
+                "file": str(file.path),
+                "format": file.format,
+                "sha256": digest,
+                "poses": int(len(file.poses)),
+                "matched": int(len(poses)),
+                "unmatched": matching.unmatched,
+                "duplicates": matching.duplicates,
+                "max_dt_s": dt,
+                "versions": {"code": versions.code_version(), "git": versions.git_commit()},
+            }
+        },
+    )
+
+
+def _key(file: PoseFile, dataset: str) -> tuple[str, str]:
+    """(evaluation key, sha256 of the file): the key names the file's content, its format and the dataset."""
+    digest = hashlib.sha256(file.path.read_bytes()).hexdigest()
+    key = hashlib.sha256(f"{digest}\n{file.format}\n{dataset}".encode()).hexdigest()[:16]
+    return key, digest

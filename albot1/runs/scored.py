@@ -1,0 +1,82 @@
+"""What evaluation scores (:class:`Scored`): one trajectory per scan against its dataset's reference.
+
+Both sources of ``albot1 evaluate`` produce one: a run folder
+(:func:`scored_run`) and an external trajectory file
+(:func:`albot1.runs.external.load_external`); :func:`albot1.runs.evaluate.score`
+scores either the same way.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.records import Timing
+
+if TYPE_CHECKING:
+    from albot1.contract import MapData
+    from albot1.data.model import Relations
+    from albot1.runs.folder import StoredRun
+
+
+@dataclass(frozen=True)
+class Scored:
+    """What :func:`score` scores: poses per scan against the dataset's reference, plus what a run adds.
+
+    ``timestamps``/``poses``/``reference`` are aligned row by row (one row
+    per scan scored). ``relation_timestamps``/``relation_poses`` are the
+    poses the relation metric looks relations up in (the same rows for a
+    run; every pose of an external file, matched to a scan or not, since a
+    relation needs only times). ``load_map``, ``counters`` and
+    ``per_scan_ns``/``timing`` are None when the source has none, and
+    ``absent`` says why for the metrics that need them.
+    """
+
+    header: dict[str, Any]
+    dataset: str
+    timestamps: NDArray[np.float64]
+    poses: NDArray[np.float64]
+    reference: NDArray[np.float64] | None
+    relations: Relations | None
+    relations_source: str
+    relation_timestamps: NDArray[np.float64]
+    relation_poses: NDArray[np.float64]
+    load_map: Callable[[], MapData] | None = None
+    counters: Mapping[str, int | float] | None = None
+    per_scan_ns: NDArray[np.int64] | None = None
+    timing: Timing | None = None
+    absent: dict[str, str] = field(default_factory=dict)
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def scored_run(run: StoredRun) -> Scored:
+    """A stored run as :class:`Scored` (its ``result.json`` gives the header, its folder the rest)."""
+    info = run.info
+    return Scored(
+        header={
+            "key": info.key,
+            "method": info.method,
+            "dataset": info.dataset,
+            "preset": info.preset,
+            "degradation": info.degradation,
+            "seed": info.seed,
+            "scans": int(len(run.poses)),
+            "has_reference": run.reference is not None,
+        },
+        dataset=info.dataset,
+        timestamps=run.timestamps,
+        poses=run.poses,
+        reference=run.reference,
+        relations=run.relations,
+        relations_source=str(run.path / "relations.txt"),
+        relation_timestamps=run.timestamps,
+        relation_poses=run.poses,
+        load_map=run.load_map,
+        counters=dict(info.counters),
+        per_scan_ns=run.per_scan_ns,
+        timing=info.timing,
+    )

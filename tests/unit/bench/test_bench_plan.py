@@ -1,0 +1,53 @@
+"""Planning a suite: unknown datasets are errors unless optional; deterministic degradations run once."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from albot1.bench.errors import SuiteError
+from albot1.bench.grid import GridPlan
+from albot1.bench.plan import plan_suite
+from albot1.bench.suite import load_suite
+from albot1.settings import Settings
+
+WORLD = "synthetic-office-startstop"
+
+
+def _plan(tmp_path: Path, datasets: str, grid: str = "") -> tuple[Path, GridPlan]:
+    path = tmp_path / "tiny.toml"
+    path.write_text(f'{grid}\n[[methods]]\nname = "odometry"\n\n[[datasets]]\nname = "{WORLD}"\n{datasets}')
+    return path, plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+
+
+def test_a_literal_dataset_that_names_nothing_is_an_error_naming_suite_and_entry(tmp_path: Path) -> None:
+    with pytest.raises(SuiteError) as caught:
+        _plan(tmp_path, '[[datasets]]\nname = "no-such-log"\n')
+    message = str(caught.value)
+    assert message.startswith(f"{tmp_path / 'tiny.toml'}: dataset entry 'no-such-log': ")
+    assert "neither a dataset name nor an existing file" in message and "optional = true" in message
+
+
+def test_an_optional_unknown_dataset_is_skipped_with_its_reason(tmp_path: Path) -> None:
+    _, plan = _plan(tmp_path, '[[datasets]]\nname = "no-such-log"\noptional = true\n')
+    assert [s.name for s in plan.skipped_datasets] == ["no-such-log"]
+    assert "neither a dataset name nor an existing file" in plan.skipped_datasets[0].reason
+    assert {c.dataset for c in plan.cells} == {WORLD}
+
+
+def test_a_registered_dataset_not_downloaded_is_skipped_not_an_error(tmp_path: Path) -> None:
+    _, plan = _plan(tmp_path, '[[datasets]]\nname = "aces"\n')
+    assert [s.name for s in plan.skipped_datasets] == ["aces"]
+
+
+def test_deterministic_degradations_run_once_and_random_ones_once_per_seed(tmp_path: Path) -> None:
+    grid = (
+        '[grid]\ndegradations = ["thesis", "bias:0.01:0.1", "gauss:0.1:1"]\n'
+        "seeds = [3, 4, 5]\nundegraded_seeds = [7, 8]\n"
+    )
+    _, plan = _plan(tmp_path, "sweep = true\n", grid)
+    runs = sorted((c.degradation, c.seed) for c in plan.cells)
+    assert runs == sorted(
+        [("none", 7), ("thesis", 3), ("bias:0.01:0.1", 3), ("gauss:0.1:1", 3), ("gauss:0.1:1", 4), ("gauss:0.1:1", 5)]
+    )

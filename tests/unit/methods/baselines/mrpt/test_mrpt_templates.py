@@ -1,0 +1,59 @@
+"""INI templates: every config field has a placeholder and every placeholder a value."""
+
+from __future__ import annotations
+
+import pytest
+from pydantic import BaseModel
+
+from albot1.methods.baselines.errors import BaselineError
+from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig
+from albot1.methods.baselines.mrpt.mapper import MrptIcpMapper, MrptRbpfMapper
+from albot1.methods.baselines.mrpt.templates import ini_value, render
+
+
+def _ini(text: str) -> dict[str, str]:
+    out = {}
+    for line in text.splitlines():
+        if "=" in line and not line.lstrip().startswith("#"):
+            key, _, value = line.partition("=")
+            out[key.strip()] = value.strip()
+    return out
+
+
+def test_icp_ini_carries_the_config_and_is_headless() -> None:
+    config = MrptIcpConfig.model_validate(MrptIcpMapper.presets["default"])
+    ini = _ini(render("icp-slam", config, rawlog_file="in.rawlog", output_dir="out"))
+    assert ini["thresholdDist"] == "0.3" and ini["ICP_algorithm"] == "icpClassic"
+    assert ini["insertionAngDistance"] == "45.0" and ini["onlyUniqueRobust"] == "1"
+    assert ini["logOutput_dir"] == "out" and ini["rawlog_file"] == "in.rawlog"
+    assert ini["SHOW_PROGRESS_3D_REAL_TIME"] == "0" and ini["SAVE_3D_SCENE"] == "0" and ini["LOG_FREQUENCY"] == "0"
+    assert "timeout_s" not in ini and "${" not in render("icp-slam", config, rawlog_file="a", output_dir="b")
+
+
+def test_rbpf_ini_has_one_update_threshold_and_the_seed() -> None:
+    config = MrptRbpfConfig.model_validate(MrptRbpfMapper.presets["optimal-sampling"])
+    ini = _ini(render("rbpf-slam", config, rawlog_file="in.rawlog", output_dir="out", seed=5))
+    assert ini["RANDOM_SEED"] == "5" and ini["PF_algorithm"] == "3" and ini["sampleSize"] == "25"
+    assert ini["localizeLinDistance"] == ini["insertionLinDistance"] == "1.0"
+    assert ini["localizeAngDistance_deg"] == ini["insertionAngDistance_deg"] == "40.0"
+    assert ini["resolution"] == "0.07" and ini["SHOW_PROGRESS_IN_WINDOW"] == "0"
+
+
+class _Extra(BaseModel):
+    surplus_m: float = 1.0
+
+
+def test_a_field_without_placeholder_or_a_missing_value_is_an_error() -> None:
+    with pytest.raises(BaselineError, match=r"fields without a placeholder: surplus_m; placeholders without a value: .*icp_alfa"):
+        render("icp-slam", _Extra(), rawlog_file="a", output_dir="b")
+    config = MrptIcpConfig.model_validate(MrptIcpMapper.presets["default"])
+    with pytest.raises(BaselineError, match="placeholders without a value: output_dir"):
+        render("icp-slam", config, rawlog_file="a")
+    with pytest.raises(BaselineError, match="no INI template"):
+        render("graph-slam", config)
+
+
+def test_values_are_written_as_mrpt_reads_them() -> None:
+    assert (ini_value(True), ini_value(False), ini_value(0.1), ini_value(3), ini_value("x")) == ("1", "0", "0.1", "3", "x")
+    with pytest.raises(BaselineError, match="non-finite"):
+        ini_value(float("nan"))
