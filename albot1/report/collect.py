@@ -17,6 +17,7 @@ when its run has no number there (a metric that does not apply, ``null``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -44,42 +45,102 @@ SOURCE_MODELS: dict[Source, type[Record]] = {
 }
 
 
+#: A loop gap applies to a route whose reference returns near its start: within this many metres ...
+ROUTE_RETURN_M = 1.0
+#: ... or this fraction of the route's length, whichever is larger (docs/metrics.md, "Loop gap").
+ROUTE_RETURN_FRACTION = 0.02
+
+
+def _route_returns(metrics: MetricsRecord) -> str | None:
+    """None when the route returns to its start (a loop gap means something), else why it does not apply."""
+    gap = metrics.loop_gap
+    if gap is None:
+        return None
+    offset = gap.route.reference_offset_m
+    route = metrics.drift.route_m if metrics.drift is not None else 0.0
+    allowed = max(ROUTE_RETURN_M, ROUTE_RETURN_FRACTION * route)
+    if offset <= allowed:
+        return None
+    return f"the route does not return to its start (it ends {offset:.1f} m away; a loop closes within {allowed:.1f} m)"
+
+
 @dataclass(frozen=True)
 class Column:
     """One table column: the number at ``path`` in the ``source`` record, shown under ``header``.
 
     The path is checked against the source's model on creation (KeyError
     when it names no numeric field), so a typo cannot become an empty column.
+    ``applies`` (metrics columns only) may declare the number not applicable
+    to a run although it was computed (a loop gap on a route that never
+    returns): it returns the reason, or None when the number applies.
     """
 
     source: Source
     path: str
     header: str
+    applies: Callable[[MetricsRecord], str | None] | None = None
 
     def __post_init__(self) -> None:
         check_number_path(SOURCE_MODELS[self.source], self.path)
 
-    def value(self, record: CellRecord) -> float | None:
-        """The cell's number (None: the run has none there, e.g. a metric that does not apply)."""
+    def _record(self, record: CellRecord) -> Record | None:
         sources: dict[Source, Record | None] = {
             "metrics": record.metrics,
             "result": record.result,
             "attempt": record.attempt,
         }
-        return number_at(sources[self.source], self.path)
+        return sources[self.source]
+
+    def value(self, record: CellRecord) -> float | None:
+        """The cell's number (None: the run has none there, e.g. a metric that does not apply)."""
+        if self.applies is not None and record.metrics is not None and self.applies(record.metrics) is not None:
+            return None
+        return number_at(self._record(record), self.path)
+
+    def reason(self, record: CellRecord) -> str | None:
+        """Why a completed cell has no number here (None when it has one): the record's own words."""
+        if record.status != "done" or self.value(record) is not None:
+            return None
+        if self.applies is not None and record.metrics is not None:
+            verdict = self.applies(record.metrics)
+            if verdict is not None:
+                return verdict
+        if self.source != "metrics" or record.metrics is None:
+            return f"no {self.source}.json value"
+        return _null_reason(record.metrics, self.path)
+
+
+def _null_reason(metrics: MetricsRecord, path: str) -> str:
+    """The ``<name>_reason`` nearest the null along ``path`` (the convention of metrics.json), else a plain note."""
+    parts = path.split(".")
+    node: object = metrics
+    reason = "not defined for this run (see its metrics.json)"
+    for part in parts:
+        if node is None:
+            break
+        named = getattr(node, f"{part}_reason", None)
+        if isinstance(named, str):
+            return named
+        if getattr(node, "pairs", None) == 0:
+            return "no pairs to measure on this route (pairs: 0)"
+        node = getattr(node, part, None)
+    return reason
 
 
 #: accuracy numbers, identical for identical inputs
 METRIC_COLUMNS: dict[str, Column] = {
     "ate_rmse_m": Column("metrics", "ate.rmse_m", "ATE RMSE (m)"),
     "ate_windows_m": Column("metrics", "ate_windows.mean_rmse_m", "ATE per 50 m window, mean (m)"),
+    "rpe_frame_m": Column("metrics", "rpe.translation_m.rmse", "RPE 1 scan trans. RMSE (m)"),
+    "rpe_frame_deg": Column("metrics", "rpe.rotation_deg.rmse", "RPE 1 scan rot. RMSE (deg)"),
     "drift_10m_m": Column("metrics", "drift.at_10m.translation_m", "RPE@10 m trans. (m)"),
     "drift_10m_deg": Column("metrics", "drift.at_10m.rotation_deg", "RPE@10 m rot. (deg)"),
-    "loop_gap_m": Column("metrics", "loop_gap.route.gap_m", "loop gap (m)"),
+    "loop_gap_m": Column("metrics", "loop_gap.route.gap_m", "loop gap (m)", applies=_route_returns),
     "revisit_gap_m": Column("metrics", "loop_gap.translation_m.mean", "revisit gap mean (m)"),
     "orientation_deg": Column("metrics", "orientation.bearing_abs_error_mean_deg", "bearing error mean (deg)"),
     "relation_m": Column("metrics", "relations.translation_m.mean", "relation trans. (m)"),
     "relation_deg": Column("metrics", "relations.rotation_deg.mean", "relation rot. (deg)"),
+    "relation_loops_m": Column("metrics", "relations.loops.translation_m.mean", "relation >30 s trans. (m)"),
     "map_precision": Column("metrics", "map_shape.precision", "map precision"),
     "map_coverage": Column("metrics", "map_shape.coverage", "map coverage"),
     "updates_per_view": Column("metrics", "updates.updates_per_view", "updates/view"),
@@ -148,7 +209,8 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
 
 
 def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
-    """Flat rows (one per cell) with coordinates, status and every metric and cost column."""
+    """Flat rows (one per cell): coordinates, status, every metric and cost column and, as ``<column>_na``,
+    why a completed cell has no number there (:meth:`Column.reason`)."""
     rows = []
     for rec in records:
         c = rec.cell
@@ -163,6 +225,8 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
         }
         for name, column in {**METRIC_COLUMNS, **COST_COLUMNS}.items():
             row[name] = column.value(rec)
+            row[f"{name}_na"] = column.reason(rec)
+        row["failure_kind"] = rec.failure.kind if rec.failure else None
         row["reason"] = rec.failure.reason if rec.failure else None
         rows.append(row)
     return rows

@@ -1,25 +1,37 @@
-"""Build ``reports/<suite>/``: tables, plots and the README that links them.
+"""Build ``reports/<suite>/``: tables, plots, the README that links them and ``index.html`` that shows them.
 
 The index states what a reader needs to trust or reproduce the numbers: the
 machine, the code and library versions, the seeds and degradations, every
 failed cell with its reason and log, every cell the runner never reached,
 and the datasets and methods that were skipped with the command that
-fetches or installs them.
+fetches or installs them. ``README.md`` is that index for a code host;
+``index.html`` (:mod:`albot1.report.html`) is the same report on one page
+with the tables and every plot, for a browser.
 """
 
 from __future__ import annotations
 
-import os
 import time
 from pathlib import Path
-from typing import Any
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
-from albot1.report.plots import plot_maps, plot_robustness, plot_runtime, plot_scan_time, plot_trajectories, slug
+from albot1.report.cost_plots import plot_runtime, plot_scan_time
+from albot1.report.html import INDEX_HTML, rel, write_html
+from albot1.report.map_plots import MapStyle, plot_maps
+from albot1.report.plots import method_colors, slug, vector_of
+from albot1.report.robustness_plots import plot_robustness
+from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.tables import aggregate, cells_frame, write_tables
+from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 
 REPORTS_ROOT = Path("reports")
+#: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
+ROBUSTNESS = (
+    ("ate_rmse_m", "ATE RMSE (m)", "robustness-ate"),
+    ("drift_10m_m", "RPE per 10 m, translation (m)", "robustness-drift"),
+    ("loop_gap_m", "loop gap (m)", "robustness-loop-gap"),
+)
 
 
 def default_out(results_dir: Path) -> Path:
@@ -28,11 +40,14 @@ def default_out(results_dir: Path) -> Path:
 
 
 def _rel(path: Path, start: Path) -> str:
-    return Path(os.path.relpath(path.resolve(), start.resolve())).as_posix()
+    return rel(path, start)
 
 
-def render_plots(records: list[CellRecord], out: Path) -> dict[str, list[Path]]:
-    """Every plot of the report; dataset label -> its plot files (key "" for cross-dataset plots)."""
+def render_plots(
+    records: list[CellRecord], out: Path, colors: dict[str, str] | None = None, *, map_style: MapStyle = "grid"
+) -> dict[str, list[Path]]:
+    """Every plot of the report (PNG, each with an SVG twin); dataset label -> its PNGs ("" for cross-dataset)."""
+    colors = colors or method_colors(r.cell.method_label for r in records)
     cells = cells_frame(records)
     metrics = aggregate(cells, METRIC_COLUMNS)
     cost = aggregate(cells, COST_COLUMNS)
@@ -43,20 +58,22 @@ def render_plots(records: list[CellRecord], out: Path) -> dict[str, list[Path]]:
     for rec in records:
         by_dataset.setdefault(rec.cell.dataset_label, []).append(rec)
     for dataset, recs in by_dataset.items():
-        stem = plots_dir / slug(dataset)
+        stem = slug(dataset)
+
+        def at(kind: str, stem: str = stem) -> Path:
+            return plots_dir / f"{stem}-{kind}.png"
+
         files = [
-            plot_maps(recs, dataset, stem.with_name(f"{stem.name}-maps.png")),
-            plot_trajectories(recs, dataset, stem.with_name(f"{stem.name}-trajectories.png")),
-            plot_robustness(
-                metrics, dataset, "ate_rmse_m", "ATE RMSE (m)", stem.with_name(f"{stem.name}-robustness-ate.png")
-            ),
-            plot_robustness(
-                metrics, dataset, "loop_gap_m", "loop gap (m)", stem.with_name(f"{stem.name}-robustness-loop-gap.png")
-            ),
-            plot_scan_time(recs, dataset, stem.with_name(f"{stem.name}-scan-time.png")),
+            plot_trajectories(recs, dataset, at("trajectories"), colors),
+            plot_ape_map(recs, dataset, at("ape"), colors),
+            plot_error_vs_distance(recs, dataset, at("error-distance"), colors),
+            plot_rpe_boxes(recs, dataset, at("rpe-boxes"), colors),
+            plot_maps(recs, dataset, at("maps"), colors, style=map_style),
+            *[plot_robustness(metrics, dataset, column, label, at(kind), colors) for column, label, kind in ROBUSTNESS],
+            plot_scan_time(recs, dataset, at("scan-time"), colors),
         ]
         made[dataset] = [f for f in files if f is not None]
-    runtime = plot_runtime(cost, plots_dir / "runtime.png")
+    runtime = plot_runtime(cost, plots_dir / "runtime.png", colors)
     made[""] = [runtime] if runtime is not None else []
     return made
 
@@ -131,16 +148,22 @@ def write_index(
         "",
         "## Grid",
         "",
-        f"- seeds: {', '.join(map(str, plan.seeds))}",
+        f"- seeds: {', '.join(map(str, plan.seeds))} (the deterministic degradations `none`, `thesis` and "
+        "`bias:...` run with the first seed only: every seed would repeat the same run)",
         f"- degradations: {', '.join(f'`{d}`' for d in plan.degradations)} "
         "(`none` = the dataset's own odometry; swept ones only on datasets with reference poses)",
         f"- datasets: {', '.join(dict.fromkeys(r.cell.dataset_label for r in records)) or '(none)'}",
         f"- methods: {', '.join(dict.fromkeys(r.cell.method_label for r in records)) or '(none)'}",
         "",
+        f"**[The whole report on one page: {INDEX_HTML}]({INDEX_HTML})** (tables and every plot; open it in a "
+        "browser, it needs no network).",
+        "",
         "## Tables",
         "",
-        f"- [accuracy (Markdown)]({_rel(tables['metrics.md'], out)}) · [CSV]({_rel(tables['metrics.csv'], out)})",
-        f"- [cost (Markdown)]({_rel(tables['cost.md'], out)}) · [CSV]({_rel(tables['cost.csv'], out)})",
+        f"- [accuracy (Markdown)]({_rel(tables['metrics.md'], out)}) · [CSV]({_rel(tables['metrics.csv'], out)}) · "
+        f"[LaTeX]({_rel(tables['metrics.tex'], out)})",
+        f"- [cost (Markdown)]({_rel(tables['cost.md'], out)}) · [CSV]({_rel(tables['cost.csv'], out)}) · "
+        f"[LaTeX]({_rel(tables['cost.tex'], out)})",
         f"- [every cell, accuracy and status (CSV)]({_rel(tables['cells.csv'], out)}) · "
         f"[every cell, cost (CSV)]({_rel(tables['cells-cost.csv'], out)})",
         "",
@@ -155,7 +178,12 @@ def write_index(
         for dataset, files in plots.items():
             if not dataset or not files:
                 continue
-            lines += [f"### {dataset}", "", *[f"- [{f.stem}]({_rel(f, out)})" for f in files], ""]
+            lines += [
+                f"### {dataset}",
+                "",
+                *[f"- [{f.stem}]({_rel(f, out)}) ([SVG]({_rel(vector_of(f), out)}))" for f in files],
+                "",
+            ]
     lines += ["## Failed cells", "", *_failure_lines(records, out)]
     not_run = [r for r in records if r.status == "not run"]
     if not_run:
@@ -186,12 +214,29 @@ def write_index(
     return index
 
 
-def build_report(results_dir: str | Path, out: str | Path | None = None, *, plots: bool = True) -> Path:
-    """Tables, plots and README for ``results_dir``; returns the README path."""
+def build_report(
+    results_dir: str | Path, out: str | Path | None = None, *, plots: bool = True, map_style: MapStyle = "grid"
+) -> Path:
+    """Tables, plots, README.md and index.html for ``results_dir``; returns the README path."""
     results = Path(results_dir)
     target = Path(out) if out is not None else default_out(results)
     plan, records = collect(results)
     target.mkdir(parents=True, exist_ok=True)
     tables = write_tables(records, target)
-    made: dict[str, Any] = render_plots(records, target) if plots else {}
-    return write_index(plan, records, tables, made, target, results)
+    colors = method_colors(r.cell.method_label for r in records)
+    made = render_plots(records, target, colors, map_style=map_style) if plots else {}
+    index = write_index(plan, records, tables, made, target, results)
+    cells = cells_frame(records)
+    write_html(
+        plan,
+        records,
+        aggregate(cells, METRIC_COLUMNS),
+        aggregate(cells, COST_COLUMNS),
+        (METRIC_COLUMNS, COST_COLUMNS),
+        {**tables, "README.md": index},
+        made,
+        colors,
+        target,
+        results,
+    )
+    return index

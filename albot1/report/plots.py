@@ -1,34 +1,69 @@
-"""Report plots, rendered headless (Agg): maps, trajectory overlays, robustness curves, cost.
+"""What every report plot shares: colours, the runs pictured, the common frame, figure sizing, saving.
 
-For every dataset the *representative run* of a method is its run on the
-dataset's own odometry (degradation ``none``) with the lowest seed, falling
-back to the first completed cell; maps and overlays show that run so every
-method is pictured on the same input. Estimates are drawn after the rigid
-alignment the ATE uses (:func:`albot1.metrics.alignment.align`), so the
-picture and the number agree; without reference poses each method is drawn
-in its own frame.
+* **One colour per method** across every plot of a report
+  (:func:`method_colors`): assigned once from the plan's method order, so a
+  method keeps its colour whatever failed where.
+* **The run pictured** for a dataset and method (:func:`representative`):
+  its run on the dataset's own odometry (degradation ``none``) with the
+  lowest seed, falling back to the first completed cell; maps and overlays
+  show that run so every method is pictured on the same input.
+* **One frame**: estimates (and their maps) are drawn after the rigid
+  alignment the ATE uses (:func:`albot1.metrics.alignment.align`), so the
+  picture and the number agree and every method shares the reference's
+  frame; without reference poses each method is drawn in its own frame
+  (they all start at the odometry's first pose) and the title says so.
+* **Figures follow the data's shape** (:func:`panel_layout`): a long narrow
+  corridor gets wide, flat panels stacked in rows instead of a 20-pixel
+  strip; legends sit outside the axes.
+* **PNG and SVG** of every figure (:func:`save`): PNG for the pages, SVG for
+  papers (dense map layers are embedded as images inside the SVG).
 """
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from albot1.geometry import se2
 from albot1.metrics.alignment import align, rigid_transform
-from albot1.report.collect import CellRecord, severity_order
+from albot1.metrics.errors import MetricsError
+from albot1.report.collect import CellRecord
 
 if TYPE_CHECKING:
-    import pandas as pd
-    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
-MAX_MAP_POINTS = 60_000
-COLORS = ("tab:blue", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
+#: Colours of methods, in plan order: matplotlib's tab10 then the light half of tab20.
+PALETTE = (
+    "#1f77b4",
+    "#ff7f0e",
+    "#2ca02c",
+    "#d62728",
+    "#9467bd",
+    "#8c564b",
+    "#e377c2",
+    "#7f7f7f",
+    "#bcbd22",
+    "#17becf",
+    "#aec7e8",
+    "#ffbb78",
+    "#98df8a",
+    "#ff9896",
+    "#c5b0d5",
+    "#c49c94",
+)
+REFERENCE_COLOR = "black"
+DPI = 120
+#: Figure width limit (inches) and the widest/tallest panel shape drawn (a longer extent is padded).
+MAX_WIDTH_IN = 13.0
+MAX_PANEL_ASPECT = 6.0
+VECTOR_FORMAT = "svg"
 
 
 def slug(text: str) -> str:
@@ -36,13 +71,20 @@ def slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "x"
 
 
-def _pyplot() -> Any:
+def pyplot() -> Any:
+    """matplotlib.pyplot on the headless Agg backend (imported on first use: it is slow to import)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def method_colors(labels: Iterable[str]) -> dict[str, str]:
+    """method label -> colour, in the order given (the plan's), cycling the palette beyond 16 methods."""
+    unique = list(dict.fromkeys(labels))
+    return {label: PALETTE[i % len(PALETTE)] for i, label in enumerate(unique)}
 
 
 def representative(records: Iterable[CellRecord]) -> dict[str, CellRecord]:
@@ -59,201 +101,170 @@ def representative(records: Iterable[CellRecord]) -> dict[str, CellRecord]:
     return best
 
 
-def _aligned_xy(poses: np.ndarray, reference: np.ndarray | None) -> np.ndarray:
-    if reference is None or len(reference) != len(poses) or len(poses) < 2:
-        return poses[:, :2]
+def has_reference(reference: NDArray[np.float64] | None, poses: NDArray[np.float64]) -> bool:
+    """Whether ``reference`` can frame ``poses`` (one reference pose per estimated pose, at least two)."""
+    return reference is not None and len(reference) == len(poses) and len(poses) >= 2
+
+
+def aligned_poses(poses: NDArray[np.float64], reference: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """``poses`` rigidly aligned to ``reference`` (as the ATE aligns them), or as they are without one."""
+    if reference is None or not has_reference(reference, poses):
+        return poses
     try:
         aligned, _ = align(poses, reference, "rigid")
-    except Exception:  # noqa: BLE001 -- a picture is still useful unaligned; the metrics say why
-        return poses[:, :2]
-    return np.asarray(aligned)[:, :2]
+    except MetricsError:  # a degenerate trajectory: a picture is still useful unaligned; the metrics say why
+        return poses
+    return np.asarray(aligned)
 
 
-def _transform_points(points: np.ndarray, poses: np.ndarray, reference: np.ndarray | None) -> np.ndarray:
-    """Apply to map points the same rigid motion that aligns ``poses`` onto ``reference``."""
-    if reference is None or len(reference) != len(poses) or len(poses) < 2 or not len(points):
+def transform_points(
+    points: NDArray[np.float64], poses: NDArray[np.float64], reference: NDArray[np.float64] | None
+) -> NDArray[np.float64]:
+    """Apply to map points the rigid motion that aligns ``poses`` onto ``reference``."""
+    if reference is None or not has_reference(reference, poses) or not len(points):
         return points
     try:
         transform = rigid_transform(poses, reference)
-    except Exception:  # noqa: BLE001 -- see _aligned_xy
+    except MetricsError:  # see aligned_poses
         return points
-    return se2.transform_points(transform, points)
+    return np.asarray(se2.transform_points(transform, points))
 
 
-def _draw_run(ax: Axes, rec: CellRecord, color: str) -> None:
-    from matplotlib.collections import LineCollection
+@dataclass(frozen=True)
+class Extent:
+    """An axis-aligned box in metres, padded to a drawable shape."""
 
-    run = rec.stored_run()
-    ref = run.reference
-    data = run.load_map()
-    if data.points is not None and len(data.points):
-        pts = np.asarray(data.points, dtype=float)
-        if len(pts) > MAX_MAP_POINTS:
-            pts = pts[np.random.default_rng(0).choice(len(pts), MAX_MAP_POINTS, replace=False)]
-        pts = _transform_points(pts, run.poses, ref)
-        ax.scatter(pts[:, 0], pts[:, 1], s=0.15, c="0.45", linewidths=0, rasterized=True)
-    if data.segments is not None and len(data.segments):
-        ends = np.asarray(data.segments, dtype=float).reshape(-1, 2)
-        seg = _transform_points(ends, run.poses, ref).reshape(-1, 2, 2)
-        ax.add_collection(LineCollection(list(seg), colors="0.2", linewidths=0.7))
-    if ref is not None:
-        ax.plot(ref[:, 0], ref[:, 1], color="tab:orange", lw=0.8, label="reference")
-    xy = _aligned_xy(run.poses, ref)
-    ax.plot(xy[:, 0], xy[:, 1], color=color, lw=0.8, label="estimate")
-    ax.set_aspect("equal")
-    ax.autoscale_view()
-    ax.tick_params(labelsize=6)
+    x0: float
+    x1: float
+    y0: float
+    y1: float
+
+    @property
+    def width(self) -> float:
+        return self.x1 - self.x0
+
+    @property
+    def height(self) -> float:
+        return self.y1 - self.y0
+
+    @property
+    def aspect(self) -> float:
+        return self.width / self.height
+
+    @classmethod
+    def around(cls, arrays: Sequence[NDArray[np.float64]], pad_fraction: float = 0.04) -> Extent:
+        """The box around every ``(N, >=2)`` array's x, y, padded, and widened to at most :data:`MAX_PANEL_ASPECT`."""
+        xy = [np.asarray(a, dtype=float)[:, :2] for a in arrays if len(a)]
+        pts = np.concatenate(xy) if xy else np.zeros((1, 2))
+        pts = pts[np.isfinite(pts).all(axis=1)]
+        if not len(pts):
+            pts = np.zeros((1, 2))
+        (x0, y0), (x1, y1) = pts.min(axis=0), pts.max(axis=0)
+        pad = max(x1 - x0, y1 - y0, 1.0) * pad_fraction
+        x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
+        w, h = x1 - x0, y1 - y0
+        if w / h > MAX_PANEL_ASPECT:
+            grow = (w / MAX_PANEL_ASPECT - h) / 2
+            y0, y1 = y0 - grow, y1 + grow
+        elif h / w > MAX_PANEL_ASPECT:
+            grow = (h / MAX_PANEL_ASPECT - w) / 2
+            x0, x1 = x0 - grow, x1 + grow
+        return cls(float(x0), float(x1), float(y0), float(y1))
+
+    def apply(self, ax: Any) -> None:
+        ax.set_xlim(self.x0, self.x1)
+        ax.set_ylim(self.y0, self.y1)
+        ax.set_aspect("equal")
 
 
-def plot_maps(records: list[CellRecord], dataset: str, path: Path) -> Path | None:
-    """One panel per method: its map and trajectory, with the reference."""
-    runs = representative(records)
-    if not runs:
+def robust_points(points: NDArray[np.float64], keep: float = 0.995) -> NDArray[np.float64]:
+    """The points inside the central ``keep`` quantile box (a map's few far-away returns would shrink the picture)."""
+    if len(points) < 50:
+        return points
+    low = np.quantile(points[:, :2], (1 - keep) / 2, axis=0)
+    high = np.quantile(points[:, :2], 1 - (1 - keep) / 2, axis=0)
+    inside = ((points[:, :2] >= low) & (points[:, :2] <= high)).all(axis=1)
+    return points[inside]
+
+
+def panel_layout(
+    extent: Extent, panels: int, *, panel_max_in: float = 5.2, extra_height_in: float = 1.1
+) -> tuple[int, int, tuple[float, float]]:
+    """(rows, columns, figure size in inches) for ``panels`` panels showing ``extent`` at equal scale.
+
+    The column count makes the whole figure closest to a 3:2 landscape
+    page; each panel is as large as the width limit allows, its height set
+    by the data's aspect ratio (so a corridor gets wide, flat panels).
+    ``extra_height_in`` leaves room for titles and the legend below.
+    """
+    aspect = extent.aspect
+    best: tuple[float, int] | None = None
+    for cols in range(1, panels + 1):
+        rows = math.ceil(panels / cols)
+        score = abs(math.log((cols * aspect) / rows / 1.5))
+        if best is None or score < best[0] - 1e-9:
+            best = (score, cols)
+    assert best is not None
+    cols = best[1]
+    rows = math.ceil(panels / cols)
+    width = min(MAX_WIDTH_IN / cols, panel_max_in * max(1.0, aspect))
+    height = width / aspect
+    if height > panel_max_in * 1.3:
+        height = panel_max_in * 1.3
+        width = height * aspect
+    return rows, cols, (max(4.0, cols * width + 0.9), rows * (height + 0.45) + extra_height_in)
+
+
+def log_floor(series: Iterable[Iterable[float]], *, decades: float = 2.0) -> float | None:
+    """A log axis's lower limit when the data span more than ``decades`` decades, else None (linear).
+
+    Values near zero (a perfect-odometry error of 1e-10 m) would stretch a
+    log axis over ten decades of nothing: the floor is 1e-4 of the largest
+    value, and values under it are drawn at the floor (and marked so by the
+    caller). Data whose positive values span less than ``decades`` decades
+    are drawn on a linear axis.
+    """
+    values = np.asarray([v for s in series for v in s], dtype=float)
+    values = values[np.isfinite(values)]
+    if not len(values) or values.max() <= 0:
         return None
-    plt = _pyplot()
-    n = len(runs)
-    cols = min(3, n)
-    rows = math.ceil(n / cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), dpi=110, squeeze=False)
-    for ax, (i, (label, rec)) in zip(axes.flat, enumerate(runs.items())):
-        _draw_run(ax, rec, COLORS[i % len(COLORS)])
-        ax.set_title(f"{label} [{rec.cell.degradation}, seed {rec.cell.seed}]", fontsize=8)
-    for ax in list(axes.flat)[n:]:
-        ax.set_visible(False)
-    axes.flat[0].legend(loc="best", fontsize=6)
-    fig.suptitle(f"{dataset}: maps and trajectories", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, format="png")
-    plt.close(fig)
-    return path
-
-
-def plot_trajectories(records: list[CellRecord], dataset: str, path: Path) -> Path | None:
-    """Every method's trajectory over the reference (aligned as for the ATE)."""
-    runs = representative(records)
-    if not runs:
+    high = float(values.max())
+    floor = high * 1e-4
+    above = values[values >= floor]
+    low = float(above.min()) if len(above) else high
+    if high / max(low, floor) < 10**decades:
         return None
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 7), dpi=110)
-    reference_drawn = False
-    for i, (label, rec) in enumerate(runs.items()):
-        run = rec.stored_run()
-        if run.reference is not None and not reference_drawn:
-            ax.plot(run.reference[:, 0], run.reference[:, 1], color="black", lw=1.4, alpha=0.5, label="reference")
-            reference_drawn = True
-        xy = _aligned_xy(run.poses, run.reference)
-        ax.plot(xy[:, 0], xy[:, 1], color=COLORS[i % len(COLORS)], lw=0.9, label=label)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    aligned = "rigidly aligned to the reference" if reference_drawn else "each in its own frame (no reference)"
-    ax.set_title(f"{dataset}: trajectories, {aligned}", fontsize=9)
-    ax.legend(loc="best", fontsize=7)
-    fig.savefig(path, format="png", bbox_inches="tight")
-    plt.close(fig)
-    return path
+    return max(floor, low / 2)
 
 
-def plot_robustness(table: pd.DataFrame, dataset: str, column: str, label: str, path: Path) -> Path | None:
-    """Error versus degradation level per method (mean with min–max bars over seeds)."""
-    rows = table[table["dataset"] == dataset]
-    if rows.empty or rows["degradation"].nunique() < 2 or rows[f"{column}_mean"].notna().sum() < 2:
-        return None
-    plt = _pyplot()
-    levels = severity_order(list(dict.fromkeys(rows["degradation"])))
-    x_of = {level: i for i, level in enumerate(levels)}
-    fig, ax = plt.subplots(figsize=(7, 4.2), dpi=110)
-    for i, (method, group) in enumerate(rows.groupby("method", sort=False)):
-        group = group[group[f"{column}_mean"].notna()]
-        if group.empty:
-            continue
-        group = group.iloc[np.argsort([x_of[d] for d in group["degradation"]], kind="stable")]
-        xs = np.array([x_of[d] for d in group["degradation"]], dtype=float) + (i - 2) * 0.04
-        mean = group[f"{column}_mean"].to_numpy(float)
-        # mean - min can come out as -1e-17 when every seed agrees: clip the rounding away
-        low = np.maximum(mean - group[f"{column}_min"].to_numpy(float), 0.0)
-        high = np.maximum(group[f"{column}_max"].to_numpy(float) - mean, 0.0)
-        ax.errorbar(
-            xs, mean, yerr=[low, high], marker="o", ms=4, capsize=3, lw=1, color=COLORS[i % len(COLORS)], label=method
-        )
-    ax.set_xticks(range(len(levels)), levels, rotation=20, fontsize=8)
-    if (rows[f"{column}_min"].dropna() > 0).all():
-        ax.set_yscale("log")
-    ax.set_xlabel("odometry degradation (SPEC)")
-    ax.set_ylabel(label)
-    ax.set_title(f"{dataset}: {label} vs odometry degradation (mean, min–max over seeds)", fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.savefig(path, format="png", bbox_inches="tight")
-    plt.close(fig)
-    return path
-
-
-def plot_scan_time(records: list[CellRecord], dataset: str, path: Path) -> Path | None:
-    """Per-scan processing time along the sequence (running median), one line per method."""
-    runs = representative(records)
-    if not runs:
-        return None
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8, 4), dpi=110)
-    for i, (label, rec) in enumerate(runs.items()):
-        ns_file = rec.run_dir / "per_scan_ns.npy"
-        if not ns_file.is_file():
-            continue
-        ms = np.load(ns_file).astype(float) / 1e6
-        if not len(ms):
-            continue
-        window = max(1, len(ms) // 100)
-        smooth = _running_median(ms, window)
-        ax.plot(np.arange(len(ms)), smooth, color=COLORS[i % len(COLORS)], lw=0.9, label=label)
+def value_axis(ax: Any, floor: float | None, clipped: list[str], unit: str) -> None:
+    """A log axis from ``floor`` (noting the series drawn at the floor), or a linear one from zero."""
+    if floor is None:
+        ax.set_ylim(bottom=0)
+        return
     ax.set_yscale("log")
-    ax.set_xlabel("scan index")
-    ax.set_ylabel("per-scan time (ms), running median")
-    ax.set_title(f"{dataset}: per-scan processing time along the sequence", fontsize=9)
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
-    fig.savefig(path, format="png", bbox_inches="tight")
-    plt.close(fig)
-    return path
-
-
-def _running_median(values: np.ndarray, window: int) -> np.ndarray:
-    if window <= 1:
-        return values
-    from numpy.lib.stride_tricks import sliding_window_view
-
-    padded = np.pad(values, (window // 2, window - 1 - window // 2), mode="edge")
-    return np.median(sliding_window_view(padded, window), axis=1)
-
-
-def plot_runtime(cost: pd.DataFrame, path: Path) -> Path | None:
-    """Grouped bars: median per-scan time per dataset and method (undegraded runs), p95 as whisker."""
-    rows = cost[(cost["degradation"] == "none") & cost["per_scan_ms_median_mean"].notna()]
-    if rows.empty:
-        return None
-    plt = _pyplot()
-    datasets = list(dict.fromkeys(rows["dataset"]))
-    methods = list(dict.fromkeys(rows["method"]))
-    width = 0.8 / len(methods)
-    fig, ax = plt.subplots(figsize=(min(16.0, max(7.0, 0.12 * len(datasets) * len(methods))), 4.5), dpi=110)
-    for i, method in enumerate(methods):
-        sub = rows[rows["method"] == method].set_index("dataset")
-        xs, med, p95 = [], [], []
-        for j, dataset in enumerate(datasets):
-            if dataset in sub.index:
-                xs.append(j + (i - (len(methods) - 1) / 2) * width)
-                med.append(float(sub.loc[dataset, "per_scan_ms_median_mean"]))
-                p95.append(float(sub.loc[dataset, "per_scan_ms_p95_mean"]))
-        upper = np.maximum(np.asarray(p95) - np.asarray(med), 0.0)
-        ax.bar(
-            xs, med, width, yerr=[np.zeros_like(upper), upper], capsize=2, color=COLORS[i % len(COLORS)], label=method
+    ax.set_ylim(bottom=floor * 0.8)
+    if clipped:
+        ax.text(
+            0.01,
+            0.01,
+            f"values below {floor:.2g} {unit} drawn at {floor:.2g} ({', '.join(clipped)})",
+            transform=ax.transAxes,
+            fontsize=7,
+            color="0.3",
+            va="bottom",
         )
-    ax.set_xticks(range(len(datasets)), datasets, rotation=35, ha="right", fontsize=7)
-    ax.set_yscale("log")
-    ax.set_ylabel("per-scan time (ms): median, whisker to p95")
-    ax.set_title("Runtime per scan on each dataset's own odometry", fontsize=9)
-    ax.grid(alpha=0.3, axis="y", which="both")
-    ax.legend(fontsize=7)
-    fig.savefig(path, format="png", bbox_inches="tight")
+
+
+def save(fig: Figure, png: Path) -> Path:
+    """Write ``png`` and its vector twin (same stem, ``.svg``); close the figure; return the PNG's path."""
+    plt = pyplot()
+    fig.savefig(png, format="png", dpi=DPI)
+    fig.savefig(png.with_suffix(f".{VECTOR_FORMAT}"), format=VECTOR_FORMAT)
     plt.close(fig)
-    return path
+    return png
+
+
+def vector_of(png: Path) -> Path:
+    """The vector twin of a PNG written by :func:`save`."""
+    return png.with_suffix(f".{VECTOR_FORMAT}")

@@ -1,7 +1,19 @@
-"""Tables per dataset x method x degradation, aggregated over seeds (CSV for tools, Markdown for people).
+"""Tables per dataset x method x degradation, aggregated over seeds: CSV for tools, Markdown and LaTeX for people.
 
-Across seeds each number is given as mean, median and (min-max), the
-rpg_trajectory_evaluation convention: a mean alone hides one bad seed.
+Across seeds each number is the mean +/- the sample standard deviation
+(ddof = 1) with the range (min-max) in brackets, the rpg_trajectory_evaluation
+convention: a mean alone hides one bad seed. All numbers of a table are
+given to :data:`SIGNIFICANT` significant digits, the std and the range with
+the decimals of their mean, so a column reads evenly.
+
+Every planned group is a row, also when no seed completed: its cells say
+``failed`` and its status column gives the reason (``failed (timeout:
+...)``), so a failure is as visible as a result. A number a run does not
+have because the metric does not apply (no reference poses, a loop gap on
+a route that never returns) is ``n/a``, with the reason under the table;
+a column that applies to no run of a dataset is left out of its table and
+named under it.
+
 Accuracy (``metrics.*``) and cost (``cost.*``) are separate tables because
 accuracy must be identical for identical inputs while cost varies with the
 machine and its load; keeping them apart lets two runs be compared byte for
@@ -11,6 +23,7 @@ byte on the first.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -27,7 +40,13 @@ from albot1.report.collect import (
 if TYPE_CHECKING:
     import pandas as pd
 
-STATS = ("mean", "median", "min", "max")
+STATS = ("mean", "std", "median", "min", "max")
+SIGNIFICANT = 3
+NOT_APPLICABLE = "n/a"
+FAILED = "failed"
+NOT_RUN = "not run"
+#: Longest failure reason shown in a table cell (the index and cells.csv have it whole).
+REASON_CHARS = 110
 
 
 def cells_frame(records: list[CellRecord]) -> pd.DataFrame:
@@ -38,75 +57,155 @@ def cells_frame(records: list[CellRecord]) -> pd.DataFrame:
 
 
 def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
-    """Completed cells grouped by dataset x method x degradation: n seeds and mean/median/min/max per column."""
+    """Every planned group (dataset x method x degradation): seed counts, status and mean/std/median/min/max.
+
+    ``seeds`` counts the completed seeds the statistics are over;
+    ``planned``, ``failed`` and ``not_run`` the cells of the group;
+    ``status`` is ``ok`` or says what failed (``failed (kind: reason)``,
+    ``1 of 3 failed (...)``). ``<column>_na`` holds the reason a column
+    has no number in this group (not applicable), empty otherwise.
+    """
     import pandas as pd
 
-    done = cells[cells["status"] == "done"]
-    out_rows: list[dict[str, Any]] = []
-    if done.empty:
-        return pd.DataFrame(columns=[*KEY_COLUMNS, "seeds"])
+    if cells.empty:
+        return pd.DataFrame(columns=[*KEY_COLUMNS, "seeds", "planned", "failed", "not_run", "status"])
     order = {name: i for i, name in enumerate(dict.fromkeys(cells["dataset"]))}
     methods = {name: i for i, name in enumerate(dict.fromkeys(cells["method"]))}
     degradations = {name: i for i, name in enumerate(severity_order(list(dict.fromkeys(cells["degradation"]))))}
-    for (dataset, method, degradation), group in done.groupby(list(KEY_COLUMNS), sort=False):
+    out_rows: list[dict[str, Any]] = []
+    for (dataset, method, degradation), group in cells.groupby(list(KEY_COLUMNS), sort=False):
+        done = group[group["status"] == "done"]
+        failed = group[group["status"] == "failed"]
         row: dict[str, Any] = {
             "dataset": dataset,
             "method": method,
             "degradation": degradation,
-            "seeds": int(group["seed"].nunique()),
+            "seeds": int(done["seed"].nunique()),
+            "planned": int(len(group)),
+            "failed": int(len(failed)),
+            "not_run": int((group["status"] == "not run").sum()),
+            "status": _status(group, failed),
         }
         for column in columns:
-            values = group[column].dropna().astype(float)
+            values = done[column].dropna().astype(float)
+            row[f"{column}_n"] = int(len(values))
             for stat in STATS:
-                row[f"{column}_{stat}"] = float(getattr(values, stat)()) if len(values) else math.nan
+                row[f"{column}_{stat}"] = _stat(values, stat)
+            reasons: list[str] = list(done[f"{column}_na"].dropna()) if f"{column}_na" in done else []
+            row[f"{column}_na"] = Counter(reasons).most_common(1)[0][0] if reasons else None
         out_rows.append(row)
     table = pd.DataFrame(out_rows)
     rank = {"dataset": order, "method": methods, "degradation": degradations}
     table = table.sort_values(by=list(KEY_COLUMNS), key=lambda s: s.map(rank[str(s.name)]), kind="stable")
-    table = table.reset_index(drop=True)
-    return table
+    return table.reset_index(drop=True)
 
 
-def _fmt(value: float) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "–"
-    magnitude = abs(value)
-    if magnitude >= 100:
-        return f"{value:.0f}"
-    if magnitude >= 10:
-        return f"{value:.1f}"
-    return f"{value:.3f}" if magnitude >= 0.01 or magnitude == 0 else f"{value:.2g}"
+def _stat(values: pd.Series, stat: str) -> float:
+    if not len(values):
+        return math.nan
+    if stat == "std":
+        return float(values.std(ddof=1)) if len(values) > 1 else math.nan
+    return float(getattr(values, stat)())
+
+
+def _status(group: pd.DataFrame, failed: pd.DataFrame) -> str:
+    not_run = int((group["status"] == "not run").sum())
+    if failed.empty and not not_run:
+        return "ok"
+    parts = []
+    if not failed.empty:
+        first = failed.iloc[0]
+        reason = _short(f"{first['failure_kind']}: {first['reason']}")
+        count = "" if len(failed) == len(group) else f"{len(failed)} of {len(group)} "
+        parts.append(f"{count}failed ({reason})")
+    if not_run:
+        parts.append(f"{not_run} of {len(group)} not run")
+    return "; ".join(parts)
+
+
+def _short(text: str) -> str:
+    flat = " ".join(str(text).split())
+    return flat if len(flat) <= REASON_CHARS else flat[: REASON_CHARS - 1] + "…"
+
+
+def decimals(value: float, significant: int = SIGNIFICANT) -> int | None:
+    """Decimals that show ``value`` to ``significant`` digits; None: use scientific notation (below 1e-3)."""
+    magnitude = abs(float(f"{value:.{significant - 1}e}"))  # as rounded: 9.9996 shows as 10.0, not 10.00
+    if magnitude == 0:
+        return significant - 1
+    if magnitude < 1e-3:
+        return None
+    return max(0, significant - 1 - math.floor(math.log10(magnitude)))
+
+
+def fmt(value: float, places: int | None) -> str:
+    """``value`` with ``places`` decimals (None: scientific, ``significant`` digits)."""
+    if places is None:
+        return f"{value:.{SIGNIFICANT - 1}e}"
+    return f"{value:.{places}f}"
+
+
+def stats_text(mean: float, std: float, low: float, high: float, n: int) -> str:
+    """``mean`` for one seed; ``mean ± std (min–max)`` for several, all with the decimals of the mean."""
+    places = decimals(mean)
+    if n <= 1 or low == high:
+        return fmt(mean, places)
+    return f"{fmt(mean, places)} ± {fmt(std, places)} ({fmt(low, places)}–{fmt(high, places)})"
 
 
 def cell_text(row: pd.Series, column: str) -> str:
-    """``mean`` for one seed, else ``mean / median (min–max)``."""
+    """The table text of ``column`` in aggregated ``row``: numbers, ``n/a``, ``failed`` or ``not run``."""
     mean = row[f"{column}_mean"]
     if isinstance(mean, float) and math.isnan(mean):
-        return "–"
-    if row["seeds"] <= 1 or row[f"{column}_min"] == row[f"{column}_max"]:
-        return _fmt(mean)
-    return f"{_fmt(mean)} / {_fmt(row[f'{column}_median'])} ({_fmt(row[f'{column}_min'])}–{_fmt(row[f'{column}_max'])})"
+        if row["seeds"] == 0:
+            return FAILED if row["failed"] else NOT_RUN
+        return NOT_APPLICABLE
+    return stats_text(
+        float(mean),
+        float(row[f"{column}_std"]),
+        float(row[f"{column}_min"]),
+        float(row[f"{column}_max"]),
+        int(row[f"{column}_n"]),
+    )
+
+
+def columns_present(group: pd.DataFrame, columns: dict[str, Column]) -> tuple[list[str], list[str]]:
+    """(columns with a number in some row, columns that apply to no completed row) of one dataset."""
+    present = [c for c in columns if group[f"{c}_mean"].notna().any()]
+    absent = [c for c in columns if c not in present and group[f"{c}_na"].notna().any()]
+    return present, absent
+
+
+def na_notes(group: pd.DataFrame, columns: dict[str, Column], present: list[str], absent: list[str]) -> list[str]:
+    notes = []
+    for c in present:
+        reasons = [str(r) for r in dict.fromkeys(group[f"{c}_na"].dropna())]
+        if reasons and (group[f"{c}_mean"].isna() & (group["seeds"] > 0)).any():
+            notes.append(f"{columns[c].header}: {'; '.join(reasons)}")
+    notes += [f"{columns[c].header}: {group[f'{c}_na'].dropna().iloc[0]} (every run of this dataset)" for c in absent]
+    return notes
 
 
 def markdown(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str:
-    """One Markdown table per dataset; columns that are empty for a dataset are left out."""
+    """One Markdown table per dataset, each followed by its not-applicable notes."""
     lines = [
         f"# {title}",
         "",
-        "Each number: mean over seeds, then median (min–max) when seeds differ. "
-        "`–`: not computable for this run (see the run's metrics.json for the reason).",
+        "Each number: mean ± sample std over the completed seeds, then (min–max); one number when there is one "
+        f"seed or all seeds agree. {SIGNIFICANT} significant digits. `n/a`: the metric does not apply to that run "
+        "(the reason is under the table); `failed`: no seed completed (the status column says why).",
         "",
     ]
     if table.empty:
-        return "\n".join([*lines, "No completed cells.", ""])
+        return "\n".join([*lines, "No planned cells.", ""])
     for dataset, group in table.groupby("dataset", sort=False):
-        present = [c for c in columns if group[f"{c}_mean"].notna().any()]
-        header = ["method", "degradation", "seeds", *[columns[c].header for c in present]]
+        present, absent = columns_present(group, columns)
+        header = ["method", "degradation", "seeds", *[columns[c].header for c in present], "status"]
         lines += [
             f"## {dataset}",
             "",
             "| " + " | ".join(header) + " |",
-            "|" + "|".join(["---"] * 3 + ["---:"] * len(present)) + "|",
+            "|" + "|".join(["---"] * 3 + ["---:"] * len(present) + ["---"]) + "|",
         ]
         for _, row in group.iterrows():
             cells = [
@@ -114,27 +213,74 @@ def markdown(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str
                 str(row["degradation"]),
                 str(int(row["seeds"])),
                 *[cell_text(row, c) for c in present],
+                str(row["status"]).replace("|", "\\|"),
             ]
             lines.append("| " + " | ".join(cells) + " |")
-        lines.append("")
+        notes = na_notes(group, columns, present, absent)
+        lines += [""] + [f"- n/a: {note}" for note in notes] + ([""] if notes else [])
     return "\n".join(lines)
 
 
+def _latex_escape(text: str) -> str:
+    table = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{"}
+    table |= {"}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "–": "--", "…": r"\dots{}"}
+    return "".join(table.get(ch, ch) for ch in str(text))
+
+
+def latex(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str:
+    """One booktabs ``table`` per dataset (``\\usepackage{booktabs}``), numbers as in the Markdown tables."""
+    lines = [
+        f"% {title}: mean $\\pm$ sample std over seeds (min--max); {SIGNIFICANT} significant digits.",
+        "% Needs \\usepackage{booktabs}. n/a: the metric does not apply (see the Markdown table for the reason).",
+        "",
+    ]
+    for dataset, group in table.groupby("dataset", sort=False):
+        present, _ = columns_present(group, columns)
+        spec = "ll" + "r" * len(present) + "l"
+        header = ["method", "degradation", *[columns[c].header for c in present], "status"]
+        lines += [
+            "\\begin{table}[ht]",
+            "\\centering\\small",
+            f"\\caption{{{_latex_escape(title)}: {_latex_escape(str(dataset))}}}",
+            f"\\begin{{tabular}}{{{spec}}}",
+            "\\toprule",
+            " & ".join(_latex_escape(h) for h in header) + " \\\\",
+            "\\midrule",
+        ]
+        for _, row in group.iterrows():
+            cells = [
+                _latex_escape(row["method"]),
+                _latex_escape(row["degradation"]),
+                *[cell_text(row, c).replace("±", "$\\pm$").replace("–", "--") for c in present],
+                _latex_escape(row["status"]),
+            ]
+            lines.append(" & ".join(cells) + " \\\\")
+        lines += ["\\bottomrule", "\\end{tabular}", "\\end{table}", ""]
+    return "\n".join(lines)
+
+
+def _csv_frame(table: pd.DataFrame) -> pd.DataFrame:
+    """The aggregated table without the internal ``_n``/``_na`` helper columns, reasons kept as ``_na``."""
+    return table[[c for c in table.columns if not c.endswith("_n")]]
+
+
 def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
-    """Write cells.csv, metrics.{csv,md} and cost.{csv,md} into ``out``; returns name -> path."""
+    """Write cells.csv, metrics.{csv,md,tex} and cost.{csv,md,tex} (+ cells-cost.csv) into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     cells = cells_frame(records)
     written = {"cells.csv": out / "cells.csv"}
-    cells.drop(columns=list(COST_COLUMNS)).to_csv(written["cells.csv"], index=False, float_format="%.9g")
+    helper = [c for c in cells.columns if c.endswith("_na")]
+    cells.drop(columns=[*COST_COLUMNS, *helper]).to_csv(written["cells.csv"], index=False, float_format="%.9g")
     for name, columns, title in (
         ("metrics", METRIC_COLUMNS, "Accuracy per dataset, method and degradation"),
         ("cost", COST_COLUMNS, "Cost per dataset, method and degradation"),
     ):
         table = aggregate(cells, columns)
-        csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
-        table.to_csv(csv_path, index=False, float_format="%.9g")
-        md_path.write_text(markdown(table, columns, title), encoding="utf-8")
-        written[f"{name}.csv"], written[f"{name}.md"] = csv_path, md_path
+        paths = {ext: out / f"{name}.{ext}" for ext in ("csv", "md", "tex")}
+        _csv_frame(table).to_csv(paths["csv"], index=False, float_format="%.9g")
+        paths["md"].write_text(markdown(table, columns, title), encoding="utf-8")
+        paths["tex"].write_text(latex(table, columns, title), encoding="utf-8")
+        written.update({f"{name}.{ext}": path for ext, path in paths.items()})
     cost_cells = out / "cells-cost.csv"
     cells[["dataset", "method", "degradation", "seed", "status", *COST_COLUMNS]].to_csv(
         cost_cells, index=False, float_format="%.9g"

@@ -26,6 +26,7 @@ import json
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -164,9 +165,9 @@ def _write_files(run_dir: Path, files: dict[str, Any]) -> None:
                 f"of the run folder's own ({', '.join(sorted(STANDARD_FILES))})"
             )
         if isinstance(content, str):
-            atomic_write(run_dir / name, lambda p, text=content: p.write_text(text, encoding="utf-8"))
+            atomic_write(run_dir / name, partial(Path.write_text, data=content, encoding="utf-8"))
         elif isinstance(content, bytes):
-            atomic_write(run_dir / name, lambda p, data=content: p.write_bytes(data))
+            atomic_write(run_dir / name, partial(Path.write_bytes, data=content))
         else:
             write_json(run_dir / name, content)
 

@@ -41,7 +41,7 @@ def test_same_seed_same_poses_other_seed_other_poses(data_file: Callable[[str], 
 def _relation_error(timestamps: np.ndarray, poses: np.ndarray, relations_file: Path) -> float:
     rows = np.loadtxt(relations_file, comments="#", ndmin=2)
     errors = []
-    for t1, t2, x, y, *_rest, yaw in rows:
+    for t1, t2, x, y, *_rest in rows:
         i, j = np.argmin(np.abs(timestamps - t1)), np.argmin(np.abs(timestamps - t2))
         assert abs(timestamps[i] - t1) < 1e-4 and abs(timestamps[j] - t2) < 1e-4
         estimate = se2.between(poses[i], poses[j])

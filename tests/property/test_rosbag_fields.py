@@ -1,5 +1,5 @@
 """Arbitrary ROS message field values (LaserScan geometry and ranges, Odometry and TF poses, stamps),
-stored in real bags with rosbags: the bag loader raises only the project's DataErrors, and what it
+stored in real (ROS2 sqlite3) bags with rosbags: the bag loader raises only the project's DataErrors, and what it
 does return keeps the data model's promises (finite poses, ascending angles, ranges NaN or >= 0)."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from albot1.data.errors import DataError
-from albot1.data.loaders.rosbag.loader import Ros1BagLoader
+from albot1.data.loaders.rosbag.loader import Ros2BagLoader
 
 ANY_FLOAT = st.one_of(
     st.floats(-10.0, 10.0),
@@ -53,18 +53,16 @@ QUATERNION = st.one_of(
 def write_bag(
     path: Path, scans: list[dict[str, Any]], poses: list[tuple[Any, ...]], stamps: list[int], tf: bool
 ) -> None:
-    from rosbags.rosbag1 import Writer
+    from rosbags.rosbag2 import Writer
     from rosbags.typesys import Stores, get_typestore
 
-    ts = get_typestore(Stores.ROS1_NOETIC)
+    ts = get_typestore(Stores.ROS2_HUMBLE)
     t = ts.types
 
     def header(sec: int, frame: str = "odom") -> Any:
-        return t["std_msgs/msg/Header"](
-            seq=0, stamp=t["builtin_interfaces/msg/Time"](sec=sec, nanosec=0), frame_id=frame
-        )
+        return t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=sec, nanosec=0), frame_id=frame)
 
-    with Writer(path) as bag:
+    with Writer(path, version=9) as bag:
         scan_conn = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
         pose_type = "tf2_msgs/msg/TFMessage" if tf else "nav_msgs/msg/Odometry"
         pose_conn = bag.add_connection("/tf" if tf else "/odom", pose_type, typestore=ts)
@@ -76,7 +74,7 @@ def write_bag(
                 intensities=np.zeros(0, np.float32),
                 **fields,
             )
-            bag.write(scan_conn, sec * 10**9, ts.serialize_ros1(scan, "sensor_msgs/msg/LaserScan"))
+            bag.write(scan_conn, sec * 10**9, ts.serialize_cdr(scan, "sensor_msgs/msg/LaserScan"))
             rotation = t["geometry_msgs/msg/Quaternion"](x=q[0], y=q[1], z=q[2], w=q[3])
             if tf:
                 transform = t["geometry_msgs/msg/TransformStamped"](
@@ -102,10 +100,10 @@ def write_bag(
                         twist=t["geometry_msgs/msg/Twist"](linear=zero, angular=zero), covariance=np.zeros(36)
                     ),
                 )
-            bag.write(pose_conn, sec * 10**9, ts.serialize_ros1(message, pose_type))
+            bag.write(pose_conn, sec * 10**9, ts.serialize_cdr(message, pose_type))
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=50, deadline=None)
 @given(
     scans=st.lists(laser_fields(), min_size=1, max_size=3),
     data=st.data(),
@@ -117,13 +115,13 @@ def test_arbitrary_field_values_give_frames_or_a_data_error(
 ) -> None:
     n = len(scans)
     poses = data.draw(st.lists(st.tuples(ANY_FLOAT, QUATERNION), min_size=n, max_size=n))
-    stamps = data.draw(st.lists(st.sampled_from([0, 5, 10, 11, 12, 4_000_000_000]), min_size=n, max_size=n))
+    stamps = data.draw(st.lists(st.sampled_from([0, 5, 10, 11, 12, 2_000_000_000]), min_size=n, max_size=n))
     folder = Path(tempfile.mkdtemp(prefix="albot1-bagfields-"))
     try:
-        path = folder / "f.bag"
+        path = folder / "bag"
         write_bag(path, scans, poses, stamps, tf)
         try:
-            for frame in Ros1BagLoader().load(path, outside_odometry=outside).frames():
+            for frame in Ros2BagLoader().load(path, outside_odometry=outside).frames():
                 assert np.isfinite(frame.odometry).all()
                 assert frame.scan.beams > 0 and np.all(np.diff(frame.scan.angles) > 0)
                 valid = frame.scan.ranges[~np.isnan(frame.scan.ranges)]

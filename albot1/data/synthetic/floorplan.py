@@ -3,7 +3,7 @@
 A plan is described the way an architect would sketch it: axis-aligned
 rectangles of free floor (``Space``: corridor pieces, rooms, alcoves) separated
 by walls of a given thickness, ``DoorwaySpec`` openings cut through those
-walls, and rectangular furniture (``obstacles``) standing on the floor. Shapely
+walls, and furniture (``obstacles``: rectangles, or polygons for pieces standing askew) on the floor. Shapely
 unions the free floor and subtracts the furniture; the walls the laser sees
 are the boundary of that free region, as line segments. Deriving the walls
 from the free region (rather than listing wall lines by hand) guarantees the
@@ -37,6 +37,8 @@ if TYPE_CHECKING:
 
 FloatArray = NDArray[np.float64]
 Rect = tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
+#: A piece of furniture: an axis-aligned :data:`Rect`, or a polygon as its corners ``((x, y), ...)``.
+Obstacle = Rect | tuple[tuple[float, float], ...]
 
 
 @dataclass(frozen=True)
@@ -94,7 +96,7 @@ class FloorPlan:
     walls: FloatArray
     doorways: tuple[Doorway, ...]
     spaces: tuple[Space, ...]
-    obstacles: tuple[Rect, ...]
+    obstacles: tuple[Obstacle, ...]
     wall_thickness: float
 
     def doorway(self, doorway_id: str) -> Doorway:
@@ -121,7 +123,7 @@ def build_plan(
     name: str,
     spaces: Sequence[Space],
     doorways: Sequence[DoorwaySpec] = (),
-    obstacles: Sequence[Rect] = (),
+    obstacles: Sequence[Obstacle] = (),
     *,
     wall_thickness: float = 0.2,
 ) -> FloorPlan:
@@ -187,12 +189,12 @@ def _passage(door: Doorway, thickness: float) -> Rect:
     return (xs[0] - reach, min(ys), xs[0] + reach, max(ys))
 
 
-def _free_space(spaces: Iterable[Space], passages: Iterable[Rect], obstacles: Iterable[Rect]) -> BaseGeometry:
-    from shapely.geometry import box
+def _free_space(spaces: Iterable[Space], passages: Iterable[Rect], obstacles: Iterable[Obstacle]) -> BaseGeometry:
+    from shapely.geometry import Polygon, box
     from shapely.ops import unary_union
 
     free = unary_union([box(*s.rect) for s in spaces] + [box(*r) for r in passages])
-    blocked = [box(*r) for r in obstacles]
+    blocked = [Polygon(r) if isinstance(r[0], tuple) else box(*r) for r in obstacles]
     if blocked:
         free = free.difference(unary_union(blocked))
     return free.simplify(0.0)

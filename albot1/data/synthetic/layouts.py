@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 
-from albot1.data.synthetic.floorplan import DoorwaySpec, FloorPlan, Rect, Space, build_plan
+from albot1.data.synthetic.floorplan import DoorwaySpec, FloorPlan, Obstacle, Rect, Space, build_plan
 from albot1.data.synthetic.route import Route
 
 OFFICE_SPACES: tuple[Space, ...] = (
@@ -106,8 +106,9 @@ def corridor_route() -> Route:
 #
 # Six rooms of different sizes (4.8-7 m deep, 5-8 m wide) and furniture, in two rows, joined in a ring by six
 # 1 m doorways: room-1 (north-west) -> room-2 -> room-3 (north-east) -> room-4 (south-east) -> room-5 ->
-# room-6 (south-west) -> room-1. No two rooms have the same shape: a room is told from another by its
-# structure (4.1.2), as the rooms of the thesis's lab floor are. The double-loop plan adds a seventh doorway
+# room-6 (south-west) -> room-1. No two rooms have the same shape, and each has one piece of furniture
+# standing askew at its own angle: a room is told from another by its structure alone (4.1.2), and
+# rectangular rooms with square-set furniture would all look alike. The double-loop plan adds a seventh doorway
 # between room-2 and room-5, so a second loop can enter room-5 from the north, a direction the first loop
 # never saw it from (4.2.2).
 
@@ -132,7 +133,15 @@ PLACES_DOORWAYS: tuple[DoorwaySpec, ...] = (
 #: The double loop's extra doorway: room-2 to room-5 through their shared wall.
 PLACES_DOOR_2_5 = DoorwaySpec("door-2-5", (9.3, 6.1), "x", 1.0)
 
-PLACES_FURNITURE: tuple[Rect, ...] = (
+def askew(centre: tuple[float, float], size: tuple[float, float], degrees: float) -> tuple[tuple[float, float], ...]:
+    """The corners of a ``size`` (length, depth) box centred at ``centre``, turned ``degrees`` counter-clockwise."""
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    half = (size[0] / 2.0, size[1] / 2.0)
+    corners = ((-half[0], -half[1]), (half[0], -half[1]), (half[0], half[1]), (-half[0], half[1]))
+    return tuple((centre[0] + c * x - s * y, centre[1] + s * x + c * y) for x, y in corners)
+
+
+PLACES_FURNITURE: tuple[Obstacle, ...] = (
     (0.8, 10.8, 2.8, 11.6),  # room-1: desk, cabinet, pillar
     (4.6, 7.0, 5.6, 7.6),
     (3.6, 7.9, 4.1, 8.4),
@@ -150,12 +159,17 @@ PLACES_FURNITURE: tuple[Rect, ...] = (
     (8.8, 2.0, 9.3, 2.5),
     (0.5, 0.5, 2.5, 1.5),  # room-6: desk and shelf
     (3.3, 1.5, 4.0, 3.3),
+    askew((4.6, 10.8), (1.2, 0.5), 25.0),  # one piece askew per room, each at its own angle
+    askew((12.8, 6.9), (1.0, 0.4), -35.0),
+    askew((19.3, 7.2), (1.0, 0.4), 50.0),
+    askew((15.8, 4.6), (1.4, 0.5), 20.0),
+    askew((6.6, 5.3), (1.0, 0.4), -20.0),
+    askew((1.0, 4.2), (1.0, 0.4), 40.0),
 )
 
 #: One lap of the single loop, from S in room-1 clockwise through the six doorways back to S.
 PLACES_LOOP: tuple[tuple[float, float], ...] = (
-    (2.5, 8.2),  # S, room-1
-    (2.5, 9.0),
+    (3.5, 9.0),  # S, room-1, facing east
     (7.0, 9.0),  # through door-1-2
     (10.0, 9.0),
     (10.0, 8.0),
@@ -172,22 +186,23 @@ PLACES_LOOP: tuple[tuple[float, float], ...] = (
     (8.0, 4.0),
     (4.3, 4.0),  # through door-5-6
     (2.5, 4.0),
-    (2.5, 8.2),  # through door-6-1, back at S
+    (2.5, 9.0),  # through door-6-1
+    (3.5, 9.0),  # back at S
 )
 
 #: The waypoints the loop may start from (``synthetic-places-loop?start=K``): S (room-1), A (room-3), B (room-5).
-PLACES_LOOP_STARTS: tuple[int, ...] = (0, 6, 13)
+PLACES_LOOP_STARTS: tuple[int, ...] = (0, 5, 12)
 
 #: After the first lap, a second loop that leaves room-2 south through door-2-5 into room-5 (a new direction).
 PLACES_SECOND_LOOP: tuple[tuple[float, float], ...] = (
-    (2.5, 9.0),
     (7.0, 9.0),  # through door-1-2
     (9.3, 9.0),
     (9.3, 5.0),  # through door-2-5: room-5 entered from the north
     (8.0, 4.0),
     (4.3, 4.0),  # through door-5-6
     (2.5, 4.0),
-    (2.5, 8.2),  # through door-6-1, back at S
+    (2.5, 9.0),  # through door-6-1
+    (3.5, 9.0),  # back at S
 )
 
 

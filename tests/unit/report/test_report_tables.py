@@ -15,7 +15,7 @@ from albot1.metrics.ate import ate as ate_block
 from albot1.metrics.updates import update_counts
 from albot1.records import METRIC_NAMES, MetricsRecord, ResultRecord, check_number_path, parse_record
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, SOURCE_MODELS, CellRecord, Column
-from albot1.report.tables import aggregate, cell_text, cells_frame, markdown, write_tables
+from albot1.report.tables import aggregate, cell_text, cells_frame, markdown, stats_text, write_tables
 
 RUN = {
     "key": "k",
@@ -128,31 +128,74 @@ def test_columns_read_numbers_and_leave_not_applicable_cells_empty() -> None:
     assert METRIC_COLUMNS["ate_rmse_m"].value(record("w", "odometry", "none", 0, None)) is None
 
 
-def test_aggregate_over_seeds_mean_median_min_max() -> None:
+def test_aggregate_over_seeds_mean_std_median_min_max() -> None:
     records = [record("w", "odometry", "gauss:0.1:1", s, ate) for s, ate in ((0, 1.0), (1, 2.0), (2, 6.0))]
     records += [record("w", "odometry", "none", 0, 0.5), record("w", "odometry", "none", 1, None, status="failed")]
     table = aggregate(cells_frame(records), METRIC_COLUMNS)
     assert list(table["degradation"]) == ["none", "gauss:0.1:1"]  # by severity, whatever the plan order
     swept = table.iloc[1]
-    assert swept["seeds"] == 3
-    assert (swept["ate_rmse_m_mean"], swept["ate_rmse_m_median"], swept["ate_rmse_m_min"], swept["ate_rmse_m_max"]) == (
-        3.0,
-        2.0,
-        1.0,
-        6.0,
-    )
-    assert cell_text(swept, "ate_rmse_m") == "3.000 / 2.000 (1.000–6.000)"
+    assert (swept["seeds"], swept["planned"], swept["failed"], swept["status"]) == (3, 3, 0, "ok")
+    stats = [swept[f"ate_rmse_m_{s}"] for s in ("mean", "median", "min", "max")]
+    assert stats == [3.0, 2.0, 1.0, 6.0]
+    assert swept["ate_rmse_m_std"] == pytest.approx(np.std([1.0, 2.0, 6.0], ddof=1))  # the sample std over seeds
+    assert cell_text(swept, "ate_rmse_m") == "3.00 ± 2.65 (1.00–6.00)"
     single = table.iloc[0]
-    assert single["seeds"] == 1  # the failed seed is not averaged in
+    assert (single["seeds"], single["planned"], single["failed"]) == (1, 2, 1)  # the failed seed is not averaged in
+    assert single["status"] == "1 of 2 failed (exception: RuntimeError: boom)"
     assert cell_text(single, "ate_rmse_m") == "0.500"
+
+
+@pytest.mark.parametrize(
+    ("mean", "std", "low", "high", "n", "text"),
+    [
+        (0.0456, 0.0012, 0.0441, 0.0467, 3, "0.0456 ± 0.0012 (0.0441–0.0467)"),
+        (36.14, 4.21, 31.5, 40.2, 3, "36.1 ± 4.2 (31.5–40.2)"),
+        (1234.5, 10.0, 1220.0, 1250.0, 2, "1234 ± 10 (1220–1250)"),  # >= 3 digits before the point: no decimals
+        (9.9996, 0.0, 9.9996, 9.9996, 3, "10.0"),  # rounded first: 10.0, not 10.00; equal seeds: one number
+        (2.5e-10, 1e-10, 1e-10, 4e-10, 3, "2.50e-10 ± 1.00e-10 (1.00e-10–4.00e-10)"),  # perfect odometry
+        (0.0, 0.0, 0.0, 0.0, 1, "0.00"),
+    ],
+)
+def test_numbers_have_three_significant_digits_and_the_spread_the_decimals_of_the_mean(
+    mean: float, std: float, low: float, high: float, n: int, text: str
+) -> None:
+    assert stats_text(mean, std, low, high, n) == text
+
+
+def test_a_group_whose_seeds_all_failed_is_a_row_marked_failed_with_the_reason() -> None:
+    records = [record("w", "odometry", "none", 0, 0.25), record("w", "x", "none", 0, None, status="failed")]
+    text = markdown(aggregate(cells_frame(records), METRIC_COLUMNS), METRIC_COLUMNS, "T")
+    failed_row = next(line for line in text.splitlines() if line.startswith("| x |"))
+    assert failed_row.startswith("| x | none | 0 | failed |")
+    assert failed_row.endswith("| failed (exception: RuntimeError: boom) |")
+
+
+def test_not_applicable_numbers_say_n_a_with_the_reason_under_the_table() -> None:
+    records = [record("w", "odometry", "none", 0, 0.25), record("w", "odometry", "thesis", 0, None)]
+    text = markdown(aggregate(cells_frame(records), METRIC_COLUMNS), METRIC_COLUMNS, "T")
+    assert "| odometry | thesis | 1 | n/a |" in text
+    assert "- n/a: ATE RMSE (m): not computed in this test" in text
+    assert "- n/a: relation trans. (m): not computed in this test (every run of this dataset)" in text
 
 
 def test_markdown_omits_columns_empty_for_a_dataset() -> None:
     records = [record("w", "odometry", "none", 0, None), record("v", "odometry", "none", 0, 0.25)]
     text = markdown(aggregate(cells_frame(records), METRIC_COLUMNS), METRIC_COLUMNS, "T")
     section_w = text.split("## w")[1].split("## v")[0]
-    assert "ATE RMSE" not in section_w and "updates/view" in section_w
-    assert "| odometry | none | 1 | 0.250 | 0.500 |" in text.split("## v")[1]
+    assert "ATE RMSE" not in section_w.split("\n\n")[1] and "updates/view" in section_w
+    assert "| odometry | none | 1 | 0.250 | 0.500 | ok |" in text.split("## v")[1]
+
+
+def test_latex_tables_are_booktabs_with_escaped_labels(tmp_path: Path) -> None:
+    records = [record("w_1", "odometry", "gauss:0.1:1", s, ate) for s, ate in ((0, 1.0), (1, 2.0))]
+    written = write_tables(records, tmp_path)
+    tex = written["metrics.tex"].read_text()
+    assert (
+        "\\toprule" in tex
+        and "\\bottomrule" in tex
+        and "\\caption{Accuracy per dataset, method and degradation: w\\_1}" in tex
+    )
+    assert "odometry & gauss:0.1:1 & 1.50 $\\pm$ 0.71 (1.00--2.00)" in tex
 
 
 def test_write_tables_keeps_cost_out_of_the_accuracy_files(tmp_path: Path) -> None:
@@ -165,3 +208,4 @@ def test_write_tables_keeps_cost_out_of_the_accuracy_files(tmp_path: Path) -> No
     assert not set(COST_COLUMNS) & set(cells.columns)
     assert cost.loc[0, "per_scan_ms_median_mean"] == 3.0
     assert list(cells["status"]) == ["done", "failed"] and cells.loc[1, "reason"] == "RuntimeError: boom"
+    assert list(metrics["status"]) == ["ok", "failed (exception: RuntimeError: boom)"]

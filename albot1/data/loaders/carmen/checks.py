@@ -90,26 +90,28 @@ def geometry_problem(
             ~np.isfinite(max_range) | (max_range < 0),
             "maximum_range is {max_range!r} m, expected a finite distance >= 0 (0 = not stated)",
         ),
-        (
-            ~np.isfinite(fov) | (fov < 0) | (fov > FULL_TURN + ANGLE_SLACK),
-            "field_of_view is {fov!r} rad, expected 0 (not stated) to 2 pi",
-        ),
     ]
+    span = (beams - 1) * resolution
+    with np.errstate(invalid="ignore"):
+        checks += [
+            (span > FULL_TURN + ANGLE_SLACK, ""),
+            (
+                ~np.isfinite(fov) | (fov < 0) | (fov > FULL_TURN + ANGLE_SLACK),
+                "field_of_view is {fov!r} rad, expected 0 (not stated) to 2 pi",
+            ),
+        ]
     for bad, template in checks:
         if bad.any():
             row = int(np.argmax(bad))
+            if not template:  # the span: said in degrees, with the resolution that makes it
+                problem = span_problem(beams, float(resolution[row]))
+                return row, f"{problem} (angular_resolution {float(resolution[row])!r} rad)"
             return row, template.format(
                 start=float(start[row]),
                 res=float(resolution[row]),
                 max_range=float(max_range[row]),
                 fov=float(fov[row]),
             )
-    span = (beams - 1) * resolution
-    too_wide = span > FULL_TURN + ANGLE_SLACK
-    if too_wide.any():
-        row = int(np.argmax(too_wide))
-        problem = span_problem(beams, float(resolution[row]))
-        return row, f"{problem} (angular_resolution {float(resolution[row])!r} rad)"
     stated = fov > 0
     off = stated & (np.abs(fov - span) > resolution + ANGLE_SLACK)
     if off.any():

@@ -17,7 +17,8 @@ class PlacesKernels(NamedTuple):
     jitted: bool
     detect_exits: Callable[[FloatArray, IntArray, float, float, float, float, bool], tuple[IntArray, IntArray]]
     match_structure: Callable[
-        [FloatArray, IntArray, FloatArray, float, float, int, int], tuple[bool, int, float, float, float]
+        [FloatArray, IntArray, FloatArray, float, float, int, int, FloatArray, int],
+        tuple[bool, int, float, float, float],
     ]
 
 

@@ -36,6 +36,7 @@ class ExitParams:
     crossing_band: float = 0.2
     crossing_margin: float = 0.2
     twin_distance: float = 1.0
+    recent_scans: int = 100
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,6 +52,7 @@ class MatchParams:
     trigger_fraction: float = 0.2
     trigger_min: int = 4
     retry_growth: int = 3
+    max_conflicts: int = 1
 
 
 class Albot1PlacesConfig(Albot1Config):
@@ -77,6 +79,14 @@ class Albot1PlacesConfig(Albot1Config):
     )
     exit_track_angle_deg: float = Field(20.0, gt=0, description="... and whose direction differs by less than this")
     exit_min_sightings: int = Field(3, ge=1, description="an exit can be crossed once seen in this many views")
+    exit_recent_scans: int = Field(
+        100,
+        ge=1,
+        description=(
+            "exits seen within this many scans decide what is seen through an exit and whether the robot stands in "
+            "one (older placements have drifted with the map)"
+        ),
+    )
     crossing_band_m: float = Field(
         0.2, ge=0, description="the robot is on one side of an exit only when farther than this from its line"
     )
@@ -98,6 +108,14 @@ class Albot1PlacesConfig(Albot1Config):
         description=(
             "Algorithm 6 line 6 'centering on S_j': a hypothesis puts S_k's midpoint on S_j's, or also tries "
             "their left and right ends"
+        ),
+    )
+    match_max_conflicts: int = Field(
+        1,
+        ge=0,
+        description=(
+            "a hypothesis is refused when it puts more than this many unmatched remembered surfaces where the "
+            "current view sees empty space (our addition; a large value turns it off)"
         ),
     )
     revisit_trigger_fraction: float = Field(
@@ -151,6 +169,7 @@ class Albot1PlacesConfig(Albot1Config):
             crossing_band=self.crossing_band_m,
             crossing_margin=self.crossing_margin_m,
             twin_distance=self.exit_link_distance_m,
+            recent_scans=self.exit_recent_scans,
         )
 
     def match_params(self) -> MatchParams:
@@ -164,4 +183,5 @@ class Albot1PlacesConfig(Albot1Config):
             trigger_fraction=self.revisit_trigger_fraction,
             trigger_min=self.revisit_trigger_min,
             retry_growth=self.match_retry_growth,
+            max_conflicts=self.match_max_conflicts,
         )

@@ -108,14 +108,25 @@ class ExitTracker:
         keep = self._sightings >= self.params.min_sightings if confirmed_only else slice(None)
         return self._seg[keep].copy()
 
-    def beyond(self, origin: tuple[float, float], points: FloatArray) -> NDArray[np.bool_]:
-        """For each point ``(J, 2)``: whether the straight line from ``origin`` to it passes through a tracked exit.
+    def _recent(self, scan: int) -> NDArray[np.bool_]:
+        """Crossable tracks seen in the last ``recent_scans``: placed consistently with the robot's current pose.
 
-        Such a point was seen *through* an exit: it belongs to the place beyond.
+        Older tracks were placed in a map that has drifted since, and may lie a
+        metre off: a doorway's old track can fall inside the room it leads to.
         """
-        out = np.zeros(len(points), dtype=bool)
-        keep = self._sightings >= self.params.min_sightings
-        if not keep.any() or len(points) == 0:
+        p = self.params
+        return (self._sightings >= p.min_sightings) & (scan - self._last_seen <= p.recent_scans)
+
+    def beyond(self, origin: tuple[float, float], points: FloatArray, scan: int) -> IntArray:
+        """For each point ``(J, 2)``: the id of the recently seen exit the line from ``origin`` to it passes through.
+
+        -1 where it passes through none. Such a point was seen *through* that
+        exit: it belongs to the place beyond (the nearest exit along the line
+        when it passes several).
+        """
+        out = np.full(len(points), -1, dtype=np.int64)
+        keep = np.flatnonzero(self._recent(scan))
+        if len(keep) == 0 or len(points) == 0:
             return out
         seg = self._seg[keep]
         ax, ay, bx, by = (seg[:, c][:, None] for c in range(4))
@@ -126,11 +137,27 @@ class ExitTracker:
         d3 = (px - ox) * (ay - oy) - (py - oy) * (ax - ox)
         d4 = (px - ox) * (by - oy) - (py - oy) * (bx - ox)
         through = (d1 * d2 < 0) & (d3 * d4 < 0)
-        return np.asarray(through.any(axis=0))
+        hit = through.any(axis=0)
+        if hit.any():
+            # fraction along origin -> point where each exit line is met; the nearest exit wins
+            with np.errstate(divide="ignore", invalid="ignore"):
+                along = np.where(through, d1 / (d1 - d2), np.inf)
+            out[hit] = self._ids[keep[np.argmin(along[:, hit], axis=0)]]
+        return out
 
-    def near(self, position: tuple[float, float], distance: float) -> bool:
-        """Whether ``position`` is within ``distance`` of a tracked exit (standing in a doorway)."""
-        keep = self._sightings >= self.params.min_sightings
+    def twins(self, track: int) -> list[int]:
+        """Ids of the tracks within the twin distance of ``track`` (itself included): one doorway's placements."""
+        row = np.flatnonzero(self._ids == track)
+        if len(row) == 0:
+            return [track]
+        mids = 0.5 * (self._seg[:, :2] + self._seg[:, 2:])
+        here = mids[row[0]]
+        close = np.hypot(mids[:, 0] - here[0], mids[:, 1] - here[1]) <= self.params.twin_distance
+        return self._ids[close].tolist()
+
+    def near(self, position: tuple[float, float], distance: float, scan: int) -> bool:
+        """Whether ``position`` is within ``distance`` of a recently seen exit (standing in a doorway)."""
+        keep = self._recent(scan)
         if not keep.any():
             return False
         seg = self._seg[keep]

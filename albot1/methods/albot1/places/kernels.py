@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
-from albot1.geometry.segments import orientation, segment_distance
+from albot1.geometry.segments import closest_parameter, orientation, point_segment_distance
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDING
 
 FloatArray = NDArray[np.float64]
@@ -105,6 +105,19 @@ def detect_exits(
     return out_i[:k], out_j[:k]
 
 
+def _colocated(a: FloatArray, b: FloatArray, max_gap: float) -> bool:
+    """Whether the shorter of two surfaces has its midpoint within ``max_gap`` of the longer one.
+
+    Stricter than their ends being near: a short piece must lie *along* the
+    longer surface, not just touch one of its ends.
+    """
+    la = np.hypot(a[2] - a[0], a[3] - a[1])
+    lb = np.hypot(b[2] - b[0], b[3] - b[1])
+    if la <= lb:
+        return point_segment_distance(0.5 * (a[0] + a[2]), 0.5 * (a[1] + a[3]), b) <= max_gap
+    return point_segment_distance(0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3]), a) <= max_gap
+
+
 def _count_matches(
     current: FloatArray,
     dir_j: FloatArray,
@@ -142,7 +155,7 @@ def _count_matches(
         for jj in range(nj):
             if used[jj] or abs(wrap_angle(dir_j[jj] - d)) >= max_angle:
                 continue
-            if segment_distance(current[jj], seg) <= max_gap:
+            if _colocated(current[jj], seg, max_gap):
                 used[jj] = True
                 partner[kk] = jj
                 count += 1
@@ -228,6 +241,48 @@ def _refine(
     return theta, (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
 
 
+def _seen_empty(x: float, y: float, poly: FloatArray, margin: float) -> bool:
+    """Whether (x, y) lies inside the view polygon ``poly`` (even-odd) and farther than ``margin`` from its edges."""
+    v = poly.shape[0]
+    inside = False
+    for e in range(v):
+        ax = poly[e, 0]
+        ay = poly[e, 1]
+        bx = poly[(e + 1) % v, 0]
+        by = poly[(e + 1) % v, 1]
+        if (ay > y) != (by > y):
+            if x < ax + (y - ay) * (bx - ax) / (by - ay):
+                inside = not inside
+    if not inside:
+        return False
+    for e in range(v):
+        ax = poly[e, 0]
+        ay = poly[e, 1]
+        bx = poly[(e + 1) % v, 0]
+        by = poly[(e + 1) % v, 1]
+        t = closest_parameter(x, y, ax, ay, bx, by)
+        if np.hypot(ax + t * (bx - ax) - x, ay + t * (by - ay) - y) <= margin:
+            return False
+    return True
+
+
+def _conflicts(
+    remembered: FloatArray, theta: float, tx: float, ty: float, partner: IntArray, poly: FloatArray, margin: float
+) -> int:
+    """Unmatched remembered surfaces the hypothesis puts where the current view sees empty space (their midpoints)."""
+    c = math.cos(theta)
+    s = math.sin(theta)
+    n = 0
+    for kk in range(remembered.shape[0]):
+        if partner[kk] >= 0:
+            continue
+        mx = 0.5 * (remembered[kk, 0] + remembered[kk, 2])
+        my = 0.5 * (remembered[kk, 1] + remembered[kk, 3])
+        if _seen_empty(tx + c * mx - s * my, ty + s * mx + c * my, poly, margin):
+            n += 1
+    return n
+
+
 def match_structure(
     current: FloatArray,
     current_side: IntArray,
@@ -236,6 +291,8 @@ def match_structure(
     max_gap: float,
     min_matches: int,
     anchors: int,
+    view_polygon: FloatArray,
+    max_conflicts: int,
 ) -> tuple[bool, int, float, float, float]:
     """Algorithm 6: does a hypothesis ``S_j = S_k`` bring more than 4 remembered surfaces onto current ones?
 
@@ -249,13 +306,17 @@ def match_structure(
     applied to every remembered surface; a transformed surface matches when
     a current surface not yet matched (pairs are one-to-one, so pieces of
     one wall cannot all count against one long surface) differs in
-    direction by less than ``max_angle`` and lies within ``max_gap`` of it.
+    direction by less than ``max_angle`` and the shorter of the two lies
+    along the longer, its midpoint within ``max_gap`` of it (:func:`_colocated`).
     A hypothesis with at least two matches is refined once from its matched
     pairs (:func:`_refine`: one surface fixes a direction badly, so a small
     angle error would push far surfaces out of the 40 cm) and counted again.
     The first hypothesis with at least ``min_matches`` matches whose matched
-    current surfaces lie on both sides of the robot confirms (line 11's
-    break). Returns ``(confirmed, best count, theta, tx, ty)``: the motion of
+    current surfaces lie on both sides of the robot, and that puts at most
+    ``max_conflicts`` remembered surfaces where the current view saw empty
+    space (inside ``view_polygon``, the current view's polygon in the map,
+    by more than ``max_gap``: Algorithm 3 would have deleted them), confirms
+    (line 11's break). Returns ``(confirmed, best count, theta, tx, ty)``: the motion of
     the confirming hypothesis (or of the best one) mapping the remembered
     frame into the map frame.
     """
@@ -308,5 +369,6 @@ def match_structure(
                     best_tx = tx
                     best_ty = ty
                 if count >= min_matches and left and right:
-                    return True, count, theta, tx, ty
+                    if _conflicts(remembered, theta, tx, ty, partner, view_polygon, max_gap) <= max_conflicts:
+                        return True, count, theta, tx, ty
     return False, max(best, 0), best_theta, best_tx, best_ty

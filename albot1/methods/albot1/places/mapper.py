@@ -41,6 +41,7 @@ from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
+from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
 from albot1.methods.albot1.places.exits import Crossing, ExitTracker
@@ -83,7 +84,10 @@ class Albot1PlacesMapper:
         )
         self._labels: list[set[int]] = []  # map surface id -> the visits it belongs to (see _on_update)
         self._members: dict[int, set[int]] = {}  # visit -> the map surface ids marked with it
-        self._colocated: dict[int, int] = {}  # place -> most co-locating surfaces in one update, not yet checked
+        self._through: set[int] = set()  # surfaces the current visit saw only through an exit
+        self._evidence: dict[int, set[int]] = {}  # place -> its surfaces the current visit's updates co-located with
+        self._ahead: dict[int, dict[int, set[int]]] = {}  # exit track -> the same, for what was seen through it
+        self._fresh = False  # evidence grew since the last check
         self._attempts: dict[tuple[int, int], int] = {}  # (visit, place) -> current surfaces at the failed attempt
         self._predicted: list[Prediction] = []
         self._predictions: list[dict[str, Any]] = []
@@ -104,11 +108,10 @@ class Albot1PlacesMapper:
         crossing = self.exits.crossing((pose[0], pose[1]), n)
         if crossing is not None:
             self._cross(crossing, pose, n)
-        if self._colocated and not self.exits.near((pose[0], pose[1]), self.config.recognition_exit_clearance_m):
-            # In a doorway the check waits until the robot is clear of it: what a view from a doorway
-            # co-locates with is mostly the place beyond, the place the robot is about to enter.
+        if self._fresh and not self.exits.near((pose[0], pose[1]), self.config.recognition_exit_clearance_m, n):
+            # In a doorway the check waits until the robot is clear of it.
             self._recognise(pose, n)
-            self._colocated.clear()
+            self._fresh = False
         self._n += 1
 
     def _on_update(self, event: UpdateEvent) -> None:
@@ -128,15 +131,19 @@ class Albot1PlacesMapper:
         top = int(max(out.view_ids.max(initial=-1), out.added.max(initial=-1))) + 1
         while len(labels) < top:
             labels.append(set())
-        touched = np.concatenate([out.deleted, out.extended, out.trimmed]).tolist()
-        if touched:
+        touched = np.concatenate([out.deleted, out.extended, out.trimmed])
+        if len(touched):
+            # What co-locates on this side of the exits is evidence about the current place; what was seen
+            # through an exit, about the place beyond it (kept until that exit is crossed).
+            seg = self.inner.map.segments(touched)
+            through = self.exits.beyond((event.pose[0], event.pose[1]), 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
             excluded = {network.find(v.place) for v in network.visits[-2:] if v.place is not None}
-            per_place: Counter[int] = Counter()
-            for sid in touched:
+            for sid, exit_id in zip(touched.tolist(), through.tolist()):
                 places = {network.find(p) for p in (network.visits[v].place for v in labels[sid]) if p is not None}
-                per_place.update(places - excluded)
-            for place, count in per_place.items():
-                self._colocated[place] = max(self._colocated.get(place, 0), count)
+                evidence = self._evidence if exit_id < 0 else self._ahead.setdefault(exit_id, {})
+                for place in places - excluded:
+                    evidence.setdefault(place, set()).add(sid)
+                    self._fresh = self._fresh or exit_id < 0
         if len(out.added) and len(out.deleted):
             pmap = self.inner.map
             same = same_surfaces(pmap.segments(out.added), pmap.segments(out.deleted), self._same_angle, self._same_gap)
@@ -144,16 +151,29 @@ class Albot1PlacesMapper:
             for row, col in zip(*np.nonzero(same)):
                 labels[int(out.added[row])] |= labels[deleted[col]]
         members = self._members.setdefault(current.id, set())
-        for sid in out.view_ids.tolist():
-            labels[sid].add(current.id)
-            members.add(sid)
+        ids = out.view_ids
+        if len(ids):
+            seg = self.inner.map.segments(ids)
+            through = self.exits.beyond((event.pose[0], event.pose[1]), 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
+            for sid, exit_id in zip(ids.tolist(), through.tolist()):
+                labels[sid].add(current.id)
+                members.add(sid)
+                if exit_id >= 0:
+                    self._through.add(sid)
+                else:
+                    self._through.discard(sid)
 
-    def _visit_surfaces(self, visit: Visit) -> FloatArray:
-        """The map surfaces (thesis map frame) marked with ``visit`` (Algorithm 5 lines 2-6)."""
+    def _visit_surfaces(self, visit: Visit) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """The map surfaces (thesis map frame) marked with the current ``visit`` (Algorithm 5 lines 2-6).
+
+        With a flag per surface: seen only through an exit.
+        """
         pmap = self.inner.map
         alive = pmap.ids()
         ids = np.fromiter(sorted(self._members.get(visit.id, ())), dtype=np.int64)
-        return pmap.segments(ids[np.isin(ids, alive, assume_unique=True)])
+        ids = ids[np.isin(ids, alive, assume_unique=True)]
+        through = np.fromiter((sid in self._through for sid in ids.tolist()), dtype=bool, count=len(ids))
+        return pmap.segments(ids), through
 
     # -- Algorithms 5 and 7: an exit crossed ---------------------------------------------------------------------
     def _cross(self, crossing: Crossing, pose: Pose, n: int) -> None:
@@ -161,7 +181,9 @@ class Albot1PlacesMapper:
         counts.exits_crossed += 1
         visit = network.current
         compared = nearest_prediction(self._predicted, crossing.segment)
-        place, exit_id = network.close(visit, self._visit_surfaces(visit), crossing.segment, n)
+        surfaces, through = self._visit_surfaces(visit)
+        place, exit_id = network.close(visit, surfaces, crossing.segment, n, through)
+        self._through = set()
         entry = np.concatenate([crossing.segment[2:], crossing.segment[:2]])  # the place entered on its left
         target = network.leads(place, exit_id)
         nxt = network.start_visit(n, pose, entry, (place, exit_id))
@@ -187,6 +209,13 @@ class Albot1PlacesMapper:
                 "not_aligned_distance_m": not_aligned_m,
             }
         self._predicted = []
+        # What co-located beyond the exit just crossed is now evidence about the current place.
+        ahead: dict[int, set[int]] = {}
+        for twin in self.exits.twins(crossing.track):
+            for place, ids in self._ahead.pop(twin, {}).items():
+                ahead.setdefault(place, set()).update(ids)
+        self._ahead.clear()
+        self._evidence, self._fresh = ahead, bool(ahead)
         if target is not None:
             known, known_exit = target
             landing = network.exit(known, known_exit)
@@ -211,8 +240,14 @@ class Albot1PlacesMapper:
         self._predicted = predict(place.exits, place.id, visit.place_in_map, n, skip)
         for p in self._predicted:
             self._predictions.append(
-                {"scan": n, "visit": visit.id, "place": p.place, "exit": p.exit, "aligned": p.aligned,
-                 "not_aligned": p.not_aligned}
+                {
+                    "scan": n,
+                    "visit": visit.id,
+                    "place": p.place,
+                    "exit": p.exit,
+                    "aligned": p.aligned,
+                    "not_aligned": p.not_aligned,
+                }
             )
 
     # -- Algorithms 6 and 8: a place re-visited -----------------------------------------------------------------
@@ -222,23 +257,31 @@ class Albot1PlacesMapper:
         excluded = {network.find(v.place) for v in network.visits[-2:] if v.place is not None}
         current_all: FloatArray | None = None
         current: FloatArray | None = None
-        for place_id, count in sorted(self._colocated.items(), key=lambda item: (-item[1], item[0])):
-            place_id = network.find(place_id)
+        polygon: FloatArray | None = None
+        counts = Counter({network.find(p): len(ids) for p, ids in self._evidence.items()})
+        for place_id, count in sorted(counts.items(), key=lambda item: (-item[1], item[0])):
             if place_id in excluded:
                 continue
-            remembered = structural(network.places[place_id].surfaces, params)
+            place = network.places[place_id]
+            remembered = structural(place.surfaces[~place.through], params)
             if count <= trigger_threshold(len(remembered), params):
                 continue
             if current_all is None:
-                current_all = self._visit_surfaces(visit)
-                current = self._this_side(structural(current_all, params), pose)
+                current_all, seen_through = self._visit_surfaces(visit)
+                current = self._this_side(structural(current_all[~seen_through], params), pose, n)
             assert current is not None
             key = (visit.id, place_id)
             last = self._attempts.get(key)
             if last is not None and len(current_all) < last + params.retry_growth:
                 continue
             self._counts.match_attempts += 1
-            match = confirm(current, remembered, pose, params, self._k)
+            if polygon is None:
+                view = self.inner.last_view
+                assert view is not None
+                polygon = view_polygon(
+                    transform_segments(pose, view.surfaces), (pose[0], pose[1]), "robot_and_endpoints"
+                )
+            match = confirm(current, remembered, pose, polygon, params, self._k)
             if not match.confirmed:
                 self._attempts[key] = len(current_all)
                 continue
@@ -261,10 +304,10 @@ class Albot1PlacesMapper:
             self._predict(visit, n)
             return
 
-    def _this_side(self, surfaces: FloatArray, pose: Pose) -> FloatArray:
+    def _this_side(self, surfaces: FloatArray, pose: Pose, scan: int) -> FloatArray:
         """The surfaces not seen through an exit: the current place's own structure (see docs/places.md)."""
         mid = 0.5 * (surfaces[:, :2] + surfaces[:, 2:])
-        return np.ascontiguousarray(surfaces[~self.exits.beyond((pose[0], pose[1]), mid)])
+        return np.ascontiguousarray(surfaces[self.exits.beyond((pose[0], pose[1]), mid, scan) < 0])
 
     def _align_at_entry(self, visit: Visit, place_id: int, place_in_map: Pose) -> Pose:
         """Re-align a matched place at the exit the visit came in by, when the place has that exit (Algorithm 8)."""
@@ -316,4 +359,3 @@ class Albot1PlacesMapper:
         extras = dict(out.extras)
         extras["places"] = {"file": "places.json", "graph": "places.graphml"}
         return MapperOutput(poses=out.poses, map=out.map, counters=counters, extras=extras, files=files)
-

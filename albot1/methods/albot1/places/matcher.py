@@ -106,9 +106,17 @@ class Match:
 
 
 def confirm(
-    current_map: FloatArray, remembered_own: FloatArray, pose: Pose, params: MatchParams, kernels: PlacesKernels
+    current_map: FloatArray,
+    remembered_own: FloatArray,
+    pose: Pose,
+    view_polygon: FloatArray,
+    params: MatchParams,
+    kernels: PlacesKernels,
 ) -> Match:
-    """Algorithm 6 on already selected surfaces (:func:`structural`); ``pose`` is the robot's, thesis frame."""
+    """Algorithm 6 on already selected surfaces (:func:`structural`); ``pose`` is the robot's, thesis frame.
+
+    ``view_polygon`` is the current view's polygon in the map (Algorithm 3 line 7): the space seen empty.
+    """
     if len(current_map) == 0 or len(remembered_own) == 0:
         return Match(False, 0, (0.0, 0.0, 0.0))
     found, count, theta, tx, ty = kernels.match_structure(
@@ -119,5 +127,7 @@ def confirm(
         params.gap,
         params.min_matches,
         params.anchors,
+        np.ascontiguousarray(view_polygon, dtype=float).reshape(-1, 2),
+        params.max_conflicts,
     )
     return Match(bool(found), int(count), (float(tx), float(ty), float(theta)))

@@ -67,6 +67,8 @@ class Place:
     created_scan: int
     frame_map: Pose
     surfaces: FloatArray = field(default_factory=lambda: np.empty((0, 4)))
+    #: per surface: seen only through one of the place's exits (part of its map, not of its structure)
+    through: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     exits: list[ExitRecord] = field(default_factory=list)
     visits: list[int] = field(default_factory=list)
     merged_into: int | None = None
@@ -160,12 +162,20 @@ class PlaceNetwork:
         self._link_entry(visit)
         return place
 
-    def close(self, visit: Visit, surfaces_map: FloatArray, exit_map: FloatArray, scan: int) -> tuple[int, int]:
+    def close(
+        self,
+        visit: Visit,
+        surfaces_map: FloatArray,
+        exit_map: FloatArray,
+        scan: int,
+        through: NDArray[np.bool_] | None = None,
+    ) -> tuple[int, int]:
         """Algorithm 5 lines 2-13: the visit's surfaces and the exit just crossed go into its place.
 
         A visit that is no known place creates one (line 9) whose frame is
         the visit's start pose; a recognised visit's description is combined
-        with its place's (line 11). Returns ``(place, exit id)`` of the exit crossed.
+        with its place's (line 11). ``through`` flags the surfaces seen only
+        through an exit. Returns ``(place, exit id)`` of the exit crossed.
         """
         if visit.place is None:
             place = Place(len(self.places), scan, visit.frame)
@@ -174,7 +184,10 @@ class PlaceNetwork:
         assert visit.place is not None and visit.place_in_map is not None
         place = self.places[self.find(visit.place)]
         to_own = invert(visit.place_in_map)
-        place.surfaces = self._combine(place.surfaces, transform_segments(to_own, surfaces_map))
+        flags = np.zeros(len(surfaces_map), dtype=bool) if through is None else np.asarray(through, dtype=bool)
+        place.surfaces, place.through = self._combine(
+            place.surfaces, place.through, transform_segments(to_own, surfaces_map), flags
+        )
         exit_id = self._add_exit(place, transform_segments(to_own, exit_map)[0], exit_map, scan)
         visit.last_scan, visit.left_by = scan, exit_id
         return place.id, exit_id
@@ -227,19 +240,29 @@ class PlaceNetwork:
                 best, best_distance = record.id, distance
         return best
 
-    def _combine(self, old: FloatArray, new: FloatArray) -> FloatArray:
-        """``old`` plus the surfaces of ``new`` that are not already there (same within 5 deg and 40 cm)."""
+    def _combine(
+        self, old: FloatArray, old_through: NDArray[np.bool_], new: FloatArray, new_through: NDArray[np.bool_]
+    ) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """``old`` plus the surfaces of ``new`` that are not already there (same within 5 deg and 40 cm).
+
+        A surface once seen from inside the place stays part of its structure.
+        """
         if len(new) == 0:
-            return old
+            return old, old_through
         if len(old) == 0:
-            return new.copy()
-        same = same_surfaces(new, old, self._same_angle, self._same_gap).any(axis=1)
-        return np.vstack([old, new[~same]])
+            return new.copy(), new_through.copy()
+        same = same_surfaces(new, old, self._same_angle, self._same_gap)
+        through = old_through.copy()
+        through[same[~new_through].any(axis=0)] = False
+        fresh = ~same.any(axis=1)
+        return np.vstack([old, new[fresh]]), np.concatenate([through, new_through[fresh]])
 
     def _merge(self, keep: int, drop: int, drop_in_keep: Pose, scan: int) -> None:
         """Fold place ``drop`` (its frame at ``drop_in_keep`` in ``keep``'s frame) into ``keep``."""
         k, d = self.places[keep], self.places[drop]
-        k.surfaces = self._combine(k.surfaces, transform_segments(drop_in_keep, d.surfaces))
+        k.surfaces, k.through = self._combine(
+            k.surfaces, k.through, transform_segments(drop_in_keep, d.surfaces), d.through
+        )
         for record in d.exits:
             moved = transform_segments(drop_in_keep, record.segment)[0]
             same = self.same_exit(k, moved)
@@ -254,7 +277,7 @@ class PlaceNetwork:
                 target.leads_to, target.leads_exit = record.leads_to, record.leads_exit
         k.visits.extend(v for v in d.visits if v not in k.visits)
         d.merged_into, d.merged_scan = keep, scan
-        d.surfaces, d.exits = np.empty((0, 4)), []
+        d.surfaces, d.through, d.exits = np.empty((0, 4)), np.zeros(0, dtype=bool), []
         for visit in self.visits:
             if visit.place is not None and self.find(visit.place) == keep and visit.place != keep:
                 assert visit.place_in_map is not None

@@ -186,9 +186,7 @@ def graphml(record: dict[str, Any]) -> str:
             created_scan=place["created_scan"],
         )
     for link in record["links"]:
-        graph.add_edge(
-            f"P{link['place']}", f"P{link['to_place']}", exit=link["exit"], to_exit=link["to_exit"]
-        )
+        graph.add_edge(f"P{link['place']}", f"P{link['to_place']}", exit=link["exit"], to_exit=link["to_exit"])
     return "\n".join(nx.generate_graphml(graph)) + "\n"
 
 

@@ -53,6 +53,7 @@ class GtsamGraphConfig(BaseModel):
         gt=0, description="prior std dev of the odometry guess over one scan period (x, y), used inside tracking ICP"
     )
     track_prior_sigma_theta_deg: float = Field(gt=0, description="... (theta)")
+    track_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of tracking matches")
     track_max_correction_m: float = Field(gt=0, description="a tracking match may move its guess this far at most")
     track_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most")
     local_map_nodes: int = Field(
@@ -186,7 +187,7 @@ class GtsamGraphConfig(BaseModel):
         """Registration parameters of per-scan tracking (a guess one scan period of odometry away)."""
         return IcpParams(
             max_iterations=self.icp_max_iterations,
-            max_correspondence_m=self.icp_max_correspondence_m,
+            max_correspondence_m=self.track_max_correspondence_m,
             min_correspondence_m=self.icp_min_correspondence_m,
             point_sigma_m=self.point_sigma_m,
             cauchy_scale_m=2.0 * self.point_sigma_m,

@@ -283,9 +283,12 @@ class GtsamGraphMapper:
         """
         cfg = self.config
         target = self._local_map()
-        reg, good, recovered = self._attempt(
-            target, points, step, self._seq_icp, cfg.seq_max_correction_m, cfg.seq_max_correction_deg
+        icp, max_m, max_deg = (
+            (self._track_icp, cfg.track_max_correction_m, cfg.track_max_correction_deg)
+            if cfg.track_scans
+            else (self._seq_icp, cfg.seq_max_correction_m, cfg.seq_max_correction_deg)
         )
+        reg, good, recovered = self._attempt(target, points, step, icp, max_m, max_deg)
         if recovered:
             self.counters["sequential_retries_recovered"] += 1
         if cfg.seq_reversed_guess:

@@ -41,8 +41,16 @@ class MrptRunConfig(BaseModel):
     )
     max_path_ratio: float = Field(
         gt=0,
-        description="the estimated path may be at most this multiple of the odometry's path length (jumps = divergence)",
+        description="the estimated path may be at most this multiple of the odometry's path length (jumps: divergence)",
     )
+    max_step_correction_m: float = Field(
+        gt=0,
+        description=(
+            "from one scan to the next the estimate may depart at most this far from the odometry's prediction; "
+            "a larger jump is a divergence (a particle or an ICP match teleported) and fails the run"
+        ),
+    )
+    max_step_correction_deg: float = Field(gt=0, description="the same bound on the heading (deg per scan)")
     sensor_offset_x_m: float = Field(description="laser position on the robot, forward (the rawlog's sensor pose)")
     sensor_offset_y_m: float = Field(description="laser position on the robot, left")
     sensor_offset_theta_deg: float = Field(description="laser heading on the robot, counter-clockwise")
@@ -60,7 +68,9 @@ class MrptIcpConfig(MrptRunConfig):
         ge=0, description="[ICP] thresholdAng_DEG: extra pairing distance per metre of range, as an angle"
     )
     icp_alfa: float = Field(gt=0, lt=1, description="[ICP] ALFA: thresholds shrink by this factor at each convergence")
-    icp_smallest_threshold_dist_m: float = Field(gt=0, description="[ICP] smallestThresholdDist: final pairing distance")
+    icp_smallest_threshold_dist_m: float = Field(
+        gt=0, description="[ICP] smallestThresholdDist: final pairing distance"
+    )
     icp_only_unique_robust: bool = Field(description="[ICP] onlyUniqueRobust: one-to-one correspondences only")
     icp_decimation: int = Field(ge=1, description="[ICP] corresponding_points_decimation: use every n-th scan point")
     localization_distance_m: float = Field(
@@ -110,6 +120,12 @@ class MrptRbpfConfig(MrptRunConfig):
     icp_global_align_min_quality: float = Field(
         ge=0, le=1, description="ICPGlobalAlign_MinQuality: worse ICP alignments fall back to odometry (PF_algorithm 2)"
     )
+    icp_covariance_method: Literal["icpCovFiniteDifferences", "icpCovLinealMSE"] = Field(
+        description=(
+            "ICP_covariance_method: how the proposal's ICP estimates the Gaussian each particle is drawn from "
+            "(PF_algorithm 2); finite differences give a long axis along corridors"
+        )
+    )
     icp_max_iterations: int = Field(ge=1, description="maxIterations of the proposal's ICP (PF_algorithm 2)")
     icp_threshold_dist_m: float = Field(gt=0, description="thresholdDist of the proposal's ICP")
     icp_threshold_ang_deg: float = Field(ge=0, description="thresholdAng_DEG of the proposal's ICP")
@@ -122,12 +138,12 @@ class MrptRbpfConfig(MrptRunConfig):
     grid_max_occupancy_update_certainty: float = Field(
         gt=0.5, lt=1, description="[occupancyGrid insertOpts] maxOccupancyUpdateCertainty: one scan's largest update"
     )
-    grid_invalid_ranges_as_free: bool = Field(
-        description="[occupancyGrid insertOpts] considerInvalidRangesAsFreeSpace"
-    )
+    grid_invalid_ranges_as_free: bool = Field(description="[occupancyGrid insertOpts] considerInvalidRangesAsFreeSpace")
     likelihood_decimation: int = Field(ge=1, description="[occupancyGrid likelihoodOpts] LF_decimation")
     likelihood_std_hit_m: float = Field(gt=0, description="[occupancyGrid likelihoodOpts] LF_stdHit")
-    likelihood_max_corr_distance_m: float = Field(gt=0, description="[occupancyGrid likelihoodOpts] LF_maxCorrsDistance")
+    likelihood_max_corr_distance_m: float = Field(
+        gt=0, description="[occupancyGrid likelihoodOpts] LF_maxCorrsDistance"
+    )
     likelihood_z_hit: float = Field(gt=0, le=1, description="[occupancyGrid likelihoodOpts] LF_zHit")
     likelihood_z_random: float = Field(ge=0, lt=1, description="[occupancyGrid likelihoodOpts] LF_zRandom")
     likelihood_max_range_m: float = Field(gt=0, description="[occupancyGrid likelihoodOpts] LF_maxRange")

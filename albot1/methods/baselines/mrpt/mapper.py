@@ -44,7 +44,7 @@ from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.errors import DataError
 from albot1.data.loaders.rawlog.serialize import GaussianMotionModel
-from albot1.data.loaders.rawlog.writer import RawlogLayout, RawlogStats, write_frames
+from albot1.data.loaders.rawlog.writer import RawlogLayout, write_frames
 from albot1.data.model import Frame
 from albot1.geometry import se2
 from albot1.methods.baselines.errors import BaselineError
@@ -137,8 +137,7 @@ class _MrptMapper:
         executable = find_app(self.app)
         if executable is None:
             raise BaselineError(
-                f"{self.name}: MRPT's {self.app} is not on PATH; install the Debian package {APT_PACKAGE} "
-                f"(`make mrpt`)"
+                f"{self.name}: MRPT's {self.app} is not on PATH; install the Debian package {APT_PACKAGE} (`make mrpt`)"
             )
         odometry = np.asarray([f.odometry for f in self._frames], dtype=float)
         with tempfile.TemporaryDirectory(prefix=f"albot1-{self.name}-") as tmp:
@@ -147,15 +146,16 @@ class _MrptMapper:
             try:
                 with (work / RAWLOG_NAME).open("wb") as out:
                     rawlog = write_frames(
-                        self._frames, out, layout=self.layout, sensor_offset=self._sensor_offset(),
+                        self._frames,
+                        out,
+                        layout=self.layout,
+                        sensor_offset=self._sensor_offset(),
                         motion_model=self._motion_model(),
                     )
             except DataError as exc:
                 raise BaselineError(f"{self.name}: cannot write the rawlog: {exc}") from None
             rawlog_s = time.perf_counter() - start
-            ini = render(
-                self.app, self.config, rawlog_file=RAWLOG_NAME, output_dir=OUTPUT_DIR, **self._run_values()
-            )
+            ini = render(self.app, self.config, rawlog_file=RAWLOG_NAME, output_dir=OUTPUT_DIR, **self._run_values())
             (work / INI_NAME).write_text(ini, encoding="ascii")
             env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
             # One thread: MRPT's OpenMP loops draw from one global random generator, so more
@@ -201,9 +201,7 @@ class _MrptMapper:
         total = outputs.total_time_s(stdout_text)
         if total is not None:
             all_counters["mrpt_total_s"] = total
-        return MapperOutput(
-            poses=poses, map=MapData(points=points), counters=all_counters, extras={"mrpt": mrpt_block}
-        )
+        return MapperOutput(poses=poses, map=MapData(points=points), counters=all_counters, extras={"mrpt": mrpt_block})
 
     def _check_outcome(
         self, outcome: ProcessOutcome, out_dir: Path, stdout_text: str, stderr_text: str, scans: int
@@ -247,6 +245,7 @@ class _MrptMapper:
         bad = np.flatnonzero(~np.isfinite(poses).all(axis=1))
         if len(bad):
             raise BaselineError(f"{self.name}: {len(bad)} non-finite poses from {self.app}, first at scan {bad[0]}")
+        self._check_steps(poses, odometry)
         odometry_m = se2.path_length(odometry)
         if odometry_m < MIN_CHECKED_PATH_M:
             return
@@ -262,6 +261,24 @@ class _MrptMapper:
             raise BaselineError(
                 f"{self.name}: the estimated path is {estimate_m:.2f} m long for {odometry_m:.2f} m of odometry "
                 f"(ratio {ratio:.3f} > max_path_ratio {self.config.max_path_ratio:g}): {self.app} diverged"
+            )
+
+    def _check_steps(self, poses: FloatArray, odometry: FloatArray) -> None:
+        """No scan may jump away from the odometry's prediction by more than the configured bounds."""
+        if len(poses) < 2:
+            return
+        predicted = se2.compose(poses[:-1], se2.between(odometry[:-1], odometry[1:]))
+        correction = se2.between(predicted, poses[1:])
+        shift = np.hypot(correction[:, 0], correction[:, 1])
+        turn = np.degrees(np.abs(correction[:, 2]))
+        bad = np.flatnonzero((shift > self.config.max_step_correction_m) | (turn > self.config.max_step_correction_deg))
+        if len(bad):
+            k = int(bad[0])
+            raise BaselineError(
+                f"{self.name}: {self.app} diverged at scan {k + 1}: the estimate jumped {shift[k]:.2f} m and "
+                f"{turn[k]:.1f} deg away from the odometry's prediction in one scan (limits max_step_correction_m = "
+                f"{self.config.max_step_correction_m:g}, max_step_correction_deg = "
+                f"{self.config.max_step_correction_deg:g}; {len(bad)} such scan(s))"
             )
 
     def _read(
@@ -317,8 +334,12 @@ class MrptRbpfMapper(_MrptMapper):
     def _motion_model(self) -> GaussianMotionModel:
         c = self.rbpf
         return GaussianMotionModel(
-            a1=c.motion_a1, a2=c.motion_a2, a3=c.motion_a3, a4=c.motion_a4,
-            min_std_xy=c.motion_min_std_xy_m, min_std_phi=math.radians(c.motion_min_std_theta_deg),
+            a1=c.motion_a1,
+            a2=c.motion_a2,
+            a3=c.motion_a3,
+            a4=c.motion_a4,
+            min_std_xy=c.motion_min_std_xy_m,
+            min_std_phi=math.radians(c.motion_min_std_theta_deg),
         )
 
     def _read(

@@ -27,6 +27,8 @@ WRAPPER_FIELDS = frozenset(
         "memory_limit_mb",
         "min_path_ratio",
         "max_path_ratio",
+        "max_step_correction_m",
+        "max_step_correction_deg",
         "sensor_offset_x_m",
         "sensor_offset_y_m",
         "sensor_offset_theta_deg",

@@ -57,3 +57,41 @@ def test_uneven_beams_are_rejected_and_nothing_is_left(tmp_path: Path) -> None:
     with pytest.raises(DataError, match="frame 0: beam angles are not evenly spaced"):
         CarmenWriter().write(seq, tmp_path / "u.clf")
     assert list(tmp_path.iterdir()) == []
+
+
+def frame(i: int, ranges: object, angles: object = None, t: float | None = None, **kw: object) -> Frame:
+    a = np.linspace(-1.0, 1.0, 5) if angles is None else np.asarray(angles, dtype=float)
+    odom = np.asarray(kw.get("odometry", np.zeros(3)), dtype=float)
+    ref = kw.get("reference")
+    scan = Scan(np.asarray(ranges, dtype=float), a, float(i) if t is None else t, float(kw.get("max_range", 10.0)))
+    return Frame(i, scan, odom, None if ref is None else np.asarray(ref, dtype=float))
+
+
+@pytest.mark.parametrize(
+    ("frames", "message"),
+    [
+        ([frame(0, np.zeros(5))], r"frame 0: all 5 ranges are 0"),
+        ([frame(0, np.ones(5), np.linspace(1.0, -1.0, 5))], r"frame 0: angular_resolution is -0\.5 rad"),
+        ([frame(0, np.ones(5), np.arange(5) * 2.0)], r"frame 0: 5 beams 114\.592 deg apart span 458\.366 deg"),
+        ([frame(0, [1.0, -1.0, 1.0, 1.0, 1.0])], r"frame 0: range 2 is -1\.0, expected a finite non-negative"),
+        ([frame(0, [1.0, np.inf, 1.0, 1.0, 1.0])], r"frame 0: range 2 is inf"),
+        ([frame(0, [1.0, 11.0, 1.0, 1.0, 1.0])], r"frame 0: a range of 11\.0 m exceeds max_range 10\.0 m"),
+        ([frame(0, np.ones(5), odometry=[0.0, np.nan, 0.0])], r"frame 0: the timestamp and poses must be finite"),
+        ([frame(0, np.ones(5), t=5.0), frame(1, np.ones(5), t=3.0)], r"frame 1: scan timestamp 3\.000000 goes back"),
+        (
+            [frame(0, np.ones(5), reference=[0, 0, 0]), frame(1, np.ones(5))],
+            r"frame 0 has a reference pose but frame 1",
+        ),
+        ([], r"the sequence has no scans"),
+    ],
+)
+def test_the_writer_refuses_what_the_reader_refuses(tmp_path: Path, frames: list[Frame], message: str) -> None:
+    with pytest.raises(DataError, match=r"out\.clf: " + message):
+        CarmenWriter().write(Sequence.from_frames("bad", frames), tmp_path / "out.clf")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_stamps_may_jitter_back_within_the_readers_tolerance(tmp_path: Path) -> None:
+    frames = [frame(0, np.ones(5), t=5.0), frame(1, np.ones(5), t=4.5), frame(2, np.ones(5), t=6.0)]
+    CarmenWriter().write(Sequence.from_frames("jitter", frames), tmp_path / "j.clf")
+    assert [f.scan.timestamp for f in CarmenLoader().load(tmp_path / "j.clf").frames()] == [5.0, 4.5, 6.0]

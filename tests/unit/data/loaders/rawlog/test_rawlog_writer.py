@@ -120,7 +120,10 @@ def test_actions_layout_carries_increments_and_one_scan_per_sensory_frame() -> N
 
 def test_invalid_beams_are_flagged_and_the_sensor_pose_centres_the_beams() -> None:
     data, invalid = encode_frame(
-        _frame(0, (0, 0, 0), ANGLES_180), None, layout="observations", sensor_offset=(0.2, 0.0, 0.0),
+        _frame(0, (0, 0, 0), ANGLES_180),
+        None,
+        layout="observations",
+        sensor_offset=(0.2, 0.0, 0.0),
         motion_model=ser.GaussianMotionModel(),
     )
     assert invalid == 2

@@ -4,7 +4,7 @@ Run as ``python fake_mrpt_app.py APP CONFIG.ini RAWLOG``. It writes the
 output files the real applications write, for ``FAKE_MRPT_SCANS`` scans on
 a straight line 0.5 m per scan (the tests' odometry), or misbehaves as
 ``FAKE_MRPT_MODE`` says: ``short`` (a scan missing), ``frozen`` (the path
-never moves), ``crash`` (an MRPT exception, status 255), ``signal`` (killed
+never moves), ``jump`` (a 5 m teleport at scan 3), ``crash`` (an MRPT exception, status 255), ``signal`` (killed
 by SIGSEGV), ``sleep`` (never ends), ``hog`` (grows its memory).
 """
 
@@ -46,6 +46,8 @@ def main() -> None:
             for k in range(2 * n):
                 # The real app logs in the odometry frame; this one starts at (10, 5) heading +y.
                 x, y = 10.0, 5.0 + step * (k // 2)
+                if mode == "jump" and k // 2 >= 3:
+                    y += 5.0  # a teleport at scan 3
                 f.write(f"{k} {x:.6f} {y:.6f} {1.570796:.6f}\n")
         with (out / "log_times.txt").open("w") as f:
             for k in range(2 * n):
@@ -80,7 +82,7 @@ def main() -> None:
         (out / "finalMap_mrpt__maps__COccupancyGridMap2D_00_limits.txt").write_text(
             "% Grid limits: [x_min x_max y_min y_max]\n-1.0 2.0 -1.0 1.0\n"
         )
-    print(f"----------- **END** (total time: 1.250 sec) ---------")
+    print("----------- **END** (total time: 1.250 sec) ---------")
 
 
 if __name__ == "__main__":

@@ -10,17 +10,17 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import fake_mrpt_app
 import numpy as np
 import pytest
 
-import fake_mrpt_app
 from albot1.contract import MapperOutput
 from albot1.data.model import Frame, Scan
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.mrpt import MrptIcpMapper, MrptRbpfMapper
 from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig
-from albot1.methods.registry import METHODS, resolve_config
 from albot1.methods.errors import UnknownMethodError
+from albot1.methods.registry import METHODS, resolve_config
 
 ANGLES = np.radians(np.linspace(-90.0, 90.0, 19))
 SCANS = 6
@@ -101,11 +101,14 @@ def test_rbpf_poses_follow_the_best_particle_and_the_odometry_between_updates(fa
     [
         ("short", r"log_estimated_path.txt: 10 steps; expected 12"),
         ("frozen", r"estimated path is 0.00 m long for 2.50 m of odometry .*did not track"),
+        ("jump", r"icp-slam diverged at scan 3: the estimate jumped 5\.00 m and 0\.0 deg .*max_step_correction_m = 3"),
         ("crash", r"icp-slam exited with status 255, .*: Message:  Assert condition failed: fake"),
         ("signal", r"icp-slam was killed by signal 11"),
     ],
 )
-def test_icp_failures_name_their_reason(fake_apps: Path, monkeypatch: pytest.MonkeyPatch, mode: str, message: str) -> None:
+def test_icp_failures_name_their_reason(
+    fake_apps: Path, monkeypatch: pytest.MonkeyPatch, mode: str, message: str
+) -> None:
     monkeypatch.setenv("FAKE_MRPT_MODE", mode)
     with pytest.raises(BaselineError, match=message):
         _run(_icp())

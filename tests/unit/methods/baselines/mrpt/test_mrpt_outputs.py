@@ -51,7 +51,9 @@ def test_poses_between_updates_compose_the_odometry_since_the_last_update() -> N
     # Initial pose, then the filter's poses at scans 0 and 3 (the second one 0.1 m off the odometry).
     best = np.array([[0, 0, 0], [0, 0, 0], [1.1, 1, np.pi / 2]], float)
     poses = outputs.poses_between_updates(best, updated, odometry)
-    np.testing.assert_allclose(poses, [[0, 0, 0], [1, 0, 0], [1, 0, np.pi / 2], [1.1, 1, np.pi / 2], [1.1, 2, np.pi / 2]], atol=1e-12)
+    np.testing.assert_allclose(
+        poses, [[0, 0, 0], [1, 0, 0], [1, 0, np.pi / 2], [1.1, 1, np.pi / 2], [1.1, 2, np.pi / 2]], atol=1e-12
+    )
     with pytest.raises(BaselineError, match="3 path poses for 1 filter updates"):
         outputs.poses_between_updates(best, np.array([True, False, False, False, False]), odometry)
 

@@ -5,13 +5,17 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from albot1.methods.baselines.mrpt.process import run_limited
+from albot1.methods.baselines.mrpt.process import ProcessOutcome, run_limited
 
 
-def _run(tmp_path: Path, code: str, timeout_s: float = 20.0, memory_limit_mb: float = 2000.0):  # type: ignore[no-untyped-def]
+def _run(tmp_path: Path, code: str, timeout_s: float = 20.0, memory_limit_mb: float = 2000.0) -> ProcessOutcome:
     return run_limited(
-        [sys.executable, "-c", code], cwd=tmp_path, timeout_s=timeout_s, memory_limit_mb=memory_limit_mb,
-        stdout_path=tmp_path / "out.txt", stderr_path=tmp_path / "err.txt",
+        [sys.executable, "-c", code],
+        cwd=tmp_path,
+        timeout_s=timeout_s,
+        memory_limit_mb=memory_limit_mb,
+        stdout_path=tmp_path / "out.txt",
+        stderr_path=tmp_path / "err.txt",
     )
 
 
@@ -28,7 +32,8 @@ def test_stdin_is_closed(tmp_path: Path) -> None:
 
 
 def test_timeout_kills_the_whole_process_group(tmp_path: Path) -> None:
-    code = "import subprocess, sys, time; subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(60)']); time.sleep(60)"
+    child = "[sys.executable, '-c', 'import time; time.sleep(60)']"
+    code = f"import subprocess, sys, time; subprocess.Popen({child}); time.sleep(60)"
     outcome = _run(tmp_path, code, timeout_s=0.5)
     assert outcome.stopped == "timeout" and outcome.returncode is None
     assert outcome.wall_s < 10

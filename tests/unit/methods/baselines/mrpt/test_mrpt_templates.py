@@ -44,7 +44,9 @@ class _Extra(BaseModel):
 
 
 def test_a_field_without_placeholder_or_a_missing_value_is_an_error() -> None:
-    with pytest.raises(BaselineError, match=r"fields without a placeholder: surplus_m; placeholders without a value: .*icp_alfa"):
+    with pytest.raises(
+        BaselineError, match=r"fields without a placeholder: surplus_m; placeholders without a value: .*icp_alfa"
+    ):
         render("icp-slam", _Extra(), rawlog_file="a", output_dir="b")
     config = MrptIcpConfig.model_validate(MrptIcpMapper.presets["default"])
     with pytest.raises(BaselineError, match="placeholders without a value: output_dir"):
@@ -54,6 +56,12 @@ def test_a_field_without_placeholder_or_a_missing_value_is_an_error() -> None:
 
 
 def test_values_are_written_as_mrpt_reads_them() -> None:
-    assert (ini_value(True), ini_value(False), ini_value(0.1), ini_value(3), ini_value("x")) == ("1", "0", "0.1", "3", "x")
+    assert (ini_value(True), ini_value(False), ini_value(0.1), ini_value(3), ini_value("x")) == (
+        "1",
+        "0",
+        "0.1",
+        "3",
+        "x",
+    )
     with pytest.raises(BaselineError, match="non-finite"):
         ini_value(float("nan"))

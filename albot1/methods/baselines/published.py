@@ -1,0 +1,68 @@
+"""Published figures of SLAM systems the project cannot run (``published.toml`` beside this module).
+
+Why a data file: the thesis's Experiment 5 compares Albot1 with DP-SLAM,
+which has no packaged implementation. Users expect the table to say what
+is known about it, and what is known must be a cited, published number (or
+the explicit finding that there is none), never a number produced here.
+The report reads :func:`published_systems` and labels every figure
+"published" with its source.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from functools import lru_cache
+from importlib.resources import files
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from albot1.config.validation import describe_errors
+from albot1.errors import ConfigError
+
+PUBLISHED_FILE = "published.toml"
+
+
+class PublishedFigure(BaseModel):
+    """One published figure on one log, with where it was printed."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    log: str = Field(min_length=1, description="catalog name of the log (e.g. intel)")
+    metric: Literal["relation_translation_m", "relation_rotation_deg"]
+    mean: float
+    std: float | None = None
+    source: str = Field(min_length=1, description="table / page of the cited work")
+    note: str = ""
+
+
+class PublishedSystem(BaseModel):
+    """A system known only from its publications."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    name: str = Field(min_length=1)
+    label: str = Field(min_length=1)
+    citation: str = Field(min_length=1)
+    implementation: str = Field(min_length=1, description="why it is not run here")
+    searched: str = Field(min_length=1, description="what was looked for (an empty figure list is a finding)")
+    figures: tuple[PublishedFigure, ...] = ()
+
+
+class _File(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    systems: tuple[PublishedSystem, ...]
+
+
+@lru_cache(maxsize=1)
+def published_systems() -> tuple[PublishedSystem, ...]:
+    """Every system of ``published.toml``, validated (ConfigError naming the file otherwise)."""
+    resource = files(__package__).joinpath(PUBLISHED_FILE)
+    try:
+        data = tomllib.loads(resource.read_text(encoding="utf-8"))
+        return _File.model_validate(data).systems
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{resource}: not valid TOML: {exc}") from None
+    except ValidationError as exc:
+        raise ConfigError(f"{resource}: {describe_errors(exc)}") from None
