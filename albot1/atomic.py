@@ -52,3 +52,18 @@ def atomic_write(path: str | Path, writer: Callable[[Path], object]) -> None:
         os.replace(tmp_path, dest)
     finally:
         tmp_path.unlink(missing_ok=True)
+
+
+def remove_temporaries(folder: str | Path) -> list[Path]:
+    """Delete the temporary files :func:`atomic_write` left in ``folder`` when its process was killed mid-write.
+
+    Only for a folder no other process is writing into (a run folder being
+    rewritten, a bench cell's folder under the results lock): a live
+    writer's temporary file would be taken from under it. Returns what was removed.
+    """
+    removed = []
+    for path in Path(folder).glob(".*.tmp*"):
+        if path.is_file():
+            path.unlink(missing_ok=True)
+            removed.append(path)
+    return removed

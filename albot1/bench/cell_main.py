@@ -1,20 +1,21 @@
 """Entry point of a cell's child process (forkserver target, or ``python -m albot1.bench.cell_main ARGS``).
 
-The child makes itself killable and bounded before touching any data: it
-exits when the runner dies (so a SIGKILLed runner leaves no orphan writing
-into the store), caps its address space (``RLIMIT_AS`` at its start size
-plus the cell's ``memory_mb``, so the libraries already mapped do not eat
-the allowance) and sends its output to the cell log. Any exception is
-written to ``.error.json`` in the run folder for the supervisor, which
-alone writes ``FAILED.json``.
+The child makes itself killable before touching any data: it exits when
+the runner dies (so a SIGKILLed runner leaves no orphan writing into the
+store) and sends its output to the cell log. Its time and memory limits are
+enforced from outside by the supervisor (:mod:`albot1.bench.limits`). Any
+exception is written to ``.error.json`` in the run folder for the
+supervisor, which alone writes ``FAILED.json``; when the results folder
+cannot be written (disk full, read-only) the exit code says so, as the
+error file itself may not fit.
 """
 
 from __future__ import annotations
 
+import errno
 import json
 import multiprocessing
 import os
-import resource
 import signal
 import sys
 import threading
@@ -28,6 +29,9 @@ EXIT_EXCEPTION = 2
 EXIT_MEMORY = 3
 EXIT_INTERRUPTED = 4
 EXIT_ORPHAN = 5
+EXIT_STORAGE = 6
+#: OS errors that mean "the results folder cannot take more": the grid cannot go on until someone frees space.
+STORAGE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG})
 
 
 def _die_with_parent(parent_pid: int | None) -> None:
@@ -56,25 +60,6 @@ def _die_with_parent(parent_pid: int | None) -> None:
         raise SystemExit(EXIT_ORPHAN)
 
 
-def _address_space_bytes() -> int:
-    with open("/proc/self/statm") as handle:
-        return int(handle.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
-
-
-def limit_memory(memory_mb: float) -> int | None:
-    """Cap the address space at its current size plus ``memory_mb``; returns the cap in bytes."""
-    try:
-        current = _address_space_bytes()
-    except OSError:  # no /proc: not Linux; the time limit still applies
-        return None
-    cap = current + int(memory_mb * 2**20)
-    _, hard = resource.getrlimit(resource.RLIMIT_AS)
-    if hard != resource.RLIM_INFINITY:
-        cap = min(cap, hard)
-    resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
-    return cap
-
-
 def _redirect_output(log_path: Path) -> None:
     sys.stdout.flush()
     sys.stderr.flush()
@@ -96,49 +81,83 @@ def _write_error(run_dir: Path, kind: str, exc: BaseException) -> None:
     from albot1.runs.folder import write_json
 
     text = "".join(traceback.format_exception(exc))
-    sys.stderr.write(text)
-    sys.stderr.flush()
-    write_json(run_dir / ERROR_FILE, {"kind": kind, "type": type(exc).__name__, "message": str(exc), "traceback": text})
+    try:  # the cell log, on the same file system: it may be full
+        sys.stderr.write(text)
+        sys.stderr.flush()
+    except OSError:
+        pass
+    storage = storage_error(exc)
+    write_json(
+        run_dir / ERROR_FILE,
+        {
+            "kind": kind,
+            "type": type(exc).__name__,
+            "message": str(exc),
+            "errno": storage.errno if storage is not None else None,
+            "traceback": text,
+        },
+    )
 
 
 def child_main(args: dict[str, Any]) -> int:
     """Run one cell; the exit code tells the supervisor how it ended (details in ``.error.json``)."""
     _die_with_parent(args.get("parent_pid"))
     run_dir = Path(args["runs_root"]) / args["cell"]["key"]
-    _redirect_output(Path(args["log_path"]))
-    _apply_environment(dict(args.get("env", {})))
     try:
-        limit_memory(float(args["cell"]["memory_mb"]))
+        _redirect_output(Path(args["log_path"]))
+        _apply_environment(dict(args.get("env", {})))
         # Imported here, inside the try: an import failure is this cell's recorded failure.
         from albot1.bench.cells import execute_cell, renderer_from_target
         from albot1.bench.grid import Cell
 
         preview = renderer_from_target(args.get("preview"))
         execute_cell(Cell.from_json(args["cell"]), Path(args["runs_root"]), preview=preview)
-    except MemoryError as exc:
-        _write_error(run_dir, "memory", exc)
-        return EXIT_MEMORY
-    except KeyboardInterrupt as exc:
-        _write_error(run_dir, "interrupted", exc)
-        return EXIT_INTERRUPTED
-    except Exception as exc:
-        if _caused_by_memory(exc):  # run_method wraps library errors in the method's error class
-            _write_error(run_dir, "memory", exc)
-            return EXIT_MEMORY
-        _write_error(run_dir, "exception", exc)
-        return EXIT_EXCEPTION
+    except BaseException as exc:  # noqa: BLE001 -- every way out is reported by its exit code
+        return _report(run_dir, exc)
     return EXIT_OK
 
 
+def _report(run_dir: Path, exc: BaseException) -> int:
+    """Write ``.error.json`` for ``exc`` and return the exit code that names its kind."""
+    if isinstance(exc, SystemExit) and isinstance(exc.code, int):
+        return exc.code
+    if storage_error(exc) is not None:
+        kind, code = "storage", EXIT_STORAGE
+    elif isinstance(exc, KeyboardInterrupt):
+        kind, code = "interrupted", EXIT_INTERRUPTED
+    elif _caused_by_memory(exc):  # run_method wraps library errors in the method's error class
+        kind, code = "memory", EXIT_MEMORY
+    else:
+        kind, code = "exception", EXIT_EXCEPTION
+    try:
+        _write_error(run_dir, kind, exc)
+    except OSError:  # the error file does not fit either (disk full): the exit code alone must tell
+        return EXIT_STORAGE
+    return code
+
+
+def storage_error(exc: BaseException) -> OSError | None:
+    """The OSError in ``exc``'s chain that says the file system cannot take more (ENOSPC, EDQUOT, EROFS, EFBIG)."""
+    for current in _chain(exc):
+        if isinstance(current, OSError) and current.errno in STORAGE_ERRNOS:
+            return current
+    return None
+
+
 def _caused_by_memory(exc: BaseException) -> bool:
+    return any(isinstance(current, MemoryError) for current in _chain(exc))
+
+
+def _chain(exc: BaseException) -> list[BaseException]:
+    """``exc`` and its causes and contexts, each once."""
+    out: list[BaseException] = []
     seen: set[int] = set()
     current: BaseException | None = exc
     while current is not None and id(current) not in seen:
-        if isinstance(current, MemoryError):
-            return True
+        out.append(current)
         seen.add(id(current))
         current = current.__cause__ or current.__context__
-    return False
+    return out
 
 
 def process_entry(args: dict[str, Any]) -> None:

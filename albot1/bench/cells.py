@@ -37,12 +37,15 @@ __all__ = [
 def open_cell_sequence(cell: Cell, settings: Settings) -> Sequence:
     """The dataset slice of ``cell`` (its label, e.g. ``intel[:4000:2]``, is what ``open_sequence`` reopens).
 
+    The slice comes from the entry's ``limit``/``stride`` or from the entry's own name (``intel[:4000]``).
+
     The relations of a slice are restricted to the kept scans
     (:func:`albot1.data.relations.restrict_relations`, the same stamp matching
     as the relation metric), so the metric scores exactly the scans the method saw.
     """
     sequence = open_sequence(cell.dataset_label, settings=settings)
-    if (cell.limit is None and cell.stride is None) or sequence.relations is None:
+    sliced = cell.limit is not None or cell.stride is not None or cell.dataset_label.endswith("]")
+    if not sliced or sequence.relations is None:
         return sequence
     return Sequence(
         sequence.name, sequence.frames, sequence.metadata, restrict_relations(sequence.relations, sequence.timestamps)

@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Literal
 
 Status = Literal["done", "cached", "failed"]
-FailureKind = Literal["exception", "memory", "timeout", "crash", "config", "executor", "interrupted"]
+FailureKind = Literal["exception", "memory", "timeout", "crash", "config", "executor", "interrupted", "storage"]
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,12 @@ class Cell:
 
 @dataclass(frozen=True)
 class CellOutcome:
-    """What became of one cell (returned by the job, shown by the progress view)."""
+    """What became of one cell (returned by the job, shown by the progress view).
+
+    ``halts_grid``: the failure is not the cell's own and would repeat for
+    every cell (the results folder is full or read-only, the cell process
+    pool was killed), so the runner starts no further cell.
+    """
 
     key: str
     description: str
@@ -72,6 +77,7 @@ class CellOutcome:
     elapsed_s: float = 0.0
     reason: str | None = None
     kind: FailureKind | None = None
+    halts_grid: bool = False
 
     @classmethod
     def of(
@@ -81,9 +87,21 @@ class CellOutcome:
         elapsed_s: float = 0.0,
         reason: str | None = None,
         kind: FailureKind | None = None,
+        *,
+        halts_grid: bool = False,
     ) -> CellOutcome:
         """The outcome of ``cell``, named by its key, description and labels."""
-        return cls(cell.key, cell.describe(), cell.method_label, cell.dataset_label, status, elapsed_s, reason, kind)
+        return cls(
+            cell.key,
+            cell.describe(),
+            cell.method_label,
+            cell.dataset_label,
+            status,
+            elapsed_s,
+            reason,
+            kind,
+            halts_grid,
+        )
 
 
 @dataclass(frozen=True)

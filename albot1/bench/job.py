@@ -2,19 +2,22 @@
 
 It runs wherever the executor puts it (a thread of the local pool, a Dask
 worker); only this function writes ``FAILED.json``, so every way a cell can
-end -- result, exception, memory cap, timeout, crash -- is recorded by one
-piece of code with one vocabulary.
+end -- result, exception, memory limit, timeout, crash, a lost process pool,
+a full disk -- is recorded by one piece of code with one vocabulary.
 """
 
 from __future__ import annotations
 
+import errno
 import json
+import os
 import signal
 import socket
 import time
+import traceback
 from pathlib import Path
 
-from albot1.bench.cell_main import ERROR_FILE, EXIT_OK
+from albot1.bench.cell_main import ERROR_FILE, EXIT_OK, EXIT_STORAGE, STORAGE_ERRNOS, storage_error
 from albot1.bench.grid import Cell, CellOutcome, FailureKind
 from albot1.bench.limits import ChildExit, run_limited
 from albot1.bench.store import ATTEMPT, LOG, ResultsStore
@@ -29,6 +32,18 @@ def _signal_name(number: int) -> str:
         return f"signal {number}"
 
 
+#: Why a cell process died from a signal, as far as the signal tells.
+_SIGNAL_HINTS = {
+    "SIGKILL": " (killed from outside, e.g. by the kernel's out-of-memory killer or by a person)",
+    "SIGTERM": " (stopped from outside: the cell pool was shut down, or someone terminated it)",
+    "SIGINT": " (interrupted: Ctrl-C)",
+    "SIGHUP": " (its terminal went away)",
+    "SIGSEGV": " (a native library crashed)",
+    "SIGBUS": " (a native library crashed)",
+    "SIGABRT": " (a native library aborted)",
+}
+
+
 def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKind, str] | None:
     """None when the cell completed, else (kind, reason); the traceback is already in the cell log."""
     run_dir = store.run_dir(cell.key)
@@ -37,26 +52,34 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
     if error_path.is_file():
         try:
             error = json.loads(error_path.read_text())
-        except json.JSONDecodeError:
+        except (OSError, json.JSONDecodeError):
             error = None
         error_path.unlink(missing_ok=True)
     if ended.timed_out:
         return "timeout", f"time limit exceeded: no result after {cell.time_s:g} s (killed)"
+    if ended.memory_exceeded:
+        return "memory", (
+            f"memory limit exceeded: resident memory reached {ended.peak_rss_mb or 0:.0f} MB, over the cell's "
+            f"limit of {cell.memory_mb:g} MB (killed)"
+        )
+    if ended.pool_lost is not None:
+        return "executor", (
+            f"the cell process pool was shut down: its forkserver {ended.pool_lost} while the cell ran, "
+            "so the cell was stopped; run `albot1 bench` again to retry it"
+        )
     if ended.exit_code is not None and ended.exit_code < 0:
         name = _signal_name(-ended.exit_code)
-        hint = {
-            "SIGKILL": " (killed from outside, e.g. by the kernel's out-of-memory killer)",
-            "SIGSEGV": " (a native library crashed)",
-            "SIGABRT": f" (a native library aborted; a failed allocation under the "
-            f"{cell.memory_mb:g} MB memory limit does this)",
-        }.get(name, "")
-        return "crash", f"the cell process died from {name}{hint}"
+        return "crash", f"the cell process was killed by {name}{_SIGNAL_HINTS.get(name, '')}"
     if error is not None:
         kind: FailureKind = error.get("kind", "exception")
         message = f"{error.get('type')}: {error.get('message')}"
         if kind == "memory":
-            message = f"memory limit exceeded ({cell.memory_mb:g} MB address space): {message}"
+            message = f"out of memory (an allocation was refused): {message}"
+        if kind == "storage" or error.get("errno") in STORAGE_ERRNOS:
+            return "storage", f"cannot write the results: {_errno_text(error.get('errno'))}: {message}"
         return kind, message
+    if ended.exit_code == EXIT_STORAGE:
+        return "storage", f"cannot write the results ({store.runs}): not even the cell's error report fitted"
     if ended.exit_code != EXIT_OK:
         return "crash", f"the cell process exited with code {ended.exit_code} without an error report"
     if not store.is_complete(cell.key):
@@ -64,28 +87,68 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
     return None
 
 
+def _errno_text(number: object) -> str:
+    if isinstance(number, int) and number in errno.errorcode:
+        return os.strerror(number).lower()
+    return "the file system refused a write"
+
+
 def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> CellOutcome:
     """Run ``cell`` into the store at ``results_root`` and record how it ended.
 
     ``preview``: the ``module:function`` that draws each run's preview (None: no preview).
+    A results folder that cannot be written (full, read-only) fails the cell
+    with kind ``storage`` and halts the grid; nothing about it raises.
     """
     store = ResultsStore(results_root)
-    run_dir = store.prepare(cell)
-    ended = run_limited(cell, store.runs, run_dir / LOG, preview=preview)
+    try:
+        run_dir = store.prepare(cell)
+        ended = run_limited(cell, store.runs, run_dir / LOG, preview=preview)
+    except OSError as exc:
+        return _storage_failure(store, cell, exc, 0.0)
     verdict = judge(cell, store, ended)
     if verdict is None:
-        write_record(
-            run_dir / ATTEMPT,
-            AttemptRecord(
-                elapsed_s=ended.elapsed_s,
-                host=socket.gethostname(),
-                finished=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-            ),
-        )
+        try:
+            write_record(
+                run_dir / ATTEMPT,
+                AttemptRecord(
+                    elapsed_s=ended.elapsed_s,
+                    host=socket.gethostname(),
+                    finished=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                ),
+            )
+        except OSError as exc:  # the run is complete; only its wall-time record did not fit
+            return _storage_failure(store, cell, exc, ended.elapsed_s, completed=True)
         return CellOutcome.of(cell, "done", ended.elapsed_s)
     kind, reason = verdict
-    store.record_failure(cell, reason, kind, exit_code=ended.exit_code, elapsed_s=ended.elapsed_s)
-    return CellOutcome.of(cell, "failed", ended.elapsed_s, reason, kind)
+    problem = store.record_failure(cell, reason, kind, exit_code=ended.exit_code, elapsed_s=ended.elapsed_s)
+    if problem is not None:
+        reason = f"{reason} [not recorded: {problem}]"
+    halts = kind == "storage" or ended.pool_lost is not None
+    return CellOutcome.of(cell, "failed", ended.elapsed_s, reason, kind, halts_grid=halts)
+
+
+def _storage_failure(
+    store: ResultsStore, cell: Cell, exc: OSError, elapsed_s: float, *, completed: bool = False
+) -> CellOutcome:
+    """The outcome of a cell whose supervisor met an OSError writing the results or starting the cell process.
+
+    A full or read-only file system halts the grid (kind ``storage``); any
+    other OSError (no process could be started, say) fails this cell only.
+    """
+    storage = storage_error(exc) is not None
+    if storage:
+        reason = f"cannot write the results: {(exc.strerror or str(exc)).lower()}: {exc.filename or store.runs}"
+    else:
+        reason = f"cannot start the cell: {type(exc).__name__}: {exc}"
+    if completed:
+        reason += " (the run itself is complete; only its attempt.json is missing)"
+        return CellOutcome.of(cell, "done", elapsed_s, reason, "storage", halts_grid=storage)
+    kind: FailureKind = "storage" if storage else "executor"
+    problem = store.record_failure(cell, reason, kind, elapsed_s=elapsed_s, traceback_text=traceback.format_exc())
+    if problem is not None:
+        reason = f"{reason} [not recorded: {problem}]"
+    return CellOutcome.of(cell, "failed", elapsed_s, reason, kind, halts_grid=storage)
 
 
 def results_path(root: Path) -> str:

@@ -1,9 +1,16 @@
-"""Run one cell in a fresh child process under a time and memory limit.
+"""Run one cell in a fresh child process under a time and a resident-memory limit.
 
 Why a fresh process per cell: a timeout can only be enforced by killing, a
-memory cap (``RLIMIT_AS``) is per process, a segfault in a C++ library must
-not take the runner down, and ``peak_mb`` (``ru_maxrss``) is only the
-cell's own peak in a process of its own.
+process's resident memory is what a memory limit can measure, a segfault in
+a C++ library must not take the runner down, and ``peak_mb`` (``ru_maxrss``)
+is only the cell's own peak in a process of its own.
+
+The limits are enforced from outside: the supervisor polls the child's
+resident memory (and that of any process the child started,
+:class:`albot1.processes.TreeMemory`) every :data:`POLL_S` seconds and kills
+the tree when it passes ``memory_mb`` or when ``time_s`` has passed. An
+address-space limit inside the child would break the compiled libraries the
+methods load (docs/benchmarking.md, "Memory limit").
 
 Two launchers, one contract (``cell_main.child_main``):
 
@@ -20,28 +27,49 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
+
+import psutil
 
 from albot1.bench.cell_main import process_entry
 from albot1.bench.grid import Cell
+from albot1.processes import MIB, TreeMemory, kill_tree
 from albot1.runs.folder import write_json
 
 PRELOAD = ["__main__", "albot1.bench.preload"]
+#: How often the supervisor checks the child's resident memory and the clock (s). A cell may
+#: overshoot its memory limit by what it allocates in this time.
+POLL_S = 0.05
 _FORKSERVER: Any = None
+
+Stop = Literal["timeout", "memory"]
 
 
 @dataclass(frozen=True)
 class ChildExit:
-    """How the child ended: its exit code (negative = killed by that signal) or a timeout."""
+    """How the child ended.
+
+    ``exit_code``: its exit code (negative = killed by that signal; None when
+    the supervisor killed it for a limit). ``stopped``: the limit that made
+    the supervisor kill it. ``peak_rss_mb``: the largest resident memory the
+    supervisor saw (the child and its own children). ``pool_lost``: how the
+    forkserver that started the child ended, when it died under the running
+    cell (the child was then stopped and its exit status is unknown).
+    """
 
     exit_code: int | None
     timed_out: bool
     elapsed_s: float
+    memory_exceeded: bool = False
+    peak_rss_mb: float | None = None
+    pool_lost: str | None = None
 
 
 def _forkserver() -> Any:
@@ -86,10 +114,78 @@ def child_args(cell: Cell, runs_root: Path, log_path: Path, preview: str | None 
     }
 
 
+def watch(pid: int) -> psutil.Process | None:
+    """The child to supervise (None when it has already exited)."""
+    try:
+        return psutil.Process(pid)
+    except psutil.Error:
+        return None
+
+
+def supervise(
+    process: psutil.Process | None, ended: Callable[[float], bool], time_s: float, memory_mb: float
+) -> tuple[Stop | None, float]:
+    """Wait for ``process`` (``ended(timeout)`` waits up to ``timeout`` s and says whether it has exited).
+
+    Kills the process and its descendants when their resident memory passes
+    ``memory_mb`` or ``time_s`` seconds have passed; returns the limit that
+    stopped it (None: it ended by itself) and the peak resident memory seen, MiB.
+    """
+    deadline = time.monotonic() + time_s
+    limit = memory_mb * MIB
+    memory = TreeMemory(process) if process is not None else None
+    stop: Stop | None = None
+    while True:
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            stop = "timeout"
+        elif ended(min(POLL_S, remaining)):
+            break
+        elif memory is not None and memory.sample() > limit:
+            stop = "memory"
+        if stop is not None:
+            if process is not None:
+                kill_tree(process)
+            break
+    peak = memory.peak_bytes / MIB if memory is not None else 0.0
+    return stop, peak
+
+
+def _server_fate(server: psutil.Process | None) -> str | None:
+    """None while the forkserver ``server`` runs; else how it ended ("was killed by SIGKILL", ...)."""
+    if server is None:
+        return None
+    try:
+        if server.is_running() and server.status() != psutil.STATUS_ZOMBIE:
+            return None
+    except psutil.Error:
+        pass
+    try:  # WNOWAIT: look at its exit status without reaping it (multiprocessing reaps and restarts it)
+        info = os.waitid(os.P_PID, server.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT)
+    except OSError:  # already reaped, or not our child
+        info = None
+    if info is not None and info.si_code in (os.CLD_KILLED, os.CLD_DUMPED):
+        try:
+            name = signal.Signals(info.si_status).name
+        except ValueError:
+            name = f"signal {info.si_status}"
+        return f"was killed by {name}"
+    if info is not None:
+        return f"exited with code {info.si_status}"
+    return "is gone"
+
+
+def _parent_of(process: psutil.Process | None) -> psutil.Process | None:
+    try:
+        return process.parent() if process is not None else None
+    except psutil.Error:
+        return None
+
+
 def run_limited(
     cell: Cell, runs_root: Path, log_path: Path, *, how: str | None = None, preview: str | None = None
 ) -> ChildExit:
-    """Run ``cell`` in a child; kill it after ``cell.time_s`` seconds.
+    """Run ``cell`` in a child; kill it when it passes ``cell.time_s`` seconds or ``cell.memory_mb`` resident.
 
     ``preview`` is the ``module:function`` of the run preview renderer (``bench.cells.renderer_target``).
     """
@@ -100,12 +196,22 @@ def run_limited(
         args["parent_pid"] = None
         proc = _forkserver().Process(target=process_entry, args=(args,), name=f"cell-{cell.key}", daemon=False)
         proc.start()
-        proc.join(cell.time_s)
-        if proc.is_alive():
+        process = watch(proc.pid)
+        server = _parent_of(process)
+
+        def proc_ended(timeout: float) -> bool:
+            proc.join(timeout)
+            return not proc.is_alive()
+
+        stop, peak = supervise(process, proc_ended, cell.time_s, cell.memory_mb)
+        if stop is not None and process is None:
             proc.kill()
-            proc.join()
-            return ChildExit(None, True, time.monotonic() - start)
-        return ChildExit(proc.exitcode, False, time.monotonic() - start)
+        proc.join()
+        code = None if stop is not None else proc.exitcode
+        lost = _server_fate(server) if code == 255 else None  # 255: the forkserver's pipe closed, no status
+        if lost is not None and process is not None:
+            kill_tree(process)  # the cell may outlive its server: stop it before it writes anything more
+        return ChildExit(code, stop == "timeout", time.monotonic() - start, stop == "memory", peak, lost)
     args_file = runs_root / cell.key / ".child-args.json"
     write_json(args_file, args)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
@@ -116,11 +222,20 @@ def run_limited(
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     ) as child:
-        try:
-            code = child.wait(timeout=cell.time_s)
-        except subprocess.TimeoutExpired:
+
+        def child_ended(timeout: float) -> bool:
+            try:
+                child.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                return False
+            return True
+
+        process = watch(child.pid)
+        stop, peak = supervise(process, child_ended, cell.time_s, cell.memory_mb)
+        if stop is not None and process is None:
             child.kill()
-            child.wait()
-            return ChildExit(None, True, time.monotonic() - start)
+        code = child.wait()
     args_file.unlink(missing_ok=True)
-    return ChildExit(code, False, time.monotonic() - start)
+    return ChildExit(
+        None if stop is not None else code, stop == "timeout", time.monotonic() - start, stop == "memory", peak
+    )

@@ -104,9 +104,18 @@ def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
 
 
 def _candidate_datasets(suite: Suite) -> list[str]:
+    """The dataset names and references the suite selects; SuiteError for a glob that matches none of them."""
     known = list(worlds.WORLDS) + sorted(catalog.names())
+    literals = suite.literal_datasets()
+    for index, entry in enumerate(suite.datasets):
+        if entry.is_pattern and not entry.optional and not any(entry.matches(n) for n in [*known, *literals]):
+            raise SuiteError(
+                f"{suite.path or suite.name}: dataset entry {index} ({entry.name!r}) matches no dataset; expected a "
+                f"glob over the names {', '.join(known)} (a prefix of every match is `limit = N`), or mark the "
+                "entry `optional = true`"
+            )
     out = [n for n in known if suite.options_for(n) is not None]
-    for literal in suite.literal_datasets():
+    for literal in literals:
         if literal not in out and suite.options_for(literal) is not None:
             out.append(literal)
     return out
@@ -166,6 +175,26 @@ def _limit(*values: float | None, default: float) -> float:
     return max(given) if given else default
 
 
+def _check_shared_folders(suite: Suite, cells: list[Cell]) -> None:
+    """SuiteError when two cells share a run folder (same inputs) but not their limits.
+
+    Two labels for the same inputs share one folder and one result (the
+    runner runs the cell once). Limits are not inputs of the result, so they
+    are not in the key; cells that differ only in their limits would
+    silently run under the first cell's limits and report its outcome for both.
+    """
+    first: dict[str, Cell] = {}
+    for cell in cells:
+        other = first.setdefault(cell.key, cell)
+        if (other.time_s, other.memory_mb) != (cell.time_s, cell.memory_mb):
+            raise SuiteError(
+                f"{suite.path or suite.name}: {other.describe()} (time_s {other.time_s:g}, memory_mb "
+                f"{other.memory_mb:g}) and {cell.describe()} (time_s {cell.time_s:g}, memory_mb {cell.memory_mb:g}) "
+                "are the same run (same dataset slice, method, config, degradation and seed) with different limits; "
+                "one run folder holds one outcome: give them the same limits, or make them differ in what they run"
+            )
+
+
 def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
     """The cells of ``suite`` on this machine (datasets present, methods installed)."""
     code = versions.code_version()
@@ -178,7 +207,10 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
     for name in _candidate_datasets(suite):
         opts = suite.options_for(name)
         assert opts is not None  # _candidate_datasets keeps selected names only
-        has_reference, skipped, known = _availability(name, settings)
+        try:
+            has_reference, skipped, known = _availability(name, settings)
+        except Albot1Error as exc:  # a bad slice or loader option, a log that does not parse
+            raise SuiteError(f"{suite.path or suite.name}: dataset {name!r}: {exc}") from None
         if skipped is not None and not known and name in literals and not opts.optional:
             raise SuiteError(
                 f"{suite.path or suite.name}: dataset entry {name!r}: {skipped.reason}; "
@@ -221,6 +253,7 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
                         requires=entry.requires,
                     )
                 )
+    _check_shared_folders(suite, cells)
     seeds = sorted({c.seed for c in cells})
     degradations = list(dict.fromkeys(c.degradation for c in cells))
     return GridPlan(

@@ -4,6 +4,11 @@ The runner holds no result in memory that is not already on disk: the plan
 is written first, every cell writes its own folder, and the summary is
 recomputed from the store. Killing the runner at any moment therefore loses
 at most the cells that were in flight.
+
+A failure that would repeat for every cell (the results folder is full or
+read-only, the cell process pool was killed) halts the grid: the runner
+starts no further cell, lets the running ones end, and says how many it did
+not start; a later run resumes where it stopped.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from pathlib import Path
 from typing import Protocol
 
 from albot1.bench.cells import renderer_target
+from albot1.bench.errors import BenchError
 from albot1.bench.executors import open_executor, parse_executor
 from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.job import results_path, run_cell_job
@@ -40,10 +46,16 @@ class GridObserver(Protocol):
 
 @dataclass
 class GridSummary:
-    """Counts and outcomes of one runner invocation."""
+    """Counts and outcomes of one runner invocation.
+
+    ``halted``: why the runner stopped starting cells (None: it ran the whole
+    grid); ``not_started``: the cells it then left for a later run.
+    """
 
     outcomes: list[CellOutcome] = field(default_factory=list)
     wall_s: float = 0.0
+    halted: str | None = None
+    not_started: list[Cell] = field(default_factory=list)
 
     @property
     def counts(self) -> Counter[str]:
@@ -62,6 +74,18 @@ def _unique(cells: list[Cell]) -> list[Cell]:
     return list(seen.values())
 
 
+def _config_failure(store: ResultsStore, cell: Cell, reason: str) -> CellOutcome:
+    """Record a cell whose config does not resolve (it never starts); a full disk halts the grid."""
+    try:
+        store.prepare(cell)
+    except OSError:
+        pass  # record_failure below says whether anything could be written
+    problem = store.record_failure(cell, reason, "config")
+    if problem is None:
+        return CellOutcome.of(cell, "failed", 0.0, reason, "config")
+    return CellOutcome.of(cell, "failed", 0.0, f"{reason} [not recorded: {problem}]", "storage", halts_grid=True)
+
+
 def run_grid(
     plan: GridPlan,
     store: ResultsStore,
@@ -69,39 +93,53 @@ def run_grid(
     observer: GridObserver | None = None,
     job: Callable[[Cell, str], CellOutcome] = run_cell_job,
 ) -> GridSummary:
-    """Run every incomplete cell of ``plan`` on ``executor``; failures are recorded, never raised."""
+    """Run every incomplete cell of ``plan`` on ``executor``; failures are recorded, never raised.
+
+    An outcome that halts the grid (:attr:`CellOutcome.halts_grid`) cancels
+    every cell not yet started; they are listed in ``summary.not_started``.
+    """
     start = time.monotonic()
     summary = GridSummary()
     cells = _unique(plan.cells)
     pending: list[Cell] = []
     for cell in cells:
-        if cell.key in plan.config_failures:
-            store.prepare(cell)
-            store.record_failure(cell, plan.config_failures[cell.key], "config")
-            summary.outcomes.append(CellOutcome.of(cell, "failed", 0.0, plan.config_failures[cell.key], "config"))
+        if summary.halted is not None:
+            summary.not_started.append(cell)
+        elif cell.key in plan.config_failures:
+            outcome = _config_failure(store, cell, plan.config_failures[cell.key])
+            summary.outcomes.append(outcome)
+            if outcome.halts_grid:
+                summary.halted = outcome.reason
         elif store.is_complete(cell.key):
             summary.outcomes.append(CellOutcome.of(cell, "cached"))
         else:
             pending.append(cell)
+    if summary.halted is not None:
+        summary.not_started += pending
+        pending = []
     if observer is not None:
-        observer.started(len(cells), len(cells) - len(pending))
+        observer.started(len(cells), len(cells) - len(pending) - len(summary.failures) - len(summary.not_started))
         for outcome in summary.outcomes:
             if outcome.status == "failed":
                 observer.finished(outcome)
     root = results_path(store.root)
     futures = {executor.submit(job, cell, root): cell for cell in pending}
+    waiting = set(futures)
     try:
-        for future in cf.as_completed(futures):
-            cell = futures[future]
-            try:
-                outcome = future.result()
-            except Exception as exc:  # the executor lost the job (worker died, unpicklable, ...)
-                reason = f"executor error: {type(exc).__name__}: {exc}"
-                store.record_failure(cell, reason, "executor", traceback_text="".join(traceback.format_exception(exc)))
-                outcome = CellOutcome.of(cell, "failed", 0.0, reason, "executor")
-            summary.outcomes.append(outcome)
-            if observer is not None:
-                observer.finished(outcome)
+        while waiting:
+            done, waiting = cf.wait(waiting, return_when=cf.FIRST_COMPLETED)
+            for future in done:
+                if future.cancelled():
+                    continue
+                outcome = _outcome(future, futures[future], store)
+                summary.outcomes.append(outcome)
+                if observer is not None:
+                    observer.finished(outcome)
+                if outcome.halts_grid and summary.halted is None:
+                    summary.halted = outcome.reason
+                    cancelled = {f for f in waiting if f.cancel()}
+                    summary.not_started += [futures[f] for f in futures if f in cancelled]
+                    waiting -= cancelled
     finally:
         for future in futures:
             future.cancel()
@@ -109,9 +147,35 @@ def run_grid(
     return summary
 
 
+def _outcome(future: cf.Future[CellOutcome], cell: Cell, store: ResultsStore) -> CellOutcome:
+    """The job's outcome, or a recorded executor failure when the executor lost the job."""
+    try:
+        return future.result()
+    except Exception as exc:  # the executor lost the job (worker died, unpicklable, ...)
+        reason = f"executor error: {type(exc).__name__}: {exc}"
+        problem = store.record_failure(
+            cell, reason, "executor", traceback_text="".join(traceback.format_exception(exc))
+        )
+        if problem is not None:
+            return CellOutcome.of(
+                cell, "failed", 0.0, f"{reason} [not recorded: {problem}]", "storage", halts_grid=True
+            )
+        return CellOutcome.of(cell, "failed", 0.0, reason, "executor")
+
+
 def bench_results_root(results: Path, suite_name: str) -> Path:
-    """``results/<suite>``: the folder `albot1 report` reads."""
-    return results / suite_name
+    """``results/<suite>``: the folder `albot1 report` reads.
+
+    A suite's name is a plain folder name (the suite model checks it); this
+    checks again, so that no name ever places a results folder outside ``results``.
+    """
+    root = results / suite_name
+    if root.resolve().parent != results.resolve():
+        raise BenchError(
+            f"suite name {suite_name!r} would put its results at {root.resolve()}, outside {results.resolve()}; "
+            "expected a plain folder name (letters, digits, '_', '.', '-', not starting with '.')"
+        )
+    return root
 
 
 def run_suite(

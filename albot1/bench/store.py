@@ -18,6 +18,11 @@ that parses: both are written by atomic rename, so a runner killed at any
 instant leaves cells that are either complete or recomputed on the next run,
 never half-read. ``FAILED.json`` is removed before a retry and never
 coexists with a completed result after one.
+
+A full or read-only file system is a failure of the grid, not of one cell:
+the cell that met it is recorded as failed (kind ``storage``) after its
+incomplete run files are deleted to make room for the record, and the
+runner starts no further cell. Complete cells are never touched.
 """
 
 from __future__ import annotations
@@ -32,7 +37,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from albot1.atomic import atomic_write
+from albot1.atomic import atomic_write, remove_temporaries
+from albot1.bench.cell_main import ERROR_FILE
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell, FailureKind, GridPlan
 from albot1.runs.folder import is_complete as run_is_complete
@@ -121,10 +127,16 @@ class ResultsStore:
         return True
 
     def prepare(self, cell: Cell) -> Path:
-        """Make the cell's folder ready for an attempt: cell.json written, old failure and log removed."""
+        """Make the cell's folder ready for an attempt: cell.json written, old failure, log and temporaries removed.
+
+        Temporary files of writers killed in an earlier attempt (a timeout, a
+        SIGKILLed runner) would otherwise stay in the completed folder.
+        """
         run_dir = self.run_dir(cell.key)
         run_dir.mkdir(parents=True, exist_ok=True)
         (run_dir / FAILED).unlink(missing_ok=True)
+        (run_dir / ERROR_FILE).unlink(missing_ok=True)
+        remove_temporaries(run_dir)
         write_json(run_dir / CELL, cell.to_json())
         (run_dir / LOG).write_text(
             f"albot1 bench: {cell.describe()}, attempt started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n",
@@ -141,30 +153,45 @@ class ResultsStore:
         exit_code: int | None = None,
         elapsed_s: float = 0.0,
         traceback_text: str | None = None,
-    ) -> None:
-        """Write FAILED.json (and append a traceback to the cell log) for ``cell``."""
+    ) -> str | None:
+        """Write FAILED.json (and append a traceback to the cell log) for ``cell``.
+
+        Never raises for the file system: returns None when the record was
+        written, else why it could not be (the caller still reports the
+        failure). For a ``storage`` failure the cell's incomplete run files
+        are deleted first, so that the small record fits where the run did not.
+        """
         run_dir = self.run_dir(cell.key)
-        run_dir.mkdir(parents=True, exist_ok=True)
         log = run_dir / LOG
-        if traceback_text:
-            with log.open("a", encoding="utf-8") as handle:
-                handle.write(f"\n--- albot1 bench: {kind} ---\n{traceback_text}\n")
-        write_json(run_dir / CELL, cell.to_json())
-        write_json(
-            run_dir / FAILED,
-            {
-                "key": cell.key,
-                "cell": cell.describe(),
-                "reason": reason,
-                "kind": kind,
-                "exit_code": exit_code,
-                "elapsed_s": elapsed_s,
-                "log": LOG if log.is_file() else None,
-                "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                "host": socket.gethostname(),
-                "description": cell.to_json(),
-            },
-        )
+        try:
+            run_dir.mkdir(parents=True, exist_ok=True)
+            if kind == "storage":
+                discard_incomplete_run(run_dir)
+            if traceback_text:
+                with log.open("a", encoding="utf-8") as handle:
+                    handle.write(f"\n--- albot1 bench: {kind} ---\n{traceback_text}\n")
+        except OSError:
+            pass  # the log is a courtesy; FAILED.json below is the record
+        try:
+            write_json(run_dir / CELL, cell.to_json())
+            write_json(
+                run_dir / FAILED,
+                {
+                    "key": cell.key,
+                    "cell": cell.describe(),
+                    "reason": reason,
+                    "kind": kind,
+                    "exit_code": exit_code,
+                    "elapsed_s": elapsed_s,
+                    "log": LOG if log.is_file() else None,
+                    "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                    "host": socket.gethostname(),
+                    "description": cell.to_json(),
+                },
+            )
+        except OSError as exc:
+            return f"{run_dir / FAILED}: cannot be written: {exc.strerror or exc}"
+        return None
 
     def failure(self, key: str) -> Failure | None:
         path = self.run_dir(key) / FAILED
@@ -188,3 +215,16 @@ class ResultsStore:
             return json.loads(path.read_text())
         except (OSError, json.JSONDecodeError):
             return None
+
+
+def discard_incomplete_run(run_dir: Path) -> None:
+    """Delete the files of an attempt that did not complete (no ``DONE``), keeping ``cell.json`` and ``cell.log``.
+
+    They are recomputed by the next attempt anyway; deleting them frees the
+    space a full disk needs for the failure record. A complete run is left alone.
+    """
+    if run_is_complete(run_dir):
+        return
+    for path in run_dir.iterdir():
+        if path.name not in (CELL, LOG) and (path.is_file() or path.is_symlink()):
+            path.unlink(missing_ok=True)

@@ -13,8 +13,8 @@ Format (every key optional except ``methods`` and ``datasets``)::
     registered_methods = true        # also run every other registered, installed method
 
     [limits]                         # per-cell defaults
-    time_s = 900                     # wall-clock limit of one cell
-    memory_mb = 4096                 # address-space growth allowed to one cell
+    time_s = 900                     # wall-clock limit of one cell (at most 7 days)
+    memory_mb = 4096                 # resident memory of one cell and the processes it starts (at most 1 TiB)
 
     [grid]
     degradations = ["thesis", "gauss:0.05:0.5"]   # swept on datasets with reference poses
@@ -30,41 +30,63 @@ Format (every key optional except ``methods`` and ``datasets``)::
 
     [[datasets]]                     # applied in order; later entries override earlier ones
     name = "*"                       # a glob (* and [...]) over dataset and world names, a name, a
-                                     # dataset reference with loader options (NAME?KEY=VALUE), or a path
+                                     # dataset reference with loader options (NAME?KEY=VALUE) or a
+                                     # slice (NAME[:N], NAME[:N:S]), or a path
     [[datasets]]
     name = "intel"
     limit = 4000                     # first 4000 scans ...
     stride = 2                       # ... every 2nd of them
     sweep = false                    # true | false | "auto" (= when the dataset has reference poses)
     # degradations / seeds / undegraded_seeds / time_s / memory_mb / skip = true
-    # optional = true                # a literal name or path that does not exist is skipped, not an error
+    # optional = true                # a name or path that does not exist, or a glob that matches
+                                     # nothing, is skipped instead of being an error
 
 A literal dataset entry (not a glob) that names no synthetic world, no
-registered dataset and no existing file is an error of the suite unless it
-says ``optional = true``; a registered dataset that is not downloaded is
-skipped with the command that fetches it. The deterministic degradations
-(``none``, ``thesis``, ``bias:...``) run with the first seed of their list
-only: every other seed would repeat the same run.
+registered dataset and no existing file, and a glob that matches no dataset,
+are errors of the suite unless the entry says ``optional = true``; a
+registered dataset that is not downloaded is skipped with the command that
+fetches it. A trailing slice (``NAME[:N]``) is not a glob: the entry names
+that prefix. The deterministic degradations (``none``, ``thesis``,
+``bias:...``) run with the first seed of their list only: every other seed
+would repeat the same run.
+
+Bounds, so that a typo fails here rather than deep in the runner: the suite
+name is a plain folder name (it names ``RESULTS/<name>``), seeds are 0 ..
+2**63 - 1, ``time_s`` is at most 7 days and ``memory_mb`` at most 1 TiB.
 """
 
 from __future__ import annotations
 
 import fnmatch
+import re
 import tomllib
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from albot1.bench.errors import SuiteError
 from albot1.config.targets import TargetError, check_target
 from albot1.config.validation import describe_errors
-from albot1.data.degrade import DegradationSpecError, parse_spec
+from albot1.data.degrade import MAX_SEED, DegradationSpecError, parse_spec
 from albot1.resources import list_resources, resource_dirs
 
 # "?" is not a glob character here: in a dataset reference it introduces loader options
 # (``intel-corrected?odometry=laser-pose``, see albot1.data.open), so such an entry is a literal.
 GLOB_CHARS = frozenset("*[")
+#: A trailing ``[:STOP]`` / ``[:STOP:STEP]`` / ``[::STEP]`` is a slice of a dataset reference, not a glob class.
+_TRAILING_SLICE = re.compile(r"\[:[^\[\]]*\]$")
+#: Upper bounds of the per-cell limits: beyond them a value is a typo, and a timer or a byte count would overflow.
+MAX_TIME_S = 7 * 24 * 3600.0
+MAX_MEMORY_MB = 1024.0 * 1024.0
+TimeS = Annotated[float, Field(gt=0, le=MAX_TIME_S, description="wall-clock seconds before the cell is killed")]
+MemoryMb = Annotated[
+    float,
+    Field(gt=0, le=MAX_MEMORY_MB, description="resident memory of the cell and the processes it starts, MiB"),
+]
+Seed = Annotated[int, Field(ge=0, le=MAX_SEED)]
+#: A suite's name is the folder of its results (``RESULTS/<name>``): a plain name that cannot climb out of it.
+SUITE_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
 
 class _Strict(BaseModel):
@@ -72,18 +94,18 @@ class _Strict(BaseModel):
 
 
 class Limits(_Strict):
-    """Per-cell resource limits."""
+    """Per-cell resource limits (enforced by :mod:`albot1.bench.limits`)."""
 
-    time_s: float = Field(900.0, gt=0, description="wall-clock seconds before the cell is killed")
-    memory_mb: float = Field(4096.0, gt=0, description="address space the cell may add to its start size, MiB")
+    time_s: TimeS = 900.0
+    memory_mb: MemoryMb = 4096.0
 
 
 class GridSpec(_Strict):
     """The degradation sweep applied to datasets with reference poses."""
 
     degradations: tuple[str, ...] = ()
-    seeds: tuple[int, ...] = (0,)
-    undegraded_seeds: tuple[int, ...] = (0,)
+    seeds: tuple[Seed, ...] = (0,)
+    undegraded_seeds: tuple[Seed, ...] = (0,)
 
     @field_validator("degradations")
     @classmethod
@@ -101,8 +123,8 @@ class MethodEntry(_Strict):
     target: str | None = Field(None, description="module:Class of a mapper outside the registry")
     error_class: str | None = Field(None, description="module:Class of that mapper's exception")
     requires: tuple[str, ...] = ()
-    time_s: float | None = Field(None, gt=0)
-    memory_mb: float | None = Field(None, gt=0)
+    time_s: TimeS | None = None
+    memory_mb: MemoryMb | None = None
 
     @field_validator("target", "error_class")
     @classmethod
@@ -128,16 +150,18 @@ class DatasetEntry(_Strict):
     name: str = Field(min_length=1)
     skip: bool = False
     optional: bool = Field(
-        False, description="a literal name or path that cannot be found is skipped, not an error of the suite"
+        False,
+        description="a literal name or path that cannot be found, or a glob that matches nothing, is skipped, "
+        "not an error of the suite",
     )
     limit: int | None = Field(None, ge=1, description="use the first LIMIT scans of the log")
     stride: int | None = Field(None, ge=1, description="then every STRIDE-th of them")
     sweep: bool | Literal["auto"] = "auto"
     degradations: tuple[str, ...] | None = None
-    seeds: tuple[int, ...] | None = None
-    undegraded_seeds: tuple[int, ...] | None = None
-    time_s: float | None = Field(None, gt=0)
-    memory_mb: float | None = Field(None, gt=0)
+    seeds: tuple[Seed, ...] | None = None
+    undegraded_seeds: tuple[Seed, ...] | None = None
+    time_s: TimeS | None = None
+    memory_mb: MemoryMb | None = None
 
     @field_validator("degradations")
     @classmethod
@@ -146,7 +170,11 @@ class DatasetEntry(_Strict):
 
     @property
     def is_pattern(self) -> bool:
-        return any(ch in GLOB_CHARS for ch in self.name)
+        """Whether ``name`` is a glob; a trailing slice (``NAME[:N]``) is part of a literal reference."""
+        text = self.name
+        while (stripped := _TRAILING_SLICE.sub("", text)) != text:
+            text = stripped
+        return any(ch in GLOB_CHARS for ch in text)
 
     def matches(self, name: str) -> bool:
         return fnmatch.fnmatchcase(name, self.name) if self.is_pattern else name == self.name
@@ -177,7 +205,7 @@ class DatasetOptions(_Strict):
 class Suite(_Strict):
     """A validated suite file."""
 
-    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    name: str
     description: str = ""
     path: Path | None = None
     registered_methods: bool = False
@@ -185,6 +213,16 @@ class Suite(_Strict):
     grid: GridSpec = Field(default_factory=GridSpec)
     methods: tuple[MethodEntry, ...] = Field(min_length=1)
     datasets: tuple[DatasetEntry, ...] = Field(min_length=1)
+
+    @field_validator("name")
+    @classmethod
+    def _plain_name(cls, value: str) -> str:
+        if SUITE_NAME.fullmatch(value) is None:
+            raise ValueError(
+                f"suite name {value!r}: expected a plain folder name of at most 100 letters, digits, '_', '.' or "
+                "'-', not starting with '.' (it names the results folder RESULTS/<name>)"
+            )
+        return value
 
     @model_validator(mode="after")
     def _unique_labels(self) -> Suite:
@@ -231,6 +269,8 @@ def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
 
 def parse_suite(data: dict[str, Any], *, name: str, source: str, path: Path | None = None) -> Suite:
     """Validate suite data (a parsed TOML table); SuiteError names ``source`` and the offending key."""
+    if "path" in data:  # set from where the file was found, never by the file
+        raise SuiteError(f"{source}: invalid suite: path: unknown key (the suite's path is where its file is)")
     try:
         return Suite.model_validate({"name": name, **data, "path": path})
     except ValidationError as exc:
@@ -243,7 +283,9 @@ def load_suite(path: str | Path) -> Suite:
     try:
         data = tomllib.loads(file.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise SuiteError(f"{file}: cannot read the suite file: {exc.strerror}") from None
+        raise SuiteError(f"{file}: cannot read the suite file: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise SuiteError(f"{file}: not UTF-8 text (byte {exc.start}); expected a TOML suite file") from None
     except tomllib.TOMLDecodeError as exc:
         raise SuiteError(f"{file}: not valid TOML: {exc}") from None
     name = data.pop("name", file.stem)

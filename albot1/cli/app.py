@@ -77,10 +77,28 @@ def main() -> None:
     """Console-script entry: known errors -> ``albot1: error: ...`` on stderr, exit 1.
 
     Typer's standalone mode already turns usage errors into a usage message
-    with exit 2; only the project's own errors need translating here.
+    with exit 2; the project's own errors, and the operating system's refusals
+    that reach this far (a disk that fills up mid-command, a file whose
+    permissions changed), are one line naming the path; Ctrl-C is one line
+    and exit 130. Any other exception is a bug and keeps its traceback.
     """
     try:
         app()
     except Albot1Error as exc:
         typer.echo(f"albot1: error: {exc}", err=True)
         sys.exit(1)
+    except OSError as exc:
+        typer.echo(f"albot1: error: {os_error_line(exc)}", err=True)
+        sys.exit(1)
+    except KeyboardInterrupt:
+        typer.echo("albot1: interrupted", err=True)
+        sys.exit(130)
+
+
+def os_error_line(exc: OSError) -> str:
+    """``PATH: cannot read or write it: no space left on device`` -- one line for an OSError."""
+    what = (exc.strerror or str(exc) or type(exc).__name__).lower()
+    where = exc.filename if exc.filename is not None else "a file"
+    if exc.filename2 is not None:
+        where = f"{where} -> {exc.filename2}"
+    return f"{where}: cannot read or write it: {what}"

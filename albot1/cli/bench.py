@@ -12,9 +12,12 @@ from tqdm import tqdm
 from albot1.bench.plan import plan_suite
 from albot1.bench.progress import TqdmProgress, plan_table, summary_table
 from albot1.bench.runner import run_suite
+from albot1.bench.store import ResultsStore
 from albot1.bench.suite import find_suite, load_suite
-from albot1.report.index import build_report
+from albot1.report.index import build_report, default_out
+from albot1.report.map_plots import MapStyle
 from albot1.report.preview import render_preview
+from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
 
@@ -41,7 +44,10 @@ def bench(
 
     Completed cells are kept and skipped on the next run; failed cells are recorded with their
     reason and retried. Then build the report with `albot1 report results/SUITE`. The exit status
-    is 1 when any cell failed (after the whole grid ran and the summary was printed).
+    is 1 when any cell failed (after the whole grid ran and the summary was printed), when the
+    suite has no cell to run, and when the runner had to stop early (the results folder is full
+    or read-only, or the cell process pool was killed: it starts no further cell, and running
+    the same command again resumes).
 
     Datasets are named as in `albot1 run`: NAME, NAME[:N] (first N scans), NAME?key=value
     (loader options), or a path; a suite entry naming none of these is an error unless it
@@ -57,6 +63,7 @@ def bench(
         plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))
         return
+    writable_folder(results, "--results")
     view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not progress)
     try:
         plan, summary, store = run_suite(
@@ -81,9 +88,19 @@ def bench(
     typer.echo(summary_table(summary))
     typer.echo(f"results: {store.root}  (report: albot1 report {store.root})")
     failed = summary.counts["failed"]
+    if not plan.cells:
+        typer.echo(f"suite {plan.suite}: no cell to run (every dataset or method it selects was skipped)", err=True)
+        raise typer.Exit(1)
+    if summary.halted is not None:
+        typer.echo(
+            f"stopped early, {len(summary.not_started)} cells not started: {summary.halted}; completed cells are "
+            "kept, run the same command again to resume",
+            err=True,
+        )
     if failed:
         # The whole grid ran and the summary is printed; the exit status tells scripts (make, CI) it is not clean.
         typer.echo(f"{failed} of {len(summary.outcomes)} cells failed (reasons above and in the report)", err=True)
+    if failed or summary.halted is not None:
         raise typer.Exit(1)
 
 
@@ -91,12 +108,23 @@ def report(
     results_dir: Annotated[Path, typer.Argument(help="a results folder written by `albot1 bench` (results/SUITE)")],
     out: Annotated[Path | None, typer.Option(help="report folder (default: reports/<suite>)")] = None,
     plots: Annotated[bool, typer.Option(help="render the plots (tables only with --no-plots)")] = True,
+    map_style: Annotated[
+        str, typer.Option(help="point maps drawn as an occupancy grid (grid) or as their points (points)")
+    ] = "grid",
 ) -> None:
-    """Build tables (Markdown, CSV), plots and an index page from a results folder.
+    """Build tables (Markdown, CSV, LaTeX), plots (PNG and SVG), README.md and index.html from a results folder.
+
+    index.html is the whole report on one page (sortable tables, every plot), with relative links
+    only: open it from the report folder in any browser, no network needed.
 
     Examples:\n
-      albot1 report results/default          # -> reports/default/README.md\n
-      albot1 report results/quick --out /tmp/quick-report
+      albot1 report results/default          # -> reports/default/README.md, reports/default/index.html\n
+      albot1 report results/quick --out /tmp/quick-report --map-style points
     """
-    index = build_report(results_dir, out, plots=plots)
+    if map_style not in ("grid", "points"):
+        raise typer.BadParameter(f"--map-style {map_style!r}: expected grid or points")
+    ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
+    writable_folder(out if out is not None else default_out(results_dir), "--out")
+    style: MapStyle = "grid" if map_style == "grid" else "points"
+    index = build_report(results_dir, out, plots=plots, map_style=style)
     typer.echo(f"report: {index}")

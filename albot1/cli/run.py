@@ -9,13 +9,15 @@ from typing import Annotated
 import typer
 
 from albot1.cli.progress import with_progress
+from albot1.data.degrade import check_seed
+from albot1.data.errors import SliceError
 from albot1.data.open import open_sequence
-from albot1.data.transforms import head
 from albot1.methods.registry import parse_overrides
 from albot1.records import dump_record
 from albot1.report.preview import render_preview
 from albot1.runs.execute import run_method
 from albot1.runs.folder import mark_latest, read_result, write_run
+from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
 
@@ -40,7 +42,9 @@ def run(
     ] = Path("runs"),
     set_: Annotated[list[str] | None, typer.Option("--set", help="config override FIELD=VALUE (repeatable)")] = None,
     data_dir: Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
-    limit: Annotated[int | None, typer.Option(help="use only the first N scans")] = None,
+    limit: Annotated[
+        int | None, typer.Option(help="use only the first N scans (same as DATASET[:N]; part of the run's name)")
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object")] = False,
 ) -> None:
     """Run METHOD on DATASET and write the run folder (trajectory, map, counters, preview).
@@ -52,12 +56,18 @@ def run(
       albot1 run albot1 aces --preset thesis --out runs\n
       albot1 run gtsam-graph intel-corrected --degrade gauss:0.1:1 --seed 1
     """
-    overrides = parse_overrides(set_ or [])  # a malformed --set fails before the log is opened
+    # Bad arguments fail before the log is opened and the method runs, not after.
+    overrides = parse_overrides(set_ or [])
+    check_seed(seed)
+    if limit is not None and limit < 1:
+        raise SliceError(f"--limit {limit}: expected a positive number of scans (at least 1)")
+    writable_folder(out, "--out")
+    # The limit is part of the dataset's name (NAME[:N], as in the bench), so it is in the run's key and
+    # result.json: runs on different prefixes get different folders, and `albot1 evaluate` reopens the prefix.
+    dataset = dataset if limit is None else f"{dataset}[:{limit}]"
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
     if preset == "default" and method == "albot1":
         preset = "thesis"
-    if limit is not None:
-        sequence = head(sequence, limit)
     sequence = with_progress(sequence, f"{method} on {dataset}")
     result = run_method(
         method,

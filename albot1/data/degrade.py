@@ -37,6 +37,8 @@ from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
 EXPECTED_SPEC = "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG or bias:DX_M:DTHETA_DEG"
+#: Seeds are what ``numpy.random.default_rng`` accepts and a suite's TOML integer can hold: 0 .. 2**63 - 1.
+MAX_SEED = 2**63 - 1
 
 
 class DegradationSpecError(DataError):
@@ -95,8 +97,20 @@ def parse_spec(spec: str) -> Degradation:
     return Degradation(kind, a, math.radians(b_deg))
 
 
+def check_seed(seed: object) -> int:
+    """``seed`` when it is an integer in 0 .. :data:`MAX_SEED`, else a DegradationSpecError saying so.
+
+    Checked before any scan is read: numpy refuses a negative seed only when
+    the first random number is drawn, deep inside a run.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= MAX_SEED:
+        raise DegradationSpecError(f"seed {seed!r}: expected an integer from 0 to {MAX_SEED} (2**63 - 1)")
+    return int(seed)
+
+
 def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Sequence:
     """``sequence`` with degraded odometry (streamed; the same seed gives the same result)."""
+    check_seed(seed)
     deg = parse_spec(spec) if isinstance(spec, str) else spec
     if deg.kind == "none":
         return sequence

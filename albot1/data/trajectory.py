@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import io
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Literal, get_args
@@ -92,7 +93,9 @@ def _rows(path: Path, columns: int, expected: str) -> NDArray[np.float64]:
     is read line by line to name the first offending line.
     """
     try:
-        rows = np.loadtxt(path, ndmin=2, comments="#", dtype=float)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data": an empty file is no poses
+            rows = np.loadtxt(path, ndmin=2, comments="#", dtype=float)
     except OSError as exc:
         raise DataError(f"{path}: cannot read the trajectory: {exc.strerror or exc}") from None
     except ValueError:

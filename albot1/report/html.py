@@ -47,6 +47,7 @@ figure { margin: 0.8em 0 1.6em 0; } figure img { max-width: 100%; height: auto; 
 figcaption { font-size: 0.85em; color: #444; }
 .notes { font-size: 0.85em; color: #444; } .meta { font-size: 0.9em; }
 nav a { margin-right: 0.8em; }
+.scroll { overflow-x: auto; max-width: 100%; } td.label { white-space: nowrap; }
 """
 
 #: Click-to-sort for every table of class "sortable" (numbers by data-v, text otherwise; n/a and failed last).
@@ -85,6 +86,7 @@ CAPTIONS = {
     "robustness-drift": "RPE per 10 m per odometry degradation: mean over seeds, ± std, min and max.",
     "robustness-loop-gap": "Loop gap per odometry degradation: mean over seeds, ± std, min and max.",
     "scan-time": "Per-scan processing time along the sequence (running median).",
+    "runtime": "Median per-scan time per dataset and method on the dataset's own odometry (whisker: p95).",
 }
 
 
@@ -112,20 +114,23 @@ def table_html(group: pd.DataFrame, columns: dict[str, Column], colors: dict[str
     """One dataset's aggregated rows as a sortable HTML table, with its not-applicable notes."""
     present, absent = columns_present(group, columns)
     head = ["method", "degradation", "seeds", *[columns[c].header for c in present], "status"]
-    lines = ['<table class="sortable">', "<thead><tr>" + "".join(f"<th>{_e(h)}</th>" for h in head) + "</tr></thead>"]
+    lines = [
+        '<div class="scroll"><table class="sortable">',
+        "<thead><tr>" + "".join(f"<th>{_e(h)}</th>" for h in head) + "</tr></thead>",
+    ]
     lines.append("<tbody>")
     for _, row in group.iterrows():
         css = ' class="failed-row"' if row["status"] != "ok" else ""
         swatch = f'<span class="swatch" style="background:{colors.get(str(row["method"]), "#999")}"></span>'
         cells = [
-            f"<td>{swatch}{_e(row['method'])}</td>",
-            f"<td>{_e(row['degradation'])}</td>",
+            f'<td class="label">{swatch}{_e(row["method"])}</td>',
+            f'<td class="label">{_e(row["degradation"])}</td>',
             f'<td class="num" data-v="{int(row["seeds"])}">{int(row["seeds"])}</td>',
             *[_number_cell(row, c) for c in present],
             f"<td>{_e(row['status'])}</td>",
         ]
         lines.append(f"<tr{css}>" + "".join(cells) + "</tr>")
-    lines.append("</tbody></table>")
+    lines.append("</tbody></table></div>")
     notes = na_notes(group, columns, present, absent)
     if notes:
         lines.append('<ul class="notes">' + "".join(f"<li>n/a: {_e(n)}</li>" for n in notes) + "</ul>")
@@ -205,8 +210,9 @@ def write_html(
     if extra_links:
         parts.append("<ul>" + "".join(f'<li><a href="{_e(rel(p, out))}">{_e(t)}</a></li>' for t, p in extra_links))
         parts.append("</ul>")
-    for plot in plots.get("", []):
-        parts.append(_figure(plot, out))
+    if plots.get(""):
+        parts.append("<h3>Runtime across datasets</h3>")
+        parts += [_figure(plot, out) for plot in plots[""]]
     for i, dataset in enumerate(datasets):
         parts.append(f'<h2 id="ds-{i}">{_e(dataset)}</h2>')
         for title, table, cols in (("Accuracy", metrics, metric_columns), ("Cost", cost, cost_columns)):

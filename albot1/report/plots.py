@@ -192,16 +192,18 @@ def panel_layout(
 ) -> tuple[int, int, tuple[float, float]]:
     """(rows, columns, figure size in inches) for ``panels`` panels showing ``extent`` at equal scale.
 
-    The column count makes the whole figure closest to a 3:2 landscape
-    page; each panel is as large as the width limit allows, its height set
-    by the data's aspect ratio (so a corridor gets wide, flat panels).
-    ``extra_height_in`` leaves room for titles and the legend below.
+    The column count makes the whole figure closest to a 4:3 landscape
+    page without leaving many panels empty; each panel is as large as the
+    width limit allows, its height set by the data's aspect ratio (so a
+    corridor gets wide, flat panels). ``extra_height_in`` leaves room for
+    titles and the legend below.
     """
     aspect = extent.aspect
     best: tuple[float, int] | None = None
     for cols in range(1, panels + 1):
         rows = math.ceil(panels / cols)
-        score = abs(math.log((cols * aspect) / rows / 1.5))
+        empty = rows * cols - panels
+        score = abs(math.log((cols * aspect) / rows / (4 / 3))) + 0.5 * empty / panels
         if best is None or score < best[0] - 1e-9:
             best = (score, cols)
     assert best is not None
@@ -258,9 +260,12 @@ def value_axis(ax: Any, floor: float | None, clipped: list[str], unit: str) -> N
 
 def save(fig: Figure, png: Path) -> Path:
     """Write ``png`` and its vector twin (same stem, ``.svg``); close the figure; return the PNG's path."""
+    import matplotlib
+
     plt = pyplot()
     fig.savefig(png, format="png", dpi=DPI)
-    fig.savefig(png.with_suffix(f".{VECTOR_FORMAT}"), format=VECTOR_FORMAT)
+    with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "albot1"}):  # text stays editable text
+        fig.savefig(png.with_suffix(f".{VECTOR_FORMAT}"), format=VECTOR_FORMAT, metadata={"Date": None})
     plt.close(fig)
     return png
 

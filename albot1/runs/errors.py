@@ -10,3 +10,7 @@ __all__ = ["RunError", "UnknownMethodError"]
 
 class RunError(Albot1Error):
     """A run could not be made or its result breaks the result contract."""
+
+
+class OutputFolderError(RunError):
+    """A folder a command writes into (``--out``, ``--results``) is a file, missing or not writable."""

@@ -23,6 +23,7 @@ metrics are null with that reason.
 from __future__ import annotations
 
 import hashlib
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,9 +32,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1 import versions
-from albot1.data.model import Sequence
+from albot1.data.model import Relations, Sequence
 from albot1.data.open import open_sequence
-from albot1.data.relations import match_stamps
+from albot1.data.relations import match_stamps, read_relations, write_relations
 from albot1.data.trajectory import PoseFile, as_stored, read_trajectory
 from albot1.runs.errors import RunError
 from albot1.runs.scored import Scored
@@ -144,7 +145,7 @@ def load_external(
         timestamps=pose_times[matching.pose_index],
         poses=poses,
         reference=reference[scans] if reference is not None else None,
-        relations=sequence.relations,
+        relations=_as_stored(sequence.relations),
         relations_source=f"the relations of {dataset}",
         relation_timestamps=pose_times[order],
         relation_poses=file.poses[order],
@@ -170,3 +171,17 @@ def _key(file: PoseFile, dataset: str) -> tuple[str, str]:
     digest = hashlib.sha256(file.path.read_bytes()).hexdigest()
     key = hashlib.sha256(f"{digest}\n{file.format}\n{dataset}".encode()).hexdigest()[:16]
     return key, digest
+
+
+def _as_stored(relations: Relations | None) -> Relations | None:
+    """``relations`` exactly as a run folder's ``relations.txt`` holds them (written and read back).
+
+    Like the reference poses (:func:`albot1.data.trajectory.as_stored`), so
+    a run folder and its trajectory scored as a file give the same numbers.
+    """
+    if relations is None:
+        return None
+    with tempfile.TemporaryDirectory(prefix="albot1-relations-") as folder:
+        path = Path(folder) / "relations.txt"
+        write_relations(path, relations)
+        return read_relations(path)

@@ -16,7 +16,8 @@ degradation, seed, code version)::
 
 Every file is written to a temporary name and renamed, so a killed process
 leaves either a complete file or none; a folder without DONE is incomplete
-and is recomputed.
+and is recomputed. The temporary files a killed writer leaves are removed
+when the folder is written again, so a completed folder holds none.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -33,7 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.atomic import atomic_write
+from albot1.atomic import atomic_write, remove_temporaries
 from albot1.contract import MapData, RunResult
 from albot1.data.model import Relations
 from albot1.data.relations import read_relations, write_relations
@@ -44,6 +46,7 @@ from albot1.runs.errors import RunError
 
 DONE = "DONE"
 RESULT_FILE = "result.json"
+PER_SCAN_FILE = "per_scan_ns.npy"
 METRICS_FILE = "metrics.json"
 LATEST = "latest"
 #: Files of a run that a new write of the same folder may not produce again (the metrics above all:
@@ -61,7 +64,7 @@ STANDARD_FILES = frozenset(
         "map.npz",
         "extras.json",
         "preview.png",
-        "per_scan_ns.npy",
+        PER_SCAN_FILE,
         METRICS_FILE,
         DONE,
         "cell.json",
@@ -118,6 +121,7 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
     run_dir = root / key
     run_dir.mkdir(parents=True, exist_ok=True)
     (run_dir / DONE).unlink(missing_ok=True)
+    remove_temporaries(run_dir)  # left by a writer killed in an earlier attempt
     for name in REWRITTEN_FILES:  # a re-run never leaves an older run's metrics, map or preview behind
         (run_dir / name).unlink(missing_ok=True)
 
@@ -149,11 +153,16 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
         "relations": len(result.relations) if result.relations is not None else 0,
     }
     write_record(run_dir / RESULT_FILE, parse_record(ResultRecord, info, f"{run_dir / RESULT_FILE} (being written)"))
-    np.save(run_dir / "per_scan_ns.npy", result.per_scan_ns)
+    atomic_write(run_dir / PER_SCAN_FILE, lambda p: _save_npy(p, result.per_scan_ns))
     if preview is not None:
         atomic_write(run_dir / "preview.png", lambda p: preview(result, p))
     atomic_write(run_dir / DONE, lambda p: p.write_text(key + "\n"))
     return run_dir
+
+
+def _save_npy(path: Path, array: NDArray[np.int64]) -> None:
+    with path.open("wb") as handle:  # a file object: np.save would append ".npy" to a name without it
+        np.save(handle, array)
 
 
 def _write_files(run_dir: Path, files: dict[str, Any]) -> None:
@@ -213,35 +222,75 @@ class StoredRun:
     per_scan_ns: NDArray[np.int64]
 
     def load_map(self) -> MapData:
-        map_file = self.path / self.info.map_file
-        if map_file.suffix == ".npz":
-            with np.load(map_file) as npz:
-                return MapData(points=npz["points"].astype(float))
-        collection = json.loads(map_file.read_text())
-        segments, props, points = [], [], None
-        for feature in collection["features"]:
-            geom = feature["geometry"]
-            if geom["type"] == "LineString":
-                (x1, y1), (x2, y2) = geom["coordinates"][0], geom["coordinates"][-1]
-                segments.append([x1, y1, x2, y2])
-                props.append(feature.get("properties") or {})
-            elif geom["type"] == "MultiPoint":
-                points = np.asarray(geom["coordinates"], dtype=float).reshape(-1, 2)
-        return MapData(
-            segments=np.asarray(segments, dtype=float).reshape(-1, 4), points=points, segment_properties=props
-        )
+        """The run's map (``map.npz`` points or ``map.geojson`` segments); RunError naming the file if damaged."""
+        map_file = _required(self.path, self.info.map_file)
+        try:
+            if map_file.suffix == ".npz":
+                with np.load(map_file, allow_pickle=False) as npz:
+                    return MapData(points=np.asarray(npz["points"], dtype=float).reshape(-1, 2))
+            return _geojson_map(json.loads(map_file.read_text(encoding="utf-8")))
+        except (OSError, ValueError, EOFError, KeyError, TypeError, IndexError, zipfile.BadZipFile) as exc:
+            kind = (
+                "a .npz archive with a 'points' array of (x, y)"
+                if map_file.suffix == ".npz"
+                else ("a GeoJSON FeatureCollection of LineString segments and MultiPoint points")
+            )
+            raise RunError(
+                f"{map_file}: not a map this project wrote ({type(exc).__name__}: {exc}); expected {kind}"
+            ) from None
+
+
+def _geojson_map(collection: Any) -> MapData:
+    segments, props, points = [], [], None
+    for feature in collection["features"]:
+        geom = feature["geometry"]
+        if geom["type"] == "LineString":
+            (x1, y1), (x2, y2) = geom["coordinates"][0], geom["coordinates"][-1]
+            segments.append([float(x1), float(y1), float(x2), float(y2)])
+            props.append(feature.get("properties") or {})
+        elif geom["type"] == "MultiPoint":
+            points = np.asarray(geom["coordinates"], dtype=float).reshape(-1, 2)
+    return MapData(segments=np.asarray(segments, dtype=float).reshape(-1, 4), points=points, segment_properties=props)
 
 
 def read_run(run_dir: str | Path) -> StoredRun:
-    """Read a complete run folder; RunError if it is missing or incomplete (see :func:`read_result`)."""
+    """Read a complete run folder; RunError if it is missing, incomplete or a file of it is damaged.
+
+    Every error names the file and what was expected of it (a parse error of
+    a TUM or relations file also names its line).
+    """
     path = Path(run_dir)
     info = read_result(path)
-    stamps, poses = read_tum(path / "trajectory.tum")
-    _, odom = read_tum(path / "odometry.tum")
-    reference = read_tum(path / "reference.tum")[1] if (path / "reference.tum").is_file() else None
-    relations = read_relations(path / "relations.txt") if (path / "relations.txt").is_file() else None
-    per_scan = np.load(path / "per_scan_ns.npy")
+    stamps, poses = read_tum(_required(path, "trajectory.tum"))
+    _, odom = read_tum(_required(path, "odometry.tum"))
+    reference = read_tum(_required(path, "reference.tum"))[1] if info.has_reference else None
+    relations = read_relations(_required(path, "relations.txt")) if info.relations else None
+    per_scan = _read_per_scan(_required(path, PER_SCAN_FILE), info.scans)
     return StoredRun(path, info, stamps, poses, odom, reference, relations, per_scan)
+
+
+def _required(run_dir: Path, name: str) -> Path:
+    """``run_dir / name``, or a RunError saying the complete run lacks it."""
+    file = run_dir / name
+    if not file.is_file():
+        raise RunError(
+            f"{file}: missing from a run folder marked complete; the folder was damaged or edited by hand "
+            "(expected every file of docs/architecture.md's run-folder contract); run it again"
+        )
+    return file
+
+
+def _read_per_scan(file: Path, scans: int) -> NDArray[np.int64]:
+    """The per-scan times: a .npy array of ``scans`` non-negative integers (ns); RunError naming the file otherwise."""
+    expected = f"expected a .npy array of {scans} per-scan times in integer nanoseconds (numpy.save)"
+    try:
+        array = np.load(file, allow_pickle=False)
+    except (OSError, ValueError, EOFError) as exc:
+        raise RunError(f"{file}: not readable as a numpy array ({exc}); {expected}") from None
+    if not isinstance(array, np.ndarray) or array.dtype.kind not in "iu" or array.shape != (scans,):
+        found = f"{getattr(array, 'dtype', type(array).__name__)} of shape {getattr(array, 'shape', '?')}"
+        raise RunError(f"{file}: holds {found}; {expected}")
+    return array.astype(np.int64, copy=False)
 
 
 def read_result(run_dir: str | Path) -> ResultRecord:

@@ -169,40 +169,40 @@ PLACES_FURNITURE: tuple[Obstacle, ...] = (
 
 #: One lap of the single loop, from S in room-1 clockwise through the six doorways back to S.
 PLACES_LOOP: tuple[tuple[float, float], ...] = (
-    (3.5, 9.0),  # S, room-1, facing east
+    (2.5, 10.0),  # S, room-1
+    (4.5, 9.0),
     (7.0, 9.0),  # through door-1-2
     (10.0, 9.0),
     (10.0, 8.0),
     (15.2, 8.0),  # through door-2-3
-    (16.0, 10.0),  # A, room-3
-    (18.0, 9.0),
+    (16.0, 10.0),
+    (18.0, 9.0),  # A, room-3
     (18.0, 5.0),  # through door-3-4
     (18.0, 0.3),
     (14.0, 0.4),
     (13.2, 3.0),
     (11.2, 3.0),  # through door-4-5
-    (10.0, 3.2),  # B, room-5
-    (8.0, 3.5),
+    (10.0, 3.2),
+    (8.0, 3.5),  # B, room-5
     (8.0, 4.0),
     (4.3, 4.0),  # through door-5-6
     (2.5, 4.0),
-    (2.5, 9.0),  # through door-6-1
-    (3.5, 9.0),  # back at S
+    (2.5, 10.0),  # through door-6-1, back at S
 )
 
 #: The waypoints the loop may start from (``synthetic-places-loop?start=K``): S (room-1), A (room-3), B (room-5).
-PLACES_LOOP_STARTS: tuple[int, ...] = (0, 5, 12)
+PLACES_LOOP_STARTS: tuple[int, ...] = (0, 7, 14)
 
 #: After the first lap, a second loop that leaves room-2 south through door-2-5 into room-5 (a new direction).
 PLACES_SECOND_LOOP: tuple[tuple[float, float], ...] = (
+    (4.5, 9.0),
     (7.0, 9.0),  # through door-1-2
     (9.3, 9.0),
     (9.3, 5.0),  # through door-2-5: room-5 entered from the north
     (8.0, 4.0),
     (4.3, 4.0),  # through door-5-6
     (2.5, 4.0),
-    (2.5, 9.0),  # through door-6-1
-    (3.5, 9.0),  # back at S
+    (2.5, 10.0),  # through door-6-1, back at S
 )
 
 

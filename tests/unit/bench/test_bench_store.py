@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from albot1.bench.cell_main import ERROR_FILE, EXIT_EXCEPTION, EXIT_MEMORY, limit_memory
+from albot1.bench.cell_main import ERROR_FILE, EXIT_EXCEPTION, EXIT_MEMORY, EXIT_STORAGE
 from albot1.bench.cells import restrict_relations
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell, GridPlan, Skipped
@@ -101,14 +101,34 @@ def test_read_plan_of_a_folder_that_is_not_a_results_folder(tmp_path: Path) -> N
     ("ended", "error", "kind", "words"),
     [
         (ChildExit(None, True, 7.1), None, "timeout", "time limit exceeded: no result after 7 s"),
-        (ChildExit(-11, False, 1.0), None, "crash", "SIGSEGV"),
+        (
+            ChildExit(None, False, 2.0, memory_exceeded=True, peak_rss_mb=140.4),
+            None,
+            "memory",
+            "memory limit exceeded: resident memory reached 140 MB, over the cell's limit of 123 MB (killed)",
+        ),
+        (ChildExit(-11, False, 1.0), None, "crash", "killed by SIGSEGV (a native library crashed)"),
         (ChildExit(-9, False, 1.0), None, "crash", "out-of-memory killer"),
+        (ChildExit(-15, False, 1.0), None, "crash", "killed by SIGTERM (stopped from outside: the cell pool"),
+        (
+            ChildExit(255, False, 1.0, pool_lost="was killed by SIGKILL"),
+            None,
+            "executor",
+            "the cell process pool was shut down: its forkserver was killed by SIGKILL while the cell ran",
+        ),
         (
             ChildExit(EXIT_MEMORY, False, 1.0),
             {"kind": "memory", "type": "MemoryError", "message": ""},
             "memory",
-            "memory limit exceeded (123 MB address space)",
+            "out of memory (an allocation was refused): MemoryError",
         ),
+        (
+            ChildExit(EXIT_STORAGE, False, 1.0),
+            {"kind": "storage", "type": "OSError", "message": "[Errno 28] No space left on device", "errno": 28},
+            "storage",
+            "cannot write the results: no space left on device",
+        ),
+        (ChildExit(EXIT_STORAGE, False, 1.0), None, "storage", "not even the cell's error report fitted"),
         (
             ChildExit(EXIT_EXCEPTION, False, 1.0),
             {"kind": "exception", "type": "BaselineError", "message": "diverged"},
@@ -151,16 +171,3 @@ def test_restrict_relations_keeps_pairs_whose_both_ends_were_kept() -> None:
     np.testing.assert_array_equal(kept.t1, [0.0, 2.0, 0.0])
     np.testing.assert_array_equal(kept.poses[:, 0], [0.0, 6.0, 9.0])
     assert restrict_relations(relations, np.array([10.0])) is None
-
-
-def test_limit_memory_caps_growth_above_the_current_size() -> None:
-    import resource
-
-    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
-    try:
-        cap = limit_memory(64)
-        assert cap is not None
-        with pytest.raises(MemoryError):
-            np.ones(16 * 2**20)  # 128 MiB > 64 MiB allowance
-    finally:
-        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))

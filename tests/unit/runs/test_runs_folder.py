@@ -86,3 +86,56 @@ def test_preview_is_drawn_by_the_callers_renderer_before_done(tmp_path: Path) ->
     assert seen == [("odometry", False)]
     assert (run_dir / "preview.png").read_bytes() == b"picture" and is_complete(run_dir)
     assert not (write_run(run_method("odometry", _sequence(), seed=3), tmp_path) / "preview.png").exists()
+
+
+def test_run_files_have_normal_permissions_not_mkstemps_private_ones(tmp_path: Path) -> None:
+    import os
+    import stat
+
+    mask = os.umask(0o022)
+    try:
+        run_dir = write_run(run_method("odometry", _sequence()), tmp_path)
+    finally:
+        os.umask(mask)
+    modes = {p.name: stat.S_IMODE(p.stat().st_mode) for p in run_dir.iterdir() if p.is_file()}
+    assert modes["trajectory.tum"] == 0o644 and modes["result.json"] == 0o644 and modes[DONE] == 0o644
+    assert all(mode & 0o044 == 0o044 for mode in modes.values()), modes  # every file readable by group and others
+
+
+def test_rewriting_a_run_never_keeps_the_older_runs_metrics_or_files(tmp_path: Path) -> None:
+    from albot1.runs.evaluate import evaluate_run
+
+    result = run_method("odometry", _sequence())
+    run_dir = write_run(result, tmp_path)
+    evaluate_run(run_dir)
+    (run_dir / "preview.png").write_bytes(b"old")
+    assert (run_dir / "metrics.json").is_file()
+    write_run(result, tmp_path)  # the same inputs again: same folder
+    assert not (run_dir / "metrics.json").exists() and not (run_dir / "preview.png").exists()
+    assert is_complete(run_dir)
+
+
+def test_latest_link_and_listing_of_a_runs_root(tmp_path: Path) -> None:
+    from albot1.runs.evaluate import evaluate_run
+    from albot1.runs.folder import LATEST, list_runs, mark_latest
+
+    first = write_run(run_method("odometry", _sequence()), tmp_path)
+    second = write_run(run_method("odometry", _sequence(), degradation="gauss:0.1:1"), tmp_path)
+    evaluate_run(second)
+    link = mark_latest(tmp_path, second)
+    assert link == tmp_path / LATEST and link.resolve() == second.resolve()
+    assert mark_latest(tmp_path, first).resolve() == first.resolve()  # replaced, not an error
+    broken = tmp_path / "0123456789abcdef"
+    broken.mkdir()
+    (broken / "result.json").write_text("{}")
+    (tmp_path / "notes").mkdir()  # not a run: not listed
+    listing = {item.path.name: item for item in list_runs(tmp_path)}
+    assert set(listing) == {first.name, second.name, broken.name}
+    assert listing[first.name].status == "done" and listing[second.name].status == "evaluated"
+    assert listing[broken.name].status == "unreadable" and "not a valid ResultRecord" in str(
+        listing[broken.name].problem
+    )
+    (tmp_path / LATEST).unlink()
+    (tmp_path / LATEST).mkdir()
+    with pytest.raises(RunError, match="exists and is not a symbolic link"):
+        mark_latest(tmp_path, first)

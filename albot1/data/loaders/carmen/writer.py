@@ -92,7 +92,8 @@ def _frame_problem(frame: Frame, step: float) -> str | None:
         return f"max_range {max_range!r} rounds to 0 in the log's 6 decimals (which means 'not stated')"
     found = geometry_problem(n, *(np.array([float(v)]) for v in (scan.angles[0], step * (n - 1), step, max_range)))
     if found is None:  # the ranges as written: 6 decimals, no return as the max range
-        found = ranges_problem(np.round(np.where(np.isnan(scan.ranges), max_range, scan.ranges), 6)[None, :])
+        written: np.ndarray = np.round(np.where(np.isnan(scan.ranges), max_range, scan.ranges), 6)
+        found = ranges_problem(written[None, :])
     if found is not None:
         return found[1]
     longest = float(np.nanmax(scan.ranges)) if not np.isnan(scan.ranges).all() else 0.0

@@ -1,4 +1,4 @@
-"""The map-update and grid-index kernels to run: jitted with numba or as written, in one typed set.
+"""The map-update, grid-index and Albot1+ pose kernels to run: jitted with numba or as written, in one typed set.
 
 Acceleration never changes results: both variants run the same source
 (:mod:`albot1.methods.albot1.jit`). A set is built once per process and flag;
@@ -13,7 +13,7 @@ from functools import lru_cache
 from typing import NamedTuple
 
 from albot1.methods.albot1.jit import kernel_compiler
-from albot1.methods.albot1.mapping import kernels
+from albot1.methods.albot1.mapping import kernels, pose_kernels
 from albot1.methods.albot1.mapping.kernels import BoolArray, FloatArray, IntArray
 
 
@@ -25,6 +25,7 @@ class MappingKernels(NamedTuple):
     best_correspondence: Callable[[FloatArray, FloatArray, BoolArray, float, float], int]
     clip_parameter: Callable[[FloatArray, FloatArray, float, float, float, float, float, bool], float]
     segment_cells: Callable[[FloatArray, float], tuple[IntArray, IntArray, IntArray]]
+    refine_pose: Callable[..., tuple[float, float, float, FloatArray]]
 
 
 @lru_cache(maxsize=2)
@@ -32,7 +33,13 @@ def mapping_kernels(accelerate: bool = True) -> MappingKernels:
     """The jitted kernels when ``accelerate`` and numba is importable, else the plain ones."""
     jit = kernel_compiler(
         accelerate,
-        (kernels.classify_endpoints, kernels.best_correspondence, kernels.clip_parameter, kernels.segment_cells),
+        (
+            kernels.classify_endpoints,
+            kernels.best_correspondence,
+            kernels.clip_parameter,
+            kernels.segment_cells,
+            pose_kernels.refine_pose,
+        ),
     )
     return MappingKernels(
         jit.jitted,
@@ -40,4 +47,5 @@ def mapping_kernels(accelerate: bool = True) -> MappingKernels:
         jit(kernels.best_correspondence),
         jit(kernels.clip_parameter),
         jit(kernels.segment_cells),
+        jit(pose_kernels.refine_pose),
     )

@@ -17,6 +17,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from albot1.methods.albot1.mapping.plus import PlusParams
 from albot1.methods.albot1.perception.view import ViewParams
 
 
@@ -63,6 +64,32 @@ class Albot1Config(BaseModel):
             "else behind)"
         ),
     )
+    end_spacing_max_m: float = Field(
+        0.2,
+        ge=0,
+        description=(
+            "3.1.4: an occluding or corner end whose neighbouring point on its own surface is farther than this is "
+            "unstable: the beams are sparse there (a wall seen at a grazing angle), so the end is wherever the last "
+            "beam fell and moves with the robot (0 = off; the thesis defines stability only loosely)"
+        ),
+    )
+    end_spacing_grazing: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "3.1.4: with the beam-spacing test, also require the spacing to exceed this multiple of the spacing "
+            "the same beams would have on a surface facing the robot (a grazing angle beyond arccos(1/value)), so "
+            "far ends seen face-on keep their label (0 = the spacing alone decides)"
+        ),
+    )
+    surface_fit: Literal["chord", "tls"] = Field(
+        "chord",
+        description=(
+            "3.1.3 step 4: a surface is the chord from its first to its last point (the thesis), or the "
+            "total-least-squares line of its points with ends projected onto it and corners at the intersection "
+            "of neighbouring lines (Algorithm 4 allows any line extractor)"
+        ),
+    )
     # 3.1.5 recognition
     motion_model: Literal["thesis", "exact"] = Field(
         "thesis", description="eqs 3.1-3.2 distance+turn model, or the full SE(2) odometry increment (note 8)"
@@ -96,6 +123,59 @@ class Albot1Config(BaseModel):
             "eq 3.5 d_R: distance of the previous endpoint from the robot in the previous view (literal) "
             "or predicted into the current view"
         ),
+    )
+    # Albot1+ (docs/albot1-mapper.md, "Albot1+"): how a pose is computed; "landmark" is the thesis
+    pose_estimate: Literal["landmark", "robust"] = Field(
+        "landmark",
+        description=(
+            "3.1.6: the pose of the best-ranked landmark alone (Algorithm 2), or robust least squares over all "
+            "recognised landmarks started from it (Albot1+)"
+        ),
+    )
+    robust_line_sigma_m: float = Field(
+        0.05, gt=0, description="Albot1+: sigma of a landmark endpoint's distance to its map copy's line"
+    )
+    robust_point_sigma_m: float = Field(
+        0.1, gt=0, description="Albot1+: sigma of a stable endpoint's distance to its map copy"
+    )
+    robust_huber_sigmas: float = Field(
+        2.0, gt=0, description="Albot1+: Huber threshold in sigmas (residuals beyond it count linearly)"
+    )
+    robust_iterations: int = Field(8, ge=1, description="Albot1+: Gauss-Newton iterations at most")
+    scan_refinement: bool = Field(
+        False,
+        description="Albot1+: also fit the view's points to the surfaces of the last update view (point-to-line)",
+    )
+    scan_sigma_m: float = Field(0.05, gt=0, description="Albot1+: sigma of a view point's distance to its surface")
+    scan_gate_m: float = Field(
+        0.5, gt=0, description="Albot1+: a view point farther than this from every update-view surface is unused"
+    )
+    scan_beam_stride: int = Field(2, ge=1, description="Albot1+: use every n-th return of the scan")
+    odometry_prior: Literal["off", "fixed", "adaptive"] = Field(
+        "off",
+        description=(
+            "Albot1+: the odometry since the last update as a prior whose variance grows with the motion since "
+            "then, at the configured rate (fixed) or at a rate learnt from the views (adaptive)"
+        ),
+    )
+    prior_xy_m_per_sqrt_m: float = Field(
+        0.05,
+        ge=0,
+        description="Albot1+: odometry position sigma per sqrt(m) of motion (fixed prior; adaptive: start value)",
+    )
+    prior_deg_per_sqrt_m: float = Field(
+        2.0,
+        ge=0,
+        description="Albot1+: odometry heading sigma per sqrt(m) of motion (fixed prior; adaptive: start value)",
+    )
+    prior_m_per_rad: float = Field(
+        1.0, ge=0, description="Albot1+: a turn of one radian counts as this many metres of motion for the prior"
+    )
+    prior_learning_rate: float = Field(
+        0.02,
+        gt=0,
+        le=1,
+        description="Albot1+: weight of the newest view in the adaptive prior's estimate (exponential forgetting)",
     )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
@@ -146,5 +226,24 @@ class Albot1Config(BaseModel):
             corner_min_turn=math.radians(self.corner_min_angle_deg),
             occlusion_margin=self.occlusion_margin_m,
             continuation_tolerance=self.continuation_tolerance_m,
+            end_spacing_max=self.end_spacing_max_m,
+            end_spacing_grazing=self.end_spacing_grazing,
+            fit_lines=self.surface_fit == "tls",
         )
 
+    def plus_params(self) -> PlusParams:
+        return PlusParams(
+            line_sigma=self.robust_line_sigma_m,
+            point_sigma=self.robust_point_sigma_m,
+            huber=self.robust_huber_sigmas,
+            iterations=self.robust_iterations,
+            scan_refinement=self.scan_refinement,
+            scan_sigma=self.scan_sigma_m,
+            scan_gate=self.scan_gate_m,
+            scan_stride=self.scan_beam_stride,
+            prior=self.odometry_prior,
+            xy_per_sqrt_m=self.prior_xy_m_per_sqrt_m,
+            rad_per_sqrt_m=math.radians(self.prior_deg_per_sqrt_m),
+            m_per_rad=self.prior_m_per_rad,
+            learning_rate=self.prior_learning_rate,
+        )

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from albot1.config.presets import TomlPresets
@@ -34,6 +35,7 @@ from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.accel import perception_kernels
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
@@ -61,7 +63,8 @@ class UpdateEvent:
     Chapter 4's places layer marks the surfaces entering the map with the
     current place and counts the map surfaces the view co-locates with
     (deleted, extended or trimmed) before they go. ``view`` is ``initial``,
-    ``current``, ``previous`` or ``forced`` (:meth:`Albot1Mapper.force_update`).
+    ``current``, ``previous`` or ``forced`` (:meth:`Albot1Mapper.force_update`);
+    ``view_map`` is that view's surfaces placed in the map (thesis frame).
     """
 
     scan: int
@@ -69,6 +72,7 @@ class UpdateEvent:
     view_scan: int
     pose: Pose
     outcome: UpdateOutcome
+    view_map: NDArray[np.float64]
 
 
 @dataclass(slots=True)
@@ -123,6 +127,15 @@ class Albot1Mapper:
         self._n = 0
         self._counts = _Counts()
         self._trace: list[dict[str, Any]] = []
+        # Albot1+ (pose_estimate="robust"): the localiser, this scan's points and odometry, the last update view's.
+        self._plus = (
+            PlusLocaliser(config.plus_params(), self._mk, config.max_range_m)
+            if config.pose_estimate == "robust"
+            else None
+        )
+        self._points = np.empty((0, 2))
+        self._odometry: Pose = (0.0, 0.0, 0.0)
+        self._update_odometry: Pose = (0.0, 0.0, 0.0)
         #: Called after every map update (chapter 4's places observe the map through it); None: nobody listens.
         self.on_update: Callable[[UpdateEvent], None] | None = None
 
@@ -156,6 +169,7 @@ class Albot1Mapper:
             which="forced",
             source="current",
             reference=-1,
+            odometry=prev.odometry,
         )
 
     # -- Algorithm 4 -------------------------------------------------------
@@ -170,6 +184,9 @@ class Albot1Mapper:
         odo = (float(frame.odometry[0]), float(frame.odometry[1]), float(frame.odometry[2]))
         if not all(map(math.isfinite, odo)):
             raise MappingError(f"scan {frame.index}: odometry {odo} is not finite")
+        self._odometry = odo
+        if self._plus is not None:
+            self._points = self._plus.scan_points(scan.ranges, scan.angles)
         c = self._counts
         c.views += 1
         if len(view) == 0:
@@ -179,7 +196,9 @@ class Albot1Mapper:
         prev = self._prev
         if prev is None:
             pose: Pose = (0.0, 0.0, 0.0)
-            tracked = self._update(view, lms, pose, n, trigger=n, which="initial", source="initial", reference=-1)
+            tracked = self._update(
+                view, lms, pose, n, trigger=n, which="initial", source="initial", reference=-1, odometry=odo
+            )
             c.recognised.append(0)
         else:
             tracked, pose = self._step(n, view, lms, odo, prev)
@@ -214,20 +233,34 @@ class Albot1Mapper:
                 which="previous",
                 source="stored",
                 reference=-1,
+                odometry=prev.odometry,
             )
             rl = self._recognise(prev.tracked, lms, step)
             if len(rl) >= cfg.min_landmarks:
                 return rl, self._pose_between_updates(rl, prev.pose, step)
             c.double_updates += 1
         # Lines 13-17: update with the current view.
-        loc = self._localise(rl)
+        if self._plus is not None:
+            pose, loc = self._robust_pose(rl, prev.pose, step)
+        else:
+            loc = self._localise(rl)
+            pose = compose_pose(prev.pose, step) if loc is None else loc.pose
         if loc is None:
             c.path_integration += 1
-            pose, source, ref = compose_pose(prev.pose, step), "odometry", -1
+            source, ref = "odometry", -1
         else:
-            pose, source, ref = loc.pose, "landmark", loc.reference_id
+            source, ref = ("landmark" if self._plus is None else "robust"), loc.reference_id
         tracked = self._update(
-            view, lms, pose, n, trigger=n, which="current", source=source, reference=ref, recognised=len(rl)
+            view,
+            lms,
+            pose,
+            n,
+            trigger=n,
+            which="current",
+            source=source,
+            reference=ref,
+            recognised=len(rl),
+            odometry=odo,
         )
         return tracked, pose
 
@@ -254,8 +287,41 @@ class Albot1Mapper:
             distance_view=self.config.goodness_distance_view,
         )
 
+    def _robust_pose(self, rl: Tracked, prev_pose: Pose, step: Pose) -> tuple[Pose, Localisation | None]:
+        """Albot1+: from the thesis's pose (or the odometry step), robust least squares over every landmark.
+
+        Returns the pose and the thesis's localisation it started from (None:
+        no landmark could place the robot; the start was the odometry).
+        """
+        assert self._plus is not None
+        loc = self._localise(rl)
+        start = compose_pose(prev_pose, step) if loc is None else loc.pose
+        rows: list[int] = []
+        maps: list[np.ndarray] = []
+        map_kinds: list[np.ndarray] = []
+        for r, sid in enumerate(rl.ids.tolist()):
+            record = self._landmark_map.get(sid)
+            if record is not None:
+                rows.append(r)
+                maps.append(record[0])
+                map_kinds.append(record[1])
+        lm_view = np.ascontiguousarray(rl.surfaces[rows], dtype=float).reshape(-1, 4)
+        lm_map = np.ascontiguousarray(np.asarray(maps, dtype=float).reshape(-1, 4))
+        kinds = (rl.kinds[rows].reshape(-1, 2), np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2))
+        since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
+        return self._plus.pose(start, lm_view, lm_map, kinds, self._points, since), loc
+
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
-        """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md)."""
+        """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md).
+
+        Albot1+ refines the same start (:meth:`_robust_pose`); a step whose
+        start was the odometry still counts in ``odometry_pose_steps``.
+        """
+        if self._plus is not None:
+            pose, loc = self._robust_pose(rl, prev_pose, step)
+            if loc is None:
+                self._counts.odometry_pose_steps += 1
+            return pose
         if self.config.pose_between_updates == "localise":
             loc = self._localise(rl)
             if loc is not None:
@@ -274,14 +340,22 @@ class Albot1Mapper:
         which: str,
         source: str,
         reference: int,
+        odometry: Pose,
         recognised: int | None = None,
     ) -> Tracked:
-        """``updatePM`` with ``view`` placed at ``pose``; returns the landmark list reset to its landmarks."""
+        """``updatePM`` with ``view`` placed at ``pose``; returns the landmark list reset to its landmarks.
+
+        ``odometry`` is the view's own odometry: Albot1+ measures the motion
+        since the update from it.
+        """
         c = self._counts
         view_map = transform_segments(pose, view.surfaces)
+        self._update_odometry = odometry
+        if self._plus is not None:
+            self._plus.reset(view_map, pose)
         out = update_map(self.map, view_map, (pose[0], pose[1]), view_scan, self._update_params, self._mk)
         if self.on_update is not None:
-            self.on_update(UpdateEvent(trigger, which, view_scan, pose, out))
+            self.on_update(UpdateEvent(trigger, which, view_scan, pose, out, view_map))
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]

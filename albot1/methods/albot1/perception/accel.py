@@ -22,7 +22,7 @@ class PerceptionKernels(NamedTuple):
 
     jitted: bool
     build_view: Callable[
-        [FloatArray, FloatArray, float, float, float, float, float, float, float, float],
+        [FloatArray, FloatArray, float, float, float, float, float, float, float, float, float, float, bool],
         tuple[FloatArray, IntArray, IntArray, IntArray],
     ]
     recognise_landmarks: Callable[

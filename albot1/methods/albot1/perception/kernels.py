@@ -39,6 +39,9 @@ def build_view(
     corner_min_turn: float,
     occlusion_margin: float,
     continuation_tolerance: float,
+    end_spacing_max: float,
+    grazing: float,
+    fit_lines: bool,
 ) -> tuple[FloatArray, IntArray, IntArray, IntArray]:
     """Thesis 3.1.3 steps 1-5 plus endpoint classification (3.1.4) for one scan.
 
@@ -46,6 +49,16 @@ def build_view(
     angle descending). Returns ``surfaces (m, 4)`` (x1, y1, x2, y2, thesis
     frame, left to right), ``kinds (m, 2)`` (endpoint codes), ``beams (m, 2)``
     (thesis-order beam index of each endpoint) and ``cluster (m,)``.
+
+    ``end_spacing_max`` > 0 turns an occluding or corner end unstable when
+    the next point on its own surface is farther from it than that: the
+    beams are sparse there (a wall seen at a grazing angle), so the end is
+    wherever the last beam happened to fall and moves with the robot.
+    ``fit_lines`` replaces the chord (first to last point, the thesis's
+    surface) by the total-least-squares line of the piece's points, ends
+    projected onto it, and puts a point shared by two neighbouring pieces
+    at the intersection of their lines (:func:`_fit_piece`,
+    :func:`_join_corner`). Labels are decided on the raw points either way.
     """
     n = ranges.shape[0]
     px = np.empty(n)
@@ -117,6 +130,8 @@ def build_view(
                 npieces += 1
     # Steps 4-5, surface forming and filtering, with endpoint kinds.
     m = 0
+    # The fitted line of each output surface (centre and unit direction), for corner intersections.
+    line = np.empty((max(npieces, 1), 4))
     for p in range(npieces):
         i0 = piece_a[p]
         i1 = piece_b[p]
@@ -146,8 +161,137 @@ def build_view(
         else:
             q1 = piece_b[p + 1]
             out_k[m, 1] = _corner(px, py, i0, i1, q1, corner_min_turn)
+        if end_spacing_max > 0.0 and i1 > i0:
+            if is_stable(out_k[m, 0]) and _sparse_end(
+                px, py, ranges, angles, beam, i0, i0 + 1, end_spacing_max, grazing
+            ):
+                out_k[m, 0] = UNSTABLE
+            if is_stable(out_k[m, 1]) and _sparse_end(
+                px, py, ranges, angles, beam, i1, i1 - 1, end_spacing_max, grazing
+            ):
+                out_k[m, 1] = UNSTABLE
+        if fit_lines:
+            _fit_piece(px, py, i0, i1, i0 != starts[c], i1 != starts[c + 1] - 1, out_s, line, m)
+            if m > 0 and out_c[m - 1] == c and out_b[m - 1, 1] == out_b[m, 0]:
+                _join_corner(line, out_s, m, px[i0], py[i0])
         m += 1
     return out_s[:m], out_k[:m], out_b[:m], out_c[:m]
+
+
+def _sparse_end(
+    px: FloatArray,
+    py: FloatArray,
+    ranges: FloatArray,
+    angles: FloatArray,
+    beam: IntArray,
+    e: int,
+    q: int,
+    spacing_max: float,
+    grazing: float,
+) -> bool:
+    """Whether the end point ``e`` lies too far from its neighbour ``q`` on the same surface to be a fixed edge.
+
+    Sparse: farther than ``spacing_max``, and (with ``grazing`` > 0) farther
+    than ``grazing`` times the spacing the same two beams would have on a
+    surface facing the robot (range times the angle between them), i.e. the
+    beams meet the surface at a grazing angle, beyond ``arccos(1 / grazing)``.
+    """
+    spacing = np.hypot(px[q] - px[e], py[q] - py[e])
+    if spacing <= spacing_max:
+        return False
+    if grazing > 0.0:
+        facing = ranges[beam[e]] * abs(angles[beam[q]] - angles[beam[e]])
+        return spacing > grazing * facing
+    return True
+
+
+#: A point shared by two fitted lines moves to their intersection only if they turn by at least this (sine)...
+TLS_CORNER_MIN_SINE = math.sin(math.radians(10.0))
+#: ... and the intersection lies within this of the shared point (m); otherwise each end keeps its projection.
+TLS_CORNER_MAX_SHIFT_M = 0.3
+
+
+def _fit_piece(
+    px: FloatArray,
+    py: FloatArray,
+    i0: int,
+    i1: int,
+    shared_start: bool,
+    shared_end: bool,
+    out_s: FloatArray,
+    line: FloatArray,
+    m: int,
+) -> None:
+    """Surface ``m`` as the total-least-squares line of points ``i0..i1``, ends projected onto it.
+
+    A point shared with the neighbouring piece (a split point) lies near
+    the corner, on either wall; it is left out of the fit when at least
+    three points remain. ``line[m]`` gets the line's centre and unit
+    direction (P1 to P2).
+    """
+    a0 = i0 + 1 if shared_start and i1 - i0 >= 3 else i0
+    a1 = i1 - 1 if shared_end and i1 - a0 >= 3 else i1
+    count = a1 - a0 + 1
+    mx = 0.0
+    my = 0.0
+    for j in range(a0, a1 + 1):
+        mx += px[j]
+        my += py[j]
+    mx /= count
+    my /= count
+    sxx = 0.0
+    syy = 0.0
+    sxy = 0.0
+    for j in range(a0, a1 + 1):
+        dx = px[j] - mx
+        dy = py[j] - my
+        sxx += dx * dx
+        syy += dy * dy
+        sxy += dx * dy
+    # The principal axis of the scatter (the direction minimising the summed squared distances to the line).
+    theta = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
+    ux = math.cos(theta)
+    uy = math.sin(theta)
+    if ux * (px[i1] - px[i0]) + uy * (py[i1] - py[i0]) < 0.0:
+        ux = -ux
+        uy = -uy
+    t0 = (px[i0] - mx) * ux + (py[i0] - my) * uy
+    t1 = (px[i1] - mx) * ux + (py[i1] - my) * uy
+    out_s[m, 0] = mx + t0 * ux
+    out_s[m, 1] = my + t0 * uy
+    out_s[m, 2] = mx + t1 * ux
+    out_s[m, 3] = my + t1 * uy
+    line[m, 0] = mx
+    line[m, 1] = my
+    line[m, 2] = ux
+    line[m, 3] = uy
+
+
+def _join_corner(line: FloatArray, out_s: FloatArray, m: int, sx: float, sy: float) -> None:
+    """Put the point shared by surfaces ``m - 1`` and ``m`` (raw position ``sx, sy``) where their lines cross.
+
+    Only when the lines turn by at least :data:`TLS_CORNER_MIN_SINE` and the
+    crossing is within :data:`TLS_CORNER_MAX_SHIFT_M` of the shared point:
+    nearly parallel lines cross far away or nowhere.
+    """
+    vx = line[m - 1, 2]
+    vy = line[m - 1, 3]
+    ux = line[m, 2]
+    uy = line[m, 3]
+    den = vx * uy - vy * ux
+    if abs(den) < TLS_CORNER_MIN_SINE:
+        return
+    wx = line[m, 0] - line[m - 1, 0]
+    wy = line[m, 1] - line[m - 1, 1]
+    t = (wx * uy - wy * ux) / den
+    qx = line[m - 1, 0] + t * vx
+    qy = line[m - 1, 1] + t * vy
+    if np.hypot(qx - sx, qy - sy) > TLS_CORNER_MAX_SHIFT_M:
+        return
+    out_s[m - 1, 2] = qx
+    out_s[m - 1, 3] = qy
+    out_s[m, 0] = qx
+    out_s[m, 1] = qy
 
 
 def _occlusion(

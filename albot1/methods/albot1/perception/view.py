@@ -34,6 +34,10 @@ class ViewParams:
     smallest turn between two pieces of one cluster that makes their shared
     point a corner (the thesis gives none); ``occlusion_margin`` is how much
     farther the next return outward must be for a cluster end to occlude.
+    ``end_spacing_max`` (0 = off) makes an occluding or corner end unstable
+    where the next point on its surface is farther than that (a grazing
+    view); ``fit_lines`` forms surfaces by total least squares with corners
+    at the intersection of neighbouring lines instead of the chord.
     """
 
     max_range: float = 30.0
@@ -44,6 +48,9 @@ class ViewParams:
     corner_min_turn: float = math.radians(30.0)
     occlusion_margin: float = 0.0
     continuation_tolerance: float = 0.1
+    end_spacing_max: float = 0.0
+    end_spacing_grazing: float = 0.0
+    fit_lines: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -93,5 +100,8 @@ def construct_view(
         params.corner_min_turn,
         params.occlusion_margin,
         params.continuation_tolerance,
+        params.end_spacing_max,
+        params.end_spacing_grazing,
+        params.fit_lines,
     )
     return View(surfaces, kinds, beams, cluster)

@@ -2,9 +2,10 @@
 
 The chapter-3 fields are inherited from
 :class:`~albot1.methods.albot1.mapping.config.Albot1Config` unchanged (the
-places layer wraps that mapper); the presets file
-``albot1/methods/albot1/places/presets.toml`` mirrors the chapter-3 presets
-and adds these fields. Where the thesis gives a value (the 40 cm surface
+places layer wraps that mapper); the chapter-4 ones are :class:`PlacesFields`,
+whose values live in ``albot1/methods/albot1/places/presets.toml``
+(:mod:`albot1.methods.albot1.places.presets` puts each on the chapter-3
+preset of the same name). Where the thesis gives a value (the 40 cm surface
 length, 40 cm gap and 5 degrees of Algorithm 6, "more than 4" matches, exits
 of about 1 m) it is the default; every other value is our reading, listed
 with its reason in ``docs/places.md``.
@@ -16,7 +17,7 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from albot1.methods.albot1.mapping.config import Albot1Config
 
@@ -53,10 +54,13 @@ class MatchParams:
     trigger_min: int = 4
     retry_growth: int = 3
     max_conflicts: int = 1
+    max_turn: float = math.radians(45.0)
 
 
-class Albot1PlacesConfig(Albot1Config):
-    """Config of the places mapper (lengths in metres, angles in degrees)."""
+class PlacesFields(BaseModel):
+    """The chapter-4 fields alone (lengths in metres, angles in degrees); ``places/presets.toml`` sets these."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     # exits (4.1.1: "a gap whose typical size is about 1 meter")
     exit_min_width_m: float = Field(0.6, gt=0, description="4.1.1: narrowest gap between two endpoints that is an exit")
@@ -118,6 +122,23 @@ class Albot1PlacesConfig(Albot1Config):
             "current view sees empty space (our addition; a large value turns it off)"
         ),
     )
+    match_max_turn_deg: float = Field(
+        45.0,
+        gt=0,
+        le=180,
+        description=(
+            "hypotheses turn a remembered place by at most this from where the perceptual map put it (the map "
+            "drifts slowly; 180 = any turn, the thesis's search)"
+        ),
+    )
+    revisit_evidence: Literal["memory", "perceptual_map"] = Field(
+        "memory",
+        description=(
+            "4.1.2 co-locating surfaces: the view against each remembered place's surfaces where the map held "
+            "them when learned, or (literal) the map surfaces an update deletes or edits, by the places they "
+            "were marked with"
+        ),
+    )
     revisit_trigger_fraction: float = Field(
         0.2,
         ge=0,
@@ -148,7 +169,7 @@ class Albot1PlacesConfig(Albot1Config):
     )
 
     @model_validator(mode="after")
-    def _widths_ordered(self) -> Albot1PlacesConfig:
+    def _widths_ordered(self) -> PlacesFields:
         if self.exit_min_width_m >= self.exit_max_width_m:
             raise ValueError(
                 f"exit_min_width_m ({self.exit_min_width_m}) must be smaller than exit_max_width_m "
@@ -184,4 +205,11 @@ class Albot1PlacesConfig(Albot1Config):
             trigger_min=self.revisit_trigger_min,
             retry_growth=self.match_retry_growth,
             max_conflicts=self.match_max_conflicts,
+            max_turn=math.radians(self.match_max_turn_deg),
         )
+
+
+class Albot1PlacesConfig(Albot1Config, PlacesFields):
+    """Config of ``albot1-places``: every chapter-3 field (:class:`Albot1Config`) and the chapter-4 ones."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)

@@ -223,7 +223,7 @@ class ExitTracker:
         changed = clear & (self._side != 0) & (side != self._side)
         best: Crossing | None = None
         best_distance = math.inf
-        for r in np.flatnonzero(changed & (self._sightings >= p.min_sightings)).tolist():
+        for r in np.flatnonzero(changed & self._recent(scan)).tolist():
             before = (float(self._side_at[r, 0]), float(self._side_at[r, 1]))
             if not _passes_between(before, position, seg[r], p.crossing_margin):
                 continue

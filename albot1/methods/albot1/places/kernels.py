@@ -241,35 +241,51 @@ def _refine(
     return theta, (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
 
 
-def _seen_empty(x: float, y: float, poly: FloatArray, margin: float) -> bool:
-    """Whether (x, y) lies inside the view polygon ``poly`` (even-odd) and farther than ``margin`` from its edges."""
-    v = poly.shape[0]
-    inside = False
-    for e in range(v):
-        ax = poly[e, 0]
-        ay = poly[e, 1]
-        bx = poly[(e + 1) % v, 0]
-        by = poly[(e + 1) % v, 1]
-        if (ay > y) != (by > y):
-            if x < ax + (y - ay) * (bx - ax) / (by - ay):
-                inside = not inside
-    if not inside:
-        return False
-    for e in range(v):
-        ax = poly[e, 0]
-        ay = poly[e, 1]
-        bx = poly[(e + 1) % v, 0]
-        by = poly[(e + 1) % v, 1]
-        t = closest_parameter(x, y, ax, ay, bx, by)
-        if np.hypot(ax + t * (bx - ax) - x, ay + t * (by - ay) - y) <= margin:
-            return False
-    return True
+def _seen_empty(x: float, y: float, polys: FloatArray, starts: IntArray, margin: float) -> bool:
+    """Whether (x, y) lies inside one of the view polygons (even-odd) by more than ``margin``.
+
+    Polygon ``p`` is ``polys[starts[p]:starts[p + 1]]`` (implicitly closed).
+    """
+    for p in range(starts.shape[0] - 1):
+        lo = starts[p]
+        v = starts[p + 1] - lo
+        inside = False
+        for e in range(v):
+            ax = polys[lo + e, 0]
+            ay = polys[lo + e, 1]
+            bx = polys[lo + (e + 1) % v, 0]
+            by = polys[lo + (e + 1) % v, 1]
+            if (ay > y) != (by > y):
+                if x < ax + (y - ay) * (bx - ax) / (by - ay):
+                    inside = not inside
+        if not inside:
+            continue
+        clear = True
+        for e in range(v):
+            ax = polys[lo + e, 0]
+            ay = polys[lo + e, 1]
+            bx = polys[lo + (e + 1) % v, 0]
+            by = polys[lo + (e + 1) % v, 1]
+            t = closest_parameter(x, y, ax, ay, bx, by)
+            if np.hypot(ax + t * (bx - ax) - x, ay + t * (by - ay) - y) <= margin:
+                clear = False
+                break
+        if clear:
+            return True
+    return False
 
 
 def _conflicts(
-    remembered: FloatArray, theta: float, tx: float, ty: float, partner: IntArray, poly: FloatArray, margin: float
+    remembered: FloatArray,
+    theta: float,
+    tx: float,
+    ty: float,
+    partner: IntArray,
+    polys: FloatArray,
+    starts: IntArray,
+    margin: float,
 ) -> int:
-    """Unmatched remembered surfaces the hypothesis puts where the current view sees empty space (their midpoints)."""
+    """Unmatched remembered surfaces the hypothesis puts where the current place's views saw empty space."""
     c = math.cos(theta)
     s = math.sin(theta)
     n = 0
@@ -278,7 +294,7 @@ def _conflicts(
             continue
         mx = 0.5 * (remembered[kk, 0] + remembered[kk, 2])
         my = 0.5 * (remembered[kk, 1] + remembered[kk, 3])
-        if _seen_empty(tx + c * mx - s * my, ty + s * mx + c * my, poly, margin):
+        if _seen_empty(tx + c * mx - s * my, ty + s * mx + c * my, polys, starts, margin):
             n += 1
     return n
 
@@ -291,8 +307,11 @@ def match_structure(
     max_gap: float,
     min_matches: int,
     anchors: int,
-    view_polygon: FloatArray,
+    polygons: FloatArray,
+    polygon_starts: IntArray,
     max_conflicts: int,
+    prior_theta: float,
+    max_turn: float,
 ) -> tuple[bool, int, float, float, float]:
     """Algorithm 6: does a hypothesis ``S_j = S_k`` bring more than 4 remembered surfaces onto current ones?
 
@@ -313,10 +332,13 @@ def match_structure(
     angle error would push far surfaces out of the 40 cm) and counted again.
     The first hypothesis with at least ``min_matches`` matches whose matched
     current surfaces lie on both sides of the robot, and that puts at most
-    ``max_conflicts`` remembered surfaces where the current view saw empty
-    space (inside ``view_polygon``, the current view's polygon in the map,
-    by more than ``max_gap``: Algorithm 3 would have deleted them), confirms
-    (line 11's break). Returns ``(confirmed, best count, theta, tx, ty)``: the motion of
+    ``max_conflicts`` unmatched remembered surfaces where the current place's
+    views saw empty space (inside one of ``polygons`` by more than
+    ``max_gap``: the view polygons of Algorithm 3, which would have deleted
+    them; polygon p is ``polygons[polygon_starts[p]:polygon_starts[p + 1]]``),
+    confirms (line 11's break). Only hypotheses turning the remembered frame
+    within ``max_turn`` of ``prior_theta`` (where the perceptual map last put
+    that place's frame) are tried. Returns ``(confirmed, best count, theta, tx, ty)``: the motion of
     the confirming hypothesis (or of the best one) mapping the remembered
     frame into the map frame.
     """
@@ -336,6 +358,8 @@ def match_structure(
     for j in range(nj):
         for k in range(nk):
             theta0 = wrap_angle(dir_j[j] - dir_k[k])
+            if abs(wrap_angle(theta0 - prior_theta)) > max_turn:
+                continue
             c = math.cos(theta0)
             s = math.sin(theta0)
             for a in range(anchors):
@@ -369,6 +393,7 @@ def match_structure(
                     best_tx = tx
                     best_ty = ty
                 if count >= min_matches and left and right:
-                    if _conflicts(remembered, theta, tx, ty, partner, view_polygon, max_gap) <= max_conflicts:
+                    conflicts = _conflicts(remembered, theta, tx, ty, partner, polygons, polygon_starts, max_gap)
+                    if conflicts <= max_conflicts:
                         return True, count, theta, tx, ty
     return False, max(best, 0), best_theta, best_tx, best_ty

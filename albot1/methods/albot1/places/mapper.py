@@ -35,23 +35,28 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel
 
-from albot1.config.presets import TomlPresets
 from albot1.contract import MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
+from albot1.methods.albot1.mapping.accel import mapping_kernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
 from albot1.methods.albot1.places.exits import Crossing, ExitTracker
 from albot1.methods.albot1.places.matcher import confirm, structural, trigger_threshold
-from albot1.methods.albot1.places.memory import PlaceNetwork, Visit, invert, same_surfaces
+from albot1.methods.albot1.places.memory import Place, PlaceNetwork, Visit, invert, same_surfaces
 from albot1.methods.albot1.places.navigation import Prediction, align_at_exit, nearest_prediction, predict
 from albot1.methods.albot1.places.network import network_files
+from albot1.methods.albot1.places.presets import PlacesPresets
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+
+
+#: The current place's empty space is that of its last this many updates (bounds the conflict test's cost).
+_MAX_POLYGONS = 30
 
 
 @dataclass
@@ -68,13 +73,14 @@ class Albot1PlacesMapper:
 
     name: ClassVar[str] = "albot1-places"
     config_model: ClassVar[type[BaseModel]] = Albot1PlacesConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets(package="albot1.methods.albot1.places")  # type: ignore[assignment]
+    presets: ClassVar[dict[str, dict[str, Any]]] = PlacesPresets()  # type: ignore[assignment]
 
     def __init__(self, config: Albot1PlacesConfig, *, seed: int = 0) -> None:
         self.config = config
         self.inner = Albot1Mapper(config, seed=seed)
         self.inner.on_update = self._on_update
         self._k = places_kernels(config.accelerate)
+        self._mk = mapping_kernels(config.accelerate)
         self._match = config.match_params()
         self.exits = ExitTracker(config.exit_params(), self._k)
         self._same_angle = math.radians(config.match_angle_deg)
@@ -82,9 +88,11 @@ class Albot1PlacesMapper:
         self.network = PlaceNetwork(
             same_angle=self._same_angle, same_gap=self._same_gap, link_distance=config.exit_link_distance_m
         )
-        self._labels: list[set[int]] = []  # map surface id -> the visits it belongs to (see _on_update)
+        self._labels: list[set[int]] = []  # map surface id -> the visits it belongs to (see _map_evidence)
+        self._placed_cache: dict[int, tuple[Any, FloatArray, FloatArray]] = {}
         self._members: dict[int, set[int]] = {}  # visit -> the map surface ids marked with it
         self._through: set[int] = set()  # surfaces the current visit saw only through an exit
+        self._polygons: list[FloatArray] = []  # the view polygons of the current visit's updates (seen empty)
         self._evidence: dict[int, set[int]] = {}  # place -> its surfaces the current visit's updates co-located with
         self._ahead: dict[int, dict[int, set[int]]] = {}  # exit track -> the same, for what was seen through it
         self._fresh = False  # evidence grew since the last check
@@ -115,46 +123,24 @@ class Albot1PlacesMapper:
         self._n += 1
 
     def _on_update(self, event: UpdateEvent) -> None:
-        """Count co-locating surfaces per remembered place, then mark the view's surfaces with the current visit.
-
-        A surface belongs to every visit that brought it into the map, and a
-        surface an update adds in place of one it deleted (the same within 5
-        degrees and 40 cm: the same wall seen again) inherits that one's
-        visits: the perceptual map replaces surfaces rather than editing
-        them, and without the inheritance a room's surfaces would lose their
-        place as soon as a neighbour's view through the doorway replaced them.
-        """
-        out = event.outcome
-        network = self.network
-        current = network.current
-        labels = self._labels
-        top = int(max(out.view_ids.max(initial=-1), out.added.max(initial=-1))) + 1
-        while len(labels) < top:
-            labels.append(set())
-        touched = np.concatenate([out.deleted, out.extended, out.trimmed])
-        if len(touched):
-            # What co-locates on this side of the exits is evidence about the current place; what was seen
-            # through an exit, about the place beyond it (kept until that exit is crossed).
-            seg = self.inner.map.segments(touched)
-            through = self.exits.beyond((event.pose[0], event.pose[1]), 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
-            excluded = {network.find(v.place) for v in network.visits[-2:] if v.place is not None}
-            for sid, exit_id in zip(touched.tolist(), through.tolist()):
-                places = {network.find(p) for p in (network.visits[v].place for v in labels[sid]) if p is not None}
-                evidence = self._evidence if exit_id < 0 else self._ahead.setdefault(exit_id, {})
-                for place in places - excluded:
-                    evidence.setdefault(place, set()).add(sid)
-                    self._fresh = self._fresh or exit_id < 0
-        if len(out.added) and len(out.deleted):
-            pmap = self.inner.map
-            same = same_surfaces(pmap.segments(out.added), pmap.segments(out.deleted), self._same_angle, self._same_gap)
-            deleted = out.deleted.tolist()
-            for row, col in zip(*np.nonzero(same)):
-                labels[int(out.added[row])] |= labels[deleted[col]]
+        """Gather re-visit evidence from the update, then mark the view's surfaces with the current visit."""
+        current = self.network.current
+        if self.config.revisit_evidence == "memory":
+            self._memory_evidence(event)
+        else:
+            self._map_evidence(event)
+        if len(event.view_map):
+            robot = (event.pose[0], event.pose[1])
+            self._polygons.append(view_polygon(event.view_map, robot, "robot_and_endpoints"))
+            del self._polygons[:-_MAX_POLYGONS]
         members = self._members.setdefault(current.id, set())
-        ids = out.view_ids
+        ids = event.outcome.view_ids
         if len(ids):
             seg = self.inner.map.segments(ids)
             through = self.exits.beyond((event.pose[0], event.pose[1]), 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
+            labels = self._labels
+            while len(labels) <= int(ids.max()):
+                labels.append(set())
             for sid, exit_id in zip(ids.tolist(), through.tolist()):
                 labels[sid].add(current.id)
                 members.add(sid)
@@ -162,6 +148,102 @@ class Albot1PlacesMapper:
                     self._through.add(sid)
                 else:
                     self._through.discard(sid)
+
+    def _add_evidence(self, place: int, key: int, exit_id: int) -> None:
+        """Surface ``key`` of ``place`` co-located: here (``exit_id`` -1) or seen through exit ``exit_id``."""
+        evidence = self._evidence if exit_id < 0 else self._ahead.setdefault(exit_id, {})
+        evidence.setdefault(place, set()).add(key)
+        self._fresh = self._fresh or exit_id < 0
+
+    def _map_evidence(self, event: UpdateEvent) -> None:
+        """``revisit_evidence = "perceptual_map"``: the places of the map surfaces the update deletes or edits.
+
+        The literal 4.1.2: "it checks to which places these surfaces belong
+        before it deletes them". A surface belongs to every visit that brought
+        it into the map, and a surface an update adds in place of one it
+        deleted (the same within 5 degrees and 40 cm: the same wall seen
+        again) inherits that one's visits, since the perceptual map replaces
+        surfaces rather than editing them.
+        """
+        out = event.outcome
+        network = self.network
+        labels = self._labels
+        top = int(max(out.view_ids.max(initial=-1), out.added.max(initial=-1))) + 1
+        while len(labels) < top:
+            labels.append(set())
+        touched = np.concatenate([out.deleted, out.extended, out.trimmed])
+        if len(touched):
+            seg = self.inner.map.segments(touched)
+            through = self.exits.beyond((event.pose[0], event.pose[1]), 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
+            excluded = self._excluded()
+            for sid, exit_id in zip(touched.tolist(), through.tolist()):
+                places = {network.find(p) for p in (network.visits[v].place for v in labels[sid]) if p is not None}
+                for place in places - excluded:
+                    self._add_evidence(place, sid, exit_id)
+        if len(out.added) and len(out.deleted):
+            pmap = self.inner.map
+            same = same_surfaces(pmap.segments(out.added), pmap.segments(out.deleted), self._same_angle, self._same_gap)
+            deleted = out.deleted.tolist()
+            for row, col in zip(*np.nonzero(same)):
+                labels[int(out.added[row])] |= labels[deleted[col]]
+
+    def _memory_evidence(self, event: UpdateEvent) -> None:
+        """``revisit_evidence = "memory"``: the remembered places' structure where the map held it when learned.
+
+        Each place's own surfaces (not those seen through its exits) are put
+        back where its frame lay in the perceptual map when it was created,
+        and co-locate with the incoming view when Algorithm 3 would delete or
+        edit them: an end inside the view's polygon or within the delete
+        margin (the chapter-3 rule and kernel). That is the perceptual map's
+        content before later updates deleted or merged it (the thesis's
+        limitation 3); see docs/places.md.
+        """
+        view = event.view_map
+        if not len(view):
+            return
+        cfg = self.config
+        robot = (event.pose[0], event.pose[1])
+        poly = view_polygon(view, robot, cfg.update_polygon)
+        lo, hi = poly.min(axis=0) - cfg.delete_margin_m, poly.max(axis=0) + cfg.delete_margin_m
+        excluded = self._excluded()
+        for place in self.network.live_places():
+            if place.id in excluded:
+                continue
+            placed, box = self._placed(place)
+            if len(placed) == 0 or (box[:2] > hi).any() or (box[2:] < lo).any():
+                continue
+            near = self._mk.classify_endpoints(
+                poly,
+                np.ascontiguousarray(view),
+                np.ascontiguousarray(placed.reshape(-1, 2)),
+                cfg.delete_margin_m,
+                cfg.delete_margin_from == "surfaces",
+            )
+            hit = np.flatnonzero(near.reshape(-1, 2).any(axis=1))
+            if len(hit) == 0:
+                continue
+            seg = placed[hit]
+            through = self.exits.beyond(robot, 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
+            for col, exit_id in zip(hit.tolist(), through.tolist()):
+                self._add_evidence(place.id, col, exit_id)
+
+    def _placed(self, place: Place) -> tuple[FloatArray, FloatArray]:
+        """A place's own surfaces in the map where its frame lay when created, with their bounding box (cached)."""
+        key = (len(place.surfaces), place.frame_map)
+        cached = self._placed_cache.get(place.id)
+        if cached is None or cached[0] != key:
+            own = place.surfaces[~place.through]
+            placed = transform_segments(place.frame_map, own) if len(own) else np.empty((0, 4))
+            pts = placed.reshape(-1, 2)
+            box = np.concatenate([pts.min(axis=0), pts.max(axis=0)]) if len(pts) else np.zeros(4)
+            cached = (key, placed, box)
+            self._placed_cache[place.id] = cached
+        return cached[1], cached[2]
+
+    def _excluded(self) -> set[int]:
+        """The current visit's place and the one just left: never candidates for a re-visit."""
+        network = self.network
+        return {network.find(v.place) for v in network.visits[-2:] if v.place is not None}
 
     def _visit_surfaces(self, visit: Visit) -> tuple[FloatArray, NDArray[np.bool_]]:
         """The map surfaces (thesis map frame) marked with the current ``visit`` (Algorithm 5 lines 2-6).
@@ -183,7 +265,7 @@ class Albot1PlacesMapper:
         compared = nearest_prediction(self._predicted, crossing.segment)
         surfaces, through = self._visit_surfaces(visit)
         place, exit_id = network.close(visit, surfaces, crossing.segment, n, through)
-        self._through = set()
+        self._through, self._polygons = set(), []
         entry = np.concatenate([crossing.segment[2:], crossing.segment[:2]])  # the place entered on its left
         target = network.leads(place, exit_id)
         nxt = network.start_visit(n, pose, entry, (place, exit_id))
@@ -254,10 +336,9 @@ class Albot1PlacesMapper:
     def _recognise(self, pose: Pose, n: int) -> None:
         network, params = self.network, self._match
         visit = network.current
-        excluded = {network.find(v.place) for v in network.visits[-2:] if v.place is not None}
+        excluded = self._excluded()
         current_all: FloatArray | None = None
         current: FloatArray | None = None
-        polygon: FloatArray | None = None
         counts = Counter({network.find(p): len(ids) for p, ids in self._evidence.items()})
         for place_id, count in sorted(counts.items(), key=lambda item: (-item[1], item[0])):
             if place_id in excluded:
@@ -275,13 +356,7 @@ class Albot1PlacesMapper:
             if last is not None and len(current_all) < last + params.retry_growth:
                 continue
             self._counts.match_attempts += 1
-            if polygon is None:
-                view = self.inner.last_view
-                assert view is not None
-                polygon = view_polygon(
-                    transform_segments(pose, view.surfaces), (pose[0], pose[1]), "robot_and_endpoints"
-                )
-            match = confirm(current, remembered, pose, polygon, params, self._k)
+            match = confirm(current, remembered, pose, self._polygons, place.frame_map, params, self._k)
             if not match.confirmed:
                 self._attempts[key] = len(current_all)
                 continue

@@ -109,13 +109,16 @@ def confirm(
     current_map: FloatArray,
     remembered_own: FloatArray,
     pose: Pose,
-    view_polygon: FloatArray,
+    view_polygons: list[FloatArray],
+    prior: Pose,
     params: MatchParams,
     kernels: PlacesKernels,
 ) -> Match:
     """Algorithm 6 on already selected surfaces (:func:`structural`); ``pose`` is the robot's, thesis frame.
 
-    ``view_polygon`` is the current view's polygon in the map (Algorithm 3 line 7): the space seen empty.
+    ``view_polygons`` are the polygons (Algorithm 3 line 7) of the current place's views in the map: the
+    space they saw empty. ``prior`` is where the perceptual map put the remembered place's frame; only
+    hypotheses turning it by at most ``params.max_turn`` are tried.
     """
     if len(current_map) == 0 or len(remembered_own) == 0:
         return Match(False, 0, (0.0, 0.0, 0.0))
@@ -127,7 +130,10 @@ def confirm(
         params.gap,
         params.min_matches,
         params.anchors,
-        np.ascontiguousarray(view_polygon, dtype=float).reshape(-1, 2),
+        np.ascontiguousarray(np.concatenate(view_polygons) if view_polygons else np.empty((0, 2))),
+        np.cumsum([0] + [len(p) for p in view_polygons]).astype(np.int64),
         params.max_conflicts,
+        float(prior[2]),
+        params.max_turn,
     )
     return Match(bool(found), int(count), (float(tx), float(ty), float(theta)))

@@ -77,15 +77,6 @@ class GtsamGraphConfig(BaseModel):
         ge=0, description="failed sequential matches are retried from the guess rotated by +-1..n steps"
     )
     seq_retry_rotation_deg: float = Field(gt=0, description="rotation step of those retries (deg)")
-    seq_reversed_guess: bool = Field(
-        description="also try the odometry step with its translation reversed when the match disagrees with it"
-    )
-    seq_reversed_min_correction_m: float = Field(
-        ge=0, description="... when the match moved the odometry guess at least this far (or failed)"
-    )
-    seq_reversed_min_gain: float = Field(
-        ge=0, le=1, description="... and keep the reversed match only if its inlier fraction is this much higher"
-    )
     match_sigma_floor_xy_m: float = Field(
         gt=0, description="added to every match's std dev (x, y): matches are never perfect"
     )

@@ -102,6 +102,7 @@ class GtsamGraphMapper:
         )
         # Tracking: the latest scan's pose in the frame of the newest node, and the local map it is matched against.
         self._track = np.zeros(3)
+        self._velocity = np.zeros(3)  # the last tracked scan-to-scan motion
         self._last_odometry: FloatArray | None = None
         self._local: Target | None = None
         # Per node.
@@ -125,9 +126,9 @@ class GtsamGraphMapper:
             "nodes": 0,
             "sequential_matches": 0,
             "sequential_retries_recovered": 0,
-            "sequential_reversed": 0,
             "scans_tracked": 0,
             "tracking_failures": 0,
+            "tracking_velocity_guess": 0,
             "odometry_fallbacks": 0,
             "loop_candidates": 0,
             "loop_coarse_searches": 0,
@@ -152,12 +153,14 @@ class GtsamGraphMapper:
                 self._start(odometry, points, frame.index)
             else:
                 guess = se2.compose(self._track, se2.between(self._last_odometry, odometry))
-                if self._moved_enough(guess):
-                    self._add_node(odometry, guess, points, frame.index)
+                reg = self._follow(guess, points)
+                pose = guess if reg is None else reg.pose
+                if self.config.track_scans:
+                    self._velocity = se2.between(self._track, pose)
+                if self._moved_enough(pose):
+                    self._add_node(odometry, pose, points, frame.index, reg)
                 else:
-                    self._track = self._follow(guess, points)
-                    if self._moved_enough(self._track):
-                        self._add_node(odometry, self._track, points, frame.index)
+                    self._track = pose
         except (
             GraphError,
             RegistrationError,
@@ -181,26 +184,37 @@ class GtsamGraphMapper:
             self._local = self._target(range(max(0, last - self.config.local_map_nodes + 1), last + 1), last)
         return self._local
 
-    def _follow(self, guess: FloatArray, points: FloatArray) -> FloatArray:
-        """Track a scan that makes no node: one ICP against the local map from ``guess``, else the guess itself.
+    def _follow(self, guess: FloatArray, points: FloatArray) -> Registration | None:
+        """Track a scan against the local map; the passing registration, or None (untracked: the guess stands).
 
-        Chaining scan-to-map matches keeps the guess of the next node's
-        sequential match within a scan period of odometry error, instead of
-        the whole node step (up to 28.6 deg of raw odometry, or a reversed
-        step on fr079, see :meth:`_try_reversed`).
+        Chaining scan-to-map matches keeps each guess within one scan period
+        of odometry error instead of a whole node step (up to 28.6 deg of raw
+        odometry). The odometry can also stall and then catch up (mit-csail
+        repeats its odometry on 87 scans and then jumps by up to 0.95 m; the
+        tracked motion already holds what it missed), so when the odometry
+        guess and the constant-velocity guess (the last tracked motion)
+        disagree, both are tried and the better fit wins.
         """
-        if not self.config.track_scans:
-            return guess
         cfg = self.config
-        reg, good, _ = self._attempt(
-            self._local_map(), points, guess, self._track_icp, cfg.track_max_correction_m, cfg.track_max_correction_deg
-        )
+        if not cfg.track_scans:
+            return None
+        target = self._local_map()
+        limits = (self._track_icp, cfg.track_max_correction_m, cfg.track_max_correction_deg)
+        reg, good, _ = self._attempt(target, points, guess, *limits)
+        coasting = se2.compose(self._track, self._velocity)
+        gap = se2.between(guess, coasting)
+        if math.hypot(gap[0], gap[1]) > cfg.track_max_correction_m / 2 or abs(gap[2]) > math.radians(
+            cfg.track_max_correction_deg / 2
+        ):
+            alt, alt_good, _ = self._attempt(target, points, coasting, *limits)
+            if alt_good and (not good or alt.fitness > reg.fitness):  # type: ignore[union-attr]
+                reg, good = alt, True
+                self.counters["tracking_velocity_guess"] += 1
         if good:
-            assert reg is not None
             self.counters["scans_tracked"] += 1
-            return reg.pose
+            return reg
         self.counters["tracking_failures"] += 1
-        return guess
+        return None
 
     def _attempt(
         self, target: Target, points: FloatArray, guess: FloatArray, params: IcpParams, max_m: float, max_deg: float
@@ -258,10 +272,12 @@ class GtsamGraphMapper:
         )
         self._node_frame.append(index)
 
-    def _add_node(self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int) -> None:
+    def _add_node(
+        self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int, tracked: Registration | None
+    ) -> None:
         prev = len(self._node_odometry) - 1
         key = self._graph.add_node(se2.compose(self._estimates[prev], step))
-        relative, covariance = self._sequential_edge(prev, step, points, index)
+        relative, covariance = self._sequential_edge(prev, step, points, index, tracked)
         self._graph.add_edge(prev, key, relative, covariance)
         self._graph.update()
         self._remember_node(odometry, relative, points, index)
@@ -272,27 +288,24 @@ class GtsamGraphMapper:
             self._close_loops(key, index)
 
     def _sequential_edge(
-        self, prev: int, step: FloatArray, points: FloatArray, index: int
+        self, prev: int, step: FloatArray, points: FloatArray, index: int, tracked: Registration | None
     ) -> tuple[FloatArray, FloatArray]:
-        """ICP against the local map in ``prev``'s frame, or the odometry step when the match is poor.
+        """The edge from node ``prev`` to the new node: its scan match, or the guess ``step`` when the match is poor.
 
-        When the match from the odometry guess fails its tests, ICP is retried
-        from the guess rotated by +-k * ``seq_retry_rotation_deg``: odometry
-        heading errors (slipping wheels while turning) are what most often
-        put the guess outside ICP's basin, and a rotated start recovers them.
+        With tracking the match is the tracking registration itself (or
+        nothing: tracking failed and ``step`` is odometry since the last
+        tracked scan). Without it, the node scan is matched from the odometry
+        step, retried from rotated guesses (:meth:`_attempt`).
         """
         cfg = self.config
-        target = self._local_map()
-        icp, max_m, max_deg = (
-            (self._track_icp, cfg.track_max_correction_m, cfg.track_max_correction_deg)
-            if cfg.track_scans
-            else (self._seq_icp, cfg.seq_max_correction_m, cfg.seq_max_correction_deg)
-        )
-        reg, good, recovered = self._attempt(target, points, step, icp, max_m, max_deg)
-        if recovered:
-            self.counters["sequential_retries_recovered"] += 1
-        if cfg.seq_reversed_guess:
-            reg, good = self._try_reversed(target, points, step, reg, good)
+        if cfg.track_scans:
+            reg, good = tracked, tracked is not None
+        else:
+            reg, good, recovered = self._attempt(
+                self._local_map(), points, step, self._seq_icp, cfg.seq_max_correction_m, cfg.seq_max_correction_deg
+            )
+            if recovered:
+                self.counters["sequential_retries_recovered"] += 1
         if good:
             self.counters["sequential_matches"] += 1
             self._consecutive_fallbacks = 0
@@ -312,38 +325,6 @@ class GtsamGraphMapper:
                 f"{cfg.max_consecutive_fallbacks})"
             )
         return step, self._fallback
-
-    def _try_reversed(
-        self, target: Target, points: FloatArray, step: FloatArray, reg: Registration | None, good: bool
-    ) -> tuple[Registration | None, bool]:
-        """The match from the odometry step with its translation reversed, when it explains the scan clearly better.
-
-        Some logs' odometry ignores the sign of the velocity (fr079's ODOM
-        lines report tv < 0 while x, y advance): while the robot reverses the
-        guess is then twice the step away from the truth, and ICP either fails
-        or stops half-way with a large correction. Only such matches (failed,
-        or moved at least ``seq_reversed_min_correction_m``) are retried, so a
-        correct odometry step in a corridor, where forward and backward
-        alignments can look alike, keeps its small-correction match.
-        """
-        cfg = self.config
-        if good:
-            assert reg is not None
-            corr = se2.between(step, reg.pose)
-            if math.hypot(corr[0], corr[1]) < cfg.seq_reversed_min_correction_m:
-                return reg, good
-        back = np.array([-step[0], -step[1], step[2]])
-        alt = self._register(target, points, back, self._seq_icp)
-        if not self._sequential_ok(alt, back):
-            return reg, good
-        assert alt is not None
-        if good and reg is not None and alt.fitness < reg.fitness + cfg.seq_reversed_min_gain:
-            return reg, good
-        self.counters["sequential_reversed"] += 1
-        return alt, True
-
-    def _sequential_ok(self, reg: Registration | None, step: FloatArray) -> bool:
-        return self._match_ok(reg, step, self.config.seq_max_correction_m, self.config.seq_max_correction_deg)
 
     def _match_ok(self, reg: Registration | None, guess: FloatArray, max_m: float, max_deg: float) -> bool:
         """Converged, fits (inlier fraction, RMS) and moved ``guess`` by at most ``max_m`` / ``max_deg``."""

@@ -147,6 +147,12 @@ class MrptRbpfConfig(MrptRunConfig):
     likelihood_z_hit: float = Field(gt=0, le=1, description="[occupancyGrid likelihoodOpts] LF_zHit")
     likelihood_z_random: float = Field(ge=0, lt=1, description="[occupancyGrid likelihoodOpts] LF_zRandom")
     likelihood_max_range_m: float = Field(gt=0, description="[occupancyGrid likelihoodOpts] LF_maxRange")
+    likelihood_cache: bool = Field(
+        description=(
+            "[occupancyGrid likelihoodOpts] enableLikelihoodCache: keep each particle's likelihood field per cell "
+            "(faster updates, several bytes per cell per particle)"
+        )
+    )
     motion_a1: float = Field(ge=0, description="Gaussian odometry model: std of x, y per metre driven (m/m)")
     motion_a2: float = Field(ge=0, description="Gaussian odometry model: std of x, y per radian turned (m/rad)")
     motion_a3: float = Field(ge=0, description="Gaussian odometry model: std of heading per metre driven (rad/m)")

@@ -1,0 +1,224 @@
+"""The per-scan loop of Albot1+'s pose: robust Gauss-Newton over landmark and scan terms.
+
+Plain Python over numpy arrays and scalars in the subset numba compiles;
+:mod:`albot1.methods.albot1.mapping.accel` hands out either the jitted or
+the interpreted version of the same source (tests run both on the same
+inputs). The maths is in ``docs/albot1-mapper.md`` ("Albot1+"); the caller
+is :mod:`albot1.methods.albot1.mapping.plus`.
+
+The unknown is the view's pose ``(x, y, phi)`` in the map (thesis frame): a
+view point ``v`` lands at ``R(phi) v + (x, y)``. Residuals, each weighted by
+``1 / sigma^2`` and a Huber weight (threshold ``huber`` sigmas, by
+iteratively reweighted least squares):
+
+* every endpoint of every recognised landmark, point-to-line against the
+  landmark's map copy (``line_sigma``);
+* every endpoint stable in both views, point-to-point against its map copy
+  (``point_sigma``): the only terms that fix the position *along* a wall;
+* every view point (``points``), point-to-line against the nearest surface
+  of the last update view (``ref``, already in the map) within ``gate``
+  metres (``scan_sigma``), re-associated at every iteration;
+* an optional prior ``(prior_x, prior_y, prior_phi)`` with information
+  ``prior_info_xy`` (1/m^2, both axes) and ``prior_info_phi`` (1/rad^2).
+
+Distances use ``np.hypot`` (see :mod:`albot1.methods.albot1.mapping.kernels`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.geometry.se2 import wrap_angle
+from albot1.geometry.segments import closest_parameter
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+def huber_weight(residual: float, threshold: float) -> float:
+    """The IRLS weight of Huber's loss: 1 inside ``threshold``, ``threshold / |r|`` beyond."""
+    a = abs(residual)
+    if a <= threshold:
+        return 1.0
+    return threshold / a
+
+
+def refine_pose(
+    x0: float,
+    y0: float,
+    phi0: float,
+    lm_view: FloatArray,
+    lm_map: FloatArray,
+    point_ok: BoolArray,
+    points: FloatArray,
+    ref: FloatArray,
+    prior_x: float,
+    prior_y: float,
+    prior_phi: float,
+    prior_info_xy: float,
+    prior_info_phi: float,
+    line_sigma: float,
+    point_sigma: float,
+    scan_sigma: float,
+    huber: float,
+    gate: float,
+    iterations: int,
+) -> tuple[float, float, float, FloatArray]:
+    """The pose minimising the weighted robust residuals, from ``(x0, y0, phi0)``.
+
+    ``lm_view`` / ``lm_map`` ``(k, 4)``: the recognised landmarks in the view
+    and their map copies; ``point_ok`` ``(k, 2)``: which endpoints are stable
+    in both. ``points`` ``(n, 2)``: view points; ``ref`` ``(m, 4)``: the last
+    update view's surfaces in the map. Returns the pose and the 3x3
+    information matrix of the measurement terms alone (no prior) at the
+    last linearisation, which says how well the view fixes each direction.
+    Stops after ``iterations`` Gauss-Newton steps or when a step moves less
+    than 1 micrometre and 0.1 microradian.
+    """
+    x = x0
+    y = y0
+    phi = phi0
+    k = lm_view.shape[0]
+    n = points.shape[0]
+    m = ref.shape[0]
+    w_line = 1.0 / (line_sigma * line_sigma)
+    w_point = 1.0 / (point_sigma * point_sigma)
+    w_scan = 1.0 / (scan_sigma * scan_sigma)
+    # Unit normals of the landmarks' map copies and of the reference surfaces (0 for a degenerate one).
+    lnx = np.zeros(k)
+    lny = np.zeros(k)
+    for i in range(k):
+        ex = lm_map[i, 2] - lm_map[i, 0]
+        ey = lm_map[i, 3] - lm_map[i, 1]
+        length = np.hypot(ex, ey)
+        if length > 0.0:
+            lnx[i] = -ey / length
+            lny[i] = ex / length
+    rnx = np.zeros(m)
+    rny = np.zeros(m)
+    for j in range(m):
+        ex = ref[j, 2] - ref[j, 0]
+        ey = ref[j, 3] - ref[j, 1]
+        length = np.hypot(ex, ey)
+        if length > 0.0:
+            rnx[j] = -ey / length
+            rny[j] = ex / length
+    info = np.zeros((3, 3))
+    for _ in range(iterations):
+        c = math.cos(phi)
+        s = math.sin(phi)
+        h00 = 0.0
+        h01 = 0.0
+        h02 = 0.0
+        h11 = 0.0
+        h12 = 0.0
+        h22 = 0.0
+        b0 = 0.0
+        b1 = 0.0
+        b2 = 0.0
+        for i in range(k):
+            for e in range(2):
+                vx = lm_view[i, 2 * e]
+                vy = lm_view[i, 2 * e + 1]
+                dx = c * vx - s * vy
+                dy = s * vx + c * vy
+                tx = x + dx
+                ty = y + dy
+                # Point-to-line: Jacobian (nx, ny, n x (R v)).
+                r = lnx[i] * (tx - lm_map[i, 0]) + lny[i] * (ty - lm_map[i, 1])
+                j2 = lny[i] * dx - lnx[i] * dy
+                w = w_line * huber_weight(r, huber * line_sigma)
+                h00 += w * lnx[i] * lnx[i]
+                h01 += w * lnx[i] * lny[i]
+                h02 += w * lnx[i] * j2
+                h11 += w * lny[i] * lny[i]
+                h12 += w * lny[i] * j2
+                h22 += w * j2 * j2
+                b0 += w * lnx[i] * r
+                b1 += w * lny[i] * r
+                b2 += w * j2 * r
+                if point_ok[i, e]:
+                    # Point-to-point: rows (1, 0, -dy) and (0, 1, dx), one Huber weight on the distance.
+                    rx = tx - lm_map[i, 2 * e]
+                    ry = ty - lm_map[i, 2 * e + 1]
+                    w = w_point * huber_weight(np.hypot(rx, ry), huber * point_sigma)
+                    h00 += w
+                    h02 -= w * dy
+                    h11 += w
+                    h12 += w * dx
+                    h22 += w * (dx * dx + dy * dy)
+                    b0 += w * rx
+                    b1 += w * ry
+                    b2 += w * (dx * ry - dy * rx)
+        for p in range(n):
+            vx = points[p, 0]
+            vy = points[p, 1]
+            dx = c * vx - s * vy
+            dy = s * vx + c * vy
+            tx = x + dx
+            ty = y + dy
+            best = gate
+            found = -1
+            for j in range(m):
+                t = closest_parameter(tx, ty, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3])
+                d = np.hypot(ref[j, 0] + t * (ref[j, 2] - ref[j, 0]) - tx, ref[j, 1] + t * (ref[j, 3] - ref[j, 1]) - ty)
+                if d < best:
+                    best = d
+                    found = j
+            if found < 0:
+                continue
+            r = rnx[found] * (tx - ref[found, 0]) + rny[found] * (ty - ref[found, 1])
+            j2 = rny[found] * dx - rnx[found] * dy
+            w = w_scan * huber_weight(r, huber * scan_sigma)
+            h00 += w * rnx[found] * rnx[found]
+            h01 += w * rnx[found] * rny[found]
+            h02 += w * rnx[found] * j2
+            h11 += w * rny[found] * rny[found]
+            h12 += w * rny[found] * j2
+            h22 += w * j2 * j2
+            b0 += w * rnx[found] * r
+            b1 += w * rny[found] * r
+            b2 += w * j2 * r
+        info[0, 0] = h00
+        info[0, 1] = h01
+        info[0, 2] = h02
+        info[1, 0] = h01
+        info[1, 1] = h11
+        info[1, 2] = h12
+        info[2, 0] = h02
+        info[2, 1] = h12
+        info[2, 2] = h22
+        if prior_info_xy > 0.0:
+            h00 += prior_info_xy
+            h11 += prior_info_xy
+            b0 += prior_info_xy * (x - prior_x)
+            b1 += prior_info_xy * (y - prior_y)
+        if prior_info_phi > 0.0:
+            h22 += prior_info_phi
+            b2 += prior_info_phi * wrap_angle(phi - prior_phi)
+        # Solve H d = -b (symmetric 3x3, by cofactors) with a tiny ridge so a direction nothing fixes stays put.
+        ridge = 1e-9 * (h00 + h11 + h22 + 1.0)
+        a00 = h00 + ridge
+        a11 = h11 + ridge
+        a22 = h22 + ridge
+        c00 = a11 * a22 - h12 * h12
+        c01 = h02 * h12 - h01 * a22
+        c02 = h01 * h12 - h02 * a11
+        det = a00 * c00 + h01 * c01 + h02 * c02
+        if not det > 0.0:
+            break
+        c11 = a00 * a22 - h02 * h02
+        c12 = h01 * h02 - a00 * h12
+        c22 = a00 * a11 - h01 * h01
+        d0 = -(c00 * b0 + c01 * b1 + c02 * b2) / det
+        d1 = -(c01 * b0 + c11 * b1 + c12 * b2) / det
+        d2 = -(c02 * b0 + c12 * b1 + c22 * b2) / det
+        x += d0
+        y += d1
+        phi = wrap_angle(phi + d2)
+        if abs(d0) + abs(d1) < 1e-6 and abs(d2) < 1e-7:
+            break
+    return x, y, phi, info

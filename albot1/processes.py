@@ -1,0 +1,79 @@
+"""Resident memory of a process tree, and stopping one: what a resident-memory limit needs.
+
+Why resident memory and not an address-space limit (``RLIMIT_AS``): the
+compiled libraries the methods use reserve large virtual ranges long before
+they use the memory (numba's LLVM, OpenMP/TBB thread pools, gtsam), so an
+address-space cap makes them fail to load (``libllvmlite.so`` not found,
+``failed to map segment``) and the failure reads as an import error instead
+of "memory limit exceeded". A supervisor instead polls the resident set of
+the process and of every process it started (psutil) and kills them when
+the sum passes the limit; the overshoot is bounded by what the tree
+allocates between two polls.
+"""
+
+from __future__ import annotations
+
+import time
+
+import psutil
+
+MIB = 1024.0 * 1024.0
+
+
+class TreeMemory:
+    """Samples the resident memory (bytes) of ``process`` and its descendants.
+
+    Listing the descendants walks every process of the machine (~10 ms with a
+    hundred processes), so the list is refreshed every ``refresh_s`` seconds
+    while the resident sizes of the known members (microseconds each) are read
+    at every sample. A helper process started between two refreshes is counted
+    from the next refresh on.
+    """
+
+    def __init__(self, process: psutil.Process, *, refresh_s: float = 1.0) -> None:
+        self._root = process
+        self._refresh_s = refresh_s
+        self._members: list[psutil.Process] = [process]
+        self._listed_at = -float("inf")
+        self.peak_bytes = 0
+
+    def _refresh(self) -> None:
+        now = time.monotonic()
+        if now - self._listed_at < self._refresh_s:
+            return
+        self._listed_at = now
+        try:
+            self._members = [self._root, *self._root.children(recursive=True)]
+        except psutil.Error:  # the root is gone: nothing to count
+            self._members = []
+
+    def sample(self) -> int:
+        """Resident bytes of the tree now (0 once it is gone); ``peak_bytes`` keeps the largest sample."""
+        self._refresh()
+        total = 0
+        for member in self._members:
+            try:
+                total += member.memory_info().rss
+            except psutil.Error:  # exited since the last listing
+                continue
+        self.peak_bytes = max(self.peak_bytes, total)
+        return total
+
+
+def kill_tree(process: psutil.Process) -> None:
+    """SIGKILL ``process``'s descendants, then ``process`` itself (its parent reaps it); gone ones are skipped.
+
+    The descendants go first so that none is left running as an orphan of a
+    dead parent (an external program started by a method, say). ``process``
+    is a ``psutil.Process``, not a pid: psutil refuses to signal a pid that a
+    new process has taken since, so a late kill never hits a stranger.
+    """
+    try:
+        members = [*process.children(recursive=True), process]
+    except psutil.Error:
+        members = [process]
+    for member in members:
+        try:
+            member.kill()
+        except psutil.Error:
+            continue

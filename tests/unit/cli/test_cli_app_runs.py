@@ -1,0 +1,40 @@
+"""`albot1 --version`, the dataset reference syntax in `--help`, `albot1 runs` and the `latest` link."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from albot1 import __version__
+from albot1.cli.app import app
+from albot1.versions import code_version
+
+runner = CliRunner()
+
+
+def test_version_prints_the_package_version_and_the_code_digest() -> None:
+    done = runner.invoke(app, ["--version"])
+    assert done.exit_code == 0 and done.stdout.strip() == f"albot1 {__version__} (code {code_version()})"
+
+
+def test_help_documents_the_dataset_reference_syntax() -> None:
+    text = runner.invoke(app, ["--help"], env={"COLUMNS": "150"}).stdout
+    for form in ("NAME[:N]", "NAME?key=value", "odometry=reference", "views=D_M:A_DEG"):
+        assert form in text, form
+    assert "NAME[:N]" in runner.invoke(app, ["run", "--help"], env={"COLUMNS": "150"}).stdout
+
+
+def test_runs_lists_the_run_folders_and_marks_the_latest(tmp_path: Path) -> None:
+    for limit in ("20", "30"):
+        done = runner.invoke(app, ["run", "odometry", "synthetic-corridor", "--limit", limit, "--out", str(tmp_path)])
+        assert done.exit_code == 0, done.output
+        assert done.stderr == ""  # no progress bar when stderr is not a terminal
+    listing = json.loads(runner.invoke(app, ["runs", str(tmp_path), "--json"]).stdout)
+    assert len(listing["runs"]) == 2 and {r["status"] for r in listing["runs"]} == {"done"}
+    latest = [r for r in listing["runs"] if r["latest"]]
+    assert len(latest) == 1 and (tmp_path / "latest").resolve().name == latest[0]["key"]
+    text = runner.invoke(app, ["runs", str(tmp_path)]).stdout
+    assert "odometry:default on synthetic-corridor[:30] [none, seed 0], 30 scans <- latest" in text
+    assert text.strip().endswith(f"2 run folders in {tmp_path}")

@@ -1,0 +1,144 @@
+"""index.html: one self-contained page whose every link and image resolves, rendered by a real browser.
+
+The results folder is built by hand (the runner's store, run folders of
+dead reckoning on a small loop, one failed cell) so the test needs no bench
+run; the browser test runs Debian's ``chromium`` headless when it is
+installed (``.ci/run`` installs it) and is skipped with the reason otherwise.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from html.parser import HTMLParser
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.image import imread
+
+from albot1.bench.grid import Cell, GridPlan
+from albot1.bench.store import ResultsStore
+from albot1.data.model import Frame, Scan, Sequence
+from albot1.geometry import se2
+from albot1.report.html import INDEX_HTML
+from albot1.report.index import build_report
+from albot1.runs.evaluate import evaluate_run
+from albot1.runs.execute import run_method
+from albot1.runs.folder import write_run
+
+ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
+BROWSER_NAMES = ("chromium", "chromium-browser")
+
+
+def _loop() -> Sequence:
+    truth = se2.integrate_steps(np.zeros(3), np.tile([[0.7, 0.0, np.radians(6.0)]], (59, 1)))
+    frames = [Frame(i, Scan(np.full(len(ANGLES), 1.5), ANGLES, 10.0 + i, 5.0), truth[i], truth[i]) for i in range(60)]
+    return Sequence.from_frames("loop", frames)
+
+
+def _cell(key: str, label: str, degradation: str, seed: int) -> Cell:
+    return Cell("tiny", "loop", "loop", "odometry", label, "default", degradation, seed, key, "v", 60.0, 100.0)
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A results folder of 4 completed cells and 1 failed one, and its report (plots included)."""
+    root = tmp_path_factory.mktemp("results") / "tiny"
+    store = ResultsStore(root)
+    store.runs.mkdir(parents=True)
+    cells = []
+    for label, degradation, seed in (
+        ("odometry", "none", 0),
+        ("odometry", "gauss:0.05:1", 0),
+        ("odometry", "gauss:0.05:1", 1),
+        ("biased", "bias:0.01:0.5", 0),
+    ):
+        run_dir = write_run(run_method("odometry", _loop(), degradation=degradation, seed=seed), store.runs)
+        evaluate_run(run_dir)
+        cells.append(_cell(run_dir.name, label, degradation, seed))
+    failed = _cell("f" * 16, "broken", "none", 0)
+    store.prepare(failed)
+    store.record_failure(failed, "RuntimeError: injected", "exception", traceback_text="Traceback ...")
+    cells.append(failed)
+    plan = GridPlan("tiny", None, "A tiny grid.", cells, [], [], {}, [0, 1], ["none", "gauss:0.05:1"], {})
+    store.write_plan(plan)
+    return build_report(root, root.parent / "report").parent
+
+
+class _Links(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.links: list[str] = []
+        self.ids: set[str] = set()
+        self.tables = 0
+        self.images = 0
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        values = dict(attrs)
+        self.tables += tag == "table"
+        self.images += tag == "img"
+        if values.get("id"):
+            self.ids.add(str(values["id"]))
+        for name in ("href", "src"):
+            if values.get(name):
+                self.links.append(str(values[name]))
+
+
+def test_every_link_and_image_of_index_html_resolves_inside_the_report(report: Path) -> None:
+    page = report / INDEX_HTML
+    parser = _Links()
+    parser.feed(page.read_text(encoding="utf-8"))
+    assert parser.tables >= 3 and parser.images >= 6  # accuracy, cost, failures; the loop's plots
+    assert any(link.endswith(".svg") for link in parser.links) and any(link.endswith(".tex") for link in parser.links)
+    for link in parser.links:
+        if link.startswith("#"):
+            assert link[1:] in parser.ids, link
+            continue
+        assert "://" not in link and not link.startswith("/"), f"not a relative link: {link}"
+        assert (report / link).is_file(), f"{link} does not resolve from {report}"
+    assert "cell.log" in " ".join(parser.links)  # the failed cell's log, in the results folder
+    text = page.read_text(encoding="utf-8")
+    assert "<script>" in text and "sortable" in text and "failed (exception: RuntimeError: injected)" in text
+
+
+def test_the_readme_links_the_page_and_every_table_format(report: Path) -> None:
+    readme = (report / "README.md").read_text(encoding="utf-8")
+    assert "(index.html)" in readme and "[LaTeX](metrics.tex)" in readme and ".svg)" in readme
+
+
+def _browser() -> str | None:
+    return next((found for name in BROWSER_NAMES if (found := shutil.which(name))), None)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(_browser() is None, reason="no chromium on PATH (.ci/run installs Debian's chromium with apt)")
+def test_a_headless_browser_renders_the_page_with_its_tables(report: Path, tmp_path: Path) -> None:
+    browser = _browser()
+    assert browser is not None
+    flags = [
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        f"--user-data-dir={tmp_path / 'profile'}",
+    ]
+    url = (report / INDEX_HTML).resolve().as_uri()
+    shot = tmp_path / "page.png"
+    done = subprocess.run(
+        [browser, *flags, f"--screenshot={shot}", "--window-size=1280,2000", url],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert shot.is_file(), done.stderr[-2000:]
+    pixels = imread(shot)[..., :3]
+    assert float(pixels.std()) > 0.05  # something was drawn: not a blank page
+    assert float((pixels < 0.5).mean()) > 0.002  # dark text and lines on the white page
+    dom = subprocess.run([browser, *flags, "--dump-dom", url], capture_output=True, text=True, timeout=120)
+    assert dom.stdout.count("<table") >= 3 and "Benchmark report" in dom.stdout
+    assert dom.stdout.count("<img") >= 6 and "gauss:0.05:1" in dom.stdout
