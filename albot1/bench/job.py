@@ -59,7 +59,7 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
         return "timeout", f"time limit exceeded: no result after {cell.time_s:g} s (killed)"
     if ended.memory_exceeded:
         return "memory", (
-            f"memory limit exceeded: resident memory reached {ended.peak_rss_mb or 0:.0f} MB, over the cell's "
+            f"memory limit exceeded: resident memory reached {ended.peak_rss_mb or 0:.1f} MB, over the cell's "
             f"limit of {cell.memory_mb:g} MB (killed)"
         )
     if ended.pool_lost is not None:
@@ -79,12 +79,28 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
             return "storage", f"cannot write the results: {_errno_text(error.get('errno'))}: {message}"
         return kind, message
     if ended.exit_code == EXIT_STORAGE:
-        return "storage", f"cannot write the results ({store.runs}): not even the cell's error report fitted"
+        return "storage", f"cannot write the results in {store.runs}: {file_system_state(store.runs)}"
     if ended.exit_code != EXIT_OK:
         return "crash", f"the cell process exited with code {ended.exit_code} without an error report"
     if not store.is_complete(cell.key):
         return "exception", "the cell process finished but left no complete run (DONE and metrics.json)"
     return None
+
+
+def file_system_state(folder: Path) -> str:
+    """Why writes in ``folder`` may fail, as far as the file system says (full, read-only), for a failure reason."""
+    try:
+        stats = os.statvfs(folder)
+    except OSError as exc:
+        return f"its file system cannot be queried ({(exc.strerror or str(exc)).lower()})"
+    if stats.f_flag & os.ST_RDONLY:
+        return "read-only file system"
+    free = stats.f_bavail * stats.f_frsize
+    if stats.f_favail == 0 and stats.f_files > 0:
+        return "no space left on device (no free inodes)"
+    if free < 16 * 2**20:
+        return f"no space left on device ({free / 2**20:.1f} MiB free)"
+    return f"a write failed although {free / 2**20:.0f} MiB are free now (quota? space freed since?)"
 
 
 def _errno_text(number: object) -> str:

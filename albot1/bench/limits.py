@@ -151,28 +151,35 @@ def supervise(
     return stop, peak
 
 
-def _server_fate(server: psutil.Process | None) -> str | None:
-    """None while the forkserver ``server`` runs; else how it ended ("was killed by SIGKILL", ...)."""
+def _server_fate(server: psutil.Process | None, wait_s: float = 2.0) -> str | None:
+    """None while the forkserver ``server`` runs; else how it ended ("was killed by SIGKILL", ...).
+
+    Asked when a cell's exit status came back as 255, which is also what
+    multiprocessing reports when the server's pipe closed. A killed process
+    closes its pipes a moment before it is a zombie, so this looks for up to
+    ``wait_s`` seconds. Its exit status is read with ``WNOWAIT``, without
+    reaping it: multiprocessing reaps it when it starts a new one.
+    """
     if server is None:
         return None
-    try:
-        if server.is_running() and server.status() != psutil.STATUS_ZOMBIE:
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            info = os.waitid(os.P_PID, server.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT)
+        except ChildProcessError:  # reaped already, or not this process's child
+            return None if server.is_running() else "is gone"
+        if info is not None:
+            break
+        if time.monotonic() > deadline:
             return None
-    except psutil.Error:
-        pass
-    try:  # WNOWAIT: look at its exit status without reaping it (multiprocessing reaps and restarts it)
-        info = os.waitid(os.P_PID, server.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT)
-    except OSError:  # already reaped, or not our child
-        info = None
-    if info is not None and info.si_code in (os.CLD_KILLED, os.CLD_DUMPED):
+        time.sleep(0.02)
+    if info.si_code in (os.CLD_KILLED, os.CLD_DUMPED):
         try:
             name = signal.Signals(info.si_status).name
         except ValueError:
             name = f"signal {info.si_status}"
         return f"was killed by {name}"
-    if info is not None:
-        return f"exited with code {info.si_status}"
-    return "is gone"
+    return f"exited with code {info.si_status}"
 
 
 def _parent_of(process: psutil.Process | None) -> psutil.Process | None:

@@ -92,7 +92,7 @@ def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
             )
     if suite.registered_methods:
         named = {e.name for e in entries}
-        entries += [MethodEntry(name=n) for n in METHODS if n not in named]
+        entries += [MethodEntry(name=n) for n, spec in METHODS.items() if n not in named and spec.auto_include]
     usable, skipped = [], []
     for entry in entries:
         spec = METHODS[entry.name]

@@ -16,6 +16,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import time
 import traceback
+import uuid
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -64,6 +65,26 @@ class GridSummary:
     @property
     def failures(self) -> list[CellOutcome]:
         return [o for o in self.outcomes if o.status == "failed"]
+
+
+#: Grids of this process that a failure halted (see :func:`_unless_halted`).
+_HALTED_GRIDS: set[str] = set()
+
+
+def _unless_halted(job: Callable[[Cell, str], CellOutcome], grid_id: str, cell: Cell, root: str) -> CellOutcome | None:
+    """Run ``job`` unless grid ``grid_id`` was halted (None: not started); a halting outcome halts it.
+
+    The flag is set by the thread that met the failure, before it takes the
+    next cell from the pool's queue: cancelling the queued futures from the
+    runner's thread alone would come too late for that next cell. (On Dask
+    workers, other processes, the runner's cancellation is what stops cells.)
+    """
+    if grid_id in _HALTED_GRIDS:
+        return None
+    outcome = job(cell, root)
+    if outcome.halts_grid:
+        _HALTED_GRIDS.add(grid_id)
+    return outcome
 
 
 def _unique(cells: list[Cell]) -> list[Cell]:
@@ -123,7 +144,8 @@ def run_grid(
             if outcome.status == "failed":
                 observer.finished(outcome)
     root = results_path(store.root)
-    futures = {executor.submit(job, cell, root): cell for cell in pending}
+    grid_id = uuid.uuid4().hex
+    futures = {executor.submit(_unless_halted, job, grid_id, cell, root): cell for cell in pending}
     waiting = set(futures)
     try:
         while waiting:
@@ -132,6 +154,9 @@ def run_grid(
                 if future.cancelled():
                     continue
                 outcome = _outcome(future, futures[future], store)
+                if outcome is None:
+                    summary.not_started.append(futures[future])
+                    continue
                 summary.outcomes.append(outcome)
                 if observer is not None:
                     observer.finished(outcome)
@@ -143,11 +168,12 @@ def run_grid(
     finally:
         for future in futures:
             future.cancel()
+        _HALTED_GRIDS.discard(grid_id)
     summary.wall_s = time.monotonic() - start
     return summary
 
 
-def _outcome(future: cf.Future[CellOutcome], cell: Cell, store: ResultsStore) -> CellOutcome:
+def _outcome(future: cf.Future[CellOutcome | None], cell: Cell, store: ResultsStore) -> CellOutcome | None:
     """The job's outcome, or a recorded executor failure when the executor lost the job."""
     try:
         return future.result()

@@ -20,9 +20,9 @@ never half-read. ``FAILED.json`` is removed before a retry and never
 coexists with a completed result after one.
 
 A full or read-only file system is a failure of the grid, not of one cell:
-the cell that met it is recorded as failed (kind ``storage``) after its
-incomplete run files are deleted to make room for the record, and the
-runner starts no further cell. Complete cells are never touched.
+the cell that met it is recorded as failed (kind ``storage``) after the
+files of its failed attempt are deleted to make room for the record, and
+the runner starts no further cell. Complete cells are never touched.
 """
 
 from __future__ import annotations
@@ -158,15 +158,15 @@ class ResultsStore:
 
         Never raises for the file system: returns None when the record was
         written, else why it could not be (the caller still reports the
-        failure). For a ``storage`` failure the cell's incomplete run files
+        failure). For a ``storage`` failure the files of the cell's attempt
         are deleted first, so that the small record fits where the run did not.
         """
         run_dir = self.run_dir(cell.key)
         log = run_dir / LOG
         try:
             run_dir.mkdir(parents=True, exist_ok=True)
-            if kind == "storage":
-                discard_incomplete_run(run_dir)
+            if kind == "storage" and not self.is_complete(cell.key):
+                discard_attempt(run_dir)
             if traceback_text:
                 with log.open("a", encoding="utf-8") as handle:
                     handle.write(f"\n--- albot1 bench: {kind} ---\n{traceback_text}\n")
@@ -217,14 +217,13 @@ class ResultsStore:
             return None
 
 
-def discard_incomplete_run(run_dir: Path) -> None:
-    """Delete the files of an attempt that did not complete (no ``DONE``), keeping ``cell.json`` and ``cell.log``.
+def discard_attempt(run_dir: Path) -> None:
+    """Delete the files of a cell's failed attempt, keeping ``cell.json`` and ``cell.log``.
 
-    They are recomputed by the next attempt anyway; deleting them frees the
-    space a full disk needs for the failure record. A complete run is left alone.
+    Only for a cell that is not complete (no ``DONE`` plus ``metrics.json``):
+    its next attempt recomputes them anyway, and deleting them frees the
+    space a full disk needs for the failure record.
     """
-    if run_is_complete(run_dir):
-        return
     for path in run_dir.iterdir():
         if path.name not in (CELL, LOG) and (path.is_file() or path.is_symlink()):
             path.unlink(missing_ok=True)

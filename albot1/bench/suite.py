@@ -11,6 +11,7 @@ Format (every key optional except ``methods`` and ``datasets``)::
     name = "default"                 # defaults to the file stem
     description = "..."
     registered_methods = true        # also run every other registered, installed method
+                                     # (not those registered with auto_include=False: mrpt-*)
 
     [limits]                         # per-cell defaults
     time_s = 900                     # wall-clock limit of one cell (at most 7 days)

@@ -92,9 +92,9 @@ def bench(
         typer.echo(f"suite {plan.suite}: no cell to run (every dataset or method it selects was skipped)", err=True)
         raise typer.Exit(1)
     if summary.halted is not None:
+        left = f"; {len(summary.not_started)} cells not started" if summary.not_started else ""
         typer.echo(
-            f"stopped early, {len(summary.not_started)} cells not started: {summary.halted}; completed cells are "
-            "kept, run the same command again to resume",
+            f"halted: {summary.halted}{left}; completed cells are kept, run the same command again to resume",
             err=True,
         )
     if failed:

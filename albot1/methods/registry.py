@@ -58,7 +58,9 @@ class MethodSpec:
 
     ``executables`` are external programs the method runs (looked up on
     ``PATH``); ``install_hint`` is the command that installs them, shown
-    when they are missing.
+    when they are missing. ``auto_include`` says whether a suite's
+    ``registered_methods = true`` adds the method: an external system whose
+    runs cost minutes per log runs only where a suite names it.
     """
 
     name: str
@@ -68,6 +70,7 @@ class MethodSpec:
     description: str = ""
     executables: tuple[str, ...] = ()
     install_hint: str = ""
+    auto_include: bool = True
     #: ``"module:function"`` the runner calls after a run on a dataset with reference poses, to score the
     #: method's own claims against them (evaluation only: the mapper never sees the reference); see
     #: :func:`albot1.runs.execute.run_method`.
@@ -168,6 +171,7 @@ METHODS: dict[str, MethodSpec] = {
             "albot1.methods.baselines.mrpt:MrptIcpMapper",
             executables=("icp-slam",),
             install_hint="apt-get install mrpt-apps (or: make mrpt)",
+            auto_include=False,
             description="MRPT icp-slam: incremental ICP scan matching against a point map, no loop closing",
         ),
         MethodSpec(
@@ -175,6 +179,7 @@ METHODS: dict[str, MethodSpec] = {
             "albot1.methods.baselines.mrpt:MrptRbpfMapper",
             executables=("rbpf-slam",),
             install_hint="apt-get install mrpt-apps (or: make mrpt)",
+            auto_include=False,
             description="MRPT rbpf-slam: Rao-Blackwellized particle filter grid SLAM (GMapping family)",
         ),
     )

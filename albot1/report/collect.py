@@ -208,6 +208,14 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
     return plan, records
 
 
+def cell_columns() -> list[str]:
+    """The keys of a :func:`cell_rows` row, in order (the columns of an empty table too)."""
+    columns = ["dataset", "method", "degradation", "seed", "status", "key", "scans"]
+    for name in {**METRIC_COLUMNS, **COST_COLUMNS}:
+        columns += [name, f"{name}_na"]
+    return [*columns, "failure_kind", "reason"]
+
+
 def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
     """Flat rows (one per cell): coordinates, status, every metric and cost column and, as ``<column>_na``,
     why a completed cell has no number there (:meth:`Column.reason`)."""

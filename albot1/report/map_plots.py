@@ -23,6 +23,7 @@ from albot1.report.plots import (
     Extent,
     aligned_poses,
     has_reference,
+    label_grid,
     panel_layout,
     pyplot,
     representative,
@@ -119,12 +120,7 @@ def plot_maps(
         extent.apply(ax)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.2, lw=0.5)
-    for ax in list(axes.flat)[len(runs) :]:
-        ax.set_visible(False)
-    for ax in axes[-1, :]:
-        ax.set_xlabel("x (m)", fontsize=8)
-    for ax in axes[:, 0]:
-        ax.set_ylabel("y (m)", fontsize=8)
+    label_grid(axes, len(runs))
     handles: list[Any] = [Patch(color=MAP_COLOR, label="map" + (" (occupied cells)" if style == "grid" else ""))]
     if framed:
         handles.append(Line2D([], [], color=REFERENCE_COLOR, lw=0.8, ls="--", label="reference trajectory"))

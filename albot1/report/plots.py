@@ -217,6 +217,21 @@ def panel_layout(
     return rows, cols, (max(4.0, cols * width + 0.9), rows * (height + 0.45) + extra_height_in)
 
 
+def label_grid(axes: Any, used: int) -> None:
+    """Hide the unused panels of a grid; label x (m) under the lowest panel of each column, y (m) on the left."""
+    rows, cols = axes.shape
+    for k, ax in enumerate(axes.flat):
+        if k >= used:
+            ax.set_visible(False)
+    for c in range(cols):
+        lowest = max((r for r in range(rows) if r * cols + c < used), default=None)
+        if lowest is not None:
+            axes[lowest, c].set_xlabel("x (m)", fontsize=8)
+            axes[lowest, c].xaxis.set_tick_params(labelbottom=True)
+    for r in range(rows):
+        axes[r, 0].set_ylabel("y (m)", fontsize=8)
+
+
 def log_floor(series: Iterable[Iterable[float]], *, decades: float = 2.0) -> float | None:
     """A log axis's lower limit when the data span more than ``decades`` decades, else None (linear).
 

@@ -1,4 +1,4 @@
-"""The PNG preview stored in each run folder: map + trajectory (+ reference).
+"""The PNG preview stored in each run folder: map + trajectory (+ reference); ``places.png`` for a network.
 
 The reference is drawn after a rigid least-squares alignment onto the
 estimate so that both share a frame; the picture is for eyes, the numbers
@@ -44,3 +44,10 @@ def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> 
     ax.legend(loc="upper right", fontsize=7)  # "best" scans every map point: slow
     fig.savefig(path, format="png", bbox_inches="tight")
     plt.close(fig)
+    places = result.files.get("places.json")
+    if isinstance(places, dict):  # a method with a network of places (albot1-places): Figure 4.2 beside it
+        from albot1.atomic import atomic_write
+        from albot1.report.places_plot import render_places
+
+        title = f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]"
+        atomic_write(path.parent / "places.png", lambda p: render_places(places, p, title))

@@ -33,6 +33,7 @@ from albot1.report.collect import (
     METRIC_COLUMNS,
     CellRecord,
     Column,
+    cell_columns,
     cell_rows,
     severity_order,
 )
@@ -53,7 +54,7 @@ def cells_frame(records: list[CellRecord]) -> pd.DataFrame:
     """One row per cell (all statuses), in plan order."""
     import pandas as pd
 
-    return pd.DataFrame(cell_rows(records))
+    return pd.DataFrame(cell_rows(records), columns=cell_columns())  # the columns also when no cell was planned
 
 
 def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:

@@ -27,6 +27,7 @@ from albot1.report.plots import (
     Extent,
     aligned_poses,
     has_reference,
+    label_grid,
     log_floor,
     panel_layout,
     pyplot,
@@ -109,12 +110,7 @@ def plot_ape_map(records: list[CellRecord], dataset: str, path: Path, colors: di
             spine.set_linewidth(1.4)
         extent.apply(ax)
         ax.tick_params(labelsize=7)
-    for ax in list(axes.flat)[len(runs) :]:
-        ax.set_visible(False)
-    for ax in axes[-1, :]:
-        ax.set_xlabel("x (m)", fontsize=8)
-    for ax in axes[:, 0]:
-        ax.set_ylabel("y (m)", fontsize=8)
+    label_grid(axes, len(runs))
     fig.suptitle(
         f"{dataset}: absolute position error per pose (rigid alignment; dashed: reference; frame colour: method)",
         fontsize=9,

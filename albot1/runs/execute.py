@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from albot1 import versions
+from albot1.config.targets import resolve_target
 from albot1.contract import MapperOutput, RunResult
 from albot1.data.degrade import degrade
 from albot1.data.model import Sequence
@@ -88,6 +89,15 @@ def run_method(
 
     _check_output(output, len(per_scan), method, dataset, error_class)
     per_scan_ns = np.asarray(per_scan, dtype=np.int64)
+    reference_poses = np.asarray(reference, dtype=float).reshape(-1, 3) if reference else None
+    counters, files = dict(output.counters), dict(output.files)
+    if spec.judge is not None and reference_poses is not None:
+        # Evaluation only, after the timed run: the method's own claims (e.g. re-visits) scored against the
+        # reference poses, which the mapper never saw (MethodSpec.judge).
+        judge = resolve_target(spec.judge)
+        judgement = judge(files, np.asarray(output.poses, dtype=float), reference_poses, seq.metadata.extra)
+        counters.update(judgement.counters)
+        files = judgement.files
     return RunResult(
         method=method,
         dataset=dataset,
@@ -98,11 +108,12 @@ def run_method(
         timestamps=np.asarray(stamps, dtype=float),
         poses=np.asarray(output.poses, dtype=float),
         odometry=np.asarray(odometry, dtype=float).reshape(-1, 3),
-        reference=np.asarray(reference, dtype=float).reshape(-1, 3) if reference else None,
+        reference=reference_poses,
         relations=seq.relations,
         map=output.map,
-        counters=dict(output.counters),
+        counters=counters,
         extras=dict(output.extras),
+        files=files,
         per_scan_ns=per_scan_ns,
         finish_s=finish_s,
         total_s=float(per_scan_ns.sum()) / 1e9 + finish_s,

@@ -111,6 +111,8 @@ def test_datasets_info_cli_json(data_file: DataFile, monkeypatch: pytest.MonkeyP
 def test_truncated_real_bz2_is_a_parse_error(data_file: DataFile, tmp_path: Path) -> None:
     cut = tmp_path / "aces-cut.clf.bz2"
     cut.write_bytes(data_file("radish/aces.clf.bz2").read_bytes()[:300_000])
-    with pytest.raises(ParseError, match=r"aces-cut\.clf\.bz2:\d+: the bzip2 data is truncated or corrupt"):
+    with pytest.raises(
+        ParseError, match=r"aces-cut\.clf\.bz2:\d+: the bzip2 data is truncated after this line .* 300000"
+    ):
         for _ in CarmenLoader().load(cut).frames():
             pass

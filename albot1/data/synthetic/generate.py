@@ -136,6 +136,7 @@ def world_metadata(data: WorldData) -> SequenceMetadata:
             "odometry_model": spec.odometry.as_dict(),
             "wall_segments": int(len(data.plan.walls)),
             "doorways": [d.as_dict() for d in data.plan.doorways],
+            "spaces": [{"name": space.name, "rect": list(space.rect)} for space in data.plan.spaces],
             "doorway_crossings": [c.as_dict() for c in data.crossings],
         },
     )

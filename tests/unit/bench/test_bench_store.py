@@ -105,7 +105,7 @@ def test_read_plan_of_a_folder_that_is_not_a_results_folder(tmp_path: Path) -> N
             ChildExit(None, False, 2.0, memory_exceeded=True, peak_rss_mb=140.4),
             None,
             "memory",
-            "memory limit exceeded: resident memory reached 140 MB, over the cell's limit of 123 MB (killed)",
+            "memory limit exceeded: resident memory reached 140.4 MB, over the cell's limit of 123 MB (killed)",
         ),
         (ChildExit(-11, False, 1.0), None, "crash", "killed by SIGSEGV (a native library crashed)"),
         (ChildExit(-9, False, 1.0), None, "crash", "out-of-memory killer"),

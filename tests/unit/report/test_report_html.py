@@ -142,3 +142,13 @@ def test_a_headless_browser_renders_the_page_with_its_tables(report: Path, tmp_p
     dom = subprocess.run([browser, *flags, "--dump-dom", url], capture_output=True, text=True, timeout=120)
     assert dom.stdout.count("<table") >= 3 and "Benchmark report" in dom.stdout
     assert dom.stdout.count("<img") >= 6 and "gauss:0.05:1" in dom.stdout
+
+
+def test_a_results_folder_whose_grid_planned_no_cell_still_gets_a_report(tmp_path: Path) -> None:
+    store = ResultsStore(tmp_path / "empty")
+    store.runs.mkdir(parents=True)
+    store.write_plan(GridPlan("empty", None, "", [], [], [], {}, [], [], {}))
+    readme = build_report(store.root, tmp_path / "report")
+    assert "Cells: 0 planned" in readme.read_text()
+    assert "No planned cells." in (tmp_path / "report" / "metrics.md").read_text()
+    assert (tmp_path / "report" / INDEX_HTML).is_file()

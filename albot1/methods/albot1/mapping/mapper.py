@@ -295,7 +295,12 @@ class Albot1Mapper:
         """
         assert self._plus is not None
         loc = self._localise(rl)
-        start = compose_pose(prev_pose, step) if loc is None else loc.pose
+        odometry = compose_pose(prev_pose, step)
+        # Starts: the thesis's pose, every landmark's candidate pose, and the odometry step.
+        if loc is None:
+            starts = np.asarray([odometry], dtype=float)
+        else:
+            starts = np.vstack([np.asarray([loc.pose, odometry], dtype=float), loc.candidates])
         rows: list[int] = []
         maps: list[np.ndarray] = []
         map_kinds: list[np.ndarray] = []
@@ -309,7 +314,7 @@ class Albot1Mapper:
         lm_map = np.ascontiguousarray(np.asarray(maps, dtype=float).reshape(-1, 4))
         kinds = (rl.kinds[rows].reshape(-1, 2), np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2))
         since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
-        return self._plus.pose(start, lm_view, lm_map, kinds, self._points, since), loc
+        return self._plus.pose(np.ascontiguousarray(starts), lm_view, lm_map, kinds, self._points, since), loc
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
         """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md).

@@ -163,14 +163,14 @@ class PlusLocaliser:
 
     def pose(
         self,
-        start: Pose,
+        starts: FloatArray,
         lm_view: FloatArray,
         lm_map: FloatArray,
         lm_kinds: tuple[NDArray[np.int64], NDArray[np.int64]],
         points: FloatArray,
         since_update: Pose,
     ) -> Pose:
-        """The pose of a view from ``start`` (the thesis's pose, or odometry).
+        """The pose of a view, from the cheapest of ``starts`` ``(c, 3)`` (candidate poses; see the mapper).
 
         ``lm_view`` / ``lm_map`` ``(k, 4)``: recognised landmarks and their
         map copies; ``lm_kinds``: their endpoint labels now and in the map;
@@ -184,8 +184,8 @@ class PlusLocaliser:
             motion = self._motion(since_update)
             v_xy = PRIOR_FLOOR[0] + p.xy_per_sqrt_m**2 * motion
             v_phi = PRIOR_FLOOR[1] + p.rad_per_sqrt_m**2 * motion
-            return self._solve(start, lm_view, lm_map, ok, points, predicted, 1.0 / v_xy, 1.0 / v_phi)[0]
-        measured, info = self._solve(start, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
+            return self._solve(starts, lm_view, lm_map, ok, points, predicted, 1.0 / v_xy, 1.0 / v_phi)[0]
+        measured, info = self._solve(starts, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
         if p.prior == "off":
             return measured
         return self._fuse(measured, info, predicted, self._motion(since_update))
@@ -195,7 +195,7 @@ class PlusLocaliser:
 
     def _solve(
         self,
-        start: Pose,
+        starts: FloatArray,
         lm_view: FloatArray,
         lm_map: FloatArray,
         ok: NDArray[np.bool_],
@@ -206,9 +206,7 @@ class PlusLocaliser:
     ) -> tuple[Pose, FloatArray]:
         p = self.params
         x, y, phi, info = self._k.refine_pose(
-            start[0],
-            start[1],
-            start[2],
+            starts,
             lm_view,
             lm_map,
             ok,

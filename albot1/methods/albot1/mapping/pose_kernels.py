@@ -46,10 +46,65 @@ def huber_weight(residual: float, threshold: float) -> float:
     return threshold / a
 
 
+def huber_cost(residual: float, threshold: float) -> float:
+    """Huber's loss: ``r^2 / 2`` inside ``threshold``, linear beyond (the cost :func:`huber_weight` minimises)."""
+    a = abs(residual)
+    if a <= threshold:
+        return 0.5 * a * a
+    return threshold * (a - 0.5 * threshold)
+
+
+def pose_cost(
+    x: float,
+    y: float,
+    phi: float,
+    lm_view: FloatArray,
+    lm_map: FloatArray,
+    point_ok: BoolArray,
+    points: FloatArray,
+    ref: FloatArray,
+    line_sigma: float,
+    point_sigma: float,
+    scan_sigma: float,
+    huber: float,
+    gate: float,
+) -> float:
+    """The robust cost of the measurement terms at pose ``(x, y, phi)`` (residuals in sigmas).
+
+    A view point with no reference surface within ``gate`` costs as much as
+    one exactly at the gate, so poses that explain fewer points do not look
+    cheaper.
+    """
+    c = math.cos(phi)
+    s = math.sin(phi)
+    total = 0.0
+    for i in range(lm_view.shape[0]):
+        ex = lm_map[i, 2] - lm_map[i, 0]
+        ey = lm_map[i, 3] - lm_map[i, 1]
+        length = np.hypot(ex, ey)
+        for e in range(2):
+            tx = x + c * lm_view[i, 2 * e] - s * lm_view[i, 2 * e + 1]
+            ty = y + s * lm_view[i, 2 * e] + c * lm_view[i, 2 * e + 1]
+            if length > 0.0:
+                r = (-ey * (tx - lm_map[i, 0]) + ex * (ty - lm_map[i, 1])) / length
+                total += huber_cost(r / line_sigma, huber)
+            if point_ok[i, e]:
+                total += huber_cost(np.hypot(tx - lm_map[i, 2 * e], ty - lm_map[i, 2 * e + 1]) / point_sigma, huber)
+    for p in range(points.shape[0]):
+        tx = x + c * points[p, 0] - s * points[p, 1]
+        ty = y + s * points[p, 0] + c * points[p, 1]
+        best = gate
+        for j in range(ref.shape[0]):
+            t = closest_parameter(tx, ty, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3])
+            d = np.hypot(ref[j, 0] + t * (ref[j, 2] - ref[j, 0]) - tx, ref[j, 1] + t * (ref[j, 3] - ref[j, 1]) - ty)
+            if d < best:
+                best = d
+        total += huber_cost(best / scan_sigma, huber)
+    return total
+
+
 def refine_pose(
-    x0: float,
-    y0: float,
-    phi0: float,
+    starts: FloatArray,
     lm_view: FloatArray,
     lm_map: FloatArray,
     point_ok: BoolArray,
@@ -67,7 +122,7 @@ def refine_pose(
     gate: float,
     iterations: int,
 ) -> tuple[float, float, float, FloatArray]:
-    """The pose minimising the weighted robust residuals, from ``(x0, y0, phi0)``.
+    """The pose minimising the weighted robust residuals, from the cheapest of ``starts`` ``(c, 3)``.
 
     ``lm_view`` / ``lm_map`` ``(k, 4)``: the recognised landmarks in the view
     and their map copies; ``point_ok`` ``(k, 2)``: which endpoints are stable
@@ -78,9 +133,31 @@ def refine_pose(
     Stops after ``iterations`` Gauss-Newton steps or when a step moves less
     than 1 micrometre and 0.1 microradian.
     """
-    x = x0
-    y = y0
-    phi = phi0
+    # The start with the lowest robust cost (a mismatched landmark places the robot far off).
+    chosen = 0
+    lowest = np.inf
+    for q in range(starts.shape[0]):
+        cost = pose_cost(
+            starts[q, 0],
+            starts[q, 1],
+            starts[q, 2],
+            lm_view,
+            lm_map,
+            point_ok,
+            points,
+            ref,
+            line_sigma,
+            point_sigma,
+            scan_sigma,
+            huber,
+            gate,
+        )
+        if cost < lowest:
+            lowest = cost
+            chosen = q
+    x = starts[chosen, 0]
+    y = starts[chosen, 1]
+    phi = starts[chosen, 2]
     k = lm_view.shape[0]
     n = points.shape[0]
     m = ref.shape[0]

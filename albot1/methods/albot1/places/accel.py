@@ -17,7 +17,22 @@ class PlacesKernels(NamedTuple):
     jitted: bool
     detect_exits: Callable[[FloatArray, IntArray, float, float, float, float, bool], tuple[IntArray, IntArray]]
     match_structure: Callable[
-        [FloatArray, IntArray, FloatArray, float, float, int, int, FloatArray, IntArray, int, float, float],
+        [
+            FloatArray,
+            IntArray,
+            FloatArray,
+            float,
+            float,
+            int,
+            int,
+            FloatArray,
+            IntArray,
+            int,
+            FloatArray,
+            FloatArray,
+            float,
+            float,
+        ],
         tuple[bool, int, float, float, float],
     ]
 

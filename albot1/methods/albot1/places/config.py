@@ -53,8 +53,9 @@ class MatchParams:
     trigger_fraction: float = 0.2
     trigger_min: int = 4
     retry_growth: int = 3
-    max_conflicts: int = 1
+    max_conflicts: int = 0
     max_turn: float = math.radians(45.0)
+    max_shift: float = 3.0
 
 
 class PlacesFields(BaseModel):
@@ -115,7 +116,7 @@ class PlacesFields(BaseModel):
         ),
     )
     match_max_conflicts: int = Field(
-        1,
+        0,
         ge=0,
         description=(
             "a hypothesis is refused when it puts more than this many unmatched remembered surfaces where the "
@@ -129,6 +130,14 @@ class PlacesFields(BaseModel):
         description=(
             "hypotheses turn a remembered place by at most this from where the perceptual map put it (the map "
             "drifts slowly; 180 = any turn, the thesis's search)"
+        ),
+    )
+    match_max_shift_m: float = Field(
+        3.0,
+        gt=0,
+        description=(
+            "a confirming hypothesis moves the remembered place's centre at most this far from where the "
+            "perceptual map put it (its surfaces co-located with the view there; large = the thesis's search)"
         ),
     )
     revisit_evidence: Literal["memory", "perceptual_map"] = Field(
@@ -206,6 +215,7 @@ class PlacesFields(BaseModel):
             retry_growth=self.match_retry_growth,
             max_conflicts=self.match_max_conflicts,
             max_turn=math.radians(self.match_max_turn_deg),
+            max_shift=self.match_max_shift_m,
         )
 
 

@@ -310,8 +310,10 @@ def match_structure(
     polygons: FloatArray,
     polygon_starts: IntArray,
     max_conflicts: int,
-    prior_theta: float,
+    prior: FloatArray,
+    centre: FloatArray,
     max_turn: float,
+    max_shift: float,
 ) -> tuple[bool, int, float, float, float]:
     """Algorithm 6: does a hypothesis ``S_j = S_k`` bring more than 4 remembered surfaces onto current ones?
 
@@ -336,9 +338,11 @@ def match_structure(
     views saw empty space (inside one of ``polygons`` by more than
     ``max_gap``: the view polygons of Algorithm 3, which would have deleted
     them; polygon p is ``polygons[polygon_starts[p]:polygon_starts[p + 1]]``),
-    confirms (line 11's break). Only hypotheses turning the remembered frame
-    within ``max_turn`` of ``prior_theta`` (where the perceptual map last put
-    that place's frame) are tried. Returns ``(confirmed, best count, theta, tx, ty)``: the motion of
+    confirms (line 11's break). ``prior`` ``(x, y, theta)`` is where the
+    perceptual map put the remembered place's frame: only hypotheses turning
+    it by at most ``max_turn`` are tried, and one that moves the place's
+    ``centre`` (own frame) farther than ``max_shift`` from where the prior
+    puts it does not confirm. Returns ``(confirmed, best count, theta, tx, ty)``: the motion of
     the confirming hypothesis (or of the best one) mapping the remembered
     frame into the map frame.
     """
@@ -358,7 +362,7 @@ def match_structure(
     for j in range(nj):
         for k in range(nk):
             theta0 = wrap_angle(dir_j[j] - dir_k[k])
-            if abs(wrap_angle(theta0 - prior_theta)) > max_turn:
+            if abs(wrap_angle(theta0 - prior[2])) > max_turn:
                 continue
             c = math.cos(theta0)
             s = math.sin(theta0)
@@ -393,7 +397,16 @@ def match_structure(
                     best_tx = tx
                     best_ty = ty
                 if count >= min_matches and left and right:
-                    conflicts = _conflicts(remembered, theta, tx, ty, partner, polygons, polygon_starts, max_gap)
-                    if conflicts <= max_conflicts:
-                        return True, count, theta, tx, ty
+                    ch = math.cos(theta)
+                    sh = math.sin(theta)
+                    cp = math.cos(prior[2])
+                    sp = math.sin(prior[2])
+                    shift = np.hypot(
+                        tx + ch * centre[0] - sh * centre[1] - (prior[0] + cp * centre[0] - sp * centre[1]),
+                        ty + sh * centre[0] + ch * centre[1] - (prior[1] + sp * centre[0] + cp * centre[1]),
+                    )
+                    if shift <= max_shift and abs(wrap_angle(theta - prior[2])) <= max_turn:
+                        conflicts = _conflicts(remembered, theta, tx, ty, partner, polygons, polygon_starts, max_gap)
+                        if conflicts <= max_conflicts:
+                            return True, count, theta, tx, ty
     return False, max(best, 0), best_theta, best_tx, best_ty

@@ -65,6 +65,7 @@ class _Counts:
     revisits_by_structure: int = 0
     revisits_by_exit: int = 0
     match_attempts: int = 0
+    merges_refused: int = 0
     updates_forced: int = 0
 
 
@@ -262,7 +263,7 @@ class Albot1PlacesMapper:
         network, counts = self.network, self._counts
         counts.exits_crossed += 1
         visit = network.current
-        compared = nearest_prediction(self._predicted, crossing.segment)
+        compared = nearest_prediction(self._predicted, crossing.segment, 2.0 * self.config.exit_link_distance_m)
         surfaces, through = self._visit_surfaces(visit)
         place, exit_id = network.close(visit, surfaces, crossing.segment, n, through)
         self._through, self._polygons = set(), []
@@ -362,6 +363,10 @@ class Albot1PlacesMapper:
                 continue
             place_in_map = self._align_at_entry(visit, place_id, match.place_in_map)
             before = None if visit.place is None else network.find(visit.place)
+            if before is not None and not self._same_place(before, place_id, place_in_map):
+                self._counts.merges_refused += 1
+                self._attempts[key] = len(current_all)
+                continue
             now = network.assign(visit, place_id, place_in_map, n)
             self._counts.revisits_by_structure += 1
             self._revisits.append(
@@ -383,6 +388,26 @@ class Albot1PlacesMapper:
         """The surfaces not seen through an exit: the current place's own structure (see docs/places.md)."""
         mid = 0.5 * (surfaces[:, :2] + surfaces[:, 2:])
         return np.ascontiguousarray(surfaces[self.exits.beyond((pose[0], pose[1]), mid, scan) < 0])
+
+    def _same_place(self, known: int, other: int, other_in_map: Pose) -> bool:
+        """Before merging: do the visit's place and the one just matched share their structure where they lie?
+
+        The visit already is ``known`` (at its ``place_in_map``); confirming
+        ``other`` too says they are one place, so their own surfaces, each
+        placed where the map now has it, must co-locate (as many as a match
+        needs). A room matched while the doorway view still shows its
+        neighbour fails this and is not merged.
+        """
+        network, params = self.network, self._match
+        visit = network.current
+        assert visit.place_in_map is not None
+        a, b = network.places[known], network.places[other]
+        mine = transform_segments(visit.place_in_map, a.surfaces[~a.through])
+        theirs = transform_segments(other_in_map, b.surfaces[~b.through])
+        if len(mine) == 0 or len(theirs) == 0:
+            return False
+        same = same_surfaces(structural(mine, params), structural(theirs, params), self._same_angle, self._same_gap)
+        return int(np.count_nonzero(same.any(axis=1))) >= params.min_matches
 
     def _align_at_entry(self, visit: Visit, place_id: int, place_in_map: Pose) -> Pose:
         """Re-align a matched place at the exit the visit came in by, when the place has that exit (Algorithm 8)."""
@@ -414,6 +439,7 @@ class Albot1PlacesMapper:
             revisits_by_structure=c.revisits_by_structure,
             revisits_by_exit=c.revisits_by_exit,
             match_attempts=c.match_attempts,
+            merges_refused=c.merges_refused,
             updates_forced=c.updates_forced,
         )
         compared = [r["prediction"] for r in self._crossings if r["prediction"] is not None]

@@ -96,6 +96,12 @@ def robot_sides(surfaces: FloatArray, pose: Pose) -> NDArray[np.int64]:
     return np.sign(lateral).astype(np.int64)
 
 
+def centre(surfaces: FloatArray) -> FloatArray:
+    """The centre of the bounding box of ``surfaces`` (the point whose displacement the shift gate measures)."""
+    pts = np.asarray(surfaces, dtype=float).reshape(-1, 2)
+    return np.ascontiguousarray(0.5 * (pts.min(axis=0) + pts.max(axis=0))) if len(pts) else np.zeros(2)
+
+
 @dataclass(frozen=True, slots=True)
 class Match:
     """The outcome of one confirmation: whether it confirmed, the best count, and the remembered place's frame."""
@@ -117,8 +123,8 @@ def confirm(
     """Algorithm 6 on already selected surfaces (:func:`structural`); ``pose`` is the robot's, thesis frame.
 
     ``view_polygons`` are the polygons (Algorithm 3 line 7) of the current place's views in the map: the
-    space they saw empty. ``prior`` is where the perceptual map put the remembered place's frame; only
-    hypotheses turning it by at most ``params.max_turn`` are tried.
+    space they saw empty. ``prior`` is where the perceptual map put the remembered place's frame: a
+    hypothesis turns it by at most ``params.max_turn`` and moves its centre by at most ``params.max_shift``.
     """
     if len(current_map) == 0 or len(remembered_own) == 0:
         return Match(False, 0, (0.0, 0.0, 0.0))
@@ -133,7 +139,9 @@ def confirm(
         np.ascontiguousarray(np.concatenate(view_polygons) if view_polygons else np.empty((0, 2))),
         np.cumsum([0] + [len(p) for p in view_polygons]).astype(np.int64),
         params.max_conflicts,
-        float(prior[2]),
+        np.asarray(prior, dtype=float),
+        centre(remembered_own),
         params.max_turn,
+        params.max_shift,
     )
     return Match(bool(found), int(count), (float(tx), float(ty), float(theta)))

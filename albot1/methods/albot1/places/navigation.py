@@ -12,8 +12,9 @@ midpoint is where the place's frame lies in the map *now*
 exits where they were first learned, unaligned (Figure 4.7's filled
 rectangles): each record keeps that map position.
 
-When the next exit is crossed, the prediction nearest to it is the one it
-is compared with (:func:`nearest_prediction`): the midpoint distance of the
+When the next exit is crossed, the prediction nearest to it (within twice
+the link distance; farther, the exit is a new one) is the one it is
+compared with (:func:`nearest_prediction`): the midpoint distance of the
 aligned and of the not-aligned prediction from the exit actually perceived.
 """
 
@@ -75,12 +76,20 @@ def predict(
     return out
 
 
-def nearest_prediction(predictions: list[Prediction], perceived: FloatArray) -> tuple[Prediction, float, float] | None:
-    """The prediction whose aligned midpoint is nearest ``perceived``'s, with its aligned and not-aligned distances."""
+def nearest_prediction(
+    predictions: list[Prediction], perceived: FloatArray, within: float
+) -> tuple[Prediction, float, float] | None:
+    """The prediction whose aligned midpoint is nearest ``perceived``'s, with its aligned and not-aligned distances.
+
+    None when no aligned prediction lies within ``within``: the exit crossed
+    is one the place did not know (a new way out), not a prediction's error.
+    """
     if not predictions:
         return None
     here = midpoint(perceived)
     distances = [float(np.hypot(*(midpoint(p.aligned) - here))) for p in predictions]
     best = int(np.argmin(distances))
+    if distances[best] > within:
+        return None
     chosen = predictions[best]
     return chosen, distances[best], float(np.hypot(*(midpoint(chosen.not_aligned) - here)))

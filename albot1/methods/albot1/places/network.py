@@ -7,12 +7,13 @@ robot had when it entered the place (its frame's origin). ``places.json``
 holds, in order:
 
 * ``places``: every place ever created, ``merged_into`` naming the place a
-  merged one became; a live place's ``surfaces`` and ``exits`` (own frame),
+  merged one became; a live place's ``surfaces`` and ``exits`` (own frame;
+  ``through`` flags the surfaces seen only through one of its exits),
   each exit with where it leads (``leads_to`` place, ``leads_exit``) and where
   it was first seen in the map (``learned_map``); ``frame_in_map`` (where its
-  frame lay in the map when created), ``extent_m`` (half the diagonal of its
-  surfaces' bounding box) and ``centre_map`` (its bounding box centre placed
-  in the map, where the network plot draws it);
+  frame lay in the map when created), ``extent_m`` (:func:`extent`) and
+  ``centre_map`` (the centre of that box placed in the map, where the
+  network plot draws it);
 * ``links``: one per pair of linked exits;
 * ``visits``: each stay, its scans and place (null for a final visit never
   recognised or closed), the exits it came in and left by;
@@ -61,11 +62,17 @@ def _point(x: float, y: float) -> list[float]:
 
 
 def extent(place: Place) -> tuple[float, tuple[float, float]]:
-    """Half the diagonal of the bounding box of a place's surfaces (m) and its centre (own thesis frame)."""
-    if len(place.surfaces) == 0:
+    """A place's size (m) and centre (own thesis frame): half the diagonal of its own surfaces' midpoints' box.
+
+    Own surfaces only (not those seen through its exits), and their
+    midpoints, not their ends: a wall the perceptual map extended along
+    several rooms would otherwise make every place as large as the building.
+    """
+    own = place.surfaces[~place.through] if len(place.through) == len(place.surfaces) else place.surfaces
+    if len(own) == 0:
         return 0.0, (0.0, 0.0)
-    pts = place.surfaces.reshape(-1, 2)
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    mids = 0.5 * (own[:, :2] + own[:, 2:])
+    lo, hi = mids.min(axis=0), mids.max(axis=0)
     return float(0.5 * np.hypot(*(hi - lo))), (float(0.5 * (lo[0] + hi[0])), float(0.5 * (lo[1] + hi[1])))
 
 
@@ -94,6 +101,7 @@ def places_record(
                 "extent_m": radius,
                 "centre_map": _point(centre_map[0], centre_map[1]),
                 "surfaces": _segs(place.surfaces),
+                "through": place.through.tolist(),
                 "exits": [
                     {
                         "id": e.id,

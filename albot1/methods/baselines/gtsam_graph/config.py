@@ -56,6 +56,10 @@ class GtsamGraphConfig(BaseModel):
     track_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of tracking matches")
     track_max_correction_m: float = Field(gt=0, description="a tracking match may move its guess this far at most")
     track_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most")
+    track_wide_correction_deg: float = Field(
+        gt=0, description="a tracking match that fits clearly may rotate its guess up to this much (deg)"
+    )
+    track_wide_min_fitness: float = Field(ge=0, le=1, description="... where 'clearly' is this inlier fraction")
     local_map_nodes: int = Field(
         ge=1, description="the last k node scans form the local map the new node is matched against"
     )

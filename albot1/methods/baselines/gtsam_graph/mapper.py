@@ -199,7 +199,12 @@ class GtsamGraphMapper:
         if not cfg.track_scans:
             return None
         target = self._local_map()
-        limits = (self._track_icp, cfg.track_max_correction_m, cfg.track_max_correction_deg)
+        limits = (
+            self._track_icp,
+            cfg.track_max_correction_m,
+            cfg.track_max_correction_deg,
+            cfg.track_wide_correction_deg,
+        )
         reg, good, _ = self._attempt(target, points, guess, *limits)
         coasting = se2.compose(self._track, self._velocity)
         gap = se2.between(guess, coasting)
@@ -217,27 +222,46 @@ class GtsamGraphMapper:
         return None
 
     def _attempt(
-        self, target: Target, points: FloatArray, guess: FloatArray, params: IcpParams, max_m: float, max_deg: float
+        self,
+        target: Target,
+        points: FloatArray,
+        guess: FloatArray,
+        params: IcpParams,
+        max_m: float,
+        max_deg: float,
+        wide_deg: float | None = None,
     ) -> tuple[Registration | None, bool, bool]:
         """ICP from ``guess``; if it fails its tests, from the guess rotated by +-k * ``seq_retry_rotation_deg``.
 
         Odometry heading errors (slipping wheels while turning, a robot
-        spinning at 2 rad/s on mit-csail) are what most often put the guess
-        outside ICP's basin, and a rotated start recovers them. Returns
-        ``(registration, passed, recovered by a retry)``.
+        spinning at 2 rad/s on mit-csail, where the odometry's turn is 20 deg
+        off within 0.4 s) are what most often put the guess outside ICP's
+        basin, and a rotated start recovers them. A match must stay within
+        ``max_m`` / ``max_deg`` of the guess; with ``wide_deg`` a match that
+        turns the guess by up to ``wide_deg`` also passes if it fits clearly
+        (inlier fraction >= ``track_wide_min_fitness``): only a scan that
+        really explains the local map may overrule the odometry's heading by
+        that much. Among passing matches the narrow ones win, then the best
+        fit. Returns ``(registration, passed, recovered by a retry)``.
         """
+        cfg = self.config
         reg = self._register(target, points, guess, params)
         if self._match_ok(reg, guess, max_m, max_deg):
             return reg, True, False
-        step_rad = math.radians(self.config.seq_retry_rotation_deg)
-        for k in range(1, self.config.seq_retries + 1):
-            best: Registration | None = None
+        candidates = [reg]
+        step_rad = math.radians(cfg.seq_retry_rotation_deg)
+        for k in range(1, cfg.seq_retries + 1):
             for sign in (1.0, -1.0):
-                retry = self._register(target, points, guess + np.array([0.0, 0.0, sign * k * step_rad]), params)
-                if self._match_ok(retry, guess, max_m, max_deg) and (best is None or retry.fitness > best.fitness):
-                    best = retry
-            if best is not None:
-                return best, True, True
+                candidates.append(
+                    self._register(target, points, guess + np.array([0.0, 0.0, sign * k * step_rad]), params)
+                )
+        tiers = [(max_deg, cfg.seq_min_fitness)]
+        if wide_deg is not None:
+            tiers.append((wide_deg, cfg.track_wide_min_fitness))
+        for limit_deg, min_fitness in tiers:
+            passing = [c for c in candidates if self._match_ok(c, guess, max_m, limit_deg, min_fitness)]
+            if passing:
+                return max(passing, key=lambda c: c.fitness), True, True  # type: ignore[union-attr]
         return reg, False, False
 
     def _preprocess(self, scan: Scan, index: int) -> FloatArray:
@@ -326,10 +350,18 @@ class GtsamGraphMapper:
             )
         return step, self._fallback
 
-    def _match_ok(self, reg: Registration | None, guess: FloatArray, max_m: float, max_deg: float) -> bool:
+    def _match_ok(
+        self,
+        reg: Registration | None,
+        guess: FloatArray,
+        max_m: float,
+        max_deg: float,
+        min_fitness: float | None = None,
+    ) -> bool:
         """Converged, fits (inlier fraction, RMS) and moved ``guess`` by at most ``max_m`` / ``max_deg``."""
         cfg = self.config
-        if reg is None or not reg.converged or reg.fitness < cfg.seq_min_fitness or reg.rmse_m > cfg.seq_max_rmse_m:
+        fitness = cfg.seq_min_fitness if min_fitness is None else min_fitness
+        if reg is None or not reg.converged or reg.fitness < fitness or reg.rmse_m > cfg.seq_max_rmse_m:
             return False
         corr = se2.between(guess, reg.pose)
         return math.hypot(corr[0], corr[1]) <= max_m and abs(corr[2]) <= math.radians(max_deg)

@@ -43,6 +43,8 @@ class IcpParams:
     gate_decay: float = 0.7
     tolerance_m: float = 5e-4
     tolerance_rad: float = 1e-4
+    #: a run that used every iteration still counts as converged if its last step was below this many tolerances
+    settle_factor: float = 10.0
     min_points: int = 10
 
 
@@ -156,6 +158,7 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
     pose = init.copy()
     gate = params.max_correspondence_m
     converged = False
+    settled = False
     iterations = 0
     for iterations in range(1, params.max_iterations + 1):  # noqa: B007 -- read after the loop (the count run)
         jac, res, w, _ = _linearise(target, src, pose, gate, params.cauchy_scale_m)
@@ -172,13 +175,22 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
             break
         pose = pose + step
         pose[2] = math.remainder(pose[2], 2.0 * math.pi)
-        small = math.hypot(step[0], step[1]) < params.tolerance_m and abs(step[2]) < params.tolerance_rad
+        moved, turned = math.hypot(step[0], step[1]), abs(step[2])
+        small = moved < params.tolerance_m and turned < params.tolerance_rad
         if small and gate <= params.min_correspondence_m:
             converged = True
             break
+        # Cauchy weights and nearest-neighbour switches can make the last digits cycle: a run that ends
+        # within settle_factor tolerances of a fixed point is as good as converged.
+        settled = (
+            gate <= params.min_correspondence_m
+            and moved < params.settle_factor * params.tolerance_m
+            and turned < params.settle_factor * params.tolerance_rad
+        )
         # Anneal the gate: wide while the guess may be far off, then down to the inlier gate.
         gate = max(params.min_correspondence_m, gate * params.gate_decay)
 
+    converged = converged or (settled and iterations == params.max_iterations)
     jac, res, w, _ = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m)
     inliers = int(len(res))
     information = (jac * (w * inv_var)[:, None]).T @ jac if inliers else np.zeros((3, 3))

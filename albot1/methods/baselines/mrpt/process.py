@@ -11,14 +11,18 @@ most), so a 0.1 s poll bounds the overshoot to a fraction of the limit.
 
 The child is reaped with ``os.wait4`` so its own peak resident set and CPU
 times (``ru_maxrss``, ``ru_utime``, ``ru_stime``) are measured exactly, not
-mixed with other children of this process.
+mixed with other children of this process. On Linux the child also asks the
+kernel to kill it when this process dies (``PR_SET_PDEATHSIG``): a benchmark
+cell killed by its own limit must not leave an unwatched MRPT run behind.
 """
 
 from __future__ import annotations
 
+import ctypes
 import os
 import signal
 import subprocess
+import sys
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -43,6 +47,17 @@ class ProcessOutcome:
     user_s: float
     system_s: float
     peak_rss_mb: float
+
+
+#: ``prctl`` option that sends a signal to this process when its parent dies (linux/prctl.h).
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """In the child before exec: be killed with the parent (Linux; elsewhere a no-op)."""
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
 
 
 def _tree_rss(process: psutil.Process) -> int:
@@ -82,6 +97,7 @@ def run_limited(
             stderr=err,
             env=dict(env) if env is not None else None,
             start_new_session=True,  # its own process group: a kill reaches every helper it started
+            preexec_fn=_die_with_parent,
         )
     watched = psutil.Process(proc.pid)
     stopped: StopReason | None = None

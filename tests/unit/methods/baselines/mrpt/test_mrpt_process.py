@@ -44,3 +44,32 @@ def test_resident_memory_limit(tmp_path: Path) -> None:
     outcome = _run(tmp_path, code, memory_limit_mb=120.0)
     assert outcome.stopped == "memory" and outcome.returncode is None
     assert outcome.peak_rss_mb > 120.0
+
+
+def test_the_child_dies_with_its_parent(tmp_path: Path) -> None:
+    """A parent killed mid-run (a benchmark cell over its limit) leaves no orphan behind."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    import psutil
+
+    pid_file = tmp_path / "child.pid"
+    parent = (
+        "import sys, pathlib\n"
+        "from albot1.methods.baselines.mrpt.process import run_limited\n"
+        "d = pathlib.Path(sys.argv[1])\n"
+        "code = 'import os, pathlib, time; pathlib.Path(\"child.pid\").write_text(str(os.getpid())); time.sleep(60)'\n"
+        "run_limited([sys.executable, '-c', code], cwd=d, timeout_s=60, memory_limit_mb=1000,\n"
+        "            stdout_path=d / 'o.txt', stderr_path=d / 'e.txt')\n"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", parent, str(tmp_path)])
+    deadline = time.monotonic() + 30
+    while not pid_file.exists() or not pid_file.read_text():
+        assert time.monotonic() < deadline and proc.poll() is None
+        time.sleep(0.05)
+    child = psutil.Process(int(pid_file.read_text()))
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    child.wait(timeout=10)  # raises TimeoutExpired if the child outlived its parent

@@ -1,0 +1,258 @@
+"""Chapter 4's network of places scored against reference poses: re-visits, crossings, exit predictions.
+
+Pure functions over ``places.json`` (:mod:`albot1.methods.albot1.places.network`),
+the run's estimated poses and the reference poses; the runner calls
+:func:`judge_places` after a run whose dataset has reference poses (the
+mapper never sees them) and stores what it returns in ``result.json`` and
+``places.json`` (``docs/places.md``, "Ground truth").
+
+**Where a visit was.** When the dataset knows its rooms (the synthetic
+worlds' ``spaces``), a visit was in the room that holds most of its
+reference positions, and two visits were in the same place when their rooms
+are the same. Otherwise (the real logs) a visit's region is the convex hull
+of the reference positions it passed through, grown by ``buffer_m``, and two
+visits were in the same place when their regions *overlap*: they share at
+least ``min_overlap`` of the smaller one's area. A visit never counts the
+one just before it as the same place by overlap (they always touch at the
+doorway between them). The defaults (1.5 m, 0.4) are calibrated against the
+room labels on the synthetic worlds (``docs/places.md``).
+
+* A claimed re-visit (Algorithm 6 or Algorithm 5 line 13) of visit v as
+  place P is **true** when v was in the same place as an earlier visit that
+  ended up in P.
+* A visit in the same place as an earlier visit is a **true re-visit**; it
+  is **recognised** when it ended up in the same place as one of those.
+  Those not recognised are **missed**. Precision is true claims over
+  claims, recall recognised over true re-visits.
+
+**Exits** (when the dataset knows its doorways, as the synthetic worlds do):
+a point the mapper placed in its map at scan s is put in the world by the
+robot's estimated pose and its reference pose at s (``reference[s] *
+inv(estimate[s]) * point``): where the robot believed it was relative to
+itself. Each prediction compared at a crossing is then measured against the
+true doorway (the one nearest the exit perceived there), aligned and not
+aligned; each detected crossing is matched to a true doorway crossing within
+``crossing_scans`` scans.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.geometry import se2
+from albot1.metrics.errors import MetricsError
+
+FloatArray = NDArray[np.float64]
+
+PLACES_JSON = "places.json"
+
+
+@dataclass
+class Judgement:
+    """Counters for ``result.json`` and the annotated files (``places.json`` with ``ground_truth``)."""
+
+    counters: dict[str, int | float] = field(default_factory=dict)
+    files: dict[str, Any] = field(default_factory=dict)
+
+
+def visit_region(reference: FloatArray, first: int, last: int, buffer_m: float) -> Any:
+    """The reference positions of scans ``first..last`` as a shapely region (hull grown by ``buffer_m``)."""
+    from shapely.geometry import MultiPoint
+
+    pts = np.asarray(reference, dtype=float)[first : last + 1, :2]
+    return MultiPoint([tuple(p) for p in pts]).convex_hull.buffer(buffer_m)
+
+
+def overlap(a: Any, b: Any) -> float:
+    """Shared area over the smaller region's area (0 for empty regions)."""
+    small = min(a.area, b.area)
+    return float(a.intersection(b).area / small) if small > 0 else 0.0
+
+
+def visit_rooms(reference: FloatArray, visits: list[Mapping[str, Any]], spaces: list[Mapping[str, Any]]) -> list[str]:
+    """The room (space name) holding most of each visit's reference positions ("" when none does)."""
+    out = []
+    for v in visits:
+        pts = np.asarray(reference, dtype=float)[v["first_scan"] : v["last_scan"] + 1, :2]
+        votes: dict[str, int] = {}
+        for space in spaces:
+            x0, y0, x1, y1 = space["rect"]
+            inside = int(
+                np.count_nonzero((pts[:, 0] >= x0) & (pts[:, 0] <= x1) & (pts[:, 1] >= y0) & (pts[:, 1] <= y1))
+            )
+            votes[space["name"]] = votes.get(space["name"], 0) + inside
+        best = max(votes.items(), key=lambda item: item[1], default=("", 0))
+        out.append(best[0] if best[1] > 0 else "")
+    return out
+
+
+def judge_revisits(
+    record: Mapping[str, Any],
+    reference: FloatArray,
+    spaces: list[Mapping[str, Any]] | None = None,
+    *,
+    buffer_m: float = 1.5,
+    min_overlap: float = 0.4,
+) -> tuple[dict[str, int | float], list[bool], dict[str, Any]]:
+    """Re-visit counters, a truth flag per claimed re-visit (``record["revisits"]`` order) and a summary."""
+    visits = record["visits"]
+    n = len(reference)
+    for v in visits:
+        if not (0 <= v["first_scan"] <= v["last_scan"] < n):
+            raise MetricsError(
+                f"places.json visit {v['id']}: scans {v['first_scan']}..{v['last_scan']} outside the "
+                f"{n} reference poses"
+            )
+    if spaces:
+        rooms = visit_rooms(reference, visits, spaces)
+
+        def same(a: int, b: int) -> bool:
+            return bool(rooms[a]) and rooms[a] == rooms[b]
+
+        rule: dict[str, Any] = {"rule": "rooms", "rooms": rooms}
+    else:
+        regions = [visit_region(reference, v["first_scan"], v["last_scan"], buffer_m) for v in visits]
+
+        def same(a: int, b: int) -> bool:
+            return abs(a - b) > 1 and overlap(regions[a], regions[b]) >= min_overlap
+
+        rule = {"rule": "overlap", "buffer_m": buffer_m, "min_overlap": min_overlap}
+    place_of = [v["place"] for v in visits]
+    truth = []
+    for claim in record["revisits"]:
+        vid, place = claim["visit"], claim["place_now"]
+        truth.append(any(same(vid, u) for u in range(vid) if place_of[u] == place))
+    revisiting = recognised = 0
+    per_visit = []
+    for vid in range(len(visits)):
+        earlier = [u for u in range(vid) if same(vid, u)]
+        correct = bool(earlier) and place_of[vid] is not None and any(place_of[u] == place_of[vid] for u in earlier)
+        revisiting += bool(earlier)
+        recognised += correct
+        per_visit.append({"visit": vid, "same_place_as": earlier, "recognised": correct})
+    claims_true = int(sum(truth))
+    counters: dict[str, int | float] = {
+        "revisits_true": claims_true,
+        "revisits_false": len(truth) - claims_true,
+        "revisits_missed": revisiting - recognised,
+        "revisits_actual": revisiting,
+    }
+    if truth:
+        counters["revisit_precision"] = claims_true / len(truth)
+    if revisiting:
+        counters["revisit_recall"] = recognised / revisiting
+    return counters, truth, {**rule, "visits": per_visit}
+
+
+def believed_in_world(point: FloatArray, estimate: FloatArray, reference: FloatArray) -> FloatArray:
+    """A map point placed in the world as the robot at ``estimate`` (its reference pose) saw it."""
+    relative = se2.transform_points(se2.inverse(estimate), np.asarray(point, dtype=float))
+    return se2.transform_points(reference, relative)
+
+
+def _midpoint(segment: Any) -> FloatArray:
+    s = np.asarray(segment, dtype=float)
+    return 0.5 * (s[:2] + s[2:])
+
+
+def judge_exits(
+    record: Mapping[str, Any],
+    poses: FloatArray,
+    reference: FloatArray,
+    doorways: list[Mapping[str, Any]],
+    true_crossings: list[Mapping[str, Any]],
+    *,
+    crossing_scans: int = 15,
+) -> tuple[dict[str, int | float], dict[str, Any]]:
+    """Exit-prediction errors against the true doorways, and detected crossings against the true ones."""
+    centres = np.array([[(d["a"][0] + d["b"][0]) / 2, (d["a"][1] + d["b"][1]) / 2] for d in doorways], dtype=float)
+    ids = [d["id"] for d in doorways]
+    per_exit = []
+    for crossing in record["crossings"]:
+        pred = crossing.get("prediction")
+        if pred is None:
+            continue
+        s = crossing["scan"]
+        est, ref = poses[s], reference[s]
+        seen = believed_in_world(_midpoint(crossing["segment"]), est, ref)
+        door = int(np.argmin(np.hypot(*(centres - seen).T)))
+        errors = {
+            key: float(np.hypot(*(believed_in_world(_midpoint(pred[key]), est, ref) - centres[door])))
+            for key in ("aligned", "not_aligned")
+        }
+        per_exit.append(
+            {
+                "scan": s,
+                "exit": crossing["exit"],
+                "doorway": ids[door],
+                "perceived_error_m": float(np.hypot(*(seen - centres[door]))),
+                "aligned_error_m": errors["aligned"],
+                "not_aligned_error_m": errors["not_aligned"],
+            }
+        )
+    counters: dict[str, int | float] = {}
+    if per_exit:
+        counters["exit_prediction_aligned_true_mean_m"] = float(np.mean([e["aligned_error_m"] for e in per_exit]))
+        counters["exit_prediction_not_aligned_true_mean_m"] = float(
+            np.mean([e["not_aligned_error_m"] for e in per_exit])
+        )
+    detected = [c["scan"] for c in record["crossings"]]
+    truth = [c["scan"] for c in true_crossings]
+    used: set[int] = set()
+    matched = 0
+    for s in detected:
+        best = min(
+            (t for t in range(len(truth)) if t not in used and abs(truth[t] - s) <= crossing_scans),
+            key=lambda t: abs(truth[t] - s),
+            default=None,
+        )
+        if best is not None:
+            used.add(best)
+            matched += 1
+    counters.update(
+        crossings_true=matched, crossings_false=len(detected) - matched, crossings_missed=len(truth) - matched
+    )
+    return counters, {"exit_predictions": per_exit, "crossing_scans": crossing_scans}
+
+
+def judge_places(
+    files: Mapping[str, Any], poses: FloatArray, reference: FloatArray, dataset: Mapping[str, Any]
+) -> Judgement:
+    """Everything above for one run: counters for ``result.json``, ``places.json`` with ``ground_truth``.
+
+    ``dataset`` is the sequence's metadata ``extra`` (doorways and their
+    crossings for the synthetic worlds; the exit checks are skipped without).
+    """
+    record = files.get(PLACES_JSON)
+    if not isinstance(record, Mapping):
+        raise MetricsError(f"the run has no {PLACES_JSON} to judge")
+    poses = se2.as_poses(poses)
+    reference = se2.as_poses(reference)
+    if len(poses) != len(reference):
+        raise MetricsError(f"{len(poses)} estimated poses but {len(reference)} reference poses")
+    counters, truth, summary = judge_revisits(record, reference, list(dataset.get("spaces") or []))
+    ground: dict[str, Any] = {"revisits": summary, "counters": dict(counters)}
+    doorways = dataset.get("doorways")
+    if doorways:
+        exit_counters, exit_summary = judge_exits(
+            record, poses, reference, list(doorways), list(dataset.get("doorway_crossings", []))
+        )
+        counters.update(exit_counters)
+        ground["exits"] = exit_summary
+        ground["counters"] = dict(counters)
+    annotated = dict(record)
+    annotated["revisits"] = [{**claim, "true": flag} for claim, flag in zip(record["revisits"], truth)]
+    annotated["ground_truth"] = ground
+    out = dict(files)
+    out[PLACES_JSON] = annotated
+    return Judgement(counters={k: v for k, v in counters.items() if not _undefined(v)}, files=out)
+
+
+def _undefined(value: int | float) -> bool:
+    return isinstance(value, float) and not math.isfinite(value)
