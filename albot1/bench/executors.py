@@ -39,11 +39,17 @@ def parse_executor(spec: str) -> tuple[str, str | None]:
     raise BenchError(f"executor {spec!r} not understood; expected {EXECUTORS_HELP}")
 
 
+def check_jobs(jobs: int) -> int:
+    """``jobs`` when it is a usable number of parallel cells (at least one), else a BenchError."""
+    if jobs < 1:
+        raise BenchError(f"-j {jobs}: expected at least one parallel job")
+    return jobs
+
+
 @contextmanager
 def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Iterator[cf.Executor]:
     """The executor named by ``spec`` with ``jobs`` parallel cells; shut down on exit."""
-    if jobs < 1:
-        raise BenchError(f"expected at least one parallel job, got -j {jobs}")
+    check_jobs(jobs)
     kind, address = parse_executor(spec)
     if kind == "local":
         with cf.ThreadPoolExecutor(max_workers=jobs, thread_name_prefix="cell") as pool:

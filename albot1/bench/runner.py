@@ -26,7 +26,7 @@ from typing import Protocol
 
 from albot1.bench.cells import renderer_target
 from albot1.bench.errors import BenchError
-from albot1.bench.executors import open_executor, parse_executor
+from albot1.bench.executors import check_jobs, open_executor, parse_executor
 from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.job import results_path, run_cell_job
 from albot1.bench.limits import start_forkserver
@@ -153,15 +153,15 @@ def run_grid(
             for future in done:
                 if future.cancelled():
                     continue
-                outcome = _outcome(future, futures[future], store)
-                if outcome is None:
+                ended = _outcome(future, futures[future], store)
+                if ended is None:
                     summary.not_started.append(futures[future])
                     continue
-                summary.outcomes.append(outcome)
+                summary.outcomes.append(ended)
                 if observer is not None:
-                    observer.finished(outcome)
-                if outcome.halts_grid and summary.halted is None:
-                    summary.halted = outcome.reason
+                    observer.finished(ended)
+                if ended.halts_grid and summary.halted is None:
+                    summary.halted = ended.reason
                     cancelled = {f for f in waiting if f.cancel()}
                     summary.not_started += [futures[f] for f in futures if f in cancelled]
                     waiting -= cancelled
@@ -169,6 +169,8 @@ def run_grid(
         for future in futures:
             future.cancel()
         _HALTED_GRIDS.discard(grid_id)
+    order = {cell.key: index for index, cell in enumerate(cells)}
+    summary.not_started.sort(key=lambda cell: order[cell.key])
     summary.wall_s = time.monotonic() - start
     return summary
 
@@ -222,6 +224,7 @@ def run_suite(
     as the cell processes import it by name.
     """
     kind, _ = parse_executor(executor)  # a typo fails before any planning work
+    check_jobs(jobs)
     job = partial(run_cell_job, preview=renderer_target(preview) if preview is not None else None)
     suite_file = find_suite(suite_ref)
     suite = load_suite(suite_file)

@@ -11,8 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
+from albot1.atomic import atomic_write
 from albot1.contract import RunResult
 from albot1.metrics.alignment import align
+from albot1.report.places_plot import render_places
 
 
 def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> None:
@@ -46,8 +48,5 @@ def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> 
     plt.close(fig)
     places = result.files.get("places.json")
     if isinstance(places, dict):  # a method with a network of places (albot1-places): Figure 4.2 beside it
-        from albot1.atomic import atomic_write
-        from albot1.report.places_plot import render_places
-
         title = f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]"
         atomic_write(path.parent / "places.png", lambda p: render_places(places, p, title))

@@ -75,5 +75,5 @@ def plot_robustness(
         fontsize=8,
         color="0.3",
     )
-    fig.legend(loc="outside right upper", fontsize=8, frameon=False)
+    fig.legend(loc="outside lower center", ncols=min(len(methods), 6), fontsize=8, frameon=False)
     return save(fig, path)

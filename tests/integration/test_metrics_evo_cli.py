@@ -77,3 +77,34 @@ def test_rpe_matches_evo_rpe_cli(tum_pair: tuple[Path, Path], tmp_path: Path, de
     for key in ("rmse", "mean", "max", "std"):
         assert ours["translation_m"][key] == pytest.approx(trans[key], abs=2e-6), key
         assert ours["rotation_deg"][key] == pytest.approx(rot[key], abs=2e-6), key
+
+
+def test_our_evo_result_files_sit_beside_evos_own_in_evo_res(tum_pair: tuple[Path, Path], tmp_path: Path) -> None:
+    """`albot1 evaluate --evo` files and `evo_ape --save_results` files compared by evo_res: the same numbers."""
+    from albot1.runs.evo_results import write_evo_results
+    from albot1.runs.scored import Scored
+
+    ref_file, est_file = tum_pair
+    stamps, ref = read_tum(ref_file)
+    _, est = read_tum(est_file)
+    header = {"method": "ours", "key": "k"}
+    scored = Scored(header, "pair", stamps, est, ref, None, "none", stamps, est)
+    ours, _ = write_evo_results(scored, tmp_path, prefix="ours.")
+    theirs = tmp_path / "theirs.zip"
+    run_evo("evo_ape", str(ref_file), str(est_file), "--align", "--save_results", str(theirs), home=tmp_path)
+    env = {**os.environ, "HOME": str(tmp_path), "MPLBACKEND": "Agg"}
+    done = subprocess.run(
+        [str(evo_tool("evo_res")), str(ours), str(theirs), "--use_filenames", "--no_warnings"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert str(ours) in done.stdout and str(theirs) in done.stdout  # both rows of evo_res's table
+    from evo.tools.file_interface import load_res_file
+
+    mine, evos = load_res_file(ours), load_res_file(theirs)
+    assert mine.info["title"] == evos.info["title"]  # no title-mismatch warning in evo_res
+    for key in ("rmse", "mean", "median", "std", "min", "max", "sse"):
+        assert mine.stats[key] == pytest.approx(evos.stats[key], rel=1e-9), key

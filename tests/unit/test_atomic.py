@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from albot1.atomic import atomic_write
+from albot1.atomic import atomic_write, remove_temporaries
 
 
 def test_replaces_and_cleans_up(tmp_path: Path) -> None:
@@ -35,3 +35,13 @@ def test_temporary_name_keeps_the_suffixes(tmp_path: Path) -> None:
     seen: list[str] = []
     atomic_write(tmp_path / "log.clf.gz", lambda p: (seen.append(p.name), p.write_bytes(b"x")))
     assert seen[0].endswith(".clf.gz")
+
+
+def test_remove_temporaries_deletes_what_a_killed_writer_left_and_nothing_else(tmp_path: Path) -> None:
+    (tmp_path / "result.json").write_text("{}")
+    (tmp_path / ".hidden").write_text("keep")
+    left = [tmp_path / ".result.json.abc123.tmp.json", tmp_path / ".per_scan_ns.npy.x1.tmp.npy"]
+    for path in left:
+        path.write_bytes(b"")
+    assert sorted(p.name for p in remove_temporaries(tmp_path)) == sorted(p.name for p in left)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".hidden", "result.json"]

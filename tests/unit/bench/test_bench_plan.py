@@ -51,3 +51,53 @@ def test_deterministic_degradations_run_once_and_random_ones_once_per_seed(tmp_p
     assert runs == sorted(
         [("none", 7), ("thesis", 3), ("bias:0.01:0.1", 3), ("gauss:0.1:1", 3), ("gauss:0.1:1", 4), ("gauss:0.1:1", 5)]
     )
+
+
+def test_a_glob_that_matches_no_dataset_is_an_error_naming_the_entry(tmp_path: Path) -> None:
+    with pytest.raises(SuiteError) as caught:
+        _plan(tmp_path, '[[datasets]]\nname = "no-such-*"\n')
+    message = str(caught.value)
+    assert message.startswith(f"{tmp_path / 'tiny.toml'}: dataset entry 1 ('no-such-*') matches no dataset")
+    assert WORLD in message and "optional = true" in message
+
+
+def test_an_optional_glob_that_matches_nothing_is_not_an_error(tmp_path: Path) -> None:
+    _, plan = _plan(tmp_path, '[[datasets]]\nname = "no-such-*"\noptional = true\n')
+    assert {c.dataset for c in plan.cells} == {WORLD} and not plan.skipped_datasets
+
+
+def test_a_sliced_reference_is_a_dataset_of_its_own(tmp_path: Path) -> None:
+    _, plan = _plan(tmp_path, f'[[datasets]]\nname = "{WORLD}[:5]"\n[[datasets]]\nname = "{WORLD}[:6]"\n')
+    labels = sorted(c.dataset_label for c in plan.cells)
+    assert labels == sorted([WORLD, f"{WORLD}[:5]", f"{WORLD}[:6]"])
+    assert len({c.key for c in plan.cells}) == 3
+
+
+def test_a_bad_slice_is_an_error_of_the_suite(tmp_path: Path) -> None:
+    with pytest.raises(SuiteError, match=rf"tiny\.toml: dataset '{WORLD}\[:0\]': .*slice STOP is 0"):
+        _plan(tmp_path, f'[[datasets]]\nname = "{WORLD}[:0]"\n')
+
+
+def _methods_plan(tmp_path: Path, methods: str) -> GridPlan:
+    path = tmp_path / "two.toml"
+    path.write_text(f'{methods}\n[[datasets]]\nname = "{WORLD}"\n')
+    return plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+
+
+def test_cells_that_differ_only_in_their_limits_are_an_error_not_one_folder(tmp_path: Path) -> None:
+    methods = (
+        '[[methods]]\nname = "odometry"\nlabel = "fast"\ntime_s = 1\n'
+        '[[methods]]\nname = "odometry"\nlabel = "slow"\ntime_s = 100\n'
+    )
+    with pytest.raises(SuiteError) as caught:
+        _methods_plan(tmp_path, methods)
+    message = str(caught.value)
+    assert "fast on synthetic-office-startstop [none, seed 0] (time_s 1, memory_mb 4096)" in message
+    assert "slow on synthetic-office-startstop [none, seed 0] (time_s 100, memory_mb 4096)" in message
+    assert "same run" in message and "different limits" in message
+
+
+def test_two_labels_for_the_same_run_with_the_same_limits_share_one_folder(tmp_path: Path) -> None:
+    plan = _methods_plan(tmp_path, '[[methods]]\nname = "odometry"\n[[methods]]\nname = "odometry"\nlabel = "dr"\n')
+    assert [c.method_label for c in plan.cells] == ["odometry", "dr"]
+    assert len({c.key for c in plan.cells}) == 1

@@ -128,7 +128,7 @@ def test_read_plan_of_a_folder_that_is_not_a_results_folder(tmp_path: Path) -> N
             "storage",
             "cannot write the results: no space left on device",
         ),
-        (ChildExit(EXIT_STORAGE, False, 1.0), None, "storage", "not even the cell's error report fitted"),
+        (ChildExit(EXIT_STORAGE, False, 1.0), None, "storage", "cannot write the results in "),
         (
             ChildExit(EXIT_EXCEPTION, False, 1.0),
             {"kind": "exception", "type": "BaselineError", "message": "diverged"},

@@ -135,3 +135,77 @@ def test_reference_with_loader_options_is_a_literal_entry() -> None:
     assert opts is not None and opts.sweep is True
     plain = suite.options_for("intel-corrected")
     assert plain is not None and plain.sweep is False
+
+
+@pytest.mark.parametrize("name", ["..", ".", ".hidden", "a/b", "../escape", "a b", "x" * 101, ""])
+def test_a_suite_name_must_be_a_plain_folder_name(name: str) -> None:
+    with pytest.raises(SuiteError, match=r"s\.toml: invalid suite: name: .*plain folder name"):
+        parse_suite(MINIMAL, name=name, source="s.toml")
+
+
+@pytest.mark.parametrize("name", ["quick", "my-suite_2.v1", "9"])
+def test_plain_suite_names_are_accepted(name: str) -> None:
+    assert parse_suite(MINIMAL, name=name, source="s.toml").name == name
+
+
+@pytest.mark.parametrize(
+    ("table", "expected"),
+    [
+        ("[limits]\ntime_s = 1e12\n", r"limits\.time_s: Input should be less than or equal to 604800"),
+        ("[limits]\ntime_s = inf\n", r"limits\.time_s"),
+        ("[limits]\ntime_s = nan\n", r"limits\.time_s"),
+        ("[limits]\ntime_s = 0\n", r"limits\.time_s: Input should be greater than 0"),
+        ("[limits]\nmemory_mb = 1e9\n", r"limits\.memory_mb: Input should be less than or equal to 1048576"),
+        ("[grid]\nseeds = [-1]\n", r"grid\.seeds\.0: Input should be greater than or equal to 0"),
+        ("[grid]\nundegraded_seeds = [0, -3]\n", r"grid\.undegraded_seeds\.1"),
+    ],
+)
+def test_limits_and_seeds_are_bounded(tmp_path: Path, table: str, expected: str) -> None:
+    path = write(tmp_path, table + '\n[[methods]]\nname = "odometry"\n[[datasets]]\nname = "*"\n')
+    with pytest.raises(SuiteError, match=expected):
+        load_suite(path)
+
+
+def test_entry_limits_and_seeds_are_bounded_too() -> None:
+    for entry, key in (
+        ({"name": "*", "time_s": 1e12}, "datasets.0.time_s"),
+        ({"name": "*", "seeds": [-2]}, "datasets.0.seeds.0"),
+    ):
+        with pytest.raises(SuiteError, match=key.replace(".", r"\.")):
+            parse_suite({"methods": [{"name": "odometry"}], "datasets": [entry]}, name="s", source="s.toml")
+    with pytest.raises(SuiteError, match=r"methods\.0\.memory_mb"):
+        parse_suite(
+            {"methods": [{"name": "odometry", "memory_mb": -1}], "datasets": [{"name": "*"}]}, name="s", source="s"
+        )
+
+
+@pytest.mark.parametrize(
+    ("name", "pattern"),
+    [
+        ("intel[:100]", False),
+        ("intel[:100:2]", False),
+        ("intel[::2]", False),
+        ("intel[:30][:20]", False),
+        ("intel-corrected?odometry=laser-pose[:100]", False),
+        ("intel*", True),
+        ("intel*[:100]", True),
+        ("intel-[ab]*", True),
+        ("log[1].clf", True),
+    ],
+)
+def test_a_trailing_slice_is_a_literal_reference_not_a_glob(name: str, pattern: bool) -> None:
+    suite = parse_suite({"methods": [{"name": "odometry"}], "datasets": [{"name": name}]}, name="s", source="s")
+    assert suite.datasets[0].is_pattern is pattern
+    assert suite.literal_datasets() == ([] if pattern else [name])
+
+
+def test_a_suite_file_that_is_not_utf8_text_is_one_error(tmp_path: Path) -> None:
+    path = tmp_path / "binary.toml"
+    path.write_bytes(b"\xff\xfe\x00name")
+    with pytest.raises(SuiteError, match=r"binary\.toml: not UTF-8 text \(byte 0\)"):
+        load_suite(path)
+
+
+def test_a_suite_cannot_set_its_own_path() -> None:
+    with pytest.raises(SuiteError, match="path: unknown key"):
+        parse_suite({**MINIMAL, "path": "/elsewhere"}, name="s", source="s.toml")

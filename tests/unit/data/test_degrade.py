@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
 
-from albot1.data.degrade import Degradation, DegradationSpecError, degrade, parse_spec
+from albot1.data.degrade import Degradation, DegradationSpecError, check_seed, degrade, parse_spec
 from albot1.data.errors import DataError
 from albot1.data.model import Frame, Relations, Scan, Sequence, SequenceMetadata
 from albot1.geometry import se2
@@ -209,3 +210,20 @@ def test_bad_spec_is_rejected_by_degrade_before_iterating() -> None:
 def test_degradation_dataclass_perturb_of_none_is_identity() -> None:
     step = np.array([0.3, -0.1, 0.2])
     np.testing.assert_array_equal(Degradation("none").perturb(step, np.random.default_rng(0)), step)
+
+
+@pytest.mark.parametrize("seed", [-1, -(2**40), 2**63, True, 1.5, "3"])
+def test_a_seed_outside_0_to_2_63_is_refused_before_any_scan_is_read(seed: object) -> None:
+    def frames() -> Iterator[Frame]:
+        raise AssertionError("the sequence was read")
+        yield  # pragma: no cover
+
+    sequence = Sequence("never-read", frames, _sequence(_straight(2)).metadata)
+    for spec in ("none", "gauss:0.1:1"):
+        with pytest.raises(DegradationSpecError, match=r"seed .*: expected an integer from 0 to 9223372036854775807"):
+            degrade(sequence, spec, seed=seed)  # type: ignore[arg-type]
+
+
+def test_seeds_at_the_bounds_and_numpy_integers_are_accepted() -> None:
+    assert check_seed(0) == 0 and check_seed(2**63 - 1) == 2**63 - 1
+    assert check_seed(np.int64(7)) == 7 and type(check_seed(np.uint32(7))) is int

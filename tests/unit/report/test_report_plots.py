@@ -128,6 +128,12 @@ def _records(tmp_path: Path, sequence: Sequence, dataset: str) -> list[CellRecor
     return out
 
 
+@pytest.fixture(scope="module")
+def corridor(tmp_path_factory: pytest.TempPathFactory) -> list[CellRecord]:
+    """Runs on a 40 m straight route (a corridor), shared by the tests of this module (they only read them)."""
+    return _records(tmp_path_factory.mktemp("corridor"), _world(40.0, 0.0), "corridor")
+
+
 def _check_png(path: Path | None) -> tuple[int, int]:
     assert path is not None and path.read_bytes()[:8] == PNG_SIGNATURE
     assert path.with_suffix(".svg").read_text().startswith("<?xml")  # the vector twin
@@ -136,8 +142,8 @@ def _check_png(path: Path | None) -> tuple[int, int]:
     return pixels.shape[1], pixels.shape[0]
 
 
-def test_every_plot_of_a_corridor_is_wide_png_and_svg(tmp_path: Path) -> None:
-    records = _records(tmp_path / "runs", _world(40.0, 0.0), "corridor")
+def test_every_plot_of_a_corridor_is_wide_png_and_svg(tmp_path: Path, corridor: list[CellRecord]) -> None:
+    records = corridor
     colors = method_colors(r.cell.method_label for r in records)
     out = tmp_path / "plots"
     out.mkdir()
@@ -153,9 +159,8 @@ def test_every_plot_of_a_corridor_is_wide_png_and_svg(tmp_path: Path) -> None:
     assert all(label in legend_text for label in ("clean", "noisy", "biased", "reference"))
 
 
-def test_rpe_boxes_use_every_segment_length_the_route_is_long_enough_for(tmp_path: Path) -> None:
-    records = _records(tmp_path, _world(40.0, 0.0), "corridor")
-    lengths, errors = segment_error_sets(records)
+def test_rpe_boxes_use_every_segment_length_the_route_is_long_enough_for(corridor: list[CellRecord]) -> None:
+    lengths, errors = segment_error_sets(corridor)
     assert lengths == [1.0, 2.0, 5.0, 10.0, 20.0]  # 50 and 100 m are beyond a 40 m route
     assert set(errors) == {"clean", "noisy", "biased"}
     assert float(np.abs(errors["clean"][0]).max()) == pytest.approx(0.0, abs=1e-6)  # clean odometry: no error

@@ -139,3 +139,56 @@ def test_latest_link_and_listing_of_a_runs_root(tmp_path: Path) -> None:
     (tmp_path / LATEST).mkdir()
     with pytest.raises(RunError, match="exists and is not a symbolic link"):
         mark_latest(tmp_path, first)
+
+
+def test_per_scan_times_are_written_atomically_and_no_temporary_file_stays(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    result = run_method("odometry", _sequence())
+
+    def killed_mid_write(file: object, array: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(np, "save", killed_mid_write)
+    with pytest.raises(OSError, match="No space left"):
+        write_run(result, tmp_path)
+    (run_dir,) = tmp_path.iterdir()
+    assert not (run_dir / "per_scan_ns.npy").exists() and not is_complete(run_dir)
+    assert not [p.name for p in run_dir.iterdir() if p.name.startswith(".")]
+    monkeypatch.undo()
+    (run_dir / ".trajectory.tum.k1ll3d.tmp.tum").write_bytes(b"")  # what a SIGKILLed writer leaves
+    write_run(result, tmp_path)
+    assert is_complete(run_dir) and not [p.name for p in run_dir.iterdir() if p.name.startswith(".")]
+    assert read_run(run_dir).per_scan_ns.shape == (8,)
+
+
+@pytest.mark.parametrize(
+    ("damage", "words"),
+    [
+        (lambda d: (d / "per_scan_ns.npy").unlink(), r"per_scan_ns\.npy: missing from a run folder marked complete"),
+        (lambda d: (d / "per_scan_ns.npy").write_text("garbage"), r"per_scan_ns\.npy: not readable as a numpy array"),
+        (
+            lambda d: np.save(d / "per_scan_ns.npy", np.zeros(3)),
+            r"per_scan_ns\.npy: holds float64 of shape \(3,\); expected a \.npy array of 8 per-scan times",
+        ),
+        (lambda d: (d / "odometry.tum").unlink(), r"odometry\.tum: missing from a run folder marked complete"),
+        (lambda d: (d / "reference.tum").unlink(), r"reference\.tum: missing"),
+        (lambda d: (d / "relations.txt").unlink(), r"relations\.txt: missing"),
+    ],
+)
+def test_a_damaged_run_folder_is_one_error_naming_the_file(tmp_path: Path, damage: object, words: str) -> None:
+    run_dir = write_run(run_method("odometry", _sequence()), tmp_path)
+    damage(run_dir)  # type: ignore[operator]
+    with pytest.raises(RunError, match=words):
+        read_run(run_dir)
+
+
+def test_a_damaged_map_is_one_error_naming_the_file(tmp_path: Path) -> None:
+    run_dir = write_run(run_method("odometry", _sequence()), tmp_path)
+    stored = read_run(run_dir)
+    (run_dir / "map.npz").write_text("not a zip")
+    with pytest.raises(RunError, match=r"map\.npz: not a map this project wrote .*expected a \.npz archive"):
+        stored.load_map()
+    (run_dir / "map.npz").unlink()
+    with pytest.raises(RunError, match=r"map\.npz: missing"):
+        stored.load_map()

@@ -298,7 +298,8 @@ class Albot1Mapper:
         odometry = compose_pose(prev_pose, step)
         # Starts: the thesis's pose, every landmark's candidate pose, and the odometry step.
         if loc is None:
-            starts = np.asarray([odometry], dtype=float)
+            turns = np.radians(np.array([0.0, -3.0, 3.0, -6.0, 6.0, -10.0, 10.0, -15.0, 15.0, -20.0, 20.0, -30.0, 30.0]))
+            starts = np.column_stack([np.full(len(turns), odometry[0]), np.full(len(turns), odometry[1]), odometry[2] + turns])
         else:
             starts = np.vstack([np.asarray([loc.pose, odometry], dtype=float), loc.candidates])
         rows: list[int] = []

@@ -15,6 +15,10 @@ class PlacesKernels(NamedTuple):
     """One consistent set of places kernels (all jitted or none); see :mod:`.kernels` for each."""
 
     jitted: bool
+    update_sides: Callable[
+        [FloatArray, IntArray, FloatArray, IntArray, IntArray, IntArray, float, float, float, int, int, int],
+        tuple[IntArray, FloatArray, FloatArray],
+    ]
     detect_exits: Callable[[FloatArray, IntArray, float, float, float, float, bool], tuple[IntArray, IntArray]]
     match_structure: Callable[
         [
@@ -40,5 +44,5 @@ class PlacesKernels(NamedTuple):
 @lru_cache(maxsize=2)
 def places_kernels(accelerate: bool = True) -> PlacesKernels:
     """The jitted kernels when ``accelerate`` and numba is importable, else the plain ones."""
-    jit = kernel_compiler(accelerate, (kernels.detect_exits, kernels.match_structure))
-    return PlacesKernels(jit.jitted, jit(kernels.detect_exits), jit(kernels.match_structure))
+    jit = kernel_compiler(accelerate, (kernels.update_sides, kernels.detect_exits, kernels.match_structure))
+    return PlacesKernels(jit.jitted, jit(kernels.update_sides), jit(kernels.detect_exits), jit(kernels.match_structure))

@@ -92,6 +92,7 @@ class ExitTracker:
         self._last_seen = np.empty(0, dtype=np.int64)
         self._side = np.empty(0, dtype=np.int64)  # +1 left of the segment, -1 right, 0 not yet known
         self._side_at = np.empty((0, 2))  # where the robot last was clearly on that side
+        self._mute = np.empty(0, dtype=np.int64)  # a twin of an exit just crossed: the side the robot heads for
         self._next_id = 0
         self.detections = 0
 
@@ -169,12 +170,15 @@ class ExitTracker:
 
     def observe(self, view: View, pose: Pose, scan: int) -> FloatArray:
         """Detect the exits of ``view`` (taken at ``pose``) and track them; returns them in the map frame."""
-        found = transform_segments(pose, view_exits(view, self.params, self._k))
+        if scan % _PRUNE_EVERY == 0:
+            self._prune(scan)
+        local = view_exits(view, self.params, self._k)
+        if len(local) == 0:
+            return local
+        found = transform_segments(pose, local)
         for seg in found:
             self._track(seg, scan)
         self.detections += len(found)
-        if scan % _PRUNE_EVERY == 0:
-            self._prune(scan)
         return found
 
     def _track(self, seg: FloatArray, scan: int) -> None:
@@ -195,6 +199,7 @@ class ExitTracker:
         self._last_seen = np.append(self._last_seen, scan)
         self._side = np.append(self._side, 0)
         self._side_at = np.vstack([self._side_at, np.zeros((1, 2))])
+        self._mute = np.append(self._mute, 0)
         self._next_id += 1
 
     def _prune(self, scan: int) -> None:
@@ -203,6 +208,7 @@ class ExitTracker:
             return
         self._seg, self._ids, self._sightings = self._seg[keep], self._ids[keep], self._sightings[keep]
         self._last_seen, self._side, self._side_at = self._last_seen[keep], self._side[keep], self._side_at[keep]
+        self._mute = self._mute[keep]
 
     def crossing(self, position: tuple[float, float], scan: int) -> Crossing | None:
         """Update every exit's side of the robot at ``position``; the exit crossed since the last call, if any.
@@ -210,31 +216,35 @@ class ExitTracker:
         With several crossed at once (a pose jump), the one whose line is
         nearest the robot is returned; the others only change side.
         """
-        n = len(self._ids)
-        if n == 0:
+        if len(self._ids) == 0:
             return None
         p = self.params
         seg = self._seg
-        ex, ey = seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]
-        width = np.hypot(ex, ey)
-        signed = (ex * (position[1] - seg[:, 1]) - ey * (position[0] - seg[:, 0])) / width
-        clear = np.abs(signed) > p.crossing_band
-        side = np.where(signed > 0, 1, -1)
-        changed = clear & (self._side != 0) & (side != self._side)
+        rows, distance, old_side = self._k.update_sides(
+            seg,
+            self._side,
+            self._side_at,
+            self._mute,
+            self._sightings,
+            self._last_seen,
+            float(position[0]),
+            float(position[1]),
+            p.crossing_band,
+            p.min_sightings,
+            p.recent_scans,
+            scan,
+        )
         best: Crossing | None = None
         best_distance = math.inf
-        for r in np.flatnonzero(changed & self._recent(scan)).tolist():
-            before = (float(self._side_at[r, 0]), float(self._side_at[r, 1]))
-            if not _passes_between(before, position, seg[r], p.crossing_margin):
-                continue
-            if abs(signed[r]) < best_distance:
-                best_distance = abs(signed[r])
+        for r, d, (bx, by) in zip(rows.tolist(), distance.tolist(), old_side.tolist()):
+            before = (bx, by)
+            if d < best_distance and _passes_between(before, position, seg[r], p.crossing_margin):
+                best_distance = d
                 best = Crossing(int(self._ids[r]), scan, orient_left(seg[r], before), before, position)
-        self._side[clear] = side[clear]
-        self._side_at[clear] = position
         if best is not None:
             # Another track of the same doorway (placed apart by map drift) is the exit just crossed too:
-            # it is put on the side the robot is heading for, so passing its line is not a second crossing.
+            # it is muted until the robot is on the side it is heading for, so passing its line is no second
+            # crossing.
             mids = 0.5 * (seg[:, :2] + seg[:, 2:])
             here = 0.5 * (best.segment[:2] + best.segment[2:])
             twins = np.hypot(mids[:, 0] - here[0], mids[:, 1] - here[1]) <= p.twin_distance
@@ -242,8 +252,7 @@ class ExitTracker:
             for r in np.flatnonzero(twins).tolist():
                 ax, ay, bx, by = seg[r]
                 before_side = (bx - ax) * (best.before[1] - ay) - (by - ay) * (best.before[0] - ax)
-                self._side[r] = -1 if before_side > 0 else 1
-                self._side_at[r] = position
+                self._mute[r] = -1 if before_side > 0 else 1
         return best
 
 

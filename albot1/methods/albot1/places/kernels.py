@@ -105,6 +105,62 @@ def detect_exits(
     return out_i[:k], out_j[:k]
 
 
+def update_sides(
+    seg: FloatArray,
+    side: IntArray,
+    side_at: FloatArray,
+    mute: IntArray,
+    sightings: IntArray,
+    last_seen: IntArray,
+    x: float,
+    y: float,
+    band: float,
+    min_sightings: int,
+    recent_scans: int,
+    scan: int,
+) -> tuple[IntArray, FloatArray, FloatArray]:
+    """The crossing test's per-scan pass over the tracked exits (updates ``side``/``side_at`` in place).
+
+    The robot at (x, y) is on a side of exit r only when farther than
+    ``band`` from its line; ``side[r]`` (+1 left of the segment, -1 right,
+    0 unknown) and ``side_at[r]`` (where the robot last was clearly on it)
+    are updated. A muted exit (``mute[r]`` = the side the robot is heading
+    for; a twin of an exit just crossed) reports nothing until the robot is
+    clearly on that side, or farther than 2 m from its line. Returns the rows
+    whose side changed and that can be crossed (seen ``min_sightings`` times,
+    the last within ``recent_scans``), the robot's distance from each one's
+    line, and where the robot was on the old side (rows ``(k, 2)``).
+    """
+    n = seg.shape[0]
+    rows = np.empty(n, dtype=np.int64)
+    dist = np.empty(n)
+    before = np.empty((n, 2))
+    k = 0
+    for r in range(n):
+        ex = seg[r, 2] - seg[r, 0]
+        ey = seg[r, 3] - seg[r, 1]
+        w = np.hypot(ex, ey)
+        if w <= 0.0:
+            continue
+        d = (ex * (y - seg[r, 1]) - ey * (x - seg[r, 0])) / w
+        if abs(d) <= band:
+            continue
+        s = 1 if d > 0.0 else -1
+        if mute[r] != 0:
+            if s == mute[r] or abs(d) > 2.0:
+                mute[r] = 0
+        elif side[r] != 0 and s != side[r] and sightings[r] >= min_sightings and scan - last_seen[r] <= recent_scans:
+            rows[k] = r
+            dist[k] = abs(d)
+            before[k, 0] = side_at[r, 0]
+            before[k, 1] = side_at[r, 1]
+            k += 1
+        side[r] = s
+        side_at[r, 0] = x
+        side_at[r, 1] = y
+    return rows[:k], dist[:k], before[:k]
+
+
 def _colocated(a: FloatArray, b: FloatArray, max_gap: float) -> bool:
     """Whether the shorter of two surfaces has its midpoint within ``max_gap`` of the longer one.
 

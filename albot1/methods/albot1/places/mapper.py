@@ -91,6 +91,7 @@ class Albot1PlacesMapper:
         )
         self._labels: list[set[int]] = []  # map surface id -> the visits it belongs to (see _map_evidence)
         self._placed_cache: dict[int, tuple[Any, FloatArray, FloatArray]] = {}
+        self._structure_cache: dict[int, tuple[Any, FloatArray]] = {}
         self._members: dict[int, set[int]] = {}  # visit -> the map surface ids marked with it
         self._through: set[int] = set()  # surfaces the current visit saw only through an exit
         self._polygons: list[FloatArray] = []  # the view polygons of the current visit's updates (seen empty)
@@ -126,29 +127,30 @@ class Albot1PlacesMapper:
     def _on_update(self, event: UpdateEvent) -> None:
         """Gather re-visit evidence from the update, then mark the view's surfaces with the current visit."""
         current = self.network.current
+        view = event.view_map
+        if len(view) == 0:
+            return
+        robot = (event.pose[0], event.pose[1])
+        poly = view_polygon(view, robot, "robot_and_endpoints")
+        # which view surfaces were seen through an exit (the view's rows are the map ids' rows)
+        through = self.exits.beyond(robot, 0.5 * (view[:, :2] + view[:, 2:]), event.scan)
         if self.config.revisit_evidence == "memory":
-            self._memory_evidence(event)
+            self._memory_evidence(event, poly)
         else:
             self._map_evidence(event)
-        if len(event.view_map):
-            robot = (event.pose[0], event.pose[1])
-            self._polygons.append(view_polygon(event.view_map, robot, "robot_and_endpoints"))
-            del self._polygons[:-_MAX_POLYGONS]
+        self._polygons.append(poly)
+        del self._polygons[:-_MAX_POLYGONS]
         members = self._members.setdefault(current.id, set())
-        ids = event.outcome.view_ids
-        if len(ids):
-            seg = self.inner.map.segments(ids)
-            through = self.exits.beyond((event.pose[0], event.pose[1]), 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
+        ids = event.outcome.view_ids.tolist()
+        members.update(ids)
+        self._through.difference_update(ids)
+        self._through.update(sid for sid, exit_id in zip(ids, through.tolist()) if exit_id >= 0)
+        if self.config.revisit_evidence == "perceptual_map":
             labels = self._labels
-            while len(labels) <= int(ids.max()):
+            while len(labels) <= max(ids):
                 labels.append(set())
-            for sid, exit_id in zip(ids.tolist(), through.tolist()):
+            for sid in ids:
                 labels[sid].add(current.id)
-                members.add(sid)
-                if exit_id >= 0:
-                    self._through.add(sid)
-                else:
-                    self._through.discard(sid)
 
     def _add_evidence(self, place: int, key: int, exit_id: int) -> None:
         """Surface ``key`` of ``place`` co-located: here (``exit_id`` -1) or seen through exit ``exit_id``."""
@@ -188,7 +190,7 @@ class Albot1PlacesMapper:
             for row, col in zip(*np.nonzero(same)):
                 labels[int(out.added[row])] |= labels[deleted[col]]
 
-    def _memory_evidence(self, event: UpdateEvent) -> None:
+    def _memory_evidence(self, event: UpdateEvent, poly: FloatArray) -> None:
         """``revisit_evidence = "memory"``: the remembered places' structure where the map held it when learned.
 
         Each place's own surfaces (not those seen through its exits) are put
@@ -200,11 +202,10 @@ class Albot1PlacesMapper:
         limitation 3); see docs/places.md.
         """
         view = event.view_map
-        if not len(view):
-            return
         cfg = self.config
         robot = (event.pose[0], event.pose[1])
-        poly = view_polygon(view, robot, cfg.update_polygon)
+        if cfg.update_polygon != "robot_and_endpoints":
+            poly = view_polygon(view, robot, cfg.update_polygon)
         lo, hi = poly.min(axis=0) - cfg.delete_margin_m, poly.max(axis=0) + cfg.delete_margin_m
         excluded = self._excluded()
         for place in self.network.live_places():
@@ -240,6 +241,15 @@ class Albot1PlacesMapper:
             cached = (key, placed, box)
             self._placed_cache[place.id] = cached
         return cached[1], cached[2]
+
+    def _structure(self, place: Place) -> FloatArray:
+        """A remembered place's structure (:func:`structural` of its own surfaces), cached until it changes."""
+        key = (len(place.surfaces), int(np.count_nonzero(place.through)))
+        cached = self._structure_cache.get(place.id)
+        if cached is None or cached[0] != key:
+            cached = (key, structural(place.surfaces[~place.through], self._match))
+            self._structure_cache[place.id] = cached
+        return cached[1]
 
     def _excluded(self) -> set[int]:
         """The current visit's place and the one just left: never candidates for a re-visit."""
@@ -345,7 +355,7 @@ class Albot1PlacesMapper:
             if place_id in excluded:
                 continue
             place = network.places[place_id]
-            remembered = structural(place.surfaces[~place.through], params)
+            remembered = self._structure(place)
             if count <= trigger_threshold(len(remembered), params):
                 continue
             if current_all is None:

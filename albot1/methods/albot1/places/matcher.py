@@ -52,27 +52,41 @@ def merge_collinear(surfaces: FloatArray, max_angle: float, max_offset: float, m
     if len(s) < 2:
         return s.copy()
     length = np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
-    groups: list[list[float]] = []  # ax, ay, ux, uy, tmin, tmax
+    n = len(s)
+    # the groups so far: a point, the unit direction, and the covered interval along it
+    gx, gy, gux, guy = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    lo_t, hi_t = np.empty(n), np.empty(n)
+    k = 0
+    cos_max = math.cos(max_angle)
     for i in np.argsort(-length, kind="stable").tolist():
-        x1, y1, x2, y2 = s[i]
         if length[i] <= 0.0:
             continue
+        x1, y1, x2, y2 = s[i]
         ux, uy = (x2 - x1) / length[i], (y2 - y1) / length[i]
         mx, my = 0.5 * (x1 + x2), 0.5 * (y1 + y2)
-        for g in groups:
-            if ux * g[2] + uy * g[3] < math.cos(max_angle):
+        if k:
+            t1 = (x1 - gx[:k]) * gux[:k] + (y1 - gy[:k]) * guy[:k]
+            t2 = (x2 - gx[:k]) * gux[:k] + (y2 - gy[:k]) * guy[:k]
+            lo, hi = np.minimum(t1, t2), np.maximum(t1, t2)
+            ok = (ux * gux[:k] + uy * guy[:k] >= cos_max) & (
+                np.abs(-guy[:k] * (mx - gx[:k]) + gux[:k] * (my - gy[:k])) <= max_offset
+            )
+            ok &= (lo <= hi_t[:k] + max_gap) & (hi >= lo_t[:k] - max_gap)
+            hits = np.flatnonzero(ok)
+            if len(hits):
+                g = int(hits[0])
+                lo_t[g], hi_t[g] = min(lo_t[g], lo[g]), max(hi_t[g], hi[g])
                 continue
-            if abs(-g[3] * (mx - g[0]) + g[2] * (my - g[1])) > max_offset:
-                continue
-            t1 = (x1 - g[0]) * g[2] + (y1 - g[1]) * g[3]
-            t2 = (x2 - g[0]) * g[2] + (y2 - g[1]) * g[3]
-            lo, hi = min(t1, t2), max(t1, t2)
-            if lo <= g[5] + max_gap and hi >= g[4] - max_gap:
-                g[4], g[5] = min(g[4], lo), max(g[5], hi)
-                break
-        else:
-            groups.append([x1, y1, ux, uy, 0.0, float(length[i])])
-    return np.array([[g[0] + g[4] * g[2], g[1] + g[4] * g[3], g[0] + g[5] * g[2], g[1] + g[5] * g[3]] for g in groups])
+        gx[k], gy[k], gux[k], guy[k], lo_t[k], hi_t[k] = x1, y1, ux, uy, 0.0, length[i]
+        k += 1
+    return np.column_stack(
+        [
+            gx[:k] + lo_t[:k] * gux[:k],
+            gy[:k] + lo_t[:k] * guy[:k],
+            gx[:k] + hi_t[:k] * gux[:k],
+            gy[:k] + hi_t[:k] * guy[:k],
+        ]
+    )
 
 
 def structural(surfaces: FloatArray, params: MatchParams) -> FloatArray:

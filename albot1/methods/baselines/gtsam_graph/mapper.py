@@ -330,11 +330,11 @@ class GtsamGraphMapper:
             )
             if recovered:
                 self.counters["sequential_retries_recovered"] += 1
-        if good:
+        if good and reg is not None:
             self.counters["sequential_matches"] += 1
             self._consecutive_fallbacks = 0
             covariance = np.linalg.inv(reg.information + self._seq_prior) + self._floor
-            return reg.pose, covariance
+            return reg.pose, np.asarray(covariance, dtype=np.float64)
         self.counters["odometry_fallbacks"] += 1
         self._consecutive_fallbacks += 1
         if self._consecutive_fallbacks >= cfg.max_consecutive_fallbacks:
@@ -498,7 +498,7 @@ class GtsamGraphMapper:
         poses = self._scan_poses(nodes)
         points = self._project_map(poses)
         n_nodes = len(self._node_odometry)
-        counters = {
+        counters: dict[str, int | float] = {
             **self.counters,
             "nodes": n_nodes,
             "updates": n_nodes,

@@ -76,8 +76,10 @@ def _views() -> list[Any]:
 def _build_view_args() -> Iterator[tuple[Any, ...]]:
     for ranges, angles in _scans():
         r, a = _thesis_order(ranges, angles)
-        yield (r, a, 30.0, 0.6, 0.2, 0.1, 0.1, math.radians(30.0), 0.0, 0.1)
-        yield (r, a, 8.0, 0.3, 0.0, 0.05, 0.0, math.radians(10.0), 0.2, 0.0)
+        yield (r, a, 30.0, 0.6, 0.2, 0.1, 0.1, math.radians(30.0), 0.0, 0.1, 0.0, 0.0, False)
+        yield (r, a, 8.0, 0.3, 0.0, 0.05, 0.0, math.radians(10.0), 0.2, 0.0, 0.0, 0.0, True)
+        yield (r, a, 30.0, 0.6, 0.2, 0.1, 0.1, math.radians(30.0), 0.0, 0.1, 0.15, 0.0, True)
+        yield (r, a, 30.0, 0.6, 0.2, 0.1, 0.1, math.radians(30.0), 0.0, 0.1, 0.1, 2.0, False)
 
 
 def _recognise_args() -> Iterator[tuple[Any, ...]]:
@@ -131,6 +133,41 @@ def _cells_args() -> Iterator[tuple[Any, ...]]:
         yield (segs, 1.0 / 3.0)
 
 
+def _refine_args() -> Iterator[tuple[Any, ...]]:
+    """Consecutive views as (current view, last update view): landmarks matched by index, points, starts, priors."""
+    rng = np.random.default_rng(7)
+    views = [v for v in _views() if len(v) >= 2]
+    for ref_view, view in zip(views, views[1:]):
+        n = min(len(ref_view), len(view), 4)
+        lm_view = np.ascontiguousarray(view.surfaces[:n])
+        lm_map = np.ascontiguousarray(ref_view.surfaces[:n] + rng.normal(0.0, 0.05, (n, 4)))
+        ok = np.ascontiguousarray(rng.random((n, 2)) < 0.6)
+        points = np.ascontiguousarray(view.surfaces.reshape(-1, 2) + rng.normal(0.0, 0.02, (2 * len(view), 2)))
+        ref = np.ascontiguousarray(ref_view.surfaces)
+        starts = np.ascontiguousarray(rng.normal(0.0, [0.1, 0.1, 0.05], (3, 3)))
+        for prior in ((0.0, 0.0, 0.0, 0.0, 0.0), (0.05, -0.02, 0.03, 400.0, 3000.0)):
+            yield (starts, lm_view, lm_map, ok, points, ref, *prior, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
+        yield (
+            starts[:1],
+            lm_view[:0],
+            lm_map[:0],
+            ok[:0],
+            points,
+            ref,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.05,
+            0.1,
+            0.05,
+            2.0,
+            0.5,
+            8,
+        )
+
+
 CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "build_view": _build_view_args,
     "recognise_landmarks": _recognise_args,
@@ -138,6 +175,7 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "best_correspondence": _correspondence_args,
     "clip_parameter": _clip_args,
     "segment_cells": _cells_args,
+    "refine_pose": _refine_args,
 }
 
 

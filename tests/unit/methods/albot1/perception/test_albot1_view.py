@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from albot1.data.synthetic.lidar import cast
 from albot1.methods.albot1.perception.endpoints import is_stable
@@ -120,3 +121,90 @@ def test_only_occluding_and_corner_endpoints_are_stable_in_both_forms() -> None:
     kinds = [UNSTABLE, OCCLUDING, CORNER, OCCLUDED]
     assert [is_stable(k) for k in kinds] == [False, True, True, False]
     assert stable(np.array([kinds, kinds[::-1]])).tolist() == [[False, True, True, False], [False, True, True, False]]
+
+
+# REP-103, robot at the origin facing +x. A wall on the left (y = 1) ends at x = 4, where a doorway opens onto a
+# room whose far wall (y = 5) is seen through it. The wall's last lit point is the 15 deg beam's (1/tan 15 deg =
+# 3.732 m), not its true end (4 m): the 14 deg beam passes the end and returns from the far wall, which is not on the
+# wall's line, so neither the range test nor the continuation test sees anything wrong. The next point inward on the
+# wall is the 16 deg beam's, 1/tan 15 deg - 1/tan 16 deg = 0.2446 m away: the beams are sparse there.
+GRAZING_WALLS = np.array([[-1.0, 1.0, 4.0, 1.0], [4.0, 5.0, 40.0, 5.0]])
+GRAZING_SPACING = 1.0 / math.tan(math.radians(15.0)) - 1.0 / math.tan(math.radians(16.0))
+
+
+def grazing_view(**params: float):
+    ranges = cast(GRAZING_WALLS, np.zeros(3), ANGLES, 30.0)
+    view = construct_view(ranges, ANGLES, ViewParams(**params))
+    # Thesis frame: the left wall is x = -1; its far (right) end P2 is the 15 deg beam's point.
+    wall = int(np.flatnonzero(np.isclose(view.surfaces[:, 0], -1.0) & np.isclose(view.surfaces[:, 2], -1.0))[0])
+    return view, wall
+
+
+def test_grazing_end_through_an_opening_is_unstable_by_beam_spacing() -> None:
+    assert GRAZING_SPACING == pytest.approx(0.24464, abs=1e-5)
+    bare, wall = grazing_view(end_spacing_max=0.0)
+    np.testing.assert_allclose(bare.surfaces[wall, 2:], [-1.0, 1.0 / math.tan(math.radians(15.0))], atol=1e-9)
+    assert bare.kinds[wall, 1] == OCCLUDING  # the thesis's test alone calls this moving end an edge
+    tested, wall = grazing_view(end_spacing_max=0.2)
+    assert tested.kinds[wall, 1] == UNSTABLE
+    # The threshold is exact: just above the spacing the end keeps its label.
+    kept, wall = grazing_view(end_spacing_max=GRAZING_SPACING + 1e-6)
+    assert kept.kinds[wall, 1] == OCCLUDING
+    below, wall = grazing_view(end_spacing_max=GRAZING_SPACING - 1e-6)
+    assert below.kinds[wall, 1] == UNSTABLE
+
+
+def test_grazing_factor_spares_far_ends_seen_face_on() -> None:
+    # The 15/16 deg beams are 1 deg apart; face-on at the end's range (1/sin 15 deg = 3.864 m) they would be
+    # 3.864 * pi/180 = 0.0674 m apart, so the spacing is 3.63 times that: a grazing angle of 74 deg.
+    ratio = GRAZING_SPACING / ((1.0 / math.sin(math.radians(15.0))) * math.radians(1.0))
+    assert ratio == pytest.approx(3.63, abs=0.01)
+    grazing, wall = grazing_view(end_spacing_max=0.2, end_spacing_grazing=ratio - 0.01)
+    assert grazing.kinds[wall, 1] == UNSTABLE
+    face_on, wall = grazing_view(end_spacing_max=0.2, end_spacing_grazing=ratio + 0.01)
+    assert face_on.kinds[wall, 1] == OCCLUDING
+
+
+def test_beam_spacing_keeps_a_face_on_occluding_end() -> None:
+    # The L's front wall (x = 3) has its occluding left end on the 18 deg beam; the next beam on it is 0.055 m away.
+    assert l_view(end_spacing_max=0.2).kinds.tolist() == l_view().kinds.tolist()
+    assert l_view(end_spacing_max=0.2).kinds[1, 0] == OCCLUDING
+
+
+def test_total_least_squares_puts_the_corner_at_the_intersection_of_the_walls() -> None:
+    # The L with its front wall moved to x = 3.05: the corner (3.05, -3) lies between the -44 and -45 deg beams,
+    # so the chords' shared split point is a beam's point on one wall, off the corner; the fitted lines cross on it.
+    walls = L_WALLS + np.array([[0.0, 0.0, 0.05, 0.0], [0.05, 0.0, 0.05, 0.0], [0.0, 0.0, 0.0, 0.0]])
+    ranges = cast(walls, np.zeros(3), ANGLES, 30.0)
+    chord = construct_view(ranges, ANGLES, ViewParams())
+    fitted = construct_view(ranges, ANGLES, ViewParams(fit_lines=True))
+    corner = np.array([3.0, 3.05])  # REP (3.05, -3) in the thesis frame
+    assert fitted.kinds.tolist() == chord.kinds.tolist() and fitted.beams.tolist() == chord.beams.tolist()
+    assert chord.kinds[1, 1] == CORNER
+    np.testing.assert_array_equal(fitted.surfaces[1, 2:], fitted.surfaces[2, :2])
+    np.testing.assert_allclose(fitted.surfaces[1, 2:], corner, atol=1e-9)
+    # The split point is the -44 deg beam's hit on the front wall, 3.05 (1 - tan 44 deg) = 5.5 cm from the corner.
+    np.testing.assert_allclose(chord.surfaces[1, 2:], [3.05 * math.tan(math.radians(44.0)), 3.05], atol=1e-9)
+
+
+def test_total_least_squares_averages_range_noise_out_of_a_wall_direction() -> None:
+    """Over 20 noisy scans the front wall's direction error is several times smaller fitted than as a chord."""
+    rng = np.random.default_rng(0)
+    exact = cast(L_WALLS, np.zeros(3), ANGLES, 30.0)
+
+    def direction_error(s: np.ndarray) -> float:
+        return abs(math.degrees(math.atan2(s[3] - s[1], s[2] - s[0])))  # the front wall runs along thesis +x
+
+    chord_err, fitted_err = [], []
+    for _ in range(20):
+        ranges = exact + rng.normal(0.0, 0.01, ANGLES.size)
+        chord_err.append(direction_error(construct_view(ranges, ANGLES, ViewParams()).surfaces[1]))
+        fitted_err.append(direction_error(construct_view(ranges, ANGLES, ViewParams(fit_lines=True)).surfaces[1]))
+    assert np.mean(fitted_err) < 0.5 * np.mean(chord_err)
+
+
+def test_total_least_squares_is_exact_on_exact_points() -> None:
+    ranges = cast(L_WALLS, np.zeros(3), ANGLES, 30.0)
+    chord = construct_view(ranges, ANGLES, ViewParams())
+    fitted = construct_view(ranges, ANGLES, ViewParams(fit_lines=True))
+    np.testing.assert_allclose(fitted.surfaces, chord.surfaces, atol=1e-9)
