@@ -355,6 +355,20 @@ def _conflicts(
     return n
 
 
+def _shift(tx: float, ty: float, theta: float, prior: FloatArray, centre: FloatArray) -> float:
+    """How far the motion (theta, tx, ty) puts the place's ``centre`` from where ``prior`` puts it."""
+    ch = math.cos(theta)
+    sh = math.sin(theta)
+    cp = math.cos(prior[2])
+    sp = math.sin(prior[2])
+    return float(
+        np.hypot(
+            tx + ch * centre[0] - sh * centre[1] - (prior[0] + cp * centre[0] - sp * centre[1]),
+            ty + sh * centre[0] + ch * centre[1] - (prior[1] + sp * centre[0] + cp * centre[1]),
+        )
+    )
+
+
 def match_structure(
     current: FloatArray,
     current_side: IntArray,
@@ -437,6 +451,10 @@ def match_structure(
                     ky = remembered[k, e + 1]
                 tx = jx - (c * kx - s * ky)
                 ty = jy - (s * kx + c * ky)
+                # a hypothesis that moves the place's centre far beyond max_shift is not counted at all
+                # (its refinement could not bring it back: one metre of slack)
+                if _shift(tx, ty, theta, prior, centre) > max_shift + 1.0:
+                    continue
                 count, left, right = _count_matches(
                     current, dir_j, current_side, remembered, dir_k, theta, tx, ty, max_angle, max_gap, partner
                 )
@@ -453,14 +471,7 @@ def match_structure(
                     best_tx = tx
                     best_ty = ty
                 if count >= min_matches and left and right:
-                    ch = math.cos(theta)
-                    sh = math.sin(theta)
-                    cp = math.cos(prior[2])
-                    sp = math.sin(prior[2])
-                    shift = np.hypot(
-                        tx + ch * centre[0] - sh * centre[1] - (prior[0] + cp * centre[0] - sp * centre[1]),
-                        ty + sh * centre[0] + ch * centre[1] - (prior[1] + sp * centre[0] + cp * centre[1]),
-                    )
+                    shift = _shift(tx, ty, theta, prior, centre)
                     if shift <= max_shift and abs(wrap_angle(theta - prior[2])) <= max_turn:
                         conflicts = _conflicts(remembered, theta, tx, ty, partner, polygons, polygon_starts, max_gap)
                         if conflicts <= max_conflicts:

@@ -307,8 +307,7 @@ class MrptIcpMapper(_MrptMapper):
         origin_inverse = se2.inverse(raw[0])
         poses = se2.compose(origin_inverse, raw)
         points = se2.transform_points(origin_inverse, outputs.icp_point_map(out_dir))
-        times = outputs.icp_step_times_ms(out_dir, 2 * scans)
-        map_sizes = np.loadtxt(out_dir / "log_times.txt", ndmin=2)[:, 1]
+        times, map_sizes = outputs.icp_steps(out_dir, 2 * scans)
         counters: dict[str, int | float] = {"updates": int(map_sizes[-1]) if len(map_sizes) else 0}
         extras = {"step_times": _stats_ms(times), "scan_step_times": _stats_ms(times[1::2])}
         return poses, points, counters, extras
@@ -354,7 +353,7 @@ class MrptRbpfMapper(_MrptMapper):
         mean = outputs.rbpf_mean_poses(out_dir, scans)
         grid = outputs.grid_map(out_dir, self.rbpf.grid_resolution_m)
         points = grid.occupied_points(self.rbpf.map_occupied_probability)
-        ess = outputs._rows(out_dir / "log_ParticlesStats.txt", 3, "particle statistics")
+        ess = outputs.read_rows(out_dir / "log_ParticlesStats.txt", 3, "particle statistics")
         gap = np.linalg.norm(poses[:, :2] - mean[:, :2], axis=1)
         counters: dict[str, int | float] = {"updates": updates, "particles": self.rbpf.particles}
         extras = {

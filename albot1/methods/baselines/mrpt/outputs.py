@@ -44,7 +44,7 @@ GRID_LIMITS = "finalMap_mrpt__maps__COccupancyGridMap2D_00_limits.txt"
 _TOTAL_TIME = re.compile(r"\*\*END\*\* \(total time: ([0-9.eE+-]+) sec\)")
 
 
-def _rows(path: Path, columns: int, what: str) -> FloatArray:
+def read_rows(path: Path, columns: int, what: str) -> FloatArray:
     """Numeric rows of a whitespace-separated text file (``%`` lines are comments), shape ``(n, columns)``."""
     if not path.is_file():
         raise BaselineError(f"{path}: missing; MRPT did not write its {what}")
@@ -90,7 +90,7 @@ def last_error_line(text: str) -> str:
 def icp_poses(out_dir: Path, scans: int) -> FloatArray:
     """One pose per scan from icp-slam's estimated path (observations layout: every second step)."""
     path = out_dir / "log_estimated_path.txt"
-    rows = _rows(path, 4, "estimated path")
+    rows = read_rows(path, 4, "estimated path")
     if len(rows) != 2 * scans:
         raise BaselineError(
             f"{path}: {len(rows)} steps; expected {2 * scans} (an odometry and a scan step for each of {scans} "
@@ -103,16 +103,16 @@ def icp_poses(out_dir: Path, scans: int) -> FloatArray:
 
 def icp_point_map(out_dir: Path) -> FloatArray:
     """The final point map ``(K, 2)`` (x, y) in icp-slam's odometry frame."""
-    return _rows(out_dir / ICP_POINT_MAP, 3, "point map")[:, :2].copy()
+    return read_rows(out_dir / ICP_POINT_MAP, 3, "point map")[:, :2].copy()
 
 
-def icp_step_times_ms(out_dir: Path, steps: int) -> FloatArray:
-    """MRPT's time per step (ms), one per rawlog object."""
+def icp_steps(out_dir: Path, steps: int) -> tuple[FloatArray, FloatArray]:
+    """MRPT's time per step (ms) and the map size (scans inserted so far), one row per rawlog object."""
     path = out_dir / "log_times.txt"
-    rows = _rows(path, 2, "step times")
+    rows = read_rows(path, 2, "step times")
     if len(rows) != steps:
         raise BaselineError(f"{path}: {len(rows)} steps; expected {steps}")
-    return rows[:, 0].copy()
+    return rows[:, 0].copy(), rows[:, 1].copy()
 
 
 # -- rbpf-slam -----------------------------------------------------------------------------------------------
@@ -129,7 +129,7 @@ class RbpfSteps:
 def rbpf_steps(out_dir: Path, scans: int) -> RbpfSteps:
     """``log_times.txt`` of rbpf-slam: one row per scan, numbered from 0."""
     path = out_dir / "log_times.txt"
-    rows = _rows(path, 4, "step times")
+    rows = read_rows(path, 4, "step times")
     if len(rows) != scans:
         raise BaselineError(f"{path}: {len(rows)} steps; expected {scans} (one per scan): rbpf-slam stopped early")
     if not np.array_equal(rows[:, 0], np.arange(scans)):
@@ -146,7 +146,7 @@ def rbpf_steps(out_dir: Path, scans: int) -> RbpfSteps:
 def rbpf_mean_poses(out_dir: Path, scans: int) -> FloatArray:
     """The particle mean at every scan (x, y, yaw), relative to the first scan's pose."""
     path = out_dir / "log_estimated_path.txt"
-    rows = _rows(path, 8, "estimated path")
+    rows = read_rows(path, 8, "estimated path")
     if len(rows) != scans:
         raise BaselineError(f"{path}: {len(rows)} poses; expected {scans} (one per scan)")
     return rows[:, [1, 2, 4]].copy()
@@ -155,7 +155,7 @@ def rbpf_mean_poses(out_dir: Path, scans: int) -> FloatArray:
 def rbpf_best_path(out_dir: Path, updates: int) -> FloatArray:
     """The most likely particle's path: the initial pose and one pose per filter update, ``(updates + 1, 3)``."""
     path = out_dir / "most_likely_path.txt"
-    rows = _rows(path, 3, "most likely path")
+    rows = read_rows(path, 3, "most likely path")
     if len(rows) != updates + 1:
         raise BaselineError(
             f"{path}: {len(rows)} poses; expected {updates + 1} (the initial pose and one per filter update "
@@ -224,7 +224,7 @@ def grid_map(out_dir: Path, expected_resolution_m: float) -> GridMap:
     import matplotlib.image as mpimg
 
     image_path, limits_path = out_dir / GRID_IMAGE, out_dir / GRID_LIMITS
-    limits = _rows(limits_path, 4, "grid limits")
+    limits = read_rows(limits_path, 4, "grid limits")
     if len(limits) != 1:
         raise BaselineError(f"{limits_path}: {len(limits)} rows; expected one (x_min x_max y_min y_max)")
     if not image_path.is_file():
