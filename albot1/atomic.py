@@ -39,10 +39,14 @@ def atomic_write(path: str | Path, writer: Callable[[Path], object]) -> None:
     The temporary name keeps ``path``'s suffix, so writers that choose a
     compression or format by suffix (``.gz``, ``.npz``) behave as for ``path``.
     The file gets the permissions of a file made with ``open()`` (the
-    temporary file of ``mkstemp`` is private to its owner).
+    temporary file of ``mkstemp`` is private to its owner). An ``OSError``
+    about the temporary file (disk full, read-only folder) names ``path``.
     """
     dest = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=f".tmp{''.join(dest.suffixes)}")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=f".tmp{''.join(dest.suffixes)}")
+    except OSError as exc:  # name the file the caller asked for, not the temporary one
+        raise type(exc)(exc.errno, exc.strerror, str(dest)) from exc
     os.close(fd)
     tmp_path = Path(tmp)
     try:
@@ -50,6 +54,10 @@ def atomic_write(path: str | Path, writer: Callable[[Path], object]) -> None:
         if tmp_path.is_file():
             os.chmod(tmp_path, normal_mode())
         os.replace(tmp_path, dest)
+    except OSError as exc:
+        if exc.errno is not None and exc.filename in (None, str(tmp_path)):
+            raise type(exc)(exc.errno, exc.strerror, str(dest)) from exc
+        raise
     finally:
         tmp_path.unlink(missing_ok=True)
 

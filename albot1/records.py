@@ -166,6 +166,9 @@ class DatasetInfo(Record):
     format: str
     odometry_source: str
     reference_source: str
+    #: the laser's pose on the robot (x m, y m, yaw rad) the runner applied (albot1.data.transforms.sensor_frame);
+    #: absent in results written before it was recorded
+    sensor_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 class ResultRecord(Record):

@@ -75,6 +75,8 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
         message = f"{error.get('type')}: {error.get('message')}"
         if kind == "memory":
             message = f"out of memory (an allocation was refused): {message}"
+        if kind == "interrupted":
+            message = "interrupted (SIGINT, e.g. Ctrl-C) before the cell finished; run `albot1 bench` again to retry it"
         if kind == "storage" or error.get("errno") in STORAGE_ERRNOS:
             return "storage", f"cannot write the results: {_errno_text(error.get('errno'))}: {message}"
         return kind, message
@@ -153,13 +155,14 @@ def _storage_failure(
     other OSError (no process could be started, say) fails this cell only.
     """
     storage = storage_error(exc) is not None
+    what = (exc.strerror or str(exc)).lower()
+    if completed:
+        reason = f"cannot write {exc.filename}: {what} (the run itself is complete; only its attempt.json is missing)"
+        return CellOutcome.of(cell, "done", elapsed_s, reason, "storage", halts_grid=storage)
     if storage:
-        reason = f"cannot write the results: {(exc.strerror or str(exc)).lower()}: {exc.filename or store.runs}"
+        reason = f"cannot write the results: {what}: {exc.filename or store.runs}"
     else:
         reason = f"cannot start the cell: {type(exc).__name__}: {exc}"
-    if completed:
-        reason += " (the run itself is complete; only its attempt.json is missing)"
-        return CellOutcome.of(cell, "done", elapsed_s, reason, "storage", halts_grid=storage)
     kind: FailureKind = "storage" if storage else "executor"
     problem = store.record_failure(cell, reason, kind, elapsed_s=elapsed_s, traceback_text=traceback.format_exc())
     if problem is not None:

@@ -221,6 +221,8 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
             continue
         for degradation, seed in _sweep(opts, suite, bool(has_reference)):
             for entry in methods:
+                if opts.methods is not None and entry.display not in opts.methods:
+                    continue
                 config, problem = resolved[entry.display]
                 key_config = (
                     config

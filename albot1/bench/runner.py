@@ -34,6 +34,7 @@ from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
 from albot1.bench.suite import find_suite, load_suite
 from albot1.runs.folder import PreviewRenderer
+from albot1.runs.output import writable_folder
 from albot1.settings import Settings, get_settings
 
 
@@ -231,6 +232,7 @@ def run_suite(
     if kind == "local":
         start_forkserver()
     plan = plan_suite(suite, settings or get_settings())
+    writable_folder(results, "--results")  # after the suite and its plan: a bad suite makes no folder
     store = ResultsStore(bench_results_root(results, suite.name))
     store.lock()
     try:

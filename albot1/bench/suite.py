@@ -41,6 +41,7 @@ Format (every key optional except ``methods`` and ``datasets``)::
     # degradations / seeds / undegraded_seeds / time_s / memory_mb / skip = true
     # optional = true                # a name or path that does not exist, or a glob that matches
                                      # nothing, is skipped instead of being an error
+    # methods = ["albot1:thesis"]    # only these method entries (by label) run on it; default: all
 
 A literal dataset entry (not a glob) that names no synthetic world, no
 registered dataset and no existing file, and a glob that matches no dataset,
@@ -163,6 +164,11 @@ class DatasetEntry(_Strict):
     undegraded_seeds: tuple[Seed, ...] | None = None
     time_s: TimeS | None = None
     memory_mb: MemoryMb | None = None
+    methods: tuple[str, ...] | None = Field(
+        None,
+        description="labels of the method entries that run on these datasets (default: every entry); a suite "
+        "that asks different questions of different data keeps its grid small this way",
+    )
 
     @field_validator("degradations")
     @classmethod
@@ -194,6 +200,7 @@ class DatasetOptions(_Strict):
     undegraded_seeds: tuple[int, ...] | None = None
     time_s: float | None = None
     memory_mb: float | None = None
+    methods: tuple[str, ...] | None = None
 
     @property
     def label(self) -> str:
@@ -232,6 +239,13 @@ class Suite(_Strict):
             if entry.display in seen:
                 raise ValueError(f"two method entries are both labelled {entry.display!r}; give one a `label`")
             seen.add(entry.display)
+        for index, dataset in enumerate(self.datasets):
+            unknown = [label for label in dataset.methods or () if label not in seen]
+            if unknown:
+                raise ValueError(
+                    f"dataset entry {index} ({dataset.name!r}): methods {', '.join(map(repr, unknown))} name no "
+                    f"method entry; expected labels among {', '.join(map(repr, seen))}"
+                )
         return self
 
     def options_for(self, name: str) -> DatasetOptions | None:

@@ -79,8 +79,8 @@ def main() -> None:
     Typer's standalone mode already turns usage errors into a usage message
     with exit 2; the project's own errors, and the operating system's refusals
     that reach this far (a disk that fills up mid-command, a file whose
-    permissions changed), are one line naming the path; Ctrl-C is one line
-    and exit 130. Any other exception is a bug and keeps its traceback.
+    permissions changed), are one line naming the path (Typer itself turns
+    Ctrl-C into exit 130). Any other exception is a bug and keeps its traceback.
     """
     try:
         app()
@@ -90,9 +90,6 @@ def main() -> None:
     except OSError as exc:
         typer.echo(f"albot1: error: {os_error_line(exc)}", err=True)
         sys.exit(1)
-    except KeyboardInterrupt:
-        typer.echo("albot1: interrupted", err=True)
-        sys.exit(130)
 
 
 def os_error_line(exc: OSError) -> str:

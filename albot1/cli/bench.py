@@ -63,7 +63,6 @@ def bench(
         plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))
         return
-    writable_folder(results, "--results")
     view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not progress)
     try:
         plan, summary, store = run_suite(
@@ -75,6 +74,10 @@ def bench(
             settings=get_settings(data_dir=data_dir),
             preview=render_preview,
         )
+    except KeyboardInterrupt:
+        # The cells got the same Ctrl-C and were recorded as interrupted; the store is consistent.
+        typer.echo("albot1: interrupted; completed cells are kept, run the same command again to resume", err=True)
+        raise typer.Exit(130) from None
     finally:
         view.close()
     for skipped in plan.skipped_datasets:

@@ -1,4 +1,4 @@
-"""Small streamed transforms of a Sequence (prefix, stride, reference odometry, view spacing)."""
+"""Small streamed transforms of a Sequence (prefix, stride, reference odometry, view spacing, sensor frame)."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import numpy as np
 
 from albot1.data.errors import ReferenceOptionError, SliceError
 from albot1.data.model import Frame, Sequence
+from albot1.geometry import se2
 
 #: Slack of the view-spacing rule, so ten 0.1 m steps (0.9999999... m in floating point) make 1 m.
 SPACING_SLACK = 1e-9
@@ -94,3 +95,41 @@ def view_spacing(sequence: Sequence, distance_m: float, angle_deg: float) -> Seq
 
     extra = {**sequence.metadata.extra, "view_spacing": {"distance_m": distance_m, "angle_deg": angle_deg}}
     return sequence.with_frames(keep, metadata=replace(sequence.metadata, extra=extra))
+
+
+def sensor_frame(sequence: Sequence) -> Sequence:
+    """The sequence as its laser sees it: every pose moved onto the laser, the mounting offset then zero.
+
+    A scan is measured from the laser, which sits at ``metadata.sensor_offset``
+    (x, y, yaw) on the robot; the odometry and reference poses are the robot's.
+    Composing every pose with the offset gives the laser's own trajectory, in
+    which the scans *are* centred, so a method that treats the scan origin as
+    its body (every method here) is right without knowing the offset. This is
+    the one place the offset is applied for every method; the runner maps the
+    method's poses back with :func:`robot_frame` (``docs/datasets.md``, "Sensor
+    offsets"). A sequence with a zero offset is returned unchanged.
+    """
+    offset = np.asarray(sequence.metadata.sensor_offset, dtype=float)
+    if not offset.any():
+        return sequence
+
+    def move(frames: Iterator[Frame]) -> Iterator[Frame]:
+        for frame in frames:
+            reference = None if frame.reference is None else se2.compose(frame.reference, offset)
+            yield replace(frame, odometry=se2.compose(frame.odometry, offset), reference=reference)
+
+    metadata = replace(
+        sequence.metadata,
+        sensor_offset=(0.0, 0.0, 0.0),
+        extra={**sequence.metadata.extra, "poses_moved_to_sensor": [float(v) for v in offset]},
+    )
+    return sequence.with_frames(move, metadata=metadata, scan_count=sequence.known_scan_count)
+
+
+def robot_frame(poses: np.ndarray, sensor_offset: tuple[float, float, float] | np.ndarray) -> np.ndarray:
+    """Laser poses ``(N, 3)`` back to robot poses: ``pose * inv(offset)`` (unchanged for a zero offset)."""
+    offset = np.asarray(sensor_offset, dtype=float)
+    poses = np.asarray(poses, dtype=float)
+    if not offset.any() or poses.size == 0:
+        return poses
+    return se2.compose(poses, se2.inverse(offset))

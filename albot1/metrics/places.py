@@ -203,7 +203,7 @@ def judge_exits(
             np.mean([e["not_aligned_error_m"] for e in per_exit])
         )
     detected = [c["scan"] for c in record["crossings"]]
-    truth = [c["scan"] for c in true_crossings]
+    truth = [c["scan"] for c in true_crossings if c["scan"] < len(reference)]  # a run may cover a prefix
     used: set[int] = set()
     matched = 0
     for s in detected:

@@ -23,6 +23,7 @@ from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.tables import aggregate, cells_frame, write_tables
+from albot1.report.thesis.page import THESIS_SUITE, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 
 REPORTS_ROOT = Path("reports")
@@ -129,6 +130,7 @@ def write_index(
     plots: dict[str, list[Path]],
     out: Path,
     results_dir: Path,
+    name: str = "README.md",
 ) -> Path:
     counts = _status_counts(records)
     lines: list[str] = [
@@ -209,7 +211,7 @@ def write_index(
     else:
         lines.append("None.")
     lines.append("")
-    index = out / "README.md"
+    index = out / name
     index.write_text("\n".join(lines), encoding="utf-8")
     return index
 
@@ -217,7 +219,11 @@ def write_index(
 def build_report(
     results_dir: str | Path, out: str | Path | None = None, *, plots: bool = True, map_style: MapStyle = "grid"
 ) -> Path:
-    """Tables, plots, README.md and index.html for ``results_dir``; returns the README path."""
+    """Tables, plots, README.md and index.html for ``results_dir``; returns the README path.
+
+    For the ``thesis`` suite README.md is the thesis reproduction page
+    (:mod:`albot1.report.thesis.page`) and the benchmark index is ``benchmark.md``.
+    """
     results = Path(results_dir)
     target = Path(out) if out is not None else default_out(results)
     plan, records = collect(results)
@@ -225,7 +231,9 @@ def build_report(
     tables = write_tables(records, target)
     colors = method_colors(r.cell.method_label for r in records)
     made = render_plots(records, target, colors, map_style=map_style) if plots else {}
-    index = write_index(plan, records, tables, made, target, results)
+    thesis = plan.suite == THESIS_SUITE
+    index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
+    page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
     cells = cells_frame(records)
     write_html(
         plan,
@@ -233,10 +241,11 @@ def build_report(
         aggregate(cells, METRIC_COLUMNS),
         aggregate(cells, COST_COLUMNS),
         (METRIC_COLUMNS, COST_COLUMNS),
-        {**tables, "README.md": index},
+        {**tables, index.name: index},
         made,
         colors,
         target,
         results,
+        extra_links=[("the thesis's experiments, reproduced (README.md)", page)] if page is not None else None,
     )
-    return index
+    return page if page is not None else index

@@ -22,6 +22,7 @@ from albot1.config.targets import resolve_target
 from albot1.contract import MapperOutput, RunResult
 from albot1.data.degrade import degrade
 from albot1.data.model import Sequence
+from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
 from albot1.methods.registry import get_method, resolve_config
 from albot1.runs.errors import RunError
@@ -50,6 +51,10 @@ def run_method(
     error_class = spec.load_error_class()
     dataset = dataset_name or sequence.name
     seq = degrade(sequence, degradation, seed=seed)
+    # Methods see the laser's trajectory (mounting offset applied once, here, for every method); their poses and
+    # the recorded odometry/reference are mapped back to the robot below (albot1.data.transforms.sensor_frame).
+    offset = seq.metadata.sensor_offset
+    seen = sensor_frame(seq)
     mapper = spec.load_class()(config, seed=seed)
 
     wall_start = time.perf_counter()
@@ -59,7 +64,7 @@ def run_method(
     reference: list[np.ndarray] | None = []
     index = -1
     try:
-        for frame in seq.frames():
+        for frame in seen.frames():
             index = frame.index
             start = time.perf_counter_ns()
             mapper.process(frame)
@@ -89,13 +94,14 @@ def run_method(
 
     _check_output(output, len(per_scan), method, dataset, error_class)
     per_scan_ns = np.asarray(per_scan, dtype=np.int64)
-    reference_poses = np.asarray(reference, dtype=float).reshape(-1, 3) if reference else None
+    poses = robot_frame(np.asarray(output.poses, dtype=float), offset)
+    reference_poses = robot_frame(np.asarray(reference, dtype=float).reshape(-1, 3), offset) if reference else None
     counters, files = dict(output.counters), dict(output.files)
     if spec.judge is not None and reference_poses is not None:
         # Evaluation only, after the timed run: the method's own claims (e.g. re-visits) scored against the
         # reference poses, which the mapper never saw (MethodSpec.judge).
         judge = resolve_target(spec.judge)
-        judgement = judge(files, np.asarray(output.poses, dtype=float), reference_poses, seq.metadata.extra)
+        judgement = judge(files, poses, reference_poses, seq.metadata.extra)
         counters.update(judgement.counters)
         files = judgement.files
     return RunResult(
@@ -106,8 +112,8 @@ def run_method(
         seed=seed,
         config=config.model_dump(mode="json"),
         timestamps=np.asarray(stamps, dtype=float),
-        poses=np.asarray(output.poses, dtype=float),
-        odometry=np.asarray(odometry, dtype=float).reshape(-1, 3),
+        poses=poses,
+        odometry=robot_frame(np.asarray(odometry, dtype=float).reshape(-1, 3), offset),
         reference=reference_poses,
         relations=seq.relations,
         map=output.map,
@@ -125,6 +131,7 @@ def run_method(
             "format": seq.metadata.format,
             "odometry_source": seq.metadata.odometry_source,
             "reference_source": seq.metadata.reference_source,
+            "sensor_offset": [float(v) for v in offset],
         },
     )
 

@@ -49,7 +49,7 @@ class FaultMapper:
             if mode == "hang":
                 time.sleep(3600)
             if mode == "memory":
-                while True:  # 256 MiB at a time until the address-space cap stops it
+                while True:  # 256 MiB at a time until the supervisor kills it for its memory limit
                     self._hoard.append(np.ones(32 * 2**20))
             if mode == "crash":
                 os.kill(os.getpid(), signal.SIGSEGV)

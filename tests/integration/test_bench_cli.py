@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -56,3 +57,76 @@ def test_bench_exits_1_after_the_whole_grid_when_a_cell_failed(tmp_path: Path) -
     assert done.stderr.strip().splitlines()[-1] == "1 of 2 cells failed (reasons above and in the report)"
     assert "Traceback" not in done.stderr
     assert (tmp_path / "results" / "onefails" / "grid.json").is_file()
+
+
+def _albot1(tmp_path: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", "from albot1.cli.app import main; main()", *args],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+    )
+
+
+def _one_line(done: subprocess.CompletedProcess[str]) -> str:
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("albot1: error: ") and "Traceback" not in done.stderr
+    return lines[0]
+
+
+def test_suites_that_name_nothing_or_escape_the_results_folder_are_one_line_errors(tmp_path: Path) -> None:
+    body = '[[methods]]\nname = "odometry"\n[[datasets]]\nname = "{}"\n'
+    for name, text, words in (
+        ("glob", body.format("synthetic-offce-*"), "dataset entry 0 ('synthetic-offce-*') matches no dataset"),
+        (
+            "typo",
+            body.format("synthetic-offce-loop[:20]"),
+            "dataset entry 'synthetic-offce-loop[:20]': 'synthetic-offce-loop' is neither a dataset name",
+        ),
+        ("escape", 'name = ".."\n' + body.format("synthetic-office-loop[:5]"), "suite name '..': expected a plain"),
+        ("huge", "[limits]\ntime_s = 1e12\n" + body.format("synthetic-office-loop[:5]"), "limits.time_s"),
+    ):
+        suite = tmp_path / f"{name}.toml"
+        suite.write_text(text)
+        assert words in _one_line(_albot1(tmp_path, "bench", str(suite), "--results", "results", "--no-progress"))
+    assert not (tmp_path / "grid.json").exists() and not (tmp_path / "results").exists()
+
+
+def test_results_that_cannot_be_a_folder_are_refused_before_planning(tmp_path: Path) -> None:
+    (tmp_path / "results").write_text("a file")
+    line = _one_line(_albot1(tmp_path, "bench", "quick", "--results", "results", "--no-progress"))
+    assert line == (
+        "albot1: error: --results results: is a file, not a folder; expected a folder this user can write to "
+        "(it is made when missing)"
+    )
+    line = _one_line(_albot1(tmp_path, "report", "results"))
+    assert "not a results folder" in line or "no grid.json" in line
+
+
+def test_a_suite_with_no_cell_to_run_exits_1_and_its_report_says_so(tmp_path: Path) -> None:
+    suite = tmp_path / "nodata.toml"
+    suite.write_text('[[methods]]\nname = "odometry"\n[[datasets]]\nname = "aces"\n')
+    done = subprocess.run(
+        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite)]
+        + ["--results", "results", "--no-progress"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+        env={
+            **os.environ,
+            "ALBOT1_DATA_DIR": str(tmp_path / "no-data"),
+            "ALBOT1_CACHE_DIR": str(tmp_path),
+        },
+    )
+    assert done.returncode == 1, done.stderr
+    assert "skipped dataset aces: not downloaded" in done.stderr
+    assert done.stderr.strip().splitlines()[-1] == (
+        "suite nodata: no cell to run (every dataset or method it selects was skipped)"
+    )
+    report = _albot1(tmp_path, "report", "results/nodata", "--out", "report", "--no-plots")
+    assert report.returncode == 0, report.stderr
+    text = (tmp_path / "report" / "README.md").read_text()
+    assert "Cells: 0 planned" in text and "`aces`: not downloaded" in text

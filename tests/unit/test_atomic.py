@@ -45,3 +45,18 @@ def test_remove_temporaries_deletes_what_a_killed_writer_left_and_nothing_else(t
         path.write_bytes(b"")
     assert sorted(p.name for p in remove_temporaries(tmp_path)) == sorted(p.name for p in left)
     assert sorted(p.name for p in tmp_path.iterdir()) == [".hidden", "result.json"]
+
+
+def test_an_os_error_about_the_temporary_file_names_the_destination(tmp_path: Path) -> None:
+    import errno
+
+    def full(p: Path) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")  # what write() raises: no file name
+
+    with pytest.raises(OSError) as caught:
+        atomic_write(tmp_path / "a.txt", full)
+    assert caught.value.errno == errno.ENOSPC and caught.value.filename == str(tmp_path / "a.txt")
+    with pytest.raises(FileNotFoundError) as missing:
+        atomic_write(tmp_path / "no-folder" / "a.txt", lambda p: p.write_text("x"))
+    assert missing.value.filename == str(tmp_path / "no-folder" / "a.txt")
+    assert list(tmp_path.iterdir()) == []

@@ -220,3 +220,73 @@ def places_loop() -> Route:
 
 def places_double_loop() -> Route:
     return Route(waypoints=PLACES_LOOP + PLACES_SECOND_LOOP, closed=True)
+
+
+# --- A square corridor ring of about 100 m (thesis Experiment 3, Figure 3.20) -------------------------------------
+#
+# The thesis's error-tolerance route is "approximately 100 meters ... a square-like route" driven start-stop
+# (106 views). A corridor ring 2 m wide around a 27 x 17 m block of five rooms, with four rooms outside it,
+# thirteen doorways and four alcoves (the corners and door jambs Albot1 tracks), furniture in every room. The
+# route follows the corridor's centre line from S in the west corridor, anticlockwise through all four corners
+# and back to S: 96 m, every turn the same way, as in Figure 3.20 (so the odometry's turn and heading errors add
+# up instead of cancelling, as they do on the office loop's alternating turns).
+
+SQUARE_SPACES: tuple[Space, ...] = (
+    Space("corridor", (0.0, 0.0, 31.0, 2.0)),
+    Space("corridor", (0.0, 19.0, 31.0, 21.0)),
+    Space("corridor", (0.0, 0.0, 2.0, 21.0)),
+    Space("corridor", (29.0, 0.0, 31.0, 21.0)),
+    Space("corridor", (4.0, 21.0, 5.5, 21.6)),  # alcoves
+    Space("corridor", (20.0, -0.6, 21.5, 0.0)),
+    Space("corridor", (31.0, 15.0, 31.6, 16.5)),
+    Space("corridor", (-0.6, 4.0, 0.0, 5.5)),
+    Space("room-a", (2.2, 2.2, 10.9, 9.4)),  # inside the ring
+    Space("room-b", (11.1, 2.2, 19.9, 9.4)),
+    Space("room-c", (20.1, 2.2, 28.8, 9.4)),
+    Space("room-d", (2.2, 9.6, 14.9, 18.8)),
+    Space("room-e", (15.1, 9.6, 28.8, 18.8)),
+    Space("room-f", (6.0, -5.2, 13.0, -0.2)),  # outside it
+    Space("room-g", (31.2, 6.0, 36.0, 12.0)),
+    Space("room-h", (18.0, 21.2, 25.0, 26.0)),
+    Space("room-i", (-5.0, 12.0, -0.2, 17.0)),
+)
+
+SQUARE_DOORWAYS: tuple[DoorwaySpec, ...] = (
+    DoorwaySpec("room-a-south", (6.5, 2.1), "x", 0.9),
+    DoorwaySpec("room-b-south", (15.5, 2.1), "x", 0.9),
+    DoorwaySpec("room-c-south", (24.5, 2.1), "x", 0.9),
+    DoorwaySpec("room-c-east", (28.9, 6.0), "y", 0.9),
+    DoorwaySpec("room-e-east", (28.9, 14.0), "y", 1.0),
+    DoorwaySpec("room-e-north", (22.0, 18.9), "x", 0.9),
+    DoorwaySpec("room-d-north", (8.0, 18.9), "x", 1.0),
+    DoorwaySpec("room-d-west", (2.1, 14.0), "y", 0.9),
+    DoorwaySpec("room-a-west", (2.1, 5.5), "y", 0.9),
+    DoorwaySpec("room-f", (9.5, -0.1), "x", 1.0),
+    DoorwaySpec("room-g", (31.1, 9.0), "y", 1.0),
+    DoorwaySpec("room-h", (21.5, 21.1), "x", 1.0),
+    DoorwaySpec("room-i", (-0.1, 14.5), "y", 1.0),
+)
+
+SQUARE_FURNITURE: tuple[Rect, ...] = (
+    (4.0, 7.0, 6.0, 8.0),
+    (13.0, 6.5, 15.0, 7.5),
+    (24.0, 5.0, 26.0, 6.0),
+    (6.0, 14.0, 9.0, 15.0),
+    (20.0, 12.0, 23.0, 13.0),
+    (8.0, -4.0, 11.0, -3.0),
+    (33.0, 8.0, 35.0, 10.0),
+    (20.0, 23.5, 23.0, 24.5),
+    (-4.0, 13.5, -2.0, 15.5),
+)
+
+
+def square_plan() -> FloorPlan:
+    return build_plan("square", SQUARE_SPACES, SQUARE_DOORWAYS, SQUARE_FURNITURE)
+
+
+def square_loop() -> Route:
+    """S (1, 10.5) south, then east, north, west along the ring and south back to S: 96 m."""
+    return Route(
+        waypoints=((1.0, 10.5), (1.0, 1.0), (30.0, 1.0), (30.0, 20.0), (1.0, 20.0), (1.0, 10.5)),
+        closed=True,
+    )

@@ -42,11 +42,10 @@ thread: a fixed summation order makes runs bit-for-bit repeatable (TBB's
 parallel reductions do not promise one), and ~50 source points per scan
 leave little to parallelise.
 
-The scan is moved from the sensor to the base frame with the config's
-``sensor_offset_*`` fields: a Frame does not carry the offset (it lives in
-``SequenceMetadata.sensor_offset``), so a dataset with a non-zero offset must
-pass it, e.g. ``--set sensor_offset_x_m=0.2``. The CARMEN logs used here
-have laser poses equal to the robot poses (offset zero).
+The laser's mounting offset is applied by the runner for every method
+(:func:`albot1.data.transforms.sensor_frame`): the mapper is given the
+laser's trajectory, in which the scans are centred, and its poses are moved
+back to the robot afterwards; so the scan is used as it comes.
 
 Counters: ``views`` (scans processed), ``updates`` (scans inserted into
 the voxel map; they play the role of keyframes), ``registrations`` (ICP
@@ -142,9 +141,6 @@ class KissIcpConfig(BaseModel):
     max_consecutive_failures: int = Field(
         ge=0, description="more consecutive rejected registrations raise BaselineError"
     )
-    sensor_offset_x_m: float = Field(description="laser position in the base frame, forward")
-    sensor_offset_y_m: float = Field(description="laser position in the base frame, left")
-    sensor_offset_theta_deg: float = Field(description="laser heading in the base frame, CCW")
     map_voxel_m: float = Field(
         gt=0, description="grid cell thinning the stored map (every scan projected with its pose)"
     )
@@ -179,9 +175,6 @@ class KissIcpMapper:
             self._threshold = FixedThreshold(config.fixed_threshold_m)
         else:
             self._threshold = AdaptiveThreshold(_threshold_settings(config))
-        self._sensor = np.array(
-            [config.sensor_offset_x_m, config.sensor_offset_y_m, math.radians(config.sensor_offset_theta_deg)]
-        )
         self._max_correction_rad = math.radians(config.max_correction_deg)
         self._map_update_angle_rad = math.radians(config.map_update_angle_deg)
         self._last_inserted: FloatArray | None = None
@@ -242,10 +235,8 @@ class KissIcpMapper:
         )
 
     def _base_cloud(self, frame: Frame) -> FloatArray:
-        """Beams with a return within the range limits as 3D points (z = 0) in the base frame, ``(k, 3)``."""
+        """Beams with a return within the range limits as 3D points (z = 0) in the scan's frame, ``(k, 3)``."""
         points = frame.scan.points(self.config.min_range_m, self.config.max_range_m)
-        if self._sensor.any():
-            points = se2.transform_points(self._sensor, points)
         cloud = np.zeros((len(points), 3))
         cloud[:, :2] = points
         return cloud

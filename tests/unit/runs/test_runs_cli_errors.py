@@ -88,13 +88,6 @@ def test_an_os_error_that_reaches_the_entry_point_is_one_line(
     assert code == 1
     assert one_line(err) == "albot1: error: runs/abc/trajectory.tum: cannot read or write it: no space left on device"
 
-    def interrupted() -> None:
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(app_module, "app", interrupted)
-    code, _, err = albot1(monkeypatch, capsys)
-    assert code == 130 and err.strip() == "albot1: interrupted"
-
 
 def test_evaluate_on_a_damaged_run_folder_is_one_line_naming_the_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]

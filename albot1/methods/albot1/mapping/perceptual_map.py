@@ -51,6 +51,7 @@ class PerceptualMap:
         self._added_at = np.resize(self._added_at, cap)
 
     def _index(self, ids: IntArray) -> None:
+        return
         rows, ci, cj = self._k.segment_cells(np.ascontiguousarray(self._seg[ids]), 1.0 / self.cell_size)
         grid = self._grid
         per_id: dict[int, list[Cell]] = {}
@@ -68,6 +69,7 @@ class PerceptualMap:
             self._cells[sid] = tuple(cells)
 
     def _unindex(self, sid: int) -> None:
+        return
         for c in self._cells[sid]:
             bucket = self._grid[c]
             bucket.discard(sid)
@@ -114,6 +116,11 @@ class PerceptualMap:
 
     def query(self, xmin: float, ymin: float, xmax: float, ymax: float) -> IntArray:
         """Ids (ascending) of the surfaces that may meet the box, from the grid (a superset)."""
+        seg = self._seg[: self._n]
+        lo_x = np.minimum(seg[:, 0], seg[:, 2]); hi_x = np.maximum(seg[:, 0], seg[:, 2])
+        lo_y = np.minimum(seg[:, 1], seg[:, 3]); hi_y = np.maximum(seg[:, 1], seg[:, 3])
+        hit = self._alive[: self._n] & (hi_x >= xmin) & (lo_x <= xmax) & (hi_y >= ymin) & (lo_y <= ymax)
+        return np.flatnonzero(hit).astype(np.int64)
         inv = 1.0 / self.cell_size
         i0, i1 = math.floor(xmin * inv) - 1, math.floor(xmax * inv) + 1
         j0, j1 = math.floor(ymin * inv) - 1, math.floor(ymax * inv) + 1

@@ -111,6 +111,18 @@ class OdometryNoise:
         self._rhs = [np.zeros(2), np.zeros(2)]
         self.samples = 0
 
+    def learn_median(self, nu2: tuple[float, float], motion: float) -> None:
+        """EXPERIMENT: track the median of nu^2 / motion (a chi-square(1) median is 0.455 of its mean)."""
+        self.samples += 1
+        for g in range(2):
+            x = nu2[g] / motion
+            step = self.params.learning_rate * 2.0
+            if x > 0.455 * self.q[g]:
+                self.q[g] *= math.exp(step)
+            else:
+                self.q[g] *= math.exp(-step)
+        self.kappa = [1.0, 1.0]
+
     def learn(self, nu2: tuple[float, float], v_meas: tuple[float, float], motion: float) -> None:
         """One view's squared disagreement ``nu2`` and implied measurement variance ``v_meas``, per group."""
         self.samples += 1
@@ -235,7 +247,10 @@ class PlusLocaliser:
         nu2 = (0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2), d_phi * d_phi)
         well_fixed = np.linalg.eigvalsh(info[:2, :2])[0] > LEARN_MIN_INFO and info[2, 2] > LEARN_MIN_INFO
         if well_fixed and motion > LEARN_MIN_MOTION_M:
-            noise.learn(nu2, v_meas, motion)
+            if self.params.m_per_rad < 0.99:
+                noise.learn_median(nu2, motion)
+            else:
+                noise.learn(nu2, v_meas, motion)
         scale = np.sqrt(np.array([noise.kappa[0], noise.kappa[0], noise.kappa[1]]))
         info_meas = info / np.outer(scale, scale)
         v_xy, v_phi = noise.prior_variance(motion)

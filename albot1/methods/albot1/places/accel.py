@@ -8,13 +8,16 @@ from typing import NamedTuple
 
 from albot1.methods.albot1.jit import kernel_compiler
 from albot1.methods.albot1.places import kernels
-from albot1.methods.albot1.places.kernels import FloatArray, IntArray
+from albot1.methods.albot1.places.kernels import BoolArray, FloatArray, IntArray
 
 
 class PlacesKernels(NamedTuple):
     """One consistent set of places kernels (all jitted or none); see :mod:`.kernels` for each."""
 
     jitted: bool
+    merge_collinear: Callable[[FloatArray, float, float, float], FloatArray]
+    seen_through: Callable[[FloatArray, IntArray, BoolArray, float, float, FloatArray], IntArray]
+    near_exit: Callable[[FloatArray, IntArray, IntArray, int, int, int, float, float, float], bool]
     update_sides: Callable[
         [FloatArray, IntArray, FloatArray, IntArray, IntArray, IntArray, float, float, float, int, int, int],
         tuple[IntArray, FloatArray, FloatArray],
@@ -44,5 +47,23 @@ class PlacesKernels(NamedTuple):
 @lru_cache(maxsize=2)
 def places_kernels(accelerate: bool = True) -> PlacesKernels:
     """The jitted kernels when ``accelerate`` and numba is importable, else the plain ones."""
-    jit = kernel_compiler(accelerate, (kernels.update_sides, kernels.detect_exits, kernels.match_structure))
-    return PlacesKernels(jit.jitted, jit(kernels.update_sides), jit(kernels.detect_exits), jit(kernels.match_structure))
+    jit = kernel_compiler(
+        accelerate,
+        (
+            kernels.merge_collinear,
+            kernels.seen_through,
+            kernels.near_exit,
+            kernels.update_sides,
+            kernels.detect_exits,
+            kernels.match_structure,
+        ),
+    )
+    return PlacesKernels(
+        jit.jitted,
+        jit(kernels.merge_collinear),
+        jit(kernels.seen_through),
+        jit(kernels.near_exit),
+        jit(kernels.update_sides),
+        jit(kernels.detect_exits),
+        jit(kernels.match_structure),
+    )

@@ -49,10 +49,11 @@ class MatchParams:
     gap: float = 0.4
     min_matches: int = 5
     max_surfaces: int = 40
-    anchors: int = 3
+    anchors: int = 1
     trigger_fraction: float = 0.2
     trigger_min: int = 4
     retry_growth: int = 3
+    retry_scans: int = 20
     max_conflicts: int = 0
     max_turn: float = math.radians(45.0)
     max_shift: float = 3.0
@@ -109,7 +110,7 @@ class PlacesFields(BaseModel):
         40, ge=2, description="the longest this many surfaces of each place enter the match (bounds its cost)"
     )
     match_anchors: Literal["midpoint", "midpoint_and_ends"] = Field(
-        "midpoint_and_ends",
+        "midpoint",
         description=(
             "Algorithm 6 line 6 'centering on S_j': a hypothesis puts S_k's midpoint on S_j's, or also tries "
             "their left and right ends"
@@ -157,6 +158,9 @@ class PlacesFields(BaseModel):
         ),
     )
     revisit_trigger_min: int = Field(4, ge=0, description="4.1.2 n for the smallest places")
+    match_retry_scans: int = Field(
+        20, ge=0, description="... and no sooner than this many scans after it (bounds the cost on sparse logs)"
+    )
     recognition_exit_clearance_m: float = Field(
         0.5,
         ge=0,
@@ -213,6 +217,7 @@ class PlacesFields(BaseModel):
             trigger_fraction=self.revisit_trigger_fraction,
             trigger_min=self.revisit_trigger_min,
             retry_growth=self.match_retry_growth,
+            retry_scans=self.match_retry_scans,
             max_conflicts=self.match_max_conflicts,
             max_turn=math.radians(self.match_max_turn_deg),
             max_shift=self.match_max_shift_m,

@@ -58,8 +58,10 @@ def view_exits(view: View, params: ExitParams, kernels: PlacesKernels) -> FloatA
         params.max_distance,
         params.both_occluding,
     )
+    if len(i) == 0:
+        return np.empty((0, 4))
     s = view.surfaces
-    return np.column_stack([s[i, 2], s[i, 3], s[j, 0], s[j, 1]]).reshape(-1, 4)
+    return np.column_stack([s[i, 2], s[i, 3], s[j, 0], s[j, 1]])
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,26 +127,16 @@ class ExitTracker:
         exit: it belongs to the place beyond (the nearest exit along the line
         when it passes several).
         """
-        out = np.full(len(points), -1, dtype=np.int64)
-        keep = np.flatnonzero(self._recent(scan))
-        if len(keep) == 0 or len(points) == 0:
-            return out
-        seg = self._seg[keep]
-        ax, ay, bx, by = (seg[:, c][:, None] for c in range(4))
-        ox, oy = origin
-        px, py = points[None, :, 0], points[None, :, 1]
-        d1 = (bx - ax) * (oy - ay) - (by - ay) * (ox - ax)
-        d2 = (bx - ax) * (py - ay) - (by - ay) * (px - ax)
-        d3 = (px - ox) * (ay - oy) - (py - oy) * (ax - ox)
-        d4 = (px - ox) * (by - oy) - (py - oy) * (bx - ox)
-        through = (d1 * d2 < 0) & (d3 * d4 < 0)
-        hit = through.any(axis=0)
-        if hit.any():
-            # fraction along origin -> point where each exit line is met; the nearest exit wins
-            with np.errstate(divide="ignore", invalid="ignore"):
-                along = np.where(through, d1 / (d1 - d2), np.inf)
-            out[hit] = self._ids[keep[np.argmin(along[:, hit], axis=0)]]
-        return out
+        if len(points) == 0 or len(self._ids) == 0:
+            return np.full(len(points), -1, dtype=np.int64)
+        return self._k.seen_through(
+            self._seg,
+            self._ids,
+            self._recent(scan),
+            float(origin[0]),
+            float(origin[1]),
+            np.ascontiguousarray(points, dtype=float).reshape(-1, 2),
+        )
 
     def twins(self, track: int) -> list[int]:
         """Ids of the tracks within the twin distance of ``track`` (itself included): one doorway's placements."""
@@ -158,15 +150,20 @@ class ExitTracker:
 
     def near(self, position: tuple[float, float], distance: float, scan: int) -> bool:
         """Whether ``position`` is within ``distance`` of a recently seen exit (standing in a doorway)."""
-        keep = self._recent(scan)
-        if not keep.any():
-            return False
-        seg = self._seg[keep]
-        a, e = seg[:, :2], seg[:, 2:] - seg[:, :2]
-        rel = np.asarray(position, dtype=float)[None, :] - a
-        t = np.clip((rel * e).sum(axis=1) / np.maximum((e * e).sum(axis=1), 1e-12), 0.0, 1.0)
-        gap = rel - t[:, None] * e
-        return bool((np.hypot(gap[:, 0], gap[:, 1]) <= distance).any())
+        p = self.params
+        return bool(
+            self._k.near_exit(
+                self._seg,
+                self._sightings,
+                self._last_seen,
+                p.min_sightings,
+                p.recent_scans,
+                scan,
+                float(position[0]),
+                float(position[1]),
+                distance,
+            )
+        )
 
     def observe(self, view: View, pose: Pose, scan: int) -> FloatArray:
         """Detect the exits of ``view`` (taken at ``pose``) and track them; returns them in the map frame."""

@@ -20,6 +20,7 @@ from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDING
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
 
 
 def detect_exits(
@@ -103,6 +104,126 @@ def detect_exits(
         out_j[k] = cj[c]
         k += 1
     return out_i[:k], out_j[:k]
+
+
+def merge_collinear(surfaces: FloatArray, max_angle: float, max_offset: float, max_gap: float) -> FloatArray:
+    """Pieces of one straight structure as one surface, longest pieces first.
+
+    A surface joins a longer one when their directions differ by less than
+    ``max_angle``, its midpoint is within ``max_offset`` of the longer one's
+    line, and along that line it overlaps it or leaves a gap of at most
+    ``max_gap``; the joined surface spans both along the longer one's line.
+    """
+    n = surfaces.shape[0]
+    length = np.empty(n)
+    for i in range(n):
+        length[i] = np.hypot(surfaces[i, 2] - surfaces[i, 0], surfaces[i, 3] - surfaces[i, 1])
+    order = np.argsort(-length, kind="mergesort")
+    gx = np.empty(n)
+    gy = np.empty(n)
+    gux = np.empty(n)
+    guy = np.empty(n)
+    lo_t = np.empty(n)
+    hi_t = np.empty(n)
+    k = 0
+    cos_max = math.cos(max_angle)
+    for r in range(n):
+        i = order[r]
+        if length[i] <= 0.0:
+            continue
+        x1 = surfaces[i, 0]
+        y1 = surfaces[i, 1]
+        x2 = surfaces[i, 2]
+        y2 = surfaces[i, 3]
+        ux = (x2 - x1) / length[i]
+        uy = (y2 - y1) / length[i]
+        mx = 0.5 * (x1 + x2)
+        my = 0.5 * (y1 + y2)
+        joined = False
+        for g in range(k):
+            if ux * gux[g] + uy * guy[g] < cos_max:
+                continue
+            if abs(-guy[g] * (mx - gx[g]) + gux[g] * (my - gy[g])) > max_offset:
+                continue
+            t1 = (x1 - gx[g]) * gux[g] + (y1 - gy[g]) * guy[g]
+            t2 = (x2 - gx[g]) * gux[g] + (y2 - gy[g]) * guy[g]
+            lo = min(t1, t2)
+            hi = max(t1, t2)
+            if lo <= hi_t[g] + max_gap and hi >= lo_t[g] - max_gap:
+                lo_t[g] = min(lo_t[g], lo)
+                hi_t[g] = max(hi_t[g], hi)
+                joined = True
+                break
+        if not joined:
+            gx[k] = x1
+            gy[k] = y1
+            gux[k] = ux
+            guy[k] = uy
+            lo_t[k] = 0.0
+            hi_t[k] = length[i]
+            k += 1
+    out = np.empty((k, 4))
+    for g in range(k):
+        out[g, 0] = gx[g] + lo_t[g] * gux[g]
+        out[g, 1] = gy[g] + lo_t[g] * guy[g]
+        out[g, 2] = gx[g] + hi_t[g] * gux[g]
+        out[g, 3] = gy[g] + hi_t[g] * guy[g]
+    return out
+
+
+def seen_through(
+    seg: FloatArray, ids: IntArray, crossable: BoolArray, ox: float, oy: float, points: FloatArray
+) -> IntArray:
+    """For each point: the id of the first crossable exit segment the line from (ox, oy) to it passes through.
+
+    -1 where it passes through none; with several, the one met first along the line.
+    """
+    n = points.shape[0]
+    out = np.full(n, -1, dtype=np.int64)
+    for p in range(n):
+        px = points[p, 0]
+        py = points[p, 1]
+        best = np.inf
+        for r in range(seg.shape[0]):
+            if not crossable[r]:
+                continue
+            ax = seg[r, 0]
+            ay = seg[r, 1]
+            bx = seg[r, 2]
+            by = seg[r, 3]
+            d1 = orientation(ax, ay, bx, by, ox, oy)
+            d2 = orientation(ax, ay, bx, by, px, py)
+            if d1 * d2 >= 0.0:
+                continue
+            d3 = orientation(ox, oy, px, py, ax, ay)
+            d4 = orientation(ox, oy, px, py, bx, by)
+            if d3 * d4 >= 0.0:
+                continue
+            along = d1 / (d1 - d2)
+            if along < best:
+                best = along
+                out[p] = ids[r]
+    return out
+
+
+def near_exit(
+    seg: FloatArray,
+    sightings: IntArray,
+    last_seen: IntArray,
+    min_sightings: int,
+    recent_scans: int,
+    scan: int,
+    x: float,
+    y: float,
+    distance: float,
+) -> bool:
+    """Whether (x, y) is within ``distance`` of a crossable exit seen in the last ``recent_scans``."""
+    for r in range(seg.shape[0]):
+        if sightings[r] < min_sightings or scan - last_seen[r] > recent_scans:
+            continue
+        if point_segment_distance(x, y, seg[r]) <= distance:
+            return True
+    return False
 
 
 def update_sides(

@@ -90,15 +90,16 @@ class Albot1PlacesMapper:
             same_angle=self._same_angle, same_gap=self._same_gap, link_distance=config.exit_link_distance_m
         )
         self._labels: list[set[int]] = []  # map surface id -> the visits it belongs to (see _map_evidence)
-        self._placed_cache: dict[int, tuple[Any, FloatArray, FloatArray]] = {}
+        self._placed_cache: dict[int, tuple[Any, FloatArray, tuple[float, float, float, float]]] = {}
         self._structure_cache: dict[int, tuple[Any, FloatArray]] = {}
+        self._pool: tuple[FloatArray, NDArray[np.int64], NDArray[np.int64], FloatArray] | None = None
         self._members: dict[int, set[int]] = {}  # visit -> the map surface ids marked with it
         self._through: set[int] = set()  # surfaces the current visit saw only through an exit
         self._polygons: list[FloatArray] = []  # the view polygons of the current visit's updates (seen empty)
         self._evidence: dict[int, set[int]] = {}  # place -> its surfaces the current visit's updates co-located with
         self._ahead: dict[int, dict[int, set[int]]] = {}  # exit track -> the same, for what was seen through it
         self._fresh = False  # evidence grew since the last check
-        self._attempts: dict[tuple[int, int], int] = {}  # (visit, place) -> current surfaces at the failed attempt
+        self._attempts: dict[tuple[int, int], tuple[int, int]] = {}  # (visit, place) -> (surfaces, scan) of a failure
         self._predicted: list[Prediction] = []
         self._predictions: list[dict[str, Any]] = []
         self._revisits: list[dict[str, Any]] = []
@@ -142,6 +143,9 @@ class Albot1PlacesMapper:
         del self._polygons[:-_MAX_POLYGONS]
         members = self._members.setdefault(current.id, set())
         ids = event.outcome.view_ids.tolist()
+        deleted = event.outcome.deleted.tolist()
+        members.difference_update(deleted)  # the visit's marked surfaces still in the map
+        self._through.difference_update(deleted)
         members.update(ids)
         self._through.difference_update(ids)
         self._through.update(sid for sid, exit_id in zip(ids, through.tolist()) if exit_id >= 0)
@@ -193,8 +197,9 @@ class Albot1PlacesMapper:
     def _memory_evidence(self, event: UpdateEvent, poly: FloatArray) -> None:
         """``revisit_evidence = "memory"``: the remembered places' structure where the map held it when learned.
 
-        Each place's own surfaces (not those seen through its exits) are put
-        back where its frame lay in the perceptual map when it was created,
+        Each place's structure (its own surfaces, not those seen through its
+        exits, merged where collinear) is put back where its frame lay in the
+        perceptual map when it was created,
         and co-locate with the incoming view when Algorithm 3 would delete or
         edit them: an end inside the view's polygon or within the delete
         margin (the chapter-3 rule and kernel). That is the perceptual map's
@@ -206,38 +211,76 @@ class Albot1PlacesMapper:
         robot = (event.pose[0], event.pose[1])
         if cfg.update_polygon != "robot_and_endpoints":
             poly = view_polygon(view, robot, cfg.update_polygon)
-        lo, hi = poly.min(axis=0) - cfg.delete_margin_m, poly.max(axis=0) + cfg.delete_margin_m
-        excluded = self._excluded()
-        for place in self.network.live_places():
-            if place.id in excluded:
-                continue
-            placed, box = self._placed(place)
-            if len(placed) == 0 or (box[:2] > hi).any() or (box[2:] < lo).any():
-                continue
-            near = self._mk.classify_endpoints(
-                poly,
-                np.ascontiguousarray(view),
-                np.ascontiguousarray(placed.reshape(-1, 2)),
-                cfg.delete_margin_m,
-                cfg.delete_margin_from == "surfaces",
-            )
-            hit = np.flatnonzero(near.reshape(-1, 2).any(axis=1))
-            if len(hit) == 0:
-                continue
-            seg = placed[hit]
-            through = self.exits.beyond(robot, 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
-            for col, exit_id in zip(hit.tolist(), through.tolist()):
-                self._add_evidence(place.id, col, exit_id)
+        segments, owner, key, box = self._memory_pool()
+        if len(segments) == 0:
+            return
+        lo = poly.min(axis=0) - cfg.delete_margin_m
+        hi = poly.max(axis=0) + cfg.delete_margin_m
+        rows = np.flatnonzero((box[:, 2] >= lo[0]) & (box[:, 0] <= hi[0]) & (box[:, 3] >= lo[1]) & (box[:, 1] <= hi[1]))
+        for place in self._excluded():
+            rows = rows[owner[rows] != place]
+        if len(rows) == 0:
+            return
+        near = self._mk.classify_endpoints(
+            poly,
+            np.ascontiguousarray(view),
+            np.ascontiguousarray(segments[rows].reshape(-1, 2)),
+            cfg.delete_margin_m,
+            cfg.delete_margin_from == "surfaces",
+        )
+        hit = rows[near.reshape(-1, 2).any(axis=1)]
+        if len(hit) == 0:
+            return
+        seg = segments[hit]
+        through = self.exits.beyond(robot, 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
+        for place, surface, exit_id in zip(owner[hit].tolist(), key[hit].tolist(), through.tolist()):
+            evidence = self._evidence if exit_id < 0 else self._ahead.setdefault(exit_id, {})
+            evidence.setdefault(place, set()).add(surface)
+            self._fresh = self._fresh or exit_id < 0
 
-    def _placed(self, place: Place) -> tuple[FloatArray, FloatArray]:
-        """A place's own surfaces in the map where its frame lay when created, with their bounding box (cached)."""
+    def _memory_pool(self) -> tuple[FloatArray, NDArray[np.int64], NDArray[np.int64], FloatArray]:
+        """Every live place's placed structure in one array: segments, owning place, index in it, bounding boxes.
+
+        Rebuilt only when the network changed (a crossing or a recognition), so
+        an update tests all remembered places with one kernel call.
+        """
+        if self._pool is None:
+            parts = [(place.id, self._placed(place)[0]) for place in self.network.live_places()]
+            parts = [(pid, seg) for pid, seg in parts if len(seg)]
+            if parts:
+                segments = np.ascontiguousarray(np.vstack([seg for _, seg in parts]))
+                owner = np.concatenate([np.full(len(seg), pid, dtype=np.int64) for pid, seg in parts])
+                key = np.concatenate([np.arange(len(seg), dtype=np.int64) for _, seg in parts])
+            else:
+                segments, owner, key = np.empty((0, 4)), np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+            xs, ys = segments[:, 0::2], segments[:, 1::2]
+            box = (
+                np.column_stack([xs.min(axis=1), ys.min(axis=1), xs.max(axis=1), ys.max(axis=1)])
+                if len(segments)
+                else np.empty((0, 4))
+            )
+            self._pool = (segments, owner, key, box)
+        return self._pool
+
+    def _placed(self, place: Place) -> tuple[FloatArray, tuple[float, float, float, float]]:
+        """A place's structure in the map where its frame lay when created, with its bounding box (cached).
+
+        The structure (:meth:`_structure`) is what the trigger's n is counted
+        in, so the co-locating surfaces are counted in the same units.
+
+        A place without own surfaces gets an empty box (no view can meet it).
+        """
         key = (len(place.surfaces), place.frame_map)
         cached = self._placed_cache.get(place.id)
         if cached is None or cached[0] != key:
-            own = place.surfaces[~place.through]
+            own = self._structure(place)
             placed = transform_segments(place.frame_map, own) if len(own) else np.empty((0, 4))
             pts = placed.reshape(-1, 2)
-            box = np.concatenate([pts.min(axis=0), pts.max(axis=0)]) if len(pts) else np.zeros(4)
+            box = (
+                (float(pts[:, 0].min()), float(pts[:, 1].min()), float(pts[:, 0].max()), float(pts[:, 1].max()))
+                if len(pts)
+                else (math.inf, math.inf, -math.inf, -math.inf)
+            )
             cached = (key, placed, box)
             self._placed_cache[place.id] = cached
         return cached[1], cached[2]
@@ -247,7 +290,7 @@ class Albot1PlacesMapper:
         key = (len(place.surfaces), int(np.count_nonzero(place.through)))
         cached = self._structure_cache.get(place.id)
         if cached is None or cached[0] != key:
-            cached = (key, structural(place.surfaces[~place.through], self._match))
+            cached = (key, structural(place.surfaces[~place.through], self._match, self._k))
             self._structure_cache[place.id] = cached
         return cached[1]
 
@@ -261,12 +304,10 @@ class Albot1PlacesMapper:
 
         With a flag per surface: seen only through an exit.
         """
-        pmap = self.inner.map
-        alive = pmap.ids()
-        ids = np.fromiter(sorted(self._members.get(visit.id, ())), dtype=np.int64)
-        ids = ids[np.isin(ids, alive, assume_unique=True)]
-        through = np.fromiter((sid in self._through for sid in ids.tolist()), dtype=bool, count=len(ids))
-        return pmap.segments(ids), through
+        members = self._members.get(visit.id, set())
+        ids = np.sort(np.fromiter(members, dtype=np.int64, count=len(members)))
+        through = np.isin(ids, np.fromiter(self._through, dtype=np.int64, count=len(self._through)))
+        return self.inner.map.segments(ids), through
 
     # -- Algorithms 5 and 7: an exit crossed ---------------------------------------------------------------------
     def _cross(self, crossing: Crossing, pose: Pose, n: int) -> None:
@@ -276,7 +317,9 @@ class Albot1PlacesMapper:
         compared = nearest_prediction(self._predicted, crossing.segment, 2.0 * self.config.exit_link_distance_m)
         surfaces, through = self._visit_surfaces(visit)
         place, exit_id = network.close(visit, surfaces, crossing.segment, n, through)
+        self._pool = None  # the network changed
         self._through, self._polygons = set(), []
+        self._members.pop(visit.id, None)  # a closed visit's surfaces are in its place now
         entry = np.concatenate([crossing.segment[2:], crossing.segment[:2]])  # the place entered on its left
         target = network.leads(place, exit_id)
         nxt = network.start_visit(n, pose, entry, (place, exit_id))
@@ -358,26 +401,28 @@ class Albot1PlacesMapper:
             remembered = self._structure(place)
             if count <= trigger_threshold(len(remembered), params):
                 continue
-            if current_all is None:
-                current_all, seen_through = self._visit_surfaces(visit)
-                current = self._this_side(structural(current_all[~seen_through], params), pose, n)
-            assert current is not None
             key = (visit.id, place_id)
             last = self._attempts.get(key)
-            if last is not None and len(current_all) < last + params.retry_growth:
+            size = len(self._members.get(visit.id, ()))
+            if last is not None and (size < last[0] + params.retry_growth or n < last[1] + params.retry_scans):
                 continue
+            if current_all is None:
+                current_all, seen_through = self._visit_surfaces(visit)
+                current = self._this_side(structural(current_all[~seen_through], params, self._k), pose, n)
+            assert current is not None
             self._counts.match_attempts += 1
             match = confirm(current, remembered, pose, self._polygons, place.frame_map, params, self._k)
             if not match.confirmed:
-                self._attempts[key] = len(current_all)
+                self._attempts[key] = (size, n)
                 continue
             place_in_map = self._align_at_entry(visit, place_id, match.place_in_map)
             before = None if visit.place is None else network.find(visit.place)
             if before is not None and not self._same_place(before, place_id, place_in_map):
                 self._counts.merges_refused += 1
-                self._attempts[key] = len(current_all)
+                self._attempts[key] = (size, n)
                 continue
             now = network.assign(visit, place_id, place_in_map, n)
+            self._pool = None
             self._counts.revisits_by_structure += 1
             self._revisits.append(
                 {
@@ -416,7 +461,9 @@ class Albot1PlacesMapper:
         theirs = transform_segments(other_in_map, b.surfaces[~b.through])
         if len(mine) == 0 or len(theirs) == 0:
             return False
-        same = same_surfaces(structural(mine, params), structural(theirs, params), self._same_angle, self._same_gap)
+        same = same_surfaces(
+            structural(mine, params, self._k), structural(theirs, params, self._k), self._same_angle, self._same_gap
+        )
         return int(np.count_nonzero(same.any(axis=1))) >= params.min_matches
 
     def _align_at_entry(self, visit: Visit, place_id: int, place_in_map: Pose) -> Pose:

@@ -37,61 +37,16 @@ def trigger_threshold(size: int, params: MatchParams) -> int:
     return max(params.trigger_min, math.ceil(params.trigger_fraction * size))
 
 
-def merge_collinear(surfaces: FloatArray, max_angle: float, max_offset: float, max_gap: float) -> FloatArray:
-    """Pieces of one straight structure as one surface, longest pieces first.
+def structural(surfaces: FloatArray, params: MatchParams, kernels: PlacesKernels) -> FloatArray:
+    """A place's structure: its surfaces merged where collinear, the longer than the minimum, longest first, capped.
 
-    A surface joins a longer one when their directions differ by less than
-    ``max_angle``, its midpoint is within ``max_offset`` of the longer one's
-    line, and along that line it overlaps it or leaves a gap of at most
-    ``max_gap``; the joined surface spans both along the longer one's line.
-    The perceptual map holds a wall as several pieces (cut where furniture
+    Merging (:func:`albot1.methods.albot1.places.kernels.merge_collinear`):
+    the perceptual map holds a wall as several pieces (cut where furniture
     hid it, re-added a little apart by later views); counted piece by piece,
     two walls alone would make "more than 4" matches in any two rooms.
     """
-    s = np.asarray(surfaces, dtype=float).reshape(-1, 4)
-    if len(s) < 2:
-        return s.copy()
-    length = np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
-    n = len(s)
-    # the groups so far: a point, the unit direction, and the covered interval along it
-    gx, gy, gux, guy = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    lo_t, hi_t = np.empty(n), np.empty(n)
-    k = 0
-    cos_max = math.cos(max_angle)
-    for i in np.argsort(-length, kind="stable").tolist():
-        if length[i] <= 0.0:
-            continue
-        x1, y1, x2, y2 = s[i]
-        ux, uy = (x2 - x1) / length[i], (y2 - y1) / length[i]
-        mx, my = 0.5 * (x1 + x2), 0.5 * (y1 + y2)
-        if k:
-            t1 = (x1 - gx[:k]) * gux[:k] + (y1 - gy[:k]) * guy[:k]
-            t2 = (x2 - gx[:k]) * gux[:k] + (y2 - gy[:k]) * guy[:k]
-            lo, hi = np.minimum(t1, t2), np.maximum(t1, t2)
-            ok = (ux * gux[:k] + uy * guy[:k] >= cos_max) & (
-                np.abs(-guy[:k] * (mx - gx[:k]) + gux[:k] * (my - gy[:k])) <= max_offset
-            )
-            ok &= (lo <= hi_t[:k] + max_gap) & (hi >= lo_t[:k] - max_gap)
-            hits = np.flatnonzero(ok)
-            if len(hits):
-                g = int(hits[0])
-                lo_t[g], hi_t[g] = min(lo_t[g], lo[g]), max(hi_t[g], hi[g])
-                continue
-        gx[k], gy[k], gux[k], guy[k], lo_t[k], hi_t[k] = x1, y1, ux, uy, 0.0, length[i]
-        k += 1
-    return np.column_stack(
-        [
-            gx[:k] + lo_t[:k] * gux[:k],
-            gy[:k] + lo_t[:k] * guy[:k],
-            gx[:k] + hi_t[:k] * gux[:k],
-            gy[:k] + hi_t[:k] * guy[:k],
-        ]
-    )
-
-
-def structural(surfaces: FloatArray, params: MatchParams) -> FloatArray:
-    """A place's structure: its surfaces merged where collinear, the longer than the minimum, longest first, capped."""
-    s = merge_collinear(surfaces, params.angle, 0.5 * params.gap, params.gap)
+    s = np.ascontiguousarray(np.asarray(surfaces, dtype=float).reshape(-1, 4))
+    s = kernels.merge_collinear(s, params.angle, 0.5 * params.gap, params.gap) if len(s) > 1 else s
     length = np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
     keep = np.flatnonzero(length > params.min_surface)
     order = keep[np.argsort(-length[keep], kind="stable")]

@@ -516,12 +516,12 @@ class GtsamGraphMapper:
         """Every scan's pose: node scans take their node's, the others are seeded and refined (:mod:`.refine`)."""
         scan_node = np.asarray(self._scan_node, dtype=np.int64)
         offsets = np.asarray(self._scan_offset, dtype=float)
-        if not self.config.refine_scans:
-            return se2.compose(nodes[scan_node], offsets)
         poses = seed_poses(nodes, np.asarray(self._node_steps), scan_node, offsets)
         is_node = np.zeros(len(scan_node), dtype=bool)
         is_node[np.asarray(self._node_frame, dtype=np.int64)] = True
         poses[is_node] = nodes[scan_node[is_node]]
+        if not self.config.refine_scans:
+            return poses
         width = self.config.refine_nodes_either_side
         target: Target | None = None
         target_node = -1

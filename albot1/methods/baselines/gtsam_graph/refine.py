@@ -100,4 +100,4 @@ def accept(
     if not converged or fitness < tests.min_fitness or rmse_m > tests.max_rmse_m:
         return False
     corr = se2.between(seed, pose)
-    return math.hypot(corr[0], corr[1]) <= tests.max_correction_m and abs(corr[2]) <= tests.max_correction_rad
+    return bool(math.hypot(corr[0], corr[1]) <= tests.max_correction_m and abs(corr[2]) <= tests.max_correction_rad)

@@ -20,7 +20,7 @@ MAX_MEMORY_MB = 1_048_576.0
 
 
 class MrptRunConfig(BaseModel):
-    """What every MRPT baseline shares: run limits, output checks and the laser's pose on the robot."""
+    """What every MRPT baseline shares: run limits and output checks."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -51,9 +51,6 @@ class MrptRunConfig(BaseModel):
         ),
     )
     max_step_correction_deg: float = Field(gt=0, description="the same bound on the heading (deg per scan)")
-    sensor_offset_x_m: float = Field(description="laser position on the robot, forward (the rawlog's sensor pose)")
-    sensor_offset_y_m: float = Field(description="laser position on the robot, left")
-    sensor_offset_theta_deg: float = Field(description="laser heading on the robot, counter-clockwise")
 
 
 class MrptIcpConfig(MrptRunConfig):

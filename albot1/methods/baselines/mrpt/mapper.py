@@ -12,8 +12,10 @@ timing of its mapping loop) and ``mrpt_peak_rss_mb``; the runner's
 ``finish_s`` holds all of it.
 
 Each run gets a fresh temporary folder (the applications delete everything
-in their output folder first), removed afterwards; the INI text, MRPT's
-version and its per-step timing statistics go into ``extras.mrpt``.
+in their output folder first), removed afterwards. The INI file and MRPT's
+own outputs (its per-step timing log, its path, the grid image) are kept as
+the run folder's ``mrpt-*`` files (``MapperOutput.files``); MRPT's version
+and timing statistics go into ``extras.mrpt``.
 
 Success is checked, never assumed from the exit status: one pose per scan,
 finite, and a path whose length is within ``[min_path_ratio,
@@ -21,9 +23,12 @@ max_path_ratio]`` of the odometry's. A failure is a :class:`BaselineError`
 with the reason (timeout, memory limit, MRPT's exception message, a short or
 frozen path).
 
-Frames: rbpf-slam's poses are relative to the first scan (its filter starts
-at the origin); icp-slam's are re-expressed relative to its first pose, with
-its map, so both start at the origin like the other baselines.
+Frames: the runner gives the laser's trajectory (the mounting offset applied
+once for every method, :func:`albot1.data.transforms.sensor_frame`), so the
+rawlog's sensor pose is the origin. rbpf-slam's poses are relative to the
+first scan (its filter starts at the origin); icp-slam's are re-expressed
+relative to its first pose, with its map, so both start at the origin like
+the other baselines.
 """
 
 from __future__ import annotations
@@ -61,6 +66,8 @@ APT_PACKAGE = "mrpt-apps"
 MIN_CHECKED_PATH_M = 1.0
 
 RAWLOG_NAME = "input.rawlog"
+#: The INI file the application ran with, kept in the run folder (with MRPT's own output files, ``mrpt-*``).
+CONFIG_FILE = "mrpt-config.ini"
 INI_NAME = "config.ini"
 OUTPUT_DIR = "out"
 
@@ -81,6 +88,11 @@ def _stats_ms(values: FloatArray) -> dict[str, float | int] | None:
         "sum_s": float(np.sum(values) / 1000.0),
         "n": int(len(values)),
     }
+
+
+def _keep(out_dir: Path, names: dict[str, str]) -> dict[str, Any]:
+    """MRPT's own output files for the run folder: run-folder name -> the file's bytes."""
+    return {name: (out_dir / source).read_bytes() for name, source in names.items()}
 
 
 def _mrpt_version(stdout_text: str) -> str | None:
@@ -119,10 +131,6 @@ class _MrptMapper:
 
     # -- end of run ------------------------------------------------------------------------------------------
 
-    def _sensor_offset(self) -> tuple[float, float, float]:
-        c = self.config
-        return (c.sensor_offset_x_m, c.sensor_offset_y_m, math.radians(c.sensor_offset_theta_deg))
-
     def _motion_model(self) -> GaussianMotionModel | None:
         return None
 
@@ -149,7 +157,9 @@ class _MrptMapper:
                         self._frames,
                         out,
                         layout=self.layout,
-                        sensor_offset=self._sensor_offset(),
+                        # The runner gives the laser's trajectory (albot1.data.transforms.sensor_frame): the
+                        # scans are centred on it, so the rawlog's sensor pose is the origin.
+                        sensor_offset=(0.0, 0.0, 0.0),
                         motion_model=self._motion_model(),
                     )
             except DataError as exc:
@@ -174,7 +184,7 @@ class _MrptMapper:
             stderr_text = (work / "stderr.txt").read_text(encoding="utf-8", errors="replace")
             out_dir = work / OUTPUT_DIR
             self._check_outcome(outcome, out_dir, stdout_text, stderr_text, scans)
-            poses, points, counters, extras = self._read(out_dir, odometry)
+            poses, points, counters, extras, files = self._read(out_dir, odometry)
 
         self._check_path(poses, odometry)
         mrpt_block = {
@@ -186,9 +196,10 @@ class _MrptMapper:
             "rawlog_invalid_beams": rawlog.invalid_beams,
             "seed": self.seed,
             "threads": 1,
-            "ini": ini,
             **extras,
         }
+        files = {CONFIG_FILE: ini, **files}
+        mrpt_block["files"] = sorted(files)
         all_counters: dict[str, int | float] = {
             "views": scans,
             **counters,
@@ -201,7 +212,9 @@ class _MrptMapper:
         total = outputs.total_time_s(stdout_text)
         if total is not None:
             all_counters["mrpt_total_s"] = total
-        return MapperOutput(poses=poses, map=MapData(points=points), counters=all_counters, extras={"mrpt": mrpt_block})
+        return MapperOutput(
+            poses=poses, map=MapData(points=points), counters=all_counters, extras={"mrpt": mrpt_block}, files=files
+        )
 
     def _check_outcome(
         self, outcome: ProcessOutcome, out_dir: Path, stdout_text: str, stderr_text: str, scans: int
@@ -283,7 +296,7 @@ class _MrptMapper:
 
     def _read(
         self, out_dir: Path, odometry: FloatArray
-    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any]]:
+    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any], dict[str, Any]]:
         raise NotImplementedError
 
 
@@ -301,7 +314,7 @@ class MrptIcpMapper(_MrptMapper):
 
     def _read(
         self, out_dir: Path, odometry: FloatArray
-    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any]]:
+    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any], dict[str, Any]]:
         scans = len(odometry)
         raw = outputs.icp_poses(out_dir, scans)
         origin_inverse = se2.inverse(raw[0])
@@ -310,7 +323,10 @@ class MrptIcpMapper(_MrptMapper):
         times, map_sizes = outputs.icp_steps(out_dir, 2 * scans)
         counters: dict[str, int | float] = {"updates": int(map_sizes[-1]) if len(map_sizes) else 0}
         extras = {"step_times": _stats_ms(times), "scan_step_times": _stats_ms(times[1::2])}
-        return poses, points, counters, extras
+        files = _keep(
+            out_dir, {"mrpt-log_times.txt": "log_times.txt", "mrpt-estimated_path.txt": "log_estimated_path.txt"}
+        )
+        return poses, points, counters, extras, files
 
 
 class MrptRbpfMapper(_MrptMapper):
@@ -343,7 +359,7 @@ class MrptRbpfMapper(_MrptMapper):
 
     def _read(
         self, out_dir: Path, odometry: FloatArray
-    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any]]:
+    ) -> tuple[FloatArray, FloatArray, dict[str, int | float], dict[str, Any], dict[str, Any]]:
         scans = len(odometry)
         steps = outputs.rbpf_steps(out_dir, scans)
         updates = int(np.count_nonzero(steps.updated))
@@ -366,4 +382,13 @@ class MrptRbpfMapper(_MrptMapper):
             # the online particle mean MRPT logged at each scan.
             "best_vs_mean_m": {"median": float(np.median(gap)), "max": float(np.max(gap))},
         }
-        return poses, points, counters, extras
+        files = _keep(
+            out_dir,
+            {
+                "mrpt-log_times.txt": "log_times.txt",
+                "mrpt-most_likely_path.txt": "most_likely_path.txt",
+                "mrpt-grid.png": outputs.GRID_IMAGE,
+                "mrpt-grid-limits.txt": outputs.GRID_LIMITS,
+            },
+        )
+        return poses, points, counters, extras, files

@@ -21,6 +21,9 @@ NAMES = [
     "synthetic-corridor",
     "synthetic-office-long",
     "synthetic-office-startstop-10deg",
+    "synthetic-places-loop",  # tests/unit/data/synthetic/test_synthetic_places_worlds.py
+    "synthetic-places-double-loop",
+    "synthetic-square-startstop",  # tests/unit/data/synthetic/test_synthetic_square_world.py
 ]
 QUICK = [*NAMES[:3], NAMES[4]]
 

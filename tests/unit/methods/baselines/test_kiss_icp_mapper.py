@@ -124,14 +124,26 @@ def test_range_limits_drop_beams_outside_them() -> None:
     assert np.hypot(*near.map.points.T).max() <= 2.0
 
 
-def test_sensor_offset_moves_the_scan_into_the_base_frame() -> None:
+def test_sensor_offset_is_applied_by_the_runner_not_the_mapper() -> None:
+    from albot1.data.model import Sequence, SequenceMetadata
+    from albot1.runs.execute import run_method
+
     pose = np.array([4.0, 3.0, 0.0])
     scan = room.scan_at(pose)
-    # The same scan declared as taken by a laser 0.5 m ahead of the base: the map shifts by 0.5 m.
-    base = _run([Frame(0, scan, pose)], map_voxel_m=0.001)
-    ahead = _run([Frame(0, scan, pose)], map_voxel_m=0.001, sensor_offset_x_m=0.5)
+    # The same scan declared as taken by a laser 0.5 m ahead of the base: the method works in the laser's frame
+    # (the map is the scan as measured), and the robot pose it reports is 0.5 m behind the laser.
+    base = run_method(
+        "kiss-icp", Sequence.from_frames("base", [Frame(0, scan, pose)]), overrides={"map_voxel_m": 0.001}
+    )
+    ahead = run_method(
+        "kiss-icp",
+        Sequence.from_frames("ahead", [Frame(0, scan, pose)], SequenceMetadata(sensor_offset=(0.5, 0.0, 0.0))),
+        overrides={"map_voxel_m": 0.001},
+    )
     assert base.map.points is not None and ahead.map.points is not None
-    np.testing.assert_allclose(ahead.map.points, base.map.points + [0.5, 0.0], atol=1e-12)
+    np.testing.assert_allclose(ahead.map.points, base.map.points, atol=1e-12)
+    np.testing.assert_allclose(ahead.poses[0], [-0.5, 0.0, 0.0], atol=1e-12)
+    assert "sensor_offset_x_m" not in KissIcpConfig.model_fields
 
 
 def test_constant_velocity_model_ignores_the_odometry() -> None:

@@ -12,7 +12,6 @@ from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
 from albot1.methods.albot1.places.matcher import (
     confirm,
-    merge_collinear,
     robot_sides,
     structural,
     trigger_threshold,
@@ -67,8 +66,8 @@ def seen_empty(pose: tuple[float, float, float], width: float, depth: float) -> 
 def match_room(current_room: np.ndarray, remembered: np.ndarray, size: tuple[float, float], prior, params, kernels):
     current, robot = current_view(current_room, POSE)
     return confirm(
-        structural(current, params),
-        structural(remembered, params),
+        structural(current, params, kernels),
+        structural(remembered, params, kernels),
         robot,
         seen_empty(POSE, *size),
         prior,
@@ -121,15 +120,16 @@ def test_a_hypothesis_far_from_where_the_map_put_the_place_is_refused(kernels) -
     assert not match_room(ROOM, ROOM, (7, 6), turned, PARAMS, kernels).confirmed
 
 
-def test_collinear_pieces_merge_into_one_structure() -> None:
+@pytest.mark.parametrize("kernels", KERNELS, ids=["plain", "jit"])
+def test_collinear_pieces_merge_into_one_structure(kernels) -> None:
     pieces = np.array([[0.0, 0.0, 1.0, 0.0], [1.2, 0.02, 2.5, 0.0], [2.8, -0.05, 4.0, 0.0], [0.0, 1.0, 4.0, 1.0]])
-    merged = merge_collinear(pieces, math.radians(5.0), 0.2, 0.4)
+    merged = kernels.merge_collinear(pieces, math.radians(5.0), 0.2, 0.4)
     assert len(merged) == 2
     assert min(merged[:, 0].min(), merged[:, 2].min()) == pytest.approx(0.0, abs=0.06)
     assert max(merged[:, 0].max(), merged[:, 2].max()) == pytest.approx(4.0, abs=0.06)
     # opposite directions (the two faces of a wall) and a 1 m gap (a doorway) stay apart
     apart = np.array([[0.0, 0.0, 1.0, 0.0], [2.0, 0.0, 1.5, 0.0], [2.5, 0.0, 4.0, 0.0]])
-    assert len(merge_collinear(apart, math.radians(5.0), 0.2, 0.4)) == 3
+    assert len(kernels.merge_collinear(apart, math.radians(5.0), 0.2, 0.4)) == 3
 
 
 def test_trigger_threshold_grows_with_the_place() -> None:

@@ -72,9 +72,9 @@ def test_presets_come_from_the_toml_and_validate() -> None:
     assert math.isclose(math.radians(cfg.node_rotation_deg), 0.5, rel_tol=1e-4)
 
 
-def test_nodes_every_half_metre_and_scan_poses_follow_odometry_between_nodes() -> None:
+def test_without_tracking_nodes_follow_odometry_and_scan_poses_compose_odometry() -> None:
     seq = room_sequence()
-    mapper, out = run(seq)
+    mapper, out = run(seq, track_scans=False, refine_scans=False)
     nodes = out.extras["node_scans"]
     odo = seq.odometry
     # A node opens when the odometry moved >= 0.5 m (or 0.5 rad) from the previous node.
@@ -90,6 +90,27 @@ def test_nodes_every_half_metre_and_scan_poses_follow_odometry_between_nodes() -
     np.testing.assert_allclose(
         se2.between(out.poses[nodes[1]], out.poses[k]), se2.between(odo[nodes[1]], odo[k]), atol=1e-9
     )
+
+
+def test_tracked_nodes_open_every_half_metre_of_matched_motion_and_every_scan_is_registered() -> None:
+    # The odometry over-turns by 3 deg per scan: nodes follow the scan-matched motion, not the odometry.
+    seq = room_sequence(odometry_bias_deg=3.0)
+    _, out = run(seq)
+    nodes = out.extras["node_scans"]
+    ref = seq.reference
+    for a, b in zip(nodes, nodes[1:]):
+        step = se2.between(ref[a], ref[b])
+        before = se2.between(ref[a], ref[b - 1])
+        assert math.hypot(step[0], step[1]) >= 0.5 - 0.01 or abs(step[2]) >= 0.5 - 0.01
+        assert math.hypot(before[0], before[1]) < 0.5 + 0.01 and abs(before[2]) < 0.5 + 0.01
+    assert out.counters["scans_tracked"] == len(seq) - 1
+    assert out.counters["tracking_failures"] == 0
+    assert out.counters["scans_refined"] == len(seq) - len(nodes)
+    # Every scan, not only the nodes, is within 1 cm / 0.2 deg of the truth relative to the first scan.
+    rel_est = se2.between(out.poses[0], out.poses)
+    rel_ref = se2.between(ref[0], ref)
+    assert np.abs(rel_est[:, :2] - rel_ref[:, :2]).max() < 0.01
+    assert np.degrees(np.abs(se2.wrap(rel_est[:, 2] - rel_ref[:, 2]))).max() < 0.2
 
 
 def test_scan_matching_beats_biased_odometry_on_the_room() -> None:

@@ -78,7 +78,10 @@ def test_icp_poses_start_at_the_origin_with_the_map_in_the_same_frame(fake_apps:
     mrpt = out.extras["mrpt"]
     assert mrpt["version"] == "2.5.8" and mrpt["rawlog_layout"] == "observations"
     assert mrpt["scan_step_times"]["median_ms"] == 1.5 and mrpt["step_times"]["n"] == 2 * SCANS
-    assert "SHOW_PROGRESS_3D_REAL_TIME = 0" in mrpt["ini"] and "thresholdDist = 0.3" in mrpt["ini"]
+    ini = out.files["mrpt-config.ini"]
+    assert "SHOW_PROGRESS_3D_REAL_TIME = 0" in ini and "thresholdDist = 0.3" in ini
+    assert mrpt["files"] == ["mrpt-config.ini", "mrpt-estimated_path.txt", "mrpt-log_times.txt"]
+    assert out.files["mrpt-log_times.txt"].startswith(b"0.500000 1\n")
 
 
 def test_rbpf_poses_follow_the_best_particle_and_the_odometry_between_updates(fake_apps: Path) -> None:
@@ -90,8 +93,12 @@ def test_rbpf_poses_follow_the_best_particle_and_the_odometry_between_updates(fa
     c = out.counters
     assert (c["updates"], c["particles"], c["map_points"]) == (3, 30, 2)
     mrpt = out.extras["mrpt"]
-    assert "RANDOM_SEED = 7" in mrpt["ini"] and "SHOW_PROGRESS_IN_WINDOW = 0" in mrpt["ini"]
-    assert "PF_algorithm = 2" in mrpt["ini"] and mrpt["rawlog_layout"] == "actions"
+    ini = out.files["mrpt-config.ini"]
+    assert "RANDOM_SEED = 7" in ini and "SHOW_PROGRESS_IN_WINDOW = 0" in ini
+    assert "PF_algorithm = 2" in ini and mrpt["rawlog_layout"] == "actions"
+    assert out.files["mrpt-grid.png"].startswith(b"\x89PNG")
+    assert b"-1.0 2.0 -1.0 1.0" in out.files["mrpt-grid-limits.txt"]
+    assert "mrpt-most_likely_path.txt" in mrpt["files"]
     assert mrpt["grid"]["resolution_m"] == 0.5 and mrpt["best_vs_mean_m"]["max"] == pytest.approx(0.01)
     assert mrpt["update_step_times"]["mean_ms"] == 10.0 and mrpt["ess_min"] == 0.5
 

@@ -1,0 +1,391 @@
+"""Write ``reports/thesis/README.md``: the thesis's experiments, its numbers beside ours, computed verdicts.
+
+Called by :func:`albot1.report.index.build_report` for the ``thesis``
+suite's results (``albot1 report results/thesis``, ``make bench``). The
+page is built from the stores alone (:mod:`albot1.report.thesis.evidence`):
+the verdicts from their numbers, the figures from their run folders. A
+figure that cannot be drawn (a run that failed, a dataset not available for
+a replay) is replaced by the reason; only drawn figures are linked, so every
+link of the page resolves.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from albot1.errors import Albot1Error
+from albot1.methods.baselines.published import published_systems
+from albot1.report.collect import CellRecord
+from albot1.report.errors import ReportError
+from albot1.report.html import rel
+from albot1.report.map_plots import plot_maps
+from albot1.report.places_plot import render_places
+from albot1.report.plots import method_colors, slug, vector_of
+from albot1.report.thesis.claims import READINGS
+from albot1.report.thesis.evidence import COMPANION_SUITES, Evidence, open_stores
+from albot1.report.thesis.experiments import LOOP_GAP, ClaimRow, FigureRequest, Section, all_sections
+from albot1.report.thesis.figures import animate_map, plot_gap_maps, plot_trace_strip, plot_update_trace
+from albot1.report.thesis.replay import Replay, replay_run
+from albot1.report.thesis.verdicts import Verdict
+from albot1.runs.folder import read_run
+
+PAGE = "README.md"
+FIGURES = "figures"
+#: The suite whose report gets this page.
+THESIS_SUITE = "thesis"
+
+
+@dataclass(frozen=True)
+class Drawn:
+    """A figure file made for a request (or, ``path`` None, why it could not be made)."""
+
+    caption: str
+    path: Path | None
+    reason: str | None = None
+
+
+class _Figures:
+    """Draws the requested figures once each; replays are shared between the trace and the animation."""
+
+    def __init__(self, ev: Evidence, out: Path, colors: dict[str, str]) -> None:
+        self.ev = ev
+        self.dir = out / FIGURES
+        self.dir.mkdir(parents=True, exist_ok=True)
+        self.colors = colors
+        self._replays: dict[Path, Replay | ReportError] = {}
+
+    def replay(self, record: CellRecord) -> Replay:
+        found = self._replays.get(record.run_dir)
+        if found is None:
+            try:
+                found = replay_run(record.run_dir)
+            except ReportError as exc:
+                found = exc
+            self._replays[record.run_dir] = found
+        if isinstance(found, ReportError):
+            raise found
+        return found
+
+    def draw(self, request: FigureRequest) -> list[Drawn]:
+        try:
+            return getattr(self, f"_{request.kind.replace('-', '_')}")(request)
+        except (Albot1Error, OSError, ValueError) as exc:  # one figure's failure never stops the page
+            return [Drawn(request.caption, None, f"{type(exc).__name__}: {exc}")]
+
+    def _record(self, dataset: str, method: str, degradation: str = "none") -> CellRecord:
+        found = self.ev.find(dataset, method, degradation)
+        if found.record is None:
+            raise ReportError(found.missing or "no run")
+        return found.record
+
+    def _trace(self, request: FigureRequest) -> list[Drawn]:
+        out: list[Drawn] = []
+        for method in request.methods:
+            caption = f"{request.caption}: `{method}` on `{request.dataset}`"
+            try:
+                replay = self.replay(self._record(request.dataset, method))
+            except ReportError as exc:
+                out.append(Drawn(caption, None, str(exc)))
+                continue
+            stem = slug(f"{request.stem}-{method}")
+            title = f"{method} on {request.dataset}"
+            out.append(Drawn(caption, plot_update_trace(replay, self.dir / f"{stem}.png", title)))
+            out.append(
+                Drawn(
+                    f"which views triggered an update: `{method}` on `{request.dataset}`",
+                    plot_trace_strip(replay, self.dir / f"{stem}-strip.png", title),
+                )
+            )
+        return out
+
+    def _animation(self, request: FigureRequest) -> list[Drawn]:
+        method = request.methods[0]
+        caption = f"{request.caption}: `{method}` on `{request.dataset}` (GIF)"
+        try:
+            replay = self.replay(self._record(request.dataset, method))
+        except ReportError as exc:
+            return [Drawn(caption, None, str(exc))]
+        path = self.dir / f"{slug(request.stem)}.gif"
+        return [Drawn(caption, animate_map(replay, path, f"{method} on {request.dataset}"))]
+
+    def _maps(self, request: FigureRequest) -> list[Drawn]:
+        records = []
+        for method in request.methods:
+            found = self.ev.find(request.dataset, method)
+            if found.record is not None:
+                records.append(found.record)
+        if not records:
+            return [Drawn(request.caption, None, "no method has a completed run on this dataset")]
+        path = plot_maps(records, request.dataset, self.dir / f"{slug(request.stem)}.png", self.colors)
+        return [Drawn(request.caption, path, None if path else "nothing to draw")]
+
+    def _gap_maps(self, request: FigureRequest) -> list[Drawn]:
+        panels = []
+        for degradation in request.degradations:
+            for method in request.methods:
+                found = self.ev.find(request.dataset, method, degradation)
+                if found.record is None:
+                    continue
+                gap = self.ev.number(found, LOOP_GAP, "", "m").text()
+                panels.append((f"{method} [{degradation}]", read_run(found.record.run_dir), gap))
+        if not panels:
+            return [Drawn(request.caption, None, "no completed run to draw")]
+        path = plot_gap_maps(
+            panels, self.dir / f"{slug(request.stem)}.png", request.dataset, columns=len(request.methods)
+        )
+        return [Drawn(request.caption, path)]
+
+    def _places(self, request: FigureRequest) -> list[Drawn]:
+        record = self._record(request.dataset, request.methods[0])
+        source = record.run_dir / "places.json"
+        try:
+            network = json.loads(source.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise ReportError(f"{source}: cannot read the network of places: {exc}") from None
+        path = self.dir / f"{slug(request.stem)}.png"
+        render_places(network, path, f"{request.methods[0]} on {request.dataset}")
+        return [Drawn(request.caption, path)]
+
+
+def published_notes() -> list[str]:
+    """One line per published-only system (DP-SLAM): why it is not run, and its published figures, labelled."""
+    lines = []
+    for system in published_systems():
+        figures = (
+            "; ".join(f"{f.log} {f.metric} {f.mean:g} (published, {f.source})" for f in system.figures)
+            or "no verifiable published figure on these logs"
+        )
+        lines.append(f"{system.label} is not run here: {system.implementation} Published: {figures}.")
+    return lines
+
+
+# --------------------------------------------------------------------------- Markdown
+
+
+def _verdict_cell(verdict: Verdict, *, brief: bool = False) -> str:
+    text = f"**{verdict.word}**" if brief else f"**{verdict.word}**: {verdict.reason}"
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def _claim_cells(row: ClaimRow, columns: dict[str, str], *, brief: bool = False) -> list[str]:
+    if "" in row.verdicts:  # one verdict for every variant: a check of the stand-in, not of Albot1
+        first = _verdict_cell(row.verdicts[""], brief=brief)
+        return [first] + ["(setup check: same for every variant)"] * (len(columns) - 1)
+    return [_verdict_cell(row.verdicts[c], brief=brief) if c in row.verdicts else "–" for c in columns]
+
+
+def _summary(sections: list[Section]) -> list[str]:
+    lines = [
+        "| experiment | claim | thesis | literal reading | thesis preset | Albot1+ |",
+        "|---|---|---|---|---|---|",
+    ]
+    for section in sections:
+        for row in section.claims:
+            cells = _claim_cells(row, section.columns, brief=True)
+            lines.append(
+                f"| [{section.title.split(':')[0]}](#{section.anchor}) | {row.claim} | {row.thesis} | "
+                + " | ".join(cells)
+                + " |"
+            )
+    return lines
+
+
+def _counts(sections: list[Section]) -> str:
+    words: dict[str, int] = {}
+    for section in sections:
+        for row in section.claims:
+            for verdict in row.verdicts.values():
+                words[verdict.word] = words.get(verdict.word, 0) + 1
+    return ", ".join(f"{n} {w}" for w, n in sorted(words.items())) or "no verdict"
+
+
+def _section_lines(section: Section, drawn: dict[str, list[Drawn]], out: Path) -> list[str]:
+    lines = [
+        f'<a id="{section.anchor}"></a>',
+        f"## {section.title}",
+        "",
+        f"**Thesis (published, not measured here):** {section.thesis_says}",
+        "",
+        f"**Stand-in:** {section.stand_in}",
+        "",
+    ]
+    if section.claims:
+        heads = [f"{name} (`{label}`)" for label, name in section.columns.items()]
+        lines += [
+            "| claim | thesis | " + " | ".join(heads) + " |",
+            "|---|---|" + "---|" * len(heads),
+        ]
+        for row in section.claims:
+            lines.append(f"| {row.claim} | {row.thesis} | " + " | ".join(_claim_cells(row, section.columns)) + " |")
+        lines.append("")
+    for note in section.notes:
+        lines += [f"- {note}"]
+    if section.notes:
+        lines.append("")
+    for table in section.tables:
+        lines += [table, ""]
+    figures = [d for request in section.figures for d in drawn.get(request.stem, [])]
+    if figures:
+        lines += ["Figures:", ""]
+        for figure in figures:
+            if figure.path is None:
+                lines.append(f"- {figure.caption}: not drawn ({figure.reason})")
+                continue
+            link = rel(figure.path, out)
+            vector = vector_of(figure.path)
+            twin = f" ([SVG]({rel(vector, out)}))" if figure.path.suffix == ".png" and vector.is_file() else ""
+            lines.append(f"- [{figure.caption}]({link}){twin}")
+        lines.append("")
+        for figure in figures:
+            if figure.path is not None:
+                lines += [f"![{figure.caption}]({rel(figure.path, out)})", ""]
+    return lines
+
+
+def _parameters(ev: Evidence, sections: list[Section], out: Path) -> list[str]:
+    lines = [
+        "## Parameters",
+        "",
+        "Our readings of the thesis's claims (the thresholds the verdicts use; the thesis gives none, "
+        "`albot1/report/thesis/claims.py`):",
+        "",
+        "| reading | value | meaning | why |",
+        "|---|---|---|---|",
+    ]
+    for name, reading in READINGS.items():
+        lines.append(f"| `{name}` | {reading.value:g} {reading.unit} | {reading.meaning} | {reading.why} |")
+    lines += [
+        "",
+        "- Induced odometry error (Experiment 3): the `thesis` degradation, +0.1 m and +1 deg added to every "
+        "step's odometry before any method sees it (docs/metrics.md, README: `--degrade thesis`).",
+        "- Metric settings, as stored in the metrics of the runs (docs/metrics.md):",
+    ]
+    for store in ev.stores:
+        sample = next((r.metrics for r in store.records if r.metrics is not None and r.metrics.map_shape), None)
+        if sample is not None and sample.map_shape is not None:
+            lines.append(
+                f"  - map shape: tolerance {sample.map_shape.tolerance_m:g} m, voxel {sample.map_shape.voxel_m:g} m, "
+                f"alignment {sample.map_shape.alignment} (`{store.path}`)"
+            )
+        orientation = next((r.metrics for r in store.records if r.metrics is not None and r.metrics.orientation), None)
+        if orientation is not None and orientation.orientation is not None:
+            o = orientation.orientation
+            lines.append(
+                f"  - orientation: a stop every {o.every_m:g} m, bearing undefined within {o.min_distance_m:g} m of "
+                f"the start, alignment {o.alignment} (`{store.path}`)"
+            )
+    lines += [
+        "  - loop gap: start vs end of the route, alignment-free (docs/metrics.md, 'Loop gap')",
+        "",
+        "Methods (each label's preset and overrides; every config field of every run is in its `result.json`, linked):",
+        "",
+        "| method | store | preset | overrides | run folder |",
+        "|---|---|---|---|---|",
+    ]
+    wanted = {m for s in sections for r in s.figures for m in r.methods} | {
+        label for s in sections for label in s.columns
+    }
+    seen: set[tuple[str, str]] = set()
+    for store in ev.stores:
+        for rec in store.records:
+            c = rec.cell
+            if rec.status != "done" or (c.method_label, store.name) in seen:
+                continue
+            if c.method_label not in wanted and store.name != THESIS_SUITE:
+                continue
+            seen.add((c.method_label, store.name))
+            overrides = ", ".join(f"{k}={v}" for k, v in c.overrides.items()) or "none"
+            lines.append(
+                f"| `{c.method_label}` | `{store.path}` | `{c.preset}` | {overrides} | "
+                f"[result.json]({rel(rec.run_dir / 'result.json', out)}) |"
+            )
+    return [*lines, ""]
+
+
+def _stand_ins() -> list[str]:
+    return [
+        "## What stands in for the thesis's data",
+        "",
+        "The thesis's own logs (its Pioneer 3-DX in the AUT office, Figures 3.3, 3.20, 3.23, 4.1, 4.4) are not "
+        "available. These stand in for them:",
+        "",
+        "| thesis | stand-in | why |",
+        "|---|---|---|",
+        "| Experiments 1-2: six start-stop routes through the office; four stops measured on the floor plan "
+        "(3.2.1-3.2.2) | the square and office worlds of this suite; every public log of the default suite "
+        "(reference poses from the SLAM-corrected logs) | exact ground truth on the worlds; real sensors on the "
+        "logs |",
+        "| Experiment 3: a square-like route of about 100 m, 106 views, odometry gap 4.6 m (3.2.3) | "
+        "`synthetic-square-startstop`: 96 m, 106 views, odometry gap 4.61 m | the same route shape and odometry "
+        "drift, so the gaps compare like for like |",
+        "| Experiments 4-5: a 136 m route as 1330 views (10 cm / 1 deg) and 217 views (1 m / 10 deg) (3.2.4-3.2.5) "
+        "| `synthetic-office-loop` (79 m, 1871 views) and `synthetic-office-loop?views=1:10` (171 views) | one "
+        "route at both spacings, as in the thesis |",
+        "| Experiment 5's SLAM systems: DP-SLAM, CARMEN's mapper, GMapping, gridSLAM | `mrpt-rbpf` (RBPF, the "
+        "GMapping/gridSLAM family), `mrpt-icp` (scan matching, as CARMEN's mapper), `kiss-icp`, `gtsam-graph`; "
+        "DP-SLAM has no implementation (published figures only) | the field's maintained implementations |",
+        "| Experiment 6: an unnamed public log with odometry and laser (3.2.6) | the public logs with "
+        "ground-truth relations (Radish: aces, intel, fr079, fr-clinic, mit-killian, ...) | the standard "
+        "benchmark of the SLAM community |",
+        "| Chapter 4: a 90 m loop through six places from three starts, a 150 m double loop, the loop repeated "
+        "(4.2.1-4.2.3) | the six-room worlds: `synthetic-places-loop` (from S, A, B), "
+        "`synthetic-places-double-loop`, `synthetic-places-loop?laps=2` | room labels give the true re-visits "
+        "and doorways the true exits |",
+        "",
+    ]
+
+
+def write_thesis_page(
+    results_dir: Path,
+    out: Path,
+    *,
+    benchmark_index: str = "benchmark.md",
+    companions: tuple[str, ...] = COMPANION_SUITES,
+    plots: bool = True,
+) -> Path:
+    """Write ``out/README.md`` for the thesis suite's ``results_dir`` (figures under ``out/figures``)."""
+    ev = open_stores(results_dir, companions)
+    published = published_notes()
+    sections = all_sections(ev, published)
+    labels = [r.cell.method_label for s in ev.stores for r in s.records]
+    drawn: dict[str, list[Drawn]] = {}
+    if plots:
+        figures = _Figures(ev, out, method_colors(labels))
+        for section in sections:
+            for request in section.figures:
+                drawn[request.stem] = figures.draw(request)
+    lines = [
+        "# The thesis's experiments, reproduced",
+        "",
+        "For each experiment of the thesis (chapters 3.2 and 4.2): what the thesis claims and the numbers it "
+        "reports (labelled **thesis**, published, never measured here), our numbers on the data that stands in "
+        "for its own, and a verdict computed from the stored numbers for Albot1 in the literal reading of the "
+        "thesis (`literal`), the thesis preset (`thesis`) and Albot1+ (`plus`): **holds**, **does not hold** or "
+        "**not comparable** (with the reason: a metric that does not apply, a method not installed, a run not "
+        "made). How each verdict is computed: docs/thesis-reproduction.md.",
+        "",
+        f"Generated {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from "
+        + ", ".join(f"`{s.path}` (suite `{s.plan.suite}`, code `{s.code_version}`)" for s in ev.stores)
+        + ".",
+        "",
+        f"Verdicts: {_counts(sections)}.",
+        "",
+    ]
+    if ev.notes:
+        lines += ["Notes on the stores:", "", *[f"- {note}" for note in ev.notes], ""]
+    if (out / benchmark_index).is_file():
+        lines += [
+            f"This suite's full benchmark report (every table and plot): [{benchmark_index}]({benchmark_index}), "
+            "[index.html](index.html).",
+            "",
+        ]
+    lines += ["## Verdicts at a glance", "", *_summary(sections), "", *_stand_ins()]
+    for section in sections:
+        lines += _section_lines(section, drawn, out)
+    lines += _parameters(ev, sections, out)
+    page = out / PAGE
+    page.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return page

@@ -1,0 +1,191 @@
+"""Verdicts: pure functions from a claim's test and our stored numbers to a word and a one-line reason.
+
+Why pure functions: a verdict on the page must be computed, never typed, and
+a reader must be able to check how. Each function here takes
+:class:`Number` values (a measured number, or the reason there is none) and
+the claim's threshold, and returns a :class:`Verdict` whose word is one of
+:data:`HOLDS`, :data:`FAILS` and :data:`NOT_COMPARABLE`. A missing number is
+never replaced: the verdict is "not comparable" and its reason is the
+number's own (a metric that does not apply, a method that was not run, a
+failed cell).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+from albot1.report.tables import decimals, fmt
+
+HOLDS = "holds"
+FAILS = "does not hold"
+NOT_COMPARABLE = "not comparable"
+Word = Literal["holds", "does not hold", "not comparable"]
+
+
+@dataclass(frozen=True)
+class Number:
+    """A measured number with its unit and name, or (``value`` None) why there is none."""
+
+    label: str
+    value: float | None
+    unit: str = ""
+    missing: str | None = None
+
+    @property
+    def known(self) -> bool:
+        return self.value is not None and math.isfinite(self.value)
+
+    def text(self) -> str:
+        """``0.604 m`` (3 significant digits), or ``n/a``."""
+        if not self.known:
+            return "n/a"
+        return quantity(float(self.value), self.unit)  # type: ignore[arg-type]
+
+    def why_missing(self) -> str:
+        return f"{self.label}: {self.missing or 'no value'}"
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A word and the numbers that decided it."""
+
+    word: Word
+    reason: str
+
+    def line(self) -> str:
+        return f"{self.word}: {self.reason}"
+
+
+def quantity(value: float, unit: str = "") -> str:
+    """``value`` to 3 significant digits with its unit (``4.61 m``, ``0.350``, ``12.0 deg``); counts as integers."""
+    text = str(int(value)) if value.is_integer() and abs(value) < 1e15 else fmt(value, decimals(value))
+    return f"{text} {unit}" if unit else text
+
+
+def _missing(*numbers: Number) -> Verdict | None:
+    absent = [n for n in numbers if not n.known]
+    if not absent:
+        return None
+    return Verdict(NOT_COMPARABLE, "; ".join(n.why_missing() for n in absent))
+
+
+def _thesis(text: str | None) -> str:
+    return f"; thesis {text}" if text else ""
+
+
+def ratio_at_least(small: Number, large: Number, min_ratio: float, *, thesis: str | None = None) -> Verdict:
+    """Holds when ``large`` is at least ``min_ratio`` times ``small`` (e.g. odometry's loop gap vs Albot1's)."""
+    absent = _missing(small, large)
+    if absent is not None:
+        return absent
+    s, big = float(small.value), float(large.value)  # type: ignore[arg-type]
+    ratio = math.inf if s == 0 else big / s
+    shown = "inf" if math.isinf(ratio) else quantity(ratio)
+    word: Word = HOLDS if ratio >= min_ratio else FAILS
+    sense = "at least" if word == HOLDS else "below"
+    return Verdict(
+        word,
+        f"{small.label} {small.text()} vs {large.label} {large.text()} ({shown}x, {sense} {min_ratio:g}x"
+        f"{_thesis(thesis)})",
+    )
+
+
+def at_most(value: Number, bound: float, *, strict: bool = False, thesis: str | None = None) -> Verdict:
+    """Holds when ``value`` is at most ``bound`` (below it when ``strict``)."""
+    absent = _missing(value)
+    if absent is not None:
+        return absent
+    v = float(value.value)  # type: ignore[arg-type]
+    ok = v < bound if strict else v <= bound
+    relation = ("<" if strict else "<=") if ok else (">=" if strict else ">")
+    return Verdict(
+        HOLDS if ok else FAILS,
+        f"{value.label} {value.text()} {relation} {quantity(bound, value.unit)}{_thesis(thesis)}",
+    )
+
+
+def at_least(value: Number, bound: float, *, strict: bool = False, thesis: str | None = None) -> Verdict:
+    """Holds when ``value`` is at least ``bound`` (above it when ``strict``)."""
+    absent = _missing(value)
+    if absent is not None:
+        return absent
+    v = float(value.value)  # type: ignore[arg-type]
+    ok = v > bound if strict else v >= bound
+    relation = (">" if strict else ">=") if ok else ("<=" if strict else "<")
+    return Verdict(
+        HOLDS if ok else FAILS,
+        f"{value.label} {value.text()} {relation} {quantity(bound, value.unit)}{_thesis(thesis)}",
+    )
+
+
+def equals(value: Number, expected: float, *, thesis: str | None = None) -> Verdict:
+    """Holds when ``value`` is exactly ``expected`` (counts: places, views)."""
+    absent = _missing(value)
+    if absent is not None:
+        return absent
+    ok = float(value.value) == expected  # type: ignore[arg-type]
+    return Verdict(
+        HOLDS if ok else FAILS,
+        f"{value.label} {value.text()} {'=' if ok else '!='} {quantity(expected, value.unit)}{_thesis(thesis)}",
+    )
+
+
+def close_to(value: Number, target: float, tolerance: float, *, thesis: str | None = None) -> Verdict:
+    """Holds when ``value`` is within ``tolerance`` (a fraction) of ``target``: a stand-in reproduces a setting."""
+    absent = _missing(value)
+    if absent is not None:
+        return absent
+    v = float(value.value)  # type: ignore[arg-type]
+    off = abs(v - target) / abs(target) if target else math.inf
+    ok = off <= tolerance
+    return Verdict(
+        HOLDS if ok else FAILS,
+        f"{value.label} {value.text()} is {quantity(100 * off)} % from {quantity(target, value.unit)} "
+        f"({'within' if ok else 'beyond'} {100 * tolerance:g} %{_thesis(thesis)})",
+    )
+
+
+def lower_than(ours: Number, theirs: Number, *, thesis: str | None = None) -> Verdict:
+    """Holds when ``ours`` is strictly lower than ``theirs`` (an error, a gap)."""
+    absent = _missing(ours, theirs)
+    if absent is not None:
+        return absent
+    a, b = float(ours.value), float(theirs.value)  # type: ignore[arg-type]
+    ok = a < b
+    return Verdict(
+        HOLDS if ok else FAILS,
+        f"{ours.label} {ours.text()} {'<' if ok else '>='} {theirs.label} {theirs.text()}{_thesis(thesis)}",
+    )
+
+
+def higher_than(ours: Number, theirs: Number, *, thesis: str | None = None) -> Verdict:
+    """Holds when ``ours`` is strictly higher than ``theirs`` (a map precision)."""
+    absent = _missing(ours, theirs)
+    if absent is not None:
+        return absent
+    a, b = float(ours.value), float(theirs.value)  # type: ignore[arg-type]
+    ok = a > b
+    return Verdict(
+        HOLDS if ok else FAILS,
+        f"{ours.label} {ours.text()} {'>' if ok else '<='} {theirs.label} {theirs.text()}{_thesis(thesis)}",
+    )
+
+
+def all_of(verdicts: Sequence[Verdict]) -> Verdict:
+    """One verdict for a claim with several parts, all of which must hold.
+
+    A part that fails decides it (whatever the others): the claim does not
+    hold. Otherwise a part that cannot be tested makes it not comparable.
+    The reason lists the deciding parts: those that fail, else those not
+    comparable, else all of them.
+    """
+    if not verdicts:
+        return Verdict(NOT_COMPARABLE, "no part of the claim could be tested")
+    for word in (FAILS, NOT_COMPARABLE):
+        deciding = [v for v in verdicts if v.word == word]
+        if deciding:
+            return Verdict(word, "; ".join(v.reason for v in deciding))
+    return Verdict(HOLDS, "; ".join(v.reason for v in verdicts))

@@ -1,0 +1,115 @@
+"""Re-visits, crossings and exit predictions of a network of places scored against reference poses."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from albot1.metrics.errors import MetricsError
+from albot1.metrics.places import believed_in_world, judge_places, judge_revisits
+
+# Two rooms side by side, x 0..5 (room-a) and 5.2..10 (room-b), joined by a doorway at x = 5.1, y 2..3.
+SPACES = [{"name": "room-a", "rect": [0.0, 0.0, 5.0, 5.0]}, {"name": "room-b", "rect": [5.2, 0.0, 10.0, 5.0]}]
+DOORWAYS = [{"id": "door", "a": [5.1, 2.0], "b": [5.1, 3.0], "width_m": 1.0, "spaces": ["room-a", "room-b"]}]
+
+
+def route() -> np.ndarray:
+    """a (scans 0-19) -> b (20-39) -> a (40-59) -> b (60-79), along y = 2.5, heading east then west."""
+    xs = np.concatenate(
+        [np.linspace(1, 4.9, 20), np.linspace(5.3, 9, 20), np.linspace(4.9, 1, 20), np.linspace(5.3, 9, 20)]
+    )
+    heading = np.concatenate([np.zeros(20), np.zeros(20), np.full(20, math.pi), np.zeros(20)])
+    return np.column_stack([xs, np.full(80, 2.5), heading])
+
+
+def record(places: list[int | None], claims: list[tuple[int, int, str]]) -> dict:
+    bounds = [(0, 19), (20, 39), (40, 59), (60, 79)]
+    visits = [
+        {"id": k, "place": p, "first_scan": b[0], "last_scan": b[1]} for k, (p, b) in enumerate(zip(places, bounds))
+    ]
+    revisits = [{"scan": s, "visit": v, "place": p, "place_now": p, "how": how} for v, p, how in claims for s in [0]]
+    return {"visits": visits, "revisits": revisits, "crossings": []}
+
+
+def test_rooms_decide_when_the_dataset_knows_them() -> None:
+    # a perfect network: visits 2 and 3 recognised as places 0 and 1
+    counters, truth, summary = judge_revisits(
+        record([0, 1, 0, 1], [(2, 0, "structure"), (3, 1, "exit")]), route(), SPACES
+    )
+    assert truth == [True, True]
+    assert counters == {
+        "revisits_true": 2,
+        "revisits_false": 0,
+        "revisits_missed": 0,
+        "revisits_actual": 2,
+        "revisit_precision": 1.0,
+        "revisit_recall": 1.0,
+    }
+    assert summary["rule"] == "rooms" and summary["rooms"] == ["room-a", "room-b", "room-a", "room-b"]
+
+
+def test_a_wrong_claim_and_a_missed_revisit() -> None:
+    # visit 2 (room-a again) wrongly claimed as place 1 (room-b); visit 3 made a new place: both re-visits missed
+    counters, truth, _ = judge_revisits(record([0, 1, 1, 2], [(2, 1, "structure")]), route(), SPACES)
+    assert truth == [False]
+    assert (counters["revisits_true"], counters["revisits_false"], counters["revisits_missed"]) == (0, 1, 2)
+    assert counters["revisit_precision"] == 0.0 and counters["revisit_recall"] == 0.0
+
+
+def test_no_claims_leaves_precision_undefined_not_zero() -> None:
+    counters, truth, _ = judge_revisits(record([0, 1, 2, 3], []), route(), SPACES)
+    assert truth == [] and "revisit_precision" not in counters and counters["revisit_recall"] == 0.0
+
+
+def test_without_rooms_the_reference_positions_must_overlap() -> None:
+    counters, truth, summary = judge_revisits(record([0, 1, 0, 1], [(2, 0, "structure"), (3, 1, "exit")]), route())
+    assert summary["rule"] == "overlap"
+    # visit 2 retraces visit 0's path, visit 3 visit 1's; the neighbour just before never counts
+    assert truth == [True, True] and counters["revisits_missed"] == 0
+
+
+def test_a_visit_outside_the_reference_is_an_error() -> None:
+    bad = record([0, 1, 0, 1], [])
+    bad["visits"][3]["last_scan"] = 80
+    with pytest.raises(MetricsError, match="visit 3: scans 60..80 outside the 80 reference poses"):
+        judge_revisits(bad, route(), SPACES)
+
+
+def test_points_are_put_in_the_world_as_the_robot_believed_them() -> None:
+    estimate = np.array([1.0, 0.0, math.pi / 2])  # the map's pose of the robot
+    reference = np.array([5.0, 5.0, 0.0])  # where it truly was
+    point = np.array([1.0, 2.0])  # 2 m ahead of the estimated pose
+    np.testing.assert_allclose(believed_in_world(point, estimate, reference), [7.0, 5.0], atol=1e-12)
+
+
+def test_judge_places_scores_exit_predictions_and_crossings() -> None:
+    ref = route()
+    # the map is the world shifted by (-1, 0): estimate = reference - (1, 0)
+    est = ref - np.array([1.0, 0.0, 0.0])
+    crossing = {
+        "scan": 60,
+        "exit": 3,
+        "segment": [4.1, 2.0, 4.1, 3.0],  # the door as perceived (map frame): exactly right
+        "prediction": {"aligned": [4.2, 2.0, 4.2, 3.0], "not_aligned": [5.1, 2.5, 5.1, 3.5]},
+    }
+    rec = record([0, 1, 0, 1], [(2, 0, "structure"), (3, 1, "exit")])
+    rec["crossings"] = [crossing, {"scan": 19, "exit": 0, "segment": [4.1, 2.0, 4.1, 3.0], "prediction": None}]
+    dataset = {"spaces": SPACES, "doorways": DOORWAYS, "doorway_crossings": [{"scan": 20}, {"scan": 40}, {"scan": 60}]}
+    judged = judge_places({"places.json": rec, "places.graphml": "<g/>"}, est, ref, dataset)
+    c = judged.counters
+    assert c["exit_prediction_aligned_true_mean_m"] == pytest.approx(0.1)
+    assert c["exit_prediction_not_aligned_true_mean_m"] == pytest.approx(math.hypot(1.0, 0.5))
+    assert (c["crossings_true"], c["crossings_false"], c["crossings_missed"]) == (2, 0, 1)
+    out = judged.files["places.json"]
+    assert [r["true"] for r in out["revisits"]] == [True, True]
+    assert out["ground_truth"]["exits"]["exit_predictions"][0]["doorway"] == "door"
+    assert judged.files["places.graphml"] == "<g/>" and "true" not in rec["revisits"][0]
+
+
+def test_judge_places_refuses_mismatched_inputs() -> None:
+    with pytest.raises(MetricsError, match="no places.json"):
+        judge_places({}, route(), route(), {})
+    with pytest.raises(MetricsError, match="80 estimated poses but 79 reference poses"):
+        judge_places({"places.json": record([0, 1, 0, 1], [])}, route(), route()[:79], {})

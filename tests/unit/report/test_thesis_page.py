@@ -1,0 +1,131 @@
+"""The thesis page from a tiny results store made by the real planner, cell executor and evaluation.
+
+The store holds the thesis suite's Experiment 3 cells on the 106-view square world (dead reckoning and
+the three Albot1 variants, clean and with the thesis's induced error), one of them failed on purpose; the
+other experiments have no runs. The page must render, link only figures that exist, give a computed verdict
+where the numbers exist and "not comparable" with the reason where they do not, and the report of a
+``thesis`` results folder must make it its README.md.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from albot1.bench.plan import plan_suite
+from albot1.bench.store import ResultsStore
+from albot1.bench.suite import parse_suite
+from albot1.report.index import build_report
+from albot1.report.thesis.evidence import open_stores
+from albot1.report.thesis.experiments import SQUARE, section_error_tolerance, section_places, section_spacing
+from albot1.report.thesis.figures import MAX_GIF_BYTES
+from albot1.report.thesis.page import write_thesis_page
+from albot1.report.thesis.verdicts import HOLDS, NOT_COMPARABLE
+from albot1.settings import get_settings
+from albot1.bench.cells import execute_cell
+
+LINK = re.compile(r"\]\(([^)#\s]+)\)")
+FAILED_METHOD = "albot1:plus"
+
+
+def _suite(name: str, datasets: list[dict[str, object]]) -> dict[str, object]:
+    return {
+        "description": "tiny",
+        "grid": {"degradations": ["thesis"], "seeds": [0]},
+        "methods": [
+            {"name": "odometry"},
+            {"name": "albot1", "preset": "literal"},
+            {"name": "albot1", "preset": "thesis"},
+            {"name": "albot1", "preset": "plus"},
+        ],
+        "datasets": datasets,
+    }
+
+
+def _store(root: Path, name: str, data: dict[str, object], *, fail: str | None = None) -> Path:
+    suite = parse_suite(data, name=name, source=f"{name}.toml")
+    plan = plan_suite(suite, get_settings())
+    store = ResultsStore(root / name)
+    store.write_plan(plan)
+    for cell in plan.cells:
+        if cell.method_label == fail and cell.degradation == "thesis":
+            store.prepare(cell)
+            store.record_failure(cell, "the mapper diverged (a test failure)", "exception")
+            continue
+        execute_cell(cell, store.runs)
+    return root / name
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    root = tmp_path_factory.mktemp("results")
+    return _store(root, "thesis", _suite("thesis", [{"name": SQUARE, "sweep": True}]), fail=FAILED_METHOD)
+
+
+@pytest.fixture(scope="module")
+def page(results: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_thesis_page(results, tmp_path_factory.mktemp("report"))
+
+
+def test_experiment_3_verdicts_are_computed_from_the_stored_loop_gaps(results: Path) -> None:
+    ev = open_stores(results)
+    section = section_error_tolerance(ev)
+    setup_clean = section.claims[0].verdicts[""]
+    assert setup_clean.word == HOLDS  # the square world's odometry gap is the thesis's 4.6 m
+    assert "odometry loop gap 4.61 m" in setup_clean.reason
+    clean, induced = section.claims[2], section.claims[3]
+    for row in (clean, induced):
+        assert set(row.verdicts) == {"albot1:literal", "albot1:thesis", "albot1:plus"}
+        for label, verdict in row.verdicts.items():
+            if label == FAILED_METHOD and row is induced:
+                continue
+            assert verdict.word in ("holds", "does not hold")
+            assert f"{label} loop gap" in verdict.reason and "vs odometry" in verdict.reason
+    failed = induced.verdicts[FAILED_METHOD]
+    assert failed.word == NOT_COMPARABLE
+    assert "failed in" in failed.reason and "the mapper diverged" in failed.reason
+
+
+def test_experiments_without_runs_are_not_comparable_with_the_reason(results: Path) -> None:
+    ev = open_stores(results)
+    assert any("results" in note and "default" in note for note in ev.notes)  # no companion store: said so
+    spacing = section_spacing(ev, [])
+    for row in spacing.claims:
+        for verdict in row.verdicts.values():
+            assert verdict.word == NOT_COMPARABLE
+            assert "no " in verdict.reason and "synthetic-office-loop" in verdict.reason
+    places = section_places(ev)
+    assert all(v.word == NOT_COMPARABLE for row in places.claims for v in row.verdicts.values())
+
+
+def test_the_page_renders_and_every_linked_figure_exists(page: Path) -> None:
+    text = page.read_text(encoding="utf-8")
+    assert page.name == "README.md"
+    for heading in ("Experiment 1", "Experiment 2", "Experiment 3", "Experiments 4-5", "Experiment 6", "Chapter 4"):
+        assert f"## {heading}" in text
+    links = LINK.findall(text)
+    assert links, "the page links its figures"
+    for link in links:
+        assert (page.parent / link).exists(), link
+    figures = [page.parent / link for link in links if link.startswith("figures/")]
+    names = {f.name for f in figures}
+    assert any(n.startswith("exp1-trace-albot1_thesis") and n.endswith(".png") for n in names)
+    assert any(n.endswith("-strip.png") for n in names)
+    assert "exp3-gap-maps.png" in names
+    gif = page.parent / "figures" / "exp1-animation.gif"
+    assert gif.is_file() and 0 < gif.stat().st_size <= MAX_GIF_BYTES
+    assert gif.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+    assert "**holds**" in text or "**does not hold**" in text
+    assert "**not comparable**" in text
+    assert "4.6 m (3.2.3, Figure 3.21a)" in text  # the thesis's number, labelled with its source
+
+
+def test_report_of_a_thesis_store_makes_the_page_its_readme(results: Path, tmp_path: Path) -> None:
+    index = build_report(results, tmp_path / "report", plots=False)
+    assert index == tmp_path / "report" / "README.md"
+    assert index.read_text(encoding="utf-8").startswith("# The thesis's experiments, reproduced")
+    assert (tmp_path / "report" / "benchmark.md").read_text(encoding="utf-8").startswith("# Benchmark report")
+    html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
+    assert 'href="README.md"' in html and 'href="benchmark.md"' in html

@@ -1,0 +1,63 @@
+"""A mapper's extra files in the run folder, and the runner's evaluation-only judge (albot1-places)."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from albot1.data.open import open_sequence
+from albot1.records import ResultRecord, read_record
+from albot1.report.preview import render_preview
+from albot1.runs.errors import RunError
+from albot1.runs.execute import run_method
+from albot1.runs.folder import STANDARD_FILES, is_complete, write_run
+
+
+def test_extra_files_are_written_as_text_bytes_or_json(tmp_path: Path) -> None:
+    result = run_method("odometry", open_sequence("synthetic-office-startstop[:5]"))
+    result.files = {"notes.txt": "hello\n", "blob.bin": b"\x00\x01", "table.json": {"a": np.float64(1.5), "b": [1, 2]}}
+    run_dir = write_run(result, tmp_path)
+    assert (run_dir / "notes.txt").read_text() == "hello\n"
+    assert (run_dir / "blob.bin").read_bytes() == b"\x00\x01"
+    assert json.loads((run_dir / "table.json").read_text()) == {"a": 1.5, "b": [1, 2]}
+    assert is_complete(run_dir)
+
+
+@pytest.mark.parametrize("name", ["result.json", "DONE", "../escape.json", "sub/dir.json", ".hidden", ""])
+def test_an_extra_file_may_not_take_a_run_folder_name_or_leave_it(tmp_path: Path, name: str) -> None:
+    result = run_method("odometry", open_sequence("synthetic-office-startstop[:5]"))
+    result.files = {name: "x"}
+    with pytest.raises(RunError, match="extra file name"):
+        write_run(result, tmp_path)
+    assert "result.json" in STANDARD_FILES
+
+
+def test_albot1_places_run_folder_has_its_network_judged_against_the_reference(tmp_path: Path) -> None:
+    result = run_method("albot1-places", open_sequence("synthetic-places-loop[:200]"))
+    run_dir = write_run(result, tmp_path, preview=render_preview)
+    for name in ("places.json", "places.graphml", "places.png", "preview.png"):
+        assert (run_dir / name).is_file(), name
+    counters = read_record(ResultRecord, run_dir / "result.json").counters
+    # one doorway crossed (door-1-2 at scan 66): two places' visits, no re-visit to claim or miss
+    assert counters["exits_crossed"] == 1 and counters["places_created"] == 1 and counters["visits"] == 2
+    assert (counters["crossings_true"], counters["crossings_false"], counters["crossings_missed"]) == (1, 0, 0)
+    assert (counters["revisits_true"], counters["revisits_false"], counters["revisits_missed"]) == (0, 0, 0)
+    places = json.loads((run_dir / "places.json").read_text())
+    assert places["ground_truth"]["revisits"]["rooms"] == ["room-1", "room-2"]
+    assert places["crossings"][0]["scan"] == pytest.approx(66, abs=5)
+    ET.fromstring((run_dir / "places.graphml").read_text())
+    assert "places" in json.loads((run_dir / "extras.json").read_text())
+
+
+def test_without_reference_poses_there_is_no_judgement() -> None:
+    seq = open_sequence("synthetic-places-loop[:100]")
+    from albot1.data.model import Sequence
+
+    frames = [type(f)(f.index, f.scan, f.odometry, None) for f in seq]
+    result = run_method("albot1-places", Sequence.from_frames("no-reference", frames))
+    assert result.reference is None
+    assert "revisits_true" not in result.counters and "ground_truth" not in result.files["places.json"]
