@@ -14,6 +14,7 @@ import os
 import platform
 import sys
 from collections.abc import Iterable
+from pathlib import Path
 from typing import Any
 
 from albot1 import versions
@@ -41,11 +42,23 @@ def machine_info() -> dict[str, Any]:
         "memory_gb": round(psutil.virtual_memory().total / 2**30, 1),
         "platform": platform.platform(),
         "processor": platform.processor() or platform.machine(),
+        "cpu_model": cpu_model(),
         "python": sys.version.split()[0],
         "code_version": versions.code_version(),
         "git": versions.git_commit(),
         "libraries": versions.library_versions(),
     }
+
+
+def cpu_model() -> str:
+    """The CPU's model name (Linux ``/proc/cpuinfo``), else what :mod:`platform` knows; timings are tied to it."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace").splitlines():
+            if line.lower().startswith("model name") and ":" in line:
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
 
 
 def register_plugin(name: str, target: str, error_class: str | None, requires: Iterable[str] = ()) -> None:

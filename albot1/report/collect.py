@@ -144,6 +144,15 @@ METRIC_COLUMNS: dict[str, Column] = {
     "map_precision": Column("metrics", "map_shape.precision", "map precision"),
     "map_coverage": Column("metrics", "map_shape.coverage", "map coverage"),
     "updates_per_view": Column("metrics", "updates.updates_per_view", "updates/view"),
+    # albot1-places (thesis chapter 4; docs/places.md): the network's size and its re-visits judged by the runner
+    "places": Column("result", "counters.places", "places"),
+    "revisits_claimed": Column("result", "counters.revisits_confirmed", "re-visits claimed"),
+    "revisit_precision": Column("result", "counters.revisit_precision", "re-visit precision"),
+    "revisit_recall": Column("result", "counters.revisit_recall", "re-visit recall"),
+    "exit_aligned_m": Column("result", "counters.exit_prediction_aligned_true_mean_m", "exit pred. aligned (m)"),
+    "exit_not_aligned_m": Column(
+        "result", "counters.exit_prediction_not_aligned_true_mean_m", "exit pred. not aligned (m)"
+    ),
 }
 #: cost numbers: they vary from run to run and machine to machine, so they live in their own table
 COST_COLUMNS: dict[str, Column] = {

@@ -22,8 +22,11 @@ from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
+from albot1.report.standard import PAGE as STANDARD_PAGE
+from albot1.report.standard import TABLE as STANDARD_TABLE
+from albot1.report.standard import write_standard
 from albot1.report.tables import aggregate, cells_frame, write_tables
-from albot1.report.thesis.page import THESIS_SUITE, write_thesis_page
+from albot1.report.thesis.page import THESIS_SUITE, own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 
 REPORTS_ROOT = Path("reports")
@@ -168,6 +171,14 @@ def write_index(
         f"[LaTeX]({_rel(tables['cost.tex'], out)})",
         f"- [every cell, accuracy and status (CSV)]({_rel(tables['cells.csv'], out)}) · "
         f"[every cell, cost (CSV)]({_rel(tables['cells-cost.csv'], out)})",
+        *(
+            [
+                f"- [the standard benchmark: relation metric on the five Freiburg logs, published figures beside "
+                f"ours]({_rel(tables[STANDARD_PAGE], out)}) · [CSV]({_rel(tables[STANDARD_TABLE], out)})"
+            ]
+            if STANDARD_PAGE in tables
+            else []
+        ),
         "",
         "Cost numbers were measured with the suite's parallelism on a possibly shared machine; "
         "compare them within one report.",
@@ -229,9 +240,11 @@ def build_report(
     plan, records = collect(results)
     target.mkdir(parents=True, exist_ok=True)
     tables = write_tables(records, target)
+    tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
     colors = method_colors(r.cell.method_label for r in records)
-    made = render_plots(records, target, colors, map_style=map_style) if plots else {}
     thesis = plan.suite == THESIS_SUITE
+    pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default
+    made = render_plots(pictured, target, colors, map_style=map_style) if plots else {}
     index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
     page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
     cells = cells_frame(records)

@@ -13,7 +13,7 @@ import resource
 import sys
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -100,7 +100,7 @@ def run_method(
     if spec.judge is not None and reference_poses is not None:
         # Evaluation only, after the timed run: the method's own claims (e.g. re-visits) scored against the
         # reference poses, which the mapper never saw (MethodSpec.judge).
-        judge = resolve_target(spec.judge)
+        judge = cast(Callable[..., Any], resolve_target(spec.judge))
         judgement = judge(files, poses, reference_poses, seq.metadata.extra)
         counters.update(judgement.counters)
         files = judgement.files

@@ -40,6 +40,7 @@ MAX_TRACE_PANELS = 24
 #: Frames of the animation at most, and the largest GIF written (bytes): the report folder stays light.
 MAX_FRAMES = 80
 MAX_GIF_BYTES = 2_000_000
+GIF_DPI = 90
 GAP_COLOR = "#2ca02c"
 NEW_COLOR = "#d62728"
 VIEW_COLORS = {"initial": "0.3", "current": "#1f77b4", "previous": "#ff7f0e", "forced": "#9467bd"}
@@ -111,10 +112,12 @@ def pick(count: int, most: int) -> list[int]:
     return sorted({round(i * (count - 1) / (most - 1)) for i in range(most)})
 
 
-def plot_update_trace(replay: Replay, path: Path, title: str, *, max_panels: int = MAX_TRACE_PANELS) -> Path:
-    """Figure 3.17: the map after each update (at most ``max_panels``, evenly spread), new surfaces in red."""
+def plot_update_trace(replay: Replay, path: Path, title: str, *, max_panels: int | None = None) -> Path:
+    """Figure 3.17: the map after each update (at most ``max_panels``, default :data:`MAX_TRACE_PANELS`, evenly
+    spread), the surfaces each update added or changed in red."""
     from matplotlib.lines import Line2D
 
+    max_panels = MAX_TRACE_PANELS if max_panels is None else max_panels
     plt = pyplot()
     transform = frame_transform(replay.run)
     extent = _extent(replay, transform)
@@ -170,8 +173,9 @@ def plot_trace_strip(replay: Replay, path: Path, title: str) -> Path:
     return save(fig, path)
 
 
-def animate_map(replay: Replay, path: Path, title: str, *, max_frames: int = MAX_FRAMES, fps: int = 5) -> Path:
-    """A GIF of the map after each update along the route (at most ``max_frames`` frames, under 2 MB).
+def animate_map(replay: Replay, path: Path, title: str, *, max_frames: int | None = None, fps: int = 5) -> Path:
+    """A GIF of the map after each update along the route (at most ``max_frames`` frames, default
+    :data:`MAX_FRAMES`; under :data:`MAX_GIF_BYTES`).
 
     Rendered with matplotlib's Pillow writer (no ffmpeg). When the file is
     larger than :data:`MAX_GIF_BYTES` the frames are halved and it is drawn again.
@@ -181,12 +185,12 @@ def animate_map(replay: Replay, path: Path, title: str, *, max_frames: int = MAX
     plt = pyplot()
     transform = frame_transform(replay.run)
     extent = _extent(replay, transform)
-    frames = max_frames
+    frames = MAX_FRAMES if max_frames is None else max_frames
     while True:
         shown = pick(len(replay.states), max(2, frames))
         aspect = extent.aspect
         width = 4.8 if aspect >= 1 else max(2.6, 4.2 * aspect)
-        fig, ax = plt.subplots(figsize=(width, width / aspect + 0.5), dpi=72, layout="constrained")
+        fig, ax = plt.subplots(figsize=(width, width / aspect + 0.5), dpi=GIF_DPI, layout="constrained")
 
         def draw(i: int, shown: list[int] = shown, ax: Any = ax) -> list[Any]:
             ax.clear()

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from albot1.errors import Albot1Error
-from albot1.methods.baselines.published import published_systems
 from albot1.report.collect import CellRecord
 from albot1.report.errors import ReportError
 from albot1.report.html import rel
@@ -26,16 +25,28 @@ from albot1.report.places_plot import render_places
 from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.thesis.claims import READINGS
 from albot1.report.thesis.evidence import COMPANION_SUITES, Evidence, open_stores
-from albot1.report.thesis.experiments import LOOP_GAP, ClaimRow, FigureRequest, Section, all_sections
+from albot1.report.thesis.experiments import LOOP_GAP, ClaimRow, FigureRequest, Section, all_sections, stand_ins
 from albot1.report.thesis.figures import animate_map, plot_gap_maps, plot_trace_strip, plot_update_trace
 from albot1.report.thesis.replay import Replay, replay_run
-from albot1.report.thesis.verdicts import Verdict
+from albot1.report.thesis.verdicts import FAILS, HOLDS, NOT_COMPARABLE, Verdict
 from albot1.runs.folder import read_run
 
 PAGE = "README.md"
 FIGURES = "figures"
 #: The suite whose report gets this page.
 THESIS_SUITE = "thesis"
+#: The methods the thesis suite runs on the default suite's datasets only to pair them with its runs there.
+PAIRED_VARIANTS = frozenset({"albot1:literal", "albot1:plus"})
+
+
+def own_records(records: list[CellRecord]) -> list[CellRecord]:
+    """The cells of the thesis's own experiments: datasets where more than the paired variants run.
+
+    The benchmark report of the thesis suite draws its per-dataset plots for these only; the public logs'
+    plots, with every method, are in the default suite's report.
+    """
+    own = {r.cell.dataset_label for r in records if r.cell.method_label not in PAIRED_VARIANTS}
+    return [r for r in records if r.cell.dataset_label in own]
 
 
 @dataclass(frozen=True)
@@ -150,43 +161,49 @@ class _Figures:
         return [Drawn(request.caption, path)]
 
 
-def published_notes() -> list[str]:
-    """One line per published-only system (DP-SLAM): why it is not run, and its published figures, labelled."""
-    lines = []
-    for system in published_systems():
-        figures = (
-            "; ".join(f"{f.log} {f.metric} {f.mean:g} (published, {f.source})" for f in system.figures)
-            or "no verifiable published figure on these logs"
-        )
-        lines.append(f"{system.label} is not run here: {system.implementation} Published: {figures}.")
-    return lines
-
-
 # --------------------------------------------------------------------------- Markdown
 
 
-def _verdict_cell(verdict: Verdict, *, brief: bool = False) -> str:
-    text = f"**{verdict.word}**" if brief else f"**{verdict.word}**: {verdict.reason}"
-    return text.replace("|", "\\|").replace("\n", " ")
+def _verdict_cell(verdict: Verdict) -> str:
+    return f"**{verdict.word}**: {verdict.reason}".replace("|", "\\|").replace("\n", " ")
 
 
-def _claim_cells(row: ClaimRow, columns: dict[str, str], *, brief: bool = False) -> list[str]:
+def _claim_cells(row: ClaimRow, columns: dict[str, str]) -> list[str]:
     if "" in row.verdicts:  # one verdict for every variant: a check of the stand-in, not of Albot1
-        first = _verdict_cell(row.verdicts[""], brief=brief)
-        return [first] + ["(setup check: same for every variant)"] * (len(columns) - 1)
-    return [_verdict_cell(row.verdicts[c], brief=brief) if c in row.verdicts else "–" for c in columns]
+        return [_verdict_cell(row.verdicts[""])] + ["(setup check: same for every variant)"] * (len(columns) - 1)
+    return [_verdict_cell(row.verdicts[c]) if c in row.verdicts else "–" for c in columns]
+
+
+def _tally(verdicts: list[Verdict]) -> str:
+    """``**holds**`` for one verdict; ``holds 12, does not hold 3 (of 15)`` for a claim tested on many datasets."""
+    if len(verdicts) == 1:
+        return f"**{verdicts[0].word}**"
+    counts: dict[str, int] = {}
+    for verdict in verdicts:
+        counts[verdict.word] = counts.get(verdict.word, 0) + 1
+    parts = [f"{word} {counts[word]}" for word in (HOLDS, FAILS, NOT_COMPARABLE) if word in counts]
+    return f"{', '.join(parts)} (of {len(verdicts)} datasets)"
 
 
 def _summary(sections: list[Section]) -> list[str]:
+    """One row per claim of each experiment; a claim tested on several datasets counts its verdicts."""
     lines = [
         "| experiment | claim | thesis | literal reading | thesis preset | Albot1+ |",
         "|---|---|---|---|---|---|",
     ]
     for section in sections:
+        claims: dict[str, list[ClaimRow]] = {}
         for row in section.claims:
-            cells = _claim_cells(row, section.columns, brief=True)
+            claims.setdefault(row.claim, []).append(row)
+        for claim, rows in claims.items():
+            text = rows[0].text if len(rows) == 1 else f"{claim} (on each dataset)"
+            if all("" in row.verdicts for row in rows):
+                cells = [_tally([row.verdicts[""] for row in rows])]
+                cells += ["(setup check: same for every variant)"] * (len(section.columns) - 1)
+            else:
+                cells = [_tally([row.verdicts[c] for row in rows if c in row.verdicts]) for c in section.columns]
             lines.append(
-                f"| [{section.title.split(':')[0]}](#{section.anchor}) | {row.claim} | {row.thesis} | "
+                f"| [{section.title.split(':')[0]}](#{section.anchor}) | {text} | {rows[0].thesis} | "
                 + " | ".join(cells)
                 + " |"
             )
@@ -219,7 +236,7 @@ def _section_lines(section: Section, drawn: dict[str, list[Drawn]], out: Path) -
             "|---|---|" + "---|" * len(heads),
         ]
         for row in section.claims:
-            lines.append(f"| {row.claim} | {row.thesis} | " + " | ".join(_claim_cells(row, section.columns)) + " |")
+            lines.append(f"| {row.text} | {row.thesis} | " + " | ".join(_claim_cells(row, section.columns)) + " |")
         lines.append("")
     for note in section.notes:
         lines += [f"- {note}"]
@@ -305,39 +322,6 @@ def _parameters(ev: Evidence, sections: list[Section], out: Path) -> list[str]:
     return [*lines, ""]
 
 
-def _stand_ins() -> list[str]:
-    return [
-        "## What stands in for the thesis's data",
-        "",
-        "The thesis's own logs (its Pioneer 3-DX in the AUT office, Figures 3.3, 3.20, 3.23, 4.1, 4.4) are not "
-        "available. These stand in for them:",
-        "",
-        "| thesis | stand-in | why |",
-        "|---|---|---|",
-        "| Experiments 1-2: six start-stop routes through the office; four stops measured on the floor plan "
-        "(3.2.1-3.2.2) | the square and office worlds of this suite; every public log of the default suite "
-        "(reference poses from the SLAM-corrected logs) | exact ground truth on the worlds; real sensors on the "
-        "logs |",
-        "| Experiment 3: a square-like route of about 100 m, 106 views, odometry gap 4.6 m (3.2.3) | "
-        "`synthetic-square-startstop`: 96 m, 106 views, odometry gap 4.61 m | the same route shape and odometry "
-        "drift, so the gaps compare like for like |",
-        "| Experiments 4-5: a 136 m route as 1330 views (10 cm / 1 deg) and 217 views (1 m / 10 deg) (3.2.4-3.2.5) "
-        "| `synthetic-office-loop` (79 m, 1871 views) and `synthetic-office-loop?views=1:10` (171 views) | one "
-        "route at both spacings, as in the thesis |",
-        "| Experiment 5's SLAM systems: DP-SLAM, CARMEN's mapper, GMapping, gridSLAM | `mrpt-rbpf` (RBPF, the "
-        "GMapping/gridSLAM family), `mrpt-icp` (scan matching, as CARMEN's mapper), `kiss-icp`, `gtsam-graph`; "
-        "DP-SLAM has no implementation (published figures only) | the field's maintained implementations |",
-        "| Experiment 6: an unnamed public log with odometry and laser (3.2.6) | the public logs with "
-        "ground-truth relations (Radish: aces, intel, fr079, fr-clinic, mit-killian, ...) | the standard "
-        "benchmark of the SLAM community |",
-        "| Chapter 4: a 90 m loop through six places from three starts, a 150 m double loop, the loop repeated "
-        "(4.2.1-4.2.3) | the six-room worlds: `synthetic-places-loop` (from S, A, B), "
-        "`synthetic-places-double-loop`, `synthetic-places-loop?laps=2` | room labels give the true re-visits "
-        "and doorways the true exits |",
-        "",
-    ]
-
-
 def write_thesis_page(
     results_dir: Path,
     out: Path,
@@ -348,8 +332,7 @@ def write_thesis_page(
 ) -> Path:
     """Write ``out/README.md`` for the thesis suite's ``results_dir`` (figures under ``out/figures``)."""
     ev = open_stores(results_dir, companions)
-    published = published_notes()
-    sections = all_sections(ev, published)
+    sections = all_sections(ev)
     labels = [r.cell.method_label for s in ev.stores for r in s.records]
     drawn: dict[str, list[Drawn]] = {}
     if plots:
@@ -382,7 +365,7 @@ def write_thesis_page(
             "[index.html](index.html).",
             "",
         ]
-    lines += ["## Verdicts at a glance", "", *_summary(sections), "", *_stand_ins()]
+    lines += ["## Verdicts at a glance", "", *_summary(sections), "", *stand_ins(ev)]
     for section in sections:
         lines += _section_lines(section, drawn, out)
     lines += _parameters(ev, sections, out)

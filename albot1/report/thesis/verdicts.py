@@ -161,19 +161,6 @@ def lower_than(ours: Number, theirs: Number, *, thesis: str | None = None) -> Ve
     )
 
 
-def higher_than(ours: Number, theirs: Number, *, thesis: str | None = None) -> Verdict:
-    """Holds when ``ours`` is strictly higher than ``theirs`` (a map precision)."""
-    absent = _missing(ours, theirs)
-    if absent is not None:
-        return absent
-    a, b = float(ours.value), float(theirs.value)  # type: ignore[arg-type]
-    ok = a > b
-    return Verdict(
-        HOLDS if ok else FAILS,
-        f"{ours.label} {ours.text()} {'>' if ok else '<='} {theirs.label} {theirs.text()}{_thesis(thesis)}",
-    )
-
-
 def all_of(verdicts: Sequence[Verdict]) -> Verdict:
     """One verdict for a claim with several parts, all of which must hold.
 

@@ -37,7 +37,7 @@ def test_run_json_summary_is_what_result_json_says(tmp_path: Path) -> None:
     assert summary == {
         "run_dir": summary["run_dir"],
         "method": "odometry",
-        "dataset": "synthetic-corridor",
+        "dataset": "synthetic-corridor[:30]",  # --limit N is the prefix NAME[:N] (issue 15: part of the run key)
         "preset": "default",
         "degradation": "none",
         "seed": 0,
@@ -48,7 +48,7 @@ def test_run_json_summary_is_what_result_json_says(tmp_path: Path) -> None:
     }
     parse_record(Timing, summary["timing"], "stdout")
     line = invoke("run", "odometry", "synthetic-corridor", "--limit", "30", "--out", str(tmp_path)).strip()
-    assert line.startswith("odometry on synthetic-corridor: 30 scans, 30 updates, ")
+    assert line.startswith("odometry on synthetic-corridor[:30]: 30 scans, 30 updates, ")
     assert line.endswith(f" ms/scan median -> {summary['run_dir']}")
 
 

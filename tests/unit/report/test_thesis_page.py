@@ -14,17 +14,18 @@ from pathlib import Path
 
 import pytest
 
+from albot1.bench.cells import execute_cell
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
 from albot1.bench.suite import parse_suite
 from albot1.report.index import build_report
+from albot1.report.thesis import figures
 from albot1.report.thesis.evidence import open_stores
 from albot1.report.thesis.experiments import SQUARE, section_error_tolerance, section_places, section_spacing
 from albot1.report.thesis.figures import MAX_GIF_BYTES
 from albot1.report.thesis.page import write_thesis_page
 from albot1.report.thesis.verdicts import HOLDS, NOT_COMPARABLE
 from albot1.settings import get_settings
-from albot1.bench.cells import execute_cell
 
 LINK = re.compile(r"\]\(([^)#\s]+)\)")
 FAILED_METHOD = "albot1:plus"
@@ -66,7 +67,10 @@ def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def page(results: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_thesis_page(results, tmp_path_factory.mktemp("report"))
+    with pytest.MonkeyPatch.context() as patch:  # fewer panels and frames: the same code, drawn faster
+        patch.setattr(figures, "MAX_TRACE_PANELS", 4)
+        patch.setattr(figures, "MAX_FRAMES", 6)
+        return write_thesis_page(results, tmp_path_factory.mktemp("report"))
 
 
 def test_experiment_3_verdicts_are_computed_from_the_stored_loop_gaps(results: Path) -> None:
@@ -91,7 +95,7 @@ def test_experiment_3_verdicts_are_computed_from_the_stored_loop_gaps(results: P
 def test_experiments_without_runs_are_not_comparable_with_the_reason(results: Path) -> None:
     ev = open_stores(results)
     assert any("results" in note and "default" in note for note in ev.notes)  # no companion store: said so
-    spacing = section_spacing(ev, [])
+    spacing = section_spacing(ev)
     for row in spacing.claims:
         for verdict in row.verdicts.values():
             assert verdict.word == NOT_COMPARABLE

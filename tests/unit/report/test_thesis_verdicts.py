@@ -18,7 +18,6 @@ from albot1.report.thesis.verdicts import (
     at_most,
     close_to,
     equals,
-    higher_than,
     lower_than,
     quantity,
     ratio_at_least,
@@ -34,7 +33,9 @@ def test_loop_gap_ratio_either_side_of_the_reading() -> None:
     odometry = m("odometry", 5.1)
     holds = ratio_at_least(m("albot1 loop gap", 0.6), odometry, ratio, thesis="0.4 m vs 4.6 m, 11.5x")
     assert holds.word == HOLDS
-    assert holds.reason == "albot1 loop gap 0.600 m vs odometry 5.10 m (8.50x, at least 2x; thesis 0.4 m vs 4.6 m, 11.5x)"
+    assert (
+        holds.reason == "albot1 loop gap 0.600 m vs odometry 5.10 m (8.50x, at least 2x; thesis 0.4 m vs 4.6 m, 11.5x)"
+    )
     assert ratio_at_least(m("albot1", 5.1 / ratio), odometry, ratio).word == HOLDS  # exactly at the threshold
     fails = ratio_at_least(m("albot1", 5.1 / ratio + 0.01), odometry, ratio)
     assert fails.word == FAILS
@@ -55,7 +56,7 @@ def test_a_missing_number_is_not_comparable_with_its_own_reason() -> None:
         equals(missing, 6.0),
         close_to(missing, 4.6, 0.25),
         lower_than(missing, m("odometry", 1.0)),
-        higher_than(m("a", 1.0), missing),
+        lower_than(m("a", 1.0), missing),
     ):
         assert verdict.word == NOT_COMPARABLE
         assert "failed in results/thesis" in verdict.reason
@@ -70,11 +71,18 @@ def test_at_most(value: float, strict: bool, word: str) -> None:
     assert at_most(Number("updates/view", value), bound, strict=strict).word == word
 
 
+@pytest.mark.parametrize(("median_m", "word"), [(0.4, HOLDS), (1.0, HOLDS), (1.01, FAILS)])
+def test_shape_kept_reading(median_m: float, word: str) -> None:
+    verdict = at_most(m("albot1 median map-to-wall", median_m), READINGS["shape_median_m"].value)
+    assert verdict.word == word
+    assert verdict.reason.startswith(f"albot1 median map-to-wall {median_m:.3g}")
+
+
 @pytest.mark.parametrize(
     ("value", "strict", "word"), [(0.49, False, FAILS), (0.5, False, HOLDS), (0.0, True, FAILS), (0.1, True, HOLDS)]
 )
 def test_at_least(value: float, strict: bool, word: str) -> None:
-    bound = 0.0 if strict else READINGS["shape_precision"].value
+    bound = 0.0 if strict else 0.5
     verdict = at_least(Number("map precision", value), bound, strict=strict)
     assert verdict.word == word
 
@@ -116,8 +124,7 @@ def test_setup_reproduction_within_the_tolerance() -> None:
 def test_comparisons_and_counts() -> None:
     assert lower_than(m("albot1 relation error", 0.3), m("odometry", 0.55)).word == HOLDS
     assert lower_than(m("albot1 relation error", 0.55), m("odometry", 0.55)).word == FAILS
-    assert higher_than(Number("albot1 precision", 0.8), Number("mrpt-rbpf", 0.4)).word == HOLDS
-    assert higher_than(Number("albot1 precision", 0.4), Number("mrpt-rbpf", 0.4)).word == FAILS
+    assert lower_than(m("albot1 median map-to-wall", 0.3), m("mrpt-rbpf", 1.4)).word == HOLDS
     places = THESIS["places_single_loop"].value
     assert equals(Number("places", 6.0, "places"), places).word == HOLDS
     assert equals(Number("places", 7.0, "places"), places).reason == "places 7 places != 6 places"

@@ -1,4 +1,4 @@
-"""The map-update, grid-index and Albot1+ pose kernels to run: jitted with numba or as written, in one typed set.
+"""The map-update and Albot1+ pose kernels to run: jitted with numba or as written, in one typed set.
 
 Acceleration never changes results: both variants run the same source
 (:mod:`albot1.methods.albot1.jit`). A set is built once per process and flag;
@@ -24,7 +24,10 @@ class MappingKernels(NamedTuple):
     classify_endpoints: Callable[[FloatArray, FloatArray, FloatArray, float, bool], BoolArray]
     best_correspondence: Callable[[FloatArray, FloatArray, BoolArray, float, float], int]
     clip_parameter: Callable[[FloatArray, FloatArray, float, float, float, float, float, bool], float]
-    segment_cells: Callable[[FloatArray, float], tuple[IntArray, IntArray, IntArray]]
+    resolve_partial: Callable[
+        [FloatArray, BoolArray, FloatArray, BoolArray, FloatArray, float, float, bool, float, bool],
+        tuple[IntArray, FloatArray, IntArray],
+    ]
     refine_pose: Callable[..., tuple[float, float, float, FloatArray]]
 
 
@@ -37,7 +40,7 @@ def mapping_kernels(accelerate: bool = True) -> MappingKernels:
             kernels.classify_endpoints,
             kernels.best_correspondence,
             kernels.clip_parameter,
-            kernels.segment_cells,
+            kernels.resolve_partial,
             pose_kernels.refine_pose,
         ),
     )
@@ -46,6 +49,6 @@ def mapping_kernels(accelerate: bool = True) -> MappingKernels:
         jit(kernels.classify_endpoints),
         jit(kernels.best_correspondence),
         jit(kernels.clip_parameter),
-        jit(kernels.segment_cells),
+        jit(kernels.resolve_partial),
         jit(pose_kernels.refine_pose),
     )

@@ -213,7 +213,6 @@ class Albot1Config(BaseModel):
         1e-6, ge=0, description="a step shorter than this and turning less than stationary_deg is stationary"
     )
     stationary_deg: float = Field(1e-6, ge=0, description="see stationary_m")
-    map_grid_cell_m: float = Field(2.0, gt=0, description="cell of the map's spatial grid index (speed only)")
     accelerate: bool = Field(True, description="run the per-scan kernels with numba (results are identical)")
 
     def view_params(self) -> ViewParams:

@@ -124,34 +124,91 @@ def clip_parameter(
     return lo
 
 
-def segment_cells(segs: FloatArray, inv_cell: float) -> tuple[IntArray, IntArray, IntArray]:
-    """Grid cells each segment passes through: ``(row, i, j)`` arrays, rows ascending.
+#: Actions of :func:`resolve_partial` on a map surface with one end inside the view.
+KEEP = 0
+EXTENDED = 1
+TRIMMED = 2
+DELETED = 3
 
-    Samples every half cell along the segment (so every cell it crosses by
-    more than a corner is hit; queries pad by one cell) and drops repeats;
-    along a straight segment the cells visited are contiguous, so comparing
-    with the previous sample suffices.
+
+def resolve_partial(
+    segs: FloatArray,
+    p1_inside: BoolArray,
+    view: FloatArray,
+    taken: BoolArray,
+    poly: FloatArray,
+    max_angle: float,
+    max_distance: float,
+    clip: bool,
+    margin: float,
+    surfaces_only: bool,
+) -> tuple[IntArray, FloatArray, IntArray]:
+    """Algorithm 3 lines 11-12 for every map surface with exactly one end inside the view, in order.
+
+    For surface ``r`` (``segs[r]``, its P1 inside when ``p1_inside[r]``):
+    the corresponding view surface is :func:`best_correspondence` among
+    those not ``taken`` yet (it is then taken); the surface runs from its
+    outside end to the far end of that view surface (seen from the outside
+    end). Without one it is cut where it enters the covered region
+    (:func:`clip_parameter`) when ``clip``, else kept. Returns per surface
+    the action (:data:`KEEP`, :data:`EXTENDED` when longer, :data:`TRIMMED`
+    when not, :data:`DELETED` when nothing is left), the new endpoints and
+    the view surface it took (-1 if none). ``taken`` is not modified.
     """
-    total = 0
-    m = segs.shape[0]
-    counts = np.empty(m, dtype=np.int64)
-    for r in range(m):
-        counts[r] = int(np.hypot(segs[r, 2] - segs[r, 0], segs[r, 3] - segs[r, 1]) * 2.0 * inv_cell) + 2
-        total += counts[r]
-    rows = np.empty(total, dtype=np.int64)
-    ci = np.empty(total, dtype=np.int64)
-    cj = np.empty(total, dtype=np.int64)
-    k = 0
-    for r in range(m):
-        n = counts[r]
-        for q in range(n):
-            t = q / (n - 1)
-            i = math.floor((segs[r, 0] + t * (segs[r, 2] - segs[r, 0])) * inv_cell)
-            j = math.floor((segs[r, 1] + t * (segs[r, 3] - segs[r, 1])) * inv_cell)
-            if q > 0 and ci[k - 1] == i and cj[k - 1] == j:
-                continue
-            rows[k] = r
-            ci[k] = i
-            cj[k] = j
-            k += 1
-    return rows[:k], ci[:k], cj[:k]
+    k = segs.shape[0]
+    action = np.zeros(k, dtype=np.int64)
+    new = np.empty((k, 4))
+    match = np.full(k, -1, dtype=np.int64)
+    used = taken.copy()
+    for r in range(k):
+        seg = segs[r]
+        if p1_inside[r]:
+            ox = seg[2]
+            oy = seg[3]
+            ix = seg[0]
+            iy = seg[1]
+        else:
+            ox = seg[0]
+            oy = seg[1]
+            ix = seg[2]
+            iy = seg[3]
+        best = best_correspondence(seg, view, used, max_angle, max_distance)
+        if best >= 0:
+            v = view[best]
+            if np.hypot(v[0] - ox, v[1] - oy) >= np.hypot(v[2] - ox, v[3] - oy):
+                fx = v[0]
+                fy = v[1]
+            else:
+                fx = v[2]
+                fy = v[3]
+            used[best] = True
+            match[r] = best
+        elif clip:
+            t = clip_parameter(poly, view, ox, oy, ix, iy, margin, surfaces_only)
+            fx = ox + t * (ix - ox)
+            fy = oy + t * (iy - oy)
+        else:
+            action[r] = KEEP
+            new[r, 0] = seg[0]
+            new[r, 1] = seg[1]
+            new[r, 2] = seg[2]
+            new[r, 3] = seg[3]
+            continue
+        if p1_inside[r]:
+            new[r, 0] = fx
+            new[r, 1] = fy
+            new[r, 2] = ox
+            new[r, 3] = oy
+        else:
+            new[r, 0] = ox
+            new[r, 1] = oy
+            new[r, 2] = fx
+            new[r, 3] = fy
+        new_len = np.hypot(new[r, 2] - new[r, 0], new[r, 3] - new[r, 1])
+        if new_len <= 1e-9:
+            action[r] = DELETED
+        elif new_len > np.hypot(seg[2] - seg[0], seg[3] - seg[1]):
+            action[r] = EXTENDED
+        else:
+            action[r] = TRIMMED
+    return action, new, match

@@ -35,7 +35,7 @@ from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
-from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.accel import perception_kernels
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
@@ -119,7 +119,7 @@ class Albot1Mapper:
         self._rec_angle = math.radians(config.recognition_angle_deg)
         self._angle_floor = math.radians(config.goodness_angle_floor_deg)
         self._stationary_rad = math.radians(config.stationary_deg)
-        self.map = PerceptualMap(config.map_grid_cell_m, self._mk)
+        self.map = PerceptualMap()
         self._landmark_map: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._poses: list[Pose] = []
         self._prev: _Step | None = None
@@ -295,13 +295,9 @@ class Albot1Mapper:
         """
         assert self._plus is not None
         loc = self._localise(rl)
-        odometry = compose_pose(prev_pose, step)
-        # Starts: the thesis's pose, every landmark's candidate pose, and the odometry step.
-        if loc is None:
-            turns = np.radians(np.array([0.0, -3.0, 3.0, -6.0, 6.0, -10.0, 10.0, -15.0, 15.0, -20.0, 20.0, -30.0, 30.0]))
-            starts = np.column_stack([np.full(len(turns), odometry[0]), np.full(len(turns), odometry[1]), odometry[2] + turns])
-        else:
-            starts = np.vstack([np.asarray([loc.pose, odometry], dtype=float), loc.candidates])
+        starts = start_poses(
+            compose_pose(prev_pose, step), None if loc is None else loc.pose, None if loc is None else loc.candidates
+        )
         rows: list[int] = []
         maps: list[np.ndarray] = []
         map_kinds: list[np.ndarray] = []
@@ -315,7 +311,7 @@ class Albot1Mapper:
         lm_map = np.ascontiguousarray(np.asarray(maps, dtype=float).reshape(-1, 4))
         kinds = (rl.kinds[rows].reshape(-1, 2), np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2))
         since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
-        return self._plus.pose(np.ascontiguousarray(starts), lm_view, lm_map, kinds, self._points, since), loc
+        return self._plus.pose(starts, lm_view, lm_map, kinds, self._points, since), loc
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
         """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md).

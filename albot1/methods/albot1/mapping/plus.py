@@ -47,17 +47,11 @@ FloatArray = NDArray[np.float64]
 
 #: The odometry learner's fixed choices (``docs/albot1-mapper.md``, "Albot1+"): a view teaches it only when its
 #: measurement alone fixes the position to better than 5 cm and the heading to better than 0.05 rad (information
-#: above 400 per m^2 / per rad^2) after at least 5 cm of motion since the update...
+#: above 400 per m^2 and per rad^2) after at least 5 cm of motion since the update.
 LEARN_MIN_INFO = 400.0
 LEARN_MIN_MOTION_M = 0.05
-#: ... one disagreement counts at most this many times its expected square (robust to a mis-association) ...
-LEARN_CLIP = 9.0
-#: ... the first views are averaged equally, as if this many had already agreed with the starting values ...
-LEARN_PRIOR_COUNT = 5
-#: ... and the measurement's own variance is never believed smaller than the one its weights imply; it starts at
-#: four times that (a view's errors are correlated, so its weights overstate what it knows).
-MEASUREMENT_SCALE_MIN = 1.0
-MEASUREMENT_SCALE_START = 4.0
+#: The median of a chi-square variable with one degree of freedom, in units of its mean.
+CHI2_1_MEDIAN = 0.45493642
 #: Variance floors of the prior (m^2, rad^2): odometry is never trusted below 1 cm and 1 mrad.
 PRIOR_FLOOR = (1e-4, 1e-6)
 
@@ -84,68 +78,60 @@ class PlusParams:
 class OdometryNoise:
     """How far the odometry since the last update can be trusted, learnt from the views (``adaptive`` prior).
 
-    At every view whose measurement fixes the pose well on its own, the
-    squared disagreement ``nu^2`` between the measured pose and the
-    odometry's prediction is modelled, per group (position, heading), as
-
-        E[nu^2] = kappa * v_meas + q * s
-
-    where ``v_meas`` is the variance the measurement's weights imply
-    (from its information matrix), ``kappa`` corrects it (weights are
-    rarely exact), ``s`` is the motion since the update (metres, turns
-    counted ``m_per_rad`` per radian) and ``q`` the odometry's variance per
-    unit of motion. Measurement errors do not grow with ``s``, odometry
-    errors do, so the two are separable: ``kappa`` and ``q`` are the
-    weighted least-squares fit of this line to the views seen so far
-    (exponentially forgetting at ``learning_rate``), each sample weighted by
-    its inverse expected variance squared and clipped at
-    :data:`LEARN_CLIP` times it. Starting values: ``kappa`` =
-    :data:`MEASUREMENT_SCALE_START` and ``q`` from the fixed-prior fields.
+    Modelled as a random walk: the odometry's prediction after motion ``s``
+    since the update (metres, a turn counting ``m_per_rad`` per radian) is
+    off by a zero-mean error of variance ``q * s`` per position axis and in
+    heading. At every view whose measurement fixes the pose well on its own,
+    the disagreement ``nu`` between the measured and predicted pose gives a
+    sample ``nu^2 / s`` of ``q`` times a chi-square(1) variable; ``q``
+    tracks the running *median* of these samples (divided by the
+    chi-square(1) median), by multiplicative steps of ``exp(+-2 *
+    learning_rate)`` up or down. The median, unlike a mean, is not moved by
+    the occasional mismatched view. ``nu`` also holds the measurement's own
+    error, so ``q`` errs on the side of distrusting the odometry: with
+    perfect odometry it settles at the measurement's error and the two are
+    weighted about equally. Starting values: the fixed-prior fields.
     """
 
     def __init__(self, params: PlusParams) -> None:
         self.params = params
-        self.kappa = [MEASUREMENT_SCALE_START, MEASUREMENT_SCALE_START]
         self.q = [params.xy_per_sqrt_m**2, params.rad_per_sqrt_m**2]
-        self._normal = [np.zeros((2, 2)), np.zeros((2, 2))]
-        self._rhs = [np.zeros(2), np.zeros(2)]
         self.samples = 0
 
-    def learn_median(self, nu2: tuple[float, float], motion: float) -> None:
-        """EXPERIMENT: track the median of nu^2 / motion (a chi-square(1) median is 0.455 of its mean)."""
+    def learn(self, nu2_xy: float, nu2_phi: float, motion: float) -> None:
+        """One view's squared disagreement (per position axis, m^2; heading, rad^2) after ``motion``."""
         self.samples += 1
-        for g in range(2):
-            x = nu2[g] / motion
-            step = self.params.learning_rate * 2.0
-            if x > 0.455 * self.q[g]:
-                self.q[g] *= math.exp(step)
-            else:
-                self.q[g] *= math.exp(-step)
-        self.kappa = [1.0, 1.0]
-
-    def learn(self, nu2: tuple[float, float], v_meas: tuple[float, float], motion: float) -> None:
-        """One view's squared disagreement ``nu2`` and implied measurement variance ``v_meas``, per group."""
-        self.samples += 1
-        rate = max(self.params.learning_rate, 1.0 / (self.samples + LEARN_PRIOR_COUNT))
-        for g in range(2):
-            expected = self.kappa[g] * v_meas[g] + self.q[g] * motion + PRIOR_FLOOR[g]
-            sample = min(nu2[g], LEARN_CLIP * expected)
-            weight = 1.0 / (expected * expected)
-            row = np.array([v_meas[g], motion])
-            self._normal[g] = (1.0 - rate) * self._normal[g] + rate * weight * np.outer(row, row)
-            self._rhs[g] = (1.0 - rate) * self._rhs[g] + rate * weight * sample * row
-            normal = self._normal[g]
-            det = normal[0, 0] * normal[1, 1] - normal[0, 1] * normal[1, 0]
-            if det <= 1e-12 * (normal[0, 0] * normal[1, 1] + 1e-300):
-                continue  # every sample so far had the same mix of measurement and motion: not separable yet
-            kappa = (self._rhs[g][0] * normal[1, 1] - self._rhs[g][1] * normal[0, 1]) / det
-            q = (self._rhs[g][1] * normal[0, 0] - self._rhs[g][0] * normal[1, 0]) / det
-            self.kappa[g] = max(MEASUREMENT_SCALE_MIN, float(kappa))
-            self.q[g] = max(0.0, float(q))
+        step = 2.0 * self.params.learning_rate
+        for g, nu2 in ((0, nu2_xy), (1, nu2_phi)):
+            up = nu2 / motion > CHI2_1_MEDIAN * self.q[g]
+            self.q[g] = max(self.q[g] * math.exp(step if up else -step), 1e-12)
 
     def prior_variance(self, motion: float) -> tuple[float, float]:
         """Variance (m^2 per axis, rad^2) of the odometry's prediction after ``motion`` since the update."""
         return (PRIOR_FLOOR[0] + self.q[0] * motion, PRIOR_FLOOR[1] + self.q[1] * motion)
+
+
+#: Heading offsets (deg) tried around the odometry when no landmark places the robot: a raw odometry step can be
+#: off by tens of degrees on a turn, beyond the reach of the scan refinement's nearest-surface matching.
+ODOMETRY_TURNS_DEG = (0.0, -3.0, 3.0, -6.0, 6.0, -10.0, 10.0, -15.0, 15.0, -20.0, 20.0, -30.0, 30.0)
+
+
+def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | None) -> FloatArray:
+    """The poses the solver starts from (it keeps the cheapest): ``(c, 3)``, contiguous.
+
+    With a thesis localisation: its pose, the odometry step and every
+    landmark's candidate pose (one mismatched landmark cannot then decide
+    alone). Without: the odometry step turned by each of
+    :data:`ODOMETRY_TURNS_DEG`.
+    """
+    if thesis is None or candidates is None:
+        turns = np.radians(np.asarray(ODOMETRY_TURNS_DEG))
+        starts = np.column_stack(
+            [np.full(turns.size, odometry[0]), np.full(turns.size, odometry[1]), odometry[2] + turns]
+        )
+    else:
+        starts = np.vstack([np.asarray([thesis, odometry], dtype=float), np.asarray(candidates, dtype=float)])
+    return np.ascontiguousarray(starts)
 
 
 class PlusLocaliser:
@@ -239,23 +225,40 @@ class PlusLocaliser:
         return (x, y, phi), info
 
     def _fuse(self, measured: Pose, info: FloatArray, predicted: Pose, motion: float) -> Pose:
-        """Learn from this view, then combine the measured and predicted poses by their information."""
+        """Learn from this view, then combine the measured and predicted poses by their information.
+
+        The measurement's information is the solver's (``info``, 3x3), the
+        prediction's the inverse of :meth:`OdometryNoise.prior_variance`
+        (diagonal): the combination is ``(I_m + I_p)^-1 (I_m m + I_p p)``,
+        written out for 3x3 symmetric matrices (numpy's per-call overhead
+        would cost more than the arithmetic).
+        """
         noise = self.noise
-        cov = np.linalg.pinv(info + np.eye(3) * 1e-9)
-        v_meas = (0.5 * (cov[0, 0] + cov[1, 1]), cov[2, 2])
+        h00, h01, h02 = float(info[0, 0]), float(info[0, 1]), float(info[0, 2])
+        h11, h12, h22 = float(info[1, 1]), float(info[1, 2]), float(info[2, 2])
         d_phi = wrap_angle(measured[2] - predicted[2])
-        nu2 = (0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2), d_phi * d_phi)
-        well_fixed = np.linalg.eigvalsh(info[:2, :2])[0] > LEARN_MIN_INFO and info[2, 2] > LEARN_MIN_INFO
-        if well_fixed and motion > LEARN_MIN_MOTION_M:
-            if self.params.m_per_rad < 0.99:
-                noise.learn_median(nu2, motion)
-            else:
-                noise.learn(nu2, v_meas, motion)
-        scale = np.sqrt(np.array([noise.kappa[0], noise.kappa[0], noise.kappa[1]]))
-        info_meas = info / np.outer(scale, scale)
+        # The smaller eigenvalue of the position block: how well the worst-fixed direction is known.
+        half_trace = 0.5 * (h00 + h11)
+        min_xy = half_trace - math.sqrt(max(0.0, half_trace * half_trace - (h00 * h11 - h01 * h01)))
+        if min_xy > LEARN_MIN_INFO and h22 > LEARN_MIN_INFO and motion > LEARN_MIN_MOTION_M:
+            nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
+            noise.learn(nu2_xy, d_phi * d_phi, motion)
         v_xy, v_phi = noise.prior_variance(motion)
-        info_prior = np.diag([1.0 / v_xy, 1.0 / v_xy, 1.0 / v_phi])
-        m = np.array(measured)
-        target = np.array([predicted[0], predicted[1], measured[2] - d_phi])  # the prediction's heading, unwrapped
-        fused = np.linalg.solve(info_meas + info_prior, info_meas @ m + info_prior @ target)
-        return (float(fused[0]), float(fused[1]), wrap_angle(float(fused[2])))
+        p_xy, p_phi = 1.0 / v_xy, 1.0 / v_phi
+        # The prediction's heading unwrapped next to the measured one, so the average does not jump by 2 pi.
+        t0, t1, t2 = predicted[0], predicted[1], measured[2] - d_phi
+        a00, a11, a22 = h00 + p_xy, h11 + p_xy, h22 + p_phi
+        r0 = h00 * measured[0] + h01 * measured[1] + h02 * measured[2] + p_xy * t0
+        r1 = h01 * measured[0] + h11 * measured[1] + h12 * measured[2] + p_xy * t1
+        r2 = h02 * measured[0] + h12 * measured[1] + h22 * measured[2] + p_phi * t2
+        c00 = a11 * a22 - h12 * h12
+        c01 = h02 * h12 - h01 * a22
+        c02 = h01 * h12 - h02 * a11
+        det = a00 * c00 + h01 * c01 + h02 * c02
+        c11 = a00 * a22 - h02 * h02
+        c12 = h01 * h02 - a00 * h12
+        c22 = a00 * a11 - h01 * h01
+        x = (c00 * r0 + c01 * r1 + c02 * r2) / det
+        y = (c01 * r0 + c11 * r1 + c12 * r2) / det
+        phi = (c02 * r0 + c12 * r1 + c22 * r2) / det
+        return (x, y, wrap_angle(phi))

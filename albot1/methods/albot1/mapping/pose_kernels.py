@@ -37,6 +37,14 @@ from albot1.geometry.segments import closest_parameter
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
+#: Levenberg-Marquardt damping of each Gauss-Newton step (1/m^2, 1/rad^2): negligible against any direction the
+#: view fixes (thousands), it stops steps along one it does not.
+DAMPING_XY = 1.0
+DAMPING_PHI = 4.0
+#: The largest Gauss-Newton step (m, rad): nearest-surface associations hold only near the current pose.
+MAX_STEP_M = 0.5
+MAX_STEP_RAD = 0.1
+
 
 def huber_weight(residual: float, threshold: float) -> float:
     """The IRLS weight of Huber's loss: 1 inside ``threshold``, ``threshold / |r|`` beyond."""
@@ -54,6 +62,36 @@ def huber_cost(residual: float, threshold: float) -> float:
     return threshold * (a - 0.5 * threshold)
 
 
+def surface_boxes(ref: FloatArray, margin: float) -> FloatArray:
+    """Each surface's bounding box grown by ``margin``: ``(m, 4)`` xmin, ymin, xmax, ymax."""
+    boxes = np.empty((ref.shape[0], 4))
+    for j in range(ref.shape[0]):
+        boxes[j, 0] = min(ref[j, 0], ref[j, 2]) - margin
+        boxes[j, 1] = min(ref[j, 1], ref[j, 3]) - margin
+        boxes[j, 2] = max(ref[j, 0], ref[j, 2]) + margin
+        boxes[j, 3] = max(ref[j, 1], ref[j, 3]) + margin
+    return boxes
+
+
+def nearest_surface(x: float, y: float, ref: FloatArray, boxes: FloatArray, gate: float) -> tuple[int, float]:
+    """The surface of ``ref`` nearest the point and its distance, if nearer than ``gate``; else ``(-1, gate)``.
+
+    ``boxes`` (:func:`surface_boxes` grown by ``gate``) skip the surfaces
+    that cannot be within ``gate`` before any distance is computed.
+    """
+    best = gate
+    found = -1
+    for j in range(ref.shape[0]):
+        if x < boxes[j, 0] or x > boxes[j, 2] or y < boxes[j, 1] or y > boxes[j, 3]:
+            continue
+        t = closest_parameter(x, y, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3])
+        d = np.hypot(ref[j, 0] + t * (ref[j, 2] - ref[j, 0]) - x, ref[j, 1] + t * (ref[j, 3] - ref[j, 1]) - y)
+        if d < best:
+            best = d
+            found = j
+    return found, best
+
+
 def pose_cost(
     x: float,
     y: float,
@@ -63,6 +101,7 @@ def pose_cost(
     point_ok: BoolArray,
     points: FloatArray,
     ref: FloatArray,
+    boxes: FloatArray,
     line_sigma: float,
     point_sigma: float,
     scan_sigma: float,
@@ -93,12 +132,7 @@ def pose_cost(
     for p in range(points.shape[0]):
         tx = x + c * points[p, 0] - s * points[p, 1]
         ty = y + s * points[p, 0] + c * points[p, 1]
-        best = gate
-        for j in range(ref.shape[0]):
-            t = closest_parameter(tx, ty, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3])
-            d = np.hypot(ref[j, 0] + t * (ref[j, 2] - ref[j, 0]) - tx, ref[j, 1] + t * (ref[j, 3] - ref[j, 1]) - ty)
-            if d < best:
-                best = d
+        best = nearest_surface(tx, ty, ref, boxes, gate)[1]
         total += huber_cost(best / scan_sigma, huber)
     return total
 
@@ -133,6 +167,7 @@ def refine_pose(
     Stops after ``iterations`` Gauss-Newton steps or when a step moves less
     than 1 micrometre and 0.1 microradian.
     """
+    boxes = surface_boxes(ref, gate)
     # The start with the lowest robust cost (a mismatched landmark places the robot far off).
     chosen = 0
     lowest = np.inf
@@ -146,6 +181,7 @@ def refine_pose(
             point_ok,
             points,
             ref,
+            boxes,
             line_sigma,
             point_sigma,
             scan_sigma,
@@ -237,14 +273,7 @@ def refine_pose(
             dy = s * vx + c * vy
             tx = x + dx
             ty = y + dy
-            best = gate
-            found = -1
-            for j in range(m):
-                t = closest_parameter(tx, ty, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3])
-                d = np.hypot(ref[j, 0] + t * (ref[j, 2] - ref[j, 0]) - tx, ref[j, 1] + t * (ref[j, 3] - ref[j, 1]) - ty)
-                if d < best:
-                    best = d
-                    found = j
+            found = nearest_surface(tx, ty, ref, boxes, gate)[0]
             if found < 0:
                 continue
             r = rnx[found] * (tx - ref[found, 0]) + rny[found] * (ty - ref[found, 1])
@@ -276,11 +305,12 @@ def refine_pose(
         if prior_info_phi > 0.0:
             h22 += prior_info_phi
             b2 += prior_info_phi * wrap_angle(phi - prior_phi)
-        # Solve H d = -b (symmetric 3x3, by cofactors) with a tiny ridge so a direction nothing fixes stays put.
-        ridge = 1e-9 * (h00 + h11 + h22 + 1.0)
-        a00 = h00 + ridge
-        a11 = h11 + ridge
-        a22 = h22 + ridge
+        # Solve (H + D) d = -b (symmetric 3x3, by cofactors). The damping D (Levenberg-Marquardt) keeps a direction
+        # nothing fixes, along a featureless corridor, from taking a step on rounding noise; it does not move the
+        # solution where the gradient vanishes.
+        a00 = h00 + DAMPING_XY
+        a11 = h11 + DAMPING_XY
+        a22 = h22 + DAMPING_PHI
         c00 = a11 * a22 - h12 * h12
         c01 = h02 * h12 - h01 * a22
         c02 = h01 * h12 - h02 * a11
@@ -293,6 +323,11 @@ def refine_pose(
         d0 = -(c00 * b0 + c01 * b1 + c02 * b2) / det
         d1 = -(c01 * b0 + c11 * b1 + c12 * b2) / det
         d2 = -(c02 * b0 + c12 * b1 + c22 * b2) / det
+        # A trust region: one step moves at most MAX_STEP_M and MAX_STEP_RAD (associations are only local).
+        shrink = max(1.0, np.hypot(d0, d1) / MAX_STEP_M, abs(d2) / MAX_STEP_RAD)
+        d0 /= shrink
+        d1 /= shrink
+        d2 /= shrink
         x += d0
         y += d1
         phi = wrap_angle(phi + d2)

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.methods.albot1.mapping.accel import MappingKernels, mapping_kernels
+from albot1.methods.albot1.mapping.kernels import DELETED, EXTENDED, TRIMMED
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 
 FloatArray = NDArray[np.float64]
@@ -101,23 +102,33 @@ def update_map(
                 sid = int(cand[row])
                 pmap.delete(sid, scan)
                 deleted.append(sid)
-            for row in np.flatnonzero(inside_count == 1).tolist():
-                sid = int(cand[row])
-                _extend_or_trim(
-                    pmap,
-                    sid,
-                    segs[row],
-                    bool(near[row, 0]),
+            partial = np.flatnonzero(inside_count == 1)
+            if len(partial):
+                action, new_segs, match = k.resolve_partial(
+                    np.ascontiguousarray(segs[partial]),
+                    np.ascontiguousarray(near[partial, 0]),
                     view_map,
-                    view_ids,
+                    view_ids >= 0,
                     poly,
-                    scan,
-                    params,
-                    k,
-                    deleted,
-                    extended,
-                    trimmed,
+                    params.correspond_angle,
+                    params.correspond_distance,
+                    params.partial_without_match == "clip",
+                    params.delete_margin,
+                    params.margin_from == "surfaces",
                 )
+                for r, (row, act, taken) in enumerate(zip(partial.tolist(), action.tolist(), match.tolist())):
+                    sid = int(cand[row])
+                    if taken >= 0:
+                        view_ids[taken] = sid
+                    if act == DELETED:
+                        pmap.delete(sid, scan)
+                        deleted.append(sid)
+                    elif act == EXTENDED:
+                        pmap.replace(sid, new_segs[r], scan, "extended")
+                        extended.append(sid)
+                    elif act == TRIMMED:
+                        pmap.replace(sid, new_segs[r], scan, "trimmed")
+                        trimmed.append(sid)
     fresh = np.flatnonzero(view_ids < 0)
     added = pmap.add(view_map[fresh], scan) if len(fresh) else np.empty(0, dtype=np.int64)
     view_ids[fresh] = added
@@ -128,69 +139,3 @@ def update_map(
         np.asarray(trimmed, dtype=np.int64),
         added,
     )
-
-
-def _extend_or_trim(
-    pmap: PerceptualMap,
-    sid: int,
-    seg: FloatArray,
-    p1_inside: bool,
-    view_map: FloatArray,
-    view_ids: IntArray,
-    poly: FloatArray,
-    scan: int,
-    params: UpdateParams,
-    k: MappingKernels,
-    deleted: list[int],
-    extended: list[int],
-    trimmed: list[int],
-) -> None:
-    """Lines 11-12: a map surface with one end inside the view.
-
-    The corresponding view surface is the closest one (segment distance)
-    that is parallel (either direction) within the angle and near within
-    the distance, and not already taken by another map surface (note 17).
-    The surface then runs from its outside end to the far end of that view
-    surface (seen from the outside end): longer is "extended", shorter
-    "trimmed" (Figure 3.13's S_e and S_r). With no corresponding surface it
-    is clipped where it enters the grown polygon, or kept whole.
-    """
-    out_xy = seg[2:] if p1_inside else seg[:2]
-    best = int(k.best_correspondence(seg, view_map, view_ids >= 0, params.correspond_angle, params.correspond_distance))
-    old_len = math.hypot(seg[2] - seg[0], seg[3] - seg[1])
-    if best >= 0:
-        v = view_map[best]
-        d1 = math.hypot(v[0] - out_xy[0], v[1] - out_xy[1])
-        d2 = math.hypot(v[2] - out_xy[0], v[3] - out_xy[1])
-        far = v[:2] if d1 >= d2 else v[2:]
-        new = np.concatenate([far, out_xy]) if p1_inside else np.concatenate([out_xy, far])
-        view_ids[best] = sid
-    elif params.partial_without_match == "clip":
-        in_xy = seg[:2] if p1_inside else seg[2:]
-        t = float(
-            k.clip_parameter(
-                poly,
-                view_map,
-                float(out_xy[0]),
-                float(out_xy[1]),
-                float(in_xy[0]),
-                float(in_xy[1]),
-                params.delete_margin,
-                params.margin_from == "surfaces",
-            )
-        )
-        cut = out_xy + t * (in_xy - out_xy)
-        new = np.concatenate([cut, out_xy]) if p1_inside else np.concatenate([out_xy, cut])
-    else:
-        return
-    new_len = math.hypot(new[2] - new[0], new[3] - new[1])
-    if new_len <= 1e-9:
-        pmap.delete(sid, scan)
-        deleted.append(sid)
-        return
-    if new_len > old_len:
-        pmap.replace(sid, new, scan, "extended")
-        extended.append(sid)
-    else:
-        pmap.replace(sid, new, scan, "trimmed")
-        trimmed.append(sid)

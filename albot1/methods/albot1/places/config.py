@@ -48,7 +48,7 @@ class MatchParams:
     angle: float = math.radians(5.0)
     gap: float = 0.4
     min_matches: int = 5
-    max_surfaces: int = 40
+    max_surfaces: int = 30
     anchors: int = 1
     trigger_fraction: float = 0.2
     trigger_min: int = 4
@@ -107,7 +107,7 @@ class PlacesFields(BaseModel):
     match_gap_m: float = Field(0.4, gt=0, description="4.1.2: matched surfaces are not separated by a larger gap")
     match_min_matches: int = Field(5, ge=1, description="Algorithm 6 line 11: 'Matched_Surfaces > 4'")
     match_max_surfaces: int = Field(
-        40, ge=2, description="the longest this many surfaces of each place enter the match (bounds its cost)"
+        30, ge=2, description="the longest this many surfaces of each place enter the match (bounds its cost)"
     )
     match_anchors: Literal["midpoint", "midpoint_and_ends"] = Field(
         "midpoint",

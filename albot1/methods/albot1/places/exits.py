@@ -96,6 +96,7 @@ class ExitTracker:
         self._side_at = np.empty((0, 2))  # where the robot last was clearly on that side
         self._mute = np.empty(0, dtype=np.int64)  # a twin of an exit just crossed: the side the robot heads for
         self._next_id = 0
+        self._confirmed_seen = -(10**9)  # the last scan a crossable exit was seen (no recent one: nothing to test)
         self.detections = 0
 
     def __len__(self) -> int:
@@ -127,7 +128,7 @@ class ExitTracker:
         exit: it belongs to the place beyond (the nearest exit along the line
         when it passes several).
         """
-        if len(points) == 0 or len(self._ids) == 0:
+        if len(points) == 0 or scan - self._confirmed_seen > self.params.recent_scans:
             return np.full(len(points), -1, dtype=np.int64)
         return self._k.seen_through(
             self._seg,
@@ -151,6 +152,8 @@ class ExitTracker:
     def near(self, position: tuple[float, float], distance: float, scan: int) -> bool:
         """Whether ``position`` is within ``distance`` of a recently seen exit (standing in a doorway)."""
         p = self.params
+        if scan - self._confirmed_seen > p.recent_scans:
+            return False
         return bool(
             self._k.near_exit(
                 self._seg,
@@ -189,6 +192,8 @@ class ExitTracker:
                 self._seg[r] = seg
                 self._sightings[r] += 1
                 self._last_seen[r] = scan
+                if self._sightings[r] >= p.min_sightings:
+                    self._confirmed_seen = scan
                 return
         self._seg = np.vstack([self._seg, seg[None]])
         self._ids = np.append(self._ids, self._next_id)
@@ -231,6 +236,8 @@ class ExitTracker:
             p.recent_scans,
             scan,
         )
+        if len(rows) == 0:
+            return None
         best: Crossing | None = None
         best_distance = math.inf
         for r, d, (bx, by) in zip(rows.tolist(), distance.tolist(), old_side.tolist()):

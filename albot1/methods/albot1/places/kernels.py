@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import closest_parameter, orientation, point_segment_distance
+from albot1.methods.albot1.mapping.kernels import classify_endpoints
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDING
 
 FloatArray = NDArray[np.float64]
@@ -204,6 +205,103 @@ def seen_through(
                 best = along
                 out[p] = ids[r]
     return out
+
+
+def colocated(
+    segments: FloatArray,
+    box: FloatArray,
+    owner: IntArray,
+    excluded: IntArray,
+    poly: FloatArray,
+    view: FloatArray,
+    margin: float,
+    surfaces_only: bool,
+) -> IntArray:
+    """Rows of ``segments`` (remembered places' structure in the map) the view ``view`` co-locates with.
+
+    Algorithm 3's rule for a map surface: an end inside the view polygon
+    ``poly`` or within ``margin`` (of the view's surfaces, or of every polygon
+    edge; the chapter-3 kernel
+    :func:`albot1.methods.albot1.mapping.kernels.classify_endpoints`).
+    Rows of an ``excluded`` place, and those whose bounding box ``box``
+    cannot meet the polygon's grown box, are skipped.
+    """
+    x0 = poly[:, 0].min() - margin
+    x1 = poly[:, 0].max() + margin
+    y0 = poly[:, 1].min() - margin
+    y1 = poly[:, 1].max() + margin
+    n = segments.shape[0]
+    rows = np.empty(n, dtype=np.int64)
+    k = 0
+    for r in range(n):
+        if box[r, 2] < x0 or box[r, 0] > x1 or box[r, 3] < y0 or box[r, 1] > y1:
+            continue
+        skip = False
+        for e in range(excluded.shape[0]):
+            if owner[r] == excluded[e]:
+                skip = True
+        if not skip:
+            rows[k] = r
+            k += 1
+    pts = np.empty((2 * k, 2))
+    for q in range(k):
+        pts[2 * q, 0] = segments[rows[q], 0]
+        pts[2 * q, 1] = segments[rows[q], 1]
+        pts[2 * q + 1, 0] = segments[rows[q], 2]
+        pts[2 * q + 1, 1] = segments[rows[q], 3]
+    near = classify_endpoints(poly, view, pts, margin, surfaces_only)
+    out = np.empty(k, dtype=np.int64)
+    m = 0
+    for q in range(k):
+        if near[2 * q] or near[2 * q + 1]:
+            out[m] = rows[q]
+            m += 1
+    return out[:m]
+
+
+def same_any(a: FloatArray, b: FloatArray, max_angle: float, max_gap: float) -> tuple[BoolArray, BoolArray]:
+    """Which surfaces of ``a`` have a same surface in ``b``, and which of ``b`` in ``a``.
+
+    The same: directions within ``max_angle`` and the smallest endpoint-to-
+    segment distance both ways within ``max_gap`` (as
+    :func:`albot1.methods.albot1.places.memory.same_surfaces`, without its
+    ``len(a) x len(b)`` arrays: a long visit closed into a large place pairs
+    thousands with thousands).
+    """
+    na = a.shape[0]
+    nb = b.shape[0]
+    a_has = np.zeros(na, dtype=np.bool_)
+    b_has = np.zeros(nb, dtype=np.bool_)
+    bx0 = np.empty(nb)
+    bx1 = np.empty(nb)
+    by0 = np.empty(nb)
+    by1 = np.empty(nb)
+    db = np.empty(nb)
+    for j in range(nb):
+        bx0[j] = min(b[j, 0], b[j, 2]) - max_gap
+        bx1[j] = max(b[j, 0], b[j, 2]) + max_gap
+        by0[j] = min(b[j, 1], b[j, 3]) - max_gap
+        by1[j] = max(b[j, 1], b[j, 3]) + max_gap
+        db[j] = math.atan2(b[j, 3] - b[j, 1], b[j, 2] - b[j, 0])
+    for i in range(na):
+        ax0 = min(a[i, 0], a[i, 2])
+        ax1 = max(a[i, 0], a[i, 2])
+        ay0 = min(a[i, 1], a[i, 3])
+        ay1 = max(a[i, 1], a[i, 3])
+        da = math.atan2(a[i, 3] - a[i, 1], a[i, 2] - a[i, 0])
+        for j in range(nb):
+            if ax1 < bx0[j] or ax0 > bx1[j] or ay1 < by0[j] or ay0 > by1[j]:
+                continue
+            if abs(wrap_angle(da - db[j])) >= max_angle:
+                continue
+            gap = min(
+                min(point_segment_distance(a[i, 0], a[i, 1], b[j]), point_segment_distance(a[i, 2], a[i, 3], b[j])),
+                min(point_segment_distance(b[j, 0], b[j, 1], a[i]), point_segment_distance(b[j, 2], b[j, 3], a[i])),
+            )
+            if gap <= max_gap:
+                a_has[i] = True
+                b_has[j] = True
+    return a_has, b_has
 
 
 def near_exit(

@@ -39,7 +39,6 @@ from albot1.contract import MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
-from albot1.methods.albot1.mapping.accel import mapping_kernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.places.accel import places_kernels
@@ -81,16 +80,18 @@ class Albot1PlacesMapper:
         self.inner = Albot1Mapper(config, seed=seed)
         self.inner.on_update = self._on_update
         self._k = places_kernels(config.accelerate)
-        self._mk = mapping_kernels(config.accelerate)
         self._match = config.match_params()
         self.exits = ExitTracker(config.exit_params(), self._k)
         self._same_angle = math.radians(config.match_angle_deg)
         self._same_gap = config.match_gap_m
         self.network = PlaceNetwork(
-            same_angle=self._same_angle, same_gap=self._same_gap, link_distance=config.exit_link_distance_m
+            same_angle=self._same_angle,
+            same_gap=self._same_gap,
+            link_distance=config.exit_link_distance_m,
+            same_any=self._k.same_any,
         )
         self._labels: list[set[int]] = []  # map surface id -> the visits it belongs to (see _map_evidence)
-        self._placed_cache: dict[int, tuple[Any, FloatArray, tuple[float, float, float, float]]] = {}
+        self._placed_cache: dict[int, tuple[Any, FloatArray]] = {}
         self._structure_cache: dict[int, tuple[Any, FloatArray]] = {}
         self._pool: tuple[FloatArray, NDArray[np.int64], NDArray[np.int64], FloatArray] | None = None
         self._members: dict[int, set[int]] = {}  # visit -> the map surface ids marked with it
@@ -214,28 +215,26 @@ class Albot1PlacesMapper:
         segments, owner, key, box = self._memory_pool()
         if len(segments) == 0:
             return
-        lo = poly.min(axis=0) - cfg.delete_margin_m
-        hi = poly.max(axis=0) + cfg.delete_margin_m
-        rows = np.flatnonzero((box[:, 2] >= lo[0]) & (box[:, 0] <= hi[0]) & (box[:, 3] >= lo[1]) & (box[:, 1] <= hi[1]))
-        for place in self._excluded():
-            rows = rows[owner[rows] != place]
-        if len(rows) == 0:
-            return
-        near = self._mk.classify_endpoints(
+        hit = self._k.colocated(
+            segments,
+            box,
+            owner,
+            np.fromiter(self._excluded(), dtype=np.int64),
             poly,
             np.ascontiguousarray(view),
-            np.ascontiguousarray(segments[rows].reshape(-1, 2)),
             cfg.delete_margin_m,
             cfg.delete_margin_from == "surfaces",
         )
-        hit = rows[near.reshape(-1, 2).any(axis=1)]
         if len(hit) == 0:
             return
         seg = segments[hit]
         through = self.exits.beyond(robot, 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
-        for place, surface, exit_id in zip(owner[hit].tolist(), key[hit].tolist(), through.tolist()):
+        owners, keys = owner[hit], key[hit]
+        for exit_id in np.unique(through).tolist():
             evidence = self._evidence if exit_id < 0 else self._ahead.setdefault(exit_id, {})
-            evidence.setdefault(place, set()).add(surface)
+            side = through == exit_id
+            for place in np.unique(owners[side]).tolist():
+                evidence.setdefault(place, set()).update(keys[side & (owners == place)].tolist())
             self._fresh = self._fresh or exit_id < 0
 
     def _memory_pool(self) -> tuple[FloatArray, NDArray[np.int64], NDArray[np.int64], FloatArray]:
@@ -245,7 +244,7 @@ class Albot1PlacesMapper:
         an update tests all remembered places with one kernel call.
         """
         if self._pool is None:
-            parts = [(place.id, self._placed(place)[0]) for place in self.network.live_places()]
+            parts = [(place.id, self._placed(place)) for place in self.network.live_places()]
             parts = [(pid, seg) for pid, seg in parts if len(seg)]
             if parts:
                 segments = np.ascontiguousarray(np.vstack([seg for _, seg in parts]))
@@ -262,28 +261,19 @@ class Albot1PlacesMapper:
             self._pool = (segments, owner, key, box)
         return self._pool
 
-    def _placed(self, place: Place) -> tuple[FloatArray, tuple[float, float, float, float]]:
-        """A place's structure in the map where its frame lay when created, with its bounding box (cached).
+    def _placed(self, place: Place) -> FloatArray:
+        """A place's structure in the map where its frame lay when created (cached until the place changes).
 
         The structure (:meth:`_structure`) is what the trigger's n is counted
         in, so the co-locating surfaces are counted in the same units.
-
-        A place without own surfaces gets an empty box (no view can meet it).
         """
         key = (len(place.surfaces), place.frame_map)
         cached = self._placed_cache.get(place.id)
         if cached is None or cached[0] != key:
             own = self._structure(place)
-            placed = transform_segments(place.frame_map, own) if len(own) else np.empty((0, 4))
-            pts = placed.reshape(-1, 2)
-            box = (
-                (float(pts[:, 0].min()), float(pts[:, 1].min()), float(pts[:, 0].max()), float(pts[:, 1].max()))
-                if len(pts)
-                else (math.inf, math.inf, -math.inf, -math.inf)
-            )
-            cached = (key, placed, box)
+            cached = (key, transform_segments(place.frame_map, own) if len(own) else np.empty((0, 4)))
             self._placed_cache[place.id] = cached
-        return cached[1], cached[2]
+        return cached[1]
 
     def _structure(self, place: Place) -> FloatArray:
         """A remembered place's structure (:func:`structural` of its own surfaces), cached until it changes."""

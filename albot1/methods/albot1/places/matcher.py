@@ -32,6 +32,10 @@ from albot1.methods.albot1.places.config import MatchParams
 FloatArray = NDArray[np.float64]
 
 
+#: At most this many of a place's longest surfaces are merged into its structure (bounds the cost).
+_MERGE_AT_MOST = 1000
+
+
 def trigger_threshold(size: int, params: MatchParams) -> int:
     """n of 4.1.2 for a remembered place with ``size`` structural surfaces: more than n co-locating triggers."""
     return max(params.trigger_min, math.ceil(params.trigger_fraction * size))
@@ -45,7 +49,11 @@ def structural(surfaces: FloatArray, params: MatchParams, kernels: PlacesKernels
     hid it, re-added a little apart by later views); counted piece by piece,
     two walls alone would make "more than 4" matches in any two rooms.
     """
-    s = np.ascontiguousarray(np.asarray(surfaces, dtype=float).reshape(-1, 4))
+    s = np.asarray(surfaces, dtype=float).reshape(-1, 4)
+    if len(s) > _MERGE_AT_MOST:  # a visit of thousands of surfaces (a long corridor): its longest make the structure
+        length = np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
+        s = s[np.sort(np.argsort(-length, kind="stable")[:_MERGE_AT_MOST])]
+    s = np.ascontiguousarray(s)
     s = kernels.merge_collinear(s, params.angle, 0.5 * params.gap, params.gap) if len(s) > 1 else s
     length = np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
     keep = np.flatnonzero(length > params.min_surface)

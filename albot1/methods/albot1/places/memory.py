@@ -27,6 +27,7 @@ as another on merging keeps an alias to it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -94,12 +95,20 @@ class Visit:
 class PlaceNetwork:
     """Places, visits, exits and their links; the bookkeeping of Algorithms 5 and 7."""
 
-    def __init__(self, *, same_angle: float, same_gap: float, link_distance: float) -> None:
+    def __init__(
+        self,
+        *,
+        same_angle: float,
+        same_gap: float,
+        link_distance: float,
+        same_any: Callable[[FloatArray, FloatArray, float, float], tuple[NDArray[np.bool_], NDArray[np.bool_]]],
+    ) -> None:
         self.places: list[Place] = []
         self.visits: list[Visit] = []
         self._same_angle = same_angle
         self._same_gap = same_gap
         self._link_distance = link_distance
+        self._same_any = same_any
         self._exit_alias: dict[int, int] = {}
         self._next_exit = 0
 
@@ -251,10 +260,12 @@ class PlaceNetwork:
             return old, old_through
         if len(old) == 0:
             return new.copy(), new_through.copy()
-        same = same_surfaces(new, old, self._same_angle, self._same_gap)
-        through = old_through.copy()
-        through[same[~new_through].any(axis=0)] = False
-        fresh = ~same.any(axis=1)
+        new = np.ascontiguousarray(new, dtype=float)
+        old = np.ascontiguousarray(old, dtype=float)
+        known, _ = self._same_any(new, old, self._same_angle, self._same_gap)
+        _, seen_inside = self._same_any(new[~new_through], old, self._same_angle, self._same_gap)
+        through = old_through & ~seen_inside
+        fresh = ~known
         return np.vstack([old, new[fresh]]), np.concatenate([through, new_through[fresh]])
 
     def _merge(self, keep: int, drop: int, drop_in_keep: Pose, scan: int) -> None:

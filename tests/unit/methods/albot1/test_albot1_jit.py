@@ -127,10 +127,18 @@ def _clip_args() -> Iterator[tuple[Any, ...]]:
                 yield (poly, view, float(s[0]), float(s[1]), float(s[2]), float(s[3]), 0.4, surfaces_only)
 
 
-def _cells_args() -> Iterator[tuple[Any, ...]]:
-    for _, view, segs in _map_inputs():
-        yield (view, 0.5)
-        yield (segs, 1.0 / 3.0)
+def _partial_args() -> Iterator[tuple[Any, ...]]:
+    rng = np.random.default_rng(11)
+    for poly, view, segs in _map_inputs():
+        inside = np.ascontiguousarray(rng.random(len(segs)) < 0.5)
+        taken = np.ascontiguousarray(rng.random(len(view)) < 0.2)
+        near_view = np.ascontiguousarray(
+            np.vstack([segs[:20], view[:6] + rng.normal(0.0, 0.05, (min(6, len(view)), 4))])
+        )
+        inside = np.ascontiguousarray(rng.random(len(near_view)) < 0.5)
+        for clip in (True, False):
+            for surfaces_only in (True, False):
+                yield (near_view, inside, view, taken, poly, math.radians(5.0), 0.4, clip, 0.4, surfaces_only)
 
 
 def _refine_args() -> Iterator[tuple[Any, ...]]:
@@ -174,8 +182,8 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "classify_endpoints": _classify_args,
     "best_correspondence": _correspondence_args,
     "clip_parameter": _clip_args,
-    "segment_cells": _cells_args,
     "refine_pose": _refine_args,
+    "resolve_partial": _partial_args,
 }
 
 

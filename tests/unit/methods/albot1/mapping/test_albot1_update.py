@@ -27,7 +27,7 @@ MAP = {
 
 
 def build_map() -> tuple[PerceptualMap, dict[str, int]]:
-    pmap = PerceptualMap(cell_size=1.0)
+    pmap = PerceptualMap()
     ids = pmap.add(np.array(list(MAP.values())), scan=0)
     return pmap, dict(zip(MAP, ids.tolist()))
 
@@ -104,8 +104,8 @@ def test_update_with_an_empty_view_changes_nothing() -> None:
     assert len(pmap) == len(MAP) and out.deleted.size == 0 and out.added.size == 0
 
 
-def test_perceptual_map_ids_history_and_grid_query() -> None:
-    pmap = PerceptualMap(cell_size=1.0)
+def test_perceptual_map_ids_history_and_box_query() -> None:
+    pmap = PerceptualMap()
     a = pmap.add(np.array([[0.0, 0.0, 10.0, 10.0], [50.0, 50.0, 51.0, 50.0]]), scan=2)
     assert a.tolist() == [0, 1]
     b = pmap.add(np.array([[5.0, 0.0, 5.0, 1.0]]), scan=3)

@@ -1,0 +1,129 @@
+"""The standard-benchmark page: measured rows from run folders, published rows from the data file, never mixed."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from albot1.bench.grid import Cell, GridPlan, Skipped
+from albot1.data.model import Frame, Relations, Scan, Sequence
+from albot1.geometry import se2
+from albot1.methods.baselines.published import published_systems
+from albot1.records import MetricsRecord, ResultRecord, read_record
+from albot1.report.collect import CellRecord
+from albot1.report.standard import PAGE, STANDARD_LOGS, TABLE, measured_rows, published_rows, write_standard
+from albot1.runs.evaluate import evaluate_run
+from albot1.runs.execute import run_method
+from albot1.runs.folder import write_run
+
+ANGLES = np.radians(np.linspace(-90.0, 90.0, 181))
+
+
+def _sequence() -> Sequence:
+    """A straight 20-scan drive, 1 s apart, odometry 10 % long; relations from the truth (exact values below)."""
+    t = np.arange(20, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(20), np.zeros(20)])
+    odometry = np.column_stack([t * 0.55, np.zeros(20), np.zeros(20)])
+    frames = [Frame(i, Scan(np.full(181, 5.0), ANGLES, 100.0 + t[i], 30.0), odometry[i]) for i in range(20)]
+    pairs = np.array([[0, 1], [0, 2], [3, 19]])  # 0.5, 1 and 8 m long
+    relations = Relations(
+        t1=100.0 + t[pairs[:, 0]], t2=100.0 + t[pairs[:, 1]], poses=se2.between(truth[pairs[:, 0]], truth[pairs[:, 1]])
+    )
+    return Sequence.from_frames("straight", frames, relations=relations)
+
+
+def _cell(log: str, method: str, key: str, limit: int | None = None) -> Cell:
+    return Cell(
+        suite="t",
+        dataset=log,
+        dataset_label=log if limit is None else f"{log}[:{limit}]",
+        method=method,
+        method_label=method,
+        preset="default",
+        degradation="none",
+        seed=0,
+        key=key,
+        code_version="v",
+        time_s=60.0,
+        memory_mb=1024.0,
+        limit=limit,
+    )
+
+
+def _plan(skipped: list[Skipped]) -> GridPlan:
+    machine = {"cpu_model": "Test CPU 3.0 GHz", "cpu_count": 2, "cpu_count_physical": 1, "memory_gb": 4.0}
+    return GridPlan("t", None, "", [], skipped, [], {}, [0], ["none"], {**machine, "platform": "test"})
+
+
+def _record(tmp_path: Path, log: str, limit: int | None = None) -> CellRecord:
+    result = run_method("odometry", _sequence(), dataset_name="straight")
+    run_dir = write_run(result, tmp_path)
+    evaluate_run(run_dir)
+    return CellRecord(
+        _cell(log, "odometry", run_dir.name, limit),
+        "done",
+        run_dir,
+        read_record(ResultRecord, run_dir / "result.json"),
+        read_record(MetricsRecord, run_dir / "metrics.json"),
+        None,
+    )
+
+
+def test_measured_rows_take_the_relation_metric_of_whole_log_runs_only(tmp_path: Path) -> None:
+    full = _record(tmp_path, "intel")
+    prefix = _record(tmp_path / "p", "intel", limit=10)
+    other = _record(tmp_path / "o", "intel-corrected")
+    rows = measured_rows([prefix, other, full])
+    assert [(r.log, r.kind, r.method) for r in rows] == [("intel", "measured", "odometry")]
+    row = rows[0]
+    # Odometry 10 % long: errors 0.05, 0.1 and 0.8 m; the longest relation spans 16 s, so none is a loop relation.
+    assert row.relations == 3
+    np.testing.assert_allclose(row.translation_mean_m, (0.05 + 0.1 + 0.8) / 3)
+    np.testing.assert_allclose(row.translation_max_m, 0.8)
+    assert row.loop_relations == 0
+    assert row.duration_s == 19.0
+    assert row.time_s is not None and row.speed == 19.0 / row.time_s
+
+
+def test_published_rows_come_from_the_data_file_labelled_with_their_source() -> None:
+    rows = published_rows({"aces": 1366.0})
+    by = {(r.log, r.method): r for r in rows}
+    carto = by[("aces", "Cartographer (Hess et al. 2016)")]
+    assert (carto.kind, carto.translation_mean_m, carto.rotation_mean_deg, carto.time_s) == (
+        "published",
+        0.0375,
+        0.373,
+        41,
+    )
+    assert carto.speed == 1366.0 / 41 and "Table II" in carto.source
+    gm = by[("mit-csail", "GM (Kuemmerle et al. 2009)")]
+    assert (gm.translation_mean_m, gm.translation_std_m) == (0.004, 0.009)
+    sm = by[("fr-clinic", "SM (Kuemmerle et al. 2009)")]
+    assert sm.rotation_mean_deg is None and "unconfirmed" in sm.note
+    assert ("aces", "Graph FLIRT (as quoted by Hess et al. 2016)") not in by  # Hess's Table III has no ACES
+    systems = {s.label for s in published_systems()}
+    assert {r.method for r in rows} <= systems
+
+
+def test_the_page_and_csv_keep_measured_and_published_rows_apart(tmp_path: Path) -> None:
+    rec = _record(tmp_path / "runs", "aces")
+    out = tmp_path / "report"
+    out.mkdir()
+    plan = _plan([Skipped("fr-clinic", "not found under the data roots", "albot1 datasets fetch fr-clinic")])
+    page, table = write_standard(plan, [rec], out)
+    assert (page.name, table.name) == (PAGE, TABLE)
+    text = page.read_text()
+    assert "Test CPU 3.0 GHz, 2 logical CPUs (1 physical)" in text
+    assert "Intel Xeon E5-1650" in text
+    assert "Not measured: not found under the data roots (`albot1 datasets fetch fr-clinic`)" in text
+    assert "| odometry | measured | 0.3167 ± 0.4193 |" in text
+    assert "| Cartographer (Hess et al. 2016) | **published** | 0.0375 ± 0.0426 |" in text
+    with table.open() as f:
+        rows = list(csv.DictReader(f))
+    kinds = {(r["log"], r["kind"]) for r in rows}
+    assert ("aces", "measured") in kinds and ("aces", "published") in kinds
+    assert {r["log"] for r in rows} <= set(STANDARD_LOGS)
+    measured = [r for r in rows if r["kind"] == "measured"]
+    assert len(measured) == 1 and measured[0]["source"].startswith("this suite, run ")

@@ -1,0 +1,54 @@
+"""The thesis suite file: it parses, runs each experiment's methods, and pairs its public-log runs with the
+default suite's by dataset label (the page joins the two stores on it)."""
+
+from __future__ import annotations
+
+from albot1.bench.suite import find_suite, load_suite
+from albot1.data import catalog
+from albot1.data.synthetic import worlds
+from albot1.report.thesis.experiments import (
+    DENSE,
+    DOUBLE_LOOP,
+    PLACES_STARTS,
+    PLACES_VARIANTS,
+    SLAM_BASELINES,
+    SPARSE,
+    SQUARE,
+    TWO_LAPS,
+    VARIANTS,
+)
+
+#: The one default-suite log the thesis suite leaves out: no reference poses and no relations.
+UNMEASURED = "mit-killian"
+
+
+def test_the_suite_is_named_thesis_and_holds_every_experiment() -> None:
+    suite = load_suite(find_suite("thesis"))
+    assert suite.name == "thesis"
+    square = suite.options_for(SQUARE)
+    assert square is not None and square.sweep is True and "thesis" in suite.grid.degradations
+    assert square.methods is not None and set(square.methods) == {"odometry", *VARIANTS}
+    for spacing in (DENSE, SPARSE):
+        opts = suite.options_for(spacing)
+        assert opts is not None and opts.methods is not None
+        assert set(opts.methods) == {"odometry", *VARIANTS, *SLAM_BASELINES}
+    for places in (*PLACES_STARTS, DOUBLE_LOOP, TWO_LAPS):
+        opts = suite.options_for(places)
+        assert opts is not None and opts.methods is not None and set(opts.methods) == set(PLACES_VARIANTS)
+
+
+def test_public_logs_get_the_default_suites_labels_and_only_the_variants_it_lacks() -> None:
+    thesis = load_suite(find_suite("thesis"))
+    default = load_suite(find_suite("default"))
+    default_methods = {m.display for m in default.methods}
+    for name in [*catalog.names(), *worlds.WORLDS]:
+        ours, theirs = thesis.options_for(name), default.options_for(name)
+        if name in (SQUARE, DENSE) or name.startswith("synthetic-places"):
+            continue  # the thesis's own experiments
+        if theirs is None or name == UNMEASURED:
+            assert ours is None, name  # nothing to pair with, or nothing of the page's to measure on it
+            continue
+        assert ours is not None, name
+        assert ours.label == theirs.label, name  # the same prefix: the page pairs the runs by label
+        assert ours.methods is not None and set(ours.methods) == {"albot1:literal", "albot1:plus"}
+        assert not set(ours.methods) & default_methods  # never a run the default suite makes already
