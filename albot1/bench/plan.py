@@ -161,26 +161,33 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
     return first.reference is not None, None, True
 
 
-def _seeds_of(degradation: str, seeds: tuple[int, ...]) -> tuple[int, ...]:
-    """``seeds``, or only the first of them for a deterministic degradation (every seed would repeat one run).
-
-    The first seed keeps the run key such a cell always had, so stored results stay found.
-    """
+def _deterministic(degradation: str) -> bool:
+    """True when a degradation ignores its seed (every seed would repeat one run)."""
     spec = parse_spec(degradation)
-    deterministic = spec.kind in ("none", "thesis", "bias") or (spec.kind == "gauss" and spec.a == spec.b == 0.0)
-    return seeds[:1] if deterministic else seeds
+    return spec.kind in ("none", "thesis", "bias") or (spec.kind == "gauss" and spec.a == spec.b == 0.0)
 
 
-def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tuple[str, int]]:
+def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tuple[str, tuple[int, ...]]]:
+    """(degradation, seeds) of a dataset entry; the caller keeps one seed where nothing depends on it."""
     grid = suite.grid
     undegraded = opts.undegraded_seeds if opts.undegraded_seeds is not None else grid.undegraded_seeds
-    runs = [("none", s) for s in _seeds_of("none", undegraded)]
+    runs = [("none", tuple(undegraded))]
     sweep = has_reference if opts.sweep == "auto" else bool(opts.sweep)
     if sweep:
         degradations = opts.degradations if opts.degradations is not None else grid.degradations
         seeds = opts.seeds if opts.seeds is not None else grid.seeds
-        runs += [(d, s) for d in degradations if d != "none" for s in _seeds_of(d, seeds)]
+        runs += [(d, tuple(seeds)) for d in degradations if d != "none"]
     return runs
+
+
+def _runs_once(degradation: str, method: str) -> bool:
+    """A deterministic degradation of a deterministic method runs with the first seed only.
+
+    The first seed keeps the run key such a cell always had, so stored results stay found; a
+    stochastic method (its registry entry says so) keeps every seed, since its output varies with it.
+    """
+    spec = METHODS.get(method)
+    return _deterministic(degradation) and not (spec is not None and spec.stochastic)
 
 
 def _limit(*values: float | None, default: float) -> float:
@@ -232,9 +239,11 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
         if skipped is not None:
             skipped_datasets.append(skipped)
             continue
-        for degradation, seed in _sweep(opts, suite, bool(has_reference)):
-            for entry in methods:
+        for degradation, sweep_seeds in _sweep(opts, suite, bool(has_reference)):
+            for seed, entry in ((s, e) for s in sweep_seeds for e in methods):
                 if opts.methods is not None and entry.display not in opts.methods:
+                    continue
+                if seed != sweep_seeds[0] and _runs_once(degradation, entry.name):
                     continue
                 config, problem = resolved[entry.display]
                 key_config = (

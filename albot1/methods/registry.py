@@ -75,6 +75,9 @@ class MethodSpec:
     #: method's own claims against them (evaluation only: the mapper never sees the reference); see
     #: :func:`albot1.runs.execute.run_method`.
     judge: str | None = None
+    #: True when the method's output depends on its seed even on undegraded odometry (a particle filter):
+    #: the bench then runs every seed under a deterministic degradation too, instead of the first only.
+    stochastic: bool = False
 
     def __post_init__(self) -> None:
         check_target(self.target)
@@ -178,6 +181,7 @@ METHODS: dict[str, MethodSpec] = {
             "mrpt-rbpf",
             "albot1.methods.baselines.mrpt:MrptRbpfMapper",
             executables=("rbpf-slam",),
+            stochastic=True,
             install_hint="apt-get install mrpt-apps (or: make mrpt)",
             auto_include=False,
             description="MRPT rbpf-slam: Rao-Blackwellized particle filter grid SLAM (GMapping family)",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,7 @@ from albot1.bench.errors import SuiteError
 from albot1.bench.grid import GridPlan
 from albot1.bench.plan import plan_suite
 from albot1.bench.suite import load_suite
+from albot1.methods.registry import METHODS
 from albot1.settings import Settings
 
 WORLD = "synthetic-office-startstop"
@@ -51,6 +53,17 @@ def test_deterministic_degradations_run_once_and_random_ones_once_per_seed(tmp_p
     assert runs == sorted(
         [("none", 7), ("thesis", 3), ("bias:0.01:0.1", 3), ("gauss:0.1:1", 3), ("gauss:0.1:1", 4), ("gauss:0.1:1", 5)]
     )
+
+
+def test_a_stochastic_method_keeps_every_seed_under_a_deterministic_degradation(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A particle filter varies with its seed even on clean odometry: its seeds are not collapsed."""
+    monkeypatch.setitem(METHODS, "odometry", replace(METHODS["odometry"], stochastic=True))
+    grid = '[grid]\ndegradations = ["thesis"]\nseeds = [3, 4]\nundegraded_seeds = [7, 8]\n'
+    _, plan = _plan(tmp_path, "sweep = true\n", grid)
+    runs = sorted((c.degradation, c.seed) for c in plan.cells)
+    assert runs == sorted([("none", 7), ("none", 8), ("thesis", 3), ("thesis", 4)])
 
 
 def test_a_glob_that_matches_no_dataset_is_an_error_naming_the_entry(tmp_path: Path) -> None:
