@@ -133,6 +133,7 @@ PLACES_DOORWAYS: tuple[DoorwaySpec, ...] = (
 #: The double loop's extra doorway: room-2 to room-5 through their shared wall.
 PLACES_DOOR_2_5 = DoorwaySpec("door-2-5", (9.3, 6.1), "x", 1.0)
 
+
 def askew(centre: tuple[float, float], size: tuple[float, float], degrees: float) -> tuple[tuple[float, float], ...]:
     """The corners of a ``size`` (length, depth) box centred at ``centre``, turned ``degrees`` counter-clockwise."""
     c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))

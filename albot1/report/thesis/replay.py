@@ -26,6 +26,7 @@ from albot1.data.degrade import degrade
 from albot1.data.open import open_sequence
 from albot1.errors import Albot1Error
 from albot1.geometry import se2
+from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
 from albot1.report.errors import ReportError
@@ -67,7 +68,7 @@ def replay_run(run_dir: Path, settings: Settings | None = None) -> Replay:
         raise ReportError(f"{run_dir}: a run of {info.method}, not of albot1: it has no perceptual-map updates")
     try:
         sequence = degrade(open_sequence(info.dataset, settings=settings), info.degradation, seed=info.seed)
-        mapper = Albot1Mapper(Albot1Mapper.config_model.model_validate(info.config), seed=info.seed)
+        mapper = Albot1Mapper(Albot1Config.model_validate(info.config), seed=info.seed)
     except Albot1Error as exc:
         raise ReportError(f"{run_dir}: cannot replay {info.dataset}: {exc}") from None
     except ValueError as exc:  # the stored config does not validate against today's config model

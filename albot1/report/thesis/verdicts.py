@@ -15,13 +15,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Final, Literal
 
 from albot1.report.tables import decimals, fmt
 
-HOLDS = "holds"
-FAILS = "does not hold"
-NOT_COMPARABLE = "not comparable"
+HOLDS: Final = "holds"
+FAILS: Final = "does not hold"
+NOT_COMPARABLE: Final = "not comparable"
 Word = Literal["holds", "does not hold", "not comparable"]
 
 

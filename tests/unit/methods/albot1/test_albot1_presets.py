@@ -1,9 +1,12 @@
-"""Albot1's presets, read from albot1/methods/albot1/presets.toml, are exactly the values of before.
+"""Albot1's presets, read from albot1/methods/albot1/presets.toml, are exactly the documented values.
 
-The expected values below are a literal copy of what the presets resolved to
+The expected values below were a literal copy of what the presets resolved to
 when they were a dict in the mapping config module (every field of the model
-at its default, plus each preset's changes): the move to a TOML file must not
-change a single number, type or string.
+at its default, plus each preset's changes), so the move to a TOML file could
+not change a single number, type or string. Since then, deliberately
+(``docs/albot1-mapper.md``): the beam-spacing test (``end_spacing_max_m``
+0.2, off in ``literal``), the line-fit and Albot1+ fields (off outside
+``plus``), the ``plus`` preset, and the grid cell field removed with the grid.
 """
 
 from __future__ import annotations
@@ -28,6 +31,9 @@ OLD_DEFAULT: dict[str, Any] = {
     "corner_min_angle_deg": 30.0,
     "occlusion_margin_m": 0.0,
     "continuation_tolerance_m": 0.1,
+    "end_spacing_max_m": 0.2,
+    "end_spacing_grazing": 0.0,
+    "surface_fit": "chord",
     "motion_model": "thesis",
     "recognition_angle_deg": 5.0,
     "recognition_distance_m": 0.4,
@@ -38,6 +44,20 @@ OLD_DEFAULT: dict[str, Any] = {
     "goodness_gap_floor_m": 0.01,
     "goodness_angle_floor_deg": 0.1,
     "goodness_distance_view": "previous",
+    "pose_estimate": "landmark",
+    "robust_line_sigma_m": 0.05,
+    "robust_point_sigma_m": 0.1,
+    "robust_huber_sigmas": 2.0,
+    "robust_iterations": 8,
+    "scan_refinement": False,
+    "scan_sigma_m": 0.05,
+    "scan_gate_m": 0.5,
+    "scan_beam_stride": 2,
+    "odometry_prior": "off",
+    "prior_xy_m_per_sqrt_m": 0.05,
+    "prior_deg_per_sqrt_m": 2.0,
+    "prior_m_per_rad": 1.0,
+    "prior_learning_rate": 0.02,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
@@ -47,7 +67,6 @@ OLD_DEFAULT: dict[str, Any] = {
     "odometry_jump_m": 5.0,
     "stationary_m": 1e-06,
     "stationary_deg": 1e-06,
-    "map_grid_cell_m": 2.0,
     "accelerate": True,
 }
 
@@ -56,7 +75,15 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
     "default": {},
     "thesis": {},
     "exact": {"motion_model": "exact"},
-    "literal": {"delete_margin_from": "boundary", "continuation_tolerance_m": 0.0},
+    "literal": {"delete_margin_from": "boundary", "continuation_tolerance_m": 0.0, "end_spacing_max_m": 0.0},
+    "plus": {
+        "motion_model": "exact",
+        "surface_fit": "tls",
+        "end_spacing_max_m": 0.0,
+        "pose_estimate": "robust",
+        "scan_refinement": True,
+        "odometry_prior": "adaptive",
+    },
 }
 
 
