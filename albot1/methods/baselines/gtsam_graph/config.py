@@ -49,6 +49,9 @@ class GtsamGraphConfig(BaseModel):
     track_scans: bool = Field(
         description="register every scan against the local map to carry the next node's guess (else: odometry)"
     )
+    track_velocity_guess: bool = Field(
+        description="also try the last tracked motion as the guess when it disagrees with the odometry increment"
+    )
     track_prior_sigma_xy_m: float = Field(
         gt=0, description="prior std dev of the odometry guess over one scan period (x, y), used inside tracking ICP"
     )

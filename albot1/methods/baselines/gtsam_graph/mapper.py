@@ -212,7 +212,9 @@ class GtsamGraphMapper:
         reg, good, _ = self._attempt(target, points, guess, *limits)
         coasting = se2.compose(self._track, self._velocity)
         gap = se2.between(guess, coasting)
-        if math.hypot(gap[0], gap[1]) > limits[1] / 2 or abs(gap[2]) > math.radians(limits[2] / 2):
+        if cfg.track_velocity_guess and (
+            math.hypot(gap[0], gap[1]) > limits[1] / 2 or abs(gap[2]) > math.radians(limits[2] / 2)
+        ):
             alt, alt_good, _ = self._attempt(target, points, coasting, *limits)
             if alt_good and (not good or alt.fitness > reg.fitness):  # type: ignore[union-attr]
                 reg, good = alt, True
@@ -247,6 +249,7 @@ class GtsamGraphMapper:
 
         params = replace(
             self._track_icp,
+            max_correspondence_m=mix(cfg.track_max_correspondence_m, cfg.icp_max_correspondence_m),
             prior_sigma_xy_m=mix(cfg.track_prior_sigma_xy_m, cfg.odometry_sigma_xy_m),
             prior_sigma_theta_rad=math.radians(mix(cfg.track_prior_sigma_theta_deg, cfg.odometry_sigma_theta_deg)),
         )
