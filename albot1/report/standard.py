@@ -232,7 +232,8 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
         "the robot recorded it the log was processed. Published timings are Hess et al.'s (Table V), measured on "
         "an Intel Xeon E5-1650 at 3.2 GHz: compare the ratios, not the seconds.",
         "",
-        f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}` (what `make bench` runs).",
+        f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}` (`make bench` does this for "
+        "the default suite).",
         "",
         "## Translational error, mean (m)",
         "",
@@ -246,13 +247,13 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
         name = f"{method} (**published**)" if kind == "published" else method
         values = []
         for log in STANDARD_LOGS:
-            row = by_log.get(log)
-            if row is None:
+            entry = by_log.get(log)
+            if entry is None:
                 values.append("–")
-            elif row.status != "done":
-                values.append(row.status)
+            elif entry.status != "done":
+                values.append(entry.status)
             else:
-                values.append(_num(row.translation_mean_m, 4))
+                values.append(_num(entry.translation_mean_m, 4))
         lines.append(f"| {name} | " + " | ".join(values) + " |")
     lines += ["", "`–`: no figure (not run here / not published for that log).", ""]
     for log, title in STANDARD_LOGS.items():

@@ -22,6 +22,7 @@ from albot1.geometry import se2
 from albot1.metrics.alignment import alignment_transform
 from albot1.metrics.errors import MetricsError
 from albot1.report.plots import (
+    DPI,
     REFERENCE_COLOR,
     Extent,
     has_reference,
@@ -38,7 +39,7 @@ FloatArray = NDArray[np.float64]
 #: Panels of the update trace at most (Figure 3.17 shows 24 maps in four parts); the strip shows every update.
 MAX_TRACE_PANELS = 24
 #: Frames of the animation at most, and the largest GIF written (bytes): the report folder stays light.
-MAX_FRAMES = 80
+MAX_FRAMES = 60
 MAX_GIF_BYTES = 2_000_000
 GIF_DPI = 90
 GAP_COLOR = "#2ca02c"
@@ -105,6 +106,13 @@ def _draw_state(ax: Any, replay: Replay, k: int, transform: FloatArray, *, highl
         ax.plot([x, x + 1.2 * math.cos(th)], [y, y + 1.2 * math.sin(th)], color="k", lw=0.8, zorder=4)
 
 
+def save_png(fig: Any, png: Path) -> Path:
+    """Write ``png`` only: the trace's many panels would make a vector twin of several MB and seconds to write."""
+    fig.savefig(png, format="png", dpi=DPI)
+    pyplot().close(fig)
+    return png
+
+
 def pick(count: int, most: int) -> list[int]:
     """``most`` indices spread evenly over ``range(count)``, first and last included (all when fewer)."""
     if count <= most:
@@ -144,7 +152,7 @@ def plot_update_trace(replay: Replay, path: Path, title: str, *, max_panels: int
     fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False)
     note = "" if len(shown) == len(replay.states) else f" ({len(shown)} of {len(replay.states)} updates shown)"
     fig.suptitle(f"{title}: the map after each update{note}", fontsize=9)
-    return save(fig, path)
+    return save_png(fig, path)
 
 
 def plot_trace_strip(replay: Replay, path: Path, title: str) -> Path:

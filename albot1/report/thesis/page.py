@@ -25,7 +25,17 @@ from albot1.report.places_plot import render_places
 from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.thesis.claims import READINGS
 from albot1.report.thesis.evidence import COMPANION_SUITES, Evidence, open_stores
-from albot1.report.thesis.experiments import LOOP_GAP, ClaimRow, FigureRequest, Section, all_sections, stand_ins
+from albot1.report.thesis.experiments import (
+    DENSE,
+    LOOP_GAP,
+    SPARSE,
+    SQUARE,
+    ClaimRow,
+    FigureRequest,
+    Section,
+    all_sections,
+    stand_ins,
+)
 from albot1.report.thesis.figures import animate_map, plot_gap_maps, plot_trace_strip, plot_update_trace
 from albot1.report.thesis.replay import Replay, replay_run
 from albot1.report.thesis.verdicts import FAILS, HOLDS, NOT_COMPARABLE, Verdict
@@ -35,18 +45,14 @@ PAGE = "README.md"
 FIGURES = "figures"
 #: The suite whose report gets this page.
 THESIS_SUITE = "thesis"
-#: The methods the thesis suite runs on the default suite's datasets only to pair them with its runs there.
-PAIRED_VARIANTS = frozenset({"albot1:literal", "albot1:plus"})
+#: The datasets whose every-method plots the thesis suite's benchmark report draws (Experiments 3-5): the page
+#: draws its own figures for the rest, and the public logs' plots are in the default suite's report.
+PICTURED = (SQUARE, DENSE, SPARSE)
 
 
 def own_records(records: list[CellRecord]) -> list[CellRecord]:
-    """The cells of the thesis's own experiments: datasets where more than the paired variants run.
-
-    The benchmark report of the thesis suite draws its per-dataset plots for these only; the public logs'
-    plots, with every method, are in the default suite's report.
-    """
-    own = {r.cell.dataset_label for r in records if r.cell.method_label not in PAIRED_VARIANTS}
-    return [r for r in records if r.cell.dataset_label in own]
+    """The cells of :data:`PICTURED`: the benchmark report of the thesis suite draws its per-dataset plots for these."""
+    return [r for r in records if r.cell.dataset_label in PICTURED]
 
 
 @dataclass(frozen=True)
@@ -63,6 +69,7 @@ class _Figures:
 
     def __init__(self, ev: Evidence, out: Path, colors: dict[str, str]) -> None:
         self.ev = ev
+        self.out = out
         self.dir = out / FIGURES
         self.dir.mkdir(parents=True, exist_ok=True)
         self.colors = colors
@@ -132,6 +139,15 @@ class _Figures:
             return [Drawn(request.caption, None, "no method has a completed run on this dataset")]
         path = plot_maps(records, request.dataset, self.dir / f"{slug(request.stem)}.png", self.colors)
         return [Drawn(request.caption, path, None if path else "nothing to draw")]
+
+    def _linked_maps(self, request: FigureRequest) -> list[Drawn]:
+        """The maps figure of the companion store's report (``reports/<store>/plots``), when it has been built."""
+        for store in self.ev.stores[1:]:
+            figure = self.out.parent / store.name / "plots" / f"{slug(request.dataset)}-maps.png"
+            if figure.is_file():
+                return [Drawn(request.caption.replace("default suite", f"`{store.name}` report"), figure)]
+        where = self.out.parent / "default" / "plots" / f"{slug(request.dataset)}-maps.png"
+        return [Drawn(request.caption, None, f"{where} does not exist (`albot1 report results/default` draws it)")]
 
     def _gap_maps(self, request: FigureRequest) -> list[Drawn]:
         panels = []

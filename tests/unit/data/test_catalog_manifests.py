@@ -29,7 +29,8 @@ RAW = ["intel", "aces", "fr079", "mit-csail", "fr-clinic"]
 PINNED = re.compile(
     r"^https://raw\.githubusercontent\.com/("
     r"MOLAorg/mola_test_datasets/13a2ed141116bc654e14ffca1d88fb740b3d1253/datasets/radish/"
-    r"|acschaefer/ple/cfcb5a7f12a793b616357381a688cfcc26eed347/data/carmen/)"
+    r"|acschaefer/ple/cfcb5a7f12a793b616357381a688cfcc26eed347/data/carmen/"
+    r"|INESCTEC/ricoslam/52bfaa91c8e5e56f119265d409b1692ca29d48d2/inesctec_mrdt_slam_2d_datasets/data/)"
 )
 
 
@@ -59,6 +60,22 @@ def test_corrected_logs_take_reference_from_the_flaser_pose() -> None:
 def test_mit_killian_is_local_only_and_aces_has_relations() -> None:
     assert catalog.get("mit-killian").local_only and not catalog.get("mit-killian").file("log").urls
     assert catalog.get("aces").file("relations").path == "radish/aces.relations"
+
+
+@pytest.mark.parametrize(
+    ("name", "sha256_prefix", "size"),
+    [
+        ("intel", "330378f1", 265713),
+        ("mit-csail", "ffd7ebe9", 98468),
+        ("fr079", "7e7f06b4", 133044),
+        ("fr-clinic", "583b7bba", 260314),
+    ],
+)
+def test_the_standard_logs_register_their_relations_files(name: str, sha256_prefix: str, size: int) -> None:
+    relations = catalog.get(name).file("relations")
+    assert relations is not None and relations.path == f"radish/{name}.relations"
+    assert relations.sha256.startswith(sha256_prefix) and relations.size == size
+    assert relations.urls[0].endswith(f"/{name}.relations")
 
 
 def test_unknown_and_missing_datasets(tmp_path) -> None:

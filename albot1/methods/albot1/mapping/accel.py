@@ -29,6 +29,7 @@ class MappingKernels(NamedTuple):
         tuple[IntArray, FloatArray, IntArray],
     ]
     refine_pose: Callable[..., tuple[float, float, float, FloatArray]]
+    scan_points: Callable[[FloatArray, FloatArray, float, int], FloatArray]
 
 
 @lru_cache(maxsize=2)
@@ -42,6 +43,7 @@ def mapping_kernels(accelerate: bool = True) -> MappingKernels:
             kernels.clip_parameter,
             kernels.resolve_partial,
             pose_kernels.refine_pose,
+            pose_kernels.scan_points,
         ),
     )
     return MappingKernels(
@@ -51,4 +53,5 @@ def mapping_kernels(accelerate: bool = True) -> MappingKernels:
         jit(kernels.clip_parameter),
         jit(kernels.resolve_partial),
         jit(pose_kernels.refine_pose),
+        jit(pose_kernels.scan_points),
     )

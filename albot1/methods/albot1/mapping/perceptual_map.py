@@ -87,8 +87,9 @@ class PerceptualMap:
     def replace(self, sid: int, segment: FloatArray, scan: int, event: str) -> None:
         """Give surface ``sid`` new endpoints (``event``: "extended" or "trimmed")."""
         self._check(sid)
-        self._seg[sid] = segment
-        self._live_box[self._slot_of[sid]] = self._boxes(self._seg[sid : sid + 1])[0]
+        x1, y1, x2, y2 = (float(v) for v in segment)
+        self._seg[sid] = (x1, y1, x2, y2)
+        self._live_box[self._slot_of[sid]] = (min(x1, x2), min(y1, y2), max(x1, x2), max(y1, y2))
         self._history[sid].append((event, scan))
 
     def delete(self, sid: int, scan: int) -> None:

@@ -154,10 +154,7 @@ class PlusLocaliser:
         """Every ``scan_stride``-th return within ``max_range``, thesis frame (none without scan refinement)."""
         if not self.params.scan_refinement:
             return np.empty((0, 2))
-        r = np.asarray(ranges, dtype=float)
-        a = np.asarray(angles, dtype=float)
-        keep = np.flatnonzero(np.isfinite(r) & (r > 0.0) & (r <= self._max_range))[:: self.params.scan_stride]
-        return np.ascontiguousarray(np.column_stack([-r[keep] * np.sin(a[keep]), r[keep] * np.cos(a[keep])]))
+        return self._k.scan_points(ranges, angles, self._max_range, self.params.scan_stride)
 
     def pose(
         self,

@@ -334,3 +334,28 @@ def refine_pose(
         if abs(d0) + abs(d1) < 1e-6 and abs(d2) < 1e-7:
             break
     return x, y, phi, info
+
+
+def scan_points(ranges: FloatArray, angles: FloatArray, max_range: float, stride: int) -> FloatArray:
+    """Every ``stride``-th return within ``max_range`` (REP-103 beams), as points ``(n, 2)`` in the thesis frame.
+
+    A return counts when its range is a number, positive and at most
+    ``max_range`` (3.1.3 step 1); ``stride`` counts returns, not beams.
+    """
+    count = 0
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        if r == r and r > 0.0 and r <= max_range:
+            count += 1
+    out = np.empty(((count + stride - 1) // stride, 2))
+    k = 0
+    seen = 0
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        if r == r and r > 0.0 and r <= max_range:
+            if seen % stride == 0:
+                out[k, 0] = -r * math.sin(angles[i])
+                out[k, 1] = r * math.cos(angles[i])
+                k += 1
+            seen += 1
+    return out

@@ -141,6 +141,17 @@ def _partial_args() -> Iterator[tuple[Any, ...]]:
                 yield (near_view, inside, view, taken, poly, math.radians(5.0), 0.4, clip, 0.4, surfaces_only)
 
 
+def _scan_points_args() -> Iterator[tuple[Any, ...]]:
+    for ranges, angles in _scans():
+        for max_range, stride in ((30.0, 2), (5.0, 1), (8.0, 3)):
+            yield (
+                np.ascontiguousarray(ranges, dtype=float),
+                np.ascontiguousarray(angles, dtype=float),
+                max_range,
+                stride,
+            )
+
+
 def _refine_args() -> Iterator[tuple[Any, ...]]:
     """Consecutive views as (current view, last update view): landmarks matched by index, points, starts, priors."""
     rng = np.random.default_rng(7)
@@ -184,6 +195,7 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "clip_parameter": _clip_args,
     "refine_pose": _refine_args,
     "resolve_partial": _partial_args,
+    "scan_points": _scan_points_args,
 }
 
 
