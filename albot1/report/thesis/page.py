@@ -289,7 +289,8 @@ def _parameters(ev: Evidence, sections: list[Section], out: Path) -> list[str]:
         "|---|---|---|---|",
     ]
     for name, reading in READINGS.items():
-        lines.append(f"| `{name}` | {reading.value:g} {reading.unit} | {reading.meaning} | {reading.why} |")
+        value = f"{reading.value:g} {reading.unit}".strip()
+        lines.append(f"| `{name}` | {value} | {reading.meaning} | {reading.why} |")
     lines += [
         "",
         "- Induced odometry error (Experiment 3): the `thesis` degradation, +0.1 m and +1 deg added to every "
