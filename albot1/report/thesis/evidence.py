@@ -60,12 +60,10 @@ class Evidence:
     stores: list[Store]
     notes: list[str] = field(default_factory=list)
 
-    def datasets(self, store: str | None = None) -> list[str]:
-        """Dataset labels with at least one planned cell, in plan order (of one store, or all)."""
+    def datasets(self) -> list[str]:
+        """Dataset labels with at least one planned cell in any store, in plan order."""
         out: list[str] = []
         for s in self.stores:
-            if store is not None and s.name != store:
-                continue
             for rec in s.records:
                 if rec.cell.dataset_label not in out:
                     out.append(rec.cell.dataset_label)

@@ -32,7 +32,7 @@ from albot1.report.plots import (
     robust_points,
     save,
 )
-from albot1.report.thesis.replay import MapState, Replay
+from albot1.report.thesis.replay import Replay
 from albot1.runs.folder import StoredRun
 
 FloatArray = NDArray[np.float64]
@@ -280,8 +280,3 @@ def plot_gap_maps(panels: list[tuple[str, StoredRun, str]], path: Path, title: s
     fig.legend(handles=handles, loc="outside lower center", ncols=4, fontsize=7, frameon=False)
     fig.suptitle(f"{title} (each map anchored at its first pose, as the thesis draws them)", fontsize=9)
     return save(fig, path)
-
-
-def state_count(states: list[MapState]) -> int:
-    """Updates among the states (the first view's initial map is not one)."""
-    return sum(1 for s in states if s.view != "initial")

@@ -109,18 +109,3 @@ def _check_same(run: StoredRun, poses: FloatArray, trace: Any, states: list[MapS
         )
     if isinstance(trace, list) and [int(t["scan"]) for t in trace] != [s.scan for s in states]:
         raise ReportError(f"{run_dir}: the replay's updates differ from the stored update trace")
-
-
-def stored_trace(run_dir: Path) -> list[dict[str, Any]]:
-    """The update trace of a run folder (``extras.json``), or ReportError naming what is missing."""
-    import json
-
-    path = Path(run_dir) / "extras.json"
-    try:
-        extras = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as exc:
-        raise ReportError(f"{path}: cannot read the update trace: {exc}") from None
-    trace = extras.get("update_trace") if isinstance(extras, dict) else None
-    if not isinstance(trace, list):
-        raise ReportError(f"{path}: no update_trace (a run of a method without map updates?)")
-    return trace

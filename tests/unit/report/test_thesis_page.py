@@ -10,6 +10,7 @@ where the numbers exist and "not comparable" with the reason where they do not, 
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import pytest
@@ -18,12 +19,14 @@ from albot1.bench.cells import execute_cell
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
 from albot1.bench.suite import parse_suite
+from albot1.report.errors import ReportError
 from albot1.report.index import build_report
 from albot1.report.thesis import figures
 from albot1.report.thesis.evidence import open_stores
 from albot1.report.thesis.experiments import SQUARE, section_error_tolerance, section_places, section_spacing
 from albot1.report.thesis.figures import MAX_GIF_BYTES
 from albot1.report.thesis.page import write_thesis_page
+from albot1.report.thesis.replay import replay_run
 from albot1.report.thesis.verdicts import HOLDS, NOT_COMPARABLE
 from albot1.settings import get_settings
 
@@ -133,3 +136,19 @@ def test_report_of_a_thesis_store_makes_the_page_its_readme(results: Path, tmp_p
     assert (tmp_path / "report" / "benchmark.md").read_text(encoding="utf-8").startswith("# Benchmark report")
     html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
     assert 'href="README.md"' in html and 'href="benchmark.md"' in html
+
+
+def test_a_replay_that_does_not_reproduce_the_stored_run_is_refused(results: Path, tmp_path: Path) -> None:
+    """The update trace is drawn from a replay only when it reproduces the stored trajectory."""
+    found = open_stores(results).find(SQUARE, "albot1:thesis")
+    assert found.record is not None
+    replay = replay_run(found.record.run_dir)
+    assert [s.view for s in replay.states][0] == "initial" and len(replay.states) > 10
+    copy = tmp_path / "run"
+    shutil.copytree(found.record.run_dir, copy)
+    lines = (copy / "trajectory.tum").read_text().splitlines()
+    last = lines[-1].split()
+    last[1] = f"{float(last[1]) + 0.5:.9f}"  # the stored end pose moved by 0.5 m: not what this code computes
+    (copy / "trajectory.tum").write_text("\n".join([*lines[:-1], " ".join(last)]) + "\n")
+    with pytest.raises(ReportError, match="does not reproduce the stored trajectory"):
+        replay_run(copy)
