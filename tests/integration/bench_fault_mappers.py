@@ -32,7 +32,7 @@ class FaultConfig(BaseModel):
 class FaultMapper:
     name: ClassVar[str] = "fault"
     config_model: ClassVar[type[BaseModel]] = FaultConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = {"default": {}}
+    presets: ClassVar[dict[str, dict[str, Any]]] = {"default": FaultConfig().model_dump()}
 
     def __init__(self, config: FaultConfig, *, seed: int = 0) -> None:
         self.config = config

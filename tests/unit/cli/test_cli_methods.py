@@ -40,7 +40,9 @@ def test_presets_table_of_one_method() -> None:
         "    default  the default column above",
         "    thesis   (same as default)",
         "    exact    motion_model = exact",
-        "    literal  continuation_tolerance_m = 0.0 m, delete_margin_from = boundary",
+        "    literal  continuation_tolerance_m = 0.0 m, end_spacing_max_m = 0.0 m, delete_margin_from = boundary",
+        "    plus     end_spacing_max_m = 0.0 m, surface_fit = tls, motion_model = exact, pose_estimate = robust, "
+        "scan_refinement = true, odometry_prior = adaptive",
     ]
 
 
@@ -55,7 +57,15 @@ def test_presets_json_of_every_method() -> None:
         "default": {},
         "thesis": {},
         "exact": {"motion_model": "exact"},
-        "literal": {"continuation_tolerance_m": 0.0, "delete_margin_from": "boundary"},
+        "literal": {"continuation_tolerance_m": 0.0, "end_spacing_max_m": 0.0, "delete_margin_from": "boundary"},
+        "plus": {
+            "end_spacing_max_m": 0.0,
+            "surface_fit": "tls",
+            "motion_model": "exact",
+            "pose_estimate": "robust",
+            "scan_refinement": True,
+            "odometry_prior": "adaptive",
+        },
     }
     field = next(f for f in albot1["fields"] if f["name"] == "delete_margin_m")
     assert field["unit"] == "m" and field["default"] == 0.4 and field["type"] == "float"
