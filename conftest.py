@@ -3,6 +3,11 @@
 Integration tests take the dataset folder from ``ALBOT1_DATA_DIR`` (set by
 the Makefile and .ci/run when the shared copies exist) and skip with a reason
 naming the missing file otherwise.
+
+The SLAM-corrected logs are taken from the catalog (:func:`corrected_names`),
+never listed by hand, so a test over "every corrected log" covers a manifest
+as soon as it is added; ``tests/unit/data/test_catalog_manifests.py`` checks
+the derived list against the manifests folder and the datasets README.
 """
 
 from __future__ import annotations
@@ -14,7 +19,29 @@ from pathlib import Path
 import matplotlib
 import pytest
 
+from albot1.data import catalog
+
 matplotlib.use("Agg")
+
+#: What marks a SLAM-corrected log in the catalog: its name is ``<site>-corrected`` (datasets/README.md).
+CORRECTED_SUFFIX = "-corrected"
+
+
+def corrected_names() -> list[str]:
+    """The registered SLAM-corrected logs (``acapulco-corrected``, ...), sorted."""
+    return [name for name in catalog.names() if name.endswith(CORRECTED_SUFFIX)]
+
+
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    """A test that takes ``corrected_name`` runs once for each corrected log of the catalog."""
+    if "corrected_name" in metafunc.fixturenames:
+        metafunc.parametrize("corrected_name", corrected_names())
+
+
+@pytest.fixture(scope="session")
+def corrected_logs() -> list[str]:
+    """Every corrected log of the catalog at once (:func:`corrected_names`)."""
+    return corrected_names()
 
 
 def _data_dir() -> Path | None:

@@ -9,15 +9,25 @@ of "memory limit exceeded". A supervisor instead polls the resident set of
 the process and of every process it started (psutil) and kills them when
 the sum passes the limit; the overshoot is bounded by what the tree
 allocates between two polls.
+
+The bench's cell processes (``albot1.bench.limits``) and the external
+programs of wrapped baselines (``albot1.methods.baselines.mrpt.process``)
+are both watched by :func:`supervise`; they differ only in how they wait for
+their child and how they stop it.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
+from typing import Literal
 
 import psutil
 
 MIB = 1024.0 * 1024.0
+
+#: The limit that made :func:`supervise` stop a process tree.
+Stop = Literal["timeout", "memory"]
 
 
 class TreeMemory:
@@ -77,3 +87,47 @@ def kill_tree(process: psutil.Process) -> None:
             member.kill()
         except psutil.Error:
             continue
+
+
+def supervise(
+    process: psutil.Process | None,
+    ended: Callable[[float], bool],
+    *,
+    time_s: float,
+    memory_mb: float,
+    poll_s: float,
+    stop: Callable[[], None] | None = None,
+) -> tuple[Stop | None, float]:
+    """Wait for ``process`` to end, stopping its tree when it passes ``time_s`` seconds or ``memory_mb`` resident.
+
+    ``ended(timeout)`` waits up to ``timeout`` s (at most ``poll_s``) and says
+    whether the process has exited; the caller owns waiting because only it
+    knows how to reap its child (``Popen.wait``, ``os.wait4`` for the child's
+    own resource usage, a multiprocessing ``join``). Between two waits the
+    tree's resident memory is sampled (:class:`TreeMemory`). ``stop`` kills
+    the tree when a limit is passed (default :func:`kill_tree`; a child in a
+    session of its own may rather be stopped by its process group). With
+    ``process`` None (it exited before it could be watched) only the clock is
+    checked and nothing is killed. Returns the limit that stopped it (None:
+    it ended by itself) and the peak resident memory seen, MiB.
+    """
+    deadline = time.monotonic() + time_s
+    limit = memory_mb * MIB
+    memory = TreeMemory(process) if process is not None else None
+    stopped: Stop | None = None
+    while True:
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            stopped = "timeout"
+        elif ended(min(poll_s, remaining)):
+            break
+        elif memory is not None and memory.sample() > limit:
+            stopped = "memory"
+        if stopped is not None:
+            if process is not None and stop is not None:
+                stop()
+            elif process is not None:
+                kill_tree(process)
+            break
+    peak = memory.peak_bytes / MIB if memory is not None else 0.0
+    return stopped, peak

@@ -463,7 +463,12 @@ class RelationLoops(Record):
 
 
 class RelationsBlock(Record):
-    """``relations``: the Kuemmerle et al. (2009) metric (sample std), with how many relations the run covered."""
+    """``relations``: the Kuemmerle et al. (2009) metric (sample std), with how many relations the run covered.
+
+    ``relations_total`` counts the dataset's relations, ``relations_used`` those scored and
+    ``relations_outside_run`` those left out because an end names a scan the run did not see (a slice of
+    the log; :func:`albot1.data.relations.relations_in_run`), so a slice never drops relations silently.
+    """
 
     alignment: str
     error: str

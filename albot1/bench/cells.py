@@ -1,8 +1,12 @@
 """The work of one cell, as it runs inside the cell's child process.
 
-Open the dataset, take the suite's slice (prefix and stride), run the method
-through :func:`albot1.runs.execute.run_method` (which degrades the odometry
-with the cell's seed), store the run folder and evaluate it. A run folder
+Open the dataset slice the cell names (its label, e.g. ``intel[:4000:2]``,
+reopened by :func:`albot1.data.open.open_sequence`), run the method through
+:func:`albot1.runs.execute.run_method` (which degrades the odometry with the
+cell's seed), store the run folder and evaluate it, exactly as ``albot1 run``
++ ``albot1 evaluate`` do: the run folder keeps the dataset's relations and
+the evaluation decides which of them the slice's scans can be scored on
+(:func:`albot1.data.relations.relations_in_run`), counting the others. A run folder
 that is complete but lacks ``metrics.json`` (the evaluation failed or was
 killed last time) is only re-evaluated, not re-run.
 """
@@ -16,9 +20,7 @@ from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell
 from albot1.bench.plan import register_plugin
 from albot1.config.targets import resolve_target
-from albot1.data.model import Sequence
 from albot1.data.open import open_sequence
-from albot1.data.relations import restrict_relations
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import PreviewRenderer, is_complete, write_run
@@ -27,29 +29,9 @@ from albot1.settings import Settings, get_settings
 __all__ = [
     "config_difference",
     "execute_cell",
-    "open_cell_sequence",
     "renderer_from_target",
     "renderer_target",
-    "restrict_relations",
 ]
-
-
-def open_cell_sequence(cell: Cell, settings: Settings) -> Sequence:
-    """The dataset slice of ``cell`` (its label, e.g. ``intel[:4000:2]``, is what ``open_sequence`` reopens).
-
-    The slice comes from the entry's ``limit``/``stride`` or from the entry's own name (``intel[:4000]``).
-
-    The relations of a slice are restricted to the kept scans
-    (:func:`albot1.data.relations.restrict_relations`, the same stamp matching
-    as the relation metric), so the metric scores exactly the scans the method saw.
-    """
-    sequence = open_sequence(cell.dataset_label, settings=settings)
-    sliced = cell.limit is not None or cell.stride is not None or cell.dataset_label.endswith("]")
-    if not sliced or sequence.relations is None:
-        return sequence
-    return Sequence(
-        sequence.name, sequence.frames, sequence.metadata, restrict_relations(sequence.relations, sequence.timestamps)
-    )
 
 
 def renderer_target(renderer: PreviewRenderer) -> str:
@@ -96,7 +78,7 @@ def execute_cell(
     settings = settings or get_settings()
     run_dir = runs_root / cell.key
     if not is_complete(run_dir):
-        sequence = open_cell_sequence(cell, settings)
+        sequence = open_sequence(cell.dataset_label, settings=settings)
         result = run_method(
             cell.method,
             sequence,

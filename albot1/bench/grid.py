@@ -12,6 +12,9 @@ from typing import Any, Literal
 
 Status = Literal["done", "cached", "failed"]
 FailureKind = Literal["exception", "memory", "timeout", "crash", "config", "executor", "interrupted", "storage"]
+#: The failures that are the method's own (its error, a crash, its limits), which a suite entry may allow
+#: (``allow_failure``); a bad config, a lost executor, an interruption or a full disk never are.
+METHOD_FAILURES: frozenset[FailureKind] = frozenset({"exception", "memory", "timeout", "crash"})
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,8 @@ class Cell:
     target: str | None = None
     error_class: str | None = None
     requires: tuple[str, ...] = ()
+    allow_failure: bool = False
+    """The suite counts this cell's own failure as a finding (not in ``key``: it changes no result)."""
 
     def describe(self) -> str:
         """One line naming the cell for humans (progress, failure lists)."""
@@ -67,6 +72,9 @@ class CellOutcome:
     ``halts_grid``: the failure is not the cell's own and would repeat for
     every cell (the results folder is full or read-only, the cell process
     pool was killed), so the runner starts no further cell.
+    ``allowed``: a failure of the method itself (:data:`METHOD_FAILURES`) in
+    a cell whose suite entry says ``allow_failure``; it is recorded and
+    reported like any other but does not make the bench exit non-zero.
     """
 
     key: str
@@ -78,6 +86,7 @@ class CellOutcome:
     reason: str | None = None
     kind: FailureKind | None = None
     halts_grid: bool = False
+    allowed: bool = False
 
     @classmethod
     def of(
@@ -101,6 +110,7 @@ class CellOutcome:
             reason,
             kind,
             halts_grid,
+            allowed=status == "failed" and cell.allow_failure and kind in METHOD_FAILURES,
         )
 
 

@@ -7,7 +7,7 @@ is only the cell's own peak in a process of its own.
 
 The limits are enforced from outside: the supervisor polls the child's
 resident memory (and that of any process the child started,
-:class:`albot1.processes.TreeMemory`) every :data:`POLL_S` seconds and kills
+:func:`albot1.processes.supervise`) every :data:`POLL_S` seconds and kills
 the tree when it passes ``memory_mb`` or when ``time_s`` has passed. An
 address-space limit inside the child would break the compiled libraries the
 methods load (docs/benchmarking.md, "Memory limit").
@@ -34,13 +34,14 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import psutil
 
+from albot1 import processes
 from albot1.bench.cell_main import process_entry
 from albot1.bench.grid import Cell
-from albot1.processes import MIB, TreeMemory, kill_tree
+from albot1.processes import Stop, kill_tree
 from albot1.runs.folder import write_json
 
 PRELOAD = ["__main__", "albot1.bench.preload"]
@@ -48,8 +49,6 @@ PRELOAD = ["__main__", "albot1.bench.preload"]
 #: overshoot its memory limit by what it allocates in this time.
 POLL_S = 0.05
 _FORKSERVER: Any = None
-
-Stop = Literal["timeout", "memory"]
 
 
 @dataclass(frozen=True)
@@ -125,30 +124,13 @@ def watch(pid: int) -> psutil.Process | None:
 def supervise(
     process: psutil.Process | None, ended: Callable[[float], bool], time_s: float, memory_mb: float
 ) -> tuple[Stop | None, float]:
-    """Wait for ``process`` (``ended(timeout)`` waits up to ``timeout`` s and says whether it has exited).
+    """:func:`albot1.processes.supervise` at the cells' :data:`POLL_S` (the tree is stopped by ``kill_tree``).
 
-    Kills the process and its descendants when their resident memory passes
-    ``memory_mb`` or ``time_s`` seconds have passed; returns the limit that
-    stopped it (None: it ended by itself) and the peak resident memory seen, MiB.
+    ``ended(timeout)`` waits up to ``timeout`` s and says whether the child has
+    exited; returns the limit that stopped it (None: it ended by itself) and
+    the peak resident memory seen, MiB.
     """
-    deadline = time.monotonic() + time_s
-    limit = memory_mb * MIB
-    memory = TreeMemory(process) if process is not None else None
-    stop: Stop | None = None
-    while True:
-        remaining = deadline - time.monotonic()
-        if remaining <= 0:
-            stop = "timeout"
-        elif ended(min(POLL_S, remaining)):
-            break
-        elif memory is not None and memory.sample() > limit:
-            stop = "memory"
-        if stop is not None:
-            if process is not None:
-                kill_tree(process)
-            break
-    peak = memory.peak_bytes / MIB if memory is not None else 0.0
-    return stop, peak
+    return processes.supervise(process, ended, time_s=time_s, memory_mb=memory_mb, poll_s=POLL_S)
 
 
 def _server_fate(server: psutil.Process | None, wait_s: float = 2.0) -> str | None:

@@ -10,6 +10,7 @@ reason, so the report shows the problem next to the results that did run.
 
 from __future__ import annotations
 
+import fnmatch
 import os
 import platform
 import sys
@@ -127,6 +128,14 @@ def _candidate_datasets(suite: Suite) -> list[str]:
                 f"glob over the names {', '.join(known)} (a prefix of every match is `limit = N`), or mark the "
                 "entry `optional = true`"
             )
+    for method in suite.methods:
+        for pattern in method.datasets or ():
+            if not any(fnmatch.fnmatchcase(n, pattern) for n in [*known, *literals]):
+                raise SuiteError(
+                    f"{suite.path or suite.name}: method entry {method.display!r}: datasets pattern {pattern!r} "
+                    f"matches no dataset; expected a glob over the names {', '.join(known)} or a dataset entry's"
+                    " reference"
+                )
     out = [n for n in known if suite.options_for(n) is not None]
     for literal in literals:
         if literal not in out and suite.options_for(literal) is not None:
@@ -243,6 +252,8 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
             for seed, entry in ((s, e) for s in sweep_seeds for e in methods):
                 if opts.methods is not None and entry.display not in opts.methods:
                     continue
+                if not entry.runs_on(name):
+                    continue
                 if seed != sweep_seeds[0] and _runs_once(degradation, entry.name):
                     continue
                 config, problem = resolved[entry.display]
@@ -275,6 +286,7 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
                         target=entry.target,
                         error_class=entry.error_class,
                         requires=entry.requires,
+                        allow_failure=entry.allow_failure,
                     )
                 )
     _check_shared_folders(suite, cells)

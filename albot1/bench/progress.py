@@ -38,7 +38,8 @@ class TqdmProgress:
     def finished(self, outcome: CellOutcome) -> None:
         if outcome.status == "failed":
             self._failed += 1
-            self._write(f"FAILED {outcome.description}: {outcome.reason}")
+            allowed = " (allowed by the suite)" if outcome.allowed else ""
+            self._write(f"FAILED{allowed} {outcome.description}: {outcome.reason}")
         if self._bar is not None and outcome.status != "cached":
             self._bar.update(1)
             self._bar.set_postfix(failed=self._failed, refresh=False)

@@ -67,6 +67,11 @@ class GridSummary:
     def failures(self) -> list[CellOutcome]:
         return [o for o in self.outcomes if o.status == "failed"]
 
+    @property
+    def blocking_failures(self) -> list[CellOutcome]:
+        """The failures that make the bench exit non-zero: all but those the suite allows."""
+        return [o for o in self.failures if not o.allowed]
+
 
 #: Grids of this process that a failure halted (see :func:`_unless_halted`).
 _HALTED_GRIDS: set[str] = set()

@@ -28,6 +28,9 @@ Format (every key optional except ``methods`` and ``datasets``)::
     set = { some_field = 1 }         # config overrides (highest precedence)
     # label = "albot1:thesis"        # defaults to name, or name:preset
     # target = "pkg.mod:Class"       # a method that is not in the registry (your own mapper)
+    # datasets = ["aces", "fr*"]     # only on the selected datasets these globs match; default: all
+    # allow_failure = true           # its failed cells (divergence, crash, limits) are findings:
+                                     # reported with their reason, not a non-zero exit of the bench
 
     [[datasets]]                     # applied in order; later entries override earlier ones
     name = "*"                       # a glob (* and [...]) over dataset and world names, a name, a
@@ -127,6 +130,17 @@ class MethodEntry(_Strict):
     requires: tuple[str, ...] = ()
     time_s: TimeS | None = None
     memory_mb: MemoryMb | None = None
+    datasets: tuple[str, ...] | None = Field(
+        None,
+        description="globs over dataset names: this entry runs only on the datasets the suite selects that match "
+        "one of them (default: on every one); an expensive method runs on the logs it is there for",
+    )
+    allow_failure: bool = Field(
+        False,
+        description="a cell of this entry that ends with the method's own failure (its error, a crash, its time or "
+        "memory limit) is a finding about the method, not a fault of the suite: it is recorded and reported with "
+        "its reason like any failure, but does not make `albot1 bench` exit non-zero",
+    )
 
     @field_validator("target", "error_class")
     @classmethod
@@ -144,6 +158,10 @@ class MethodEntry(_Strict):
         if self.label:
             return self.label
         return self.name if self.preset == "default" else f"{self.name}:{self.preset}"
+
+    def runs_on(self, dataset: str) -> bool:
+        """Whether this entry runs on ``dataset`` (a name or reference the suite selected)."""
+        return self.datasets is None or any(fnmatch.fnmatchcase(dataset, pattern) for pattern in self.datasets)
 
 
 class DatasetEntry(_Strict):

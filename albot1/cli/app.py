@@ -1,9 +1,14 @@
 """The ``albot1`` entry point: assembles the command groups and turns the
 project's known errors into one line on stderr with a non-zero exit.
 
-The command modules import the package at module level; the heavy optional
-libraries (gtsam, kiss-icp, rosbags, matplotlib, dask, ...) are imported only
-by the code that uses them, so ``albot1 --help`` loads none of them.
+Every command module is imported here, as Typer needs each command's
+parameters and help to build ``albot1 --help``; so a command module's top
+imports only Typer, the standard library and the cheap base modules
+(``settings``, ``errors``, ``runs.output``, ``cli.progress``), and each command
+function imports the layers that do its work (data, runs, bench, report and,
+below them, numpy and pydantic) when it runs. ``albot1 --help`` then costs
+about Typer's import, not the whole package's;
+``tests/unit/cli/test_cli_imports.py`` keeps it so.
 """
 
 from __future__ import annotations
@@ -16,7 +21,6 @@ import typer
 
 from albot1 import __version__
 from albot1.errors import Albot1Error
-from albot1.versions import code_version
 
 HELP = """Albot1 perceptual mapping vs SLAM baselines on 2D laser datasets.
 
@@ -40,6 +44,8 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
+        from albot1.versions import code_version  # importlib.metadata: only for --version
+
         typer.echo(f"albot1 {__version__} (code {code_version()})")
         raise typer.Exit()
 

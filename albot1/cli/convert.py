@@ -8,10 +8,6 @@ from typing import Annotated
 import typer
 
 from albot1.cli.progress import with_progress
-from albot1.data.convert import convert as run_conversion
-from albot1.data.loaders.output import check_output
-from albot1.data.open import open_sequence
-from albot1.data.transforms import head
 from albot1.settings import get_settings
 
 FORMAT_HELP = "carmen | ros1 | ros2-sqlite3 | ros2-mcap | albot-log (default: from OUT's name)"
@@ -60,6 +56,12 @@ def convert(
       albot1 convert radish/aces.clf.bz2 aces.mcap\n
       albot1 convert run1/ aces.albotlog --scan-topic /base_scan --odom-topic /odom_raw
     """
+    # The data layer is imported by the command, not by this module: see albot1.cli.app.
+    from albot1.data.convert import convert as run_conversion
+    from albot1.data.loaders.output import check_output
+    from albot1.data.open import open_sequence
+    from albot1.data.transforms import head
+
     options = {
         "scan_topic": scan_topic,
         "odom_topic": odom_topic,

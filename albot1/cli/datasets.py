@@ -13,9 +13,6 @@ from typing import Annotated, Any
 import typer
 
 from albot1.cli.progress import with_progress
-from albot1.data import catalog
-from albot1.data.open import open_sequence
-from albot1.data.synthetic import worlds
 from albot1.settings import get_settings
 
 app = typer.Typer(
@@ -28,6 +25,9 @@ DataDir = Annotated[Path | None, typer.Option(help="dataset folder (default: $AL
 
 def _synthetic_worlds() -> dict[str, str]:
     """Embedded synthetic worlds (name -> description)."""
+    # The data layer is imported by the commands, not by this module: see albot1.cli.app.
+    from albot1.data.synthetic import worlds
+
     return {name: getattr(spec, "description", "") for name, spec in worlds.WORLDS.items()}
 
 
@@ -41,6 +41,8 @@ def list_(
       albot1 datasets list\n
       ALBOT1_DATA_DIR=/data/albot1 albot1 datasets list --json
     """
+    from albot1.data import catalog
+
     settings = get_settings(data_dir=data_dir)
     rows: list[dict[str, Any]] = []
     for name in catalog.names():
@@ -99,6 +101,8 @@ def fetch(
       albot1 datasets fetch intel\n
       ALBOT1_CACHE_DIR=/data/cache albot1 datasets fetch aces
     """
+    from albot1.data import catalog
+
     path = catalog.fetch(name, get_settings(data_dir=data_dir), base_url=base_url)
     typer.echo(f"{name}: {path}")
 
@@ -121,6 +125,8 @@ def info(
       albot1 datasets info intel --json\n
       albot1 datasets info recording.bag --scan-topic /base_scan --odom-topic /odom_raw
     """
+    from albot1.data.open import open_sequence
+
     options = {
         key: value
         for key, value in (("scan_topic", scan_topic), ("odom_topic", odom_topic), ("reference_topic", reference_topic))

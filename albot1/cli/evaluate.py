@@ -5,39 +5,25 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from albot1.cli.progress import with_progress
 from albot1.errors import Albot1Error
-from albot1.records import (
-    METRIC_NAMES,
-    AteBlock,
-    AteWindowsBlock,
-    ClosedRouteGapBlock,
-    DriftBlock,
-    LoopGapBlock,
-    MapShapeBlock,
-    MetricBlock,
-    MetricsRecord,
-    OrientationBlock,
-    RelationsBlock,
-    RpeBlock,
-    UpdatesBlock,
-    dump_record,
-)
-from albot1.runs.evaluate import METRICS_FILE, evaluate_run, evaluate_trajectory
-from albot1.runs.evo_results import write_evo_results
-from albot1.runs.external import MAX_DT_S
-from albot1.runs.folder import read_run
-from albot1.runs.scored import Scored, scored_run
 from albot1.settings import get_settings
+
+if TYPE_CHECKING:
+    from albot1.records import MetricBlock, MetricsRecord
+    from albot1.runs.scored import Scored
 
 DATASET_HELP = (
     "the dataset the trajectory was made on: NAME, NAME[:N] (its first N scans), NAME?key=value "
     "(loader options) or a log path (see `albot1 datasets list`)"
 )
+#: ``albot1.runs.external.MAX_DT_S`` as the help states it; written out so that the help does not import the
+#: runs layer (see albot1.cli.app), kept equal to it by tests/unit/cli/test_cli_evaluate.py.
+MAX_DT_HELP = "largest pose-to-scan time difference (s; default 0.01, evo's t_max_diff)"
 
 
 def register(app: typer.Typer) -> None:
@@ -65,9 +51,7 @@ def evaluate(
     label: Annotated[
         str | None, typer.Option(help="the method's name in the metrics (default: the file's stem)")
     ] = None,
-    max_dt: Annotated[
-        float | None, typer.Option(help=f"largest pose-to-scan time difference (s; default {MAX_DT_S:g})")
-    ] = None,
+    max_dt: Annotated[float | None, typer.Option(help=MAX_DT_HELP)] = None,
     out: Annotated[Path | None, typer.Option(help="with --trajectory: write the metrics JSON to this file")] = None,
     evo: Annotated[
         Path | None,
@@ -93,6 +77,12 @@ def evaluate(
       albot1 evaluate --trajectory cartographer.tum --dataset intel-corrected --out carto.json\n
       albot1 evaluate --trajectory intel.gfs.log --format carmen --dataset aces --evo evo-results/
     """
+    # The runs layer is imported by the command, not by this module: see albot1.cli.app.
+    from albot1.records import dump_record
+    from albot1.runs.evaluate import METRICS_FILE, evaluate_run, evaluate_trajectory
+    from albot1.runs.folder import read_run
+    from albot1.runs.scored import scored_run
+
     settings = get_settings(data_dir=data_dir)
     if (run_dir is None) == (trajectory is None):
         raise typer.BadParameter("give either RUN_DIR or --trajectory FILE (with --dataset NAME), not both")
@@ -135,6 +125,8 @@ def evaluate(
 
 
 def _print_headlines(metrics: MetricsRecord) -> None:
+    from albot1.records import METRIC_NAMES
+
     for name in METRIC_NAMES:
         block = metrics.block(name)
         line = _headline(block) if block is not None else f"null: {metrics.reason(name)}"
@@ -155,6 +147,8 @@ def _note_left_out(metrics: MetricsRecord) -> None:
 
 
 def _evo(scored: Scored, folder: Path, name: str) -> None:
+    from albot1.runs.evo_results import write_evo_results
+
     try:
         written = write_evo_results(scored, folder, prefix=f"{name}.")
     except Albot1Error as exc:
@@ -173,6 +167,19 @@ def _f(value: float | None, fmt: str = ".3f") -> str:
 
 def _headline(block: MetricBlock) -> str:
     """One line per metric for people; the JSON has everything."""
+    from albot1.records import (
+        AteBlock,
+        AteWindowsBlock,
+        ClosedRouteGapBlock,
+        DriftBlock,
+        LoopGapBlock,
+        MapShapeBlock,
+        OrientationBlock,
+        RelationsBlock,
+        RpeBlock,
+        UpdatesBlock,
+    )
+
     f = _f
     if isinstance(block, AteBlock):
         return f"rmse {f(block.rmse_m)} m, max {f(block.max_m)} m ({block.alignment} alignment)"
@@ -202,7 +209,9 @@ def _headline(block: MetricBlock) -> str:
         )
     if isinstance(block, RelationsBlock):
         t, r = block.translation_m, block.rotation_deg
-        return f"{f(t.mean)} +/- {f(t.std)} m, {f(r.mean, '.2f')} +/- {f(r.std, '.2f')} deg, N = {t.n}"
+        outside, total = block.relations_outside_run, block.relations_total
+        left_out = f" ({outside} of {total} relations left out: they name scans the run did not see)" if outside else ""
+        return f"{f(t.mean)} +/- {f(t.std)} m, {f(r.mean, '.2f')} +/- {f(r.std, '.2f')} deg, N = {t.n}{left_out}"
     if isinstance(block, MapShapeBlock):
         return f"precision {f(block.precision)}, coverage {f(block.coverage)} (within {block.tolerance_m} m)"
     if isinstance(block, UpdatesBlock):

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import inspect
 import json
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from albot1.config.describe import describe_presets
-from albot1.config.presets import TomlPresets
-from albot1.methods.registry import METHODS, MethodSpec, get_method
+if TYPE_CHECKING:
+    from albot1.methods.registry import MethodSpec
 
 
 def register(app: typer.Typer) -> None:
@@ -40,6 +39,9 @@ def methods(
       albot1 methods --presets\n
       albot1 methods kiss-icp --json
     """
+    # The registry is imported by the command, not by this module: see albot1.cli.app.
+    from albot1.methods.registry import METHODS, get_method
+
     specs = [get_method(method)] if method is not None else list(METHODS.values())
     detail = presets or method is not None
     records = [_record(spec, detail) for spec in specs]
@@ -72,6 +74,9 @@ def _record(spec: MethodSpec, detail: bool) -> dict[str, Any]:
         record["unavailable"] = f"{spec.unavailable_reason()}" + (f" (install: {hint})" if hint else "")
     if not detail or not record["available"]:
         return record
+    from albot1.config.describe import describe_presets
+    from albot1.config.presets import TomlPresets
+
     cls = spec.load_class()
     source = inspect.getattr_static(cls, "presets")
     description = describe_presets(cls.config_model, cls.presets)

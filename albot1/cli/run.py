@@ -9,14 +9,6 @@ from typing import Annotated
 import typer
 
 from albot1.cli.progress import with_progress
-from albot1.data.degrade import check_seed
-from albot1.data.errors import SliceError
-from albot1.data.open import open_sequence
-from albot1.methods.registry import parse_overrides
-from albot1.records import dump_record
-from albot1.report.preview import render_preview
-from albot1.runs.execute import run_method
-from albot1.runs.folder import mark_latest, read_result, write_run
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
@@ -56,6 +48,16 @@ def run(
       albot1 run albot1 aces --preset thesis --out runs\n
       albot1 run gtsam-graph intel-corrected --degrade gauss:0.1:1 --seed 1
     """
+    # The layers that do the work are imported by the command, not by this module: see albot1.cli.app.
+    from albot1.data.degrade import check_seed
+    from albot1.data.errors import SliceError
+    from albot1.data.open import open_sequence
+    from albot1.methods.registry import parse_overrides
+    from albot1.records import dump_record
+    from albot1.report.preview import render_preview
+    from albot1.runs.execute import run_method
+    from albot1.runs.folder import mark_latest, read_result, write_run
+
     # Bad arguments fail before the log is opened and the method runs, not after.
     overrides = parse_overrides(set_ or [])
     check_seed(seed)

@@ -9,8 +9,6 @@ from typing import Annotated, Any
 
 import typer
 
-from albot1.runs.folder import LATEST, list_runs
-
 
 def register(app: typer.Typer) -> None:
     app.command("runs")(runs)
@@ -32,6 +30,9 @@ def runs(
       albot1 runs\n
       albot1 runs results/quick/runs --json | jq '.runs[] | select(.status == "failed")'
     """
+    # The runs layer is imported by the command, not by this module: see albot1.cli.app.
+    from albot1.runs.folder import LATEST, list_runs
+
     listing = list_runs(root)
     latest_link = root / LATEST
     latest = latest_link.resolve().name if latest_link.is_symlink() else None

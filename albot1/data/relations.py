@@ -11,7 +11,8 @@ and ``#`` comments are allowed; a file without relations gives zero relations
 A relation names its two poses by timestamp, and those are the timestamps
 of scans, so :func:`match_stamps` is the one place where a relation end is
 turned into a scan index: the nearest scan stamp, accepted within
-:data:`STAMP_TOLERANCE_S`. Scan stamps need not be sorted: the Intel log's
+:data:`STAMP_TOLERANCE_S`, and :func:`relations_in_run` the one place that
+decides which relations a run on part of a log is scored on. Scan stamps need not be sorted: the Intel log's
 ipc stamps go back by up to 0.9 s at 631 places, which is also why 6 of
 ``intel.relations``' lines have ``t2 < t1`` -- the scan stamped ``t1``
 comes *first* in the log and the relation, read as written
@@ -109,19 +110,20 @@ def match_stamps(timestamps: ArrayLike, query: ArrayLike) -> tuple[NDArray[np.in
     return order[pick].astype(np.int64), np.abs(ts[pick] - q)
 
 
-def restrict_relations(
+def relations_in_run(
     relations: Relations, timestamps: ArrayLike, tolerance_s: float = STAMP_TOLERANCE_S
-) -> Relations | None:
-    """The relations whose two ends are both among ``timestamps`` (None when none are).
+) -> NDArray[np.bool_]:
+    """Which of ``relations`` apply to a run that saw the scans stamped ``timestamps`` (a mask, one per relation).
 
-    A run on a slice of a log (a prefix, every n-th scan) must be scored only on the scans it saw.
+    A relation applies when both its ends are within ``tolerance_s`` of one of the run's scan stamps: a run
+    on part of a log (a prefix, every n-th scan) has no pose for a scan it did not see, so a relation naming
+    one cannot be scored. This is the one rule for ``albot1 run`` + ``albot1 evaluate``, the bench's cells
+    and external trajectories alike (the relation metric applies it when it excludes); its callers count
+    what it leaves out and report it (``relations_outside_run`` in ``metrics.json``), never drop it silently.
     """
-    t = np.asarray(timestamps, dtype=float)
+    t = np.asarray(timestamps, dtype=float).reshape(-1)
     if len(t) == 0 or len(relations) == 0:
-        return None
+        return np.zeros(len(relations), dtype=bool)
     _, gap1 = match_stamps(t, relations.t1)
     _, gap2 = match_stamps(t, relations.t2)
-    mask = (gap1 <= tolerance_s) & (gap2 <= tolerance_s)
-    if not mask.any():
-        return None
-    return Relations(t1=relations.t1[mask], t2=relations.t2[mask], poses=relations.poses[mask])
+    return np.asarray((gap1 <= tolerance_s) & (gap2 <= tolerance_s), dtype=bool)

@@ -16,7 +16,7 @@ import importlib.util
 import inspect
 import shutil
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from pydantic import BaseModel
 
@@ -24,8 +24,12 @@ from albot1.config.env import method_prefix
 from albot1.config.keyvalue import parse_key_values
 from albot1.config.resolve import ResolvedConfig, resolve
 from albot1.config.targets import TargetError, check_target, resolve_class
-from albot1.contract import Mapper
 from albot1.methods.errors import UnknownMethodError
+
+if TYPE_CHECKING:
+    # For the types only: the contract imports the data layer (numpy, the records), which listing the
+    # methods (`albot1 methods`) does not need; a mapper class's own module imports it when loaded.
+    from albot1.contract import Mapper
 
 #: What a class must define to be run as a mapper (:class:`albot1.contract.Mapper`).
 MAPPER_ATTRIBUTES = ("name", "config_model", "presets", "process", "finish")
@@ -42,7 +46,7 @@ def load_mapper_class(target: str) -> type[Mapper]:
     missing = [name for name in MAPPER_ATTRIBUTES if _static_attr(cls, name) is None]
     if missing:
         raise TargetError(f"{target}: not a mapper class, it lacks {', '.join(missing)} (see albot1.contract.Mapper)")
-    return cast(type[Mapper], cls)
+    return cast("type[Mapper]", cls)
 
 
 def _static_attr(cls: type, name: str) -> object | None:

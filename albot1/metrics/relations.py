@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from albot1.data.model import Relations
-from albot1.data.relations import STAMP_TOLERANCE_S, match_stamps
+from albot1.data.relations import STAMP_TOLERANCE_S, match_stamps, relations_in_run
 from albot1.geometry import se2
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.stats import summarize
@@ -53,11 +53,12 @@ def relation_errors(
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """``(errors (K, 3), used mask (M,))``: the error pose of each used relation.
 
-    A relation whose time lies within the trajectory's span but more than
-    ``max_gap_s`` from every scan is a MetricsError naming its line in
-    ``source`` (1-based). Relations entirely outside the span (a run on a
-    prefix of the log) raise too unless ``outside="exclude"``, in which case
-    the mask says which were used and callers report how many were not.
+    With ``outside="error"`` every relation must name two scans of the
+    trajectory: one with a time more than ``max_gap_s`` from every scan is a
+    MetricsError naming its line in ``source`` (1-based). With
+    ``outside="exclude"`` (a run on part of a log: a prefix, every n-th scan)
+    the relations used are those :func:`albot1.data.relations.relations_in_run`
+    says apply to these scans, and the mask tells callers how many were not.
     """
     t = np.asarray(timestamps, dtype=float)
     est = np.asarray(poses, dtype=float)
@@ -65,10 +66,10 @@ def relation_errors(
         raise MetricsError(f"relations: expected {len(t)} poses (x, y, theta), one per timestamp, got {est.shape}")
     if len(t) == 0:
         raise MetricsError("relations: the trajectory has no poses to look relations up in")
-    used = np.ones(len(relations), dtype=bool)
     if outside == "exclude":
-        lo, hi = t.min() - max_gap_s, t.max() + max_gap_s
-        used = (relations.t1 >= lo) & (relations.t1 <= hi) & (relations.t2 >= lo) & (relations.t2 <= hi)
+        used = relations_in_run(relations, t, max_gap_s)
+    else:
+        used = np.ones(len(relations), dtype=bool)
     i1, gap1 = match_stamps(t, relations.t1)
     i2, gap2 = match_stamps(t, relations.t2)
     bad = np.flatnonzero(used & ((gap1 > max_gap_s) | (gap2 > max_gap_s)))

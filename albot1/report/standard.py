@@ -86,7 +86,13 @@ def _full_log_cell(rec: CellRecord) -> bool:
 
 
 def measured_rows(records: list[CellRecord]) -> list[Row]:
-    """A row per (standard log, method label) the results hold on the whole log (first seed of each)."""
+    """A row per (standard log, method label) the results hold on the whole log (first seed of each).
+
+    A method the suite ran on some standard logs but not on another gets a
+    "not measured" row there, so a missing figure reads as a choice of the
+    suite (an expensive method on the logs that fit its budget), not as a
+    gap in the table.
+    """
     rows: list[Row] = []
     seen: set[tuple[str, str]] = set()
     for rec in records:
@@ -97,6 +103,12 @@ def measured_rows(records: list[CellRecord]) -> list[Row]:
             continue
         seen.add(key)
         rows.append(_measured(rec))
+    measured_logs = {log for log, _ in seen}
+    for method in dict.fromkeys(method for _, method in seen):
+        for log in STANDARD_LOGS:
+            if log in measured_logs and (log, method) not in seen:
+                note = "not in this suite's grid for this log (see the suite file)"
+                rows.append(Row(log, "measured", method, status="not measured", note=note))
     return rows
 
 
@@ -215,6 +227,15 @@ def _machine(plan: GridPlan) -> str:
     )
 
 
+def _unpublished() -> list[str]:
+    """One line per published system with no verified figure on these logs (a finding, with what was searched)."""
+    return [
+        f"- {system.label}: no published figure on these logs. {system.searched} ({system.implementation})"
+        for system in published_systems()
+        if not any(f.log in STANDARD_LOGS for f in system.figures)
+    ]
+
+
 def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str:
     """The Markdown page (see the module docstring)."""
     lines = [
@@ -256,6 +277,15 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
                 values.append(_num(entry.translation_mean_m, 4))
         lines.append(f"| {name} | " + " | ".join(values) + " |")
     lines += ["", "`–`: no figure (not run here / not published for that log).", ""]
+    if plan.skipped_methods:
+        lines += [
+            "Methods not run on this machine: "
+            + "; ".join(
+                f"{s.name} ({s.reason}" + (f"; `{s.hint}`" if s.hint else "") + ")" for s in plan.skipped_methods
+            )
+            + ".",
+            "",
+        ]
     for log, title in STANDARD_LOGS.items():
         lines += [f"## {log}: {title}", ""]
         log_rows = [r for r in rows if r.log == log]
@@ -280,6 +310,9 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
         "FLIRT were checked against the text of Hess et al. (2016), Tables II, III and V.",
         "- fr-clinic is the local relations set (no relation longer than 5 m); Hess et al. also report a global "
         "set, which is not used here.",
+        "- A **failed** measured row is the method's own failure on that log (a divergence caught by its checks, a "
+        "crash, its time or memory limit), recorded with its reason: a finding about the method, not a missing run.",
+        *_unpublished(),
         "",
     ]
     return "\n".join(lines)

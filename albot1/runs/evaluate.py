@@ -18,6 +18,9 @@ Missing metrics. Every metric has one top-level key (``ate``,
 ``relations``, ``map_shape``, ``updates``, ``cost``). When a metric cannot be computed its key is ``null`` and the key
 ``<metric>_reason`` beside it says why (no reference poses, no relations
 file, the dataset cannot be opened, inputs that do not fit together...).
+The relation metric scores the relations whose two scans the run saw and
+says how many it left out (``relations_total``, ``relations_used``,
+``relations_outside_run``).
 A computed metric never has a ``_reason`` key. Numbers are never invented to
 fill a slot. The file is an :class:`albot1.records.MetricsRecord`: it is
 validated against that model before it is written, so a metric whose block
@@ -152,6 +155,9 @@ def score(scored: Scored, *, settings: Settings | None = None, source: str = "me
         )
         put("orientation", lambda: orientation_table(poses, reference, scored.timestamps))
 
+    # A run folder keeps every relation of its dataset, whether from `albot1 run` or a bench cell; the ones
+    # the run's scans cannot score (a slice: a prefix, every n-th scan) are left out here, by the one rule
+    # (albot1.data.relations.relations_in_run), and counted in the block (relations_outside_run).
     relations = scored.relations
     put(
         "relations",

@@ -59,6 +59,32 @@ def test_bench_exits_1_after_the_whole_grid_when_a_cell_failed(tmp_path: Path) -
     assert (tmp_path / "results" / "onefails" / "grid.json").is_file()
 
 
+def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(tmp_path: Path) -> None:
+    fault = 'target = "bench_fault_mappers:FaultMapper"\n'
+    suite = tmp_path / "allowed.toml"
+    suite.write_text(
+        '[[methods]]\nname = "odometry"\n\n'
+        f'[[methods]]\nname = "fault"\n{fault}set = {{ mode = "raise", at_scan = 3 }}\nallow_failure = true\n\n'
+        '[[datasets]]\nname = "synthetic-office-startstop"\n'
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent), *sys.path]))
+    args = [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+    args += ["--results", str(tmp_path / "results"), "--no-progress"]
+    done = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    assert "FAILED (allowed by the suite) fault on synthetic-office-startstop" in done.stderr
+    assert "injected fault at scan 3" in done.stderr
+    assert done.stderr.strip().splitlines()[-1] == (
+        "1 of 2 cells failed (reasons above and in the report); 1 of them by methods the suite allows to fail "
+        "(allow_failure)"
+    )
+    # A failure that is not the method's own (a bad config) is never allowed: the exit says so.
+    suite.write_text(suite.read_text().replace('mode = "raise"', 'mode = "nonsense"'))
+    done = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=env)
+    assert done.returncode == 1, done.stderr
+    assert "1 of 2 cells failed" in done.stderr and "allow" not in done.stderr.strip().splitlines()[-1]
+
+
 def _albot1(tmp_path: Path, *args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [sys.executable, "-c", "from albot1.cli.app import main; main()", *args],

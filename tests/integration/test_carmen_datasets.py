@@ -58,28 +58,9 @@ def test_fr_clinic_from_robotlaser1(data_file: DataFile) -> None:
     assert seq.metadata.sensor_offset[0] == pytest.approx(0.22, abs=1e-6)
 
 
-@pytest.mark.parametrize(
-    "site",
-    [
-        "acapulco",
-        "aces",
-        "belgioioso",
-        "csail",
-        "edmonton",
-        "fhw",
-        "freiburg-079",
-        "freiburg-101",
-        "freiburg-campus",
-        "infinite-corridor",
-        "intel",
-        "orebro",
-        "seattle",
-    ],
-)
-def test_every_corrected_log_has_reference_poses(data_file: DataFile, site: str) -> None:
-    seq = catalog.open_dataset(
-        f"{site}-corrected", settings_for(data_file, f"radish-corrected/{site}-corrected.log.gz")
-    )
+def test_every_corrected_log_has_reference_poses(data_file: DataFile, corrected_name: str) -> None:
+    """One case per corrected log of the catalog (``corrected_name``: the root conftest derives them)."""
+    seq = catalog.open_dataset(corrected_name, settings_for(data_file, catalog.get(corrected_name).log.path))
     frames = [f for _, f in zip(range(50), seq.frames())]
     assert len(frames) == 50 and all(f.reference is not None for f in frames)
 

@@ -1,14 +1,15 @@
-"""Resident memory of a process tree and killing it (real child processes, a few MB each)."""
+"""Resident memory of a process tree, killing it, and watching it under limits (real child processes)."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 
 import psutil
 
-from albot1.processes import MIB, TreeMemory, kill_tree
+from albot1.processes import MIB, TreeMemory, kill_tree, supervise
 
 #: A child that starts a grandchild, then holds ~64 MiB of touched memory until killed.
 PARENT = """
@@ -57,3 +58,69 @@ def test_kill_tree_of_a_process_that_is_gone_does_nothing() -> None:
     process = psutil.Process(proc.pid)
     proc.wait()
     kill_tree(process)  # the pid may even be reused by now: psutil refuses to signal a stranger
+
+
+#: Touches ``{mb}`` MiB, then waits to be killed.
+HOLD = """
+import time
+block = bytearray({mb} * 2**20)
+for i in range(0, len(block), 4096):
+    block[i] = 1
+time.sleep(600)
+"""
+
+
+def _ended(proc: subprocess.Popen[bytes]) -> Callable[[float], bool]:
+    """``supervise``'s wait: a poll after each pause is precise enough for these tests."""
+
+    def ended(timeout: float) -> bool:
+        time.sleep(timeout)
+        return proc.poll() is not None
+
+    return ended
+
+
+def test_supervise_stops_a_tree_over_its_memory_limit_with_the_callers_stop() -> None:
+    proc = subprocess.Popen([sys.executable, "-c", HOLD.format(mb=160)])
+    stops: list[int] = []
+
+    def stop() -> None:
+        stops.append(proc.pid)
+        proc.kill()
+
+    try:
+        stopped, peak = supervise(
+            psutil.Process(proc.pid), _ended(proc), time_s=60, memory_mb=100, poll_s=0.05, stop=stop
+        )
+        assert stopped == "memory" and stops == [proc.pid]
+        assert 100 < peak < 400
+        assert proc.wait(timeout=10) == -9
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_supervise_times_out_and_kills_the_tree_by_default() -> None:
+    proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    try:
+        start = time.monotonic()
+        stopped, peak = supervise(psutil.Process(proc.pid), _ended(proc), time_s=0.3, memory_mb=1024, poll_s=0.05)
+        assert stopped == "timeout" and 0.3 <= time.monotonic() - start < 5
+        assert peak > 1
+        assert proc.wait(timeout=10) == -9  # kill_tree
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_supervise_of_a_process_that_could_not_be_watched_checks_only_the_clock() -> None:
+    waits: list[float] = []
+
+    def ended(timeout: float) -> bool:
+        waits.append(timeout)
+        time.sleep(timeout)
+        return len(waits) == 3
+
+    assert supervise(None, ended, time_s=60, memory_mb=0, poll_s=0.01) == (None, 0.0)
+    assert waits == [0.01, 0.01, 0.01]
+    assert supervise(None, lambda timeout: False, time_s=0.05, memory_mb=0, poll_s=0.01) == ("timeout", 0.0)

@@ -682,8 +682,8 @@ def section_public(ev: Evidence) -> Section:
         "Every public log of the default suite with ground-truth relations, scored with the relation metric of "
         "Kuemmerle et al. (2009) as the standard benchmark scores it (docs/metrics.md). We read 'reasonable "
         "shape' as a relation error below the raw odometry's (the map Albot1 starts from); the RBPF (`mrpt-rbpf`, "
-        "run by this suite on `mit-csail`: the default suite runs no MRPT) and graph (`gtsam-graph`) baselines are "
-        "shown beside it, without a verdict: the thesis made no claim about them here.",
+        "run by the default suite on the standard logs where it fits its budget) and graph (`gtsam-graph`) "
+        "baselines are shown beside it, without a verdict: the thesis made no claim about them here.",
     )
     datasets = [
         d

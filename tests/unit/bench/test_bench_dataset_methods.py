@@ -1,4 +1,5 @@
-"""A dataset entry's `methods`: only the named method entries run on it; a label that names none is an error."""
+"""Which method entries run on which datasets (a dataset entry's `methods`, a method entry's `datasets`), and
+`allow_failure`."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from albot1.bench.errors import SuiteError
+from albot1.bench.grid import CellOutcome
 from albot1.bench.plan import plan_suite
 from albot1.bench.suite import load_suite
 from albot1.settings import Settings
@@ -66,3 +68,51 @@ def test_a_method_label_that_names_no_method_entry_is_an_error_of_the_suite(tmp_
     message = str(caught.value)
     assert str(path) in message and "'albot1:plus' name no method entry" in message
     assert "'albot1:thesis'" in message  # the labels that exist
+
+
+def test_a_method_entrys_datasets_restrict_it_to_the_datasets_its_globs_match(tmp_path: Path) -> None:
+    text = SUITE.replace(
+        'name = "albot1"\npreset = "thesis"', 'name = "albot1"\npreset = "thesis"\ndatasets = ["*-corridor"]'
+    )
+    assert _plan(tmp_path, text) == [
+        ("synthetic-corridor", "albot1:literal"),
+        ("synthetic-office-startstop", "albot1:literal"),
+        ("synthetic-office-startstop", "odometry"),
+    ]  # albot1:thesis is on no dataset: the corridor entry lists albot1:literal only
+
+
+def test_a_method_entrys_datasets_glob_that_matches_no_dataset_is_an_error(tmp_path: Path) -> None:
+    path = tmp_path / "tiny.toml"
+    path.write_text(SUITE.replace('name = "odometry"', 'name = "odometry"\ndatasets = ["no-such-log*"]'))
+    with pytest.raises(SuiteError) as caught:
+        plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    assert "method entry 'odometry': datasets pattern 'no-such-log*' matches no dataset" in str(caught.value)
+
+
+def test_allow_failure_reaches_the_cells_and_allows_only_the_methods_own_failures(tmp_path: Path) -> None:
+    path = tmp_path / "tiny.toml"
+    path.write_text(SUITE.replace('name = "odometry"', 'name = "odometry"\nallow_failure = true'))
+    plan = plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    odometry = next(c for c in plan.cells if c.method_label == "odometry")
+    other = next(c for c in plan.cells if c.method_label != "odometry")
+    assert odometry.allow_failure and not other.allow_failure
+    for kind in ("exception", "memory", "timeout", "crash"):
+        assert CellOutcome.of(odometry, "failed", 1.0, "x", kind).allowed  # type: ignore[arg-type]
+        assert not CellOutcome.of(other, "failed", 1.0, "x", kind).allowed  # type: ignore[arg-type]
+    for kind in ("config", "executor", "interrupted", "storage"):
+        assert not CellOutcome.of(odometry, "failed", 1.0, "x", kind).allowed  # type: ignore[arg-type]
+    assert not CellOutcome.of(odometry, "done", 1.0).allowed
+    # Not part of the run's identity: allowing a failure changes no result.
+    assert odometry.key == next(
+        c.key
+        for c in plan_suite(
+            load_suite(_write(tmp_path, SUITE)), Settings(data_dir=None, cache_dir=tmp_path / "c")
+        ).cells
+        if c.method_label == "odometry" and c.dataset_label == odometry.dataset_label
+    )
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "plain.toml"
+    path.write_text(text)
+    return path

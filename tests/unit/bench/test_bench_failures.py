@@ -301,20 +301,3 @@ def test_the_file_system_state_names_a_full_or_read_only_results_folder(
     assert job.file_system_state(tmp_path) == "no space left on device (no free inodes)"
     monkeypatch.setattr(os, "statvfs", lambda path: fake(f_flag=os.ST_RDONLY))
     assert job.file_system_state(tmp_path) == "read-only file system"
-
-
-def test_a_slice_in_the_entrys_own_name_restricts_the_relations_like_a_limit(monkeypatch: pytest.MonkeyPatch) -> None:
-    import numpy as np
-
-    from albot1.bench import cells
-    from albot1.data.model import Frame, Relations, Scan, Sequence
-    from albot1.settings import Settings
-
-    frames = [Frame(i, Scan(np.ones(3), np.zeros(3), float(i), 10.0), np.zeros(3)) for i in range(3)]
-    relations = Relations(np.array([0.0, 1.0]), np.array([1.0, 5.0]), np.zeros((2, 3)))
-    monkeypatch.setattr(cells, "open_sequence", lambda ref, **_: Sequence.from_frames(ref, frames, relations=relations))
-    settings = Settings(data_dir=None, cache_dir=Path("unused"))
-    kept = cells.open_cell_sequence(make_cell(dataset_label="log[:3]"), settings).relations
-    assert kept is not None and list(kept.t2) == [1.0]  # the pair reaching scan time 5 is outside the slice
-    whole = cells.open_cell_sequence(make_cell(dataset_label="log"), settings).relations
-    assert whole is relations

@@ -5,17 +5,14 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from albot1.bench.cell_main import ERROR_FILE, EXIT_EXCEPTION, EXIT_MEMORY, EXIT_STORAGE
-from albot1.bench.cells import restrict_relations
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.job import judge
 from albot1.bench.limits import ChildExit
 from albot1.bench.store import ResultsStore
-from albot1.data.model import Relations
 
 
 def make_cell(**changes: object) -> Cell:
@@ -158,16 +155,3 @@ def test_judge_accepts_a_complete_cell(tmp_path: Path) -> None:
     (run_dir / "DONE").write_text("k1\n")
     (run_dir / "metrics.json").write_text("{}")
     assert judge(make_cell(), store, ChildExit(0, False, 1.0)) is None
-
-
-def test_restrict_relations_keeps_pairs_whose_both_ends_were_kept() -> None:
-    relations = Relations(
-        t1=np.array([0.0, 1.0, 2.0, 0.0]),
-        t2=np.array([1.0, 3.0, 4.0, 4.0]),
-        poses=np.arange(12, dtype=float).reshape(4, 3),
-    )
-    kept = restrict_relations(relations, np.array([0.0, 1.0, 2.0, 4.0]))
-    assert kept is not None
-    np.testing.assert_array_equal(kept.t1, [0.0, 2.0, 0.0])
-    np.testing.assert_array_equal(kept.poses[:, 0], [0.0, 6.0, 9.0])
-    assert restrict_relations(relations, np.array([10.0])) is None

@@ -9,7 +9,9 @@ import pytest
 from typer.testing import CliRunner
 
 from albot1.cli.app import app
+from albot1.cli.evaluate import MAX_DT_HELP
 from albot1.records import METRIC_NAMES, MapShapeBlock, MetricsRecord, Timing, parse_record, read_record
+from albot1.runs.external import MAX_DT_S
 from albot1.runs.folder import read_result
 
 runner = CliRunner()
@@ -72,3 +74,9 @@ def test_evaluate_prints_one_headline_per_metric_in_file_order(run_dir: Path) ->
     assert by_name["ate"] == f"rmse {record.ate.rmse_m:.3f} m, max {record.ate.max_m:.3f} m (rigid alignment)"
     assert by_name["relations"] == "null: the dataset has no ground-truth relations"
     assert by_name["updates"] == "120 updates / 120 views"
+
+
+def test_the_max_dt_help_states_the_default_the_runs_layer_uses() -> None:
+    # The help writes the value out (the CLI module does not import the runs layer); it must stay the same.
+    assert f"default {MAX_DT_S:g}," in MAX_DT_HELP
+    assert MAX_DT_HELP in runner.invoke(app, ["evaluate", "--help"], env={"COLUMNS": "400"}).stdout

@@ -8,23 +8,9 @@ import pytest
 
 from albot1.data import catalog
 from albot1.data.errors import DatasetNotFoundError
+from albot1.resources import shipped_dir
 from albot1.settings import Settings
 
-SITES = [
-    "acapulco",
-    "aces",
-    "belgioioso",
-    "csail",
-    "edmonton",
-    "fhw",
-    "freiburg-079",
-    "freiburg-101",
-    "freiburg-campus",
-    "infinite-corridor",
-    "intel",
-    "orebro",
-    "seattle",
-]
 RAW = ["intel", "aces", "fr079", "mit-csail", "fr-clinic"]
 PINNED = re.compile(
     r"^https://raw\.githubusercontent\.com/("
@@ -34,9 +20,22 @@ PINNED = re.compile(
 )
 
 
-def test_every_dataset_of_the_readme_is_registered() -> None:
-    expected = set(RAW) | {"mit-killian"} | {f"{s}-corrected" for s in SITES}
-    assert expected <= set(catalog.names())
+#: The SLAM-corrected logs the project registers (datasets/*-corrected.toml).
+CORRECTED_LOGS = 13
+
+
+def test_the_corrected_logs_derived_from_the_catalog_are_the_manifests_folders(corrected_logs: list[str]) -> None:
+    """The root conftest's list (every test over "each corrected log" uses it) against the files themselves."""
+    files = sorted(p.stem for p in shipped_dir("datasets").glob("*-corrected.toml"))
+    assert len(files) == CORRECTED_LOGS
+    assert corrected_logs == files
+
+
+def test_every_dataset_of_the_readme_is_registered(corrected_logs: list[str]) -> None:
+    readme = (shipped_dir("datasets") / "README.md").read_text(encoding="utf-8")
+    listed = set(re.findall(r"`([a-z0-9-]+-corrected)`", readme))
+    assert listed == set(corrected_logs)
+    assert set(RAW) | {"mit-killian"} | listed <= set(catalog.names())
 
 
 @pytest.mark.parametrize("name", catalog.names())
@@ -50,16 +49,17 @@ def test_manifest_fields(name: str) -> None:
             assert f.urls and all(PINNED.match(u) and u.endswith(f.path.split("/")[-1]) for u in f.urls)
 
 
-def test_corrected_logs_take_reference_from_the_flaser_pose() -> None:
-    for site in SITES:
-        loader = catalog.get(f"{site}-corrected").loader
-        assert loader["reference"] == "laser-pose"
-        assert loader["odometry"] == ("laser-pose" if site == "orebro" else "odom-segments")
+def test_corrected_logs_take_reference_from_the_flaser_pose(corrected_name: str) -> None:
+    manifest = catalog.get(corrected_name)
+    assert manifest.log.path == f"radish-corrected/{corrected_name}.log.gz"
+    assert manifest.loader["reference"] == "laser-pose"
+    assert manifest.loader["odometry"] == ("laser-pose" if corrected_name == "orebro-corrected" else "odom-segments")
 
 
 def test_mit_killian_is_local_only_and_aces_has_relations() -> None:
-    assert catalog.get("mit-killian").local_only and not catalog.get("mit-killian").file("log").urls
-    assert catalog.get("aces").file("relations").path == "radish/aces.relations"
+    assert catalog.get("mit-killian").local_only and not catalog.get("mit-killian").log.urls
+    relations = catalog.get("aces").file("relations")
+    assert relations is not None and relations.path == "radish/aces.relations"
 
 
 @pytest.mark.parametrize(

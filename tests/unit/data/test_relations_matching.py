@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from albot1.data.model import Relations
-from albot1.data.relations import STAMP_TOLERANCE_S, match_stamps, restrict_relations
+from albot1.data.relations import STAMP_TOLERANCE_S, match_stamps, relations_in_run
 
 
 def test_nearest_stamp_and_gap_in_sorted_stamps() -> None:
@@ -37,15 +37,25 @@ def test_empty_stamps_are_refused() -> None:
         match_stamps([], [1.0])
 
 
-def test_restrict_keeps_pairs_whose_both_ends_are_kept_scans_with_rounded_stamps() -> None:
+def test_a_relation_applies_when_both_ends_are_scans_of_the_run_with_rounded_stamps() -> None:
     relations = Relations(
         t1=np.array([100.00001, 101.0, 102.0, 100.0]),
         t2=np.array([101.0, 103.0, 104.0, 104.00003]),
         poses=np.arange(12, dtype=float).reshape(4, 3),
     )
-    kept = restrict_relations(relations, np.array([104.0, 100.0, 101.0, 102.0]))
-    assert kept is not None
-    np.testing.assert_array_equal(kept.t1, [100.00001, 102.0, 100.0])
-    np.testing.assert_array_equal(kept.poses[:, 0], [0.0, 6.0, 9.0])
-    assert restrict_relations(relations, np.array([100.5])) is None
-    assert restrict_relations(relations, np.array([])) is None
+    assert relations_in_run(relations, np.array([104.0, 100.0, 101.0, 102.0])).tolist() == [True, False, True, True]
+    assert relations_in_run(relations, np.array([100.5])).tolist() == [False] * 4
+    assert relations_in_run(relations, np.array([])).tolist() == [False] * 4
+
+
+def test_a_relation_naming_a_skipped_scan_inside_the_runs_time_span_does_not_apply() -> None:
+    """Every second scan of 0..9 s: (0, 1) lies inside the run's time span, but scan 1 was not seen."""
+    kept = np.arange(0.0, 10.0, 2.0)
+    relations = Relations(np.array([0.0, 2.0, 8.0, 3.0]), np.array([1.0, 8.0, 2.0, 4.0]), np.zeros((4, 3)))
+    assert relations_in_run(relations, kept).tolist() == [False, True, True, False]
+
+
+def test_the_tolerance_decides_a_near_stamp() -> None:
+    relations = Relations(np.array([0.0]), np.array([1.0 + 2e-4]), np.zeros((1, 3)))
+    assert relations_in_run(relations, np.array([0.0, 1.0])).tolist() == [False]
+    assert relations_in_run(relations, np.array([0.0, 1.0]), tolerance_s=3e-4).tolist() == [True]

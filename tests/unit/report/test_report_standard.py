@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from albot1.bench.grid import Cell, GridPlan, Skipped
+from albot1.bench.store import Failure
 from albot1.data.model import Frame, Relations, Scan, Sequence
 from albot1.geometry import se2
 from albot1.methods.baselines.published import published_systems
@@ -127,3 +128,26 @@ def test_the_page_and_csv_keep_measured_and_published_rows_apart(tmp_path: Path)
     assert {r["log"] for r in rows} <= set(STANDARD_LOGS)
     measured = [r for r in rows if r["kind"] == "measured"]
     assert len(measured) == 1 and measured[0]["source"].startswith("this suite, run ")
+
+
+def test_a_failed_method_a_method_left_out_of_a_log_and_unrun_systems_are_said_so(tmp_path: Path) -> None:
+    aces, intel = _record(tmp_path / "a", "aces"), _record(tmp_path / "i", "intel")
+    reason = "mrpt-rbpf: rbpf-slam diverged at scan 2651: the estimate jumped 21.30 m"
+    failed = CellRecord(
+        _cell("aces", "mrpt-rbpf", "k1"), "failed", tmp_path, None, None, Failure(reason, "exception", 1, 9.0, None)
+    )
+    rows = measured_rows([aces, intel, failed])
+    by = {(r.log, r.method): r for r in rows}
+    assert by[("aces", "mrpt-rbpf")].status == "failed" and by[("aces", "mrpt-rbpf")].note == reason
+    left_out = by[("intel", "mrpt-rbpf")]
+    assert left_out.status == "not measured" and "not in this suite's grid for this log" in left_out.note
+    assert ("mit-csail", "mrpt-rbpf") not in by  # no method ran on mit-csail: the log itself says not measured
+    out = tmp_path / "report"
+    out.mkdir()
+    plan = _plan([])
+    plan.skipped_methods.append(Skipped("mrpt-icp", "unavailable: needs icp-slam", "make mrpt"))
+    text = write_standard(plan, [aces, intel, failed], out)[0].read_text()
+    assert f"| mrpt-rbpf | measured | **failed**: {reason} |" in text
+    assert "| mrpt-rbpf | failed | not measured | – | – | – |" in text  # the summary table's row
+    assert "Methods not run on this machine: mrpt-icp (unavailable: needs icp-slam; `make mrpt`)." in text
+    assert "- DP-SLAM: no published figure on these logs." in text

@@ -20,8 +20,8 @@ from albot1.report.thesis.experiments import (
 
 #: The one default-suite log the thesis suite leaves out: no reference poses and no relations.
 UNMEASURED = "mit-killian"
-#: The public log on which the thesis suite runs Experiment 6's RBPF baseline (the default suite runs no MRPT).
-RBPF_LOG = "mit-csail"
+#: The standard logs on which the default suite runs Experiment 6's RBPF baseline (the thesis page reads it there).
+RBPF_LOGS = ("aces", "intel", "mit-csail", "fr079")
 
 
 def test_the_suite_is_named_thesis_and_holds_every_experiment() -> None:
@@ -52,6 +52,15 @@ def test_public_logs_get_the_default_suites_labels_and_only_the_variants_it_lack
             continue
         assert ours is not None, name
         assert ours.label == theirs.label, name  # the same prefix: the page pairs the runs by label
-        extra = {"mrpt-rbpf"} if name == RBPF_LOG else set()
-        assert ours.methods is not None and set(ours.methods) == {"albot1:literal", "albot1:plus", *extra}
+        assert ours.methods is not None and set(ours.methods) == {"albot1:literal", "albot1:plus"}
         assert not set(ours.methods) & default_methods  # never a run the default suite makes already
+
+
+def test_the_default_suite_runs_experiment_6s_baselines_on_the_standard_logs() -> None:
+    default = load_suite(find_suite("default"))
+    entries = {m.display: m for m in default.methods}
+    for label in ("mrpt-rbpf", "mrpt-icp"):
+        assert label in entries and entries[label].allow_failure, label
+    for log in RBPF_LOGS:
+        assert entries["mrpt-rbpf"].runs_on(log) and entries["mrpt-icp"].runs_on(log), log
+    assert not entries["mrpt-rbpf"].runs_on("synthetic-office-loop")  # not on every dataset: its cost

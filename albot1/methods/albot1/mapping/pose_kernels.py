@@ -62,6 +62,50 @@ def huber_cost(residual: float, threshold: float) -> float:
     return threshold * (a - 0.5 * threshold)
 
 
+#: The sums of the Gauss-Newton normal equations, ``(h00, h01, h02, h11, h12, h22, b0, b1, b2)``: the upper
+#: triangle of the 3x3 matrix ``H`` and the right-hand side ``b`` over ``(x, y, phi)``.
+NormalSums = tuple[float, float, float, float, float, float, float, float, float]
+
+
+def add_point_to_line(
+    sums: NormalSums,
+    nx: float,
+    ny: float,
+    ox: float,
+    oy: float,
+    dx: float,
+    dy: float,
+    weight: float,
+    threshold: float,
+) -> NormalSums:
+    """``sums`` with one robust point-to-line term added: landmark and scan terms share this one implementation.
+
+    The point sits at offset ``(ox, oy)`` from a point of the line with unit
+    normal ``(nx, ny)``; ``(dx, dy)`` is the rotated view point ``R(phi) v``,
+    so the residual's Jacobian is ``(nx, ny, n x (R v))``. ``weight`` is
+    ``1 / sigma^2`` and ``threshold`` the Huber threshold in metres. The
+    sums go in and come back as scalars, not an array, so that the compiled
+    caller (which inlines this) keeps them in registers; each term is added
+    in call order with the operations the caller once wrote out inline, so
+    poses stay bit-identical to earlier runs.
+    """
+    h00, h01, h02, h11, h12, h22, b0, b1, b2 = sums
+    r = nx * ox + ny * oy
+    j2 = ny * dx - nx * dy
+    w = weight * huber_weight(r, threshold)
+    return (
+        h00 + w * nx * nx,
+        h01 + w * nx * ny,
+        h02 + w * nx * j2,
+        h11 + w * ny * ny,
+        h12 + w * ny * j2,
+        h22 + w * j2 * j2,
+        b0 + w * nx * r,
+        b1 + w * ny * r,
+        b2 + w * j2 * r,
+    )
+
+
 def surface_boxes(ref: FloatArray, margin: float) -> FloatArray:
     """Each surface's bounding box grown by ``margin``: ``(m, 4)`` xmin, ymin, xmax, ymax."""
     boxes = np.empty((ref.shape[0], 4))
@@ -240,19 +284,18 @@ def refine_pose(
                 dy = s * vx + c * vy
                 tx = x + dx
                 ty = y + dy
-                # Point-to-line: Jacobian (nx, ny, n x (R v)).
-                r = lnx[i] * (tx - lm_map[i, 0]) + lny[i] * (ty - lm_map[i, 1])
-                j2 = lny[i] * dx - lnx[i] * dy
-                w = w_line * huber_weight(r, huber * line_sigma)
-                h00 += w * lnx[i] * lnx[i]
-                h01 += w * lnx[i] * lny[i]
-                h02 += w * lnx[i] * j2
-                h11 += w * lny[i] * lny[i]
-                h12 += w * lny[i] * j2
-                h22 += w * j2 * j2
-                b0 += w * lnx[i] * r
-                b1 += w * lny[i] * r
-                b2 += w * j2 * r
+                # Point-to-line against the landmark's map copy.
+                h00, h01, h02, h11, h12, h22, b0, b1, b2 = add_point_to_line(
+                    (h00, h01, h02, h11, h12, h22, b0, b1, b2),
+                    lnx[i],
+                    lny[i],
+                    tx - lm_map[i, 0],
+                    ty - lm_map[i, 1],
+                    dx,
+                    dy,
+                    w_line,
+                    huber * line_sigma,
+                )
                 if point_ok[i, e]:
                     # Point-to-point: rows (1, 0, -dy) and (0, 1, dx), one Huber weight on the distance.
                     rx = tx - lm_map[i, 2 * e]
@@ -276,18 +319,18 @@ def refine_pose(
             found = nearest_surface(tx, ty, ref, boxes, gate)[0]
             if found < 0:
                 continue
-            r = rnx[found] * (tx - ref[found, 0]) + rny[found] * (ty - ref[found, 1])
-            j2 = rny[found] * dx - rnx[found] * dy
-            w = w_scan * huber_weight(r, huber * scan_sigma)
-            h00 += w * rnx[found] * rnx[found]
-            h01 += w * rnx[found] * rny[found]
-            h02 += w * rnx[found] * j2
-            h11 += w * rny[found] * rny[found]
-            h12 += w * rny[found] * j2
-            h22 += w * j2 * j2
-            b0 += w * rnx[found] * r
-            b1 += w * rny[found] * r
-            b2 += w * j2 * r
+            # Point-to-line against the nearest reference surface.
+            h00, h01, h02, h11, h12, h22, b0, b1, b2 = add_point_to_line(
+                (h00, h01, h02, h11, h12, h22, b0, b1, b2),
+                rnx[found],
+                rny[found],
+                tx - ref[found, 0],
+                ty - ref[found, 1],
+                dx,
+                dy,
+                w_scan,
+                huber * scan_sigma,
+            )
         info[0, 0] = h00
         info[0, 1] = h01
         info[0, 2] = h02

@@ -3,9 +3,10 @@
 Why not ``subprocess.run(timeout=...)`` plus ``RLIMIT_AS``: an address-space
 limit breaks programs that reserve large virtual ranges (OpenMP/TBB thread
 pools, JIT runtimes) long before they use the memory, so the failure would
-look like a crash rather than "memory limit exceeded". The parent here
-polls the child's *resident* memory (psutil) and kills its whole process
-group when either limit is passed, and says which limit stopped it. A
+look like a crash rather than "memory limit exceeded". The child's tree is
+watched as the bench watches its cells (:func:`albot1.processes.supervise`:
+resident memory polled, the limit that stopped it named); here the whole
+process group is killed, as the child runs in a session of its own. A
 diverging particle filter grows steadily (hundreds of MB per second at
 most), so a 0.1 s poll bounds the overshoot to a fraction of the limit.
 
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import ctypes
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -27,11 +29,10 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import psutil
 
-StopReason = Literal["timeout", "memory"]
+from albot1.processes import MIB, Stop, supervise
 
 #: How often the child's memory and the clock are checked (s).
 POLL_S = 0.1
@@ -42,7 +43,7 @@ class ProcessOutcome:
     """How a limited child process ended and what it cost."""
 
     returncode: int | None  # None when this module killed it (see ``stopped``)
-    stopped: StopReason | None
+    stopped: Stop | None
     wall_s: float
     user_s: float
     system_s: float
@@ -60,19 +61,10 @@ def _die_with_parent() -> None:
         libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
 
 
-def _tree_rss(process: psutil.Process) -> int:
-    """Resident bytes of a process and its descendants (0 when it is gone)."""
-    total = 0
-    try:
-        total += process.memory_info().rss
-        for child in process.children(recursive=True):
-            try:
-                total += child.memory_info().rss
-            except psutil.Error:
-                continue
-    except psutil.Error:
-        return 0
-    return total
+def _reap(pid: int) -> tuple[int, resource.struct_rusage] | None:
+    """The exit status and resource usage of the child ``pid`` once it has exited (None while it runs)."""
+    done, status, usage = os.wait4(pid, os.WNOHANG)
+    return (status, usage) if done != 0 else None
 
 
 def run_limited(
@@ -86,7 +78,6 @@ def run_limited(
     env: Mapping[str, str] | None = None,
 ) -> ProcessOutcome:
     """Run ``argv`` in ``cwd`` (stdin closed, output to files) until it exits or passes a limit."""
-    limit_bytes = memory_limit_mb * 1024.0 * 1024.0
     with stdout_path.open("wb") as out, stderr_path.open("wb") as err:
         start = time.perf_counter()
         proc = subprocess.Popen(
@@ -99,35 +90,40 @@ def run_limited(
             start_new_session=True,  # its own process group: a kill reaches every helper it started
             preexec_fn=_die_with_parent,
         )
-    watched = psutil.Process(proc.pid)
-    stopped: StopReason | None = None
-    polled_peak = 0
-    while True:
-        pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
-        if pid != 0:
-            break
-        rss = _tree_rss(watched)
-        polled_peak = max(polled_peak, rss)
-        if stopped is None:
-            if rss > limit_bytes:
-                stopped = "memory"
-            elif time.perf_counter() - start > timeout_s:
-                stopped = "timeout"
-            if stopped is not None:
-                try:
-                    os.killpg(proc.pid, signal.SIGKILL)
-                except ProcessLookupError:
-                    pass
-        time.sleep(POLL_S)
+    reaped: tuple[int, resource.struct_rusage] | None = None
+
+    def ended(timeout: float) -> bool:
+        """Reap the child if it has exited, else after ``timeout`` s (``wait4`` has no timeout of its own)."""
+        nonlocal reaped
+        reaped = _reap(proc.pid)
+        if reaped is None:
+            time.sleep(timeout)
+            reaped = _reap(proc.pid)
+        return reaped is not None
+
+    def kill_group() -> None:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+    # Not reaped before ``ended`` says so, so the pid is still this child's: psutil.Process cannot fail here.
+    stopped, polled_peak_mb = supervise(
+        psutil.Process(proc.pid), ended, time_s=timeout_s, memory_mb=memory_limit_mb, poll_s=POLL_S, stop=kill_group
+    )
+    if reaped is None:  # killed for a limit: reap it now
+        _, status, usage = os.wait4(proc.pid, 0)
+    else:
+        status, usage = reaped
     wall_s = time.perf_counter() - start
     code = os.waitstatus_to_exitcode(status)
     proc.returncode = code  # reaped here: keep Popen from waiting on a pid that is gone
-    peak = max(polled_peak, usage.ru_maxrss * 1024)  # ru_maxrss is KiB on Linux
+    peak_mb = max(polled_peak_mb, usage.ru_maxrss * 1024 / MIB)  # ru_maxrss is KiB on Linux
     return ProcessOutcome(
         returncode=None if stopped is not None else code,
         stopped=stopped,
         wall_s=wall_s,
         user_s=usage.ru_utime,
         system_s=usage.ru_stime,
-        peak_rss_mb=peak / (1024.0 * 1024.0),
+        peak_rss_mb=peak_mb,
     )

@@ -18,6 +18,7 @@ import pytest
 from albot1.data.synthetic.worlds import load_world
 from albot1.geometry import se2, segments
 from albot1.methods.albot1.jit import callees, kernel_compiler
+from albot1.methods.albot1.mapping import pose_kernels
 from albot1.methods.albot1.mapping.accel import MappingKernels, mapping_kernels
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
@@ -259,6 +260,28 @@ def test_wrap_and_stability_give_the_same_bits_jitted_and_interpreted() -> None:
         assert_same_bits(jit(se2.wrap_angle)(a), se2.wrap_angle(a))
     for kind in range(4):
         assert jit(endpoints.is_stable)(kind) == endpoints.is_stable(kind)
+
+
+def test_point_to_line_term_gives_the_same_bits_jitted_and_interpreted() -> None:
+    """The landmark and scan terms of ``refine_pose`` share it: both Huber branches, and a degenerate normal."""
+    jit = kernel_compiler(True, (pose_kernels.add_point_to_line,))
+    compiled = jit(pose_kernels.add_point_to_line)
+    assert compiled is not pose_kernels.add_point_to_line
+    rng = np.random.default_rng(10)
+    inside = outside = 0
+    for _ in range(400):
+        sums = tuple(rng.normal(0.0, 100.0, 9).tolist())
+        angle = rng.uniform(-math.pi, math.pi)
+        nx, ny = (math.cos(angle), math.sin(angle)) if rng.random() < 0.95 else (0.0, 0.0)
+        ox, oy, dx, dy = rng.normal(0.0, 0.3, 4).tolist()
+        threshold = float(rng.uniform(0.02, 0.4))
+        args = (sums, nx, ny, ox, oy, dx, dy, float(rng.uniform(1.0, 2500.0)), threshold)
+        assert_same_bits(compiled(*args), pose_kernels.add_point_to_line(*args))
+        if abs(nx * ox + ny * oy) <= threshold:
+            inside += 1
+        else:
+            outside += 1
+    assert inside > 50 and outside > 50
 
 
 # -- the mechanism ------------------------------------------------------------------------------------------------

@@ -46,6 +46,15 @@ def test_resident_memory_limit(tmp_path: Path) -> None:
     assert outcome.peak_rss_mb > 120.0
 
 
+def test_the_memory_of_the_childs_own_children_counts_and_the_group_is_killed(tmp_path: Path) -> None:
+    """A helper the program starts counts toward the limit (from the next listing of the tree, within 1 s)."""
+    hold = "import time; b = bytearray(200 * 2**20); b[::4096] = b'x' * len(b[::4096]); time.sleep(60)"
+    code = f"import subprocess, sys, time; subprocess.Popen([sys.executable, '-c', {hold!r}]); time.sleep(60)"
+    outcome = _run(tmp_path, code, memory_limit_mb=120.0)
+    assert outcome.stopped == "memory" and outcome.returncode is None
+    assert 120.0 < outcome.peak_rss_mb < 400.0 and outcome.wall_s < 10
+
+
 def test_the_child_dies_with_its_parent(tmp_path: Path) -> None:
     """A parent killed mid-run (a benchmark cell over its limit) leaves no orphan behind."""
     import os
