@@ -37,7 +37,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	status=0; \
 	for suite in $(SUITE); do $(BIN)/albot1 bench $$suite -j $(JOBS) || status=$$?; done; \
-	for suite in $(SUITE); do $(BIN)/albot1 report results/$$suite || status=$$?; done; \
+	for suite in $(SUITE); do $(BIN)/albot1 report results/$$suite -j $(JOBS) || status=$$?; done; \
 	exit $$status
 
 # pytest-benchmark timing suite (short real sequences); JSON kept for CI.

@@ -122,6 +122,8 @@ class RunResult:
     dataset_info: dict[str, Any] = field(default_factory=dict)
     #: the mapper's extra files (``MapperOutput.files``), written beside the standard ones
     files: dict[str, Any] = field(default_factory=dict)
+    #: CPU seconds over the span of ``wall_s`` (this process's threads + waited children); None when not measured
+    cpu_s: float | None = None
 
     def timing(self) -> Timing:
         """The ``timing`` block of ``result.json`` (per-scan statistics are None for a run of no scans)."""
@@ -134,4 +136,5 @@ class RunResult:
             total_s=self.total_s,
             wall_s=self.wall_s,
             peak_mb=self.peak_mb,
+            cpu_s=self.cpu_s,
         )

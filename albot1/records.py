@@ -157,6 +157,9 @@ class Timing(Record):
     total_s: float
     wall_s: float
     peak_mb: float
+    #: CPU seconds (user + system, threads and waited children) over the span of ``wall_s``: the cost a shared
+    #: machine's load does not inflate; absent in results written before it was recorded
+    cpu_s: OptFloat = None
 
 
 class DatasetInfo(Record):

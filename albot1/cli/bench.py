@@ -121,6 +121,7 @@ def report(
     map_style: Annotated[
         str, typer.Option(help="point maps drawn as an occupancy grid (grid) or as their points (points)")
     ] = "grid",
+    jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="processes drawing the plots")] = 1,
 ) -> None:
     """Build tables (Markdown, CSV, LaTeX), plots (PNG and SVG), README.md and index.html from a results folder.
 
@@ -128,7 +129,7 @@ def report(
     only: open it from the report folder in any browser, no network needed.
 
     Examples:\n
-      albot1 report results/default          # -> reports/default/README.md, reports/default/index.html\n
+      albot1 report results/default -j 2     # -> reports/default/README.md, reports/default/index.html\n
       albot1 report results/quick --out /tmp/quick-report --map-style points
     """
     # Imported by the command, not by this module: see albot1.cli.app.
@@ -141,5 +142,5 @@ def report(
     ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
     writable_folder(out if out is not None else default_out(results_dir), "--out")
     style: MapStyle = "grid" if map_style == "grid" else "points"
-    index = build_report(results_dir, out, plots=plots, map_style=style)
+    index = build_report(results_dir, out, plots=plots, map_style=style, jobs=jobs)
     typer.echo(f"report: {index}")

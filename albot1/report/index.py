@@ -11,8 +11,12 @@ with the tables and every plot, for a browser.
 
 from __future__ import annotations
 
+import multiprocessing
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+
+import pandas as pd
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
@@ -48,38 +52,66 @@ def _rel(path: Path, start: Path) -> str:
 
 
 def render_plots(
-    records: list[CellRecord], out: Path, colors: dict[str, str] | None = None, *, map_style: MapStyle = "grid"
+    records: list[CellRecord],
+    out: Path,
+    colors: dict[str, str] | None = None,
+    *,
+    map_style: MapStyle = "grid",
+    jobs: int = 1,
 ) -> dict[str, list[Path]]:
-    """Every plot of the report (PNG, each with an SVG twin); dataset label -> its PNGs ("" for cross-dataset)."""
+    """Every plot of the report (PNG, each with an SVG twin); dataset label -> its PNGs ("" for cross-dataset).
+
+    Drawing is most of a report's time (matplotlib's layout and two file
+    formats per figure) and each dataset's figures depend on its records
+    alone, so with ``jobs`` > 1 the datasets are drawn in that many worker
+    processes; the figures are the same files either way.
+    """
     colors = colors or method_colors(r.cell.method_label for r in records)
     cells = cells_frame(records)
     metrics = aggregate(cells, METRIC_COLUMNS)
     cost = aggregate(cells, COST_COLUMNS)
     plots_dir = out / "plots"
     plots_dir.mkdir(parents=True, exist_ok=True)
-    made: dict[str, list[Path]] = {}
     by_dataset: dict[str, list[CellRecord]] = {}
     for rec in records:
         by_dataset.setdefault(rec.cell.dataset_label, []).append(rec)
-    for dataset, recs in by_dataset.items():
-        stem = slug(dataset)
-
-        def at(kind: str, stem: str = stem) -> Path:
-            return plots_dir / f"{stem}-{kind}.png"
-
-        files = [
-            plot_trajectories(recs, dataset, at("trajectories"), colors),
-            plot_ape_map(recs, dataset, at("ape"), colors),
-            plot_error_vs_distance(recs, dataset, at("error-distance"), colors),
-            plot_rpe_boxes(recs, dataset, at("rpe-boxes"), colors),
-            plot_maps(recs, dataset, at("maps"), colors, style=map_style),
-            *[plot_robustness(metrics, dataset, column, label, at(kind), colors) for column, label, kind in ROBUSTNESS],
-            plot_scan_time(recs, dataset, at("scan-time"), colors),
-        ]
-        made[dataset] = [f for f in files if f is not None]
+    tasks = [(dataset, recs, metrics, plots_dir, colors, map_style) for dataset, recs in by_dataset.items()]
+    if jobs > 1 and len(tasks) > 1:
+        # spawn: a fresh interpreter per worker, whatever threads or matplotlib state this process holds.
+        with ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=multiprocessing.get_context("spawn")) as pool:
+            drawn = list(pool.map(_dataset_plots, *zip(*tasks, strict=True)))
+    else:
+        drawn = [_dataset_plots(*task) for task in tasks]
+    made = dict(zip(by_dataset, drawn, strict=True))
     runtime = plot_runtime(cost, plots_dir / "runtime.png", colors)
     made[""] = [runtime] if runtime is not None else []
     return made
+
+
+def _dataset_plots(
+    dataset: str,
+    recs: list[CellRecord],
+    metrics: pd.DataFrame,
+    plots_dir: Path,
+    colors: dict[str, str],
+    map_style: MapStyle,
+) -> list[Path]:
+    """The figures of one dataset (a module-level function: worker processes run it)."""
+    stem = slug(dataset)
+
+    def at(kind: str) -> Path:
+        return plots_dir / f"{stem}-{kind}.png"
+
+    files = [
+        plot_trajectories(recs, dataset, at("trajectories"), colors),
+        plot_ape_map(recs, dataset, at("ape"), colors),
+        plot_error_vs_distance(recs, dataset, at("error-distance"), colors),
+        plot_rpe_boxes(recs, dataset, at("rpe-boxes"), colors),
+        plot_maps(recs, dataset, at("maps"), colors, style=map_style),
+        *[plot_robustness(metrics, dataset, column, label, at(kind), colors) for column, label, kind in ROBUSTNESS],
+        plot_scan_time(recs, dataset, at("scan-time"), colors),
+    ]
+    return [f for f in files if f is not None]
 
 
 def _machine_lines(plan: GridPlan) -> list[str]:
@@ -228,9 +260,16 @@ def write_index(
 
 
 def build_report(
-    results_dir: str | Path, out: str | Path | None = None, *, plots: bool = True, map_style: MapStyle = "grid"
+    results_dir: str | Path,
+    out: str | Path | None = None,
+    *,
+    plots: bool = True,
+    map_style: MapStyle = "grid",
+    jobs: int = 1,
 ) -> Path:
     """Tables, plots, README.md and index.html for ``results_dir``; returns the README path.
+
+    ``jobs``: worker processes drawing the plots (:func:`render_plots`).
 
     For the ``thesis`` suite README.md is the thesis reproduction page
     (:mod:`albot1.report.thesis.page`) and the benchmark index is ``benchmark.md``.
@@ -244,7 +283,7 @@ def build_report(
     colors = method_colors(r.cell.method_label for r in records)
     thesis = plan.suite == THESIS_SUITE
     pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default
-    made = render_plots(pictured, target, colors, map_style=map_style) if plots else {}
+    made = render_plots(pictured, target, colors, map_style=map_style, jobs=jobs) if plots else {}
     index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
     page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
     cells = cells_frame(records)

@@ -63,16 +63,26 @@ class Row:
     loop_rotation_mean_deg: float | None = None
     loop_relations: int | None = None
     time_s: float | None = None
+    cpu_s: float | None = None
     duration_s: float | None = None
     source: str = ""
     note: str = ""
 
     @property
     def speed(self) -> float | None:
-        """How many times faster than the log's own duration the whole log was processed."""
-        if self.time_s is None or self.duration_s is None or self.time_s <= 0:
-            return None
-        return self.duration_s / self.time_s
+        """How many times faster than the log's own duration the whole log was processed (wall clock)."""
+        return _ratio(self.duration_s, self.time_s)
+
+    @property
+    def cpu_speed(self) -> float | None:
+        """The same per CPU second: what the method costs, whatever else the machine was doing."""
+        return _ratio(self.duration_s, self.cpu_s)
+
+
+def _ratio(duration_s: float | None, spent_s: float | None) -> float | None:
+    if spent_s is None or duration_s is None or spent_s <= 0:
+        return None
+    return duration_s / spent_s
 
 
 def _full_log_cell(rec: CellRecord) -> bool:
@@ -123,7 +133,7 @@ def _measured(rec: CellRecord) -> Row:
     block = rec.metrics.relations
     if block is None:
         why = rec.metrics.relations_reason or "no relation metric"
-        return Row(log, "measured", method, time_s=timing.wall_s, duration_s=duration, note=why)
+        return Row(log, "measured", method, time_s=timing.wall_s, cpu_s=timing.cpu_s, duration_s=duration, note=why)
     t, r, loops = block.translation_m, block.rotation_deg, block.loops
     note = ""
     if block.relations_outside_run:
@@ -144,6 +154,7 @@ def _measured(rec: CellRecord) -> Row:
         loop_rotation_mean_deg=loops.rotation_deg.mean,
         loop_relations=loops.translation_m.n,
         time_s=timing.wall_s,
+        cpu_s=timing.cpu_s,
         duration_s=duration,
         source=f"this suite, run {rec.cell.key}",
         note=note,
@@ -195,7 +206,7 @@ def _pm(mean: float | None, std: float | None, digits: int) -> str:
 
 def _cell(row: Row) -> list[str]:
     if row.status != "done":
-        return [row.method, row.kind, f"**{row.status}**: {row.note}", *[""] * 7]
+        return [row.method, row.kind, f"**{row.status}**: {row.note}", *[""] * 8]
     return [
         row.method,
         f"**{row.kind}**" if row.kind == "published" else row.kind,
@@ -208,13 +219,17 @@ def _cell(row: Row) -> list[str]:
         + ("" if row.loop_rotation_mean_deg is None else f", {_num(row.loop_rotation_mean_deg, 3)}°")
         + ("" if row.loop_relations is None else f" (N = {row.loop_relations})"),
         _num(row.time_s, 1),
-        NA if row.speed is None else f"{row.speed:.0f}x",
+        _num(row.cpu_s, 1),
+        NA
+        if row.speed is None
+        else f"{row.speed:.0f}x" + ("" if row.cpu_speed is None else f" / {row.cpu_speed:.0f}x"),
     ]
 
 
 _HEAD = (
     "| method | row | translation (m), mean ± std | max (m) | N | rotation (deg), mean ± std | max (deg) "
-    "| loop relations (> 30 s): translation (m), rotation | time (s) | log duration / time |"
+    "| loop relations (> 30 s): translation (m), rotation | wall time (s) | CPU time (s) "
+    "| log duration / time: wall / CPU |"
 )
 
 
@@ -248,9 +263,11 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
         "degradation). Measured rows come from this results folder; rows marked **published** are figures "
         "printed in the cited papers, read from `albot1/methods/baselines/published.toml`, never measured here.",
         "",
-        f"Our timings: wall-clock time of the whole run (decoding included) on {_machine(plan)}, with the "
-        "suite's parallelism on a possibly shared machine; *log duration / time* is how many times faster than "
-        "the robot recorded it the log was processed. Published timings are Hess et al.'s (Table V), measured on "
+        f"Our timings: wall-clock and CPU time (user + system, every thread, and the external program of the "
+        f"MRPT methods) of the whole run, decoding included, on {_machine(plan)}, with the suite's parallelism "
+        "on a possibly shared machine: the CPU time is the method's cost whatever the load; *log duration / "
+        "time* is how many times faster than the robot recorded it the log was processed, per wall-clock and "
+        "per CPU second. Published timings are Hess et al.'s (Table V), measured on "
         "an Intel Xeon E5-1650 at 3.2 GHz: compare the ratios, not the seconds.",
         "",
         f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}` (`make bench` does this for "
@@ -293,7 +310,7 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
             lines += [f"Not measured: {skipped[log]}", ""]
         elif not any(r.kind == "measured" for r in log_rows):
             lines += ["Not measured: the suite has no cell on the whole log with its own odometry.", ""]
-        lines += [_HEAD, "|" + "---|" * 10]
+        lines += [_HEAD, "|" + "---|" * 11]
         lines += ["| " + " | ".join(_cell(r)) + " |" for r in log_rows]
         sources = [f"- {r.method}: {r.source}" + (f" ({r.note})" if r.note else "") for r in log_rows if r.source]
         lines += ["", *sources, ""]
@@ -337,11 +354,11 @@ def _csv(rows: list[Row]) -> str:
     names = [f.name for f in fields(Row)]
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*names, "speed_x"])
+    writer.writerow([*names, "speed_x", "cpu_speed_x"])
     for row in rows:
         values: list[Any] = [getattr(row, name) for name in names]
         writer.writerow(
             ["" if v is None else (f"{v:.9g}" if isinstance(v, float) else v) for v in values]
-            + ["" if row.speed is None else f"{row.speed:.6g}"]
+            + ["" if row.speed is None else f"{row.speed:.6g}", "" if row.cpu_speed is None else f"{row.cpu_speed:.6g}"]
         )
     return buffer.getvalue()

@@ -152,3 +152,45 @@ def test_a_results_folder_whose_grid_planned_no_cell_still_gets_a_report(tmp_pat
     assert "Cells: 0 planned" in readme.read_text()
     assert "No planned cells." in (tmp_path / "report" / "metrics.md").read_text()
     assert (tmp_path / "report" / INDEX_HTML).is_file()
+
+
+def test_plots_drawn_by_worker_processes_are_the_same_files(tmp_path: Path) -> None:
+    root = tmp_path / "two"
+    store = ResultsStore(root)
+    store.runs.mkdir(parents=True)
+    cells = []
+    for dataset, seed in (("loop-a", 0), ("loop-b", 1)):
+        run_dir = write_run(run_method("odometry", _loop(), degradation="gauss:0.05:1", seed=seed), store.runs)
+        evaluate_run(run_dir)
+        cells.append(
+            Cell(
+                "two",
+                dataset,
+                dataset,
+                "odometry",
+                "odometry",
+                "default",
+                "gauss:0.05:1",
+                seed,
+                run_dir.name,
+                "v",
+                60.0,
+                100.0,
+            )
+        )
+    store.write_plan(GridPlan("two", None, "", cells, [], [], {}, [0, 1], ["gauss:0.05:1"], {}))
+    build_report(root, tmp_path / "serial")
+    build_report(root, tmp_path / "parallel", jobs=2)
+    serial = sorted(p.name for p in (tmp_path / "serial" / "plots").glob("*.png"))
+    parallel = sorted(p.name for p in (tmp_path / "parallel" / "plots").glob("*.png"))
+    assert (
+        serial == parallel
+        and any(n.startswith("loop-a-") for n in serial)
+        and any(n.startswith("loop-b-") for n in serial)
+    )
+    for name in serial:
+        a = imread(tmp_path / "serial" / "plots" / name)
+        b = imread(tmp_path / "parallel" / "plots" / name)
+        assert np.array_equal(a, b), name
+    links = [line for line in (tmp_path / "serial" / "README.md").read_text().splitlines() if "plots/" in line]
+    assert links and all(line in (tmp_path / "parallel" / "README.md").read_text() for line in links)

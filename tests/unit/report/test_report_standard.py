@@ -86,6 +86,7 @@ def test_measured_rows_take_the_relation_metric_of_whole_log_runs_only(tmp_path:
     assert row.loop_relations == 0
     assert row.duration_s == 19.0
     assert row.time_s is not None and row.speed == 19.0 / row.time_s
+    assert row.cpu_s is not None and row.cpu_s > 0 and row.cpu_speed == 19.0 / row.cpu_s
 
 
 def test_published_rows_come_from_the_data_file_labelled_with_their_source() -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from typing import Any, ClassVar
 
 import numpy as np
@@ -53,6 +55,9 @@ class FakeMapper:
     def process(self, frame: Frame) -> None:
         if self.config.mode == "raise" and frame.index == 3:
             raise ZeroDivisionError("boom")
+        if self.config.mode == "child" and frame.index == 0:  # an external program's CPU time (as MRPT's)
+            burn = "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass"
+            subprocess.run([sys.executable, "-c", burn], check=True)
         self.n += 1
 
     def finish(self) -> MapperOutput:
@@ -111,6 +116,13 @@ def test_successful_run_records_everything(fake_method: str) -> None:
     median = result.timing().per_scan_ms_median
     assert median is not None and median >= 0.0
     assert not np.allclose(result.odometry, _sequence().odometry)  # degraded before the method saw it
+    cpu_s = result.timing().cpu_s
+    assert cpu_s is not None and 0.0 <= cpu_s
+
+
+def test_the_cpu_time_counts_the_external_program_the_method_waited_for(fake_method: str) -> None:
+    cpu_s = run_method(fake_method, _sequence(), overrides={"mode": "child"}).timing().cpu_s
+    assert cpu_s is not None and cpu_s >= 0.3  # the child burnt 0.3 s of CPU; this process waited, idle
 
 
 @pytest.mark.parametrize(

@@ -156,6 +156,36 @@ class GtsamGraphConfig(BaseModel):
         gt=0, description="kernel parameter on the whitened error (in standard deviations)"
     )
 
+    # Place recognition (large-drift loops; docs/baselines.md, "Place recognition").
+    place_recognition: bool = Field(
+        description="search the whole map region the drift allows with a branch-and-bound correlative match"
+    )
+    place_every_nodes: int = Field(ge=1, description="run the place-recognition search at every n-th node")
+    place_min_path_m: float = Field(
+        ge=0, description="earlier nodes closer than this along the graph (m) are left to the ordinary loop search"
+    )
+    place_drift_rate: float = Field(
+        gt=0, description="an earlier node is searched if within this fraction of its graph distance (path length)"
+    )
+    place_max_radius_m: float = Field(gt=0, description="upper bound of that radius and of the search half-width (m)")
+    place_half_angle_deg: float = Field(ge=0, description="rotations within +-this of the estimate are searched")
+    place_step_deg: float = Field(gt=0, description="rotation step of the search (deg)")
+    place_cell_m: float = Field(gt=0, description="cell of the search's likelihood field and translation step (m)")
+    place_sigma_m: float = Field(gt=0, description="std dev of the likelihood field (m)")
+    place_source_nodes: int = Field(
+        ge=1, description="the searched scan is the local map of the last n node scans (more structure than one)"
+    )
+    place_max_points: int = Field(ge=10, description="the searched local map is thinned evenly to this many points")
+    place_min_score: float = Field(
+        ge=0, le=1, description="the best pose must score this fraction of the searched points"
+    )
+    place_max_ambiguity: float = Field(
+        gt=0, le=1, description="refused when a pose >2 m away scores this fraction of the best or more"
+    )
+    place_max_blocks: int = Field(
+        ge=1, description="the search gives up (no match) when more blocks than this survive a level of its tree"
+    )
+
     # Optimisation.
     isam_relinearize_threshold: float = Field(
         gt=0, description="ISAM2 relinearises variables that moved more than this"

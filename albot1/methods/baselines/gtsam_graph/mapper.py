@@ -23,6 +23,7 @@ projected with those poses, thinned on a grid.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import replace
 from typing import ClassVar
 
@@ -36,7 +37,12 @@ from albot1.data.model import Frame, Scan
 from albot1.geometry import se2
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
-from albot1.methods.baselines.gtsam_graph.correlative import SearchWindow, correlative_search
+from albot1.methods.baselines.gtsam_graph.correlative import (
+    GlobalWindow,
+    SearchWindow,
+    branch_and_bound_search,
+    correlative_search,
+)
 from albot1.methods.baselines.gtsam_graph.errors import GraphError, RegistrationError
 from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
 from albot1.methods.baselines.gtsam_graph.loop_closure import (
@@ -93,6 +99,14 @@ class GtsamGraphMapper:
             agreement_rad=math.radians(config.loop_agreement_deg),
         )
         self._confirmer = Confirmer(self._tests)
+        # A place-recognition pose is already the best of a fine grid: ICP may move it by little more than a cell.
+        self._place_confirmer = Confirmer(
+            replace(
+                self._tests,
+                max_correction_m=2.0 * config.loop_agreement_m,
+                max_correction_rad=2.0 * math.radians(config.loop_agreement_deg),
+            )
+        )
         self._refine_icp = config.refine_icp()
         self._track_icp = config.track_icp()
         self._refine_tests = RefineTests(
@@ -135,6 +149,8 @@ class GtsamGraphMapper:
             "loop_coarse_searches": 0,
             "loop_closures_accepted": 0,
             "loop_closures_rejected": 0,
+            "place_searches": 0,
+            "place_closures_accepted": 0,
             "scans_refined": 0,
         }
 
@@ -350,6 +366,8 @@ class GtsamGraphMapper:
         self._path_since_closure += math.hypot(relative[0], relative[1])
         if key % self.config.loop_every_nodes == 0:
             self._close_loops(key, index)
+        if self.config.place_recognition and key % self.config.place_every_nodes == 0:
+            self._recognise_place(key)
 
     def _sequential_edge(
         self, prev: int, step: FloatArray, points: FloatArray, index: int, tracked: Registration | None
@@ -406,7 +424,7 @@ class GtsamGraphMapper:
         corr = se2.between(guess, reg.pose)
         return math.hypot(corr[0], corr[1]) <= max_m and abs(corr[2]) <= math.radians(max_deg)
 
-    def _target(self, nodes: range, frame_node: int, poses: FloatArray | None = None) -> Target:
+    def _target(self, nodes: Iterable[int], frame_node: int, poses: FloatArray | None = None) -> Target:
         """The line-like points of ``nodes``' scans, expressed in ``frame_node``'s frame.
 
         Nodes are placed with ``poses`` (default: the current estimates).
@@ -486,8 +504,12 @@ class GtsamGraphMapper:
         accepted, expired = self._confirmer.offer(key, verified, cfg.loop_every_nodes)
         if expired:
             self._reject("not confirmed", expired)
-        if not accepted:
-            return
+        if accepted:
+            self._add_loops(accepted)
+
+    def _add_loops(self, accepted: list[LoopMatch]) -> None:
+        """Add confirmed loop matches as robust edges and bring the estimates up to date."""
+        cfg = self.config
         for match in accepted:
             self._graph.add_edge(
                 match.candidate,
@@ -503,6 +525,93 @@ class GtsamGraphMapper:
         self._estimates = self._graph.estimates()
         self._local = None
         self._path_since_closure = 0.0
+
+    def _recognise_place(self, key: int) -> None:
+        """Loops beyond the ordinary gate: a branch-and-bound match over the whole region the drift allows.
+
+        Drift grows with the path driven between two visits, and a loop
+        closure shortens that path, so an earlier node ``j`` is searched when
+        it lies within ``place_drift_rate`` x its graph distance from node
+        ``key`` (the shortest path through the sequential and loop edges: a
+        proxy for their relative uncertainty that needs no marginals). The
+        local map of the last ``place_source_nodes`` node scans (one sparse
+        scan holds too little structure) is matched against every such node's
+        scan at once, over that whole radius and +-``place_half_angle_deg``
+        (:func:`branch_and_bound_search`). The best pose must explain enough
+        of the local map and have no distinct rival; ICP of the node's scan
+        against the nearest earlier node's submap then refines it, the loop
+        tests judge it, and a second search must agree before it is added.
+        """
+        cfg = self.config
+        last = key - cfg.loop_min_node_gap
+        if last < 0:
+            return
+        graph_m = self._graph_distances(key)[: last + 1]
+        near_m = np.hypot(*(self._estimates[: last + 1, :2] - self._estimates[key, :2]).T)
+        radius_m = np.minimum(cfg.place_max_radius_m, cfg.place_drift_rate * graph_m)
+        chosen = np.flatnonzero((graph_m >= cfg.place_min_path_m) & (near_m <= radius_m))
+        if not chosen.size:
+            return
+        self.counters["place_searches"] += 1
+        target = self._target((int(n) for n in chosen), key)
+        source = self._target(range(max(0, key - cfg.place_source_nodes + 1), key + 1), key).points
+        window = GlobalWindow(
+            half_width_m=float(radius_m[chosen].max()),
+            half_angle_rad=math.radians(cfg.place_half_angle_deg),
+            step_rad=math.radians(cfg.place_step_deg),
+            cell_m=cfg.place_cell_m,
+            sigma_m=cfg.place_sigma_m,
+            max_points=cfg.place_max_points,
+            max_nodes=cfg.place_max_blocks,
+            min_ambiguity=cfg.place_max_ambiguity,
+        )
+        found = branch_and_bound_search(target.points, first_per_cell(source, cfg.place_cell_m), np.zeros(3), window)
+        if found.score < cfg.place_min_score:
+            self._reject(f"place-score {found.score:.2f}")
+            return
+        if found.ambiguity > cfg.place_max_ambiguity:
+            self._reject(f"place-ambiguous ({found.ambiguity:.2f})")
+            return
+        world = se2.compose(self._estimates[key], found.pose)
+        j = int(chosen[np.argmin(np.hypot(*(self._estimates[chosen, :2] - world[:2]).T))])
+        nodes = range(max(0, j - cfg.loop_submap_nodes), min(last, j + cfg.loop_submap_nodes) + 1)
+        guess = se2.between(self._estimates[j], world)
+        reg = self._register(self._target(nodes, j), self._node_scans[key], guess, self._loop_icp)
+        if reg is None:
+            self._reject("place-too-few-points")
+            return
+        covariance, reason = verify(reg, guess, self._place_confirmer.tests, self._loop_prior)
+        if covariance is None:
+            self._reject(f"place-{reason}")
+            return
+        implied = se2.compose(self._estimates[j], reg.pose)
+        correction = np.array(
+            [*(implied[:2] - self._estimates[key, :2]), se2.wrap(implied[2] - self._estimates[key, 2])]
+        )
+        match = LoopMatch(key, j, reg.pose, covariance + self._floor, correction)
+        accepted, expired = self._place_confirmer.offer(key, [match], cfg.place_every_nodes)
+        if expired:
+            self._reject("place-not-confirmed", expired)
+        if accepted:
+            self.counters["place_closures_accepted"] += len(accepted)
+            self._add_loops(accepted)
+
+    def _graph_distances(self, key: int) -> FloatArray:
+        """Shortest path length (m) from node ``key`` to every node ``0..key`` along sequential and loop edges."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+
+        n = key + 1
+        steps = np.asarray(self._node_steps[1:n], dtype=float).reshape(-1, 3)
+        rows = [*range(n - 1), *(a for a, _ in self._loop_edges)]
+        cols = [*range(1, n), *(b for _, b in self._loop_edges)]
+        lengths = [
+            *np.hypot(steps[:, 0], steps[:, 1]),
+            *(math.hypot(*(self._estimates[a, :2] - self._estimates[b, :2])) for a, b in self._loop_edges),
+        ]
+        # csgraph treats a zero weight as a missing edge; a node step can be a pure rotation.
+        graph = coo_matrix((np.maximum(lengths, 1e-6), (rows, cols)), shape=(n, n)).tocsr()
+        return np.asarray(dijkstra(graph, directed=False, indices=key), dtype=np.float64)
 
     def _reject(self, reason: str, count: int = 1) -> None:
         self.counters["loop_closures_rejected"] += count

@@ -203,3 +203,30 @@ def test_refinement_registers_every_scan_that_is_not_a_node_when_enabled() -> No
     rel_est = se2.between(out.poses[0], out.poses)
     rel_ref = se2.between(seq.reference[0], seq.reference)
     assert np.abs(rel_est[:, :2] - rel_ref[:, :2]).max() < 0.01
+
+
+def test_place_recognition_searches_far_along_the_graph_and_keeps_the_room_straight() -> None:
+    # Every earlier node is "far" along the graph here, so each 2nd node runs the branch-and-bound search; the
+    # closures it proposes must be right (the room has one true answer) or be refused.
+    seq = room_sequence()
+    overrides = {
+        "place_recognition": True,
+        "place_every_nodes": 2,
+        "place_min_path_m": 1.0,
+        "place_drift_rate": 1.0,
+        "place_source_nodes": 3,
+        "loop_min_node_gap": 4,
+    }
+    mapper, out = run(seq, **overrides)
+    assert out.counters["place_searches"] > 0
+    ref = seq.reference
+    err = np.hypot(*(se2.compose(ref[0], out.poses)[:, :2] - ref[:, :2]).T)
+    assert err.max() < 0.05
+    # Graph distances follow the edges: node k is the sum of the node steps from node 0 away (no shortcut).
+    steps = np.asarray(mapper._node_steps)
+    path = np.concatenate([[0.0], np.cumsum(np.hypot(steps[1:, 0], steps[1:, 1]))])
+    last = len(steps) - 1
+    if not mapper._loop_edges:
+        np.testing.assert_allclose(mapper._graph_distances(last), path[last] - path, atol=1e-5)
+    else:
+        assert (mapper._graph_distances(last) <= path[last] - path + 1e-5).all()
