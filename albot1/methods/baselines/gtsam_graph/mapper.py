@@ -12,6 +12,10 @@ The method of Grisetti et al. (2010), the thesis's section 2.2.3:
 * **loop-closure edges** from ICP against the submaps of earlier nodes near
   the current estimate (:mod:`.loop_closure`), added only after strict tests
   and with a robust kernel;
+* **place recognition** for loops whose drift is beyond that search: a
+  branch-and-bound match of the local map over the region the drift allows
+  (:meth:`GtsamGraphMapper._recognise_place`), verified the same way
+  (``place_closures_accepted`` counts these among ``loop_closures_accepted``);
 * GTSAM **ISAM2** after every node, a final batch **Levenberg-Marquardt** in
   :meth:`GtsamGraphMapper.finish`.
 

@@ -8,6 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from albot1.contract import MapperOutput
 from albot1.data.model import Frame, Scan, Sequence
 from albot1.data.synthetic.lidar import cast
 from albot1.geometry import se2
@@ -218,8 +219,10 @@ def test_place_recognition_searches_far_along_the_graph_and_keeps_the_room_strai
         "loop_min_node_gap": 4,
     }
     mapper, out = run(seq, **overrides)
+    assert isinstance(out, MapperOutput)
     assert out.counters["place_searches"] > 0
     ref = seq.reference
+    assert ref is not None
     err = np.hypot(*(se2.compose(ref[0], out.poses)[:, :2] - ref[:, :2]).T)
     assert err.max() < 0.05
     # Graph distances follow the edges: node k is the sum of the node steps from node 0 away (no shortcut).
