@@ -18,8 +18,6 @@ from albot1.report.thesis.experiments import (
     VARIANTS,
 )
 
-#: The one default-suite log the thesis suite leaves out: no reference poses and no relations.
-UNMEASURED = "mit-killian"
 #: The standard logs on which the default suite runs Experiment 6's RBPF baseline (the thesis page reads it there).
 RBPF_LOGS = ("aces", "intel", "mit-csail", "fr079")
 
@@ -34,9 +32,14 @@ def test_the_suite_is_named_thesis_and_holds_every_experiment() -> None:
         opts = suite.options_for(spacing)
         assert opts is not None and opts.methods is not None
         assert set(opts.methods) == {"odometry", *VARIANTS, *SLAM_BASELINES}
+    default = load_suite(find_suite("default"))
     for places in (*PLACES_STARTS, DOUBLE_LOOP, TWO_LAPS):
         opts = suite.options_for(places)
-        assert opts is not None and opts.methods is not None and set(opts.methods) == set(PLACES_VARIANTS)
+        assert opts is not None and opts.methods is not None
+        # The worlds the default suite also runs get Experiments 1-2's two variants it lacks.
+        in_default = places in worlds.WORLDS and default.options_for(places) is not None
+        extra = {"albot1:literal", "albot1:plus"} if in_default else set()
+        assert set(opts.methods) == {*PLACES_VARIANTS, *extra}, places
 
 
 def test_public_logs_get_the_default_suites_labels_and_only_the_variants_it_lacks() -> None:
@@ -47,8 +50,8 @@ def test_public_logs_get_the_default_suites_labels_and_only_the_variants_it_lack
         ours, theirs = thesis.options_for(name), default.options_for(name)
         if name in (SQUARE, DENSE) or name.startswith("synthetic-places"):
             continue  # the thesis's own experiments
-        if theirs is None or name == UNMEASURED:
-            assert ours is None, name  # nothing to pair with, or nothing of the page's to measure on it
+        if theirs is None:
+            assert ours is None, name  # nothing to pair with
             continue
         assert ours is not None, name
         assert ours.label == theirs.label, name  # the same prefix: the page pairs the runs by label
@@ -64,3 +67,17 @@ def test_the_default_suite_runs_experiment_6s_baselines_on_the_standard_logs() -
     for log in RBPF_LOGS:
         assert entries["mrpt-rbpf"].runs_on(log) and entries["mrpt-icp"].runs_on(log), log
     assert not entries["mrpt-rbpf"].runs_on("synthetic-office-loop")  # not on every dataset: its cost
+
+
+def test_every_dataset_of_the_default_suite_gets_the_two_variants_it_lacks() -> None:
+    """Experiments 1-2 compare literal, thesis and plus on the same datasets: none may lack a variant."""
+    thesis = load_suite(find_suite("thesis"))
+    default = load_suite(find_suite("default"))
+    literals = [e.name for e in default.datasets if not e.is_pattern and not e.skip]
+    for name in [*catalog.names(), *worlds.WORLDS, *literals]:
+        theirs = default.options_for(name)
+        if theirs is None:
+            continue
+        ours = thesis.options_for(name)
+        assert ours is not None and ours.label == theirs.label, name
+        assert ours.methods is not None and {"albot1:literal", "albot1:plus"} <= set(ours.methods), name
