@@ -52,7 +52,9 @@ def test_the_memory_of_the_childs_own_children_counts_and_the_group_is_killed(tm
     code = f"import subprocess, sys, time; subprocess.Popen([sys.executable, '-c', {hold!r}]); time.sleep(60)"
     outcome = _run(tmp_path, code, memory_limit_mb=120.0)
     assert outcome.stopped == "memory" and outcome.returncode is None
-    assert 120.0 < outcome.peak_rss_mb < 400.0 and outcome.wall_s < 10
+    # No upper bound on the peak: the tree's resident sum counts pages a fork shares twice (472 MB was seen
+    # once for this 200 MB holder), and the limit, not the peak's exact size, is what is under test.
+    assert outcome.peak_rss_mb > 120.0 and outcome.wall_s < 10
 
 
 def test_the_child_dies_with_its_parent(tmp_path: Path) -> None:
