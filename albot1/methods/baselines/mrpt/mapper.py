@@ -207,8 +207,9 @@ class _MrptMapper:
             "rawlog_write_s": rawlog_s,
             "mrpt_wall_s": outcome.wall_s,
             "mrpt_cpu_s": outcome.user_s + outcome.system_s,
-            "mrpt_peak_rss_mb": outcome.peak_rss_mb,
         }
+        if outcome.peak_rss_mb is not None:  # unknown only for a program gone before its first reading
+            all_counters["mrpt_peak_rss_mb"] = outcome.peak_rss_mb
         total = outputs.total_time_s(stdout_text)
         if total is not None:
             all_counters["mrpt_total_s"] = total
@@ -229,7 +230,7 @@ class _MrptMapper:
         if outcome.stopped == "memory":
             raise BaselineError(
                 f"{self.name}: {self.app} stopped by its memory limit (memory_limit_mb = "
-                f"{self.config.memory_limit_mb:g}; resident {outcome.peak_rss_mb:.0f} MB) after "
+                f"{self.config.memory_limit_mb:g}; resident {outcome.peak_rss_mb or 0:.0f} MB) after "
                 f"{outcome.wall_s:.1f} s, {progress}"
             )
         if outcome.returncode != 0:

@@ -10,9 +10,16 @@ process group is killed, as the child runs in a session of its own. A
 diverging particle filter grows steadily (hundreds of MB per second at
 most), so a 0.1 s poll bounds the overshoot to a fraction of the limit.
 
-The child is reaped with ``os.wait4`` so its own peak resident set and CPU
-times (``ru_maxrss``, ``ru_utime``, ``ru_stime``) are measured exactly, not
-mixed with other children of this process. On Linux the child also asks the
+The child is reaped with ``os.wait4`` so its CPU times (``ru_utime``,
+``ru_stime``) are measured exactly, not mixed with other children of this
+process. Its peak resident set is *not* ``ru_maxrss``: the kernel carries
+the high-water mark of the image the child had before ``exec`` into it, and
+that image is a fork of this Python process (``preexec_fn`` rules out
+vfork), so ``/bin/sleep`` started from a 400 MB process reported 432 MB.
+The peak is the program's own ``VmHWM`` (``/proc/PID/status``, monotonic,
+read at every poll: only a rise in the last poll interval before it exits
+can be missed) or the polled resident sum of its process tree, whichever is
+larger. On Linux the child also asks the
 kernel to kill it when this process dies (``PR_SET_PDEATHSIG``): a benchmark
 cell killed by its own limit must not leave an unwatched MRPT run behind.
 """
@@ -47,7 +54,7 @@ class ProcessOutcome:
     wall_s: float
     user_s: float
     system_s: float
-    peak_rss_mb: float
+    peak_rss_mb: float | None  # None: the program exited before its memory could be read once
 
 
 #: ``prctl`` option that sends a signal to this process when its parent dies (linux/prctl.h).
@@ -59,6 +66,18 @@ def _die_with_parent() -> None:
     if sys.platform.startswith("linux"):
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+
+
+def _high_water_mb(pid: int) -> float:
+    """The resident high-water mark of the program running as ``pid`` (``VmHWM``, Linux; 0 where unknown)."""
+    try:
+        with open(f"/proc/{pid}/status", "rb") as status:
+            for line in status:
+                if line.startswith(b"VmHWM:"):
+                    return int(line.split()[1]) * 1024 / MIB  # kB
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0.0
 
 
 def _reap(pid: int) -> tuple[int, resource.struct_rusage] | None:
@@ -91,10 +110,12 @@ def run_limited(
             preexec_fn=_die_with_parent,
         )
     reaped: tuple[int, resource.struct_rusage] | None = None
+    high_water_mb = 0.0
 
     def ended(timeout: float) -> bool:
         """Reap the child if it has exited, else after ``timeout`` s (``wait4`` has no timeout of its own)."""
-        nonlocal reaped
+        nonlocal reaped, high_water_mb
+        high_water_mb = max(high_water_mb, _high_water_mb(proc.pid))  # before the reap: /proc/PID goes with it
         reaped = _reap(proc.pid)
         if reaped is None:
             time.sleep(timeout)
@@ -118,7 +139,7 @@ def run_limited(
     wall_s = time.perf_counter() - start
     code = os.waitstatus_to_exitcode(status)
     proc.returncode = code  # reaped here: keep Popen from waiting on a pid that is gone
-    peak_mb = max(polled_peak_mb, usage.ru_maxrss * 1024 / MIB)  # ru_maxrss is KiB on Linux
+    peak_mb = max(polled_peak_mb, high_water_mb) or None  # not ru_maxrss: see the module docstring
     return ProcessOutcome(
         returncode=None if stopped is not None else code,
         stopped=stopped,
