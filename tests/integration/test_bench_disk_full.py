@@ -75,10 +75,14 @@ def test_a_full_disk_stops_the_grid_loses_nothing_and_a_later_run_resumes(tmp_pa
     failed = {c.key: store.failure(c.key) for c in plan.cells if store.failure(c.key) is not None}
     assert complete and failed and len(complete) + len(failed) < len(plan.cells)
     assert all(f.kind == "storage" and "no space left on device" in f.reason for f in failed.values() if f)
+    # A cell that completed just as the disk filled stays complete with only its attempt record missing (by
+    # design: albot1.bench.job; its outcome halts the grid): at most one such cell per running job (-j 2).
+    no_attempt = [key for key in complete if not (store.run_dir(key) / "attempt.json").exists()]
+    assert len(no_attempt) <= 2, no_attempt
     for key in complete:  # complete cells are whole: every file, no temporary or empty file
         folder = store.run_dir(key)
         names = {p.name for p in folder.iterdir()}
-        assert {"DONE", "metrics.json", "result.json", "per_scan_ns.npy", "attempt.json"} <= names
+        assert {"DONE", "metrics.json", "result.json", "per_scan_ns.npy"} <= names
         assert not [n for n in names if n.startswith(".")], names
         assert all(p.stat().st_size > 0 for p in folder.iterdir()), names
         json.loads((folder / "metrics.json").read_text())
