@@ -30,9 +30,11 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from multiprocessing.connection import wait as wait_ready
 from pathlib import Path
 from typing import Any
 
@@ -49,6 +51,8 @@ PRELOAD = ["__main__", "albot1.bench.preload"]
 #: overshoot its memory limit by what it allocates in this time.
 POLL_S = 0.05
 _FORKSERVER: Any = None
+#: Held while a forkserver child is started or its exit status read (:class:`ForkserverChild`).
+_STATUS_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -69,6 +73,44 @@ class ChildExit:
     memory_exceeded: bool = False
     peak_rss_mb: float | None = None
     pool_lost: str | None = None
+
+
+class ForkserverChild:
+    """A started forkserver child whose exit status is read safely from any number of threads.
+
+    Python 3.11's ``Process.start()`` polls every unreaped child of the
+    process (``multiprocessing.process._cleanup``), so a cell starting in one
+    runner thread could read the exit status of a cell ending in another at
+    the same moment as that cell's own thread: the status pipe holds it once,
+    the second reader gets EOF and multiprocessing reports exit code 255 for
+    a child that exited 0 (measured: 17 of 600 short children under two
+    threads; none with :data:`_STATUS_LOCK`; CPython issue 140867). Starting
+    and status reads therefore hold one lock; waiting does not need it.
+    """
+
+    def __init__(self, target: Callable[..., object], args: tuple[Any, ...], name: str) -> None:
+        self._proc = _forkserver().Process(target=target, args=args, name=name, daemon=False)
+        with _STATUS_LOCK:
+            self._proc.start()
+
+    @property
+    def pid(self) -> int:
+        return int(self._proc.pid)
+
+    def ended(self, timeout: float) -> bool:
+        """Wait up to ``timeout`` s; whether the child has exited."""
+        wait_ready([self._proc.sentinel], timeout)  # waits for the pipe without reading the status
+        with _STATUS_LOCK:
+            return not self._proc.is_alive()
+
+    def exit_code(self) -> int | None:
+        """The exit code (negative: killed by that signal; 255: the forkserver gave no status)."""
+        with _STATUS_LOCK:
+            code = self._proc.exitcode
+        return None if code is None else int(code)
+
+    def kill(self) -> None:
+        self._proc.kill()
 
 
 def _forkserver() -> Any:
@@ -183,20 +225,15 @@ def run_limited(
     if (how or launcher()) == "forkserver":
         # The forkserver, not this process, is the child's parent; it exits when this process dies.
         args["parent_pid"] = None
-        proc = _forkserver().Process(target=process_entry, args=(args,), name=f"cell-{cell.key}", daemon=False)
-        proc.start()
-        process = watch(proc.pid)
+        forked = ForkserverChild(process_entry, (args,), name=f"cell-{cell.key}")
+        process = watch(forked.pid)
         server = _parent_of(process)
-
-        def proc_ended(timeout: float) -> bool:
-            proc.join(timeout)
-            return not proc.is_alive()
-
-        stop, peak = supervise(process, proc_ended, cell.time_s, cell.memory_mb)
+        stop, peak = supervise(process, forked.ended, cell.time_s, cell.memory_mb)
         if stop is not None and process is None:
-            proc.kill()
-        proc.join()
-        code = None if stop is not None else proc.exitcode
+            forked.kill()
+        while not forked.ended(POLL_S):
+            pass
+        code = None if stop is not None else forked.exit_code()
         lost = _server_fate(server) if code == 255 else None  # 255: the forkserver's pipe closed, no status
         if lost is not None and process is not None:
             kill_tree(process)  # the cell may outlive its server: stop it before it writes anything more
