@@ -75,6 +75,9 @@ class CellOutcome:
     ``allowed``: a failure of the method itself (:data:`METHOD_FAILURES`) in
     a cell whose suite entry says ``allow_failure``; it is recorded and
     reported like any other but does not make the bench exit non-zero.
+    ``kept``: an allowed failure recorded by an earlier run of this very cell
+    (same key: same code version, config, data and seed) and not run again
+    (:func:`albot1.bench.runner.kept_failure`).
     """
 
     key: str
@@ -87,6 +90,7 @@ class CellOutcome:
     kind: FailureKind | None = None
     halts_grid: bool = False
     allowed: bool = False
+    kept: bool = False
 
     @classmethod
     def of(

@@ -39,6 +39,8 @@ class TqdmProgress:
         if outcome.status == "failed":
             self._failed += 1
             allowed = " (allowed by the suite)" if outcome.allowed else ""
+            if outcome.kept:
+                allowed = " (allowed by the suite; kept from an earlier run of this cell, --retry-failed runs it again)"
             self._write(f"FAILED{allowed} {outcome.description}: {outcome.reason}")
         if self._bar is not None and outcome.status != "cached":
             self._bar.update(1)

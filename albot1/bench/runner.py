@@ -19,7 +19,7 @@ import traceback
 import uuid
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from pathlib import Path
 from typing import Protocol
@@ -31,7 +31,7 @@ from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.job import results_path, run_cell_job
 from albot1.bench.limits import start_forkserver
 from albot1.bench.plan import plan_suite
-from albot1.bench.store import ResultsStore
+from albot1.bench.store import UNREADABLE_FAILURE, ResultsStore
 from albot1.bench.suite import find_suite, load_suite
 from albot1.runs.folder import PreviewRenderer
 from albot1.runs.output import writable_folder
@@ -119,11 +119,15 @@ def run_grid(
     executor: cf.Executor,
     observer: GridObserver | None = None,
     job: Callable[[Cell, str], CellOutcome] = run_cell_job,
+    *,
+    keep_allowed_failures: bool = False,
 ) -> GridSummary:
     """Run every incomplete cell of ``plan`` on ``executor``; failures are recorded, never raised.
 
     An outcome that halts the grid (:attr:`CellOutcome.halts_grid`) cancels
     every cell not yet started; they are listed in ``summary.not_started``.
+    ``keep_allowed_failures``: a cell whose recorded failure :func:`kept_failure`
+    keeps is reported from its record instead of being run again.
     """
     start = time.monotonic()
     summary = GridSummary()
@@ -139,6 +143,8 @@ def run_grid(
                 summary.halted = outcome.reason
         elif store.is_complete(cell.key):
             summary.outcomes.append(CellOutcome.of(cell, "cached"))
+        elif keep_allowed_failures and (kept := kept_failure(store, cell)) is not None:
+            summary.outcomes.append(kept)
         else:
             pending.append(cell)
     if summary.halted is not None:
@@ -179,6 +185,26 @@ def run_grid(
     summary.not_started.sort(key=lambda cell: order[cell.key])
     summary.wall_s = time.monotonic() - start
     return summary
+
+
+def kept_failure(store: ResultsStore, cell: Cell) -> CellOutcome | None:
+    """The recorded failure of ``cell`` when running it again would only repeat it, else None.
+
+    Kept: the method's own error (kind ``exception``, e.g. MRPT's detected
+    divergence) in a cell whose suite entry allows it to fail. The cell's key
+    names its code version, config, data and seed, so the same key is the
+    same computation; without this, every `make bench` spent minutes
+    re-running the same divergences. Retried as before: time and memory
+    limits and crashes (they depend on the machine's load), every failure
+    not allowed by the suite, and an unreadable record.
+    """
+    if not cell.allow_failure:
+        return None
+    recorded = store.failure(cell.key)
+    if recorded is None or recorded.kind != "exception" or recorded.reason == UNREADABLE_FAILURE:
+        return None
+    outcome = CellOutcome.of(cell, "failed", recorded.elapsed_s, recorded.reason, "exception")
+    return replace(outcome, kept=True)
 
 
 def _outcome(future: cf.Future[CellOutcome | None], cell: Cell, store: ResultsStore) -> CellOutcome | None:
@@ -222,8 +248,11 @@ def run_suite(
     settings: Settings | None = None,
     dask_processes: bool = True,
     preview: PreviewRenderer | None = None,
+    retry_failed: bool = False,
 ) -> tuple[GridPlan, GridSummary, ResultsStore]:
     """Load, plan and run a suite into ``results/<suite>``: what `albot1 bench` does.
+
+    ``retry_failed``: run again the allowed failures :func:`kept_failure` would keep.
 
     ``preview`` draws each run's ``preview.png`` (the CLI passes
     ``albot1.report.preview.render_preview``); it must be a module-level function,
@@ -243,7 +272,7 @@ def run_suite(
     try:
         store.write_plan(plan, suite_file)
         with open_executor(executor, jobs, dask_processes=dask_processes) as pool:
-            summary = run_grid(plan, store, pool, observer, job=job)
+            summary = run_grid(plan, store, pool, observer, job=job, keep_allowed_failures=not retry_failed)
     finally:
         store.unlock()
     return plan, summary, store

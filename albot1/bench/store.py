@@ -50,6 +50,8 @@ LOG = "cell.log"
 METRICS = "metrics.json"
 PLAN = "grid.json"
 ATTEMPT = "attempt.json"
+#: The reason of a ``FAILED.json`` that cannot be parsed (such a record is never trusted to skip a cell).
+UNREADABLE_FAILURE = "unreadable FAILED.json"
 
 
 @dataclass(frozen=True)
@@ -200,7 +202,7 @@ class ResultsStore:
         try:
             data = json.loads(path.read_text())
         except json.JSONDecodeError:
-            return Failure("unreadable FAILED.json", "exception", None, 0.0, None)
+            return Failure(UNREADABLE_FAILURE, "exception", None, 0.0, None)
         return Failure(
             str(data.get("reason")),
             str(data.get("kind")),

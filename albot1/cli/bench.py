@@ -29,17 +29,25 @@ def bench(
     data_dir: Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
     progress: Annotated[bool, typer.Option(help="show the progress bar")] = True,
     dry_run: Annotated[bool, typer.Option("--dry-run", help="print the planned cells per dataset and stop")] = False,
+    retry_failed: Annotated[
+        bool,
+        typer.Option(
+            "--retry-failed", help="also run again the allowed failures (allow_failure) recorded by an earlier run"
+        ),
+    ] = False,
 ) -> None:
     """Run a benchmark suite: every dataset x method x degradation x seed cell, each in its own
     process under the suite's time and memory limits.
 
     Completed cells are kept and skipped on the next run; failed cells are recorded with their
-    reason and retried. Then build the report with `albot1 report results/SUITE`. The exit status
-    is 1 when any cell failed (after the whole grid ran and the summary was printed; not for a
-    method's own failure in a cell whose suite entry says `allow_failure`), when the suite has no
-    cell to run, and when the runner had to stop early (the results folder is full
-    or read-only, or the cell process pool was killed: it starts no further cell, and running
-    the same command again resumes).
+    reason and retried, except a method's own error in a cell whose suite entry says
+    `allow_failure` (the same key is the same code, config, data and seed: it would fail the
+    same way; `--retry-failed` runs those again too). Then build the report with
+    `albot1 report results/SUITE`. The exit status is 1 when any cell failed (after the whole
+    grid ran and the summary was printed; not for a method's own failure in a cell whose suite
+    entry says `allow_failure`), when the suite has no cell to run, and when the runner had to
+    stop early (the results folder is full or read-only, or the cell process pool was killed:
+    it starts no further cell, and running the same command again resumes).
 
     Datasets are named as in `albot1 run`: NAME, NAME[:N] (first N scans), NAME?key=value
     (loader options), or a path; a suite entry naming none of these is an error unless it
@@ -74,6 +82,7 @@ def bench(
             observer=view,
             settings=get_settings(data_dir=data_dir),
             preview=render_preview,
+            retry_failed=retry_failed,
         )
     except KeyboardInterrupt:
         # The cells got the same Ctrl-C and were recorded as interrupted; the store is consistent.

@@ -78,6 +78,25 @@ def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(tmp
         "1 of 2 cells failed (reasons above and in the report); 1 of them by methods the suite allows to fail "
         "(allow_failure)"
     )
+    # Run again: the same cell would fail the same way, so its record is kept, said so, and not run again.
+    failed = next((tmp_path / "results" / "allowed" / "runs").glob("*/FAILED.json"))
+    stamp = failed.stat().st_mtime_ns
+    again = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=env)
+    assert again.returncode == 0, again.stderr
+    assert "2 of 2 cells" not in again.stderr  # an allowed failure is not counted as complete
+    assert "1 of 2 cells already complete (kept)" in again.stderr
+    assert (
+        "FAILED (allowed by the suite; kept from an earlier run of this cell, --retry-failed runs it again) "
+        "fault on synthetic-office-startstop"
+    ) in again.stderr
+    assert "injected fault at scan 3" in again.stderr
+    assert failed.stat().st_mtime_ns == stamp
+    retried = subprocess.run(
+        [*args, "--retry-failed"], capture_output=True, text=True, cwd=tmp_path, timeout=300, env=env
+    )
+    assert retried.returncode == 0, retried.stderr
+    assert "FAILED (allowed by the suite) fault on" in retried.stderr and "kept from" not in retried.stderr
+    assert failed.stat().st_mtime_ns != stamp
     # A failure that is not the method's own (a bad config) is never allowed: the exit says so.
     suite.write_text(suite.read_text().replace('mode = "raise"', 'mode = "nonsense"'))
     done = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=env)

@@ -701,21 +701,25 @@ def section_public(ev: Evidence) -> Section:
         )
     methods = [ODOMETRY, *VARIANTS, *EXP6_BASELINES]
     rows = []
+    missing: list[str] = []  # why a table cell reads n/a: a diverged baseline is not a missing number
     for dataset in datasets:
         used = next(
             (n for m in methods if (n := _n(ev, dataset, m, RELATIONS_USED, "")).known), Number("relations", None)
         )
         row = [f"`{dataset}`", _store_of(ev, dataset, methods), used.text()]
-        row += [
-            f"{_cell(_n(ev, dataset, m, RELATION_M, '', 'm'))} / {_cell(_n(ev, dataset, m, RELATION_DEG, '', 'deg'))}"
-            for m in methods
-        ]
+        for m in methods:
+            metres = _n(ev, dataset, m, RELATION_M, "", "m")
+            row.append(f"{_cell(metres)} / {_cell(_n(ev, dataset, m, RELATION_DEG, '', 'deg'))}")
+            if not metres.known:
+                missing.append(f"`{m}` on `{dataset}`: {metres.missing or 'no value'}")
         rows.append(row)
     if rows:
         section.tables.append(
             "Relation metric, mean translational / rotational error over the relations inside the run:\n\n"
             + _table(["dataset", "store", "relations", *methods], rows)
         )
+        if missing:
+            section.notes.append("Why a cell of the relation table reads n/a: " + "; ".join(missing) + ".")
     else:
         section.notes.append(
             "No public log with ground-truth relations has results in the stores read (run the default suite "

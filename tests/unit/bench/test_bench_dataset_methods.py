@@ -10,6 +10,8 @@ import pytest
 from albot1.bench.errors import SuiteError
 from albot1.bench.grid import CellOutcome
 from albot1.bench.plan import plan_suite
+from albot1.bench.runner import kept_failure
+from albot1.bench.store import ResultsStore
 from albot1.bench.suite import load_suite
 from albot1.settings import Settings
 
@@ -116,3 +118,27 @@ def _write(tmp_path: Path, text: str) -> Path:
     path = tmp_path / "plain.toml"
     path.write_text(text)
     return path
+
+
+def test_only_an_allowed_methods_own_error_is_kept_from_an_earlier_run(tmp_path: Path) -> None:
+    """The same key fails the same way only for the method's own error; limits and crashes depend on the load."""
+    path = tmp_path / "tiny.toml"
+    path.write_text(SUITE.replace('name = "odometry"', 'name = "odometry"\nallow_failure = true'))
+    plan = plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    odometry = next(c for c in plan.cells if c.method_label == "odometry")
+    other = next(c for c in plan.cells if c.method_label != "odometry")
+    store = ResultsStore(tmp_path / "store")
+    for cell in (odometry, other):
+        store.prepare(cell)
+        assert kept_failure(store, cell) is None  # nothing recorded: run it
+    store.record_failure(other, "diverged", "exception")
+    assert kept_failure(store, other) is None  # not allowed by the suite: always retried
+    for kind in ("timeout", "memory", "crash", "executor", "storage", "interrupted"):
+        store.record_failure(odometry, f"a {kind}", kind)  # type: ignore[arg-type]
+        assert kept_failure(store, odometry) is None, kind
+    store.record_failure(odometry, "diverged at scan 7", "exception")
+    kept = kept_failure(store, odometry)
+    assert kept is not None and kept.kept and kept.allowed and kept.status == "failed"
+    assert (kept.key, kept.kind, kept.reason) == (odometry.key, "exception", "diverged at scan 7")
+    (store.run_dir(odometry.key) / "FAILED.json").write_text("{not json")
+    assert kept_failure(store, odometry) is None  # an unreadable record is never trusted

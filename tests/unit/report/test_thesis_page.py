@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import re
 import shutil
+from functools import partial
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -152,3 +154,30 @@ def test_a_replay_that_does_not_reproduce_the_stored_run_is_refused(results: Pat
     (copy / "trajectory.tum").write_text("\n".join([*lines[:-1], " ".join(last)]) + "\n")
     with pytest.raises(ReportError, match="does not reproduce the stored trajectory"):
         replay_run(copy)
+
+
+def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A failed baseline's n/a in the relation table is explained by its recorded reason, not left bare.
+
+    The synthetic world has no ground-truth relations, so the section is pointed at its ATE and RPE and at
+    the thesis error level the tiny store ran; the rows, n/a cells and notes are the section's own.
+    """
+    from albot1.report.thesis import experiments
+
+    monkeypatch.setattr(experiments, "_public", lambda dataset: dataset == SQUARE)
+    monkeypatch.setattr(experiments, "RELATION_M", "ate.rmse_m")
+    monkeypatch.setattr(experiments, "RELATION_DEG", "rpe.rotation_deg.rmse")
+    monkeypatch.setattr(experiments, "_n", partial(_n_at_thesis_level, experiments._n))
+    section = experiments.section_public(open_stores(results))
+    assert section.tables and "n/a" in section.tables[0] and f"`{SQUARE}`" in section.tables[0]
+    why = [note for note in section.notes if note.startswith("Why a cell of the relation table reads n/a")]
+    assert len(why) == 1
+    assert f"`{FAILED_METHOD}` on `{SQUARE}`: failed in" in why[0] and "the mapper diverged" in why[0]
+    assert f"`mrpt-rbpf` on `{SQUARE}`: no mrpt-rbpf run" in why[0]  # planned nowhere here: said so, too
+    assert "`odometry` on" not in why[0] and "`albot1:literal` on" not in why[0]  # measured: no note
+
+
+def _n_at_thesis_level(
+    inner: Any, ev: Any, dataset: str, method: str, path: str, label: str, unit: str = "", deg: str = "none"
+) -> Any:
+    return inner(ev, dataset, method, path, label, unit, "thesis")
