@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from albot1.bench.errors import SuiteError
-from albot1.bench.grid import CellOutcome
+from albot1.bench.grid import Cell, CellOutcome
 from albot1.bench.plan import plan_suite
 from albot1.bench.runner import kept_failure
 from albot1.bench.store import ResultsStore
@@ -92,11 +92,7 @@ def test_a_method_entrys_datasets_glob_that_matches_no_dataset_is_an_error(tmp_p
 
 
 def test_allow_failure_reaches_the_cells_and_allows_only_the_methods_own_failures(tmp_path: Path) -> None:
-    path = tmp_path / "tiny.toml"
-    path.write_text(SUITE.replace('name = "odometry"', 'name = "odometry"\nallow_failure = true'))
-    plan = plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
-    odometry = next(c for c in plan.cells if c.method_label == "odometry")
-    other = next(c for c in plan.cells if c.method_label != "odometry")
+    odometry, other = _allowed_and_not(tmp_path)
     assert odometry.allow_failure and not other.allow_failure
     for kind in ("exception", "memory", "timeout", "crash"):
         assert CellOutcome.of(odometry, "failed", 1.0, "x", kind).allowed  # type: ignore[arg-type]
@@ -114,6 +110,15 @@ def test_allow_failure_reaches_the_cells_and_allows_only_the_methods_own_failure
     )
 
 
+def _allowed_and_not(tmp_path: Path) -> tuple[Cell, Cell]:
+    """A cell of odometry, whose entry says allow_failure, and a cell of another method."""
+    path = tmp_path / "tiny.toml"
+    path.write_text(SUITE.replace('name = "odometry"', 'name = "odometry"\nallow_failure = true'))
+    plan = plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    odometry = next(c for c in plan.cells if c.method_label == "odometry")
+    return odometry, next(c for c in plan.cells if c.method_label != "odometry")
+
+
 def _write(tmp_path: Path, text: str) -> Path:
     path = tmp_path / "plain.toml"
     path.write_text(text)
@@ -122,11 +127,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 def test_only_an_allowed_methods_own_error_is_kept_from_an_earlier_run(tmp_path: Path) -> None:
     """The same key fails the same way only for the method's own error; limits and crashes depend on the load."""
-    path = tmp_path / "tiny.toml"
-    path.write_text(SUITE.replace('name = "odometry"', 'name = "odometry"\nallow_failure = true'))
-    plan = plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
-    odometry = next(c for c in plan.cells if c.method_label == "odometry")
-    other = next(c for c in plan.cells if c.method_label != "odometry")
+    odometry, other = _allowed_and_not(tmp_path)
     store = ResultsStore(tmp_path / "store")
     for cell in (odometry, other):
         store.prepare(cell)
