@@ -203,7 +203,8 @@ def kept_failure(store: ResultsStore, cell: Cell) -> CellOutcome | None:
     recorded = store.failure(cell.key)
     if recorded is None or recorded.kind != "exception" or recorded.reason == UNREADABLE_FAILURE:
         return None
-    outcome = CellOutcome.of(cell, "failed", recorded.elapsed_s, recorded.reason, "exception")
+    # No time spent in this run (its attempt's time stays in FAILED.json), as for a complete cell kept.
+    outcome = CellOutcome.of(cell, "failed", 0.0, recorded.reason, "exception")
     return replace(outcome, kept=True)
 
 

@@ -137,9 +137,10 @@ def test_only_an_allowed_methods_own_error_is_kept_from_an_earlier_run(tmp_path:
     for kind in ("timeout", "memory", "crash", "executor", "storage", "interrupted"):
         store.record_failure(odometry, f"a {kind}", kind)  # type: ignore[arg-type]
         assert kept_failure(store, odometry) is None, kind
-    store.record_failure(odometry, "diverged at scan 7", "exception")
+    store.record_failure(odometry, "diverged at scan 7", "exception", elapsed_s=12.5)
     kept = kept_failure(store, odometry)
     assert kept is not None and kept.kept and kept.allowed and kept.status == "failed"
     assert (kept.key, kept.kind, kept.reason) == (odometry.key, "exception", "diverged at scan 7")
+    assert kept.elapsed_s == 0.0  # no time spent in this run: the summary's cell-seconds are this run's
     (store.run_dir(odometry.key) / "FAILED.json").write_text("{not json")
     assert kept_failure(store, odometry) is None  # an unreadable record is never trusted
