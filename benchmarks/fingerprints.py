@@ -5,7 +5,8 @@ kernels are compiled) must leave every pose and every map bit for bit as it
 was. This script runs each registered method that is available on this
 machine (every Albot1 preset, the places mapper, the baselines) on three
 datasets and prints one line per run with a sha256 of the poses, of the map
-(segments and points, float64 bytes) and of the counters, so two checkouts
+(segments and points, float64 bytes) and of the counters (less the
+ones that measure time or memory), so two checkouts
 can be compared line by line::
 
     python benchmarks/fingerprints.py > before.txt      # on the old code
@@ -31,6 +32,9 @@ from albot1.data import open_sequence
 from albot1.errors import Albot1Error
 from albot1.methods.registry import METHODS
 from albot1.runs.execute import run_method
+
+#: Counters that are measurements of this machine (MRPT's wall time, peak memory), not outputs of the method.
+MEASURED_SUFFIXES = ("_s", "_mb")
 
 #: Three datasets: exact synthetic geometry, and prefixes of two public raw logs with their own odometry.
 DATASETS = ("synthetic-office-loop", "aces[:400]", "mit-csail[:400]")
@@ -74,7 +78,8 @@ def main(argv: list[str] | None = None) -> int:
             except Albot1Error as error:
                 sys.stdout.write(f"{dataset} {method}:{preset}: failed ({type(error).__name__}: {error})\n")
                 continue
-            counters = hashlib.sha256(json.dumps(result.counters, sort_keys=True).encode()).hexdigest()[:16]
+            counted = {k: v for k, v in result.counters.items() if not k.endswith(MEASURED_SUFFIXES)}
+            counters = hashlib.sha256(json.dumps(counted, sort_keys=True).encode()).hexdigest()[:16]
             sys.stdout.write(
                 f"{dataset} {method}:{preset} poses={_digest(result.poses)} "
                 f"segments={_digest(result.map.segments)} points={_digest(result.map.points)} counters={counters}\n"
