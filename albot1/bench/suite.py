@@ -191,8 +191,7 @@ class DatasetEntry(_Strict):
     )
     tags: tuple[str, ...] = Field(
         (),
-        description="names a report finds this entry's datasets by (the thesis page's experiments); they change "
-        "no run",
+        description="names a report finds this entry's datasets by (the thesis page's experiments); they change no run",
     )
 
     @field_validator("degradations")
