@@ -70,8 +70,8 @@ class FrontEnd:
         """The newest node is where the robot is now: tracking continues from its frame."""
         self.track = np.zeros(3)
 
-    def step(self, odometry: FloatArray, points: FloatArray) -> tuple[FloatArray, FloatArray, Registration | None]:
-        """Track one scan: its pose relative to the newest node, the odometry increment, and the passing match.
+    def step(self, odometry: FloatArray, points: FloatArray) -> tuple[FloatArray, Registration | None]:
+        """Track one scan: its pose relative to the newest node, and the passing match.
 
         The match is None when tracking is off or failed; the pose is then the
         odometry guess.
@@ -83,7 +83,7 @@ class FrontEnd:
         pose = guess if reg is None else reg.pose
         if self.config.track_scans:
             self._velocity = se2.between(self.track, pose)
-        return pose, increment, reg
+        return pose, reg
 
     def moved_enough(self, relative: FloatArray) -> bool:
         """Whether a pose relative to the newest node is far enough from it to become a node."""

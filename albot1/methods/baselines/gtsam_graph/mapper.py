@@ -104,7 +104,7 @@ class GtsamGraphMapper:
                 self.back.start(odometry, points, frame.index)
                 front.new_node()
             else:
-                pose, _, reg = front.step(odometry, points)
+                pose, reg = front.step(odometry, points)
                 if front.moved_enough(pose):
                     self._add_node(odometry, pose, points, frame.index, reg)
                 else:
