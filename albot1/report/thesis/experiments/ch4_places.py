@@ -40,6 +40,8 @@ def section_places(ev: Evidence) -> Section:
     """Chapter 4 (4.2.1-4.2.3): places learned, re-visits recognised, exits predicted aligned vs not."""
     ds = thesis_datasets()
     places = THESIS["places_single_loop"]
+    loop, *starts = ds.places_starts  # the other start points and the two laps are options of the loop's world
+    variants = ", ".join(f"`{label.removeprefix(loop)}`" for label in starts)
     section = Section(
         "chapter-4",
         "Chapter 4: places (4.2.1-4.2.3)",
@@ -48,11 +50,11 @@ def section_places(ev: Evidence) -> Section:
         "re-visit (a new place P7 is created) but recognises P2 and P1 later, and never confuses two places "
         "(4.2.2, Figure 4.5). Exits of a re-visited place brought into the perceptual map and aligned at the "
         "exit just crossed predict the exits ahead better than unaligned ones (4.2.3, Figure 4.8; no number).",
-        "The six-room worlds (docs/synthetic-worlds.md): `synthetic-places-loop` from S, A and B (`?start=1`, "
-        "`?start=2`), `synthetic-places-double-loop` (a second loop entering room 5 from a new side) and the loop "
-        "driven twice (`?laps=2`) for the exit predictions. Re-visits are judged against the rooms the reference "
-        "poses were in (docs/places.md); precision = true claimed re-visits / claims, recall = recognised / "
-        "actual re-visits. Exit-prediction error: distance of a predicted exit's midpoint from the exit "
+        f"The six-room worlds (docs/synthetic-worlds.md): `{loop}` from S, A and B ({variants}), "
+        f"`{ds.double_loop}` (a second loop entering room 5 from a new side) and the loop driven twice "
+        f"(`{ds.two_laps.removeprefix(loop)}`) for the exit predictions. Re-visits are judged against the rooms "
+        "the reference poses were in (docs/places.md); precision = true claimed re-visits / claims, recall = "
+        "recognised / actual re-visits. Exit-prediction error: distance of a predicted exit's midpoint from the exit "
         "perceived (Figure 4.8's measure) and from the true doorway.",
         columns=dict(PLACES_VARIANTS),
     )

@@ -46,7 +46,7 @@ def section_error_tolerance(ev: Evidence) -> Section:
         f"and {alb_induced.text()} ({odo_induced.source}, {alb_induced.source}).",
         f"`{ds.square}`: a 96 m square corridor ring driven start-stop (1 m / 45 deg), whose simulated odometry "
         "(the office worlds' error model, docs/synthetic-worlds.md) ends 4.6 m from its start, so both rows are "
-        "compared like for like. The induced error is the `thesis` degradation (+0.1 m and +1 deg on every "
+        f"compared like for like. The induced error is the `{ds.induced}` degradation (+0.1 m and +1 deg on every "
         "step's odometry). Loop gap: distance between the estimated start and end of the closed route.",
     )
     views = number(ev, ds.square, ODOMETRY, VIEWS, "views")
