@@ -31,6 +31,7 @@ import numpy as np
 
 from albot1.data.errors import DataError, ParseError, TopicError
 from albot1.data.loaders.rosbag.bag1_check import version_problem
+from albot1.data.loaders.rosbag.mounting import bag_mounting
 from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, scan_arrays
 from albot1.data.loaders.rosbag.reader import header_stamp, odometry_track, opened_bag, tf_track, topic_messages
 from albot1.data.loaders.rosbag.topics import LASER_SCAN, TopicChoice, TopicInfo, choose_topics, normalize_type
@@ -149,6 +150,7 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
         if topic is not None and topics[topic].count == 0:
             raise TopicError(f"{shown}: topic {topic} ({role}) has no messages; expected at least one")
     source = _BagSource(bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"])
+    mounting = bag_mounting(bag, shown, topics, choice, opts["base_frame"], opts["odom_frame"])
     odom_desc = (
         f"{choice.odom} transforms {opts['odom_frame']} -> {opts['base_frame'] or '(its only child)'}"
         if choice.odom_is_tf
@@ -157,6 +159,7 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
     metadata = SequenceMetadata(
         source=str(shown),
         format=format_name,
+        sensor_offset=mounting.offset,
         odometry_source=f"{odom_desc}, SE(2)-interpolated to the {LASER_SCAN} header stamps of {choice.scan}",
         reference_source=(
             f"{choice.reference} (nav_msgs/msg/Odometry), SE(2)-interpolated to the scan stamps"
@@ -168,6 +171,7 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
             "odom_topic": choice.odom,
             "reference_topic": choice.reference,
             "outside_odometry": opts["outside_odometry"],
+            "sensor_offset_source": mounting.note,
         },
     )
     return Sequence(name, source.frames, metadata)
