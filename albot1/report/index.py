@@ -21,6 +21,7 @@ import pandas as pd
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
+from albot1.report.external_notes import external_markdown
 from albot1.report.html import INDEX_HTML, rel, write_html
 from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.plots import method_colors, slug, vector_of
@@ -229,6 +230,7 @@ def write_index(
                 *[f"- [{f.stem}]({_rel(f, out)}) ([SVG]({_rel(vector_of(f), out)}))" for f in files],
                 "",
             ]
+    lines += external_markdown(records)
     lines += ["## Failed cells", "", *_failure_lines(records, out)]
     not_run = [r for r in records if r.status == "not run"]
     if not_run:

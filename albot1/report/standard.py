@@ -128,12 +128,14 @@ def _measured(rec: CellRecord) -> Row:
         reason = rec.failure.reason if rec.failure is not None else "the runner did not reach this cell"
         return Row(log, "measured", method, status=rec.status, note=reason.replace("\n", " "))
     timing = rec.result.timing
+    external = rec.cell.trajectory is not None  # another system's file: no timing measured (zeros in result.json)
+    wall_s, cpu_s = (None, None) if external else (timing.wall_s, timing.cpu_s)
     stamps = rec.stored_run().timestamps
     duration = float(stamps.max() - stamps.min()) if len(stamps) > 1 else None
     block = rec.metrics.relations
     if block is None:
         why = rec.metrics.relations_reason or "no relation metric"
-        return Row(log, "measured", method, time_s=timing.wall_s, cpu_s=timing.cpu_s, duration_s=duration, note=why)
+        return Row(log, "measured", method, time_s=wall_s, cpu_s=cpu_s, duration_s=duration, note=why)
     t, r, loops = block.translation_m, block.rotation_deg, block.loops
     note = ""
     if block.relations_outside_run:
@@ -153,10 +155,14 @@ def _measured(rec: CellRecord) -> Row:
         loop_translation_std_m=loops.translation_m.std,
         loop_rotation_mean_deg=loops.rotation_deg.mean,
         loop_relations=loops.translation_m.n,
-        time_s=timing.wall_s,
-        cpu_s=timing.cpu_s,
+        time_s=wall_s,
+        cpu_s=cpu_s,
         duration_s=duration,
-        source=f"this suite, run {rec.cell.key}",
+        source=(
+            f"external file {rec.cell.trajectory}, sha256 {(rec.cell.config or {}).get('sha256')}"
+            if external
+            else f"this suite, run {rec.cell.key}"
+        ),
         note=note,
     )
 
