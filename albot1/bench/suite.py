@@ -35,7 +35,7 @@ Format (every key optional except ``methods`` and ``datasets``)::
     [[methods]]                      # another system's output, scored beside the methods run
     name = "cartographer"
     trajectories = "runs/carto/{dataset}.tum"   # one file per dataset (relative to the suite file);
-                                     # {dataset}: the dataset's name (a path's stem); see external_runs.py
+                                     # {dataset}: the dataset's name (a path's stem); see albot1/bench/external.py
     # trajectory_format = "tum"      # tum | kitti | carmen (default: guessed from each file)
 
     [[datasets]]                     # applied in order; later entries override earlier ones
