@@ -25,6 +25,7 @@ from albot1.report.external_notes import external_markdown
 from albot1.report.html import INDEX_HTML, rel, write_html
 from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.plots import method_colors, slug, vector_of
+from albot1.report.relation_plots import plot_relation_boxes
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.standard import PAGE as STANDARD_PAGE
@@ -108,6 +109,7 @@ def _dataset_plots(
         plot_ape_map(recs, dataset, at("ape"), colors),
         plot_error_vs_distance(recs, dataset, at("error-distance"), colors),
         plot_rpe_boxes(recs, dataset, at("rpe-boxes"), colors),
+        plot_relation_boxes(recs, dataset, at("relation-boxes"), colors),
         plot_maps(recs, dataset, at("maps"), colors, style=map_style),
         *[plot_robustness(metrics, dataset, column, label, at(kind), colors) for column, label, kind in ROBUSTNESS],
         plot_scan_time(recs, dataset, at("scan-time"), colors),

@@ -94,3 +94,36 @@ def test_run_tag_and_running_median_window() -> None:
     spiky = np.array([1.0] * 20)
     spiky[[3, 11]] = 100.0
     assert running_median(spiky, median_window(len(spiky))).tolist() == [1.0] * 20  # spikes gone, unlike raw data
+
+
+def test_relation_boxes_hold_each_relation_error_and_the_published_marks(tmp_path: Path) -> None:
+    from albot1.data.model import Relations
+    from albot1.methods.baselines.published import published_systems
+    from albot1.report.relation_plots import plot_relation_boxes, published_marks, relation_error_sets
+
+    n = 20
+    truth = se2.integrate_steps(np.zeros(3), np.tile([[0.5, 0.0, np.radians(5.0)]], (n - 1, 1)))
+    stamps = 10.0 + np.arange(n)
+    i1, i2 = np.arange(0, n - 5), np.arange(5, n)
+    # every relation is the true motion followed by 0.1 m forward and 2 deg: the error is exactly that, inverted
+    rel = se2.compose(se2.between(truth[i1], truth[i2]), np.array([0.1, 0.0, np.radians(2.0)]))
+    relations = Relations(stamps[i1], stamps[i2], rel)
+    frames = [Frame(i, Scan(np.full(9, 1.0), ANGLES, stamps[i], 5.0), truth[i], truth[i]) for i in range(n)]
+    run_dir = write_run(run_method("odometry", Sequence.from_frames("r", frames, relations=relations)), tmp_path)
+    cell = Cell("t", "aces", "aces", "odometry", "odometry", "default", "none", 0, "k", "v", 1, 1)
+    records = [CellRecord(cell, "done", run_dir, read_result(run_dir), evaluate_run(run_dir), None)]
+    ((label, (tag, trans, rot)),) = relation_error_sets(records).items()
+    assert (label, tag, len(trans)) == ("odometry", "[none, seed 0]", n - 5)
+    assert trans == pytest.approx(np.full(n - 5, 0.1), abs=1e-8)  # relations.txt stores them to ~1e-9
+    assert rot == pytest.approx(np.full(n - 5, 2.0), abs=1e-6)
+    expected = sorted(
+        (s.label, f.mean) for s in published_systems() for f in s.figures
+        if f.log == "aces" and f.metric == "relation_translation_m"
+    )  # fmt: skip
+    assert sorted((name, mean) for name, mean, _ in published_marks("aces")["relation_translation_m"]) == expected
+    assert len(expected) >= 4 and published_marks("aces[:500]") == {
+        "relation_translation_m": [],
+        "relation_rotation_deg": [],
+    }
+    assert plot_relation_boxes(records, "aces", tmp_path / "r.png", {"odometry": "#7f7f7f"}) == tmp_path / "r.png"
+    assert "published" in (tmp_path / "r.svg").read_text()
