@@ -78,7 +78,9 @@ def plot_relation_boxes(records: list[CellRecord], dataset: str, path: Path, col
     for ax, (column, (metric, axis_label)) in zip(axes, enumerate(PANELS)):
         labels = list(sets)
         raw: list[NDArray[np.float64]] = [sets[label][2] if column else sets[label][1] for label in labels]
-        floor = log_floor([*(r.tolist() for r in raw), [m for _, m, _ in marks[metric]]])  # errors span decades: a log axis
+        floor = log_floor(
+            [*(r.tolist() for r in raw), [m for _, m, _ in marks[metric]]]
+        )  # errors span decades: a log axis
         data = raw if floor is None else [np.maximum(values, floor) for values in raw]
         clipped = [label for label, values in zip(labels, raw) if floor is not None and (values < floor).any()]
         boxes = ax.boxplot(
