@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -100,3 +101,33 @@ def test_external_trajectory_is_scored_beside_the_runs_and_reported(tmp_path: Pa
     pages = "\n".join(p.read_text() for p in (tmp_path / "report").rglob("*") if p.suffix in {".md", ".html", ".csv"})
     assert "mysys (external)" in pages
     assert sha in pages
+    maps = next((tmp_path / "report" / "plots").glob("*-maps.svg")).read_text()
+    assert "no map: an external trajectory file" in maps
+
+
+def test_standard_page_shows_an_external_system_beside_ours_and_the_published_rows(tmp_path: Path) -> None:
+
+    if not (Path(os.environ.get("ALBOT1_DATA_DIR", "/nonexistent")) / "radish" / "aces.clf.bz2").is_file():
+        pytest.skip("the ACES log is not in ALBOT1_DATA_DIR")
+    results = tmp_path / "results"
+    suite = tmp_path / "std.toml"
+    suite.write_text('[[methods]]\nname = "odometry"\n\n[[datasets]]\nname = "aces"\n')
+    done = _cli("bench", str(suite), "-j", "1", "--results", str(results), "--no-progress", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    (run,) = collect(results / "std")[1]
+    (tmp_path / "carto").mkdir()
+    shutil.copy(run.run_dir / "trajectory.tum", tmp_path / "carto" / "aces.tum")
+    suite.write_text(suite.read_text() + '\n[[methods]]\nname = "carto"\ntrajectories = "carto/{dataset}.tum"\n')
+    done = _cli("bench", str(suite), "-j", "1", "--results", str(results), "--no-progress", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    done = _cli("report", str(results / "std"), "--out", str(tmp_path / "report"), cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    page = (tmp_path / "report" / "standard-benchmark.md").read_text()
+    ours = next(line for line in page.splitlines() if line.startswith("| odometry | measured |"))
+    theirs = next(line for line in page.splitlines() if line.startswith("| carto (external) | measured |"))
+    # the same poses: the same relation numbers; no timing for a file (n/a), ours measured
+    assert theirs.split("|")[3:9] == ours.split("|")[3:9]
+    assert theirs.rstrip(" |").endswith("n/a | n/a | n/a") and not ours.rstrip(" |").endswith("n/a")
+    assert "| Cartographer (Hess et al. 2016) | **published** |" in page
+    sha = hashlib.sha256((tmp_path / "carto" / "aces.tum").read_bytes()).hexdigest()
+    assert f"sha256 {sha}" in page
