@@ -46,6 +46,7 @@ from pydantic import (
     BeforeValidator,
     ConfigDict,
     SerializerFunctionWrapHandler,
+    StringConstraints,
     ValidationError,
     model_serializer,
     model_validator,
@@ -55,6 +56,8 @@ from albot1.config.validation import describe_errors
 from albot1.errors import Albot1Error
 
 RecordT = TypeVar("RecordT", bound="Record")
+#: A sha256 checksum as the files hold it: 64 lower-case hex digits.
+Sha256 = Annotated[str, StringConstraints(pattern=r"^[0-9a-f]{64}$")]
 
 
 class RecordError(Albot1Error):
@@ -172,6 +175,9 @@ class DatasetInfo(Record):
     #: the laser's pose on the robot (x m, y m, yaw rad) the runner applied (albot1.data.transforms.sensor_frame);
     #: absent in results written before it was recorded
     sensor_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    #: sha256 of every file the sequence was read from, by file name (albot1.data.identity); empty for a
+    #: synthetic world (its code version names it) and in results written before it was recorded
+    data_sha256: dict[str, Sha256] = {}
 
 
 class ResultRecord(Record):

@@ -26,12 +26,14 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from albot1.config.keyvalue import KeyValueError, parse_query
 from albot1.data import catalog
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
+from albot1.data.identity import content_sha256
 from albot1.data.loaders.registry import load
 from albot1.data.model import Sequence
 from albot1.data.synthetic import worlds
@@ -70,14 +72,37 @@ def open_sequence(
         return worlds.load_world(text, **options)  # a world's own options (start=, laps=) or SyntheticWorldError
     settings = settings or get_settings()
     if text in catalog.names():
-        return catalog.open_dataset(text, settings, **options)
+        return _with_checksums(catalog.open_dataset(text, settings, **options), None, options)
     path = Path(text).expanduser()
     if _exists(text):
-        return load(path, format_name, **options)
+        return _with_checksums(load(path, format_name, **options), path, options)
     raise DatasetNotFoundError(
         f"{text!r} is neither a dataset name nor an existing file; known datasets: "
         f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
     )
+
+
+def _with_checksums(sequence: Sequence, path: Path | None, options: dict[str, Any]) -> Sequence:
+    """``sequence`` with the sha256 of every file it was read from in its metadata.
+
+    The log (``path``; a catalog dataset's files are verified and recorded by
+    the catalog) and every loader option that names a file (``relations=``,
+    ``reference=``): the content a result is computed from
+    (:mod:`albot1.data.identity`, cached).
+    """
+    files = [path] if path is not None else []
+    files += [Path(v) for v in options.values() if isinstance(v, (str, Path)) and _is_file(str(v))]
+    if not files:
+        return sequence
+    checksums = {**sequence.metadata.checksums, **{f.name: content_sha256(f) for f in files}}
+    return sequence.with_metadata(replace(sequence.metadata, checksums=checksums))
+
+
+def _is_file(text: str) -> bool:
+    try:
+        return Path(text).expanduser().is_file()
+    except (OSError, ValueError):
+        return False
 
 
 def _exists(text: str) -> bool:

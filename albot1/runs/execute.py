@@ -22,7 +22,7 @@ from albot1 import versions
 from albot1.config.targets import resolve_target
 from albot1.contract import MapperOutput, RunResult
 from albot1.data.degrade import degrade
-from albot1.data.model import Sequence
+from albot1.data.model import Frame, Sequence
 from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
 from albot1.methods.registry import get_method, resolve_config
@@ -78,8 +78,9 @@ def run_method(
     try:
         for frame in seen.frames():
             index = frame.index
+            blind = withhold_ground_truth(frame)
             start = time.perf_counter_ns()
-            mapper.process(frame)
+            mapper.process(blind)
             per_scan.append(time.perf_counter_ns() - start)
             stamps.append(frame.scan.timestamp)
             odometry.append(frame.odometry)
@@ -145,8 +146,20 @@ def run_method(
             "odometry_source": seq.metadata.odometry_source,
             "reference_source": seq.metadata.reference_source,
             "sensor_offset": [float(v) for v in offset],
+            "data_sha256": dict(seq.metadata.checksums),
         },
     )
+
+
+def withhold_ground_truth(frame: Frame) -> Frame:
+    """What a method is given of ``frame``: the scan and the odometry, never the reference pose.
+
+    The one place where ground truth is kept from the methods (relations
+    never reach them: a mapper is given frames only). The runner keeps the
+    reference for evaluation and for the method's judge (``MethodSpec.judge``),
+    which run after the mapper has finished.
+    """
+    return frame if frame.reference is None else Frame(frame.index, frame.scan, frame.odometry)
 
 
 def _check_output(output: MapperOutput, n: int, method: str, dataset: str, error_class: type[Exception]) -> None:

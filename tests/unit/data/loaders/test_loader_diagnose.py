@@ -34,13 +34,13 @@ def write(tmp_path: Path, name: str, data: bytes | str) -> Path:
             "t.txt",
             "# header\nhello world\n",
             ParseError,
-            r"t\.txt:2: the first line that is not a comment is 'hello world'",
+            r"t\.txt:2: the first line that is not a comment \(text, 11 characters\) begins no known format",
         ),
         (
             "s.clf",
             "flaser 3 1 2 3\n",
             ParseError,
-            r"s\.clf:1: the first line that is not a comment is 'flaser 3 1 2 3'",
+            r"s\.clf:1: the first line that is not a comment \(text, 14 characters\) begins no known format",
         ),
     ],
 )
