@@ -100,7 +100,6 @@ def _relative_path(value: str, where: Path) -> str:
     fetch writes it: ``../../x`` or ``/etc/x`` would read or overwrite a file
     outside them.
     """
-    parts = PurePosixPath(value).parts
     if (
         not value.strip()
         or PurePosixPath(value).is_absolute()
@@ -108,7 +107,7 @@ def _relative_path(value: str, where: Path) -> str:
         or value.startswith("~")
         or "\\" in value
         or "\0" in value
-        or any(part in ("..", ".") for part in parts)
+        or any(part in ("", ".", "..") for part in value.split("/"))
     ):
         raise DataError(
             f"{where}: path {value!r} must be a relative path inside the data folder, like 'radish/aces.clf.bz2' "
