@@ -134,6 +134,7 @@ def info(
     }
     sequence = open_sequence(ref, settings=get_settings(data_dir=data_dir), **options)
     summary = with_progress(sequence, f"reading {ref}").summary()
+    summary["data_sha256"] = dict(sequence.metadata.checksums)  # the files' content the numbers describe
     if as_json:
         typer.echo(json.dumps(summary))
         return
@@ -149,3 +150,7 @@ def info(
     )
     typer.echo(f"  odometry: {summary.get('odometry_source', '')}")
     typer.echo(f"  source: {summary.get('source', '')} ({summary.get('format', '')})")
+    checksums = summary["data_sha256"]
+    typer.echo(
+        "  data: " + (", ".join(f"{n} sha256 {sha}" for n, sha in checksums.items()) or "generated (no data file)")
+    )

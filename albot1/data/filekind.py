@@ -56,7 +56,9 @@ def check_input(path: Path, expected: str, *, folder_ok: bool = False) -> os.sta
         raise DataError(f"{path}: no such file or directory; expected {expected}") from None
     except (OSError, ValueError) as exc:  # a name too long, a NUL, a permission problem on a parent folder
         shown = str(path) if len(str(path)) <= 200 else f"{str(path)[:200]}..."
-        raise DataError(f"{shown}: not a usable path ({getattr(exc, 'strerror', None) or exc}); expected {expected}") from None
+        raise DataError(
+            f"{shown}: not a usable path ({getattr(exc, 'strerror', None) or exc}); expected {expected}"
+        ) from None
     kind = special_kind(st.st_mode)
     if kind is None and stat.S_ISDIR(st.st_mode) and not folder_ok:
         kind = "a folder"

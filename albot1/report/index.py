@@ -259,7 +259,10 @@ def write_index(
         lines.append("None: every dataset the suite selects was available.")
     lines += ["", "## Skipped methods", ""]
     if plan.skipped_methods:
-        lines += [f"- {code(s.name)}: {text(s.reason)}" + (f" ({code(s.hint)})" if s.hint else "") for s in plan.skipped_methods]
+        lines += [
+            f"- {code(s.name)}: {text(s.reason)}" + (f" ({code(s.hint)})" if s.hint else "")
+            for s in plan.skipped_methods
+        ]
     else:
         lines.append("None.")
     lines.append("")

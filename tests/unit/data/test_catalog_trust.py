@@ -34,7 +34,9 @@ def private_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[N
     catalog._manifests.cache_clear()
 
 
-def manifest(tmp_path: Path, *, path: str = "radish/tiny.clf", url: str = "http://127.0.0.1:9/x", size: str = "") -> Path:
+def manifest(
+    tmp_path: Path, *, path: str = "radish/tiny.clf", url: str = "http://127.0.0.1:9/x", size: str = ""
+) -> Path:
     folder = tmp_path / "project" / "datasets"
     folder.mkdir(parents=True, exist_ok=True)
     (tmp_path / "project" / "baselines").mkdir(exist_ok=True)
@@ -92,7 +94,9 @@ def test_a_path_dataset_edited_after_its_run_gets_a_new_key(tmp_path: Path) -> N
     assert run_key("w", "odometry", {}, "none", 0, "v", {}) == run_key("w", "odometry", {}, "none", 0, "v")
 
 
-@pytest.mark.parametrize("bad", ["../../../x", "/etc/x", "radish/../../x", "~/x", "./x", "a//x", "radish\\\\x", "", "a/"])
+@pytest.mark.parametrize(
+    "bad", ["../../../x", "/etc/x", "radish/../../x", "~/x", "./x", "a//x", "radish\\\\x", "", "a/"]
+)
 def test_a_manifest_path_outside_the_data_folder_is_refused(tmp_path: Path, bad: str) -> None:
     toml = manifest(tmp_path, path=bad)
     with pytest.raises(DataError, match=r"files\[0\]: path .* must be a relative path inside the data folder"):
@@ -105,7 +109,9 @@ def test_a_symlink_in_the_cache_cannot_lead_a_download_out_of_it(tmp_path: Path)
     outside = tmp_path / "outside"
     outside.mkdir()
     (cache / "radish").symlink_to(outside)
-    with pytest.raises(FetchError, match=r"radish/tiny.clf: resolves to .*outside/tiny.clf, outside the download cache"):
+    with pytest.raises(
+        FetchError, match=r"radish/tiny.clf: resolves to .*outside/tiny.clf, outside the download cache"
+    ):
         fetch.confined(cache, "radish/tiny.clf")
     assert fetch.confined(cache, "other/tiny.clf") == cache / "other" / "tiny.clf"
 
@@ -167,4 +173,6 @@ def test_a_short_download_names_both_sizes(tmp_path: Path) -> None:
     source.write_bytes(PAYLOAD)
     with pytest.raises(FetchError, match=rf"{len(PAYLOAD)} bytes, but the manifest's size is {len(PAYLOAD) + 1}"):
         fetch.download_verified(source.as_uri(), tmp_path / "out" / "f", SHA, size=len(PAYLOAD) + 1)
-    assert fetch.download_verified(source.as_uri(), tmp_path / "out" / "f", SHA, size=len(PAYLOAD)).read_bytes() == PAYLOAD
+    assert (
+        fetch.download_verified(source.as_uri(), tmp_path / "out" / "f", SHA, size=len(PAYLOAD)).read_bytes() == PAYLOAD
+    )

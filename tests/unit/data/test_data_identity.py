@@ -100,7 +100,10 @@ def test_special_files_are_refused_by_their_stat_without_reading(tmp_path: Path)
     os.mkfifo(fifo)
     with pytest.raises(DataError) as caught:
         content_sha256(fifo)
-    assert str(caught.value) == f"{fifo}: a FIFO (named pipe), not a regular file; expected a data file or a ROS2 bag folder"
+    assert (
+        str(caught.value)
+        == f"{fifo}: a FIFO (named pipe), not a regular file; expected a data file or a ROS2 bag folder"
+    )
     for device in ("/dev/zero", "/dev/urandom"):
         with pytest.raises(DataError, match=rf"^{device}: a character device, not a regular file; expected x$"):
             check_input(Path(device), "x")
