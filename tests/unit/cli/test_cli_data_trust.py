@@ -166,3 +166,22 @@ def test_a_report_names_the_data_and_escapes_names(tmp_path: Path) -> None:
     assert json.loads(result.read_text())["dataset_info"]["data_sha256"] == {
         log.name: hashlib.sha256(log.read_bytes()).hexdigest()
     }
+
+
+def test_a_dataset_edited_after_its_cell_ran_is_run_again_not_kept(tmp_path: Path) -> None:
+    log = carmen_log(tmp_path / "t.clf")
+    suite = tmp_path / "s.toml"
+    suite.write_text(f'[[methods]]\nname = "odometry"\n\n[[datasets]]\nname = "{log}"\n')
+    args = ("bench", str(suite), "--results", str(tmp_path / "r"), "--no-progress", "-j", "1")
+    env = {"ALBOT1_CACHE_DIR": str(tmp_path / "cache")}
+    assert albot1(*args, env=env).returncode == 0
+    again = albot1(*args, env=env)
+    assert again.returncode == 0 and "1 of 1 cells already complete (kept)" in again.stderr
+    log.unlink()
+    carmen_log(log, scans=30)  # the same file name, other content
+    edited = albot1(*args, env=env)
+    assert edited.returncode == 0 and "already complete" not in edited.stderr, edited.stderr
+    runs = sorted(p.parent.name for p in (tmp_path / "r" / "s" / "runs").glob("*/result.json"))
+    assert len(runs) == 2  # the old data's cell is kept apart, under its own key
+    scans = [json.loads(p.read_text())["scans"] for p in (tmp_path / "r" / "s" / "runs").glob("*/result.json")]
+    assert sorted(scans) == [30, 40]
