@@ -29,6 +29,8 @@ from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.methods.baselines.published import published_systems
 from albot1.report.collect import CellRecord
+from albot1.report.markdown import text as md_text
+from albot1.report.provenance import data_lines
 
 #: The five logs of the standard benchmark, with the names the published tables use.
 STANDARD_LOGS: dict[str, str] = {
@@ -345,6 +347,9 @@ def write_standard(plan: GridPlan, records: list[CellRecord], out: Path) -> tupl
     skipped = {s.name: s.reason + (f" (`{s.hint}`)" if s.hint else "") for s in plan.skipped_datasets}
     page, table = out / PAGE, out / TABLE
     text = render_page(plan, rows, {k: v for k, v in skipped.items() if k in STANDARD_LOGS})
+    data = data_lines([r for r in records if r.cell.dataset_label in STANDARD_LOGS])
+    if data:  # which data the measured rows come from (albot1.report.provenance)
+        text = text.rstrip("\n") + "\n\n## Data\n\n" + "".join(f"- {md_text(line)}\n" for line in data)
     atomic_write(page, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     atomic_write(table, lambda tmp: tmp.write_text(_csv(rows), encoding="utf-8"))
     return page, table

@@ -21,8 +21,10 @@ from albot1.report.collect import CellRecord
 from albot1.report.errors import ReportError
 from albot1.report.html import rel
 from albot1.report.map_plots import plot_maps
+from albot1.report.markdown import text as md_text
 from albot1.report.places_plot import render_places
 from albot1.report.plots import method_colors, slug, vector_of
+from albot1.report.provenance import data_lines
 from albot1.report.thesis.claims import READINGS
 from albot1.report.thesis.evidence import COMPANION_SUITES, Evidence, open_stores
 from albot1.report.thesis.experiments import (
@@ -386,6 +388,13 @@ def write_thesis_page(
     for section in sections:
         lines += _section_lines(section, drawn, out)
     lines += _parameters(ev, sections, out)
+    lines += [
+        "## Data",
+        "",
+        "The sha256 (first 12 hex digits) of the files each dataset's numbers come from:",
+        "",
+        *[f"- {md_text(line)}" for line in data_lines([r for s in ev.stores for r in s.records])],
+    ]
     page = out / PAGE
     page.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return page

@@ -9,7 +9,7 @@ from typing import Any, cast
 from albot1.bench.grid import Cell
 from albot1.report.collect import CellRecord
 from albot1.report.markdown import code, text
-from albot1.report.provenance import data_by_dataset, data_identity, describe_data, separate_data
+from albot1.report.provenance import data_by_dataset, data_identity, data_lines, describe_data, separate_data
 
 A, B = "a" * 64, "b" * 64
 
@@ -47,3 +47,11 @@ def test_markdown_text_and_code_never_carry_html_or_break_out() -> None:
     assert code("a`b") == "``a`b``"
     assert code("`x") == "`` `x ``"
     assert code("<b>") == "`<b>`"  # a code span shows its content as written, it never renders HTML
+
+
+def test_pages_of_several_stores_list_each_data_identity_of_a_label() -> None:
+    records = [record("aces", {"aces.clf": A}), record("aces", {"aces.clf": A}), record("aces", {"aces.clf": B})]
+    assert data_lines([*records, record("aces", None)]) == [
+        "aces: aces.clf sha256 aaaaaaaaaaaa",
+        "aces: aces.clf sha256 bbbbbbbbbbbb",
+    ]
