@@ -19,7 +19,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from pydantic import NonNegativeFloat, TypeAdapter, ValidationError
+from pydantic import NonNegativeFloat, TypeAdapter, ValidationError, field_validator
 
 from albot1.bench.grid import FailureKind, GridPlan
 from albot1.config.validation import describe_errors
@@ -44,6 +44,14 @@ class FailureRecord(Record):
     time: str | None = None
     host: str | None = None
     description: dict[str, Any] | None = None
+
+    @field_validator("log")
+    @classmethod
+    def _plain_name(cls, value: str | None) -> str | None:
+        """The log is a file of the cell's own folder: a path elsewhere (``../../etc/passwd``) is refused."""
+        if value is not None and (not value or Path(value).name != value or value in (".", "..")):
+            raise ValueError(f"{value[:40]!r} is not a file name of the cell's folder (expected e.g. 'cell.log')")
+        return value
 
 
 def read_json_file(path: Path, what: str) -> Any:

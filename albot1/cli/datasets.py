@@ -48,10 +48,12 @@ def list_(
     for name in catalog.names():
         manifest = catalog.get(name)
         found = catalog.find_file(manifest.log, settings)
+        available = catalog.is_available(name, settings)
         rows.append(
             {
                 "name": name,
-                "available": catalog.is_available(name, settings),
+                "available": available,
+                "checksum_problem": catalog.copy_problem(name, settings) if available else None,
                 "path": str(found) if found else None,
                 "local_only": manifest.local_only,
                 "description": manifest.description,
@@ -78,6 +80,8 @@ def list_(
             if row.get("synthetic")
             else ("local" if row["available"] else ("missing (local only)" if row["local_only"] else "missing (fetch)"))
         )
+        if row.get("checksum_problem"):
+            state = "wrong copy (sha256)"  # `albot1 datasets info NAME` says which file and how to fix it
         typer.echo(f"{row['name']:30s} {state:21s} {_first_sentence(row['description'])}")
     typer.echo(f"searched: {', '.join(str(r) for r in settings.search_roots())}")
 

@@ -107,6 +107,23 @@ def is_available(name: str, settings: Settings) -> bool:
     return all(find_file(f, settings) is not None for f in manifest.files)
 
 
+def copy_problem(name: str, settings: Settings) -> str | None:
+    """Why a present copy of the dataset would be refused (a checksum mismatch), None when none would.
+
+    Missing files are not a problem here (:func:`is_available` says so);
+    the checksums are cached, so listing the catalog costs one hash per file once.
+    """
+    manifest = get(name)
+    for data_file in manifest.files:
+        if find_file(data_file, settings) is None:
+            continue
+        try:
+            verified_file(manifest, data_file, settings)
+        except ChecksumError as exc:
+            return str(exc)
+    return None
+
+
 def open_dataset(name: str, settings: Settings, **options: Any) -> Sequence:
     """The dataset as a streamed Sequence; ``options`` override the manifest's loader options."""
     manifest = get(name)

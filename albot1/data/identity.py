@@ -12,8 +12,10 @@ check costs a ``stat`` and a small JSON read; ``docs/datasets.md``,
 
 The cache (:func:`albot1.settings.checksum_cache_file`) is a convenience
 and never trusted beyond that: a cache that does not parse, or an entry of
-the wrong shape, is ignored and rebuilt, and writes are atomic (a
-concurrent writer's entries may be lost, never mixed). An entry is stored
+the wrong shape or whose seal (a digest over its fields) does not match, is
+ignored and rebuilt, a cache that is not a regular file is never opened,
+and writes are atomic (a concurrent writer's entries may be lost, never
+mixed). An entry is stored
 only for a file whose modification time is at least :data:`RACY_S` older
 than the hashing, so a file changed twice within one timestamp tick is
 never cached with its first content.
@@ -40,7 +42,9 @@ _BLOCK = 1 << 20
 #: Files modified less than this many seconds before they were hashed are not cached (their mtime may not
 #: change on a second edit within the file system's timestamp resolution).
 RACY_S = 2.0
-_FORMAT = 1
+_FORMAT = 2
+#: A cache file larger than this is not read (it holds a few hundred bytes per data file).
+_MAX_CACHE_BYTES = 16 * 1024 * 1024
 #: Hex digits of a checksum shown to people (tables, report pages); the files keep all 64.
 SHORT = 12
 
@@ -76,12 +80,14 @@ class _Cache:
         if stamp == self._stamp:
             return
         self._entries, self._stamp = {}, stamp
+        if not stat.S_ISREG(st.st_mode) or st.st_size > _MAX_CACHE_BYTES:
+            return  # a FIFO or a device would block or never end; a huge file is no cache of ours
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             return  # unreadable or damaged: rebuilt as files are hashed
         if isinstance(data, dict) and data.get("format") == _FORMAT and isinstance(data.get("files"), dict):
-            self._entries = {k: v for k, v in data["files"].items() if isinstance(k, str) and _valid_entry(v)}
+            self._entries = {k: v for k, v in data["files"].items() if isinstance(k, str) and _valid_entry(k, v)}
 
     def get(self, key: str, signature: list[int]) -> str | None:
         self._load(checksum_cache_file())
@@ -93,7 +99,7 @@ class _Cache:
     def put(self, key: str, signature: list[int], sha256: str) -> None:
         path = checksum_cache_file()
         self._load(path)
-        self._entries[key] = [*signature, sha256]
+        self._entries[key] = [*signature, sha256, _seal(key, signature, sha256)]
         payload = json.dumps({"format": _FORMAT, "files": self._entries}, sort_keys=True)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -103,15 +109,21 @@ class _Cache:
         self._stamp = None
 
 
-def _valid_entry(value: object) -> bool:
-    return (
+def _seal(key: str, signature: list[int], sha256: str) -> str:
+    """A check over an entry's fields: an entry damaged or edited by hand does not match it and is dropped."""
+    return hashlib.sha256(json.dumps([key, signature, sha256]).encode()).hexdigest()[:16]
+
+
+def _valid_entry(key: str, value: object) -> bool:
+    """``[size, mtime_ns, inode, device, sha256, seal]`` with the types and the seal it must have."""
+    if not (
         isinstance(value, list)
-        and len(value) == 5
+        and len(value) == 6
         and all(isinstance(v, int) and not isinstance(v, bool) for v in value[:4])
-        and isinstance(value[4], str)
-        and len(value[4]) == 64
-        and all(c in "0123456789abcdef" for c in value[4])
-    )
+        and all(isinstance(v, str) for v in value[4:])
+    ):
+        return False
+    return value[5] == _seal(key, value[:4], value[4])
 
 
 _CACHE = _Cache()

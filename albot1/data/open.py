@@ -33,6 +33,7 @@ from typing import Any
 from albot1.config.keyvalue import KeyValueError, parse_query
 from albot1.data import catalog
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
+from albot1.data.filekind import check_input
 from albot1.data.identity import content_sha256
 from albot1.data.loaders.registry import load
 from albot1.data.model import Sequence
@@ -71,6 +72,7 @@ def open_sequence(
     if text in worlds.WORLDS:
         return worlds.load_world(text, **options)  # a world's own options (start=, laps=) or SyntheticWorldError
     settings = settings or get_settings()
+    _check_option_files(options, text)
     if text in catalog.names():
         return _with_checksums(catalog.open_dataset(text, settings, **options), None, options)
     path = Path(text).expanduser()
@@ -91,11 +93,35 @@ def _with_checksums(sequence: Sequence, path: Path | None, options: dict[str, An
     (:mod:`albot1.data.identity`, cached).
     """
     files = [path] if path is not None else []
-    files += [Path(v) for v in options.values() if isinstance(v, (str, Path)) and _is_file(str(v))]
+    files += [Path(v).expanduser() for k, v in options.items() if _names_path(k, v) and _is_file(str(v))]
     if not files:
         return sequence
     checksums = {**sequence.metadata.checksums, **{f.name: content_sha256(f) for f in files}}
     return sequence.with_metadata(replace(sequence.metadata, checksums=checksums))
+
+
+def _check_option_files(options: dict[str, Any], ref: str) -> None:
+    """DataError for a loader option naming a FIFO, device, socket, pseudo-file or folder (``relations=/dev/zero``).
+
+    Checked by ``stat`` before any loader opens it, as a log is
+    (:func:`albot1.data.filekind.check_input`): reading one would hang or never end.
+    """
+    for key, value in options.items():
+        if _names_path(key, value) and _exists(str(value)):
+            check_input(Path(value).expanduser(), f"a regular file for the option {key}= of {ref!r}")
+
+
+def _names_path(key: str, value: object) -> bool:
+    """Whether a loader option's value is meant as a path (not a word such as ``odom`` that a folder may share).
+
+    A value with a folder separator, a leading ``~`` or a file suffix, or any
+    value of ``relations=``.
+    """
+    if isinstance(value, Path):
+        return True
+    if not isinstance(value, str):
+        return False
+    return key == "relations" or "/" in value or value.startswith("~") or bool(Path(value).suffix)
 
 
 def _is_file(text: str) -> bool:

@@ -91,6 +91,7 @@ def test_a_key_never_leads_out_of_the_runs_folder(tmp_path: Path) -> None:
         ({"kind": "boom"}, "kind: Input should be"),
         ({"reason": None}, "reason: Input should be a valid string"),
         ({"surprise": 1}, "surprise: Extra inputs are not permitted"),
+        ({"log": "../../../etc/passwd"}, "log: Value error, '../../../etc/passwd' is not a file name of the cell"),
     ],
 )
 def test_a_hand_edited_failure_record_names_file_and_field(tmp_path: Path, edit: dict[str, Any], field: str) -> None:

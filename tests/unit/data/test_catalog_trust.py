@@ -176,3 +176,27 @@ def test_a_short_download_names_both_sizes(tmp_path: Path) -> None:
     assert (
         fetch.download_verified(source.as_uri(), tmp_path / "out" / "f", SHA, size=len(PAYLOAD)).read_bytes() == PAYLOAD
     )
+
+
+def test_the_catalog_listing_names_a_wrong_copy(tmp_path: Path) -> None:
+    manifest(tmp_path)
+    settings = Settings(None, tmp_path / "cache")
+    assert catalog.copy_problem("tiny", settings) is None  # missing is not a wrong copy
+    put(tmp_path / "cache", PAYLOAD)
+    assert catalog.copy_problem("tiny", settings) is None
+    put(tmp_path / "cache", WRONG)
+    problem = catalog.copy_problem("tiny", settings)
+    assert problem is not None and problem.startswith("dataset 'tiny': ") and SHA in problem
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("special", ["fifo", "/dev/zero", "folder"])
+def test_a_relations_option_naming_a_special_file_is_refused_before_reading(tmp_path: Path, special: str) -> None:
+    log = put(tmp_path, PAYLOAD)
+    target = {"fifo": tmp_path / "p", "/dev/zero": Path("/dev/zero"), "folder": tmp_path}[special]
+    if special == "fifo":
+        os.mkfifo(target)
+    with pytest.raises(
+        DataError, match=rf"^{target}: a .*, not a regular file; expected a regular file for the option"
+    ):
+        open_sequence(f"{log}?relations={target}")

@@ -62,7 +62,7 @@ def test_a_file_modified_just_now_is_not_cached(tmp_path: Path) -> None:
     assert not cache.exists() or str(log.resolve()) not in json.loads(cache.read_text())["files"]
 
 
-@pytest.mark.parametrize("damage", ["{not json", '{"format": 1, "files": {"/x": [1, 2]}}', "[]", '{"format": 1}'])
+@pytest.mark.parametrize("damage", ["{not json", '{"format": 2, "files": {"/x": [1, 2]}}', "[]", '{"format": 2}'])
 def test_a_damaged_cache_is_ignored_and_rebuilt(tmp_path: Path, damage: str) -> None:
     log = old_file(tmp_path / "a.clf", b"abc")
     cache = checksum_cache_file()
@@ -77,8 +77,27 @@ def test_a_cache_entry_with_a_wrong_checksum_for_another_stat_is_never_used(tmp_
     cache = checksum_cache_file()
     cache.parent.mkdir(parents=True)
     st = log.stat()
-    wrong = [st.st_size, st.st_mtime_ns + 1, st.st_ino, st.st_dev, "0" * 64]  # not this file's stat
-    cache.write_text(json.dumps({"format": 1, "files": {str(log.resolve()): wrong}}))
+    wrong = [st.st_size, st.st_mtime_ns + 1, st.st_ino, st.st_dev, "0" * 64, "x"]  # not this file's stat
+    cache.write_text(json.dumps({"format": 2, "files": {str(log.resolve()): wrong}}))
+    assert content_sha256(log) == hashlib.sha256(b"abc").hexdigest()
+
+
+def test_a_hand_edited_checksum_in_the_cache_is_not_trusted(tmp_path: Path) -> None:
+    log = old_file(tmp_path / "a.clf", b"abc")
+    content_sha256(log)
+    cache = checksum_cache_file()
+    data = json.loads(cache.read_text())
+    data["files"][str(log.resolve())][4] = "0" * 64  # the stat still matches, the seal does not
+    cache.write_text(json.dumps(data))
+    assert content_sha256(log) == hashlib.sha256(b"abc").hexdigest()
+
+
+@pytest.mark.timeout(30)
+def test_a_cache_that_is_a_fifo_is_never_opened(tmp_path: Path) -> None:
+    cache = checksum_cache_file()
+    cache.parent.mkdir(parents=True)
+    os.mkfifo(cache)
+    log = old_file(tmp_path / "a.clf", b"abc")
     assert content_sha256(log) == hashlib.sha256(b"abc").hexdigest()
 
 
