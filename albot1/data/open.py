@@ -74,30 +74,38 @@ def open_sequence(
     settings = settings or get_settings()
     _check_option_files(options, text)
     if text in catalog.names():
-        return _with_checksums(catalog.open_dataset(text, settings, **options), None, options)
+        checksums = _checksums(None, options)
+        return _attach(catalog.open_dataset(text, settings, **options), checksums)
     path = Path(text).expanduser()
     if _exists(text):
-        return _with_checksums(load(path, format_name, **options), path, options)
+        # The file (or every file of a bag folder) is checked and hashed before a loader opens it: a FIFO
+        # among a bag's files would block the loader, and the checksum is cached for every later use.
+        check_input(path, "a log file or a ROS2 bag folder", folder_ok=True)
+        checksums = _checksums(path, options)
+        return _attach(load(path, format_name, **options), checksums)
     raise DatasetNotFoundError(
         f"{text!r} is neither a dataset name nor an existing file; known datasets: "
         f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
     )
 
 
-def _with_checksums(sequence: Sequence, path: Path | None, options: dict[str, Any]) -> Sequence:
-    """``sequence`` with the sha256 of every file it was read from in its metadata.
+def _checksums(path: Path | None, options: dict[str, Any]) -> dict[str, str]:
+    """File name -> sha256 of the log at ``path`` and of every loader option naming a file.
 
-    The log (``path``; a catalog dataset's files are verified and recorded by
-    the catalog) and every loader option that names a file (``relations=``,
-    ``reference=``): the content a result is computed from
-    (:mod:`albot1.data.identity`, cached).
+    The content a result is computed from (``relations=``, ``reference=``
+    files included; :mod:`albot1.data.identity`, cached). A catalog
+    dataset's own files are verified and recorded by the catalog.
     """
     files = [path] if path is not None else []
     files += [Path(v).expanduser() for k, v in options.items() if _names_path(k, v) and _is_file(str(v))]
-    if not files:
+    return {f.name: content_sha256(f) for f in files}
+
+
+def _attach(sequence: Sequence, checksums: dict[str, str]) -> Sequence:
+    """``sequence`` with ``checksums`` added to its metadata's."""
+    if not checksums:
         return sequence
-    checksums = {**sequence.metadata.checksums, **{f.name: content_sha256(f) for f in files}}
-    return sequence.with_metadata(replace(sequence.metadata, checksums=checksums))
+    return sequence.with_metadata(replace(sequence.metadata, checksums={**sequence.metadata.checksums, **checksums}))
 
 
 def _check_option_files(options: dict[str, Any], ref: str) -> None:

@@ -200,3 +200,16 @@ def test_a_relations_option_naming_a_special_file_is_refused_before_reading(tmp_
         DataError, match=rf"^{target}: a .*, not a regular file; expected a regular file for the option"
     ):
         open_sequence(f"{log}?relations={target}")
+
+
+@pytest.mark.timeout(30)
+def test_a_bag_folder_holding_a_fifo_is_refused_before_its_loader_opens_it(tmp_path: Path) -> None:
+    bag = tmp_path / "bag"
+    bag.mkdir()
+    os.mkfifo(bag / "metadata.yaml")
+    (bag / "bag_0.db3").write_bytes(b"")
+    with pytest.raises(DataError) as caught:
+        open_sequence(str(bag))
+    assert str(caught.value) == (
+        f"{bag / 'metadata.yaml'}: a FIFO (named pipe) inside the bag folder {bag}; expected regular files only"
+    )
