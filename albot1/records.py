@@ -54,6 +54,7 @@ from pydantic import (
 
 from albot1.config.validation import describe_errors
 from albot1.errors import Albot1Error
+from albot1.filetypes import not_regular
 
 RecordT = TypeVar("RecordT", bound="Record")
 #: A sha256 checksum as the files hold it: 64 lower-case hex digits.
@@ -134,6 +135,9 @@ def parse_record(model: type[RecordT], data: object, source: str) -> RecordT:
 
 def read_record(model: type[RecordT], path: Path) -> RecordT:
     """Read and validate one record file; RecordError (one line) when it is unreadable or does not fit."""
+    problem = not_regular(path)  # a FIFO would block the read, a device never end it
+    if problem is not None:
+        raise RecordError(f"{path}: {problem}; expected a {model.__name__} file")
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError) as exc:

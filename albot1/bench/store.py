@@ -43,6 +43,7 @@ from albot1.bench.cell_main import ERROR_FILE
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell, FailureKind, GridPlan
 from albot1.bench.store_records import parse_failure, parse_plan, read_json_file
+from albot1.filetypes import not_regular
 from albot1.records import RecordError
 from albot1.runs.folder import is_complete as run_is_complete
 from albot1.runs.folder import write_json
@@ -85,7 +86,7 @@ class ResultsStore:
 
     def read_plan(self) -> GridPlan:
         path = self.root / PLAN
-        if not path.is_file():
+        if not path.exists():
             raise BenchError(
                 f"{self.root}: not a results folder of `albot1 bench` (no {PLAN}); run `albot1 bench SUITE` first"
             )
@@ -128,8 +129,8 @@ class ResultsStore:
     def is_complete(self, key: str) -> bool:
         """DONE marker plus a metrics.json that parses."""
         run_dir = self.run_dir(key)
-        if not run_is_complete(run_dir):
-            return False
+        if not run_is_complete(run_dir) or not_regular(run_dir / METRICS) is not None:
+            return False  # a FIFO or device in place of metrics.json is no result (and reading it would hang)
         try:
             json.loads((run_dir / METRICS).read_text())
         except (OSError, json.JSONDecodeError):

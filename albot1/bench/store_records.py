@@ -23,6 +23,7 @@ from pydantic import NonNegativeFloat, TypeAdapter, ValidationError, field_valid
 
 from albot1.bench.grid import FailureKind, GridPlan
 from albot1.config.validation import describe_errors
+from albot1.filetypes import not_regular
 from albot1.records import Record, RecordError
 
 #: What :func:`albot1.runs.folder.run_key` produces: the only cell keys a results folder may hold.
@@ -56,6 +57,9 @@ class FailureRecord(Record):
 
 def read_json_file(path: Path, what: str) -> Any:
     """The JSON value of ``path``; RecordError naming the file when it cannot be read or parsed."""
+    problem = not_regular(path)
+    if problem is not None:
+        raise RecordError(f"{path}: {problem}; expected a {what}")
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:

@@ -2,7 +2,7 @@
 
 A log, a relations file or a manifest is read from a *regular file* (or, for
 a ROS2 bag, a folder). Anything else is refused up front, by its ``stat``
-alone, because reading it would hang (a FIFO blocks until a writer comes, a
+alone (:mod:`albot1.filetypes`), because reading it would hang (a FIFO blocks until a writer comes, a
 socket cannot be opened), never end (``/dev/zero``, ``/dev/urandom``) or read
 what is no data set at all (``/proc/self/environ``: a kernel pseudo-file that
 reports 0 bytes and yet has content). Error messages describe a file's
@@ -13,34 +13,10 @@ pointed at the wrong file must not have that file's secrets printed back.
 from __future__ import annotations
 
 import os
-import stat
 from pathlib import Path
 
 from albot1.data.errors import DataError
-
-#: ``stat`` predicates of the file types that are not regular files or folders, with their names.
-_SPECIAL = (
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-)
-
-
-def special_kind(mode: int) -> str | None:
-    """The name of a non-regular, non-folder file type (``"a FIFO (named pipe)"``), None otherwise."""
-    return next((name for test, name in _SPECIAL if test(mode)), None)
-
-
-def _is_pseudo_file(path: Path, st: os.stat_result) -> bool:
-    """A regular file whose size is 0 and yet can be read (``/proc``, ``/sys``): its size says nothing."""
-    if st.st_size != 0:
-        return False
-    try:
-        with path.open("rb") as handle:
-            return handle.read(1) != b""
-    except OSError:
-        return False
+from albot1.filetypes import kind_of
 
 
 def check_input(path: Path, expected: str, *, folder_ok: bool = False) -> os.stat_result:
@@ -59,11 +35,7 @@ def check_input(path: Path, expected: str, *, folder_ok: bool = False) -> os.sta
         raise DataError(
             f"{shown}: not a usable path ({getattr(exc, 'strerror', None) or exc}); expected {expected}"
         ) from None
-    kind = special_kind(st.st_mode)
-    if kind is None and stat.S_ISDIR(st.st_mode) and not folder_ok:
-        kind = "a folder"
-    if kind is None and stat.S_ISREG(st.st_mode) and _is_pseudo_file(path, st):
-        kind = "a kernel pseudo-file (it reports 0 bytes yet has content, like the files under /proc and /sys)"
+    kind = kind_of(path, st, folder_ok=folder_ok)
     if kind is not None:
         raise DataError(f"{path}: {kind}, not a regular file; expected {expected}")
     return st

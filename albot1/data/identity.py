@@ -35,7 +35,8 @@ from pathlib import Path
 
 from albot1.atomic import atomic_write
 from albot1.data.errors import DataError
-from albot1.data.filekind import check_input, special_kind
+from albot1.data.filekind import check_input
+from albot1.filetypes import special_kind
 from albot1.settings import checksum_cache_file
 
 _BLOCK = 1 << 20

@@ -255,9 +255,9 @@ class StoredRun:
                 if map_file.suffix == ".npz"
                 else ("a GeoJSON FeatureCollection of LineString segments and MultiPoint points")
             )
-            raise RunError(
-                f"{map_file}: not a map this project wrote ({type(exc).__name__}: {exc}); expected {kind}"
-            ) from None
+            # numpy's words for a file that is no array suggest loading it unsafely (allow_pickle): not repeated
+            detail = "not a numpy archive" if "pickle" in str(exc) else f"{type(exc).__name__}: {exc}"
+            raise RunError(f"{map_file}: not a map this project wrote ({detail}); expected {kind}") from None
 
 
 def _geojson_map(collection: Any) -> MapData:
@@ -305,8 +305,8 @@ def _read_per_scan(file: Path, scans: int) -> NDArray[np.int64]:
     expected = f"expected a .npy array of {scans} per-scan times in integer nanoseconds (numpy.save)"
     try:
         array = np.load(file, allow_pickle=False)
-    except (OSError, ValueError, EOFError) as exc:
-        raise RunError(f"{file}: not readable as a numpy array ({exc}); {expected}") from None
+    except (OSError, ValueError, EOFError):  # numpy's own words would suggest loading the file unsafely
+        raise RunError(f"{file}: not a numpy array file this project wrote; {expected}") from None
     if not isinstance(array, np.ndarray) or array.dtype.kind not in "iu" or array.shape != (scans,):
         found = f"{getattr(array, 'dtype', type(array).__name__)} of shape {getattr(array, 'shape', '?')}"
         raise RunError(f"{file}: holds {found}; {expected}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import errno
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -17,7 +18,7 @@ from albot1.bench.store import UNREADABLE_FAILURE, ResultsStore
 from albot1.bench.suite import load_suite
 from albot1.data.loaders.registry import writer_for
 from albot1.data.open import open_sequence
-from albot1.records import RecordError
+from albot1.records import AttemptRecord, RecordError, read_record
 from albot1.settings import Settings
 
 KEY = "0123456789abcdef"
@@ -149,3 +150,22 @@ def test_a_cell_key_names_the_data_content(tmp_path: Path) -> None:
     text = log.read_text()
     log.write_text(text.replace("FLASER", "FLASER", 1) + "# edited\n")
     assert plan_suite(load_suite(suite), settings).cells[0].key != first
+
+
+@pytest.mark.timeout(30)
+def test_store_files_that_are_fifos_are_refused_without_blocking(tmp_path: Path) -> None:
+    os.mkfifo(tmp_path / "grid.json")
+    with pytest.raises(RecordError) as caught:
+        ResultsStore(tmp_path).read_plan()
+    assert str(caught.value) == (
+        f"{tmp_path / 'grid.json'}: a FIFO (named pipe), not a regular file; expected a grid plan written by "
+        "`albot1 bench`"
+    )
+    store = ResultsStore(tmp_path / "other")
+    run_dir = store.prepare(cell())
+    (run_dir / "DONE").write_text(KEY)
+    os.mkfifo(run_dir / "metrics.json")
+    assert not store.is_complete(KEY)  # never read: the cell is run again
+    os.mkfifo(run_dir / "attempt.json")
+    with pytest.raises(RecordError, match=r"attempt\.json: a FIFO \(named pipe\), not a regular file; expected a"):
+        read_record(AttemptRecord, run_dir / "attempt.json")
