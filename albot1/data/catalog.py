@@ -91,7 +91,7 @@ def verified_file(manifest: DatasetManifest, data_file: DataFile, settings: Sett
     else:
         fix = f"remove it and run `albot1 datasets fetch {manifest.name}`, or replace it with the right file"
     raise ChecksumError(
-        f"dataset {manifest.name!r}: {found} has sha256 {got}, but the manifest{where} says {data_file.sha256}; {fix}"
+        f"{found}: sha256 {got}, but the manifest of dataset {manifest.name!r}{where} says {data_file.sha256}; {fix}"
     )
 
 

@@ -62,7 +62,7 @@ def test_a_wrong_catalog_copy_is_refused_with_both_checksums(tmp_path: Path) -> 
     line = one_line_error(albot1("datasets", "info", "tiny", env=env))
     got = hashlib.sha256(log.read_bytes()).hexdigest()
     assert line == (
-        f"albot1: error: dataset 'tiny': {log} has sha256 {got}, but the manifest "
+        f"albot1: error: {log}: sha256 {got}, but the manifest of dataset 'tiny' "
         f"({tmp_path / 'project' / 'datasets' / 'tiny.toml'}) says {right}; remove it and run "
         "`albot1 datasets fetch tiny`, or replace it with the right file"
     )

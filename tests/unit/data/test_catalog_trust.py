@@ -69,7 +69,7 @@ def test_a_wrong_copy_in_the_data_folder_never_wins_over_the_verified_cache_copy
     with pytest.raises(ChecksumError) as caught:
         open_sequence("tiny", settings=Settings(tmp_path / "data", tmp_path / "cache"))
     assert str(caught.value) == (
-        f"dataset 'tiny': {wrong} has sha256 {hashlib.sha256(WRONG).hexdigest()}, but the manifest ({toml}) says "
+        f"{wrong}: sha256 {hashlib.sha256(WRONG).hexdigest()}, but the manifest of dataset 'tiny' ({toml}) says "
         f"{SHA}; a verified copy is at {good}: remove or replace the wrong one (or point ALBOT1_DATA_DIR elsewhere)"
     )
 
@@ -186,7 +186,8 @@ def test_the_catalog_listing_names_a_wrong_copy(tmp_path: Path) -> None:
     assert catalog.copy_problem("tiny", settings) is None
     put(tmp_path / "cache", WRONG)
     problem = catalog.copy_problem("tiny", settings)
-    assert problem is not None and problem.startswith("dataset 'tiny': ") and SHA in problem
+    assert problem is not None and problem.startswith(f"{tmp_path / 'cache' / 'radish' / 'tiny.clf'}: sha256 ")
+    assert SHA in problem
 
 
 @pytest.mark.timeout(30)
