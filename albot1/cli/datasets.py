@@ -107,8 +107,13 @@ def fetch(
     """
     from albot1.data import catalog
 
-    path = catalog.fetch(name, get_settings(data_dir=data_dir), base_url=base_url)
+    settings = get_settings(data_dir=data_dir)
+    path = catalog.fetch(name, settings, base_url=base_url)
     typer.echo(f"{name}: {path}")
+    problem = catalog.copy_problem(name, settings)  # a wrong copy earlier in the search roots would still be read
+    if problem is not None:
+        typer.echo(f"albot1: error: fetched, but the dataset cannot be used yet: {problem}", err=True)
+        raise typer.Exit(1)
 
 
 @app.command("info")

@@ -185,3 +185,16 @@ def test_a_dataset_edited_after_its_cell_ran_is_run_again_not_kept(tmp_path: Pat
     assert len(runs) == 2  # the old data's cell is kept apart, under its own key
     scans = [json.loads(p.read_text())["scans"] for p in (tmp_path / "r" / "s" / "runs").glob("*/result.json")]
     assert sorted(scans) == [30, 40]
+
+
+def test_fetch_says_when_a_wrong_copy_would_still_be_read_first(tmp_path: Path) -> None:
+    good = carmen_log(tmp_path / "www" / "radish" / "tiny.clf")
+    wrong = carmen_log(tmp_path / "data" / "radish" / "tiny.clf", scans=20)
+    sha = hashlib.sha256(good.read_bytes()).hexdigest()
+    env = {"ALBOT1_CONFIG_DIR": str(project(tmp_path, "radish/tiny.clf", sha, good.as_uri()))}
+    env.update({"ALBOT1_DATA_DIR": str(tmp_path / "data"), "ALBOT1_CACHE_DIR": str(tmp_path / "cache")})
+    done = albot1("datasets", "fetch", "tiny", env=env)
+    line = one_line_error(done)
+    assert done.stdout.strip() == f"tiny: {tmp_path / 'cache' / 'radish' / 'tiny.clf'}"
+    assert line.startswith(f"albot1: error: fetched, but the dataset cannot be used yet: {wrong}: sha256 ")
+    assert f"a verified copy is at {tmp_path / 'cache' / 'radish' / 'tiny.clf'}" in line
