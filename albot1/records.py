@@ -567,6 +567,9 @@ class RunHeader(Record):
     seed: int | None
     scans: int
     has_reference: bool
+    #: the sha256 of the dataset's files the run read (result.json ``dataset_info.data_sha256``); empty for a
+    #: synthetic world, an external trajectory, and metrics written before it was recorded
+    data_sha256: dict[str, Sha256] = {}
 
 
 class TrajectorySource(Record):

@@ -66,6 +66,7 @@ def scored_run(run: StoredRun) -> Scored:
             "seed": info.seed,
             "scans": int(len(run.poses)),
             "has_reference": run.reference is not None,
+            "data_sha256": dict(info.dataset_info.data_sha256),
         },
         dataset=info.dataset,
         timestamps=run.timestamps,

@@ -163,9 +163,9 @@ def test_a_report_names_the_data_and_escapes_names(tmp_path: Path) -> None:
     tables = (tmp_path / "rep" / "metrics.md").read_text()
     assert "<b>" not in tables and f"Data: &lt;b&gt;bold.clf sha256 {short}." in tables
     result = next((tmp_path / "r" / "s" / "runs").glob("*/result.json"))
-    assert json.loads(result.read_text())["dataset_info"]["data_sha256"] == {
-        log.name: hashlib.sha256(log.read_bytes()).hexdigest()
-    }
+    checksums = {log.name: hashlib.sha256(log.read_bytes()).hexdigest()}
+    assert json.loads(result.read_text())["dataset_info"]["data_sha256"] == checksums
+    assert json.loads((result.parent / "metrics.json").read_text())["run"]["data_sha256"] == checksums
 
 
 def test_a_dataset_edited_after_its_cell_ran_is_run_again_not_kept(tmp_path: Path) -> None:
