@@ -46,6 +46,8 @@ RACY_S = 2.0
 _FORMAT = 2
 #: A cache file larger than this is not read (it holds a few hundred bytes per data file).
 _MAX_CACHE_BYTES = 16 * 1024 * 1024
+#: Above this many entries, a write drops the entries of files that no longer exist.
+_PRUNE_ABOVE = 512
 #: Hex digits of a checksum shown to people (tables, report pages); the files keep all 64.
 SHORT = 12
 
@@ -101,6 +103,8 @@ class _Cache:
         path = checksum_cache_file()
         self._load(path)
         self._entries[key] = [*signature, sha256, _seal(key, signature, sha256)]
+        if len(self._entries) > _PRUNE_ABOVE:  # files deleted since (temporary copies, old downloads)
+            self._entries = {k: v for k, v in self._entries.items() if os.path.exists(k)}
         payload = json.dumps({"format": _FORMAT, "files": self._entries}, sort_keys=True)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)

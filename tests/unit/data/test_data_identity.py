@@ -147,3 +147,16 @@ def test_content_is_described_by_kind_never_quoted() -> None:
     assert describe_content(b"\x00\x01\x02\x03") == "binary"
     assert describe_content(b"\xff\xfe\xfa" * 10) == "binary"
     assert content_kind("grüße\n".encode()) == "text"
+
+
+def test_entries_of_deleted_files_are_pruned_once_the_cache_grows(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(identity, "_PRUNE_ABOVE", 3)
+    files = [old_file(tmp_path / f"f{i}", bytes([i])) for i in range(4)]
+    for path in files[:3]:
+        content_sha256(path)
+    files[0].unlink()
+    content_sha256(files[3])
+    kept = json.loads(checksum_cache_file().read_text())["files"]
+    assert sorted(kept) == sorted(str(p.resolve()) for p in files[1:])
