@@ -212,6 +212,11 @@ def _map_shape(scored: Scored, settings: Settings | None) -> dict[str, Any]:
         sequence = head(open_sequence(dataset, settings=settings), n)
     except Albot1Error as exc:
         raise MetricsError(f"cannot reopen dataset {dataset!r} for the reference map: {exc}") from exc
+    recorded = scored.header.get("data_sha256") or {}
+    if recorded and sequence.metadata.checksums != recorded:  # the scans on disk are not the ones the run read
+        raise MetricsError(
+            f"dataset {dataset!r}: its files' sha256 differ from the run's; the dataset changed since the run"
+        )
     offset = np.asarray(sequence.metadata.sensor_offset, dtype=float)
     parts: list[np.ndarray] = []
     count = 0
