@@ -181,3 +181,29 @@ def _n_at_thesis_level(
     inner: Any, ev: Any, dataset: str, method: str, path: str, label: str, unit: str = "", deg: str = "none"
 ) -> Any:
     return inner(ev, dataset, method, path, label, unit, "thesis")
+
+
+def test_a_page_written_again_draws_no_figure_whose_runs_did_not_change(
+    results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from albot1.report.thesis import page as page_module
+
+    monkeypatch.setattr(figures, "MAX_TRACE_PANELS", 4)
+    monkeypatch.setattr(figures, "MAX_FRAMES", 6)
+    drawn: list[str] = []
+    original = page_module._Figures.draw
+
+    def spy(self: Any, request: Any) -> Any:
+        drawn.append(request.stem)
+        return original(self, request)
+
+    monkeypatch.setattr(page_module._Figures, "draw", spy)
+    first = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
+    assert drawn
+    made = sorted(drawn)
+    drawn.clear()
+    second = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
+    # only the requests that could not be drawn (a failed run, no run) are worked out again, for their reason
+    assert set(drawn) < set(made)
+    strip = re.compile(r"^Generated .*$", re.MULTILINE)
+    assert strip.sub("", first) == strip.sub("", second)
