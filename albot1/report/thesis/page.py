@@ -27,16 +27,15 @@ from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.thesis.claims import READINGS
 from albot1.report.thesis.evidence import COMPANION_SUITES, Evidence, open_stores
 from albot1.report.thesis.experiments import (
-    DENSE,
-    LOOP_GAP,
-    SPARSE,
-    SQUARE,
     ClaimRow,
     FigureRequest,
     Section,
     all_sections,
     stand_ins,
+    thesis_datasets,
 )
+from albot1.report.thesis.experiments.common import LOOP_GAP
+from albot1.report.thesis.experiments.datasets import THESIS_SUITE  # the suite whose report gets this page
 from albot1.report.thesis.figures import animate_map, plot_gap_maps, plot_trace_strip, plot_update_trace
 from albot1.report.thesis.replay import Replay, replay_run
 from albot1.report.thesis.verdicts import FAILS, HOLDS, NOT_COMPARABLE, Verdict
@@ -44,16 +43,21 @@ from albot1.runs.folder import read_run
 
 PAGE = "README.md"
 FIGURES = "figures"
-#: The suite whose report gets this page.
-THESIS_SUITE = "thesis"
-#: The datasets whose every-method plots the thesis suite's benchmark report draws (Experiments 3-5): the page
-#: draws its own figures for the rest, and the public logs' plots are in the default suite's report.
-PICTURED = (SQUARE, DENSE, SPARSE)
+
+
+def pictured() -> tuple[str, ...]:
+    """The datasets whose every-method plots the thesis suite's benchmark report draws (Experiments 3-5).
+
+    The page draws its own figures for the rest, and the public logs' plots are in the default suite's report.
+    """
+    ds = thesis_datasets()
+    return (ds.square, ds.dense, ds.sparse)
 
 
 def own_records(records: list[CellRecord]) -> list[CellRecord]:
-    """The cells of :data:`PICTURED`: the benchmark report of the thesis suite draws its per-dataset plots for these."""
-    return [r for r in records if r.cell.dataset_label in PICTURED]
+    """The cells of :func:`pictured`: the benchmark report of the thesis suite draws its per-dataset plots for these."""
+    shown = pictured()
+    return [r for r in records if r.cell.dataset_label in shown]
 
 
 @dataclass(frozen=True)
