@@ -17,8 +17,9 @@ from functools import partial
 
 from albot1.data import catalog
 from albot1.methods.baselines.published import published_systems
+from albot1.metrics.measures.orientation import METRIC as ORIENTATION_METRIC
 from albot1.report.thesis.claims import READINGS, TABLE_3_1, TABLE_3_1_SOURCE, THESIS
-from albot1.report.thesis.evidence import Evidence, Lookup
+from albot1.report.thesis.evidence import Evidence, Lookup, counter_path
 from albot1.report.thesis.verdicts import (
     Number,
     Verdict,
@@ -79,7 +80,7 @@ RELATIONS_USED = "relations.relations_used"
 
 
 def counter(name: str) -> str:
-    return f"updates.counters.{name}"
+    return counter_path(name)
 
 
 @dataclass(frozen=True)
@@ -240,7 +241,7 @@ def far_stops(ev: Evidence, dataset: str, method: str, min_distance_m: float) ->
     )
     units = ("", "deg", "m", "deg", "m")
     record = found.record
-    block = record.metrics.orientation if record is not None and record.metrics is not None else None
+    block = record.metrics.get(ORIENTATION_METRIC) if record is not None and record.metrics is not None else None
     if not stops.known or block is None:
         return FarStops(*(Number(lab, None, u, stops.missing) for lab, u in zip(labels, units, strict=True)))
     rows = [r for r in block.rows if r.reference_distance_m >= min_distance_m]
