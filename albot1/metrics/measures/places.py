@@ -111,8 +111,11 @@ def headline(block: PlacesBlock) -> str:
     exits = block.exits
     if exits is None:
         return text
+    crossings = f"{exits.crossings_true} of {exits.crossings_true + exits.crossings_missed} true crossings found"
+    if not exits.exit_predictions:
+        return f"{text}; {crossings}, no exit prediction compared"
     return (
-        f"{text}; exit predictions {fmt(exits.exit_prediction_aligned_true_mean_m)} m aligned, "
+        f"{text}; {crossings}, exit predictions {fmt(exits.exit_prediction_aligned_true_mean_m)} m aligned, "
         f"{fmt(exits.exit_prediction_not_aligned_true_mean_m)} m not"
     )
 
