@@ -166,7 +166,6 @@ class Metric(Generic[BlockT]):
 
     name: str
     position: int
-    summary: str
     models: tuple[type[BlockT], ...]
     needs: tuple[Need, ...]
     compute: Callable[[MetricInputs], BlockT]

@@ -46,7 +46,6 @@ def headline(block: AteBlock) -> str:
 METRIC = Metric(
     name="ate",
     position=10,
-    summary="absolute trajectory error after a rigid alignment (evo's APE)",
     models=(AteBlock,),
     needs=(REFERENCE,),
     compute=compute,

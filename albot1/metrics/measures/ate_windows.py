@@ -58,7 +58,6 @@ def headline(block: AteWindowsBlock) -> str:
 METRIC = Metric(
     name="ate_windows",
     position=20,
-    summary="ATE of consecutive windows of reference travel, each aligned on its own",
     models=(AteWindowsBlock,),
     needs=(REFERENCE,),
     compute=compute,

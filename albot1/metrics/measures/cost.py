@@ -53,7 +53,6 @@ def headline(block: CostBlock) -> str:
 METRIC = Metric(
     name="cost",
     position=100,
-    summary="per-scan time, total time, peak memory and growth with position",
     models=(CostBlock,),
     needs=(TIMING,),
     compute=compute,

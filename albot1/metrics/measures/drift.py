@@ -65,7 +65,6 @@ def headline(block: DriftBlock) -> str:
 METRIC = Metric(
     name="drift",
     position=40,
-    summary="relative error per travelled distance (segment-length sweep, every start point)",
     models=(DriftBlock,),
     needs=(REFERENCE,),
     compute=compute,

@@ -118,7 +118,6 @@ def route_returns(block: Block, others: BlockLookup) -> str | None:
 METRIC: Metric[Block] = Metric(
     name="loop_gap",
     position=50,
-    summary="the thesis's loop gap: route end vs start, and every revisit pair",
     models=(LoopGapBlock, ClosedRouteGapBlock),
     needs=(RETURNING_ROUTE,),
     compute=compute,

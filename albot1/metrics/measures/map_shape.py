@@ -92,7 +92,6 @@ def headline(block: MapShapeBlock) -> str:
 METRIC = Metric(
     name="map_shape",
     position=80,
-    summary="agreement of the map with the scans projected by the reference poses",
     models=(MapShapeBlock,),
     needs=(REFERENCE, MAP),
     compute=compute,

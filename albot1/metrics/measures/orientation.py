@@ -53,7 +53,6 @@ def headline(block: OrientationBlock) -> str:
 METRIC = Metric(
     name="orientation",
     position=60,
-    summary="the thesis's Table 3.1: bearing and distance to the start at stop points",
     models=(OrientationBlock,),
     needs=(REFERENCE,),
     compute=compute,

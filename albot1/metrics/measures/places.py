@@ -123,7 +123,6 @@ def headline(block: PlacesBlock) -> str:
 METRIC = Metric(
     name="places",
     position=110,
-    summary="a method's network of places (thesis chapter 4): re-visits and exit predictions judged",
     models=(PlacesBlock,),
     needs=(PLACES_FILE, REFERENCE),
     compute=compute,

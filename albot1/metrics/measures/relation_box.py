@@ -114,7 +114,6 @@ def headline(block: RelationBoxBlock) -> str:
 METRIC = Metric(
     name="relation_box",
     position=120,
-    summary="box-plot numbers (quartiles, whiskers, outliers) of the per-relation errors",
     models=(RelationBoxBlock,),
     needs=(RELATIONS,),
     compute=compute,

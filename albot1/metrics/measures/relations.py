@@ -69,7 +69,6 @@ def headline(block: RelationsBlock) -> str:
 METRIC = Metric(
     name="relations",
     position=70,
-    summary="the relation metric of Kuemmerle et al. (2009), as the published benchmark scores it",
     models=(RelationsBlock,),
     needs=(RELATIONS,),
     compute=compute,

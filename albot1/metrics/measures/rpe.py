@@ -49,7 +49,6 @@ def headline(block: RpeBlock) -> str:
 METRIC = Metric(
     name="rpe",
     position=30,
-    summary="relative pose error over steps of frames and metres (evo's RPE)",
     models=(RpeBlock,),
     needs=(REFERENCE,),
     compute=compute,

@@ -29,7 +29,6 @@ def headline(block: UpdatesBlock) -> str:
 METRIC = Metric(
     name="updates",
     position=90,
-    summary="views, updates, updates per view and the method's other counters",
     models=(UpdatesBlock,),
     needs=(COUNTERS,),
     compute=compute,

@@ -174,7 +174,7 @@ GOOD = """
     def compute(inputs): return B(x_m=1.0)
     def headline(block): return f"{block.x_m} m"
 
-    METRIC = Metric(name="{name}", position={position}, summary="s", models=(B,), needs=(),
+    METRIC = Metric(name="{name}", position={position}, models=(B,), needs=(),
                     compute=compute, headline=headline)
 """
 
@@ -221,7 +221,7 @@ def test_a_need_unmet_records_its_reason_and_compute_is_not_called() -> None:
     def compute(inputs: MetricInputs) -> Toy:
         raise AssertionError("compute without its need")
 
-    toy = Metric("toy", 1, "s", (Toy,), (REFERENCE,), compute, lambda b: "", (ColumnSpec("toy_m", "x_m", "toy"),))
+    toy = Metric("toy", 1, (Toy,), (REFERENCE,), compute, lambda b: "", (ColumnSpec("toy_m", "x_m", "toy"),))
     registry = MetricRegistry((toy,))
     poses = np.zeros((2, 3))
     record = score(Scored(RUN, "d", np.arange(2.0), poses, None, None, "r", np.arange(2.0), poses), registry=registry)
@@ -232,3 +232,9 @@ def test_a_need_unmet_records_its_reason_and_compute_is_not_called() -> None:
 def test_a_block_that_does_not_fit_its_model_is_the_metrics_bug_and_is_raised() -> None:
     with pytest.raises(RecordError, match="the RelationBoxBlock being computed: not a valid RelationBoxBlock"):
         block_of(RelationBoxBlock, {"units": {}})
+
+
+def test_the_docs_list_the_fields_of_every_metric_of_the_registry() -> None:
+    text = (Path(__file__).resolve().parents[3] / "docs" / "metrics.md").read_text(encoding="utf-8")
+    table = [line.split("|")[1].strip() for line in text.splitlines() if line.startswith("| `")]
+    assert [name for name in table if name.strip("`") in ORDER] == [f"`{name}`" for name in ORDER]

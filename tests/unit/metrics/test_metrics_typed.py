@@ -31,7 +31,7 @@ MODULE = """
 
 
     METRIC: Metric[GoodBlock] = Metric(
-        name="typed", position=1, summary="s", models=(GoodBlock,), needs=(), {parts}
+        name="typed", position=1, models=(GoodBlock,), needs=(), {parts}
     )
 """
 
