@@ -144,6 +144,8 @@ class ColumnSpec(Generic[BlockT]):
     beside the metric that judges it). ``applies`` may declare the number not
     applicable to a run although it was computed (a loop gap on a route that
     never returns): it returns the reason, or None when the number applies.
+    ``undefined`` says why the number can be null in a computed block (a
+    ratio without a denominator), for the report's not-applicable notes.
     """
 
     key: str
@@ -151,6 +153,7 @@ class ColumnSpec(Generic[BlockT]):
     header: str
     source: Literal["block", "result"] = "block"
     applies: Callable[[BlockT, BlockLookup], str | None] | None = None
+    undefined: str | None = None
 
 
 @dataclass(frozen=True)

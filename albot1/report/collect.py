@@ -64,6 +64,8 @@ class Column:
     applies: Callable[[MetricsRecord], str | None] | None = None
     #: where the column comes from: a metric's name (its ``columns``; docs/metrics.md), or "" for the cost table
     metric: str = ""
+    #: why the number is null in a computed block (e.g. a precision without a claim), when the metric says
+    undefined: str | None = None
 
     def __post_init__(self) -> None:
         check_number_path(SOURCE_MODELS[self.source], self.path)
@@ -92,14 +94,14 @@ class Column:
                 return verdict
         if self.source != "metrics" or record.metrics is None:
             return f"no {self.source}.json value"
-        return _null_reason(record.metrics, self.path)
+        return _null_reason(record.metrics, self.path, self.undefined)
 
 
-def _null_reason(metrics: MetricsRecord, path: str) -> str:
+def _null_reason(metrics: MetricsRecord, path: str, undefined: str | None = None) -> str:
     """The ``<name>_reason`` nearest the null along ``path`` (the convention of metrics.json), else a plain note."""
     parts = path.split(".")
     node: object = metrics
-    reason = "not defined for this run (see its metrics.json)"
+    reason = undefined or "not defined for this run (see its metrics.json)"
     for part in parts:
         if node is None:
             break
@@ -128,6 +130,7 @@ def metric_columns(registry: MetricRegistry) -> dict[str, Column]:
                 spec.header,
                 applies=_applies(metric, spec) if spec.applies is not None else None,
                 metric=metric.name,
+                undefined=spec.undefined,
             )
     return columns
 

@@ -131,8 +131,12 @@ METRIC = Metric(
         # the network's size and its claims are the method's own counters (result.json), shown beside the judgement
         ColumnSpec("places", "counters.places", "places", source="result"),
         ColumnSpec("revisits_claimed", "counters.revisits_confirmed", "re-visits claimed", source="result"),
-        ColumnSpec("revisit_precision", "revisit_precision", "re-visit precision"),
-        ColumnSpec("revisit_recall", "revisit_recall", "re-visit recall"),
+        ColumnSpec(
+            "revisit_precision", "revisit_precision", "re-visit precision", undefined="no re-visit claimed (claims: 0)"
+        ),
+        ColumnSpec(
+            "revisit_recall", "revisit_recall", "re-visit recall", undefined="no true re-visit (revisits_actual: 0)"
+        ),
         ColumnSpec("exit_aligned_m", "exits.exit_prediction_aligned_true_mean_m", "exit pred. aligned (m)"),
         ColumnSpec("exit_not_aligned_m", "exits.exit_prediction_not_aligned_true_mean_m", "exit pred. not aligned (m)"),
     ),

@@ -238,3 +238,36 @@ def test_the_docs_list_the_fields_of_every_metric_of_the_registry() -> None:
     text = (Path(__file__).resolve().parents[3] / "docs" / "metrics.md").read_text(encoding="utf-8")
     table = [line.split("|")[1].strip() for line in text.splitlines() if line.startswith("| `")]
     assert [name for name in table if name.strip("`") in ORDER] == [f"`{name}`" for name in ORDER]
+
+
+def test_a_ratio_without_a_denominator_is_not_applicable_with_the_metrics_words() -> None:
+    from albot1.bench.grid import Cell
+    from albot1.metrics.measures.places import PlacesBlock
+    from albot1.report.collect import CellRecord
+
+    places = {
+        "units": {},
+        "rule": "rooms",
+        "rooms": ["a"],
+        "buffer_m": None,
+        "min_overlap": None,
+        "claims": 0,
+        "claims_true": [],
+        "revisits_true": 0,
+        "revisits_false": 0,
+        "revisits_missed": 0,
+        "revisits_actual": 0,
+        "revisit_precision": None,
+        "revisit_recall": None,
+        "visits": [],
+        "exits": None,
+        "exits_reason": "the dataset knows no doorways (exit checks need them)",
+    }
+    block_of(PlacesBlock, places)
+    metrics = parse_record(MetricsRecord, {"run": RUN, "places": places}, "m")
+    cell = Cell("s", "d", "d", "m", "m", "p", "none", 0, "k", "v", 1, 1)
+    record = CellRecord(cell, "done", Path("/nonexistent"), None, metrics, None)
+    assert METRIC_COLUMNS["revisit_precision"].reason(record) == "no re-visit claimed (claims: 0)"
+    assert METRIC_COLUMNS["revisit_recall"].reason(record) == "no true re-visit (revisits_actual: 0)"
+    assert METRIC_COLUMNS["exit_aligned_m"].reason(record) == places["exits_reason"]
+    assert METRIC_COLUMNS["relation_iqr_m"].reason(record) == NOT_IN_FILE
