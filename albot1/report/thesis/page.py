@@ -17,6 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from albot1.errors import Albot1Error
+from albot1.metrics.measures.map_shape import METRIC as MAP_SHAPE
+from albot1.metrics.measures.orientation import METRIC as ORIENTATION
 from albot1.report.collect import CellRecord
 from albot1.report.errors import ReportError
 from albot1.report.figure_cache import FigureCache, inputs_digest
@@ -335,15 +337,14 @@ def _parameters(ev: Evidence, sections: list[Section], out: Path) -> list[str]:
         "- Metric settings, as stored in the metrics of the runs (docs/metrics.md):",
     ]
     for store in ev.stores:
-        sample = next((r.metrics for r in store.records if r.metrics is not None and r.metrics.map_shape), None)
-        if sample is not None and sample.map_shape is not None:
+        shape = next((sb for r in store.records if r.metrics is not None and (sb := r.metrics.get(MAP_SHAPE))), None)
+        if shape is not None:
             lines.append(
-                f"  - map shape: tolerance {sample.map_shape.tolerance_m:g} m, voxel {sample.map_shape.voxel_m:g} m, "
-                f"alignment {sample.map_shape.alignment} (`{store.path}`)"
+                f"  - map shape: tolerance {shape.tolerance_m:g} m, voxel {shape.voxel_m:g} m, "
+                f"alignment {shape.alignment} (`{store.path}`)"
             )
-        orientation = next((r.metrics for r in store.records if r.metrics is not None and r.metrics.orientation), None)
-        if orientation is not None and orientation.orientation is not None:
-            o = orientation.orientation
+        o = next((ob for r in store.records if r.metrics is not None and (ob := r.metrics.get(ORIENTATION))), None)
+        if o is not None:
             lines.append(
                 f"  - orientation: a stop every {o.every_m:g} m, bearing undefined within {o.min_distance_m:g} m of "
                 f"the start, alignment {o.alignment} (`{store.path}`)"
