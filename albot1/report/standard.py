@@ -28,6 +28,7 @@ from typing import Any
 from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.methods.baselines.published import published_systems
+from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.report.collect import CellRecord
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import data_lines
@@ -132,9 +133,9 @@ def _measured(rec: CellRecord) -> Row:
     timing = rec.result.timing
     stamps = rec.stored_run().timestamps
     duration = float(stamps.max() - stamps.min()) if len(stamps) > 1 else None
-    block = rec.metrics.relations
+    block = rec.metrics.get(RELATIONS)
     if block is None:
-        why = rec.metrics.relations_reason or "no relation metric"
+        why = rec.metrics.reason(RELATIONS.name) or "no relation metric"
         return Row(log, "measured", method, time_s=timing.wall_s, cpu_s=timing.cpu_s, duration_s=duration, note=why)
     t, r, loops = block.translation_m, block.rotation_deg, block.loops
     note = ""

@@ -22,7 +22,7 @@ def test_map_shape_is_not_computed_against_data_that_changed_since_the_run(
     result = run_method("odometry", open_sequence(str(log)), dataset_name=str(log))
     run_dir = write_run(result, tmp_path / "runs")
     assert read_result(run_dir).dataset_info.data_sha256.keys() == {"w.clf"}
-    assert evaluate_run(run_dir).map_shape is not None
+    assert evaluate_run(run_dir).block("map_shape") is not None
     # The same scans and times, one range changed: only the checksum can tell.
     lines = log.read_text().splitlines(keepends=True)
     index = next(i for i, line in enumerate(lines) if line.startswith("ROBOTLASER1"))
@@ -31,7 +31,8 @@ def test_map_shape_is_not_computed_against_data_that_changed_since_the_run(
     lines[index] = " ".join(fields)
     log.write_text("".join(lines))
     metrics = evaluate_run(run_dir)
-    assert metrics.map_shape is None
-    assert metrics.map_shape_reason == (
-        f"dataset {str(log)!r}: its files' sha256 differ from the run's; the dataset changed since the run"
+    assert metrics.block("map_shape") is None
+    assert metrics.reason("map_shape") == (
+        f"cannot reopen dataset {str(log)!r} for the reference map: dataset {str(log)!r}: its files' sha256 differ "
+        "from the run's; the dataset changed since the run"
     )
