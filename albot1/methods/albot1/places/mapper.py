@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -41,14 +42,15 @@ from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
-from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
 from albot1.methods.albot1.places.exits import Crossing, ExitTracker
+from albot1.methods.albot1.places.kernels import PlacesKernels
 from albot1.methods.albot1.places.matcher import confirm, structural, trigger_threshold
 from albot1.methods.albot1.places.memory import Place, PlaceNetwork, Visit, invert, same_surfaces
 from albot1.methods.albot1.places.navigation import Prediction, align_at_exit, nearest_prediction, predict
 from albot1.methods.albot1.places.network import network_files
 from albot1.methods.albot1.places.presets import PlacesPresets
+from albot1.methods.albot1.warm_up import warm_up
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -79,7 +81,7 @@ class Albot1PlacesMapper:
         self.config = config
         self.inner = Albot1Mapper(config, seed=seed)
         self.inner.on_update = self._on_update
-        self._k = places_kernels(config.accelerate)
+        self._k = PlacesKernels(config.accelerate)
         self._match = config.match_params()
         self.exits = ExitTracker(config.exit_params(), self._k)
         self._same_angle = math.radians(config.match_angle_deg)
@@ -107,6 +109,11 @@ class Albot1PlacesMapper:
         self._crossings: list[dict[str, Any]] = []
         self._counts = _Counts()
         self._n = 0
+
+    def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
+        """Compile every kernel, the places layer's too, before the timed loop (:meth:`Albot1Mapper.warm_up`)."""
+        if self.config.accelerate:
+            warm_up((*self.inner.kernels, self._k), announce)
 
     # -- per scan ----------------------------------------------------------------------------------------------
     def process(self, frame: Frame) -> None:
