@@ -66,9 +66,7 @@ def _fresh(method: str, preset: str, world: str) -> dict[str, Any]:
     return found
 
 
-@pytest.mark.parametrize(
-    ("method", "preset"), [("albot1", "thesis"), ("albot1", "plus"), ("albot1-places", "default")]
-)
+@pytest.mark.parametrize(("method", "preset"), [("albot1", "thesis"), ("albot1", "plus"), ("albot1-places", "default")])
 def test_first_scan_of_a_fresh_process_costs_a_few_medians(benchmark: Any, method: str, preset: str) -> None:
     _fresh(method, preset, "synthetic-office-loop")  # fills numba's cache for this code version if empty
     found = benchmark.pedantic(_fresh, args=(method, preset, "synthetic-office-loop"), rounds=1, iterations=1)
