@@ -350,6 +350,21 @@ def test_kernels_are_cached_in_a_folder_named_by_the_code_version() -> None:
     assert compiled.is_cached() and any(compiled.CACHE_DIR.rglob("kernels.build_view-*.nbi"))
 
 
+def test_an_unwritable_user_cache_falls_back_to_a_per_user_temporary_folder() -> None:
+    """As for an installed wheel whose user cache cannot be written: numba still caches, elsewhere."""
+    code = (
+        "import tempfile\n"
+        "from albot1.methods.albot1 import compiled\n"
+        "from albot1.methods.albot1.places.kernels import PlacesKernels\n"
+        "from albot1.methods.albot1.warm_up import sample_calls\n"
+        "for name, kernel, args in sample_calls(PlacesKernels()):\n"
+        "    if name == 'same_any':\n"
+        "        kernel(*args)\n"
+        "print(compiled.CACHE_DIR.is_relative_to(tempfile.gettempdir()), compiled.is_cached())\n"
+    )
+    assert _python(code, XDG_CACHE_HOME="/proc/albot1-cannot-write-here").split() == ["True", "True"]
+
+
 def test_without_acceleration_a_mapper_calls_the_kernels_as_written() -> None:
     plain = PerceptionKernels(False)
     assert not plain.compiled and plain.build_view is perception_source.build_view.py_func
