@@ -19,6 +19,7 @@ from pathlib import Path
 from albot1.errors import Albot1Error
 from albot1.report.collect import CellRecord
 from albot1.report.errors import ReportError
+from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.html import rel
 from albot1.report.map_plots import plot_maps
 from albot1.report.places_plot import render_places
@@ -26,16 +27,15 @@ from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.thesis.claims import READINGS
 from albot1.report.thesis.evidence import COMPANION_SUITES, Evidence, open_stores
 from albot1.report.thesis.experiments import (
-    DENSE,
-    LOOP_GAP,
-    SPARSE,
-    SQUARE,
     ClaimRow,
     FigureRequest,
     Section,
     all_sections,
     stand_ins,
+    thesis_datasets,
 )
+from albot1.report.thesis.experiments.common import LOOP_GAP
+from albot1.report.thesis.experiments.datasets import THESIS_SUITE  # the suite whose report gets this page
 from albot1.report.thesis.figures import animate_map, plot_gap_maps, plot_trace_strip, plot_update_trace
 from albot1.report.thesis.replay import Replay, replay_run
 from albot1.report.thesis.verdicts import FAILS, HOLDS, NOT_COMPARABLE, Verdict
@@ -43,16 +43,21 @@ from albot1.runs.folder import read_run
 
 PAGE = "README.md"
 FIGURES = "figures"
-#: The suite whose report gets this page.
-THESIS_SUITE = "thesis"
-#: The datasets whose every-method plots the thesis suite's benchmark report draws (Experiments 3-5): the page
-#: draws its own figures for the rest, and the public logs' plots are in the default suite's report.
-PICTURED = (SQUARE, DENSE, SPARSE)
+
+
+def pictured() -> tuple[str, ...]:
+    """The datasets whose every-method plots the thesis suite's benchmark report draws (Experiments 3-5).
+
+    The page draws its own figures for the rest, and the public logs' plots are in the default suite's report.
+    """
+    ds = thesis_datasets()
+    return (ds.square, ds.dense, ds.sparse)
 
 
 def own_records(records: list[CellRecord]) -> list[CellRecord]:
-    """The cells of :data:`PICTURED`: the benchmark report of the thesis suite draws its per-dataset plots for these."""
-    return [r for r in records if r.cell.dataset_label in PICTURED]
+    """The cells of :func:`pictured`: the benchmark report of the thesis suite draws its per-dataset plots for these."""
+    shown = pictured()
+    return [r for r in records if r.cell.dataset_label in shown]
 
 
 @dataclass(frozen=True)
@@ -175,6 +180,38 @@ class _Figures:
         path = self.dir / f"{slug(request.stem)}.png"
         render_places(network, path, f"{request.methods[0]} on {request.dataset}")
         return [Drawn(request.caption, path)]
+
+
+def _cached_draw(figures: _Figures, cache: FigureCache, request: FigureRequest) -> list[Drawn]:
+    """``figures.draw(request)``, or what it drew last time when nothing it is drawn from has changed.
+
+    A request reads the runs of its own dataset in every store (and, for a
+    linked figure, the other report's file): their records, the request
+    itself and the colours make its digest (:mod:`albot1.report.figure_cache`).
+    Drawings that failed are not kept: their reason is worked out again.
+    """
+    records = [r for store in figures.ev.stores for r in store.records if r.cell.dataset_label == request.dataset]
+    linked = [
+        (str(path), path.stat().st_size, path.stat().st_mtime_ns)
+        for store in figures.ev.stores[1:]
+        for path in [figures.out.parent / store.name / "plots" / f"{slug(request.dataset)}-maps.png"]
+        if path.is_file()
+    ]
+    colors = sorted((k, v) for k, v in figures.colors.items() if k in {r.cell.method_label for r in records})
+    digest = inputs_digest(records, "thesis", repr(request), colors, linked)
+    group = f"thesis:{request.stem}"
+    cached = cache.lookup(group, digest)
+    if cached is not None:
+        return [Drawn(caption, cache.path(path), reason) for caption, path, reason in cached.payload]
+    drawn = figures.draw(request)
+    if all(d.path is not None for d in drawn):
+        cache.store(
+            group,
+            digest,
+            [d.path for d in drawn if d.path],
+            [[d.caption, cache.name(d.path), d.reason] for d in drawn if d.path],
+        )
+    return drawn
 
 
 # --------------------------------------------------------------------------- Markdown
@@ -354,9 +391,11 @@ def write_thesis_page(
     drawn: dict[str, list[Drawn]] = {}
     if plots:
         figures = _Figures(ev, out, method_colors(labels))
+        cache = FigureCache(figures.dir)
         for section in sections:
             for request in section.figures:
-                drawn[request.stem] = figures.draw(request)
+                drawn[request.stem] = _cached_draw(figures, cache, request)
+        cache.save()
     lines = [
         "# The thesis's experiments, reproduced",
         "",
