@@ -78,7 +78,9 @@ def cache_dir() -> Path:
 def _use_cache_dir() -> Path:
     path = cache_dir()
     os.environ[CACHE_DIR_ENV] = str(path)  # numba re-reads its config from the environment when it compiles
-    numba_config.reload_config()  # numba may have been imported (and read its environment) before this module
+    # numba may have been imported (and have read its environment) before this module: read it again
+    reload_config: Callable[[], None] = numba_config.reload_config
+    reload_config()
     return path
 
 
