@@ -159,6 +159,9 @@ class Timing(Record):
     #: CPU seconds (user + system, threads and waited children) over the span of ``wall_s``: the cost a shared
     #: machine's load does not inflate; absent in results written before it was recorded
     cpu_s: OptFloat = None
+    #: seconds before the first scan (the method's warm-up, e.g. compiling kernels), outside the per-scan figures;
+    #: absent in results written before it was recorded
+    startup_s: OptFloat = None
 
 
 class DatasetInfo(Record):

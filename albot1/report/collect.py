@@ -155,6 +155,7 @@ COST_COLUMNS: dict[str, Column] = {
     "per_scan_ms_mean": Column("result", "timing.per_scan_ms_mean", "per-scan mean (ms)"),
     "per_scan_ms_p95": Column("result", "timing.per_scan_ms_p95", "per-scan p95 (ms)"),
     "total_s": Column("result", "timing.total_s", "total (s)"),
+    "startup_s": Column("result", "timing.startup_s", "start-up (s)"),
     "peak_mb": Column("result", "timing.peak_mb", "peak (MB)"),
     "cell_s": Column("attempt", "elapsed_s", "cell wall (s)"),
 }

@@ -2,7 +2,10 @@
 
 Per-scan time is ``perf_counter_ns`` around ``Mapper.process`` only (decoding
 and degradation happen outside it); ``finish`` is timed separately and added
-to ``total_s``. ``peak_mb`` is the process's resident-set high-water mark
+to ``total_s``. A method's start-up before the first scan (``Mapper.warm_up``,
+e.g. numba compiling or loading its kernels) is ``startup_s``, outside the
+per-scan times and ``total_s`` and inside ``wall_s``, so the per-scan
+statistics describe the steady state. ``peak_mb`` is the process's resident-set high-water mark
 (``ru_maxrss``) at the end of the run: the benchmark runs each cell in a fresh
 process, so there it is the cell's peak. ``cpu_s`` is the CPU time of the
 same span as ``wall_s`` (:func:`cpu_time_s`).
@@ -55,8 +58,14 @@ def run_method(
     seed: int = 0,
     dataset_name: str | None = None,
     on_frame: Callable[[int], None] | None = None,
+    announce: Callable[[str], None] | None = None,
 ) -> RunResult:
-    """Degrade (seeded), run and check one method; raises the method's error class on failure."""
+    """Degrade (seeded), run and check one method; raises the method's error class on failure.
+
+    A mapper with a ``warm_up`` method (``Mapper.warm_up``) gets it called
+    before the timed loop, with ``announce`` for what it has to say (e.g.
+    that it compiles); its time is the run's ``startup_s``.
+    """
     spec = get_method(method)
     config = resolve_config(method, preset, overrides)
     error_class = spec.load_error_class()
@@ -69,6 +78,10 @@ def run_method(
     mapper = spec.load_class()(config, seed=seed)
 
     wall_start, cpu_start = time.perf_counter(), cpu_time_s()
+    warm_up = getattr(mapper, "warm_up", None)
+    if callable(warm_up):
+        warm_up(announce)
+    startup_s = time.perf_counter() - wall_start
     per_scan: list[int] = []
     stamps: list[float] = []
     odometry: list[np.ndarray] = []
@@ -129,6 +142,7 @@ def run_method(
         files=files,
         per_scan_ns=per_scan_ns,
         finish_s=finish_s,
+        startup_s=startup_s,
         total_s=float(per_scan_ns.sum()) / 1e9 + finish_s,
         wall_s=time.perf_counter() - wall_start,
         cpu_s=cpu_time_s() - cpu_start,

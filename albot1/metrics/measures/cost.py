@@ -31,6 +31,8 @@ class CostBlock(Record):
     process_total_s: float
     total_s: OptFloat
     finish_s: OptFloat
+    #: seconds before the first scan (compiling or loading kernels); None for runs recorded before it was measured
+    startup_s: OptFloat = None
     peak_mb: OptFloat
     by_position: CostByPosition
     growth_slope_ms_per_1000_scans: OptFloat
@@ -44,9 +46,10 @@ def compute(inputs: MetricInputs) -> CostBlock:
 
 
 def headline(block: CostBlock) -> str:
+    startup = f", start-up {fmt(block.startup_s, '.2f')} s" if block.startup_s else ""
     return (
         f"{fmt(block.per_scan_ms_median)} ms/scan median, p95 {fmt(block.per_scan_ms_p95)} ms, "
-        f"peak {fmt(block.peak_mb, '.1f')} MiB"
+        f"peak {fmt(block.peak_mb, '.1f')} MiB{startup}"
     )
 
 
