@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -178,3 +179,29 @@ def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path) -> None
     assert f"`{FAILED_METHOD}` on `{SQUARE}`: failed in" in why[0] and "the mapper diverged" in why[0]
     assert f"`mrpt-rbpf` on `{SQUARE}`: no mrpt-rbpf run" in why[0]  # planned nowhere here: said so, too
     assert "`odometry` on" not in why[0] and "`albot1:literal` on" not in why[0]  # measured: no note
+
+
+def test_a_page_written_again_draws_no_figure_whose_runs_did_not_change(
+    results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from albot1.report.thesis import page as page_module
+
+    monkeypatch.setattr(figures, "MAX_TRACE_PANELS", 4)
+    monkeypatch.setattr(figures, "MAX_FRAMES", 6)
+    drawn: list[str] = []
+    original = page_module._Figures.draw
+
+    def spy(self: Any, request: Any) -> Any:
+        drawn.append(request.stem)
+        return original(self, request)
+
+    monkeypatch.setattr(page_module._Figures, "draw", spy)
+    first = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
+    assert drawn
+    made = sorted(drawn)
+    drawn.clear()
+    second = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
+    # only the requests that could not be drawn (a failed run, no run) are worked out again, for their reason
+    assert set(drawn) < set(made)
+    strip = re.compile(r"^Generated .*$", re.MULTILINE)
+    assert strip.sub("", first) == strip.sub("", second)

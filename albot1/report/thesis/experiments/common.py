@@ -11,7 +11,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from albot1.report.thesis.claims import READINGS, THESIS
-from albot1.report.thesis.evidence import Evidence, Lookup
+from albot1.report.thesis.evidence import Evidence, Lookup, counter_path
 from albot1.report.thesis.verdicts import Number, Verdict, at_most
 
 #: The Albot1 variants every claim is tested for: label -> column heading.
@@ -49,8 +49,8 @@ RELATIONS_USED = "relations.relations_used"
 
 
 def counter(name: str) -> str:
-    """The metrics.json path of a mapper counter (``updates.counters.NAME``)."""
-    return f"updates.counters.{name}"
+    """The metrics.json path of a mapper counter (``updates.counters.NAME``), or of the places metric's judgement."""
+    return counter_path(name)
 
 
 @dataclass(frozen=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from albot1.metrics.measures.orientation import METRIC as ORIENTATION
 from albot1.report.thesis.claims import READINGS, TABLE_3_1, TABLE_3_1_SOURCE, THESIS
 from albot1.report.thesis.evidence import Evidence
 from albot1.report.thesis.experiments.common import (
@@ -50,7 +51,7 @@ def far_stops(ev: Evidence, dataset: str, method: str, min_distance_m: float) ->
     )
     units = ("", "deg", "m", "deg", "m")
     record = found.record
-    block = record.metrics.orientation if record is not None and record.metrics is not None else None
+    block = record.metrics.get(ORIENTATION) if record is not None and record.metrics is not None else None
     if not stops.known or block is None:
         return FarStops(*(Number(lab, None, u, stops.missing) for lab, u in zip(labels, units, strict=True)))
     rows = [r for r in block.rows if r.reference_distance_m >= min_distance_m]
