@@ -13,6 +13,7 @@ from __future__ import annotations
 from html import escape
 
 from albot1.report.collect import CellRecord
+from albot1.report.markdown import code, text
 
 TITLE = "External methods (other systems' trajectory files, scored here, not run)"
 
@@ -36,7 +37,10 @@ def external_markdown(records: list[CellRecord]) -> list[str]:
     return [
         f"## {TITLE}",
         "",
-        *[f"- {label} on {dataset}: `{path}`, sha256 `{sha}`" for label, dataset, path, sha in entries],
+        *[
+            f"- {text(label)} on {text(dataset)}: {code(path)}, sha256 {code(sha)}"
+            for label, dataset, path, sha in entries
+        ],
         "",
     ]
 
