@@ -10,7 +10,9 @@ What is read:
 * reference (optional): the ``nav_msgs/Odometry`` topic named by
   ``reference_topic`` (e.g. simulator ground truth), else ``/ground_truth``
   when present (the layout ``albot1 convert`` writes), interpolated the same
-  way. Topic choice rules live in :mod:`.rosbag_topics`.
+  way. Topic choice rules live in :mod:`.rosbag_topics`;
+* the laser's mount on the base (``metadata.sensor_offset``) from
+  ``/tf_static`` (else ``/tf``), a warning when absent: :mod:`.mounting`.
 
 A scan outside the odometry (or reference) time span is an error by default
 because extrapolating a pose would invent data; ``outside_odometry="drop"``
