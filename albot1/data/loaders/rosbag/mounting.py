@@ -99,20 +99,24 @@ def _links(reader: AnyReader, topic: str, shown: Path) -> dict[str, _Link]:
 
 
 def _chain(links: Mapping[str, _Link], laser: str, base: str | None, odom_frame: str) -> list[_Link] | None:
-    """The links from the base down to ``laser`` (base first), or None when ``base`` is not above it."""
+    """The links from the base down to ``laser`` (base first; empty when ``laser`` is the base), or None.
+
+    None: ``base`` is not above the laser (or, with no base named, the laser
+    has no parent at all, or the links loop).
+    """
     path: list[_Link] = []
     frame, seen = laser, {laser}
-    while frame in links and frame != base:
-        link = links[frame]
+    while frame != base:
+        link = links.get(frame)
+        if link is None:  # the root of the tree: the base when none is named and the laser hangs below it
+            return path[::-1] if base is None and path else None
         if base is None and link.parent == odom_frame:
-            break  # frame is the base: odometry moves it
+            return path[::-1]  # frame is the base: odometry moves it
         path.append(link)
         frame = link.parent
         if frame in seen:
-            return None  # a loop in the tree: no base above the laser
+            return None
         seen.add(frame)
-    if base is not None and frame != base:
-        return None
     return path[::-1]
 
 
@@ -153,7 +157,9 @@ def read_mounting(
             continue
         searched.append(topic)
         path = _chain(_links(reader, topic, shown), laser, base_frame, odom_frame)
-        if path:
+        if path is not None and not path:
+            return Mounting((0.0, 0.0, 0.0), True, f"the scans' frame {laser!r} is the base frame ({topic})")
+        if path is not None:
             base = base_frame or path[0].parent
             offset = _planar(path, laser, base, shown)
             shown_offset = ", ".join(f"{v:.6g}" for v in offset)

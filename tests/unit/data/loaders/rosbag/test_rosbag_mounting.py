@@ -185,3 +185,27 @@ def test_static_mount_not_reaching_the_odometry_base_is_missing(tmp_path: Path) 
     assert Ros2BagLoader().load(tmp_path / "other", base_frame="chassis").metadata.sensor_offset == pytest.approx(
         (0.1, 0.0, 0.0)
     )
+
+
+def test_scans_in_the_frame_odometry_moves_need_no_mount(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """Odometry from /tf (odom -> base_link) and scans stamped in base_link itself: offset 0, no warning."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    msgs = RosMessages(ts, ros1=False)
+    with Writer(tmp_path / "onbase", version=9) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        tf = bag.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=ts)
+        for f in sequence(3).frames():
+            ns = seconds_to_ns(f.scan.timestamp)
+            link = [("odom", "base_link", (float(f.odometry[0]), 0.0, 0.0), yaw_q(float(f.odometry[2])))]
+            bag.write(tf, ns, ts.serialize_cdr(_tf(ts, msgs, ns, link), "tf2_msgs/msg/TFMessage"))
+            message = msgs.scan(f, ns)
+            message.header.frame_id = "base_link"
+            bag.write(scan, ns, ts.serialize_cdr(message, "sensor_msgs/msg/LaserScan"))
+    with caplog.at_level(logging.WARNING):
+        loaded = Ros2BagLoader().load(tmp_path / "onbase")
+    assert loaded.metadata.sensor_offset == (0.0, 0.0, 0.0)
+    assert loaded.metadata.extra["sensor_offset_source"] == "the scans' frame 'base_link' is the base frame (/tf)"
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
