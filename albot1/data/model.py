@@ -27,8 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry import se2
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 class _BeamDirections:

@@ -33,7 +33,8 @@ from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
 from albot1.report.standard import write_standard
 from albot1.report.tables import aggregate, cells_frame, write_tables
-from albot1.report.thesis.page import THESIS_SUITE, own_records, write_thesis_page
+from albot1.report.thesis.experiments.datasets import THESIS_SUITE
+from albot1.report.thesis.page import own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 
 REPORTS_ROOT = Path("reports")

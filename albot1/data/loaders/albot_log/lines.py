@@ -17,9 +17,10 @@ from typing import Any
 import numpy as np
 
 from albot1.data.errors import ParseError, UnwritableError
-from albot1.data.loaders.rosbag.msg import even_spacing
-from albot1.data.model import FloatArray, Frame, Scan
+from albot1.data.loaders.beams import even_spacing
+from albot1.data.model import Frame, Scan
 from albot1.data.tokens import parse_floats
+from albot1.geometry.types import FloatArray
 
 MAGIC = "ALBOT1-LOG"
 VERSION = 1
