@@ -120,7 +120,8 @@ def parse_tuned_on(data: dict[str, Any], source: str) -> TunedOnTable | None:
     expected = f"expected [{TUNED_ON}] PRESET = [dataset names its values were chosen on]"
     if not isinstance(table, dict):
         raise ConfigError(f"{source}: {TUNED_ON}: {expected}, got {type(table).__name__}")
-    presets = data.get("presets") if isinstance(data.get("presets"), dict) else {}
+    declared = data.get("presets")
+    presets: dict[str, Any] = declared if isinstance(declared, dict) else {}
     if "default" not in table:
         raise ConfigError(f"{source}: [{TUNED_ON}] must name the datasets of preset 'default'; {expected}")
     out: TunedOnTable = {}

@@ -21,6 +21,9 @@ import pandas as pd
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
+from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
+from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
+from albot1.report.generalisation import write_generalisation
 from albot1.report.html import INDEX_HTML, rel, write_html
 from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.plots import method_colors, slug, vector_of
@@ -211,6 +214,14 @@ def write_index(
             if STANDARD_PAGE in tables
             else []
         ),
+        *(
+            [
+                f"- [every method against the odometry it was given (paired comparison, held-in marks)]"
+                f"({_rel(tables[GENERALISATION_PAGE], out)}) · [CSV]({_rel(tables[GENERALISATION_TABLE], out)})"
+            ]
+            if GENERALISATION_PAGE in tables
+            else []
+        ),
         "",
         "Cost numbers were measured with the suite's parallelism on a possibly shared machine; "
         "compare them within one report.",
@@ -280,6 +291,9 @@ def build_report(
     target.mkdir(parents=True, exist_ok=True)
     tables = write_tables(records, target)
     tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
+    generalisation = write_generalisation(plan, records, target)
+    if generalisation is not None:
+        tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
     colors = method_colors(r.cell.method_label for r in records)
     thesis = plan.suite == THESIS_SUITE
     pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default

@@ -308,7 +308,9 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
                 values.append(marked(_num(entry.translation_mean_m, 4), entry.held_in))
         lines.append(f"| {name} | " + " | ".join(values) + " |")
     lines += ["", "`–`: no figure (not run here / not published for that log).", "", LEGEND, ""]
-    unrecorded = sorted({r.method for r in rows if r.kind == "measured" and r.status != "not measured" and r.held_in is None})
+    unrecorded = sorted(
+        {r.method for r in rows if r.kind == "measured" and r.status != "not measured" and r.held_in is None}
+    )
     if unrecorded:
         lines += [f"Tuning not recorded (no `[tuned_on]` table; numbers unmarked): {', '.join(unrecorded)}.", ""]
     if plan.skipped_methods:

@@ -32,7 +32,7 @@ from albot1.methods.registry import METHODS, load_mapper_class
 MARK = "†"
 LEGEND = (
     f"{MARK} measured on a dataset this method's values were chosen on (held-in: the `[tuned_on]` table of its "
-    "preset file, docs/benchmarking.md \"Held-in and held-out\"); such a number shows fit, not generalisation."
+    'preset file, docs/benchmarking.md "Held-in and held-out"); such a number shows fit, not generalisation.'
 )
 
 _SLICE = re.compile(r"\[[^\[\]]*\]$")

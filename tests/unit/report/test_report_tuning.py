@@ -5,8 +5,8 @@ from __future__ import annotations
 import pandas as pd
 
 from albot1.bench.grid import Cell
-from albot1.report.tables import LEGEND, markdown
 from albot1.report.collect import METRIC_COLUMNS
+from albot1.report.tables import LEGEND, markdown
 from albot1.report.tuning import MARK, dataset_name, held_in, marked, tuned_datasets
 
 

@@ -1,0 +1,65 @@
+"""The generalisation page (albot1.report.generalisation): paired ratio to the odometry, bootstrap verdicts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from albot1.bench.grid import GridPlan
+from albot1.report.generalisation import Comparison, bootstrap_ratio, render_page
+from albot1.report.tuning import LEGEND, MARK
+
+
+def test_the_ratio_is_the_pooled_rmse_ratio_and_a_clear_difference_is_significant() -> None:
+    rng = np.random.default_rng(1)
+    odo = [np.abs(rng.normal(1.0, 0.1, 200)), np.abs(rng.normal(1.0, 0.1, 150))]
+    worse = [(2.0 * o, o) for o in odo]
+    ratio, low, high = bootstrap_ratio(worse, resamples=200)
+    assert ratio == pytest.approx(2.0)
+    assert low == pytest.approx(2.0) and high == pytest.approx(2.0)  # paired: every resample has ratio 2
+    better = [(0.5 * o + rng.normal(0, 0.01, len(o)), o) for o in odo]
+    ratio, low, high = bootstrap_ratio(better, resamples=200)
+    assert high < 1.0 and low < ratio < high
+
+
+def test_equal_errors_up_to_noise_are_indistinguishable_and_the_draws_are_seeded() -> None:
+    rng = np.random.default_rng(2)
+    odo = np.abs(rng.normal(1.0, 0.5, 300))
+    method = odo[rng.permutation(300)]  # the same errors at other scans: the same RMSE, unpaired noise
+    first = bootstrap_ratio([(method, odo)], resamples=300)
+    assert first == bootstrap_ratio([(method, odo)], resamples=300)
+    assert first[1] < 1.0 < first[2]
+
+
+def _row(method: str, ratio: float, low: float, high: float, verdict: str, held: bool | None) -> Comparison:
+    return Comparison(
+        "fhw-corrected?odometry=laser-pose",
+        method,
+        "none",
+        1,
+        ratio,
+        1.0,
+        ratio,
+        low,
+        high,
+        verdict,
+        0.2,
+        0.1,
+        None,
+        2.0,
+        held,
+    )
+
+
+def test_the_page_lists_where_a_method_is_worse_than_its_odometry_with_marks() -> None:
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    rows = [_row("gtsam-graph", 11.0, 9.0, 13.0, "worse", False), _row("albot1:plus", 0.2, 0.1, 0.3, "better", True)]
+    text = render_page(plan, rows)
+    assert LEGEND in text
+    assert (
+        "| gtsam-graph | fhw-corrected?odometry=laser-pose | none | 1 | 11.000 | 1.000 | 11.00 | 9.00–13.00 |" in text
+    )
+    assert f"| albot1:plus {MARK} | none | 1 |" in text
+    assert "| gtsam-graph | 1 | 0 | 0 | 1 | 11.00 | 11.00 (fhw-corrected?odometry=laser-pose, none) |" in text
+    assert "0.200 / 0.100 (2.00x)" in text and "| n/a |" in text
+    assert "Nowhere" in render_page(plan, rows[1:])
