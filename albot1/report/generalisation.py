@@ -48,6 +48,10 @@ RESAMPLES = 2000
 BLOCKS = 20
 ODOMETRY = "odometry"
 NA = "n/a"
+#: An odometry ATE below this (m) is perfect odometry (the reference itself): a ratio to it means nothing, the
+#: method's own ATE is the figure (issue 21's target for gtsam-graph: <= 0.3 m).
+PERFECT_M = 1e-6
+PERFECT = "perfect odometry"
 
 
 @dataclass(frozen=True)
@@ -58,12 +62,13 @@ class Comparison:
     method: str
     degradation: str
     seeds: int
+    failed: int
     ate_m: float
     odometry_ate_m: float
     ratio: float
     ratio_low: float
     ratio_high: float
-    verdict: str  # better | worse | indistinguishable
+    verdict: str  # better | worse | indistinguishable | perfect odometry
     rpe10_m: float | None
     odometry_rpe10_m: float | None
     loop_gap_m: float | None
@@ -115,7 +120,9 @@ def bootstrap_ratio(
     return ratio, float(low), float(high)
 
 
-def _verdict(low: float, high: float) -> str:
+def _verdict(odometry_ate_m: float, low: float, high: float) -> str:
+    if odometry_ate_m < PERFECT_M:
+        return PERFECT
     if low > 1.0:
         return "worse"
     if high < 1.0:
@@ -146,7 +153,8 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
         if not scored:
             continue
         pairs = [errors for _, errors in scored]
-        ratio, low, high = bootstrap_ratio(pairs)
+        odometry_ate = math.sqrt(sum(float(np.sum(o**2)) for _, o in pairs) / sum(len(o) for _, o in pairs))
+        ratio, low, high = bootstrap_ratio(pairs) if odometry_ate >= PERFECT_M else (math.nan,) * 3
         odo = [odometry_cells.get((dataset, degradation, rec.cell.seed)) for rec, _ in scored]
         out.append(
             Comparison(
@@ -154,12 +162,13 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
                 method=method,
                 degradation=degradation,
                 seeds=len(scored),
+                failed=sum(rec.status == "failed" for rec in recs),
                 ate_m=math.sqrt(sum(float(np.sum(m**2)) for m, _ in pairs) / sum(len(m) for m, _ in pairs)),
-                odometry_ate_m=math.sqrt(sum(float(np.sum(o**2)) for _, o in pairs) / sum(len(o) for _, o in pairs)),
+                odometry_ate_m=odometry_ate,
                 ratio=ratio,
                 ratio_low=low,
                 ratio_high=high,
-                verdict=_verdict(low, high),
+                verdict=_verdict(odometry_ate, low, high),
                 rpe10_m=_mean([rpe.value(rec) for rec, _ in scored]),
                 odometry_rpe10_m=_mean([rpe.value(o) for o in odo if o is not None]),
                 loop_gap_m=_mean([gap.value(rec) for rec, _ in scored]),
@@ -174,15 +183,39 @@ def _num(value: float | None, digits: int = 3) -> str:
     return NA if value is None or not math.isfinite(value) else f"{value:.{digits}f}"
 
 
+def _ratio(value: float) -> str:
+    return NA if not math.isfinite(value) else f"{value:.3g}"
+
+
+def _interval(row: Comparison) -> str:
+    if row.verdict == PERFECT:
+        return NA
+    return f"{_ratio(row.ratio)} [{_ratio(row.ratio_low)}–{_ratio(row.ratio_high)}]"
+
+
+def _seeds(row: Comparison) -> str:
+    return str(row.seeds) + (f" ({row.failed} failed)" if row.failed else "")
+
+
 def _pair(value: float | None, odometry: float | None) -> str:
     if value is None:
         return NA
-    if odometry is None or odometry <= 0:
-        return _num(value)
+    if odometry is None or odometry < PERFECT_M:
+        return f"{_num(value)} / {_num(odometry)}"
     return f"{_num(value)} / {_num(odometry)} ({value / odometry:.2f}x)"
 
 
-def render_page(plan: GridPlan, rows: list[Comparison]) -> str:
+def failed_groups(records: list[CellRecord]) -> list[str]:
+    """``method on dataset (degradation)`` for every group of the page's kind without one completed run."""
+    groups: dict[tuple[str, str, str], list[str]] = {}
+    for rec in records:
+        if rec.cell.method != ODOMETRY:
+            key = (rec.cell.method_label, rec.cell.dataset_label, rec.cell.degradation)
+            groups.setdefault(key, []).append(rec.status)
+    return [f"{m} on {d} ({g})" for (m, d, g), statuses in groups.items() if "done" not in statuses]
+
+
+def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None = None) -> str:
     """The Markdown page (see the module docstring)."""
     pct = f"{CONFIDENCE:.0%}"
     lines = [
@@ -208,18 +241,18 @@ def render_page(plan: GridPlan, rows: list[Comparison]) -> str:
         lines += ["| method | dataset | degradation | seeds | ATE (m) | odometry ATE (m) | ratio | interval |"]
         lines += ["|---|---|---|---:|---:|---:|---:|---|"]
         lines += [
-            f"| {marked(r.method, r.held_in)} | {r.dataset} | {r.degradation} | {r.seeds} | {_num(r.ate_m)} | "
-            f"{_num(r.odometry_ate_m)} | {r.ratio:.2f} | {r.ratio_low:.2f}–{r.ratio_high:.2f} |"
+            f"| {marked(r.method, r.held_in)} | {r.dataset} | {r.degradation} | {_seeds(r)} | {_num(r.ate_m)} | "
+            f"{_num(r.odometry_ate_m)} | {_ratio(r.ratio)} | {_ratio(r.ratio_low)}–{_ratio(r.ratio_high)} |"
             for r in worse
         ]
     else:
         lines.append(f"Nowhere at {pct} confidence.")
-    above = [r for r in rows if r.verdict != "worse" and r.ratio > 1.0]
+    above = [r for r in rows if r.verdict == "indistinguishable" and r.ratio > 1.0]
     if above:
         lines += [
             "",
             "Ratio above 1 but not significantly: "
-            + "; ".join(f"{r.method} on {r.dataset} ({r.degradation}) {r.ratio:.2f}" for r in above)
+            + "; ".join(f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio)}" for r in above)
             + ".",
         ]
     lines += [
@@ -229,14 +262,34 @@ def render_page(plan: GridPlan, rows: list[Comparison]) -> str:
         "| method | cells | better | indistinguishable | worse | median ATE ratio | largest ratio (where) |",
         "|---|---:|---:|---:|---:|---:|---|",
     ]
-    for method in dict.fromkeys(r.method for r in rows):
-        mine = [r for r in rows if r.method == method]
+    compared = [r for r in rows if r.verdict != PERFECT]
+    for method in dict.fromkeys(r.method for r in compared):
+        mine = [r for r in compared if r.method == method]
         top = max(mine, key=lambda r: r.ratio)
         counts = [sum(r.verdict == v for r in mine) for v in ("better", "indistinguishable", "worse")]
         lines.append(
             f"| {method} | {len(mine)} | {counts[0]} | {counts[1]} | {counts[2]} | "
-            f"{median(r.ratio for r in mine):.2f} | {top.ratio:.2f} ({top.dataset}, {top.degradation}) |"
+            f"{_ratio(median(r.ratio for r in mine))} | {_ratio(top.ratio)} ({top.dataset}, {top.degradation}) |"
         )
+    perfect = [r for r in rows if r.verdict == PERFECT]
+    if perfect:
+        logs = list(dict.fromkeys(r.dataset for r in perfect))
+        lines += [
+            "",
+            "## With perfect odometry",
+            "",
+            "ATE (m) of each method given the reference poses as odometry (no ratio: the odometry's is 0).",
+            "",
+            "| method | " + " | ".join(logs) + " |",
+            "|---|" + "---:|" * len(logs),
+        ]
+        for method in dict.fromkeys(r.method for r in perfect):
+            by = {r.dataset: r for r in perfect if r.method == method}
+            lines.append(
+                f"| {method} | "
+                + " | ".join(marked(_num(by[d].ate_m), by[d].held_in) if d in by else "–" for d in logs)
+                + " |"
+            )
     for dataset in dict.fromkeys(r.dataset for r in rows):
         lines += [
             "",
@@ -248,10 +301,17 @@ def render_page(plan: GridPlan, rows: list[Comparison]) -> str:
         ]
         for r in (r for r in rows if r.dataset == dataset):
             lines.append(
-                f"| {marked(r.method, r.held_in)} | {r.degradation} | {r.seeds} | {_num(r.ate_m)} | "
-                f"{_num(r.odometry_ate_m)} | {r.ratio:.2f} [{r.ratio_low:.2f}–{r.ratio_high:.2f}] | {r.verdict} | "
+                f"| {marked(r.method, r.held_in)} | {r.degradation} | {_seeds(r)} | {_num(r.ate_m)} | "
+                f"{_num(r.odometry_ate_m)} | {_interval(r)} | {r.verdict} | "
                 f"{_pair(r.rpe10_m, r.odometry_rpe10_m)} | {_pair(r.loop_gap_m, r.odometry_loop_gap_m)} |"
             )
+    if failed:
+        lines += [
+            "",
+            "## No completed run",
+            "",
+            "Every seed failed (reasons: the report's README): " + "; ".join(failed) + ".",
+        ]
     lines.append("")
     return "\n".join(lines)
 
@@ -273,7 +333,7 @@ def write_generalisation(plan: GridPlan, records: list[CellRecord], out: Path) -
     if not rows:
         return None
     page, table = out / PAGE, out / TABLE
-    text = render_page(plan, rows)
+    text = render_page(plan, rows, failed_groups(records))
     atomic_write(page, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     atomic_write(table, lambda tmp: tmp.write_text(_csv(rows), encoding="utf-8"))
     return page, table

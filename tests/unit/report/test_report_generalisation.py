@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from albot1.bench.grid import GridPlan
-from albot1.report.generalisation import Comparison, bootstrap_ratio, render_page
+from albot1.report.generalisation import PERFECT, Comparison, bootstrap_ratio, render_page
 from albot1.report.tuning import LEGEND, MARK
 
 
@@ -37,6 +39,7 @@ def _row(method: str, ratio: float, low: float, high: float, verdict: str, held:
         method,
         "none",
         1,
+        0,
         ratio,
         1.0,
         ratio,
@@ -54,12 +57,21 @@ def _row(method: str, ratio: float, low: float, high: float, verdict: str, held:
 def test_the_page_lists_where_a_method_is_worse_than_its_odometry_with_marks() -> None:
     plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
     rows = [_row("gtsam-graph", 11.0, 9.0, 13.0, "worse", False), _row("albot1:plus", 0.2, 0.1, 0.3, "better", True)]
-    text = render_page(plan, rows)
+    text = render_page(plan, rows, ["mrpt-icp on fhw-corrected (none)"])
     assert LEGEND in text
-    assert (
-        "| gtsam-graph | fhw-corrected?odometry=laser-pose | none | 1 | 11.000 | 1.000 | 11.00 | 9.00–13.00 |" in text
-    )
-    assert f"| albot1:plus {MARK} | none | 1 |" in text
-    assert "| gtsam-graph | 1 | 0 | 0 | 1 | 11.00 | 11.00 (fhw-corrected?odometry=laser-pose, none) |" in text
+    assert "| gtsam-graph | fhw-corrected?odometry=laser-pose | none | 1 | 11.000 | 1.000 | 11 | 9–13 |" in text
+    assert f"| albot1:plus {MARK} | none | 1 | 0.200 | 1.000 | 0.2 [0.1–0.3] | better |" in text
+    assert "| gtsam-graph | 1 | 0 | 0 | 1 | 11 | 11 (fhw-corrected?odometry=laser-pose, none) |" in text
     assert "0.200 / 0.100 (2.00x)" in text and "| n/a |" in text
+    assert "Every seed failed (reasons: the report's README): mrpt-icp on fhw-corrected (none)." in text
     assert "Nowhere" in render_page(plan, rows[1:])
+
+
+def test_with_perfect_odometry_the_method_ate_is_shown_without_a_ratio() -> None:
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    row = replace(_row("gtsam-graph", 0.0, 0.0, 0.0, PERFECT, False), ate_m=0.126, odometry_ate_m=0.0)
+    text = render_page(plan, [row])
+    assert "## With perfect odometry" in text
+    assert "| gtsam-graph | 0.126 |" in text
+    assert f"| gtsam-graph | none | 1 | 0.126 | 0.000 | n/a | {PERFECT} |" in text
+    assert "Nowhere" in text  # perfect odometry is not counted as "worse"
