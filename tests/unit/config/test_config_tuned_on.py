@@ -65,10 +65,13 @@ def test_what_the_issue_says_each_baseline_was_tuned_on_is_recorded() -> None:
     """The logs named in the comments of the preset files and docs/baselines.md (issue 21)."""
     graph = load_mapper_class(METHODS["gtsam-graph"].target)
     assert {"aces", "mit-csail", "fr-clinic", "intel-corrected"} <= set(tuned_on(graph, "default") or ())
-    for held_out in ("seattle-corrected", "edmonton-corrected", "belgioioso-corrected", "fhw-corrected"):
-        for name, spec in METHODS.items():
-            cls = load_mapper_class(spec.target)
-            assert held_out not in (tuned_on(cls, "default") or ()), f"{name} is tuned on {held_out}"
+    suite_logs = {"seattle-corrected", "edmonton-corrected", "belgioioso-corrected", "fhw-corrected"}
+    # gtsam-graph's tracker gating (issue 21) was chosen by its scores on the generalisation suite's logs
+    assert suite_logs <= set(tuned_on(graph, "default") or ())
+    for name, spec in METHODS.items():
+        if name != "gtsam-graph":
+            tuned = set(tuned_on(load_mapper_class(spec.target), "default") or ())
+            assert not suite_logs & tuned, f"{name} is tuned on {sorted(suite_logs & tuned)}"
     places = load_mapper_class(METHODS["albot1-places"].target)
     albot1 = load_mapper_class(METHODS["albot1"].target)
     plus = tuned_on(places, "plus") or ()

@@ -48,6 +48,7 @@ from albot1.methods.baselines.gtsam_graph.correlative import (
     correlative_search,
 )
 from albot1.methods.baselines.gtsam_graph.errors import GraphError, RegistrationError
+from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
 from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
 from albot1.methods.baselines.gtsam_graph.loop_closure import (
     Confirmer,
@@ -122,6 +123,9 @@ class GtsamGraphMapper:
         # Tracking: the latest scan's pose in the frame of the newest node, and the local map it is matched against.
         self._track = np.zeros(3)
         self._velocity = np.zeros(3)  # the last tracked scan-to-scan motion
+        self._corrections = CorrectionScale(
+            config.track_outlier_window, config.match_sigma_floor_xy_m, config.match_sigma_floor_theta_deg
+        )
         self._last_odometry: FloatArray | None = None
         self._local: Target | None = None
         # Per node.
@@ -148,6 +152,8 @@ class GtsamGraphMapper:
             "scans_tracked": 0,
             "tracking_failures": 0,
             "tracking_velocity_guess": 0,
+            "tracking_velocity_rejected": 0,
+            "tracking_outliers_rejected": 0,
             "odometry_fallbacks": 0,
             "loop_candidates": 0,
             "loop_coarse_searches": 0,
@@ -236,9 +242,21 @@ class GtsamGraphMapper:
             math.hypot(gap[0], gap[1]) > limits[1] / 2 or abs(gap[2]) > math.radians(limits[2] / 2)
         ):
             alt, alt_good, _ = self._attempt(target, points, coasting, *limits)
+            if alt_good and not velocity_match_allowed(alt.pose, guess, good, limits[3]):  # type: ignore[union-attr]
+                alt_good = False
+                self.counters["tracking_velocity_rejected"] += 1
             if alt_good and (not good or alt.fitness > reg.fitness):  # type: ignore[union-attr]
                 reg, good = alt, True
                 self.counters["tracking_velocity_guess"] += 1
+        if good:
+            correction = se2.between(guess, reg.pose)  # type: ignore[union-attr]
+            if reg.fitness < cfg.track_wide_min_fitness and self._corrections.is_outlier(  # type: ignore[union-attr]
+                correction, cfg.track_outlier_factor
+            ):
+                good = False
+                self.counters["tracking_outliers_rejected"] += 1
+            else:
+                self._corrections.add(correction)
         if good:
             self.counters["scans_tracked"] += 1
             return reg
