@@ -35,6 +35,7 @@ from albot1.report.standard import write_standard
 from albot1.report.tables import aggregate, cells_frame, write_tables
 from albot1.report.thesis.page import THESIS_SUITE, own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
+from albot1.report.tuning import held_in
 
 REPORTS_ROOT = Path("reports")
 #: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
@@ -301,6 +302,7 @@ def build_report(
     index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
     page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
     cells = cells_frame(records)
+    cells["held_in"] = [held_in(rec.cell) for rec in records]
     write_html(
         plan,
         records,
