@@ -37,6 +37,7 @@ import numpy as np
 from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
+from albot1.metrics.measures.ate import METRIC as ATE
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
 from albot1.report.tuning import LEGEND, held_in, marked
 
@@ -78,7 +79,7 @@ class Comparison:
 
 def paired_errors(rec: CellRecord) -> tuple[np.ndarray, np.ndarray] | None:
     """Per-scan position errors of the run's poses and of the odometry it was given, or None (no reference)."""
-    if rec.status != "done" or rec.metrics is None or rec.metrics.ate is None:
+    if rec.status != "done" or rec.metrics is None or rec.metrics.get(ATE) is None:
         return None
     run = rec.stored_run()
     if run.reference is None:

@@ -21,6 +21,7 @@ import pandas as pd
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
+from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
 from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
 from albot1.report.generalisation import write_generalisation
@@ -79,17 +80,44 @@ def render_plots(
     by_dataset: dict[str, list[CellRecord]] = {}
     for rec in records:
         by_dataset.setdefault(rec.cell.dataset_label, []).append(rec)
-    tasks = [(dataset, recs, metrics, plots_dir, colors, map_style) for dataset, recs in by_dataset.items()]
+    cache = FigureCache(plots_dir)
+    made: dict[str, list[Path]] = {}
+    digests: dict[str, str] = {}
+    tasks = []
+    for dataset, recs in by_dataset.items():
+        digests[dataset] = inputs_digest(recs, "dataset", dataset, map_style, sorted(_colors_of(recs, colors).items()))
+        cached = cache.lookup(f"dataset:{dataset}", digests[dataset])
+        if cached is not None:
+            made[dataset] = [cache.path(name) for name in cached.payload]
+        else:
+            tasks.append((dataset, recs, metrics, plots_dir, colors, map_style))
     if jobs > 1 and len(tasks) > 1:
         # spawn: a fresh interpreter per worker, whatever threads or matplotlib state this process holds.
         with ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=multiprocessing.get_context("spawn")) as pool:
             drawn = list(pool.map(_dataset_plots, *zip(*tasks, strict=True)))
     else:
         drawn = [_dataset_plots(*task) for task in tasks]
-    made = dict(zip(by_dataset, drawn, strict=True))
-    runtime = plot_runtime(cost, plots_dir / "runtime.png", colors)
-    made[""] = [runtime] if runtime is not None else []
+    for task, files in zip(tasks, drawn, strict=True):
+        dataset = task[0]
+        made[dataset] = files
+        cache.store(f"dataset:{dataset}", digests[dataset], files, [cache.name(f) for f in files])
+    made = {dataset: made[dataset] for dataset in by_dataset}  # suite order, whichever were drawn now
+    runtime_digest = inputs_digest(records, "runtime", sorted(colors.items()))
+    cached = cache.lookup("runtime", runtime_digest)
+    if cached is not None:
+        made[""] = [cache.path(name) for name in cached.payload]
+    else:
+        runtime = plot_runtime(cost, plots_dir / "runtime.png", colors)
+        made[""] = [runtime] if runtime is not None else []
+        cache.store("runtime", runtime_digest, made[""], [cache.name(f) for f in made[""]])
+    cache.save()
     return made
+
+
+def _colors_of(records: list[CellRecord], colors: dict[str, str]) -> dict[str, str]:
+    """The colours of the methods in ``records`` (what a dataset's figures draw them in)."""
+    labels = {r.cell.method_label for r in records}
+    return {label: color for label, color in colors.items() if label in labels}
 
 
 def _dataset_plots(

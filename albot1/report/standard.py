@@ -28,6 +28,7 @@ from typing import Any
 from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.methods.baselines.published import published_systems
+from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.report.collect import CellRecord
 from albot1.report.tuning import LEGEND, held_in, marked
 
@@ -134,9 +135,9 @@ def _measured(rec: CellRecord) -> Row:
     timing = rec.result.timing
     stamps = rec.stored_run().timestamps
     duration = float(stamps.max() - stamps.min()) if len(stamps) > 1 else None
-    block = rec.metrics.relations
+    block = rec.metrics.get(RELATIONS)
     if block is None:
-        why = rec.metrics.relations_reason or "no relation metric"
+        why = rec.metrics.reason(RELATIONS.name) or "no relation metric"
         return Row(
             log,
             "measured",

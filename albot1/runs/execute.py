@@ -14,12 +14,11 @@ import resource
 import sys
 import time
 from collections.abc import Callable
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 
 from albot1 import versions
-from albot1.config.targets import resolve_target
 from albot1.contract import MapperOutput, RunResult
 from albot1.data.degrade import degrade
 from albot1.data.model import Sequence
@@ -108,14 +107,9 @@ def run_method(
     per_scan_ns = np.asarray(per_scan, dtype=np.int64)
     poses = robot_frame(np.asarray(output.poses, dtype=float), offset)
     reference_poses = robot_frame(np.asarray(reference, dtype=float).reshape(-1, 3), offset) if reference else None
+    # A method's own claims (e.g. re-visits in places.json) are scored against the reference poses, which the
+    # mapper never saw, when the run is evaluated (the `places` metric, albot1.metrics.measures.places).
     counters, files = dict(output.counters), dict(output.files)
-    if spec.judge is not None and reference_poses is not None:
-        # Evaluation only, after the timed run: the method's own claims (e.g. re-visits) scored against the
-        # reference poses, which the mapper never saw (MethodSpec.judge).
-        judge = cast(Callable[..., Any], resolve_target(spec.judge))
-        judgement = judge(files, poses, reference_poses, seq.metadata.extra)
-        counters.update(judgement.counters)
-        files = judgement.files
     return RunResult(
         method=method,
         dataset=dataset,
