@@ -3,13 +3,21 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from albot1.bench.grid import GridPlan
-from albot1.report.generalisation import PERFECT, Comparison, bootstrap_ratio, render_page
+from albot1.bench.grid import Cell, GridPlan
+from albot1.data.model import Frame, Scan, Sequence
+from albot1.metrics.record import MetricsRecord
+from albot1.records import ResultRecord, read_record
+from albot1.report.collect import CellRecord
+from albot1.report.generalisation import PERFECT, Comparison, bootstrap_ratio, comparisons, render_page
 from albot1.report.tuning import LEGEND, MARK
+from albot1.runs.evaluate import evaluate_run
+from albot1.runs.execute import run_method
+from albot1.runs.folder import write_run
 
 
 def test_the_ratio_is_the_pooled_rmse_ratio_and_a_clear_difference_is_significant() -> None:
@@ -75,3 +83,37 @@ def test_with_perfect_odometry_the_method_ate_is_shown_without_a_ratio() -> None
     assert "| gtsam-graph | 0.126 |" in text
     assert f"| gtsam-graph | none | 1 | 0.126 | 0.000 | n/a | {PERFECT} |" in text
     assert "Nowhere" in text  # perfect odometry is not counted as "worse"
+
+
+def _drive(name: str) -> Sequence:
+    """A straight 40-scan drive with reference poses; the odometry is 10 % long and turns 0.5 deg per step."""
+    t = np.arange(40, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(40), np.zeros(40)])
+    odometry = np.column_stack([t * 0.55, np.zeros(40), np.radians(0.5) * t])
+    angles = np.radians(np.linspace(-90.0, 90.0, 181))
+    frames = [
+        Frame(i, Scan(np.full(181, 5.0), angles, 100.0 + t[i], 30.0), odometry[i], reference=truth[i])
+        for i in range(40)
+    ]
+    return Sequence.from_frames(name, frames)
+
+
+def _stored(tmp_path: Path, method_label: str, method: str) -> CellRecord:
+    result = run_method("odometry", _drive("drive"), dataset_name="drive")
+    run_dir = write_run(result, tmp_path)
+    evaluate_run(run_dir)
+    cell = Cell("t", "drive", "drive", method, method_label, "default", "none", 0, run_dir.name, "v", 1.0, 1.0)
+    metrics = read_record(MetricsRecord, run_dir / "metrics.json")
+    return CellRecord(cell, "done", run_dir, read_record(ResultRecord, run_dir / "result.json"), metrics, None)
+
+
+def test_a_run_whose_poses_are_its_odometry_has_ratio_one_from_its_own_run_folder(tmp_path: Path) -> None:
+    """The pair is read from one run folder: poses vs the odometry it was given, both against the reference."""
+    same = _stored(tmp_path / "a", "kiss-icp", "kiss-icp")  # an odometry run filed as another method's cell
+    odometry = _stored(tmp_path / "b", "odometry", "odometry")
+    rows = comparisons([odometry, same])
+    assert [(r.method, r.seeds, r.failed) for r in rows] == [("kiss-icp", 1, 0)]  # odometry is not compared
+    row = rows[0]
+    assert row.ratio == pytest.approx(1.0) and row.ratio_low == pytest.approx(1.0)
+    assert row.verdict == "indistinguishable" and row.ate_m == pytest.approx(row.odometry_ate_m) and row.ate_m > 0.1
+    assert row.held_in is False  # kiss-icp is not tuned on "drive"
