@@ -39,7 +39,7 @@ from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
-from albot1.report.tuning import LEGEND, held_in, marked
+from albot1.report.tuning import LEGEND, MARK, held_in, marked
 
 PAGE = "generalisation.md"
 TABLE = "generalisation.csv"
@@ -260,16 +260,18 @@ def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None
         "",
         "## Per method",
         "",
-        "| method | cells | better | indistinguishable | worse | median ATE ratio | largest ratio (where) |",
-        "|---|---:|---:|---:|---:|---:|---|",
+        f"| method | cells | of them held-in ({MARK}) | better | indistinguishable | worse | median ATE ratio "
+        "| largest ratio (where) |",
+        "|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     compared = [r for r in rows if r.verdict != PERFECT]
     for method in dict.fromkeys(r.method for r in compared):
         mine = [r for r in compared if r.method == method]
         top = max(mine, key=lambda r: r.ratio)
         counts = [sum(r.verdict == v for r in mine) for v in ("better", "indistinguishable", "worse")]
+        tuned = sum(bool(r.held_in) for r in mine)
         lines.append(
-            f"| {method} | {len(mine)} | {counts[0]} | {counts[1]} | {counts[2]} | "
+            f"| {method} | {len(mine)} | {tuned} | {counts[0]} | {counts[1]} | {counts[2]} | "
             f"{_ratio(median(r.ratio for r in mine))} | {_ratio(top.ratio)} ({top.dataset}, {top.degradation}) |"
         )
     perfect = [r for r in rows if r.verdict == PERFECT]

@@ -69,8 +69,9 @@ def test_the_page_lists_where_a_method_is_worse_than_its_odometry_with_marks() -
     assert LEGEND in text
     assert "| gtsam-graph | fhw-corrected?odometry=laser-pose | none | 1 | 11.000 | 1.000 | 11 | 9–13 |" in text
     assert f"| albot1:plus {MARK} | none | 1 | 0.200 | 1.000 | 0.2 [0.1–0.3] | better |" in text
-    assert "| gtsam-graph | 1 | 0 | 0 | 1 | 11 | 11 (fhw-corrected?odometry=laser-pose, none) |" in text
+    assert "| gtsam-graph | 1 | 0 | 0 | 0 | 1 | 11 | 11 (fhw-corrected?odometry=laser-pose, none) |" in text
     assert "0.200 / 0.100 (2.00x)" in text and "| n/a |" in text
+    assert "| albot1:plus | 1 | 1 | 1 | 0 | 0 | 0.2 |" in text  # its one cell is held-in
     assert "Every seed failed (reasons: the report's README): mrpt-icp on fhw-corrected (none)." in text
     assert "Nowhere" in render_page(plan, rows[1:])
 
