@@ -71,6 +71,8 @@ class GtsamGraphMapper:
             "scans_tracked": 0,
             "tracking_failures": 0,
             "tracking_velocity_guess": 0,
+            "tracking_velocity_rejected": 0,
+            "tracking_outliers_rejected": 0,
             "odometry_fallbacks": 0,
             "loop_candidates": 0,
             "loop_coarse_searches": 0,
