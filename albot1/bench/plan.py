@@ -98,6 +98,12 @@ def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
 def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
     entries = [e for e in suite.methods if e.trajectories is None]
     external = [e for e in suite.methods if e.trajectories is not None]  # scored files: nothing to install
+    for entry in external:
+        if entry.name in METHODS:
+            raise SuiteError(
+                f"{suite.path or suite.name}: method {entry.name!r} with trajectories: {entry.name!r} is a method "
+                f"this project runs; name another system's output differently (e.g. {entry.name + '-theirs'!r})"
+            )
     for entry in entries:
         if entry.target is not None:
             register_plugin(entry.name, entry.target, entry.error_class, entry.requires)

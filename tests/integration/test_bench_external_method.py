@@ -48,6 +48,11 @@ def test_a_missing_file_and_a_bad_entry_are_suite_errors(tmp_path: Path) -> None
         SuiteError, match=rf"no trajectory file for dataset '{DATASET}': expected .*carto/{DATASET}.tum"
     ):
         plan_suite(load_suite(suite), get_settings())
+    suite.write_text(
+        f'[[methods]]\nname = "kiss-icp"\ntrajectories = "k/{{dataset}}.tum"\n\n[[datasets]]\nname = "{DATASET}"\n'
+    )
+    with pytest.raises(SuiteError, match="'kiss-icp' is a method this project runs; name another system's output"):
+        plan_suite(load_suite(suite), get_settings())
     suite.write_text('[[methods]]\nname = "carto"\ntrajectories = "carto.tum"\n\n[[datasets]]\nname = "x"\n')
     with pytest.raises(SuiteError, match=r"has no \{dataset\}"):
         load_suite(suite)
