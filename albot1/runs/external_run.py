@@ -28,8 +28,8 @@ from albot1.data.open import open_sequence
 from albot1.data.trajectory import read_trajectory
 from albot1.runs.errors import RunError
 from albot1.runs.evaluate import score
-from albot1.runs.external import EXTERNAL_PRESET, MAX_DT_S, load_external, match_by_time
-from albot1.runs.folder import METRICS_FILE, PreviewRenderer, write_record, write_run
+from albot1.runs.external import MAX_DT_S, load_external, match_by_time
+from albot1.runs.folder import EXTERNAL_PRESET, METRICS_FILE, PreviewRenderer, write_record, write_run
 from albot1.settings import Settings
 
 __all__ = ["EXTERNAL_PRESET", "external_config", "write_external_run"]
