@@ -40,9 +40,10 @@ def methods(
       albot1 methods kiss-icp --json
     """
     # The registry is imported by the command, not by this module: see albot1.cli.app.
-    from albot1.methods.registry import METHODS, get_method
+    from albot1.methods.registry import method_registry
 
-    specs = [get_method(method)] if method is not None else list(METHODS.values())
+    registry = method_registry()
+    specs = [registry.get(method)] if method is not None else list(registry)
     detail = presets or method is not None
     records = [_record(spec, detail) for spec in specs]
     if as_json:

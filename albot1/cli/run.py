@@ -68,8 +68,6 @@ def run(
     # result.json: runs on different prefixes get different folders, and `albot1 evaluate` reopens the prefix.
     dataset = dataset if limit is None else f"{dataset}[:{limit}]"
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
-    if preset == "default" and method == "albot1":
-        preset = "thesis"
     sequence = with_progress(sequence, f"{method} on {dataset}")
     result = run_method(
         method,

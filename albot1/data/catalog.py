@@ -18,6 +18,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from albot1.config.suggest import unknown_name_message
 from albot1.data.errors import DatasetNotFoundError
 from albot1.data.fetch import ensure_file
 from albot1.data.loaders.registry import load
@@ -42,7 +43,9 @@ def get(name: str) -> DatasetManifest:
     try:
         return _manifests()[name]
     except KeyError:
-        raise DatasetNotFoundError(f"unknown dataset {name!r}; known datasets: {', '.join(names())}") from None
+        raise DatasetNotFoundError(
+            unknown_name_message("dataset", name, names(), listing="albot1 datasets list")
+        ) from None
 
 
 def find_file(data_file: DataFile, settings: Settings) -> Path | None:
