@@ -146,20 +146,6 @@ class MethodEntry(_Strict):
         "its reason like any failure, but does not make `albot1 bench` exit non-zero",
     )
 
-    @model_validator(mode="before")
-    @classmethod
-    def _no_imports(cls, data: Any) -> Any:
-        """A suite names methods; it never names code to import (an installed plugin does that)."""
-        if isinstance(data, dict):
-            named = [key for key in REMOVED_METHOD_KEYS if key in data]
-            if named:
-                raise ValueError(
-                    f"method entry {data.get('name')!r}: `{named[0]}` is not read: a suite names registered methods "
-                    f"only and imports no module; a mapper of your own registers through the entry point group "
-                    f"albot1.methods (docs/benchmarking.md)"
-                )
-        return data
-
     @property
     def display(self) -> str:
         """The column name in reports: the label, else ``name`` or ``name:preset``."""
@@ -247,6 +233,21 @@ class Suite(_Strict):
     grid: GridSpec = Field(default_factory=GridSpec)
     methods: tuple[MethodEntry, ...] = Field(min_length=1)
     datasets: tuple[DatasetEntry, ...] = Field(min_length=1)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_imports(cls, data: Any) -> Any:
+        """A suite names methods; it never names code to import (an installed plugin does that)."""
+        methods = data.get("methods") if isinstance(data, dict) else None
+        for index, entry in enumerate(methods if isinstance(methods, list) else ()):
+            named = [key for key in REMOVED_METHOD_KEYS if isinstance(entry, dict) and key in entry]
+            if named:
+                raise ValueError(
+                    f"methods.{index} ({entry.get('name')!r}): `{named[0]}` is not read: a suite names registered "
+                    "methods only and imports no module; a mapper of your own registers through the entry point "
+                    "group albot1.methods (docs/benchmarking.md)"
+                )
+        return data
 
     @field_validator("name")
     @classmethod
