@@ -49,7 +49,9 @@ class EchoMapper:
         import numpy as np
 
         return MapperOutput(
-            poses=np.asarray(self.poses), map=MapData(points=np.zeros((1, 2))), counters={"views": len(self.poses), "updates": len(self.poses)}
+            poses=np.asarray(self.poses),
+            map=MapData(points=np.zeros((1, 2))),
+            counters={"views": len(self.poses), "updates": len(self.poses)},
         )
 
 
