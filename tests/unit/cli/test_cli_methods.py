@@ -26,7 +26,7 @@ def test_presets_table_of_one_method() -> None:
     lines = result.output.splitlines()
     assert lines[0] == "albot1: the Albot1 perceptual mapper (thesis chapter 3)"
     assert "environment prefix ALBOT1_ALBOT1_" in lines[1]
-    assert lines[2].startswith("  presets file ") and lines[2].endswith("albot1/methods/albot1/presets.toml")
+    assert lines[2].startswith("  presets file ") and lines[2].endswith("baselines/albot1.toml")
     header = next(line for line in lines if line.lstrip().startswith("field"))
     assert header.split() == ["field", "unit", "type", "default", "meaning"]
     row = next(line for line in lines if line.strip().startswith("corner_min_angle_deg"))

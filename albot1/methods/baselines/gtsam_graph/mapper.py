@@ -69,7 +69,7 @@ class GtsamGraphMapper:
 
     name: ClassVar[str] = "gtsam-graph"
     config_model: ClassVar[type[BaseModel]] = GtsamGraphConfig
-    presets: ClassVar[dict[str, dict]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: GtsamGraphConfig, *, seed: int = 0) -> None:
         # Nothing here is random; the seed is kept for the protocol and the record.
