@@ -13,6 +13,8 @@ from typing import Any
 
 from typer.core import TyperArgument, TyperCommand, TyperOption
 
+from albot1.errors import Albot1Error
+
 #: Shown until ``--help`` fills in the names (never seen by a user).
 METHOD_HELP = "a registered method (`albot1 methods`)"
 PRESET_HELP = "config preset of the method (`albot1 methods --presets`)"
@@ -31,10 +33,13 @@ def preset_choices() -> str:
 
     parts = []
     for spec in method_registry():
-        if spec.available():
-            parts.append(f"{spec.name}: {' | '.join(spec.load_class().presets)}")
-        else:
+        if not spec.available():
             parts.append(f"{spec.name}: (not installed)")
+            continue
+        try:
+            parts.append(f"{spec.name}: {' | '.join(spec.load_class().presets)}")
+        except Albot1Error:  # a broken plugin: help still shows, running it says why
+            parts.append(f"{spec.name}: (cannot be loaded, see `albot1 methods`)")
     return "; ".join(parts)
 
 
