@@ -14,7 +14,7 @@ runner = CliRunner()
 def test_help_lists_every_method_and_every_preset_of_the_installed_methods() -> None:
     result = runner.invoke(app, ["run", "--help"], env={"COLUMNS": "400"})
     assert result.exit_code == 0, result.output
-    text = " ".join(result.output.split())
+    text = " ".join(result.output.replace("│", " ").split())
     for spec in method_registry():
         assert spec.name in text
         if spec.available():
@@ -26,5 +26,5 @@ def test_help_follows_a_registry_with_a_plugin(install_method_plugin: PluginInst
     install_method_plugin({"my-slam": "tests_no_such_module:Mapper"})
     result = runner.invoke(app, ["run", "--help"], env={"COLUMNS": "400"})
     assert result.exit_code == 0, result.output
-    text = " ".join(result.output.split())
+    text = " ".join(result.output.replace("│", " ").split())
     assert "my-slam" in text and "my-slam: (cannot be loaded, see `albot1 methods`)" in text
