@@ -60,7 +60,7 @@ class MatchParams:
 
 
 class PlacesFields(BaseModel):
-    """The chapter-4 fields alone (lengths in metres, angles in degrees); ``baselines/albot1-places.toml`` sets these."""
+    """The chapter-4 fields alone (lengths in metres, angles in degrees), set by ``baselines/albot1-places.toml``."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
