@@ -28,18 +28,23 @@ def method_choices() -> str:
 
 
 def preset_choices() -> str:
-    """``albot1: default | thesis | ...; kiss-icp: default | ...``: each installed method's presets."""
+    """``albot1: default | thesis | ...; kiss-icp: default | ...``: each method's presets.
+
+    Read from the presets files alone (:func:`~albot1.config.presets.preset_names`): showing help imports no
+    mapper and no numerical library. A plugin's presets are its class's, so help points to the listing.
+    """
+    from albot1.config.presets import preset_names
     from albot1.methods.registry import method_registry
 
     parts = []
     for spec in method_registry():
-        if not spec.available():
-            parts.append(f"{spec.name}: (not installed)")
+        if spec.plugin is not None:
+            parts.append(f"{spec.name}: `albot1 methods --presets {spec.name}`")
             continue
         try:
-            parts.append(f"{spec.name}: {' | '.join(spec.load_class().presets)}")
-        except Albot1Error:  # a broken plugin: help still shows, running it says why
-            parts.append(f"{spec.name}: (cannot be loaded, see `albot1 methods`)")
+            parts.append(f"{spec.name}: {' | '.join(preset_names(spec.name))}")
+        except Albot1Error:  # a broken presets file: help still shows, running the method says why
+            parts.append(f"{spec.name}: (its presets file cannot be read, see `albot1 methods --presets`)")
     return "; ".join(parts)
 
 

@@ -87,6 +87,9 @@ class MethodSpec:
     #: True when the method's output depends on its seed even on undegraded odometry (a particle filter):
     #: the bench then runs every seed under a deterministic degradation too, instead of the first only.
     stochastic: bool = False
+    #: The distribution that declares the method (an installed plugin), None for a method of this package,
+    #: whose presets are the file ``baselines/<name>.toml`` (:func:`albot1.config.presets.preset_names`).
+    plugin: str | None = None
 
     def __post_init__(self) -> None:
         check_target(self.target)
@@ -264,6 +267,7 @@ def method_registry() -> MethodRegistry:
             error_class=PLUGIN_ERROR_CLASS,
             auto_include=False,  # a suite runs an installed plugin where it names it
             description=f"plugin {p.target} from {p.source}",
+            plugin=p.source,
         )
         for p in installed_plugins(spec.name for spec in BUILTIN_METHODS)
     ]

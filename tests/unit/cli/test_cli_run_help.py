@@ -27,4 +27,4 @@ def test_help_follows_a_registry_with_a_plugin(install_method_plugin: PluginInst
     result = runner.invoke(app, ["run", "--help"], env={"COLUMNS": "400"})
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.replace("│", " ").split())
-    assert "my-slam" in text and "my-slam: (cannot be loaded, see `albot1 methods`)" in text
+    assert "my-slam" in text and "my-slam: `albot1 methods --presets my-slam`" in text
