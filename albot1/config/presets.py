@@ -36,10 +36,20 @@ raised before any run starts. Every entry point (``albot1 run``, the bench,
 
 The precedence applied later by :func:`albot1.config.resolve.resolve`
 is: model < preset < env ``ALBOT1_<METHOD>_<FIELD>`` < ``--set``.
+
+Beside the presets a file records where its values came from: a
+``[tuned_on]`` table maps a preset to the dataset names its values were
+chosen on by looking at their scores (the *held-in* datasets; a preset the
+table does not name has ``default``'s). A number measured on one of them is
+not evidence of how the method generalises, so the reports mark it
+(:func:`tuned_on`, ``albot1.report.tuning``). The table is data, not config:
+it never enters a run's config or its key. A file that
+``extends`` another adds its held-in datasets to the other's, preset by preset.
 """
 
 from __future__ import annotations
 
+import inspect
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -51,6 +61,11 @@ from albot1.errors import ConfigError
 from albot1.resources import find_resource
 
 PresetTable = dict[str, dict[str, Any]]
+#: preset name -> the datasets its values were tuned on (``[tuned_on]`` of a preset file)
+TunedOnTable = dict[str, tuple[str, ...]]
+
+#: The top-level table of a preset file that names the held-in datasets of each preset.
+TUNED_ON = "tuned_on"
 
 #: The top-level key of a presets file that builds on another method's presets.
 EXTENDS = "extends"
@@ -66,16 +81,45 @@ def _tables(data: dict[str, Any], source: str) -> dict[str, dict[str, Any]]:
     tables = data.get("presets")
     if not isinstance(tables, dict) or not isinstance(tables.get("default"), dict):
         raise ConfigError(f"{source}: expected a [presets.default] table (and optional [presets.NAME] tables)")
-    unknown_top = sorted(set(data) - {"presets", EXTENDS})
+    unknown_top = sorted(set(data) - {"presets", EXTENDS, TUNED_ON})
     if unknown_top:
         raise ConfigError(
-            f"{source}: unexpected top-level key(s) {', '.join(unknown_top)}; only [presets.NAME] tables and "
-            f'`{EXTENDS} = "METHOD"` are read'
+            f"{source}: unexpected top-level key(s) {', '.join(unknown_top)}; only [presets.NAME] tables, "
+            f'[{TUNED_ON}] and `{EXTENDS} = "METHOD"` are read'
         )
+    parse_tuned_on(data, source)
     for name, values in tables.items():
         if not isinstance(values, dict):
             raise ConfigError(f"{source}: presets.{name} must be a table of FIELD = VALUE, got {type(values).__name__}")
     return tables
+
+
+def parse_tuned_on(data: dict[str, Any], source: str) -> TunedOnTable | None:
+    """The ``[tuned_on]`` table of a parsed preset file (None when the file has none), validated.
+
+    Keys are preset names of the file (``default`` required), values lists of
+    distinct, non-empty dataset names (an empty list: tuned on no dataset).
+    """
+    table = data.get(TUNED_ON)
+    if table is None:
+        return None
+    expected = f"expected [{TUNED_ON}] PRESET = [dataset names its values were chosen on]"
+    if not isinstance(table, dict):
+        raise ConfigError(f"{source}: {TUNED_ON}: {expected}, got {type(table).__name__}")
+    declared = data.get("presets")
+    presets: dict[str, Any] = declared if isinstance(declared, dict) else {}
+    if "default" not in table:
+        raise ConfigError(f"{source}: [{TUNED_ON}] must name the datasets of preset 'default'; {expected}")
+    out: TunedOnTable = {}
+    for preset, names in table.items():
+        if preset not in presets:
+            raise ConfigError(f"{source}: [{TUNED_ON}] names preset {preset!r}, which the file does not define")
+        if not isinstance(names, list) or not all(isinstance(n, str) and n.strip() for n in names):
+            raise ConfigError(f"{source}: {TUNED_ON}.{preset}: {expected}, got {names!r}")
+        if len(set(names)) != len(names):
+            raise ConfigError(f"{source}: {TUNED_ON}.{preset}: a dataset is named twice in {names!r}")
+        out[preset] = tuple(names)
+    return out
 
 
 def _merge(base: dict[str, dict[str, Any]], tables: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
@@ -188,6 +232,7 @@ class TomlPresets:
 
     def __init__(self) -> None:
         self._cache: dict[type, PresetTable] = {}
+        self._tuned: dict[type, TunedOnTable | None] = {}
 
     def __get__(self, instance: object, owner: type[Any]) -> PresetTable:
         table = self._cache.get(owner)
@@ -199,3 +244,48 @@ class TomlPresets:
     def location(self, owner: type[Any]) -> str:
         """Where the owner's presets are read from (for listings and messages)."""
         return str(preset_file(owner.name))
+
+    def tuned_on(self, owner: type[Any]) -> TunedOnTable | None:
+        """The owner file's ``[tuned_on]`` table (None: the file records none); read once per owner class."""
+        if owner not in self._tuned:
+            self.__get__(None, owner)  # validates the whole file (and what it extends) first
+            self._tuned[owner] = load_tuned_on(owner.name)
+        return self._tuned[owner]
+
+
+def load_tuned_on(method: str) -> TunedOnTable | None:
+    """``[tuned_on]`` of ``method``'s file; with ``extends``, the base's held-in datasets plus its own, per preset.
+
+    None when a file of the chain records none (the tuning is then not known).
+    """
+    path = preset_file(method)
+    data = _read(path)
+    own = parse_tuned_on(data, str(path))
+    parent = data.get(EXTENDS)
+    if own is None or not isinstance(parent, str):
+        return own
+    base = load_tuned_on(parent)
+    if base is None:
+        return None
+    return {
+        name: tuple(dict.fromkeys([*base.get(name, base["default"]), *own.get(name, own["default"])]))
+        for name in [*base, *(n for n in own if n not in base)]
+    }
+
+
+def tuned_on_table(owner: type) -> TunedOnTable | None:
+    """``owner``'s ``[tuned_on]`` table (preset -> datasets), or None when its presets record none."""
+    descriptor = inspect.getattr_static(owner, "presets", None)
+    return descriptor.tuned_on(owner) if isinstance(descriptor, TomlPresets) else None
+
+
+def tuned_on(owner: type, preset: str) -> tuple[str, ...] | None:
+    """The datasets ``owner``'s ``preset`` was tuned on; None when its preset file does not record them.
+
+    A preset that ``[tuned_on]`` does not name inherits ``default``'s list
+    (its values are ``default``'s but for what it changes).
+    """
+    table = tuned_on_table(owner)
+    if table is None:
+        return None
+    return table.get(preset, table["default"])

@@ -23,7 +23,9 @@ from typing import TYPE_CHECKING, Any
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import CellRecord, Column
 from albot1.report.plots import vector_of
+from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
+from albot1.report.tuning import LEGEND, marked
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -122,8 +124,10 @@ def table_html(group: pd.DataFrame, columns: dict[str, Column], colors: dict[str
     for _, row in group.iterrows():
         css = ' class="failed-row"' if row["status"] != "ok" else ""
         swatch = f'<span class="swatch" style="background:{colors.get(str(row["method"]), "#999")}"></span>'
+        tuned = bool(row.get("held_in", False))
+        tip = f' title="{_e(LEGEND)}"' if tuned else ""
         cells = [
-            f'<td class="label">{swatch}{_e(row["method"])}</td>',
+            f'<td class="label"{tip}>{swatch}{_e(marked(str(row["method"]), tuned))}</td>',
             f'<td class="label">{_e(row["degradation"])}</td>',
             f'<td class="num" data-v="{int(row["seeds"])}">{int(row["seeds"])}</td>',
             *[_number_cell(row, c) for c in present],
@@ -213,8 +217,12 @@ def write_html(
     if plots.get(""):
         parts.append("<h3>Runtime across datasets</h3>")
         parts += [_figure(plot, out) for plot in plots[""]]
+    data = data_by_dataset(records)
     for i, dataset in enumerate(datasets):
         parts.append(f'<h2 id="ds-{i}">{_e(dataset)}</h2>')
+        files = data.get(dataset)
+        shown = describe_data(files) if files is not None else "no completed run"
+        parts.append(f'<p class="meta">data: {_e(shown)}</p>')
         for title, table, cols in (("Accuracy", metrics, metric_columns), ("Cost", cost, cost_columns)):
             group = table[table["dataset"] == dataset] if not table.empty else table
             if group.empty:

@@ -37,6 +37,9 @@ from albot1.report.collect import (
     cell_rows,
     severity_order,
 )
+from albot1.report.markdown import text as md_text
+from albot1.report.provenance import data_by_dataset, describe_data
+from albot1.report.tuning import LEGEND, held_in, marked
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -86,6 +89,7 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
             "failed": int(len(failed)),
             "not_run": int((group["status"] == "not run").sum()),
             "status": _status(group, failed),
+            "held_in": bool(group["held_in"].eq(True).any()) if "held_in" in group else False,
         }
         for column in columns:
             values = done[column].dropna().astype(float)
@@ -187,14 +191,22 @@ def na_notes(group: pd.DataFrame, columns: dict[str, Column], present: list[str]
     return notes
 
 
-def markdown(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str:
-    """One Markdown table per dataset, each followed by its not-applicable notes."""
+def markdown(
+    table: pd.DataFrame, columns: dict[str, Column], title: str, data: dict[str, dict[str, str]] | None = None
+) -> str:
+    """One Markdown table per dataset, each followed by its not-applicable notes.
+
+    ``data``: dataset label -> {file: short sha256} (:func:`albot1.report.provenance.data_by_dataset`), stated
+    under each dataset's heading. Names are written as text (:mod:`albot1.report.markdown`), never as HTML.
+    """
     lines = [
         f"# {title}",
         "",
         "Each number: mean ± sample std over the completed seeds, then (min–max); one number when there is one "
         f"seed or all seeds agree. {SIGNIFICANT} significant digits. `n/a`: the metric does not apply to that run "
         "(the reason is under the table); `failed`: no seed completed (the status column says why).",
+        "",
+        LEGEND,
         "",
     ]
     if table.empty:
@@ -203,22 +215,23 @@ def markdown(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str
         present, absent = columns_present(group, columns)
         header = ["method", "degradation", "seeds", *[columns[c].header for c in present], "status"]
         lines += [
-            f"## {dataset}",
+            f"## {md_text(dataset)}",
             "",
+            *([f"Data: {md_text(describe_data(data[str(dataset)]))}.", ""] if data and str(dataset) in data else []),
             "| " + " | ".join(header) + " |",
             "|" + "|".join(["---"] * 3 + ["---:"] * len(present) + ["---"]) + "|",
         ]
         for _, row in group.iterrows():
             cells = [
-                str(row["method"]),
-                str(row["degradation"]),
+                md_text(marked(str(row["method"]), bool(row.get("held_in", False)))),
+                md_text(row["degradation"]),
                 str(int(row["seeds"])),
                 *[cell_text(row, c) for c in present],
-                str(row["status"]).replace("|", "\\|"),
+                md_text(row["status"]),
             ]
             lines.append("| " + " | ".join(cells) + " |")
         notes = na_notes(group, columns, present, absent)
-        lines += [""] + [f"- n/a: {note}" for note in notes] + ([""] if notes else [])
+        lines += [""] + [f"- n/a: {md_text(note)}" for note in notes] + ([""] if notes else [])
     return "\n".join(lines)
 
 
@@ -269,6 +282,7 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
     """Write cells.csv, metrics.{csv,md,tex} and cost.{csv,md,tex} (+ cells-cost.csv) into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     cells = cells_frame(records)
+    cells["held_in"] = [held_in(rec.cell) for rec in records]
     written = {"cells.csv": out / "cells.csv"}
     helper = [c for c in cells.columns if c.endswith("_na")]
     cells.drop(columns=[*COST_COLUMNS, *helper]).to_csv(written["cells.csv"], index=False, float_format="%.9g")
@@ -279,7 +293,7 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
         table = aggregate(cells, columns)
         paths = {ext: out / f"{name}.{ext}" for ext in ("csv", "md", "tex")}
         _csv_frame(table).to_csv(paths["csv"], index=False, float_format="%.9g")
-        paths["md"].write_text(markdown(table, columns, title), encoding="utf-8")
+        paths["md"].write_text(markdown(table, columns, title, data_by_dataset(records)), encoding="utf-8")
         paths["tex"].write_text(latex(table, columns, title), encoding="utf-8")
         written.update({f"{name}.{ext}": path for ext, path in paths.items()})
     cost_cells = out / "cells-cost.csv"

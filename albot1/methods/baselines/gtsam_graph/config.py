@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from typing import Literal
 
+import numpy as np
+from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams
@@ -63,6 +65,12 @@ class GtsamGraphConfig(BaseModel):
         gt=0, description="a tracking match that fits clearly may rotate its guess up to this much (deg)"
     )
     track_wide_min_fitness: float = Field(ge=0, le=1, description="... where 'clearly' is this inlier fraction")
+    track_outlier_factor: float = Field(
+        ge=0,
+        description="a tracking correction beyond this many times the recent ones' median must fit clearly "
+        "(track_wide_min_fitness), else the odometry guess stands (0 = off)",
+    )
+    track_outlier_window: int = Field(ge=1, description="... the median over this many recent tracked scans")
     local_map_nodes: int = Field(
         ge=1, description="the last k node scans form the local map the new node is matched against"
     )
@@ -234,6 +242,10 @@ class GtsamGraphConfig(BaseModel):
             prior_sigma_xy_m=self.refine_max_correction_m,
             prior_sigma_theta_rad=math.radians(self.refine_max_correction_deg),
         )
+
+    def match_floor(self) -> NDArray[np.float64]:
+        """The covariance added to every match edge's (sequential, loop, place): matches are never perfect."""
+        return np.diag([self.match_sigma_floor_xy_m**2] * 2 + [math.radians(self.match_sigma_floor_theta_deg) ** 2])
 
     def icp(self, loop: bool = False) -> IcpParams:
         """Registration parameters for sequential (``loop=False``) or loop matches."""
