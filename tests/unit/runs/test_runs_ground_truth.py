@@ -87,8 +87,8 @@ def trap(monkeypatch: pytest.MonkeyPatch) -> list[Frame]:
     monkeypatch.setattr(Frame, "reference", _Trap(Frame.__dict__["reference"]))
     real = execute.get_method
 
-    def get_method(name: str) -> Any:
-        spec = real(name)
+    def get_method(name: str, registry: Any = None) -> Any:
+        spec = real(name, registry)
         return _Spec(spec, _trapped(spec.load_class(), seen))
 
     monkeypatch.setattr(execute, "get_method", get_method)
@@ -122,7 +122,7 @@ class _Cheat:
 
 def test_a_mapper_that_reads_ground_truth_fails_loudly(trap: list[Frame], monkeypatch: pytest.MonkeyPatch) -> None:
     spec = method_registry().get("odometry")
-    monkeypatch.setattr(execute, "get_method", lambda name: _Spec(spec, _trapped(_Cheat, trap)))
+    monkeypatch.setattr(execute, "get_method", lambda name, registry=None: _Spec(spec, _trapped(_Cheat, trap)))
     with pytest.raises(Exception, match=r"odometry on synthetic-office-startstop.* failed at scan 0: GroundTruthAccess"):
         execute.run_method("odometry", open_sequence(WORLD), seed=0)
 
