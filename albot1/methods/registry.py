@@ -258,6 +258,9 @@ def method_registry() -> MethodRegistry:
             p.name,
             p.target,
             error_class=PLUGIN_ERROR_CLASS,
+            # its top-level module, found without importing it: a distribution whose code is gone is unavailable
+            requires=(p.target.partition(":")[0].split(".")[0],),
+            install_hint=f"reinstall {p.source.split()[0]}, which declares it",
             auto_include=False,  # a suite runs an installed plugin where it names it
             description=f"plugin {p.target} from {p.source}",
             plugin=p.source,
