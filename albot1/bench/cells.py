@@ -18,9 +18,9 @@ from typing import Any, cast
 
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell
-from albot1.bench.plan import register_plugin
 from albot1.config.targets import resolve_target
 from albot1.data.open import open_sequence
+from albot1.methods.registry import MethodRegistry
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.external_run import write_external_run
@@ -68,14 +68,18 @@ def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
 
 
 def execute_cell(
-    cell: Cell, runs_root: Path, settings: Settings | None = None, preview: PreviewRenderer | None = None
+    cell: Cell,
+    runs_root: Path,
+    settings: Settings | None = None,
+    preview: PreviewRenderer | None = None,
+    registry: MethodRegistry | None = None,
 ) -> Path:
     """Run, store and evaluate ``cell`` under ``runs_root/<key>``; returns the run folder.
 
-    ``preview`` draws the run's ``preview.png`` (see :func:`albot1.runs.folder.write_run`).
+    ``preview`` draws the run's ``preview.png`` (see :func:`albot1.runs.folder.write_run`);
+    ``registry`` is the method registry (default: this process's, built once from the same installed
+    entry points the planner read).
     """
-    if cell.target is not None:
-        register_plugin(cell.method, cell.target, cell.error_class, cell.requires)
     settings = settings or get_settings()
     run_dir = runs_root / cell.key
     if cell.trajectory is not None:  # another system's output: scored, not run (albot1.bench.external)
@@ -103,6 +107,7 @@ def execute_cell(
             degradation=cell.degradation,
             seed=cell.seed,
             dataset_name=cell.dataset_label,
+            registry=registry,
         )
         if result.config != cell.config:
             raise BenchError(

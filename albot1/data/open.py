@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from albot1.config.keyvalue import KeyValueError, parse_query
+from albot1.config.suggest import did_you_mean
 from albot1.data import catalog
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
 from albot1.data.filekind import check_input
@@ -70,6 +71,11 @@ def open_sequence(
     if options.get("odometry") == REFERENCE or "views" in options:
         return _with_reference_options(text, settings, format_name, options)
     if text in worlds.WORLDS:
+        if "odometry" in options:  # not REFERENCE (handled above): a world's odometry has no other source
+            raise DatasetNotFoundError(
+                f"{text!r}: odometry={options['odometry']!r}{did_you_mean(str(options['odometry']), [REFERENCE])}; "
+                f"a synthetic world takes odometry={REFERENCE} only (its odometry is simulated)"
+            )
         return worlds.load_world(text, **options)  # a world's own options (start=, laps=) or SyntheticWorldError
     settings = settings or get_settings()
     _check_option_files(options, text)
@@ -83,9 +89,10 @@ def open_sequence(
         check_input(path, "a log file or a ROS2 bag folder", folder_ok=True)
         checksums = _checksums(path, options)
         return _attach(load(path, format_name, **options), checksums)
+    known = catalog.names() + sorted(worlds.WORLDS)
     raise DatasetNotFoundError(
-        f"{text!r} is neither a dataset name nor an existing file; known datasets: "
-        f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
+        f"{text!r} is neither a dataset name nor an existing file"
+        f"{did_you_mean(text, known)}; `albot1 datasets list` lists all {len(known)} datasets"
     )
 
 

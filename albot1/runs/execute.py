@@ -27,7 +27,7 @@ from albot1.data.degrade import degrade
 from albot1.data.model import Frame, Sequence
 from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
-from albot1.methods.registry import get_method, resolve_config
+from albot1.methods.registry import MethodRegistry, get_method, resolve_config
 from albot1.runs.errors import RunError
 
 
@@ -59,15 +59,17 @@ def run_method(
     dataset_name: str | None = None,
     on_frame: Callable[[int], None] | None = None,
     announce: Callable[[str], None] | None = None,
+    registry: MethodRegistry | None = None,
 ) -> RunResult:
     """Degrade (seeded), run and check one method; raises the method's error class on failure.
 
     A mapper with a ``warm_up`` method (``Mapper.warm_up``) gets it called
     before the timed loop, with ``announce`` for what it has to say (e.g.
-    that it compiles); its time is the run's ``startup_s``.
+    that it compiles); its time is the run's ``startup_s``. ``registry``: where
+    ``method`` is looked up (default: this process's :func:`method_registry`).
     """
-    spec = get_method(method)
-    config = resolve_config(method, preset, overrides)
+    spec = get_method(method, registry)
+    config = resolve_config(method, preset, overrides, registry)
     error_class = spec.load_error_class()
     dataset = dataset_name or sequence.name
     seq = degrade(sequence, degradation, seed=seed)

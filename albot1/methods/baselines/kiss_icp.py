@@ -150,7 +150,7 @@ class KissIcpMapper:
 
     name: ClassVar[str] = "kiss-icp"
     config_model: ClassVar[type[BaseModel]] = KissIcpConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: KissIcpConfig, *, seed: int = 0) -> None:
         # KISS-ICP is deterministic; ``seed`` is accepted for the protocol.

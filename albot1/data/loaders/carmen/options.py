@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 
@@ -52,7 +53,10 @@ class CarmenOptions:
                     raise DataError(f"{path}: {key}={options[key]!r}; expected a number") from None
         opts = CarmenOptions(**options)
         if opts.odometry not in ODOMETRY_SOURCES:
-            raise DataError(f"{path}: odometry={opts.odometry!r}; expected one of {', '.join(ODOMETRY_SOURCES)}")
+            raise DataError(  # "reference" is taken by albot1.data.open before the loader runs
+                f"{path}: odometry={opts.odometry!r}{did_you_mean(opts.odometry, [*ODOMETRY_SOURCES, 'reference'])}; "
+                f"expected one of {', '.join(ODOMETRY_SOURCES)}, reference"
+            )
         if opts.reference not in REFERENCE_SOURCES:
             raise DataError(f"{path}: reference={opts.reference!r}; expected one of {', '.join(REFERENCE_SOURCES)}")
         if opts.laser is not None and opts.laser not in LASER_MESSAGES:

@@ -33,7 +33,7 @@ map projection). They share one set of counters.
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 from pydantic import BaseModel
@@ -57,7 +57,7 @@ class GtsamGraphMapper:
 
     name: ClassVar[str] = "gtsam-graph"
     config_model: ClassVar[type[BaseModel]] = GtsamGraphConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: GtsamGraphConfig, *, seed: int = 0) -> None:
         # Nothing here is random; the seed is kept for the protocol and the record.

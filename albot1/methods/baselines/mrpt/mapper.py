@@ -108,7 +108,7 @@ class _MrptMapper:
     app: ClassVar[str]
     layout: ClassVar[RawlogLayout]
     config_model: ClassVar[type[BaseModel]]
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: MrptRunConfig, *, seed: int = 0) -> None:
         self.config = config
