@@ -91,6 +91,21 @@ def test_a_plugin_runs_in_a_bench_suite(echo: str, tmp_path: Path) -> None:
     assert '"method": "echo"' in plan
 
 
+def test_a_plugin_installed_after_the_cell_forkserver_started_runs_in_its_cells(
+    install_method_plugin: PluginInstaller, tmp_path: Path
+) -> None:
+    """The forkserver forks cells from its own state: the runner's import path (and so the plugin) reaches them."""
+    from albot1.bench.limits import start_forkserver
+
+    start_forkserver()  # as an earlier grid of this process would have
+    install_method_plugin({"echo": f"{__name__}:EchoMapper"})
+    suite = tmp_path / "late.toml"
+    suite.write_text(f'[[methods]]\nname = "echo"\n\n[[datasets]]\nname = "{WORLD}"\n')
+    args = ["bench", str(suite), "-j", "1", "--results", str(tmp_path / "results"), "--no-progress"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+
+
 def test_planning_a_suite_imports_no_module_it_names(install_method_plugin: PluginInstaller, tmp_path: Path) -> None:
     """Only the registry decides what is imported: a suite naming a method imports its registered class only."""
     install_method_plugin({"lazy": "albot1_plugin_never_imported:Mapper"})
