@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.data.attach import COMMON_OPTIONS
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
 from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError
@@ -189,7 +190,7 @@ def variant(name: str, options: dict[str, Any]) -> WorldSpec:
     if unknown:
         raise WorldOptionError(
             f"synthetic world {name!r}: unknown loader option(s) {', '.join(unknown)}; "
-            f"expected {' or '.join(WORLD_OPTIONS)}"
+            f"expected {' or '.join(WORLD_OPTIONS)} (and the options of every source: {', '.join(COMMON_OPTIONS)})"
         )
     if not options:
         return spec

@@ -27,7 +27,7 @@ def test_tum_round_trip_keeps_nanometres_and_the_heading(tmp_path: Path) -> None
         ("# t x y z qx qy qz qw\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n", 3, "found 7 values, expected 8"),
         ("1 0 0 0 0 0 0 1\n\n2 0 zero 0 0 0 0 1\n", 3, "value 3 is 'zero', expected a number"),
         ("1 0 0 0 0 0 0 1\n2 nan 0 0 0 0 0 1\n", 2, "value 2 is 'nan', expected a finite number"),
-        ("1 0 0 0 0 0 0 1\n# a comment\n2 0 0 0 0 0 0 0\n", 3, "quaternion (qx qy qz qw) has zero length"),
+        ("1 0 0 0 0 0 0 1\n# a comment\n2 0 0 0 0 0 0 0\n", 3, "quaternion (qx qy qz qw) has length 0"),
     ],
 )
 def test_a_bad_tum_line_is_named_with_what_was_expected(tmp_path: Path, text: str, line: int, problem: str) -> None:

@@ -37,6 +37,7 @@ from typing import IO, Any, ClassVar
 
 import numpy as np
 
+from albot1.data.attach import COMMON_OPTIONS
 from albot1.data.errors import DataError, ParseError, UnwritableError
 from albot1.data.loaders.albot_log.lines import (
     FRAME,
@@ -113,7 +114,10 @@ class AlbotLogLoader:
         path = Path(path)
         unknown = sorted(k for k, v in options.items() if v is not None)
         if unknown:
-            raise DataError(f"{path}: an albot log takes no loading options, got {', '.join(unknown)}")
+            raise DataError(
+                f"{path}: an albot log takes no loading options of its own, got {', '.join(unknown)}; "
+                f"expected only the options of every source: {', '.join(COMMON_OPTIONS)}"
+            )
         if not path.is_file():
             raise DataError(f"{path}: no such file")
         name, _ = read_header(path, _lines(path))

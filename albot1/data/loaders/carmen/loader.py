@@ -62,6 +62,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from albot1.data.attach import COMMON_OPTIONS
 from albot1.data.errors import DataError, ParseError
 from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.checks import span_problem, time_problem
@@ -113,7 +114,7 @@ class CarmenOptions:
         if unknown:
             raise DataError(
                 f"{path}: unknown CARMEN loader option(s) {', '.join(unknown)}; "
-                f"expected some of {', '.join(sorted(known))}"
+                f"expected some of {', '.join(sorted(known) + list(COMMON_OPTIONS))}"
             )
         for key in ("max_range", "time_tolerance"):
             if options.get(key) is not None:
