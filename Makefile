@@ -8,6 +8,7 @@ STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 # `make bench` runs both suites (the thesis page reads the default suite's results); SUITE=NAME runs one.
 SUITE  ?= default thesis
 JOBS   ?= 2
+TEST_JOBS ?= auto
 
 # Point the dataset setting at the local copies when they sit beside the repo
 # and the user has not chosen a folder already.
@@ -29,8 +30,14 @@ $(STAMP): pyproject.toml
 	rm -f $(VENV)/.installed-*
 	touch $@
 
+# Every test (unit, property, integration on the public logs when ALBOT1_DATA_DIR has them, the slow
+# whole-world runs), spread over TEST_JOBS worker processes (pytest-xdist; auto = one per core).
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(TEST_JOBS)
+
+# The edit-test loop: unit and property tests without the slow ones and without the public logs.
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -q -n $(TEST_JOBS) -m "not slow and not integration" tests/unit tests/property
 
 # Every suite runs first, then every report is built, even when cells failed (the reports list them); then
 # a non-zero status (the last one) is passed on. reports/thesis/README.md reads results/default too.

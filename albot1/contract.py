@@ -90,6 +90,10 @@ class Mapper(Protocol):
         """Final poses (one per processed frame), map and counters."""
         ...
 
+    # Optional, not part of the protocol's check: ``warm_up(self, announce: Callable[[str], None] | None) -> None``
+    # does once what would otherwise land on the first timed scan (e.g. compiling kernels); the runner calls it
+    # before the timed loop and records its time as ``startup_s``; ``announce`` takes a line for the user.
+
 
 @dataclass
 class RunResult:
@@ -124,6 +128,8 @@ class RunResult:
     files: dict[str, Any] = field(default_factory=dict)
     #: CPU seconds over the span of ``wall_s`` (this process's threads + waited children); None when not measured
     cpu_s: float | None = None
+    #: seconds of the mapper's ``warm_up`` before the first scan (0 for a mapper without one)
+    startup_s: float = 0.0
 
     def timing(self) -> Timing:
         """The ``timing`` block of ``result.json`` (per-scan statistics are None for a run of no scans)."""
@@ -133,6 +139,7 @@ class RunResult:
             per_scan_ms_p95=float(np.percentile(ms, 95)) if len(ms) else None,
             per_scan_ms_mean=float(np.mean(ms)) if len(ms) else None,
             finish_s=self.finish_s,
+            startup_s=self.startup_s,
             total_s=self.total_s,
             wall_s=self.wall_s,
             peak_mb=self.peak_mb,

@@ -17,10 +17,30 @@ DATA_DIR_ENV = "ALBOT1_DATA_DIR"
 CACHE_DIR_ENV = "ALBOT1_CACHE_DIR"
 
 
-def _default_cache_dir() -> Path:
+def _user_cache_dir() -> Path:
     from platformdirs import user_cache_dir
 
-    return Path(user_cache_dir("albot1-bench")) / "datasets"
+    return Path(user_cache_dir("albot1-bench"))
+
+
+def _default_cache_dir() -> Path:
+    return _user_cache_dir() / "datasets"
+
+
+#: The file of :mod:`albot1.data.identity`'s checksum cache.
+CHECKSUM_CACHE = "checksums.json"
+
+
+def checksum_cache_file() -> Path:
+    """Where the data checksums are cached: beside the download cache of ``ALBOT1_CACHE_DIR``, else the user cache.
+
+    Under ``ALBOT1_CACHE_DIR`` it is a hidden file (``.checksums.json``), as
+    that folder holds the data files themselves.
+    """
+    cache = os.environ.get(CACHE_DIR_ENV)
+    if cache:
+        return Path(cache).expanduser() / f".{CHECKSUM_CACHE}"
+    return _user_cache_dir() / CHECKSUM_CACHE
 
 
 @dataclass(frozen=True)

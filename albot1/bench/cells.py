@@ -98,7 +98,7 @@ def execute_cell(
         if written.name != cell.key:
             raise BenchError(
                 f"{cell.describe()}: stored under {written.name}, expected key {cell.key} "
-                "(the code changed while the grid was running?)"
+                "(the code or a data file changed while the grid was running?)"
             )
     evaluate_run(run_dir, settings=settings)
     return run_dir

@@ -143,8 +143,10 @@ def _candidate_datasets(suite: Suite) -> list[str]:
     return out
 
 
-def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None, bool]:
-    """(has reference poses, None, True) when the dataset can be opened, else (None, why skipped, known).
+def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None, bool, dict[str, str]]:
+    """(has reference poses, None, True, data checksums) when the dataset opens, else (None, why skipped, known, {}).
+
+    The checksums (``SequenceMetadata.checksums``, cached) go into the cells' keys.
 
     ``known`` is False when ``name`` names nothing that exists (no world, no
     registered dataset, no file, or options its loader rejects): for a
@@ -159,15 +161,15 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
             manifest = catalog.get(base)
             fetchable = not manifest.local_only and bool(manifest.log.urls)
             hint = f"albot1 datasets fetch {base}" if fetchable else ""
-            return None, Skipped(name, f"not downloaded: {exc}", hint), True
+            return None, Skipped(name, f"not downloaded: {exc}", hint), True, {}
     try:
         sequence = open_sequence(name, settings=settings)
         first = next(iter(sequence.frames()), None)
     except DatasetNotFoundError as exc:
-        return None, Skipped(name, str(exc)), False
+        return None, Skipped(name, str(exc)), False, {}
     if first is None:
-        return None, Skipped(name, "the dataset holds no scans"), True
-    return first.reference is not None, None, True
+        return None, Skipped(name, "the dataset holds no scans"), True, {}
+    return first.reference is not None, None, True, dict(sequence.metadata.checksums)
 
 
 def _deterministic(degradation: str) -> bool:
@@ -237,7 +239,7 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
         opts = suite.options_for(name)
         assert opts is not None  # _candidate_datasets keeps selected names only
         try:
-            has_reference, skipped, known = _availability(name, settings)
+            has_reference, skipped, known, checksums = _availability(name, settings)
         except Albot1Error as exc:  # a bad slice or loader option, a log that does not parse
             raise SuiteError(f"{suite.path or suite.name}: dataset {name!r}: {exc}") from None
         if skipped is not None and not known and name in literals and not opts.optional:
@@ -262,7 +264,7 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
                     if config is not None
                     else {"unresolved": True, "preset": entry.preset, "set": dict(entry.set)}
                 )
-                key = run_key(opts.label, entry.name, key_config, degradation, seed, code)
+                key = run_key(opts.label, entry.name, key_config, degradation, seed, code, checksums)
                 if problem is not None:
                     config_failures[key] = problem
                 cells.append(

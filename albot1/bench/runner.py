@@ -200,7 +200,7 @@ def kept_failure(store: ResultsStore, cell: Cell) -> CellOutcome | None:
     """
     if not cell.allow_failure:
         return None
-    recorded = store.failure(cell.key)
+    recorded = store.failure(cell.key, strict=False)
     if recorded is None or recorded.kind != "exception" or recorded.reason == UNREADABLE_FAILURE:
         return None
     # No time spent in this run (its attempt's time stays in FAILED.json), as for a complete cell kept.

@@ -27,6 +27,7 @@ the runner starts no further cell. Complete cells are never touched.
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import json
 import os
@@ -41,6 +42,9 @@ from albot1.atomic import atomic_write, remove_temporaries
 from albot1.bench.cell_main import ERROR_FILE
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell, FailureKind, GridPlan
+from albot1.bench.store_records import parse_failure, parse_plan, read_json_file
+from albot1.filetypes import not_regular
+from albot1.records import RecordError
 from albot1.runs.folder import is_complete as run_is_complete
 from albot1.runs.folder import write_json
 
@@ -82,14 +86,11 @@ class ResultsStore:
 
     def read_plan(self) -> GridPlan:
         path = self.root / PLAN
-        if not path.is_file():
+        if not path.exists():
             raise BenchError(
                 f"{self.root}: not a results folder of `albot1 bench` (no {PLAN}); run `albot1 bench SUITE` first"
             )
-        try:
-            return GridPlan.from_json(json.loads(path.read_text()))
-        except (json.JSONDecodeError, KeyError, TypeError) as exc:
-            raise BenchError(f"{path}: not a grid plan written by `albot1 bench`: {exc}") from None
+        return parse_plan(read_json_file(path, "grid plan written by `albot1 bench`"), path)
 
     # -- locking ----------------------------------------------------------
     def lock(self) -> None:
@@ -101,10 +102,15 @@ class ResultsStore:
         except BlockingIOError:
             handle.close()
             raise BenchError(f"{self.root}: another `albot1 bench` is running on this results folder") from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(f"{socket.gethostname()} pid {os.getpid()}\n")
-        handle.flush()
+        try:
+            handle.seek(0)
+            handle.truncate()
+            handle.write(f"{socket.gethostname()} pid {os.getpid()}\n")
+            handle.flush()
+        except OSError as exc:  # a full or read-only disk: say which file (a bare write error names none)
+            with contextlib.suppress(OSError):  # closing flushes the unwritten line again
+                handle.close()
+            raise type(exc)(exc.errno, exc.strerror, str(self.root / ".lock")) from None
         self._lock_file = handle
 
     def unlock(self) -> None:
@@ -115,13 +121,16 @@ class ResultsStore:
 
     # -- cells ------------------------------------------------------------
     def run_dir(self, key: str) -> Path:
+        """``runs/<key>``; BenchError for a key that is not one plain folder name (it would lead elsewhere)."""
+        if not key or key in (".", "..") or "/" in key or "\\" in key or "\0" in key:
+            raise BenchError(f"{self.root}: cell key {key[:40]!r} is not a folder name; expected 16 hex digits")
         return self.runs / key
 
     def is_complete(self, key: str) -> bool:
         """DONE marker plus a metrics.json that parses."""
         run_dir = self.run_dir(key)
-        if not run_is_complete(run_dir):
-            return False
+        if not run_is_complete(run_dir) or not_regular(run_dir / METRICS) is not None:
+            return False  # a FIFO or device in place of metrics.json is no result (and reading it would hang)
         try:
             json.loads((run_dir / METRICS).read_text())
         except (OSError, json.JSONDecodeError):
@@ -195,21 +204,24 @@ class ResultsStore:
             return f"{run_dir / FAILED}: cannot be written: {exc.strerror or exc}"
         return None
 
-    def failure(self, key: str) -> Failure | None:
+    def failure(self, key: str, *, strict: bool = True) -> Failure | None:
+        """The cell's ``FAILED.json``, None when there is none.
+
+        A record that cannot be read or does not fit :class:`FailureRecord`
+        is a RecordError naming the file and the field; with ``strict=False``
+        (the runner, which is about to retry the cell) it is a failure whose
+        reason is :data:`UNREADABLE_FAILURE`, never trusted to skip the cell.
+        """
         path = self.run_dir(key) / FAILED
         if not path.is_file():
             return None
         try:
-            data = json.loads(path.read_text())
-        except json.JSONDecodeError:
+            record = parse_failure(read_json_file(path, "failure record written by `albot1 bench`"), path)
+        except RecordError:
+            if strict:
+                raise
             return Failure(UNREADABLE_FAILURE, "exception", None, 0.0, None)
-        return Failure(
-            str(data.get("reason")),
-            str(data.get("kind")),
-            data.get("exit_code"),
-            float(data.get("elapsed_s") or 0.0),
-            data.get("log"),
-        )
+        return Failure(record.reason, record.kind, record.exit_code, record.elapsed_s, record.log)
 
     def read_json(self, key: str, name: str) -> dict[str, Any] | None:
         path = self.run_dir(key) / name

@@ -45,6 +45,8 @@ Format (every key optional except ``methods`` and ``datasets``)::
     # optional = true                # a name or path that does not exist, or a glob that matches
                                      # nothing, is skipped instead of being an error
     # methods = ["albot1:thesis"]    # only these method entries (by label) run on it; default: all
+    # tags = ["dense-views"]         # names a report finds this entry's datasets by (the thesis page's
+                                     # experiments, docs/thesis-reproduction.md); not merged, no effect on runs
 
 A literal dataset entry (not a glob) that names no synthetic world, no
 registered dataset and no existing file, and a glob that matches no dataset,
@@ -187,6 +189,10 @@ class DatasetEntry(_Strict):
         description="labels of the method entries that run on these datasets (default: every entry); a suite "
         "that asks different questions of different data keeps its grid small this way",
     )
+    tags: tuple[str, ...] = Field(
+        (),
+        description="names a report finds this entry's datasets by (the thesis page's experiments); they change no run",
+    )
 
     @field_validator("degradations")
     @classmethod
@@ -278,7 +284,7 @@ class Suite(_Strict):
                 merged = {}
                 continue
             selected = True
-            for field_name in entry.model_fields_set - {"name", "skip"}:
+            for field_name in entry.model_fields_set - {"name", "skip", "tags"}:
                 merged[field_name] = getattr(entry, field_name)
         return DatasetOptions(name=name, **merged) if selected else None
 

@@ -48,10 +48,12 @@ def list_(
     for name in catalog.names():
         manifest = catalog.get(name)
         found = catalog.find_file(manifest.log, settings)
+        available = catalog.is_available(name, settings)
         rows.append(
             {
                 "name": name,
-                "available": catalog.is_available(name, settings),
+                "available": available,
+                "checksum_problem": catalog.copy_problem(name, settings) if available else None,
                 "path": str(found) if found else None,
                 "local_only": manifest.local_only,
                 "description": manifest.description,
@@ -78,6 +80,8 @@ def list_(
             if row.get("synthetic")
             else ("local" if row["available"] else ("missing (local only)" if row["local_only"] else "missing (fetch)"))
         )
+        if row.get("checksum_problem"):
+            state = "wrong copy (sha256)"  # `albot1 datasets info NAME` says which file and how to fix it
         typer.echo(f"{row['name']:30s} {state:21s} {_first_sentence(row['description'])}")
     typer.echo(f"searched: {', '.join(str(r) for r in settings.search_roots())}")
 
@@ -103,8 +107,13 @@ def fetch(
     """
     from albot1.data import catalog
 
-    path = catalog.fetch(name, get_settings(data_dir=data_dir), base_url=base_url)
+    settings = get_settings(data_dir=data_dir)
+    path = catalog.fetch(name, settings, base_url=base_url)
     typer.echo(f"{name}: {path}")
+    problem = catalog.copy_problem(name, settings)  # a wrong copy earlier in the search roots would still be read
+    if problem is not None:
+        typer.echo(f"albot1: error: fetched, but the dataset cannot be used yet: {problem}", err=True)
+        raise typer.Exit(1)
 
 
 @app.command("info")
@@ -134,6 +143,7 @@ def info(
     }
     sequence = open_sequence(ref, settings=get_settings(data_dir=data_dir), **options)
     summary = with_progress(sequence, f"reading {ref}").summary()
+    summary["data_sha256"] = dict(sequence.metadata.checksums)  # the files' content the numbers describe
     if as_json:
         typer.echo(json.dumps(summary))
         return
@@ -149,3 +159,7 @@ def info(
     )
     typer.echo(f"  odometry: {summary.get('odometry_source', '')}")
     typer.echo(f"  source: {summary.get('source', '')} ({summary.get('format', '')})")
+    checksums = summary["data_sha256"]
+    typer.echo(
+        "  data: " + (", ".join(f"{n} sha256 {sha}" for n, sha in checksums.items()) or "generated (no data file)")
+    )

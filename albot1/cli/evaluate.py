@@ -14,7 +14,7 @@ from albot1.errors import Albot1Error
 from albot1.settings import get_settings
 
 if TYPE_CHECKING:
-    from albot1.records import MetricBlock, MetricsRecord
+    from albot1.metrics.record import MetricsRecord
     from albot1.runs.scored import Scored
 
 DATASET_HELP = (
@@ -125,12 +125,20 @@ def evaluate(
 
 
 def _print_headlines(metrics: MetricsRecord) -> None:
-    from albot1.records import METRIC_NAMES
+    for line in headlines(metrics):
+        typer.echo(line)
 
-    for name in METRIC_NAMES:
-        block = metrics.block(name)
-        line = _headline(block) if block is not None else f"null: {metrics.reason(name)}"
-        typer.echo(f"  {name:12s} {line}")
+
+def headlines(metrics: MetricsRecord) -> list[str]:
+    """One line per metric of the registry: its own headline, or ``null:`` and the reason it does not apply."""
+    from albot1.metrics.registry import metric_registry
+
+    lines = []
+    for metric in metric_registry():
+        block = metrics.block(metric.name)
+        line = metric.headline(block) if block is not None else f"null: {metrics.reason(metric.name)}"
+        lines.append(f"  {metric.name:12s} {line}")
+    return lines
 
 
 def _note_left_out(metrics: MetricsRecord) -> None:
@@ -159,64 +167,3 @@ def _evo(scored: Scored, folder: Path, name: str) -> None:
 
 def _file_name(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "trajectory"
-
-
-def _f(value: float | None, fmt: str = ".3f") -> str:
-    return "n/a" if value is None else format(value, fmt)
-
-
-def _headline(block: MetricBlock) -> str:
-    """One line per metric for people; the JSON has everything."""
-    from albot1.records import (
-        AteBlock,
-        AteWindowsBlock,
-        ClosedRouteGapBlock,
-        DriftBlock,
-        LoopGapBlock,
-        MapShapeBlock,
-        OrientationBlock,
-        RelationsBlock,
-        RpeBlock,
-        UpdatesBlock,
-    )
-
-    f = _f
-    if isinstance(block, AteBlock):
-        return f"rmse {f(block.rmse_m)} m, max {f(block.max_m)} m ({block.alignment} alignment)"
-    if isinstance(block, AteWindowsBlock):
-        return (
-            f"mean rmse {f(block.mean_rmse_m)} m over {block.windows} windows of {block.window_m:g} m "
-            f"(max {f(block.window_rmse.max_m)} m)"
-        )
-    if isinstance(block, DriftBlock):
-        at = block.at_10m
-        if at is None:
-            return f"no 10 m segment: {block.at_10m_reason}"
-        return f"at 10 m: {f(at.translation_m)} m, {f(at.rotation_deg, '.2f')} deg mean over {at.pairs} segments"
-    if isinstance(block, RpeBlock):
-        return (
-            f"delta {block.delta} {block.delta_unit}: {f(block.translation_m.rmse)} m, "
-            f"{f(block.rotation_deg.rmse)} deg rmse"
-        )
-    if isinstance(block, (LoopGapBlock, ClosedRouteGapBlock)):
-        pairs = block.translation_m if isinstance(block, LoopGapBlock) else None
-        extra = f", {block.pairs} revisit pairs mean {f(pairs.mean)} m max {f(pairs.max)} m" if pairs else ""
-        return f"route gap {f(block.route.gap_m)} m{extra}"
-    if isinstance(block, OrientationBlock):
-        return (
-            f"{block.stops} stops, bearing |err| mean {f(block.bearing_abs_error_mean_deg, '.2f')} deg, "
-            f"distance |err| mean {f(block.distance_abs_error_mean_m)} m"
-        )
-    if isinstance(block, RelationsBlock):
-        t, r = block.translation_m, block.rotation_deg
-        outside, total = block.relations_outside_run, block.relations_total
-        left_out = f" ({outside} of {total} relations left out: they name scans the run did not see)" if outside else ""
-        return f"{f(t.mean)} +/- {f(t.std)} m, {f(r.mean, '.2f')} +/- {f(r.std, '.2f')} deg, N = {t.n}{left_out}"
-    if isinstance(block, MapShapeBlock):
-        return f"precision {f(block.precision)}, coverage {f(block.coverage)} (within {block.tolerance_m} m)"
-    if isinstance(block, UpdatesBlock):
-        return f"{block.updates} updates / {block.views} views"
-    return (
-        f"{f(block.per_scan_ms_median)} ms/scan median, p95 {f(block.per_scan_ms_p95)} ms, "
-        f"peak {f(block.peak_mb, '.1f')} MiB"
-    )

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from albot1.cli.progress import with_progress
+from albot1.cli.progress import enabled, with_progress
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
@@ -79,6 +79,8 @@ def run(
         degradation=degrade,
         seed=seed,
         dataset_name=dataset,
+        # Said once, on a terminal: a method's start-up (e.g. numba compiling on a code version's first run).
+        announce=(lambda line: typer.echo(line, err=True)) if enabled() else None,
     )
     run_dir = write_run(result, out, preview=render_preview)
     mark_latest(out, run_dir)

@@ -14,12 +14,14 @@ wheel), plus a user's own under ``ALBOT1_CONFIG_DIR/datasets/``; see
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from albot1.data.errors import DatasetNotFoundError
+from albot1.data.errors import ChecksumError, DatasetNotFoundError
 from albot1.data.fetch import ensure_file
+from albot1.data.identity import content_sha256
 from albot1.data.loaders.registry import load
 from albot1.data.manifest import DataFile, DatasetManifest, parse_manifest
 from albot1.data.model import Sequence
@@ -64,13 +66,39 @@ def _missing(manifest: DatasetManifest, data_file: DataFile, settings: Settings)
     return DatasetNotFoundError(f"dataset {manifest.name!r}: {data_file.path} not found under {roots}; {hint}")
 
 
+def verified_file(manifest: DatasetManifest, data_file: DataFile, settings: Settings) -> Path:
+    """The first copy of ``data_file`` under the search roots, checked against the manifest's sha256.
+
+    The checksum is computed once and cached (:mod:`albot1.data.identity`).
+    The copy that would be read must be the right one: a wrong copy is
+    refused (ChecksumError naming both checksums and the fix), even when a
+    verified copy sits in a later root, since silently reading the other
+    one would hide which data a result came from.
+    """
+    copies = [root / data_file.path for root in settings.search_roots() if (root / data_file.path).exists()]
+    if not copies:
+        raise _missing(manifest, data_file, settings)
+    found = copies[0]
+    got = content_sha256(found, folder_ok=False)
+    if got == data_file.sha256:
+        return found
+    where = f" ({manifest.manifest_path})" if manifest.manifest_path else ""
+    good = next((c for c in copies[1:] if content_sha256(c, folder_ok=False) == data_file.sha256), None)
+    if good is not None:
+        fix = f"a verified copy is at {good}: remove or replace the wrong one (or point ALBOT1_DATA_DIR elsewhere)"
+    elif manifest.local_only or not data_file.urls:
+        fix = "replace it with the file the manifest names (it is derived locally), or remove it"
+    else:
+        fix = f"remove it and run `albot1 datasets fetch {manifest.name}`, or replace it with the right file"
+    raise ChecksumError(
+        f"{found}: sha256 {got}, but the manifest of dataset {manifest.name!r}{where} says {data_file.sha256}; {fix}"
+    )
+
+
 def locate(name: str, settings: Settings) -> Path:
-    """Path of the dataset's log file; DatasetNotFoundError naming the roots searched."""
+    """Path of the dataset's verified log file; DatasetNotFoundError naming the roots searched, ChecksumError."""
     manifest = get(name)
-    found = find_file(manifest.log, settings)
-    if found is None:
-        raise _missing(manifest, manifest.log, settings)
-    return found
+    return verified_file(manifest, manifest.log, settings)
 
 
 def is_available(name: str, settings: Settings) -> bool:
@@ -79,22 +107,40 @@ def is_available(name: str, settings: Settings) -> bool:
     return all(find_file(f, settings) is not None for f in manifest.files)
 
 
+def copy_problem(name: str, settings: Settings) -> str | None:
+    """Why a present copy of the dataset would be refused (a checksum mismatch), None when none would.
+
+    Missing files are not a problem here (:func:`is_available` says so);
+    the checksums are cached, so listing the catalog costs one hash per file once.
+    """
+    manifest = get(name)
+    for data_file in manifest.files:
+        if find_file(data_file, settings) is None:
+            continue
+        try:
+            verified_file(manifest, data_file, settings)
+        except ChecksumError as exc:
+            return str(exc)
+    return None
+
+
 def open_dataset(name: str, settings: Settings, **options: Any) -> Sequence:
     """The dataset as a streamed Sequence; ``options`` override the manifest's loader options."""
     manifest = get(name)
     path = locate(name, settings)
     merged: dict[str, Any] = {**manifest.loader, **options}
+    checksums = {path.name: manifest.log.sha256}
     relations = manifest.file("relations")
     if relations is not None and "relations" not in options:
-        found = find_file(relations, settings)
-        if found is None:
-            raise _missing(manifest, relations, settings)
+        found = verified_file(manifest, relations, settings)
         merged["relations"] = found
+        checksums[found.name] = relations.sha256
     if manifest.format == "carmen":
         merged.setdefault("name", manifest.name)
         merged.setdefault("license", manifest.license)
         merged.setdefault("citation", manifest.citation)
-    return load(path, manifest.format, **merged)
+    sequence = load(path, manifest.format, **merged)
+    return sequence.with_metadata(replace(sequence.metadata, checksums={**sequence.metadata.checksums, **checksums}))
 
 
 def fetch(name: str, settings: Settings, *, base_url: str | None = None) -> Path:

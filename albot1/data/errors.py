@@ -47,6 +47,10 @@ class FetchError(DataError):
     """A download failed or its checksum did not match."""
 
 
+class ChecksumError(DataError):
+    """A data file is not the one its manifest's sha256 names (a wrong or damaged copy)."""
+
+
 class ReferenceOptionError(DataError):
     """A dataset reference option (``odometry=reference``, ``views=D_M:A_DEG``) cannot be applied."""
 

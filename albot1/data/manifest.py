@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import tomllib
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
 from albot1.data.errors import DataError
@@ -87,6 +87,35 @@ def _strings(data: dict[str, Any], key: str, where: Path) -> tuple[str, ...]:
     return tuple(values)
 
 
+def _size(value: int | None, where: Path) -> int | None:
+    if value is not None and value < 0:
+        raise DataError(f"{where}: size {value} must be a number of bytes >= 0")
+    return value
+
+
+def _relative_path(value: str, where: Path) -> str:
+    """A file's ``path``: relative, inside its data root (no ``..``, not absolute); DataError otherwise.
+
+    The path is joined to the data folder and to the download cache, where a
+    fetch writes it: ``../../x`` or ``/etc/x`` would read or overwrite a file
+    outside them.
+    """
+    if (
+        not value.strip()
+        or PurePosixPath(value).is_absolute()
+        or PureWindowsPath(value).is_absolute()
+        or value.startswith("~")
+        or "\\" in value
+        or "\0" in value
+        or any(part in ("", ".", "..") for part in value.split("/"))
+    ):
+        raise DataError(
+            f"{where}: path {value!r} must be a relative path inside the data folder, like 'radish/aces.clf.bz2' "
+            "(no leading '/' or '~', no '..' or '.' parts, '/' as separator)"
+        )
+    return value
+
+
 def parse_manifest(path: Path) -> DatasetManifest:
     """Read and check one manifest; DataError naming the file (and file entry) on bad input."""
     try:
@@ -110,9 +139,9 @@ def parse_manifest(path: Path) -> DatasetManifest:
         files.append(
             DataFile(
                 role=role,
-                path=_require(entry, "path", str, where),
+                path=_relative_path(_require(entry, "path", str, where), where),
                 sha256=sha,
-                size=_optional(entry, "size", int, where, None),
+                size=_size(_optional(entry, "size", int, where, None), where),
                 urls=_strings(entry, "urls", where),
             )
         )

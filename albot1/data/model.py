@@ -146,6 +146,9 @@ class SequenceMetadata:
     odometry_source: str = ""
     reference_source: str = ""
     extra: dict[str, Any] = field(default_factory=dict)
+    #: sha256 of every file the sequence was read from, by file name (:mod:`albot1.data.identity`); empty for a
+    #: sequence made in memory (a synthetic world is named by the code version)
+    checksums: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -235,6 +238,10 @@ class Sequence:
             self.relations,
             scan_count=scan_count,
         )
+
+    def with_metadata(self, metadata: SequenceMetadata) -> Sequence:
+        """The same frames (still streamed) under new metadata."""
+        return Sequence(self.name, self._frames_factory, metadata, self.relations, scan_count=self._scan_count)
 
     @property
     def arrays(self) -> SequenceArrays:

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +41,8 @@ from albot1.config.keyvalue import KeyValueError, parse_query
 from albot1.data import catalog
 from albot1.data.attach import REFERENCE_KEYWORDS, with_reference, with_relations
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
+from albot1.data.filekind import check_input
+from albot1.data.identity import content_sha256
 from albot1.data.loaders.registry import load
 from albot1.data.model import Sequence
 from albot1.data.synthetic import worlds
@@ -79,15 +82,71 @@ def open_sequence(
     if text in worlds.WORLDS:
         return worlds.load_world(text, **options)  # a world's own options (start=, laps=) or SyntheticWorldError
     settings = settings or get_settings()
+    _check_option_files(options, text)
     if text in catalog.names():
-        return catalog.open_dataset(text, settings, **options)
+        checksums = _checksums(None, options)
+        return _attach(catalog.open_dataset(text, settings, **options), checksums)
     path = Path(text).expanduser()
     if _exists(text):
-        return load(path, format_name, **options)
+        # The file (or every file of a bag folder) is checked and hashed before a loader opens it: a FIFO
+        # among a bag's files would block the loader, and the checksum is cached for every later use.
+        check_input(path, "a log file or a ROS2 bag folder", folder_ok=True)
+        checksums = _checksums(path, options)
+        return _attach(load(path, format_name, **options), checksums)
     raise DatasetNotFoundError(
         f"{text!r} is neither a dataset name nor an existing file; known datasets: "
         f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
     )
+
+
+def _checksums(path: Path | None, options: dict[str, Any]) -> dict[str, str]:
+    """File name -> sha256 of the log at ``path`` and of every loader option naming a file.
+
+    The content a result is computed from (``relations=``, ``reference=``
+    files included; :mod:`albot1.data.identity`, cached). A catalog
+    dataset's own files are verified and recorded by the catalog.
+    """
+    files = [path] if path is not None else []
+    files += [Path(v).expanduser() for k, v in options.items() if _names_path(k, v) and _is_file(str(v))]
+    return {f.name: content_sha256(f) for f in files}
+
+
+def _attach(sequence: Sequence, checksums: dict[str, str]) -> Sequence:
+    """``sequence`` with ``checksums`` added to its metadata's."""
+    if not checksums:
+        return sequence
+    return sequence.with_metadata(replace(sequence.metadata, checksums={**sequence.metadata.checksums, **checksums}))
+
+
+def _check_option_files(options: dict[str, Any], ref: str) -> None:
+    """DataError for a loader option naming a FIFO, device, socket, pseudo-file or folder (``relations=/dev/zero``).
+
+    Checked by ``stat`` before any loader opens it, as a log is
+    (:func:`albot1.data.filekind.check_input`): reading one would hang or never end.
+    """
+    for key, value in options.items():
+        if _names_path(key, value) and _exists(str(value)):
+            check_input(Path(value).expanduser(), f"a regular file for the option {key}= of {ref!r}")
+
+
+def _names_path(key: str, value: object) -> bool:
+    """Whether a loader option's value is meant as a path (not a word such as ``odom`` that a folder may share).
+
+    A value with a folder separator, a leading ``~`` or a file suffix, or any
+    value of ``relations=``.
+    """
+    if isinstance(value, Path):
+        return True
+    if not isinstance(value, str):
+        return False
+    return key == "relations" or "/" in value or value.startswith("~") or bool(Path(value).suffix)
+
+
+def _is_file(text: str) -> bool:
+    try:
+        return Path(text).expanduser().is_file()
+    except (OSError, ValueError):
+        return False
 
 
 def _exists(text: str) -> bool:

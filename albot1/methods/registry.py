@@ -75,10 +75,6 @@ class MethodSpec:
     executables: tuple[str, ...] = ()
     install_hint: str = ""
     auto_include: bool = True
-    #: ``"module:function"`` the runner calls after a run on a dataset with reference poses, to score the
-    #: method's own claims against them (evaluation only: the mapper never sees the reference); see
-    #: :func:`albot1.runs.execute.run_method`.
-    judge: str | None = None
     #: True when the method's output depends on its seed even on undegraded odometry (a particle filter):
     #: the bench then runs every seed under a deterministic degradation too, instead of the first only.
     stochastic: bool = False
@@ -86,8 +82,6 @@ class MethodSpec:
     def __post_init__(self) -> None:
         check_target(self.target)
         check_target(self.error_class)
-        if self.judge is not None:
-            check_target(self.judge)
 
     def missing_modules(self) -> list[str]:
         """Required imports that cannot be found (without importing them)."""
@@ -159,7 +153,6 @@ METHODS: dict[str, MethodSpec] = {
             requires=("networkx",),
             error_class="albot1.methods.albot1.mapping.errors:MappingError",
             description="Albot1 with its network of places (thesis chapter 4: exits, places, re-visits, exit aid)",
-            judge="albot1.metrics.places:judge_places",
         ),
         MethodSpec(
             "kiss-icp",

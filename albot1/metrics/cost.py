@@ -4,7 +4,9 @@ Per-scan time is what the runner measured around ``process`` alone
 (``per_scan_ns.npy``). Growth is shown by the median per-scan time in each
 tenth of the sequence and by the least-squares slope of those medians
 against the position (ms per 1000 scans): a method whose map grows without
-bound shows a rising slope, a constant-time method a flat one. Medians per
+bound shows a rising slope, a constant-time method a flat one. The start-up
+(``startup_s``: compiling or loading compiled kernels before the first scan)
+is carried apart, never in a per-scan figure. Medians per
 decile rather than raw times make the slope robust to the odd scan stalled
 by the operating system.
 """
@@ -50,6 +52,7 @@ def cost(per_scan_ns: ArrayLike, timing: dict[str, Any] | None = None, *, bins: 
         "process_total_s": float(ns.sum() / 1e9),
         "total_s": timing.get("total_s"),
         "finish_s": timing.get("finish_s"),
+        "startup_s": timing.get("startup_s"),
         "peak_mb": timing.get("peak_mb"),
         "by_position": {"scan_centres": centres, "per_scan_ms_median": medians},
         "growth_slope_ms_per_1000_scans": slope,

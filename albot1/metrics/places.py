@@ -1,10 +1,11 @@
 """Chapter 4's network of places scored against reference poses: re-visits, crossings, exit predictions.
 
 Pure functions over ``places.json`` (:mod:`albot1.methods.albot1.places.network`),
-the run's estimated poses and the reference poses; the runner calls
-:func:`judge_places` after a run whose dataset has reference poses (the
-mapper never sees them) and stores what it returns in ``result.json`` and
-``places.json`` (``docs/places.md``, "Ground truth").
+the run's estimated poses and the reference poses. The ``places`` metric
+(:mod:`albot1.metrics.measures.places`) calls :func:`judge_network` when the
+run folder is evaluated, so the mapper never sees the reference poses: it
+wrote its claims during the run, and they are scored afterwards, into
+``metrics.json`` (``docs/places.md``, "Ground truth").
 
 **Where a visit was.** When the dataset knows its rooms (the synthetic
 worlds' ``spaces``), a visit was in the room that holds most of its
@@ -37,9 +38,7 @@ aligned; each detected crossing is matched to a true doorway crossing within
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -51,14 +50,6 @@ from albot1.metrics.errors import MetricsError
 FloatArray = NDArray[np.float64]
 
 PLACES_JSON = "places.json"
-
-
-@dataclass
-class Judgement:
-    """Counters for ``result.json`` and the annotated files (``places.json`` with ``ground_truth``)."""
-
-    counters: dict[str, int | float] = field(default_factory=dict)
-    files: dict[str, Any] = field(default_factory=dict)
 
 
 def visit_region(reference: FloatArray, first: int, last: int, buffer_m: float) -> Any:
@@ -221,38 +212,49 @@ def judge_exits(
     return counters, {"exit_predictions": per_exit, "crossing_scans": crossing_scans}
 
 
-def judge_places(
-    files: Mapping[str, Any], poses: FloatArray, reference: FloatArray, dataset: Mapping[str, Any]
-) -> Judgement:
-    """Everything above for one run: counters for ``result.json``, ``places.json`` with ``ground_truth``.
+def judge_network(
+    record: Mapping[str, Any], poses: FloatArray, reference: FloatArray, dataset: Mapping[str, Any]
+) -> dict[str, Any]:
+    """Everything above for one run: the ``places`` block of ``metrics.json`` as plain data.
 
-    ``dataset`` is the sequence's metadata ``extra`` (doorways and their
-    crossings for the synthetic worlds; the exit checks are skipped without).
+    ``record`` is the run's ``places.json``; ``dataset`` is the sequence's
+    metadata ``extra`` (doorways and their crossings for the synthetic worlds;
+    the exit checks are left out, with the reason, without them). Undefined
+    ratios (no claim, no re-visit) are NaN, null in the file.
     """
-    record = files.get(PLACES_JSON)
-    if not isinstance(record, Mapping):
-        raise MetricsError(f"the run has no {PLACES_JSON} to judge")
     poses = se2.as_poses(poses)
     reference = se2.as_poses(reference)
     if len(poses) != len(reference):
         raise MetricsError(f"{len(poses)} estimated poses but {len(reference)} reference poses")
     counters, truth, summary = judge_revisits(record, reference, list(dataset.get("spaces") or []))
-    ground: dict[str, Any] = {"revisits": summary, "counters": dict(counters)}
+    nan = float("nan")
+    block: dict[str, Any] = {
+        "units": {"distance": "m", "precision": "fraction", "recall": "fraction"},
+        "rule": summary["rule"],
+        "rooms": summary.get("rooms"),
+        "buffer_m": summary.get("buffer_m"),
+        "min_overlap": summary.get("min_overlap"),
+        "claims": len(truth),
+        "claims_true": truth,
+        **{key: counters[key] for key in ("revisits_true", "revisits_false", "revisits_missed", "revisits_actual")},
+        "revisit_precision": counters.get("revisit_precision", nan),
+        "revisit_recall": counters.get("revisit_recall", nan),
+        "visits": summary["visits"],
+    }
     doorways = dataset.get("doorways")
-    if doorways:
-        exit_counters, exit_summary = judge_exits(
-            record, poses, reference, list(doorways), list(dataset.get("doorway_crossings", []))
-        )
-        counters.update(exit_counters)
-        ground["exits"] = exit_summary
-        ground["counters"] = dict(counters)
-    annotated = dict(record)
-    annotated["revisits"] = [{**claim, "true": flag} for claim, flag in zip(record["revisits"], truth)]
-    annotated["ground_truth"] = ground
-    out = dict(files)
-    out[PLACES_JSON] = annotated
-    return Judgement(counters={k: v for k, v in counters.items() if not _undefined(v)}, files=out)
-
-
-def _undefined(value: int | float) -> bool:
-    return isinstance(value, float) and not math.isfinite(value)
+    if not doorways:
+        return {**block, "exits": None, "exits_reason": "the dataset knows no doorways (exit checks need them)"}
+    exit_counters, exit_summary = judge_exits(
+        record, poses, reference, list(doorways), list(dataset.get("doorway_crossings", []))
+    )
+    return {
+        **block,
+        "exits": {
+            **exit_summary,
+            "exit_prediction_aligned_true_mean_m": exit_counters.get("exit_prediction_aligned_true_mean_m", nan),
+            "exit_prediction_not_aligned_true_mean_m": exit_counters.get(
+                "exit_prediction_not_aligned_true_mean_m", nan
+            ),
+            **{key: exit_counters[key] for key in ("crossings_true", "crossings_false", "crossings_missed")},
+        },
+    }

@@ -5,8 +5,8 @@ are read: run folders left from older code versions stay on disk but never
 mix into a report. Each row carries the cell's coordinates, its status
 (done, failed, or not run -- the runner was stopped before it), and the
 numbers the tables use, taken from ``metrics.json``, ``result.json`` and
-``attempt.json`` by the dotted paths in :data:`METRIC_COLUMNS` and
-:data:`COST_COLUMNS`.
+``attempt.json`` by the dotted paths in :data:`METRIC_COLUMNS` (each
+metric's own columns, from the metric registry) and :data:`COST_COLUMNS`.
 
 The files are read through their models (:mod:`albot1.records`), and every
 column's path is checked against its model when the column is defined: a
@@ -25,9 +25,11 @@ from typing import Any, Literal
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ATTEMPT, METRICS, Failure, ResultsStore
 from albot1.data.degrade import parse_spec
+from albot1.metrics.record import MetricsRecord
+from albot1.metrics.registry import MetricRegistry, metric_registry
+from albot1.metrics.unit import ColumnSpec, Metric
 from albot1.records import (
     AttemptRecord,
-    MetricsRecord,
     Record,
     ResultRecord,
     check_number_path,
@@ -45,25 +47,6 @@ SOURCE_MODELS: dict[Source, type[Record]] = {
 }
 
 
-#: A loop gap applies to a route whose reference returns near its start: within this many metres ...
-ROUTE_RETURN_M = 1.0
-#: ... or this fraction of the route's length, whichever is larger (docs/metrics.md, "Loop gap").
-ROUTE_RETURN_FRACTION = 0.02
-
-
-def _route_returns(metrics: MetricsRecord) -> str | None:
-    """None when the route returns to its start (a loop gap means something), else why it does not apply."""
-    gap = metrics.loop_gap
-    if gap is None:
-        return None
-    offset = gap.route.reference_offset_m
-    route = metrics.drift.route_m if metrics.drift is not None else 0.0
-    allowed = max(ROUTE_RETURN_M, ROUTE_RETURN_FRACTION * route)
-    if offset <= allowed:
-        return None
-    return f"the route does not return to its start (it ends {offset:.1f} m away; a loop closes within {allowed:.1f} m)"
-
-
 @dataclass(frozen=True)
 class Column:
     """One table column: the number at ``path`` in the ``source`` record, shown under ``header``.
@@ -79,6 +62,10 @@ class Column:
     path: str
     header: str
     applies: Callable[[MetricsRecord], str | None] | None = None
+    #: where the column comes from: a metric's name (its ``columns``; docs/metrics.md), or "" for the cost table
+    metric: str = ""
+    #: why the number is null in a computed block (e.g. a precision without a claim), when the metric says
+    undefined: str | None = None
 
     def __post_init__(self) -> None:
         check_number_path(SOURCE_MODELS[self.source], self.path)
@@ -107,14 +94,14 @@ class Column:
                 return verdict
         if self.source != "metrics" or record.metrics is None:
             return f"no {self.source}.json value"
-        return _null_reason(record.metrics, self.path)
+        return _null_reason(record.metrics, self.path, self.undefined)
 
 
-def _null_reason(metrics: MetricsRecord, path: str) -> str:
+def _null_reason(metrics: MetricsRecord, path: str, undefined: str | None = None) -> str:
     """The ``<name>_reason`` nearest the null along ``path`` (the convention of metrics.json), else a plain note."""
     parts = path.split(".")
     node: object = metrics
-    reason = "not defined for this run (see its metrics.json)"
+    reason = undefined or "not defined for this run (see its metrics.json)"
     for part in parts:
         if node is None:
             break
@@ -127,39 +114,48 @@ def _null_reason(metrics: MetricsRecord, path: str) -> str:
     return reason
 
 
-#: accuracy numbers, identical for identical inputs
-METRIC_COLUMNS: dict[str, Column] = {
-    "ate_rmse_m": Column("metrics", "ate.rmse_m", "ATE RMSE (m)"),
-    "ate_windows_m": Column("metrics", "ate_windows.mean_rmse_m", "ATE per 50 m window, mean (m)"),
-    "rpe_frame_m": Column("metrics", "rpe.translation_m.rmse", "RPE 1 scan trans. RMSE (m)"),
-    "rpe_frame_deg": Column("metrics", "rpe.rotation_deg.rmse", "RPE 1 scan rot. RMSE (deg)"),
-    "drift_10m_m": Column("metrics", "drift.at_10m.translation_m", "RPE@10 m trans. (m)"),
-    "drift_10m_deg": Column("metrics", "drift.at_10m.rotation_deg", "RPE@10 m rot. (deg)"),
-    "loop_gap_m": Column("metrics", "loop_gap.route.gap_m", "loop gap (m)", applies=_route_returns),
-    "revisit_gap_m": Column("metrics", "loop_gap.translation_m.mean", "revisit gap mean (m)"),
-    "orientation_deg": Column("metrics", "orientation.bearing_abs_error_mean_deg", "bearing error mean (deg)"),
-    "relation_m": Column("metrics", "relations.translation_m.mean", "relation trans. (m)"),
-    "relation_deg": Column("metrics", "relations.rotation_deg.mean", "relation rot. (deg)"),
-    "relation_loops_m": Column("metrics", "relations.loops.translation_m.mean", "relation >30 s trans. (m)"),
-    "map_precision": Column("metrics", "map_shape.precision", "map precision"),
-    "map_coverage": Column("metrics", "map_shape.coverage", "map coverage"),
-    "updates_per_view": Column("metrics", "updates.updates_per_view", "updates/view"),
-    # albot1-places (thesis chapter 4; docs/places.md): the network's size and its re-visits judged by the runner
-    "places": Column("result", "counters.places", "places"),
-    "revisits_claimed": Column("result", "counters.revisits_confirmed", "re-visits claimed"),
-    "revisit_precision": Column("result", "counters.revisit_precision", "re-visit precision"),
-    "revisit_recall": Column("result", "counters.revisit_recall", "re-visit recall"),
-    "exit_aligned_m": Column("result", "counters.exit_prediction_aligned_true_mean_m", "exit pred. aligned (m)"),
-    "exit_not_aligned_m": Column(
-        "result", "counters.exit_prediction_not_aligned_true_mean_m", "exit pred. not aligned (m)"
-    ),
-}
+def metric_columns(registry: MetricRegistry) -> dict[str, Column]:
+    """The accuracy columns: each metric's own :attr:`~albot1.metrics.unit.Metric.columns`, in registry order."""
+    columns: dict[str, Column] = {}
+    for metric in registry:
+        for spec in metric.columns:
+            if spec.key in columns:
+                raise KeyError(f"report column {spec.key!r} of metric {metric.name!r} is already {columns[spec.key]}")
+            if spec.source == "result":
+                columns[spec.key] = Column("result", spec.path, spec.header, metric=metric.name)
+                continue
+            columns[spec.key] = Column(
+                "metrics",
+                f"{metric.name}.{spec.path}",
+                spec.header,
+                applies=_applies(metric, spec) if spec.applies is not None else None,
+                metric=metric.name,
+                undefined=spec.undefined,
+            )
+    return columns
+
+
+def _applies(metric: Metric[Any], spec: ColumnSpec[Any]) -> Callable[[MetricsRecord], str | None]:
+    """A column's rule on the metric's block (and the run's other blocks) as a rule on the record."""
+    rule = spec.applies
+    assert rule is not None
+
+    def applies(metrics: MetricsRecord) -> str | None:
+        block = metrics.get(metric)
+        return None if block is None else rule(block, metrics)
+
+    return applies
+
+
+#: accuracy numbers, identical for identical inputs (from the metric registry)
+METRIC_COLUMNS: dict[str, Column] = metric_columns(metric_registry())
 #: cost numbers: they vary from run to run and machine to machine, so they live in their own table
 COST_COLUMNS: dict[str, Column] = {
     "per_scan_ms_median": Column("result", "timing.per_scan_ms_median", "per-scan median (ms)"),
     "per_scan_ms_mean": Column("result", "timing.per_scan_ms_mean", "per-scan mean (ms)"),
     "per_scan_ms_p95": Column("result", "timing.per_scan_ms_p95", "per-scan p95 (ms)"),
     "total_s": Column("result", "timing.total_s", "total (s)"),
+    "startup_s": Column("result", "timing.startup_s", "start-up (s)"),
     "peak_mb": Column("result", "timing.peak_mb", "peak (MB)"),
     "cell_s": Column("attempt", "elapsed_s", "cell wall (s)"),
 }

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import CellRecord, Column
 from albot1.report.plots import vector_of
+from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
 
 if TYPE_CHECKING:
@@ -213,8 +214,12 @@ def write_html(
     if plots.get(""):
         parts.append("<h3>Runtime across datasets</h3>")
         parts += [_figure(plot, out) for plot in plots[""]]
+    data = data_by_dataset(records)
     for i, dataset in enumerate(datasets):
         parts.append(f'<h2 id="ds-{i}">{_e(dataset)}</h2>')
+        files = data.get(dataset)
+        shown = describe_data(files) if files is not None else "no completed run"
+        parts.append(f'<p class="meta">data: {_e(shown)}</p>')
         for title, table, cols in (("Accuracy", metrics, metric_columns), ("Cost", cost, cost_columns)):
             group = table[table["dataset"] == dataset] if not table.empty else table
             if group.empty:

@@ -21,9 +21,12 @@ import pandas as pd
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
+from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.html import INDEX_HTML, rel, write_html
 from albot1.report.map_plots import MapStyle, plot_maps
+from albot1.report.markdown import code, text
 from albot1.report.plots import method_colors, slug, vector_of
+from albot1.report.provenance import data_by_dataset, describe_data, separate_data
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.standard import PAGE as STANDARD_PAGE
@@ -75,17 +78,44 @@ def render_plots(
     by_dataset: dict[str, list[CellRecord]] = {}
     for rec in records:
         by_dataset.setdefault(rec.cell.dataset_label, []).append(rec)
-    tasks = [(dataset, recs, metrics, plots_dir, colors, map_style) for dataset, recs in by_dataset.items()]
+    cache = FigureCache(plots_dir)
+    made: dict[str, list[Path]] = {}
+    digests: dict[str, str] = {}
+    tasks = []
+    for dataset, recs in by_dataset.items():
+        digests[dataset] = inputs_digest(recs, "dataset", dataset, map_style, sorted(_colors_of(recs, colors).items()))
+        cached = cache.lookup(f"dataset:{dataset}", digests[dataset])
+        if cached is not None:
+            made[dataset] = [cache.path(name) for name in cached.payload]
+        else:
+            tasks.append((dataset, recs, metrics, plots_dir, colors, map_style))
     if jobs > 1 and len(tasks) > 1:
         # spawn: a fresh interpreter per worker, whatever threads or matplotlib state this process holds.
         with ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=multiprocessing.get_context("spawn")) as pool:
             drawn = list(pool.map(_dataset_plots, *zip(*tasks, strict=True)))
     else:
         drawn = [_dataset_plots(*task) for task in tasks]
-    made = dict(zip(by_dataset, drawn, strict=True))
-    runtime = plot_runtime(cost, plots_dir / "runtime.png", colors)
-    made[""] = [runtime] if runtime is not None else []
+    for task, files in zip(tasks, drawn, strict=True):
+        dataset = task[0]
+        made[dataset] = files
+        cache.store(f"dataset:{dataset}", digests[dataset], files, [cache.name(f) for f in files])
+    made = {dataset: made[dataset] for dataset in by_dataset}  # suite order, whichever were drawn now
+    runtime_digest = inputs_digest(records, "runtime", sorted(colors.items()))
+    cached = cache.lookup("runtime", runtime_digest)
+    if cached is not None:
+        made[""] = [cache.path(name) for name in cached.payload]
+    else:
+        runtime = plot_runtime(cost, plots_dir / "runtime.png", colors)
+        made[""] = [runtime] if runtime is not None else []
+        cache.store("runtime", runtime_digest, made[""], [cache.name(f) for f in made[""]])
+    cache.save()
     return made
+
+
+def _colors_of(records: list[CellRecord], colors: dict[str, str]) -> dict[str, str]:
+    """The colours of the methods in ``records`` (what a dataset's figures draw them in)."""
+    labels = {r.cell.method_label for r in records}
+    return {label: color for label, color in colors.items() if label in labels}
 
 
 def _dataset_plots(
@@ -118,11 +148,11 @@ def _machine_lines(plan: GridPlan) -> list[str]:
     m = plan.machine
     libraries = ", ".join(f"{k} {v}" for k, v in (m.get("libraries") or {}).items() if v)
     return [
-        f"- CPUs: {m.get('cpu_count')} logical ({m.get('cpu_count_physical')} physical), "
-        f"memory {m.get('memory_gb')} GB; {m.get('processor')}",
-        f"- platform: {m.get('platform')}; Python {m.get('python')}",
-        f"- code version: `{m.get('code_version')}` (git `{m.get('git')}`)",
-        f"- libraries: {libraries}",
+        f"- CPUs: {text(m.get('cpu_count'))} logical ({text(m.get('cpu_count_physical'))} physical), "
+        f"memory {text(m.get('memory_gb'))} GB; {text(m.get('processor'))}",
+        f"- platform: {text(m.get('platform'))}; Python {text(m.get('python'))}",
+        f"- code version: {code(m.get('code_version'))} (git {code(m.get('git'))})",
+        f"- libraries: {text(libraries)}",
     ]
 
 
@@ -142,7 +172,7 @@ def _failure_lines(records: list[CellRecord], out: Path) -> list[str]:
         kind = rec.failure.kind if rec.failure else "?"
         counts[(rec.cell.method_label, kind)] = counts.get((rec.cell.method_label, kind), 0) + 1
     lines = [
-        f"{len(failed)} cells failed: " + ", ".join(f"{m} {n} ({k})" for (m, k), n in counts.items()) + ".",
+        f"{len(failed)} cells failed: " + ", ".join(f"{text(m)} {n} ({text(k)})" for (m, k), n in counts.items()) + ".",
         "",
         "| dataset | method | degradation | seed | kind | reason | log |",
         "|---|---|---|---|---|---|---|",
@@ -151,9 +181,9 @@ def _failure_lines(records: list[CellRecord], out: Path) -> list[str]:
         c, f = rec.cell, rec.failure
         assert f is not None
         log = f"[log]({_rel(rec.run_dir / f.log, out)})" if f.log else "–"
-        reason = f.reason.replace("|", "\\|").replace("\n", " ")
         lines.append(
-            f"| {c.dataset_label} | {c.method_label} | {c.degradation} | {c.seed} | {f.kind} | {reason} | {log} |"
+            f"| {text(c.dataset_label)} | {text(c.method_label)} | {text(c.degradation)} | {c.seed} | {text(f.kind)} "
+            f"| {text(f.reason)} | {log} |"
         )
     return [*lines, ""]
 
@@ -169,12 +199,12 @@ def write_index(
 ) -> Path:
     counts = _status_counts(records)
     lines: list[str] = [
-        f"# Benchmark report: suite `{plan.suite}`",
+        f"# Benchmark report: suite {code(plan.suite)}",
         "",
-        plan.description.strip() or "",
+        text(plan.description.strip()) if plan.description.strip() else "",
         "",
-        f"Generated {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from `{results_dir}` "
-        f"(suite file `{plan.suite_path}`).",
+        f"Generated {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from {code(results_dir)} "
+        f"(suite file {code(plan.suite_path)}).",
         "",
         f"Cells: {len(records)} planned, {counts['done']} complete, {counts['failed']} failed, "
         f"{counts['not run']} not run.",
@@ -187,10 +217,17 @@ def write_index(
         "",
         f"- seeds: {', '.join(map(str, plan.seeds))} (the deterministic degradations `none`, `thesis` and "
         "`bias:...` run with the first seed only: every seed would repeat the same run)",
-        f"- degradations: {', '.join(f'`{d}`' for d in plan.degradations)} "
+        f"- degradations: {', '.join(code(d) for d in plan.degradations)} "
         "(`none` = the dataset's own odometry; swept ones only on datasets with reference poses)",
-        f"- datasets: {', '.join(dict.fromkeys(r.cell.dataset_label for r in records)) or '(none)'}",
-        f"- methods: {', '.join(dict.fromkeys(r.cell.method_label for r in records)) or '(none)'}",
+        f"- datasets: {', '.join(text(d) for d in dict.fromkeys(r.cell.dataset_label for r in records)) or '(none)'}",
+        f"- methods: {', '.join(text(m) for m in dict.fromkeys(r.cell.method_label for r in records)) or '(none)'}",
+        "",
+        "## Data",
+        "",
+        "The checksums (sha256, first 12 hex digits) of the files each dataset's numbers come from "
+        "(`result.json`, `dataset_info.data_sha256`):",
+        "",
+        *[f"- {text(d)}: {text(describe_data(files))}" for d, files in data_by_dataset(records).items()],
         "",
         f"**[The whole report on one page: {INDEX_HTML}]({INDEX_HTML})** (tables and every plot; open it in a "
         "browser, it needs no network).",
@@ -224,7 +261,7 @@ def write_index(
             if not dataset or not files:
                 continue
             lines += [
-                f"### {dataset}",
+                f"### {text(dataset)}",
                 "",
                 *[f"- [{f.stem}]({_rel(f, out)}) ([SVG]({_rel(vector_of(f), out)}))" for f in files],
                 "",
@@ -237,20 +274,23 @@ def write_index(
             "",
             "The runner stopped before these cells finished; run `albot1 bench` again to complete them.",
             "",
-            *[f"- {r.cell.describe()}" for r in not_run],
+            *[f"- {text(r.cell.describe())}" for r in not_run],
             "",
         ]
     lines += ["## Skipped datasets", ""]
     if plan.skipped_datasets:
         lines += [
-            f"- `{s.name}`: {s.reason}" + (f" — fetch it with `{s.hint}`" if s.hint else "")
+            f"- {code(s.name)}: {text(s.reason)}" + (f" — fetch it with {code(s.hint)}" if s.hint else "")
             for s in plan.skipped_datasets
         ]
     else:
         lines.append("None: every dataset the suite selects was available.")
     lines += ["", "## Skipped methods", ""]
     if plan.skipped_methods:
-        lines += [f"- `{s.name}`: {s.reason}" + (f" (`{s.hint}`)" if s.hint else "") for s in plan.skipped_methods]
+        lines += [
+            f"- {code(s.name)}: {text(s.reason)}" + (f" ({code(s.hint)})" if s.hint else "")
+            for s in plan.skipped_methods
+        ]
     else:
         lines.append("None.")
     lines.append("")
@@ -276,7 +316,8 @@ def build_report(
     """
     results = Path(results_dir)
     target = Path(out) if out is not None else default_out(results)
-    plan, records = collect(results)
+    plan, collected = collect(results)
+    records = separate_data(collected)  # runs of one dataset on different data never share a row
     target.mkdir(parents=True, exist_ok=True)
     tables = write_tables(records, target)
     tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)

@@ -28,7 +28,10 @@ from typing import Any
 from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.methods.baselines.published import published_systems
+from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.report.collect import CellRecord
+from albot1.report.markdown import text as md_text
+from albot1.report.provenance import data_lines
 
 #: The five logs of the standard benchmark, with the names the published tables use.
 STANDARD_LOGS: dict[str, str] = {
@@ -130,9 +133,9 @@ def _measured(rec: CellRecord) -> Row:
     timing = rec.result.timing
     stamps = rec.stored_run().timestamps
     duration = float(stamps.max() - stamps.min()) if len(stamps) > 1 else None
-    block = rec.metrics.relations
+    block = rec.metrics.get(RELATIONS)
     if block is None:
-        why = rec.metrics.relations_reason or "no relation metric"
+        why = rec.metrics.reason(RELATIONS.name) or "no relation metric"
         return Row(log, "measured", method, time_s=timing.wall_s, cpu_s=timing.cpu_s, duration_s=duration, note=why)
     t, r, loops = block.translation_m, block.rotation_deg, block.loops
     note = ""
@@ -345,6 +348,9 @@ def write_standard(plan: GridPlan, records: list[CellRecord], out: Path) -> tupl
     skipped = {s.name: s.reason + (f" (`{s.hint}`)" if s.hint else "") for s in plan.skipped_datasets}
     page, table = out / PAGE, out / TABLE
     text = render_page(plan, rows, {k: v for k, v in skipped.items() if k in STANDARD_LOGS})
+    data = data_lines([r for r in records if r.cell.dataset_label in STANDARD_LOGS])
+    if data:  # which data the measured rows come from (albot1.report.provenance)
+        text = text.rstrip("\n") + "\n\n## Data\n\n" + "".join(f"- {md_text(line)}\n" for line in data)
     atomic_write(page, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     atomic_write(table, lambda tmp: tmp.write_text(_csv(rows), encoding="utf-8"))
     return page, table

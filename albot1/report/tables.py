@@ -37,6 +37,8 @@ from albot1.report.collect import (
     cell_rows,
     severity_order,
 )
+from albot1.report.markdown import text as md_text
+from albot1.report.provenance import data_by_dataset, describe_data
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -187,8 +189,14 @@ def na_notes(group: pd.DataFrame, columns: dict[str, Column], present: list[str]
     return notes
 
 
-def markdown(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str:
-    """One Markdown table per dataset, each followed by its not-applicable notes."""
+def markdown(
+    table: pd.DataFrame, columns: dict[str, Column], title: str, data: dict[str, dict[str, str]] | None = None
+) -> str:
+    """One Markdown table per dataset, each followed by its not-applicable notes.
+
+    ``data``: dataset label -> {file: short sha256} (:func:`albot1.report.provenance.data_by_dataset`), stated
+    under each dataset's heading. Names are written as text (:mod:`albot1.report.markdown`), never as HTML.
+    """
     lines = [
         f"# {title}",
         "",
@@ -203,22 +211,23 @@ def markdown(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str
         present, absent = columns_present(group, columns)
         header = ["method", "degradation", "seeds", *[columns[c].header for c in present], "status"]
         lines += [
-            f"## {dataset}",
+            f"## {md_text(dataset)}",
             "",
+            *([f"Data: {md_text(describe_data(data[str(dataset)]))}.", ""] if data and str(dataset) in data else []),
             "| " + " | ".join(header) + " |",
             "|" + "|".join(["---"] * 3 + ["---:"] * len(present) + ["---"]) + "|",
         ]
         for _, row in group.iterrows():
             cells = [
-                str(row["method"]),
-                str(row["degradation"]),
+                md_text(row["method"]),
+                md_text(row["degradation"]),
                 str(int(row["seeds"])),
                 *[cell_text(row, c) for c in present],
-                str(row["status"]).replace("|", "\\|"),
+                md_text(row["status"]),
             ]
             lines.append("| " + " | ".join(cells) + " |")
         notes = na_notes(group, columns, present, absent)
-        lines += [""] + [f"- n/a: {note}" for note in notes] + ([""] if notes else [])
+        lines += [""] + [f"- n/a: {md_text(note)}" for note in notes] + ([""] if notes else [])
     return "\n".join(lines)
 
 
@@ -279,7 +288,7 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
         table = aggregate(cells, columns)
         paths = {ext: out / f"{name}.{ext}" for ext in ("csv", "md", "tex")}
         _csv_frame(table).to_csv(paths["csv"], index=False, float_format="%.9g")
-        paths["md"].write_text(markdown(table, columns, title), encoding="utf-8")
+        paths["md"].write_text(markdown(table, columns, title, data_by_dataset(records)), encoding="utf-8")
         paths["tex"].write_text(latex(table, columns, title), encoding="utf-8")
         written.update({f"{name}.{ext}": path for ext, path in paths.items()})
     cost_cells = out / "cells-cost.csv"

@@ -2,7 +2,10 @@
 
 Per-scan time is ``perf_counter_ns`` around ``Mapper.process`` only (decoding
 and degradation happen outside it); ``finish`` is timed separately and added
-to ``total_s``. ``peak_mb`` is the process's resident-set high-water mark
+to ``total_s``. A method's start-up before the first scan (``Mapper.warm_up``,
+e.g. numba compiling or loading its kernels) is ``startup_s``, outside the
+per-scan times and ``total_s`` and inside ``wall_s``, so the per-scan
+statistics describe the steady state. ``peak_mb`` is the process's resident-set high-water mark
 (``ru_maxrss``) at the end of the run: the benchmark runs each cell in a fresh
 process, so there it is the cell's peak. ``cpu_s`` is the CPU time of the
 same span as ``wall_s`` (:func:`cpu_time_s`).
@@ -14,15 +17,14 @@ import resource
 import sys
 import time
 from collections.abc import Callable
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 
 from albot1 import versions
-from albot1.config.targets import resolve_target
 from albot1.contract import MapperOutput, RunResult
 from albot1.data.degrade import degrade
-from albot1.data.model import Sequence
+from albot1.data.model import Frame, Sequence
 from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
 from albot1.methods.registry import get_method, resolve_config
@@ -56,8 +58,14 @@ def run_method(
     seed: int = 0,
     dataset_name: str | None = None,
     on_frame: Callable[[int], None] | None = None,
+    announce: Callable[[str], None] | None = None,
 ) -> RunResult:
-    """Degrade (seeded), run and check one method; raises the method's error class on failure."""
+    """Degrade (seeded), run and check one method; raises the method's error class on failure.
+
+    A mapper with a ``warm_up`` method (``Mapper.warm_up``) gets it called
+    before the timed loop, with ``announce`` for what it has to say (e.g.
+    that it compiles); its time is the run's ``startup_s``.
+    """
     spec = get_method(method)
     config = resolve_config(method, preset, overrides)
     error_class = spec.load_error_class()
@@ -70,6 +78,10 @@ def run_method(
     mapper = spec.load_class()(config, seed=seed)
 
     wall_start, cpu_start = time.perf_counter(), cpu_time_s()
+    warm_up = getattr(mapper, "warm_up", None)
+    if callable(warm_up):
+        warm_up(announce)
+    startup_s = time.perf_counter() - wall_start
     per_scan: list[int] = []
     stamps: list[float] = []
     odometry: list[np.ndarray] = []
@@ -78,8 +90,9 @@ def run_method(
     try:
         for frame in seen.frames():
             index = frame.index
+            blind = withhold_ground_truth(frame)
             start = time.perf_counter_ns()
-            mapper.process(frame)
+            mapper.process(blind)
             per_scan.append(time.perf_counter_ns() - start)
             stamps.append(frame.scan.timestamp)
             odometry.append(frame.odometry)
@@ -108,14 +121,9 @@ def run_method(
     per_scan_ns = np.asarray(per_scan, dtype=np.int64)
     poses = robot_frame(np.asarray(output.poses, dtype=float), offset)
     reference_poses = robot_frame(np.asarray(reference, dtype=float).reshape(-1, 3), offset) if reference else None
+    # A method's own claims (e.g. re-visits in places.json) are scored against the reference poses, which the
+    # mapper never saw, when the run is evaluated (the `places` metric, albot1.metrics.measures.places).
     counters, files = dict(output.counters), dict(output.files)
-    if spec.judge is not None and reference_poses is not None:
-        # Evaluation only, after the timed run: the method's own claims (e.g. re-visits) scored against the
-        # reference poses, which the mapper never saw (MethodSpec.judge).
-        judge = cast(Callable[..., Any], resolve_target(spec.judge))
-        judgement = judge(files, poses, reference_poses, seq.metadata.extra)
-        counters.update(judgement.counters)
-        files = judgement.files
     return RunResult(
         method=method,
         dataset=dataset,
@@ -134,6 +142,7 @@ def run_method(
         files=files,
         per_scan_ns=per_scan_ns,
         finish_s=finish_s,
+        startup_s=startup_s,
         total_s=float(per_scan_ns.sum()) / 1e9 + finish_s,
         wall_s=time.perf_counter() - wall_start,
         cpu_s=cpu_time_s() - cpu_start,
@@ -145,8 +154,20 @@ def run_method(
             "odometry_source": seq.metadata.odometry_source,
             "reference_source": seq.metadata.reference_source,
             "sensor_offset": [float(v) for v in offset],
+            "data_sha256": dict(seq.metadata.checksums),
         },
     )
+
+
+def withhold_ground_truth(frame: Frame) -> Frame:
+    """What a method is given of ``frame``: the scan and the odometry, never the reference pose.
+
+    The one place where ground truth is kept from the methods (relations
+    never reach them: a mapper is given frames only). The runner keeps the
+    reference for evaluation and for the method's judge (``MethodSpec.judge``),
+    which run after the mapper has finished.
+    """
+    return frame if frame.reference is None else Frame(frame.index, frame.scan, frame.odometry)
 
 
 def _check_output(output: MapperOutput, n: int, method: str, dataset: str, error_class: type[Exception]) -> None:

@@ -26,7 +26,7 @@ import hashlib
 import json
 import os
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -79,20 +79,34 @@ STANDARD_FILES = frozenset(
 PreviewRenderer = Callable[[RunResult, Path], None]
 
 
-def run_key(dataset: str, method: str, config: dict[str, Any], degradation: str, seed: int, code_version: str) -> str:
-    """Content hash naming a run folder (16 hex digits)."""
-    payload = json.dumps(
-        {
-            "dataset": dataset,
-            "method": method,
-            "config": config,
-            "degradation": degradation,
-            "seed": seed,
-            "code": code_version,
-        },
-        sort_keys=True,
-        default=str,
-    )
+def run_key(
+    dataset: str,
+    method: str,
+    config: dict[str, Any],
+    degradation: str,
+    seed: int,
+    code_version: str,
+    data: Mapping[str, str] | None = None,
+) -> str:
+    """Content hash naming a run folder (16 hex digits).
+
+    ``data`` is the sha256 of every file the dataset was read from
+    (``SequenceMetadata.checksums``): a log edited after its run gets a new
+    key, so its old result is never taken for the new data's. A sequence read
+    from no file (a synthetic world: its code version names it) keeps the key
+    it had before checksums were recorded.
+    """
+    fields: dict[str, Any] = {
+        "dataset": dataset,
+        "method": method,
+        "config": config,
+        "degradation": degradation,
+        "seed": seed,
+        "code": code_version,
+    }
+    if data:
+        fields["data"] = dict(data)
+    payload = json.dumps(fields, sort_keys=True, default=str)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
 
@@ -116,7 +130,13 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
     ``preview`` draws ``preview.png`` before DONE is written; without it the folder has no preview.
     """
     key = run_key(
-        result.dataset, result.method, result.config, result.degradation, result.seed, str(result.versions.get("code"))
+        result.dataset,
+        result.method,
+        result.config,
+        result.degradation,
+        result.seed,
+        str(result.versions.get("code")),
+        result.dataset_info.get("data_sha256"),
     )
     run_dir = root / key
     run_dir.mkdir(parents=True, exist_ok=True)
@@ -235,9 +255,9 @@ class StoredRun:
                 if map_file.suffix == ".npz"
                 else ("a GeoJSON FeatureCollection of LineString segments and MultiPoint points")
             )
-            raise RunError(
-                f"{map_file}: not a map this project wrote ({type(exc).__name__}: {exc}); expected {kind}"
-            ) from None
+            # numpy's words for a file that is no array suggest loading it unsafely (allow_pickle): not repeated
+            detail = "not a numpy archive" if "pickle" in str(exc) else f"{type(exc).__name__}: {exc}"
+            raise RunError(f"{map_file}: not a map this project wrote ({detail}); expected {kind}") from None
 
 
 def _geojson_map(collection: Any) -> MapData:
@@ -285,8 +305,8 @@ def _read_per_scan(file: Path, scans: int) -> NDArray[np.int64]:
     expected = f"expected a .npy array of {scans} per-scan times in integer nanoseconds (numpy.save)"
     try:
         array = np.load(file, allow_pickle=False)
-    except (OSError, ValueError, EOFError) as exc:
-        raise RunError(f"{file}: not readable as a numpy array ({exc}); {expected}") from None
+    except (OSError, ValueError, EOFError):  # numpy's own words would suggest loading the file unsafely
+        raise RunError(f"{file}: not a numpy array file this project wrote; {expected}") from None
     if not isinstance(array, np.ndarray) or array.dtype.kind not in "iu" or array.shape != (scans,):
         found = f"{getattr(array, 'dtype', type(array).__name__)} of shape {getattr(array, 'shape', '?')}"
         raise RunError(f"{file}: holds {found}; {expected}")

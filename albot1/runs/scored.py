@@ -8,14 +8,18 @@ scores either the same way.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from albot1.records import Timing
+from albot1.runs.errors import RunError
 
 if TYPE_CHECKING:
     from albot1.contract import MapData
@@ -49,6 +53,9 @@ class Scored:
     counters: Mapping[str, int | float] | None = None
     per_scan_ns: NDArray[np.int64] | None = None
     timing: Timing | None = None
+    #: a method's own output file of the run folder by name, parsed (None: no such file; the field is None
+    #: for a source without a run folder)
+    read_file: Callable[[str], object | None] | None = None
     absent: dict[str, str] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
 
@@ -66,6 +73,7 @@ def scored_run(run: StoredRun) -> Scored:
             "seed": info.seed,
             "scans": int(len(run.poses)),
             "has_reference": run.reference is not None,
+            "data_sha256": dict(info.dataset_info.data_sha256),
         },
         dataset=info.dataset,
         timestamps=run.timestamps,
@@ -79,4 +87,28 @@ def scored_run(run: StoredRun) -> Scored:
         counters=dict(info.counters),
         per_scan_ns=run.per_scan_ns,
         timing=info.timing,
+        read_file=run_file_reader(run.path),
     )
+
+
+def run_file_reader(run_dir: Path) -> Callable[[str], object | None]:
+    """Reads a method's own JSON file of ``run_dir`` by name (once each); None when the run has no such file.
+
+    Only plain names of the folder are read (a mapper's extra files, ``places.json``); an unreadable file is
+    a RunError naming it.
+    """
+
+    @cache
+    def read(name: str) -> object | None:
+        if Path(name).name != name:
+            raise RunError(f"{run_dir}: {name!r} is not a plain file name of the run folder")
+        path = run_dir / name
+        if not path.is_file():
+            return None
+        try:
+            content: object = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise RunError(f"{path}: cannot read the method's file: {exc}") from None
+        return content
+
+    return read

@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from albot1.methods.albot1.perception.accel import perception_kernels
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.perception.landmarks import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
 from albot1.methods.albot1.perception.view import ViewParams, construct_view
 
@@ -38,6 +38,6 @@ def test_view_invariants(ranges: np.ndarray) -> None:
     flat = view.beams.ravel()
     assert np.all(np.diff(flat) >= 0)
     # Same result from the interpreted kernels.
-    plain = construct_view(ranges, ANGLES, params, perception_kernels(False))
+    plain = construct_view(ranges, ANGLES, params, PerceptionKernels(False))
     np.testing.assert_array_equal(plain.surfaces, view.surfaces)
     np.testing.assert_array_equal(plain.kinds, view.kinds)

@@ -53,8 +53,14 @@ TEXT = st.text(st.characters(codec="utf-8", exclude_categories=("Cs",)), max_siz
 SCALAR = st.one_of(st.booleans(), st.integers(-(2**63), 2**63 - 1), st.floats(), TEXT)
 ANY_VALUE = st.recursive(SCALAR, lambda inner: st.lists(inner, max_size=3) | st.dictionaries(TEXT, inner, max_size=3))
 SHA = st.text("0123456789abcdefABCDEF", min_size=64, max_size=64)
+#: A path a manifest may give: relative, inside the data folder (test_data_trust_props.py covers the refused ones).
+RELATIVE_PATH = (
+    st.lists(st.text("abcXYZ019-_.é", min_size=1, max_size=6), min_size=1, max_size=3)
+    .filter(lambda parts: all(p not in (".", "..") for p in parts))
+    .map("/".join)
+)
 GOOD_FILE = st.fixed_dictionaries(
-    {"role": st.sampled_from(["log", "relations"]), "path": TEXT, "sha256": SHA},
+    {"role": st.sampled_from(["log", "relations"]), "path": RELATIVE_PATH, "sha256": SHA},
     optional={"size": st.integers(0, 2**40), "urls": st.lists(TEXT, max_size=2)},
 )
 ENTRY = st.one_of(GOOD_FILE, st.dictionaries(st.sampled_from(["role", "path", "sha256", "size", "urls"]), ANY_VALUE))

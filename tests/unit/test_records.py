@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
+from albot1.metrics.blocks import Stats
+from albot1.metrics.measures.drift import DriftBlock
+from albot1.metrics.record import MetricsRecord
 from albot1.records import (
     AttemptRecord,
-    DriftBlock,
-    MetricsRecord,
     RecordError,
     ResultRecord,
-    Stats,
     Timing,
     check_number_path,
     dump_record,

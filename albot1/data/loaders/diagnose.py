@@ -4,7 +4,7 @@ Reached only after every loader's ``sniff`` said no, so it may read the
 whole file: an empty file, a file of comments only, a folder, damaged
 compressed data (truncated or corrupt ``.gz``/``.bz2``, with the byte offset
 and the last complete line), binary data, or the first line that starts no
-known format, shown as found.
+known format, described by its kind and length (never quoted: the file may hold secrets).
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from albot1.data.errors import DataError, ParseError, UnknownFormatError
+from albot1.data.filekind import content_kind
 from albot1.data.loaders.compressed import DamagedStream, compression_of, iter_lines, read_head
 
 EXPECTED = (
@@ -22,11 +23,6 @@ EXPECTED = (
 #: Decompressed lines looked at before giving up on finding a first message (the rest is not needed to
 #: describe the file, except when it is damaged, which only a full pass can show).
 _MAX_LINES = 1_000_000
-_SHOWN = 40
-
-
-def _shown(line: bytes) -> str:
-    return repr(line.strip()[:_SHOWN].decode("utf-8", "replace"))
 
 
 def _is_binary(line: bytes) -> bool:
@@ -44,7 +40,7 @@ def unrecognised(path: Path) -> DataError:
     packed = "" if compression == "none" else f"{compression}-compressed "
     head = read_head(path)
     if _is_binary(head):
-        return UnknownFormatError(f"{path}: binary {packed}data of no known format (starts {head[:16]!r}); {EXPECTED}")
+        return UnknownFormatError(f"{path}: binary {packed}data of no known format; {EXPECTED}")
     count = 0
     first: tuple[int, bytes] | None = None
     try:
@@ -69,8 +65,10 @@ def unrecognised(path: Path) -> DataError:
             f"{path}: the {packed}file holds only comments and blank lines ({count} lines); {EXPECTED}"
         )
     line_no, line = first
+    # The content is described, never quoted: the file may be anything a user pointed at by mistake (/etc/passwd).
     return ParseError(
         path,
-        f"the first line that is not a comment is {_shown(line)}, which begins no known format; {EXPECTED}",
+        f"the first line that is not a comment ({content_kind(line)}, {len(line.strip())} characters) "
+        f"begins no known format; {EXPECTED}",
         line=line_no,
     )

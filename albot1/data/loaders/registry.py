@@ -11,6 +11,7 @@ from typing import Any
 
 from albot1.config.targets import TargetError, resolve_class
 from albot1.data.errors import DataError, UnknownFormatError
+from albot1.data.filekind import check_input
 from albot1.data.loaders.base import SequenceLoader, SequenceWriter
 from albot1.data.loaders.diagnose import unrecognised
 from albot1.data.model import Sequence
@@ -60,12 +61,14 @@ def _check_format(name: str) -> tuple[str, str | None]:
 def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoader:
     """The loader for ``format_name``, or the first whose ``sniff`` accepts the file."""
     p = Path(path)
-    if format_name is not None:
-        return _import(_check_format(format_name)[0])()
     try:
         found = p.exists()
     except (OSError, ValueError) as exc:  # a name too long for the file system, an embedded NUL
         raise DataError(f"{str(p)[:80]}...: not a usable path ({exc.__class__.__name__})") from None
+    if found:  # a FIFO, a device, /proc/self/environ: refused by its stat, before a sniff could hang on it
+        check_input(p, "a log file or a ROS2 bag folder", folder_ok=True)
+    if format_name is not None:
+        return _import(_check_format(format_name)[0])()
     if not found:
         raise DataError(f"{p}: no such file or directory")
     seen: set[str] = set()

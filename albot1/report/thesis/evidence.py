@@ -17,6 +17,9 @@ from pathlib import Path
 
 from albot1.bench.grid import GridPlan
 from albot1.errors import Albot1Error
+from albot1.metrics.measures.places import METRIC as PLACES
+from albot1.metrics.measures.places import ExitsJudgement, PlacesBlock
+from albot1.metrics.measures.updates import METRIC as UPDATES
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, Column, collect
 from albot1.report.thesis.verdicts import Number
 
@@ -24,6 +27,20 @@ from albot1.report.thesis.verdicts import Number
 COMPANION_SUITES = ("default",)
 #: Where a method's own counters sit in ``metrics.json`` (places, re-visits, exit predictions, ...).
 COUNTERS = "updates.counters."
+
+
+def counter_path(name: str) -> str:
+    """The ``metrics.json`` path of a method's counter ``name``, or of the judgement of its claims.
+
+    The counters of a network of places judged against the reference poses
+    (``revisit_precision``, ``crossings_true``, ...) are the ``places``
+    metric's block, not the method's own counters.
+    """
+    if name in PlacesBlock.model_fields:
+        return f"{PLACES.name}.{name}"
+    if name in ExitsJudgement.model_fields:
+        return f"{PLACES.name}.exits.{name}"
+    return f"{COUNTERS}{name}"
 
 
 @dataclass
@@ -112,7 +129,7 @@ class Evidence:
         value = column.value(lookup.record)
         if value is None:
             counter = path.removeprefix(COUNTERS)
-            if counter != path and lookup.record.metrics is not None and lookup.record.metrics.updates is not None:
+            if counter != path and lookup.record.metrics is not None and lookup.record.metrics.get(UPDATES) is not None:
                 reason = f"the run reports no counter {counter!r} (its method or version does not count it)"
             else:
                 reason = column.reason(lookup.record) or "no value"

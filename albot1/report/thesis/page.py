@@ -17,25 +17,29 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from albot1.errors import Albot1Error
+from albot1.metrics.measures.map_shape import METRIC as MAP_SHAPE
+from albot1.metrics.measures.orientation import METRIC as ORIENTATION
 from albot1.report.collect import CellRecord
 from albot1.report.errors import ReportError
+from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.html import rel
 from albot1.report.map_plots import plot_maps
+from albot1.report.markdown import text as md_text
 from albot1.report.places_plot import render_places
 from albot1.report.plots import method_colors, slug, vector_of
+from albot1.report.provenance import data_lines
 from albot1.report.thesis.claims import READINGS
 from albot1.report.thesis.evidence import COMPANION_SUITES, Evidence, open_stores
 from albot1.report.thesis.experiments import (
-    DENSE,
-    LOOP_GAP,
-    SPARSE,
-    SQUARE,
     ClaimRow,
     FigureRequest,
     Section,
     all_sections,
     stand_ins,
+    thesis_datasets,
 )
+from albot1.report.thesis.experiments.common import LOOP_GAP
+from albot1.report.thesis.experiments.datasets import THESIS_SUITE  # the suite whose report gets this page
 from albot1.report.thesis.figures import animate_map, plot_gap_maps, plot_trace_strip, plot_update_trace
 from albot1.report.thesis.replay import Replay, replay_run
 from albot1.report.thesis.verdicts import FAILS, HOLDS, NOT_COMPARABLE, Verdict
@@ -43,16 +47,21 @@ from albot1.runs.folder import read_run
 
 PAGE = "README.md"
 FIGURES = "figures"
-#: The suite whose report gets this page.
-THESIS_SUITE = "thesis"
-#: The datasets whose every-method plots the thesis suite's benchmark report draws (Experiments 3-5): the page
-#: draws its own figures for the rest, and the public logs' plots are in the default suite's report.
-PICTURED = (SQUARE, DENSE, SPARSE)
+
+
+def pictured() -> tuple[str, ...]:
+    """The datasets whose every-method plots the thesis suite's benchmark report draws (Experiments 3-5).
+
+    The page draws its own figures for the rest, and the public logs' plots are in the default suite's report.
+    """
+    ds = thesis_datasets()
+    return (ds.square, ds.dense, ds.sparse)
 
 
 def own_records(records: list[CellRecord]) -> list[CellRecord]:
-    """The cells of :data:`PICTURED`: the benchmark report of the thesis suite draws its per-dataset plots for these."""
-    return [r for r in records if r.cell.dataset_label in PICTURED]
+    """The cells of :func:`pictured`: the benchmark report of the thesis suite draws its per-dataset plots for these."""
+    shown = pictured()
+    return [r for r in records if r.cell.dataset_label in shown]
 
 
 @dataclass(frozen=True)
@@ -177,6 +186,38 @@ class _Figures:
         return [Drawn(request.caption, path)]
 
 
+def _cached_draw(figures: _Figures, cache: FigureCache, request: FigureRequest) -> list[Drawn]:
+    """``figures.draw(request)``, or what it drew last time when nothing it is drawn from has changed.
+
+    A request reads the runs of its own dataset in every store (and, for a
+    linked figure, the other report's file): their records, the request
+    itself and the colours make its digest (:mod:`albot1.report.figure_cache`).
+    Drawings that failed are not kept: their reason is worked out again.
+    """
+    records = [r for store in figures.ev.stores for r in store.records if r.cell.dataset_label == request.dataset]
+    linked = [
+        (str(path), path.stat().st_size, path.stat().st_mtime_ns)
+        for store in figures.ev.stores[1:]
+        for path in [figures.out.parent / store.name / "plots" / f"{slug(request.dataset)}-maps.png"]
+        if path.is_file()
+    ]
+    colors = sorted((k, v) for k, v in figures.colors.items() if k in {r.cell.method_label for r in records})
+    digest = inputs_digest(records, "thesis", repr(request), colors, linked)
+    group = f"thesis:{request.stem}"
+    cached = cache.lookup(group, digest)
+    if cached is not None:
+        return [Drawn(caption, cache.path(path), reason) for caption, path, reason in cached.payload]
+    drawn = figures.draw(request)
+    if all(d.path is not None for d in drawn):
+        cache.store(
+            group,
+            digest,
+            [d.path for d in drawn if d.path],
+            [[d.caption, cache.name(d.path), d.reason] for d in drawn if d.path],
+        )
+    return drawn
+
+
 # --------------------------------------------------------------------------- Markdown
 
 
@@ -298,15 +339,14 @@ def _parameters(ev: Evidence, sections: list[Section], out: Path) -> list[str]:
         "- Metric settings, as stored in the metrics of the runs (docs/metrics.md):",
     ]
     for store in ev.stores:
-        sample = next((r.metrics for r in store.records if r.metrics is not None and r.metrics.map_shape), None)
-        if sample is not None and sample.map_shape is not None:
+        shape = next((sb for r in store.records if r.metrics is not None and (sb := r.metrics.get(MAP_SHAPE))), None)
+        if shape is not None:
             lines.append(
-                f"  - map shape: tolerance {sample.map_shape.tolerance_m:g} m, voxel {sample.map_shape.voxel_m:g} m, "
-                f"alignment {sample.map_shape.alignment} (`{store.path}`)"
+                f"  - map shape: tolerance {shape.tolerance_m:g} m, voxel {shape.voxel_m:g} m, "
+                f"alignment {shape.alignment} (`{store.path}`)"
             )
-        orientation = next((r.metrics for r in store.records if r.metrics is not None and r.metrics.orientation), None)
-        if orientation is not None and orientation.orientation is not None:
-            o = orientation.orientation
+        o = next((ob for r in store.records if r.metrics is not None and (ob := r.metrics.get(ORIENTATION))), None)
+        if o is not None:
             lines.append(
                 f"  - orientation: a stop every {o.every_m:g} m, bearing undefined within {o.min_distance_m:g} m of "
                 f"the start, alignment {o.alignment} (`{store.path}`)"
@@ -354,9 +394,11 @@ def write_thesis_page(
     drawn: dict[str, list[Drawn]] = {}
     if plots:
         figures = _Figures(ev, out, method_colors(labels))
+        cache = FigureCache(figures.dir)
         for section in sections:
             for request in section.figures:
-                drawn[request.stem] = figures.draw(request)
+                drawn[request.stem] = _cached_draw(figures, cache, request)
+        cache.save()
     lines = [
         "# The thesis's experiments, reproduced",
         "",
@@ -386,6 +428,13 @@ def write_thesis_page(
     for section in sections:
         lines += _section_lines(section, drawn, out)
     lines += _parameters(ev, sections, out)
+    lines += [
+        "## Data",
+        "",
+        "The sha256 (first 12 hex digits) of the files each dataset's numbers come from:",
+        "",
+        *[f"- {md_text(line)}" for line in data_lines([r for s in ev.stores for r in s.records])],
+    ]
     page = out / PAGE
     page.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return page

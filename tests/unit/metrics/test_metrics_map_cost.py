@@ -80,3 +80,15 @@ def test_cost_statistics_and_growth_slope() -> None:
     assert flat["growth_slope_ms_per_1000_scans"] == pytest.approx(0.0, abs=1e-9)
     with pytest.raises(MetricsError, match="no per-scan times"):
         cost(np.array([]))
+
+
+def test_the_start_up_is_carried_apart_from_the_per_scan_figures() -> None:
+    from albot1.metrics.measures.cost import CostBlock, headline
+
+    per_scan_ms = np.full(100, 2.0)
+    block = cost(per_scan_ms * 1e6, {"total_s": 0.2, "startup_s": 1.5})
+    assert block["startup_s"] == 1.5
+    assert block["per_scan_ms_mean"] == pytest.approx(2.0)  # the start-up is in no per-scan figure
+    assert block["process_total_s"] == pytest.approx(0.2)
+    assert headline(CostBlock.model_validate(block)).endswith("start-up 1.50 s")
+    assert cost(per_scan_ms * 1e6, {})["startup_s"] is None  # a run recorded before it was measured

@@ -3,12 +3,17 @@
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from albot1.metrics.errors import MetricsError
-from albot1.metrics.places import believed_in_world, judge_places, judge_revisits
+from albot1.metrics.measures.places import METRIC as PLACES
+from albot1.metrics.measures.places import compute as places_compute
+from albot1.metrics.measures.places import headline as places_headline
+from albot1.metrics.places import believed_in_world, judge_network, judge_revisits
+from albot1.metrics.unit import MetricInputs
 
 # Two rooms side by side, x 0..5 (room-a) and 5.2..10 (room-b), joined by a doorway at x = 5.1, y 2..3.
 SPACES = [{"name": "room-a", "rect": [0.0, 0.0, 5.0, 5.0]}, {"name": "room-b", "rect": [5.2, 0.0, 10.0, 5.0]}]
@@ -84,7 +89,7 @@ def test_points_are_put_in_the_world_as_the_robot_believed_them() -> None:
     np.testing.assert_allclose(believed_in_world(point, estimate, reference), [7.0, 5.0], atol=1e-12)
 
 
-def test_judge_places_scores_exit_predictions_and_crossings() -> None:
+def test_judge_network_scores_exit_predictions_and_crossings() -> None:
     ref = route()
     # the map is the world shifted by (-1, 0): estimate = reference - (1, 0)
     est = ref - np.array([1.0, 0.0, 0.0])
@@ -97,19 +102,64 @@ def test_judge_places_scores_exit_predictions_and_crossings() -> None:
     rec = record([0, 1, 0, 1], [(2, 0, "structure"), (3, 1, "exit")])
     rec["crossings"] = [crossing, {"scan": 19, "exit": 0, "segment": [4.1, 2.0, 4.1, 3.0], "prediction": None}]
     dataset = {"spaces": SPACES, "doorways": DOORWAYS, "doorway_crossings": [{"scan": 20}, {"scan": 40}, {"scan": 60}]}
-    judged = judge_places({"places.json": rec, "places.graphml": "<g/>"}, est, ref, dataset)
-    c = judged.counters
-    assert c["exit_prediction_aligned_true_mean_m"] == pytest.approx(0.1)
-    assert c["exit_prediction_not_aligned_true_mean_m"] == pytest.approx(math.hypot(1.0, 0.5))
-    assert (c["crossings_true"], c["crossings_false"], c["crossings_missed"]) == (2, 0, 1)
-    out = judged.files["places.json"]
-    assert [r["true"] for r in out["revisits"]] == [True, True]
-    assert out["ground_truth"]["exits"]["exit_predictions"][0]["doorway"] == "door"
-    assert judged.files["places.graphml"] == "<g/>" and "true" not in rec["revisits"][0]
+    block = judge_network(rec, est, ref, dataset)
+    exits = block["exits"]
+    assert exits["exit_prediction_aligned_true_mean_m"] == pytest.approx(0.1)
+    assert exits["exit_prediction_not_aligned_true_mean_m"] == pytest.approx(math.hypot(1.0, 0.5))
+    assert (exits["crossings_true"], exits["crossings_false"], exits["crossings_missed"]) == (2, 0, 1)
+    assert exits["exit_predictions"][0]["doorway"] == "door"
+    assert block["claims_true"] == [True, True] and block["rule"] == "rooms"
+    assert "true" not in rec["revisits"][0] and "ground_truth" not in rec  # the method's file is left as it was
 
 
-def test_judge_places_refuses_mismatched_inputs() -> None:
-    with pytest.raises(MetricsError, match="no places.json"):
-        judge_places({}, route(), route(), {})
+def test_judge_network_without_doorways_says_why_there_is_no_exit_check() -> None:
+    block = judge_network(record([0, 1, 2, 3], []), route(), route(), {"spaces": SPACES})
+    assert block["exits"] is None and block["exits_reason"].startswith("the dataset knows no doorways")
+    assert math.isnan(block["revisit_precision"]) and block["revisit_recall"] == 0.0  # no claim: undefined, not 0
+
+
+def test_judge_network_refuses_mismatched_inputs() -> None:
     with pytest.raises(MetricsError, match="80 estimated poses but 79 reference poses"):
-        judge_places({"places.json": record([0, 1, 0, 1], [])}, route(), route()[:79], {})
+        judge_network(record([0, 1, 0, 1], []), route(), route()[:79], {})
+
+
+def _places_inputs(rec: dict | None, extra: dict, estimate: np.ndarray | None = None) -> MetricInputs:
+    ref = route()
+    est = ref if estimate is None else estimate
+    files = {"places.json": rec} if rec is not None else {}
+    return MetricInputs(
+        dataset="two-rooms",
+        timestamps=np.arange(80.0),
+        poses=est,
+        reference=ref,
+        relations=None,
+        relations_source="",
+        relation_timestamps=np.arange(80.0),
+        relation_poses=est,
+        open_dataset=lambda: SimpleNamespace(metadata=SimpleNamespace(extra=extra)),  # type: ignore[arg-type,return-value]
+        read_file=files.get,
+    )
+
+
+def test_the_places_metric_judges_the_claims_file_into_its_block_and_headline() -> None:
+    rec = record([0, 1, 0, 2], [(2, 0, "structure")])  # visit 3 (room-b again) made a new place: one missed
+    inputs = _places_inputs(rec, {"spaces": SPACES})
+    assert PLACES.missing(inputs) is None
+    block = places_compute(inputs)
+    assert (block.claims, block.revisits_true, block.revisits_missed, block.revisits_actual) == (1, 1, 1, 2)
+    assert (block.revisit_precision, block.revisit_recall, block.rooms) == (1.0, 0.5, ["room-a", "room-b"] * 2)
+    assert block.exits is None and block.exits_reason == "the dataset knows no doorways (exit checks need them)"
+    assert places_headline(block) == (
+        "1 of 1 claimed re-visits true (precision 1.00), recall 0.50 of 2 true re-visits (rooms)"
+    )
+
+
+def test_the_places_metric_does_not_apply_without_a_claims_file_and_says_why() -> None:
+    inputs = _places_inputs(None, {})
+    assert PLACES.missing(inputs) == "the method keeps no network of places (no places.json)"
+
+
+def test_a_claims_file_of_the_wrong_shape_is_one_clear_error() -> None:
+    bad = {"visits": [{"id": 0}], "revisits": []}
+    with pytest.raises(MetricsError, match=r"^places.json: unexpected content \(KeyError: 'first_scan'\)$"):
+        places_compute(_places_inputs(bad, {}))

@@ -11,7 +11,7 @@ from matplotlib.image import imread
 from albot1.bench.grid import Cell
 from albot1.data.model import Frame, Scan, Sequence
 from albot1.geometry import se2
-from albot1.records import MetricsRecord
+from albot1.metrics.record import MetricsRecord
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, severity_order
 from albot1.report.cost_plots import plot_scan_time
 from albot1.report.map_plots import occupancy, plot_maps

@@ -12,7 +12,8 @@ from albot1.bench.store import Failure
 from albot1.data.model import Frame, Relations, Scan, Sequence
 from albot1.geometry import se2
 from albot1.methods.baselines.published import published_systems
-from albot1.records import MetricsRecord, ResultRecord, read_record
+from albot1.metrics.record import MetricsRecord
+from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
 from albot1.report.standard import PAGE, STANDARD_LOGS, TABLE, measured_rows, published_rows, write_standard
 from albot1.runs.evaluate import evaluate_run

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import re
 import shutil
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +24,15 @@ from albot1.report.errors import ReportError
 from albot1.report.index import build_report
 from albot1.report.thesis import figures
 from albot1.report.thesis.evidence import open_stores
-from albot1.report.thesis.experiments import SQUARE, section_error_tolerance, section_places, section_spacing
+from albot1.report.thesis.experiments import (
+    section_error_tolerance,
+    section_places,
+    section_public,
+    section_spacing,
+    thesis_datasets,
+)
+from albot1.report.thesis.experiments.common import RELATIONS_USED
+from albot1.report.thesis.experiments.exp6_public import Scoring
 from albot1.report.thesis.figures import MAX_GIF_BYTES
 from albot1.report.thesis.page import write_thesis_page
 from albot1.report.thesis.replay import replay_run
@@ -34,6 +41,8 @@ from albot1.settings import get_settings
 
 LINK = re.compile(r"\]\(([^)#\s]+)\)")
 FAILED_METHOD = "albot1:plus"
+#: Experiment 3's square world, as the thesis suite file names it.
+SQUARE = thesis_datasets().square
 
 
 def _suite(name: str, datasets: list[dict[str, object]]) -> dict[str, object]:
@@ -156,19 +165,14 @@ def test_a_replay_that_does_not_reproduce_the_stored_run_is_refused(results: Pat
         replay_run(copy)
 
 
-def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path) -> None:
     """A failed baseline's n/a in the relation table is explained by its recorded reason, not left bare.
 
-    The synthetic world has no ground-truth relations, so the section is pointed at its ATE and RPE and at
-    the thesis error level the tiny store ran; the rows, n/a cells and notes are the section's own.
+    The synthetic world has no ground-truth relations, so the section scores it by its ATE and RPE at the
+    thesis error level the tiny store ran; the rows, n/a cells and notes are the section's own.
     """
-    from albot1.report.thesis import experiments
-
-    monkeypatch.setattr(experiments, "_public", lambda dataset: dataset == SQUARE)
-    monkeypatch.setattr(experiments, "RELATION_M", "ate.rmse_m")
-    monkeypatch.setattr(experiments, "RELATION_DEG", "rpe.rotation_deg.rmse")
-    monkeypatch.setattr(experiments, "_n", partial(_n_at_thesis_level, experiments._n))
-    section = experiments.section_public(open_stores(results))
+    scoring = Scoring("ate.rmse_m", "rpe.rotation_deg.rmse", RELATIONS_USED, degradation="thesis")
+    section = section_public(open_stores(results), scoring, candidates=[SQUARE])
     assert section.tables and "n/a" in section.tables[0] and f"`{SQUARE}`" in section.tables[0]
     why = [note for note in section.notes if note.startswith("Why a cell of the relation table reads n/a")]
     assert len(why) == 1
@@ -177,7 +181,27 @@ def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path, monkeyp
     assert "`odometry` on" not in why[0] and "`albot1:literal` on" not in why[0]  # measured: no note
 
 
-def _n_at_thesis_level(
-    inner: Any, ev: Any, dataset: str, method: str, path: str, label: str, unit: str = "", deg: str = "none"
-) -> Any:
-    return inner(ev, dataset, method, path, label, unit, "thesis")
+def test_a_page_written_again_draws_no_figure_whose_runs_did_not_change(
+    results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from albot1.report.thesis import page as page_module
+
+    monkeypatch.setattr(figures, "MAX_TRACE_PANELS", 4)
+    monkeypatch.setattr(figures, "MAX_FRAMES", 6)
+    drawn: list[str] = []
+    original = page_module._Figures.draw
+
+    def spy(self: Any, request: Any) -> Any:
+        drawn.append(request.stem)
+        return original(self, request)
+
+    monkeypatch.setattr(page_module._Figures, "draw", spy)
+    first = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
+    assert drawn
+    made = sorted(drawn)
+    drawn.clear()
+    second = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
+    # only the requests that could not be drawn (a failed run, no run) are worked out again, for their reason
+    assert set(drawn) < set(made)
+    strip = re.compile(r"^Generated .*$", re.MULTILINE)
+    assert strip.sub("", first) == strip.sub("", second)

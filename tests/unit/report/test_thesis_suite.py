@@ -6,17 +6,13 @@ from __future__ import annotations
 from albot1.bench.suite import find_suite, load_suite
 from albot1.data import catalog
 from albot1.data.synthetic import worlds
-from albot1.report.thesis.experiments import (
-    DENSE,
-    DOUBLE_LOOP,
-    PLACES_STARTS,
-    PLACES_VARIANTS,
-    SLAM_BASELINES,
-    SPARSE,
-    SQUARE,
-    TWO_LAPS,
-    VARIANTS,
-)
+from albot1.report.thesis.experiments.common import PLACES_VARIANTS, SLAM_BASELINES, VARIANTS
+from albot1.report.thesis.experiments.datasets import thesis_datasets
+
+#: The thesis's own experiments' datasets, found in the suite file by their tags.
+_DS = thesis_datasets()
+SQUARE, DENSE, SPARSE = _DS.square, _DS.dense, _DS.sparse
+PLACES_STARTS, DOUBLE_LOOP, TWO_LAPS = _DS.places_starts, _DS.double_loop, _DS.two_laps
 
 #: The standard logs on which the default suite runs Experiment 6's RBPF baseline (the thesis page reads it there).
 RBPF_LOGS = ("aces", "intel", "mit-csail", "fr079")

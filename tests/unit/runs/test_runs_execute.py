@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import time
 from typing import Any, ClassVar
 
 import numpy as np
@@ -51,8 +52,19 @@ class FakeMapper:
     def __init__(self, config: FakeConfig, *, seed: int = 0) -> None:
         self.config = config
         self.n = 0
+        self.warmed = False
+
+    def warm_up(self, announce: Any = None) -> None:
+        """In mode ``warm``: a start-up that must happen before the first scan and stay out of its time."""
+        if self.config.mode == "warm":
+            time.sleep(0.2)
+            self.warmed = True
+            if announce is not None:
+                announce("fake: warmed up")
 
     def process(self, frame: Frame) -> None:
+        if self.config.mode == "warm" and not self.warmed:
+            raise RuntimeError("process before warm_up")
         if self.config.mode == "raise" and frame.index == 3:
             raise ZeroDivisionError("boom")
         if self.config.mode == "child" and frame.index == 0:  # an external program's CPU time (as MRPT's)
@@ -118,6 +130,17 @@ def test_successful_run_records_everything(fake_method: str) -> None:
     assert not np.allclose(result.odometry, _sequence().odometry)  # degraded before the method saw it
     cpu_s = result.timing().cpu_s
     assert cpu_s is not None and 0.0 <= cpu_s
+
+
+def test_the_warm_up_runs_before_the_timed_loop_and_is_recorded_as_startup(fake_method: str) -> None:
+    said: list[str] = []
+    result = run_method(fake_method, _sequence(), overrides={"mode": "warm"}, announce=said.append)
+    timing = result.timing()
+    assert said == ["fake: warmed up"]
+    assert timing.startup_s is not None and timing.startup_s >= 0.2  # it slept 0.2 s
+    assert timing.total_s == float(result.per_scan_ns.sum()) / 1e9 + timing.finish_s  # start-up is not scan time
+    assert timing.wall_s >= timing.startup_s
+    assert run_method(fake_method, _sequence()).timing().startup_s is not None
 
 
 def test_the_cpu_time_counts_the_external_program_the_method_waited_for(fake_method: str) -> None:

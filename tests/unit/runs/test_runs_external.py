@@ -13,13 +13,16 @@ from albot1.cli.app import app
 from albot1.data.model import Frame, Relations, Scan, Sequence
 from albot1.data.trajectory import read_tum, write_tum
 from albot1.geometry import se2
-from albot1.records import METRIC_NAMES, MetricsRecord
+from albot1.metrics.record import MetricsRecord
+from albot1.metrics.registry import metric_registry
 from albot1.runs.errors import RunError
 from albot1.runs.evaluate import evaluate_run, evaluate_trajectory
 from albot1.runs.evo_results import write_evo_results
 from albot1.runs.execute import run_method
 from albot1.runs.external import NO_MAP, match_by_time
 from albot1.runs.folder import write_run
+
+METRIC_NAMES = metric_registry().names
 
 N = 130
 SCORED_ALIKE = ("ate", "ate_windows", "rpe", "drift", "loop_gap", "orientation", "relations")

@@ -1,4 +1,4 @@
-"""A mapper's extra files in the run folder, and the runner's evaluation-only judge (albot1-places)."""
+"""A mapper's extra files in the run folder, and the places metric judging albot1-places's claims in them."""
 
 from __future__ import annotations
 
@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 
 from albot1.data.open import open_sequence
+from albot1.metrics.measures.places import METRIC as PLACES
 from albot1.records import ResultRecord, read_record
 from albot1.report.preview import render_preview
 from albot1.runs.errors import RunError
+from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import STANDARD_FILES, is_complete, write_run
 
@@ -44,16 +46,22 @@ def test_albot1_places_run_folder_has_its_network_judged_against_the_reference(t
     counters = read_record(ResultRecord, run_dir / "result.json").counters
     # one doorway crossed (door-1-2 at scan 66): two places' visits, no re-visit to claim or miss
     assert counters["exits_crossed"] == 1 and counters["places_created"] == 1 and counters["visits"] == 2
-    assert (counters["crossings_true"], counters["crossings_false"], counters["crossings_missed"]) == (1, 0, 0)
-    assert (counters["revisits_true"], counters["revisits_false"], counters["revisits_missed"]) == (0, 0, 0)
+    # the runner does not judge: the method's claims leave the run as the mapper wrote them ...
+    assert "crossings_true" not in counters and "revisits_true" not in counters
     places = json.loads((run_dir / "places.json").read_text())
-    assert places["ground_truth"]["revisits"]["rooms"] == ["room-1", "room-2"]
-    assert places["crossings"][0]["scan"] == pytest.approx(66, abs=5)
+    assert "ground_truth" not in places and places["crossings"][0]["scan"] == pytest.approx(66, abs=5)
     ET.fromstring((run_dir / "places.graphml").read_text())
     assert "places" in json.loads((run_dir / "extras.json").read_text())
+    # ... and the evaluation judges them against the reference poses: the places metric
+    block = evaluate_run(run_dir).get(PLACES)
+    assert block is not None and block.rule == "rooms" and block.rooms == ["room-1", "room-2"]
+    assert block.exits is not None
+    assert (block.exits.crossings_true, block.exits.crossings_false, block.exits.crossings_missed) == (1, 0, 0)
+    assert (block.revisits_true, block.revisits_false, block.revisits_missed, block.claims) == (0, 0, 0, 0)
+    assert block.revisit_precision is None and block.revisit_recall is None  # nothing to claim: undefined
 
 
-def test_without_reference_poses_there_is_no_judgement() -> None:
+def test_without_reference_poses_there_is_no_judgement(tmp_path: Path) -> None:
     seq = open_sequence("synthetic-places-loop[:100]")
     from albot1.data.model import Sequence
 
@@ -61,3 +69,12 @@ def test_without_reference_poses_there_is_no_judgement() -> None:
     result = run_method("albot1-places", Sequence.from_frames("no-reference", frames))
     assert result.reference is None
     assert "revisits_true" not in result.counters and "ground_truth" not in result.files["places.json"]
+    metrics = evaluate_run(write_run(result, tmp_path))
+    assert metrics.get(PLACES) is None and metrics.reason("places") == "the dataset has no reference poses"
+
+
+def test_a_method_without_a_network_of_places_has_no_places_metric(tmp_path: Path) -> None:
+    run_dir = write_run(run_method("odometry", open_sequence("synthetic-places-loop[:20]")), tmp_path)
+    metrics = evaluate_run(run_dir)
+    assert metrics.places is None  # type: ignore[attr-defined]  # the runtime record has every metric's field
+    assert metrics.reason("places") == "the method keeps no network of places (no places.json)"

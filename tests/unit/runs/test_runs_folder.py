@@ -166,7 +166,7 @@ def test_per_scan_times_are_written_atomically_and_no_temporary_file_stays(
     ("damage", "words"),
     [
         (lambda d: (d / "per_scan_ns.npy").unlink(), r"per_scan_ns\.npy: missing from a run folder marked complete"),
-        (lambda d: (d / "per_scan_ns.npy").write_text("garbage"), r"per_scan_ns\.npy: not readable as a numpy array"),
+        (lambda d: (d / "per_scan_ns.npy").write_text("garbage"), r"per_scan_ns\.npy: not a numpy array file this project wrote"),
         (
             lambda d: np.save(d / "per_scan_ns.npy", np.zeros(3)),
             r"per_scan_ns\.npy: holds float64 of shape \(3,\); expected a \.npy array of 8 per-scan times",

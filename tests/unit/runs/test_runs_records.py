@@ -10,22 +10,17 @@ import pytest
 
 from albot1.data.model import Frame, Relations, Scan, Sequence, SequenceMetadata
 from albot1.geometry import se2
-from albot1.records import (
-    METRIC_NAMES,
-    AteBlock,
-    ClosedRouteGapBlock,
-    LoopGapBlock,
-    MetricsRecord,
-    RecordError,
-    RelationsBlock,
-    ResultRecord,
-    dump_record,
-    parse_record,
-    read_record,
-)
+from albot1.metrics.measures.ate import AteBlock
+from albot1.metrics.measures.loop_gap import ClosedRouteGapBlock, LoopGapBlock
+from albot1.metrics.measures.relations import RelationsBlock
+from albot1.metrics.record import MetricsRecord
+from albot1.metrics.registry import metric_registry
+from albot1.records import RecordError, ResultRecord, dump_record, parse_record, read_record
 from albot1.runs.evaluate import METRICS_FILE, evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import RESULT_FILE, read_result, write_run
+
+METRIC_NAMES = metric_registry().names
 
 N = 130  # 1 m and 3 deg per scan: a 120 m circle driven about 1.1 times, 1 s per scan
 

@@ -29,7 +29,8 @@ from albot1.bench.suite import parse_suite
 from albot1.cli.app import app
 from albot1.data.model import Relations
 from albot1.data.relations import read_relations, write_relations
-from albot1.records import MetricsRecord, RelationsBlock
+from albot1.metrics.measures.relations import RelationsBlock
+from albot1.metrics.record import MetricsRecord
 from albot1.runs.folder import METRICS_FILE
 from albot1.settings import get_settings
 

@@ -1,10 +1,10 @@
 """The per-scan loops of Albot1's map update and of the perceptual map's grid index.
 
 Plain Python over numpy arrays and scalars in the subset numba compiles;
-:mod:`albot1.methods.albot1.mapping.accel` hands out either the jitted or the
-interpreted version of the same source (tests run both on the same inputs).
-Segment geometry comes from :mod:`albot1.geometry.segments`, compiled
-together with these loops.
+numba compiles them (:mod:`albot1.methods.albot1.compiled`) and
+:class:`MappingKernels` hands out the compiled or the Python version of the
+same source (tests run both on the same inputs). Segment geometry comes from
+:mod:`albot1.geometry.segments`, compiled into these loops.
 
 Distances use ``np.hypot``, not ``math.hypot``: numba compiles both to C's
 ``hypot``, while CPython's ``math.hypot`` is its own, more accurate routine
@@ -20,12 +20,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.segments import closest_parameter, line_angle, segment_distance
+from albot1.methods.albot1.compiled import kernel, select
+from albot1.methods.albot1.mapping import pose_kernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
 
+@kernel
 def classify_endpoints(
     poly: FloatArray, view: FloatArray, pts: FloatArray, margin: float, surfaces_only: bool
 ) -> BoolArray:
@@ -80,6 +83,7 @@ def classify_endpoints(
     return out
 
 
+@kernel
 def best_correspondence(
     seg: FloatArray, view: FloatArray, taken: BoolArray, max_angle: float, max_distance: float
 ) -> int:
@@ -101,6 +105,7 @@ def best_correspondence(
     return best
 
 
+@kernel
 def clip_parameter(
     poly: FloatArray, view: FloatArray, x0: float, y0: float, x1: float, y1: float, margin: float, surfaces_only: bool
 ) -> float:
@@ -131,6 +136,7 @@ TRIMMED = 2
 DELETED = 3
 
 
+@kernel
 def resolve_partial(
     segs: FloatArray,
     p1_inside: BoolArray,
@@ -212,3 +218,14 @@ def resolve_partial(
         else:
             action[r] = TRIMMED
     return action, new, match
+
+
+class MappingKernels:
+    """The map-update and Albot1+ pose kernels a mapper calls: each compiled, or its Python source."""
+
+    def __init__(self, compiled: bool = True) -> None:
+        self.compiled = compiled
+        self.classify_endpoints = select(classify_endpoints, compiled)
+        self.resolve_partial = select(resolve_partial, compiled)
+        self.refine_pose = select(pose_kernels.refine_pose, compiled)
+        self.scan_points = select(pose_kernels.scan_points, compiled)

@@ -30,18 +30,19 @@ from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
 from albot1.geometry.segments import transform_segments
-from albot1.methods.albot1.mapping.accel import mapping_kernels
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
+from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
-from albot1.methods.albot1.perception.accel import perception_kernels
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
 from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise
 from albot1.methods.albot1.perception.view import View, construct_view
+from albot1.methods.albot1.warm_up import warm_up
 
 
 @dataclass(slots=True)
@@ -105,8 +106,8 @@ class Albot1Mapper:
     def __init__(self, config: Albot1Config, *, seed: int = 0) -> None:
         # The method is deterministic; ``seed`` is accepted for the protocol.
         self.config = config
-        self._pk = perception_kernels(config.accelerate)
-        self._mk = mapping_kernels(config.accelerate)
+        self._pk = PerceptionKernels(config.accelerate)
+        self._mk = MappingKernels(config.accelerate)
         self._view_params = config.view_params()
         self._update_params = UpdateParams(
             delete_margin=config.delete_margin_m,
@@ -173,6 +174,16 @@ class Albot1Mapper:
         )
 
     # -- Algorithm 4 -------------------------------------------------------
+    @property
+    def kernels(self) -> tuple[PerceptionKernels, MappingKernels]:
+        """The kernel sets this mapper calls (compiled unless ``accelerate`` is false)."""
+        return self._pk, self._mk
+
+    def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
+        """Compile every kernel now (or load numba's cache), before the runner's timed loop (``Mapper.warm_up``)."""
+        if self.config.accelerate:
+            warm_up(self.kernels, announce)
+
     def process(self, frame: Frame) -> None:
         n = self._n
         scan = frame.scan

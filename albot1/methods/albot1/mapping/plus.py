@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
-from albot1.methods.albot1.mapping.accel import MappingKernels
+from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.perception.endpoints import STABLE
 
 FloatArray = NDArray[np.float64]

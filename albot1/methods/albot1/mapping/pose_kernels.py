@@ -1,9 +1,10 @@
 """The per-scan loop of Albot1+'s pose: robust Gauss-Newton over landmark and scan terms.
 
 Plain Python over numpy arrays and scalars in the subset numba compiles;
-:mod:`albot1.methods.albot1.mapping.accel` hands out either the jitted or
-the interpreted version of the same source (tests run both on the same
-inputs). The maths is in ``docs/albot1-mapper.md`` ("Albot1+"); the caller
+numba compiles them (:mod:`albot1.methods.albot1.compiled`) and
+:class:`albot1.methods.albot1.mapping.kernels.MappingKernels` hands out the
+compiled or the Python version of the same source (tests run both on the
+same inputs). The maths is in ``docs/albot1-mapper.md`` ("Albot1+"); the caller
 is :mod:`albot1.methods.albot1.mapping.plus`.
 
 The unknown is the view's pose ``(x, y, phi)`` in the map (thesis frame): a
@@ -33,6 +34,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import closest_parameter
+from albot1.methods.albot1.compiled import jitable, kernel
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -46,6 +48,7 @@ MAX_STEP_M = 0.5
 MAX_STEP_RAD = 0.1
 
 
+@jitable
 def huber_weight(residual: float, threshold: float) -> float:
     """The IRLS weight of Huber's loss: 1 inside ``threshold``, ``threshold / |r|`` beyond."""
     a = abs(residual)
@@ -54,6 +57,7 @@ def huber_weight(residual: float, threshold: float) -> float:
     return threshold / a
 
 
+@jitable
 def huber_cost(residual: float, threshold: float) -> float:
     """Huber's loss: ``r^2 / 2`` inside ``threshold``, linear beyond (the cost :func:`huber_weight` minimises)."""
     a = abs(residual)
@@ -67,6 +71,7 @@ def huber_cost(residual: float, threshold: float) -> float:
 NormalSums = tuple[float, float, float, float, float, float, float, float, float]
 
 
+@jitable
 def add_point_to_line(
     sums: NormalSums,
     nx: float,
@@ -106,6 +111,7 @@ def add_point_to_line(
     )
 
 
+@jitable
 def surface_boxes(ref: FloatArray, margin: float) -> FloatArray:
     """Each surface's bounding box grown by ``margin``: ``(m, 4)`` xmin, ymin, xmax, ymax."""
     boxes = np.empty((ref.shape[0], 4))
@@ -117,6 +123,7 @@ def surface_boxes(ref: FloatArray, margin: float) -> FloatArray:
     return boxes
 
 
+@jitable
 def nearest_surface(x: float, y: float, ref: FloatArray, boxes: FloatArray, gate: float) -> tuple[int, float]:
     """The surface of ``ref`` nearest the point and its distance, if nearer than ``gate``; else ``(-1, gate)``.
 
@@ -136,6 +143,7 @@ def nearest_surface(x: float, y: float, ref: FloatArray, boxes: FloatArray, gate
     return found, best
 
 
+@jitable
 def pose_cost(
     x: float,
     y: float,
@@ -181,6 +189,7 @@ def pose_cost(
     return total
 
 
+@kernel
 def refine_pose(
     starts: FloatArray,
     lm_view: FloatArray,
@@ -379,6 +388,7 @@ def refine_pose(
     return x, y, phi, info
 
 
+@kernel
 def scan_points(ranges: FloatArray, angles: FloatArray, max_range: float, stride: int) -> FloatArray:
     """Every ``stride``-th return within ``max_range`` (REP-103 beams), as points ``(n, 2)`` in the thesis frame.
 

@@ -17,8 +17,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1.mapping.accel import MappingKernels, mapping_kernels
-from albot1.methods.albot1.mapping.kernels import DELETED, EXTENDED, TRIMMED
+from albot1.methods.albot1.mapping.kernels import DELETED, EXTENDED, TRIMMED, MappingKernels
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 
 FloatArray = NDArray[np.float64]
@@ -75,7 +74,7 @@ def update_map(
     Lines 1-6 (placing the view with the reference landmark) are the
     caller's: that is the localisation pose applied to every surface.
     """
-    k = kernels or mapping_kernels()
+    k = kernels or MappingKernels()
     view_map = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
     m = view_map.shape[0]
     view_ids = np.full(m, -1, dtype=np.int64)

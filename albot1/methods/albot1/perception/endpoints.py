@@ -26,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.methods.albot1.compiled import jitable
+
 UNSTABLE = 0
 OCCLUDING = 1
 CORNER = 2
@@ -36,6 +38,7 @@ STABLE: NDArray[np.bool_] = np.zeros(4, dtype=np.bool_)
 STABLE[[OCCLUDING, CORNER]] = True
 
 
+@jitable
 def is_stable(kind: int) -> bool:
     """Whether an endpoint labelled ``kind`` is stable (compiled into the recognition kernel)."""
     return bool(STABLE[kind])

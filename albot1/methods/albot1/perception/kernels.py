@@ -1,8 +1,8 @@
 """The per-scan loops of Albot1's perception: view construction and landmark recognition.
 
 Every function here is plain Python over numpy arrays and scalars in the
-subset numba compiles. :mod:`albot1.methods.albot1.perception.accel` hands out
-either the jitted or the interpreted version of the same source, so the
+subset numba compiles (:mod:`albot1.methods.albot1.compiled`);
+:class:`PerceptionKernels` hands out the compiled or the Python version of the same source, so the
 accelerated path can never drift from the readable one (tests run both on
 the same inputs). Geometry is in the thesis frame (robot at the origin facing
 +y); endpoint labels are those of
@@ -22,12 +22,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
+from albot1.methods.albot1.compiled import jitable, kernel, select
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, UNSTABLE, is_stable
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
+@kernel
 def build_view(
     ranges: FloatArray,
     angles: FloatArray,
@@ -178,6 +180,7 @@ def build_view(
     return out_s[:m], out_k[:m], out_b[:m], out_c[:m]
 
 
+@jitable
 def _sparse_end(
     px: FloatArray,
     py: FloatArray,
@@ -211,6 +214,7 @@ TLS_CORNER_MIN_SINE = math.sin(math.radians(10.0))
 TLS_CORNER_MAX_SHIFT_M = 0.3
 
 
+@jitable
 def _fit_piece(
     px: FloatArray,
     py: FloatArray,
@@ -267,6 +271,7 @@ def _fit_piece(
     line[m, 3] = uy
 
 
+@jitable
 def _join_corner(line: FloatArray, out_s: FloatArray, m: int, sx: float, sy: float) -> None:
     """Put the point shared by surfaces ``m - 1`` and ``m`` (raw position ``sx, sy``) where their lines cross.
 
@@ -294,6 +299,7 @@ def _join_corner(line: FloatArray, out_s: FloatArray, m: int, sx: float, sy: flo
     out_s[m, 1] = qy
 
 
+@jitable
 def _occlusion(
     ranges: FloatArray, angles: FloatArray, b: int, step: int, margin: float, ox: float, oy: float, tolerance: float
 ) -> int:
@@ -330,6 +336,7 @@ def _occlusion(
     return UNSTABLE
 
 
+@jitable
 def _corner(px: FloatArray, py: FloatArray, a: int, b: int, c: int, min_turn: float) -> int:
     """CORNER when the pieces a->b and b->c turn by at least ``min_turn`` radians at b."""
     ux = px[b] - px[a]
@@ -344,6 +351,7 @@ def _corner(px: FloatArray, py: FloatArray, a: int, b: int, c: int, min_turn: fl
     return UNSTABLE
 
 
+@kernel
 def recognise_landmarks(
     prev: FloatArray,
     prev_kinds: IntArray,
@@ -450,3 +458,12 @@ def recognise_landmarks(
         odc[k] = np.hypot(pred[i, 2 * e], pred[i, 2 * e + 1])
         k += 1
     return oi, oj, os_, og, oa, od, odc
+
+
+class PerceptionKernels:
+    """The perception kernels a mapper calls: each compiled, or its Python source when ``compiled`` is False."""
+
+    def __init__(self, compiled: bool = True) -> None:
+        self.compiled = compiled
+        self.build_view = select(build_view, compiled)
+        self.recognise_landmarks = select(recognise_landmarks, compiled)

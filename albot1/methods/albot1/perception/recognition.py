@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, PoseLike
-from albot1.methods.albot1.perception.accel import PerceptionKernels, perception_kernels
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -97,7 +97,7 @@ def recognise(
     id onto the current surface (the last pair wins) and each current
     surface is saved once.
     """
-    k = kernels or perception_kernels()
+    k = kernels or PerceptionKernels()
     if len(previous) == 0 or len(surfaces) == 0:
         return Tracked.fresh(np.empty((0, 4)), np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.int64))
     i, j, side, gap, angle_diff, d_prev, d_prev_cur = k.recognise_landmarks(

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1.perception.accel import PerceptionKernels, perception_kernels
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -86,7 +86,7 @@ def construct_view(
     The thesis orders surfaces left to right, i.e. by *descending* beam
     angle, so the beams are reversed before the pass.
     """
-    k = kernels or perception_kernels()
+    k = kernels or PerceptionKernels()
     r = np.ascontiguousarray(np.asarray(ranges, dtype=np.float64)[::-1])
     a = np.ascontiguousarray(np.asarray(angles, dtype=np.float64)[::-1])
     surfaces, kinds, beams, cluster = k.build_view(

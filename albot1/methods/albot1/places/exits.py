@@ -34,8 +34,8 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import segments_cross, transform_segments
 from albot1.methods.albot1.perception.view import View
-from albot1.methods.albot1.places.accel import PlacesKernels
 from albot1.methods.albot1.places.config import ExitParams
+from albot1.methods.albot1.places.kernels import PlacesKernels
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

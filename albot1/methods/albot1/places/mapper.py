@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from dataclasses import dataclass
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -41,14 +41,16 @@ from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
-from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
+from albot1.methods.albot1.places.counts import PlacesCounts, places_counters
 from albot1.methods.albot1.places.exits import Crossing, ExitTracker
+from albot1.methods.albot1.places.kernels import PlacesKernels
 from albot1.methods.albot1.places.matcher import confirm, structural, trigger_threshold
 from albot1.methods.albot1.places.memory import Place, PlaceNetwork, Visit, invert, same_surfaces
 from albot1.methods.albot1.places.navigation import Prediction, align_at_exit, nearest_prediction, predict
 from albot1.methods.albot1.places.network import network_files
 from albot1.methods.albot1.places.presets import PlacesPresets
+from albot1.methods.albot1.warm_up import warm_up
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -56,16 +58,6 @@ IntArray = NDArray[np.int64]
 
 #: The current place's empty space is that of its last this many updates (bounds the conflict test's cost).
 _MAX_POLYGONS = 30
-
-
-@dataclass
-class _Counts:
-    exits_crossed: int = 0
-    revisits_by_structure: int = 0
-    revisits_by_exit: int = 0
-    match_attempts: int = 0
-    merges_refused: int = 0
-    updates_forced: int = 0
 
 
 class Albot1PlacesMapper:
@@ -79,7 +71,7 @@ class Albot1PlacesMapper:
         self.config = config
         self.inner = Albot1Mapper(config, seed=seed)
         self.inner.on_update = self._on_update
-        self._k = places_kernels(config.accelerate)
+        self._k = PlacesKernels(config.accelerate)
         self._match = config.match_params()
         self.exits = ExitTracker(config.exit_params(), self._k)
         self._same_angle = math.radians(config.match_angle_deg)
@@ -105,8 +97,13 @@ class Albot1PlacesMapper:
         self._predictions: list[dict[str, Any]] = []
         self._revisits: list[dict[str, Any]] = []
         self._crossings: list[dict[str, Any]] = []
-        self._counts = _Counts()
+        self._counts = PlacesCounts()
         self._n = 0
+
+    def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
+        """Compile every kernel, the places layer's too, before the timed loop (:meth:`Albot1Mapper.warm_up`)."""
+        if self.config.accelerate:
+            warm_up((*self.inner.kernels, self._k), announce)
 
     # -- per scan ----------------------------------------------------------------------------------------------
     def process(self, frame: Frame) -> None:
@@ -472,30 +469,8 @@ class Albot1PlacesMapper:
     # -- output ------------------------------------------------------------------------------------------------
     def finish(self) -> MapperOutput:
         out = self.inner.finish()
-        network, c = self.network, self._counts
-        counters = dict(out.counters)
-        counters.update(
-            places_created=len(network.places),
-            places=len(network.live_places()),
-            places_merged=len(network.places) - len(network.live_places()),
-            visits=len(network.visits),
-            exits_tracked=self.exits.confirmed,
-            exit_detections=self.exits.detections,
-            exits_crossed=c.exits_crossed,
-            revisits_confirmed=c.revisits_by_structure + c.revisits_by_exit,
-            revisits_by_structure=c.revisits_by_structure,
-            revisits_by_exit=c.revisits_by_exit,
-            match_attempts=c.match_attempts,
-            merges_refused=c.merges_refused,
-            updates_forced=c.updates_forced,
-        )
-        compared = [r["prediction"] for r in self._crossings if r["prediction"] is not None]
-        if compared:
-            counters["exit_predictions_compared"] = len(compared)
-            counters["exit_prediction_aligned_mean_m"] = float(np.mean([p["aligned_distance_m"] for p in compared]))
-            counters["exit_prediction_not_aligned_mean_m"] = float(
-                np.mean([p["not_aligned_distance_m"] for p in compared])
-            )
+        network = self.network
+        counters = places_counters(out.counters, network, self.exits, self._counts, self._crossings)
         files = network_files(
             network,
             crossings=self._crossings,

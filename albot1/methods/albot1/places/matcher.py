@@ -26,8 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose
-from albot1.methods.albot1.places.accel import PlacesKernels
 from albot1.methods.albot1.places.config import MatchParams
+from albot1.methods.albot1.places.kernels import PlacesKernels
 
 FloatArray = NDArray[np.float64]
 

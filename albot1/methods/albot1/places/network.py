@@ -23,8 +23,9 @@ holds, in order:
   aligned / not-aligned midpoint distances of Figure 4.8;
 * ``predictions``: every exit brought into the map (Figure 4.7).
 
-The runner adds ``ground_truth`` (and a ``true`` flag on each revisit) from
-the reference poses when the dataset has them (``docs/places.md``).
+The claims are judged against the reference poses when the run is evaluated,
+by the ``places`` metric (:mod:`albot1.metrics.measures.places`,
+``docs/places.md``); this file stays as the mapper wrote it.
 """
 
 from __future__ import annotations

@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from typing import Literal
 
+import numpy as np
+from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams
@@ -234,6 +236,10 @@ class GtsamGraphConfig(BaseModel):
             prior_sigma_xy_m=self.refine_max_correction_m,
             prior_sigma_theta_rad=math.radians(self.refine_max_correction_deg),
         )
+
+    def match_floor(self) -> NDArray[np.float64]:
+        """The covariance added to every match edge's (sequential, loop, place): matches are never perfect."""
+        return np.diag([self.match_sigma_floor_xy_m**2] * 2 + [math.radians(self.match_sigma_floor_theta_deg) ** 2])
 
     def icp(self, loop: bool = False) -> IcpParams:
         """Registration parameters for sequential (``loop=False``) or loop matches."""

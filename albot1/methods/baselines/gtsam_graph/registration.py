@@ -134,6 +134,25 @@ class Target:
         return int(len(self.points))
 
 
+def rotate(vectors: FloatArray, angle: float) -> FloatArray:
+    """Row vectors ``(N, 2)`` (points or normals) rotated by ``angle`` rad: ``R v`` for each row.
+
+    One matrix product rather than :func:`albot1.geometry.se2.transform_points`
+    with a zero translation: the same maths, but BLAS rounds the products
+    differently in the last bit, and every recorded gtsam-graph result was
+    computed with this form.
+    """
+    c, s = math.cos(angle), math.sin(angle)
+    return vectors @ np.array([[c, s], [-s, c]])
+
+
+def try_register(target: Target, points: FloatArray, guess: FloatArray, params: IcpParams) -> Registration | None:
+    """:func:`register`, or None when either side has too few usable points to try (a miss, not an error)."""
+    if len(points) < params.min_points or len(target) < params.min_points:
+        return None
+    return register(target, points, guess, params)
+
+
 def register(target: Target, source: FloatArray, initial: FloatArray, params: IcpParams = IcpParams()) -> Registration:
     """Align ``source`` points (sensor frame) to ``target``, starting at ``initial``.
 
@@ -210,8 +229,7 @@ def _linearise(
     target: Target, src: FloatArray, pose: FloatArray, gate: float, cauchy_scale: float
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Jacobian rows, point-to-line residuals, Cauchy weights and distances of matches within ``gate``."""
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    rot = src @ np.array([[c, s], [-s, c]])  # R p for row vectors
+    rot = rotate(src, pose[2])
     assert target.tree is not None  # register() raises before linearising against an empty target
     dist, idx = target.tree.query(rot + pose[:2], k=1, distance_upper_bound=gate)
     ok = dist < gate

@@ -266,7 +266,7 @@ def test_small_chunks_give_the_same_frames(
     """The look-ahead buffers carry state across chunk boundaries: chunking never changes a pose."""
     import functools
 
-    from albot1.data.loaders.carmen import loader as carmen_module
+    from albot1.data.loaders.carmen import frames as frames_module
     from albot1.data.loaders.carmen.source import iter_line_chunks
 
     rng = np.random.default_rng(5)
@@ -283,7 +283,7 @@ def test_small_chunks_give_the_same_frames(
     path = write(tmp_path, lines)
     whole = CarmenLoader().load(path, odometry=odometry, reference=reference)
     expected_odom, expected_ref = whole.odometry, whole.reference
-    monkeypatch.setattr(carmen_module, "iter_line_chunks", functools.partial(iter_line_chunks, chunk_bytes=3000))
+    monkeypatch.setattr(frames_module, "iter_line_chunks", functools.partial(iter_line_chunks, chunk_bytes=3000))
     chunked = CarmenLoader().load(path, odometry=odometry, reference=reference)
     np.testing.assert_array_equal(chunked.odometry, expected_odom)
     np.testing.assert_array_equal(chunked.reference, expected_ref)

@@ -63,14 +63,17 @@ def test_mixed_front_laser_kinds_are_refused_with_counts(tmp_path: Path) -> None
 def test_a_mix_beyond_the_first_chunk_is_refused_while_streaming(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
     import functools
 
-    from albot1.data.loaders.carmen import loader as carmen_module
+    from albot1.data.loaders.carmen import frames as frames_module
+    from albot1.data.loaders.carmen import probe as probe_module
     from albot1.data.loaders.carmen.source import iter_line_chunks
 
     lines = [flaser(float(k), RANGES) for k in range(200)] + [robotlaser(300.0, RANGES)]
     path = write(tmp_path, lines)
-    monkeypatch.setattr(carmen_module, "iter_line_chunks", functools.partial(iter_line_chunks, chunk_bytes=500))
-    monkeypatch.setattr(carmen_module, "_PROBE_BYTES", 500)
-    monkeypatch.setattr(carmen_module, "_PROBE_LIMIT", 500)
+    small_chunks = functools.partial(iter_line_chunks, chunk_bytes=500)
+    monkeypatch.setattr(frames_module, "iter_line_chunks", small_chunks)
+    monkeypatch.setattr(probe_module, "iter_line_chunks", small_chunks)
+    monkeypatch.setattr(probe_module, "PROBE_BYTES", 500)
+    monkeypatch.setattr(probe_module, "PROBE_LIMIT", 500)
     with pytest.raises(ParseError, match=r"log\.clf:201: the log mixes .* 200 FLASER lines .* 1 ROBOTLASER1 lines"):
         frames(path)
 

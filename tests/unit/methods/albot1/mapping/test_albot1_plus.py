@@ -10,8 +10,8 @@ import pytest
 from albot1.data.open import open_sequence
 from albot1.geometry import se2
 from albot1.geometry.segments import transform_segments
-from albot1.methods.albot1.mapping.accel import mapping_kernels
 from albot1.methods.albot1.mapping.config import Albot1Config
+from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.plus import (
     CHI2_1_MEDIAN,
@@ -23,7 +23,7 @@ from albot1.methods.albot1.mapping.plus import (
 from albot1.methods.albot1.perception.endpoints import CORNER, UNSTABLE
 from albot1.metrics.ate import ate
 
-KERNELS = mapping_kernels(False)  # the plain functions: exactness, not speed, is tested here
+KERNELS = MappingKernels(False)  # the plain functions: exactness, not speed, is tested here
 TRUE_POSE = (0.3, -0.2, math.radians(4.0))  # the view's pose in the map (thesis frame)
 
 # A room seen from the view (thesis frame, robot facing +y): a back wall, two side walls and a box.

@@ -9,8 +9,8 @@ import pytest
 
 from albot1.data.synthetic.lidar import cast
 from albot1.geometry import se2
-from albot1.methods.albot1.perception.accel import perception_kernels
 from albot1.methods.albot1.perception.frames import rep_to_thesis_pose
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.perception.landmarks import CORNER, OCCLUDING, UNSTABLE, find_landmarks
 from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise, thesis_motion
 from albot1.methods.albot1.perception.view import ViewParams, construct_view
@@ -67,7 +67,7 @@ def test_eqs_3_3_3_4_in_the_kernel_equal_the_inverse_rigid_motion(accelerate: bo
     seg = np.array([[1.0, 2.0, -0.5, 3.0]])
     want = se2.transform_points(se2.inverse(np.array(step)), seg.reshape(2, 2)).reshape(1, 4)
     kinds = np.array([[OCCLUDING, CORNER]])
-    kernel = perception_kernels(accelerate).recognise_landmarks
+    kernel = PerceptionKernels(accelerate).recognise_landmarks
     i, j, side, gap, angle_diff, d_prev, d_pred = kernel(seg, kinds, want, kinds, *step, MAX_ANGLE, MAX_DISTANCE, True)
     assert (i.tolist(), j.tolist(), side.tolist()) == ([0], [0], [0])
     assert gap[0] == pytest.approx(0.0, abs=1e-12) and angle_diff[0] == pytest.approx(0.0, abs=1e-12)

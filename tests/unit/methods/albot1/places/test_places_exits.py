@@ -9,11 +9,11 @@ import pytest
 
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
 from albot1.methods.albot1.perception.view import View
-from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig, ExitParams
 from albot1.methods.albot1.places.exits import ExitTracker, orient_left, view_exits
+from albot1.methods.albot1.places.kernels import PlacesKernels
 
-KERNELS = [places_kernels(False), places_kernels(True)]
+KERNELS = [PlacesKernels(False), PlacesKernels(True)]
 PARAMS = ExitParams()
 
 

@@ -1,7 +1,8 @@
 """albot1-places end to end: the chapter-3 hooks it uses, and thesis 4.2.1-4.2.3 on the six-room worlds.
 
-The world runs go through the runner, so the re-visits are judged against
-the worlds' rooms (``albot1.metrics.places``) exactly as in a run folder.
+The world runs go through the runner, and the re-visits are judged against
+the worlds' rooms by the rules of the ``places`` metric
+(:func:`albot1.metrics.places.judge_network`), as a run folder's evaluation does.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from albot1.data.transforms import head
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
+from albot1.metrics.places import judge_network
 from albot1.runs.execute import run_method
 
 
@@ -37,8 +39,14 @@ def test_the_chapter3_mapper_reports_its_updates_and_can_be_forced_to_update() -
 
 
 def run_places(dataset: str) -> dict:
-    result = run_method("albot1-places", open_sequence(dataset))
-    return {"counters": result.counters, "places": result.files["places.json"]}
+    """The run's counters with the places metric's judgement of its claims merged in (as ``metrics.json`` has it)."""
+    sequence = open_sequence(dataset)
+    result = run_method("albot1-places", sequence)
+    assert result.reference is not None
+    judged = judge_network(result.files["places.json"], result.poses, result.reference, sequence.metadata.extra)
+    numbers = {**judged, **(judged["exits"] or {})}
+    flat = {k: v for k, v in numbers.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
+    return {"counters": {**result.counters, **flat}, "places": result.files["places.json"], "judged": judged}
 
 
 @pytest.mark.slow
@@ -74,7 +82,7 @@ def test_re_traversing_the_loop_predicts_each_exit_better_aligned() -> None:
     run = run_places("synthetic-places-loop?laps=2")
     c = run["counters"]
     assert c["exit_predictions_compared"] == 6 and c["revisits_false"] == 0 and c["revisits_missed"] == 0
-    per_exit = run["places"]["ground_truth"]["exits"]["exit_predictions"]
+    per_exit = run["judged"]["exits"]["exit_predictions"]
     assert len(per_exit) == 6
     assert c["exit_prediction_aligned_true_mean_m"] < 0.5 < c["exit_prediction_not_aligned_true_mean_m"]
     assert sum(e["aligned_error_m"] < e["not_aligned_error_m"] for e in per_exit) >= 5

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from albot1.geometry.segments import transform_segments
-from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
+from albot1.methods.albot1.places.kernels import PlacesKernels
 from albot1.methods.albot1.places.matcher import (
     confirm,
     robot_sides,
@@ -17,7 +17,7 @@ from albot1.methods.albot1.places.matcher import (
     trigger_threshold,
 )
 
-KERNELS = [places_kernels(False), places_kernels(True)]
+KERNELS = [PlacesKernels(False), PlacesKernels(True)]
 PARAMS = Albot1PlacesConfig().match_params()
 
 

@@ -10,8 +10,8 @@ import pytest
 
 from albot1.geometry.se2 import between_pose
 from albot1.geometry.segments import transform_segments
-from albot1.methods.albot1.places.accel import places_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
+from albot1.methods.albot1.places.kernels import PlacesKernels
 from albot1.methods.albot1.places.memory import PlaceNetwork, invert, same_surfaces
 from albot1.methods.albot1.places.navigation import align_at_exit, nearest_prediction, predict
 from albot1.methods.albot1.places.network import extent, network_files
@@ -19,7 +19,7 @@ from albot1.methods.albot1.places.network import extent, network_files
 
 def network() -> PlaceNetwork:
     return PlaceNetwork(
-        same_angle=math.radians(5.0), same_gap=0.4, link_distance=1.0, same_any=places_kernels(False).same_any
+        same_angle=math.radians(5.0), same_gap=0.4, link_distance=1.0, same_any=PlacesKernels(False).same_any
     )
 
 
@@ -92,12 +92,12 @@ def test_same_surfaces_needs_direction_and_nearness(accelerate: bool) -> None:
     a = np.array([[0.0, 0.0, 2.0, 0.0]])
     b = np.array([[0.5, 0.3, 1.5, 0.31], [1.5, 0.3, 0.5, 0.3], [0.5, 0.6, 1.5, 0.6], [0.5, 0.3, 1.5, 0.5]])
     assert same_surfaces(a, b, math.radians(5.0), 0.4).tolist() == [[True, False, False, False]]
-    a_has, b_has = places_kernels(accelerate).same_any(a, b, math.radians(5.0), 0.4)
+    a_has, b_has = PlacesKernels(accelerate).same_any(a, b, math.radians(5.0), 0.4)
     assert a_has.tolist() == [True] and b_has.tolist() == [True, False, False, False]
     rng = np.random.default_rng(3)
     x, y = rng.uniform(0, 5, (40, 4)), rng.uniform(0, 5, (30, 4))
     same = same_surfaces(x, y, math.radians(20.0), 0.4)
-    x_has, y_has = places_kernels(accelerate).same_any(x, y, math.radians(20.0), 0.4)
+    x_has, y_has = PlacesKernels(accelerate).same_any(x, y, math.radians(20.0), 0.4)
     assert x_has.tolist() == same.any(axis=1).tolist() and y_has.tolist() == same.any(axis=0).tolist()
 
 

@@ -41,7 +41,7 @@ def test_the_config_is_the_chapter3_config_plus_places_fields() -> None:
 
 def test_registry_environment_and_overrides(monkeypatch: pytest.MonkeyPatch) -> None:
     spec = get_method("albot1-places")
-    assert spec.env_prefix == "ALBOT1_ALBOT1_PLACES_" and spec.judge == "albot1.metrics.places:judge_places"
+    assert spec.env_prefix == "ALBOT1_ALBOT1_PLACES_"
     monkeypatch.setenv("ALBOT1_ALBOT1_PLACES_EXIT_MAX_WIDTH_M", "1.1")
     monkeypatch.setenv("ALBOT1_ALBOT1_CORNER_MIN_ANGLE_DEG", "45")  # chapter 3's variable: not this method's
     resolved = resolve_method_config("albot1-places", "exact", {"match_min_matches": "6"})

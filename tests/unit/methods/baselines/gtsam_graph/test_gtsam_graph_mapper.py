@@ -226,10 +226,10 @@ def test_place_recognition_searches_far_along_the_graph_and_keeps_the_room_strai
     err = np.hypot(*(se2.compose(ref[0], out.poses)[:, :2] - ref[:, :2]).T)
     assert err.max() < 0.05
     # Graph distances follow the edges: node k is the sum of the node steps from node 0 away (no shortcut).
-    steps = np.asarray(mapper._node_steps)
+    steps = np.asarray(mapper.back.steps)
     path = np.concatenate([[0.0], np.cumsum(np.hypot(steps[1:, 0], steps[1:, 1]))])
     last = len(steps) - 1
-    if not mapper._loop_edges:
-        np.testing.assert_allclose(mapper._graph_distances(last), path[last] - path, atol=1e-5)
+    if not mapper.back.loop_edges:
+        np.testing.assert_allclose(mapper.back.graph_distances(last), path[last] - path, atol=1e-5)
     else:
-        assert (mapper._graph_distances(last) <= path[last] - path + 1e-5).all()
+        assert (mapper.back.graph_distances(last) <= path[last] - path + 1e-5).all()

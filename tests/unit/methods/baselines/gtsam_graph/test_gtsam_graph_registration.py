@@ -11,7 +11,14 @@ from albot1.data.synthetic.lidar import cast
 from albot1.geometry import se2
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
-from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Target, line_normals, register
+from albot1.methods.baselines.gtsam_graph.registration import (
+    IcpParams,
+    Target,
+    line_normals,
+    register,
+    rotate,
+    try_register,
+)
 
 # A 10 m x 6 m room with a pillar and an alcove: enough structure to fix x, y and theta.
 WALLS = np.array(
@@ -115,3 +122,23 @@ def test_unusable_input_raises_registration_error(bad: str, message: str) -> Non
 def test_target_refuses_non_finite_points() -> None:
     with pytest.raises(RegistrationError, match="finite"):
         Target.from_points(np.array([[0.0, 0.0], [np.nan, 1.0], [1.0, 1.0]]))
+
+
+def test_rotate_turns_row_vectors_counter_clockwise() -> None:
+    """The one rotation of the package (ICP's linearisation, normals of a local map): R v per row."""
+    vectors = np.array([[1.0, 0.0], [0.0, 2.0], [3.0, -4.0]])
+    np.testing.assert_allclose(rotate(vectors, math.pi / 2), [[0.0, 1.0], [-2.0, 0.0], [4.0, 3.0]], atol=1e-15)
+    np.testing.assert_allclose(
+        rotate(vectors, 0.7), se2.transform_points(np.array([0.0, 0.0, 0.7]), vectors), rtol=0, atol=1e-15
+    )
+
+
+def test_try_register_is_none_below_the_minimum_points_and_register_otherwise() -> None:
+    target = Target.from_points(scan_points(np.array([2.0, 1.5, 0.3])))
+    source = scan_points(np.array([2.0, 1.5, 0.3]))
+    params = IcpParams(min_points=10)
+    assert try_register(target, source[:9], np.zeros(3), params) is None
+    assert try_register(Target(np.empty((0, 2)), np.empty((0, 2))), source, np.zeros(3), params) is None
+    found = try_register(target, source, np.zeros(3), params)
+    expected = register(target, source, np.zeros(3), params)
+    assert found is not None and np.array_equal(found.pose, expected.pose) and found.converged

@@ -1,35 +1,44 @@
-"""Compiled (numba) and interpreted kernels give the same bits: per kernel, and on whole synthetic runs.
+"""Compiled (numba) and as-written kernels give the same bits: per kernel, per callee, and on whole runs.
 
-``albot1.methods.albot1.jit`` claims acceleration never changes results.
-Every field of the two kernel sets (and every callee they compile) is run
-both ways on inputs that reach its branches, and whole runs of the synthetic
-worlds with every Albot1 preset are compared with ``accelerate`` on and off.
+The kernels are compiled by numba's own decorators
+(:mod:`albot1.methods.albot1.compiled`); their Python source is numba's
+``py_func``, or the whole process with ``NUMBA_DISABLE_JIT=1``. Every kernel
+is run both ways on its warm-up sample (once per kernel) and on inputs from
+real scans that reach its branches; whole runs of the synthetic worlds are
+compared in the ``slow`` lane (CI runs it).
 """
 
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
+import numba  # noqa: E402  (after the project: its cache folder is set before numba compiles)
 import numpy as np
 import pytest
 
+from albot1 import versions
 from albot1.data.synthetic.worlds import load_world
 from albot1.geometry import se2, segments
-from albot1.methods.albot1.jit import callees, kernel_compiler
+from albot1.methods.albot1 import compiled
+from albot1.methods.albot1.compiled import as_written
+from albot1.methods.albot1.mapping import kernels as mapping_source
 from albot1.methods.albot1.mapping import pose_kernels
-from albot1.methods.albot1.mapping.accel import MappingKernels, mapping_kernels
 from albot1.methods.albot1.mapping.config import Albot1Config
+from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.perception import endpoints
 from albot1.methods.albot1.perception import kernels as perception_source
-from albot1.methods.albot1.perception.accel import PerceptionKernels, perception_kernels
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.perception.landmarks import find_landmarks
 from albot1.methods.albot1.perception.view import ViewParams, construct_view
-
-numba = pytest.importorskip("numba", reason="numba is not installed: only the interpreted kernels exist")
+from albot1.methods.albot1.places.kernels import PlacesKernels
+from albot1.methods.albot1.warm_up import kernel_names, sample_calls
 
 PARAMS = ViewParams()
 
@@ -68,7 +77,7 @@ def _thesis_order(ranges: np.ndarray, angles: np.ndarray) -> tuple[np.ndarray, n
 
 
 def _views() -> list[Any]:
-    return [construct_view(r, a, PARAMS, perception_kernels(False)) for r, a in _scans()]
+    return [construct_view(r, a, PARAMS, PerceptionKernels(False)) for r, a in _scans()]
 
 
 # -- one generator of argument tuples per kernel ------------------------------------------------------------------
@@ -200,23 +209,53 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
 }
 
 
+#: the kernels by name, as compiled (module attributes: numba dispatchers)
+KERNELS: dict[str, Any] = {
+    **{name: getattr(perception_source, name) for name in ("build_view", "recognise_landmarks")},
+    **{
+        name: getattr(mapping_source, name)
+        for name in ("classify_endpoints", "best_correspondence", "clip_parameter", "resolve_partial")
+    },
+    **{name: getattr(pose_kernels, name) for name in ("refine_pose", "scan_points")},
+}
+
+
+def _all_sets(compiled: bool = True) -> tuple[Any, ...]:
+    return PerceptionKernels(compiled), MappingKernels(compiled), PlacesKernels(compiled)
+
+
 def test_every_kernel_has_a_case() -> None:
-    fields = [f for f in PerceptionKernels._fields + MappingKernels._fields if f != "jitted"]
-    assert sorted(fields) == sorted(CASES)
+    assert sorted(CASES) == sorted(KERNELS)
+    called = {name for s in (PerceptionKernels(), MappingKernels()) for name in kernel_names(s)}
+    assert called <= set(KERNELS)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
-def test_kernel_gives_the_same_bits_jitted_and_interpreted(name: str) -> None:
-    sets = (perception_kernels, mapping_kernels)
-    (fast, slow) = next((s(True), s(False)) for s in sets if name in s(True)._fields)
-    assert fast.jitted and not slow.jitted
-    jitted, plain = getattr(fast, name), getattr(slow, name)
+def test_kernel_gives_the_same_bits_compiled_and_as_written(name: str) -> None:
+    jitted = KERNELS[name]
+    plain = as_written(jitted)
     assert isinstance(jitted, numba.core.registry.CPUDispatcher) and not hasattr(plain, "py_func")
     count = 0
     for args in CASES[name]():
         assert_same_bits(jitted(*args), plain(*args))
         count += 1
     assert count >= 20
+
+
+def test_every_kernel_a_mapper_calls_has_a_warm_up_sample() -> None:
+    names = [name for s in _all_sets() for name in kernel_names(s)]
+    assert sorted(names) == sorted({name for name, _, _ in sample_calls(*_all_sets())})
+
+
+@pytest.mark.parametrize("name", sorted(name for s in _all_sets() for name in kernel_names(s)))
+def test_kernel_sample_gives_the_same_bits_compiled_and_as_written(name: str) -> None:
+    """Once per kernel, on its warm-up sample: the parity lane of the places kernels too."""
+    calls = [(fast, args) for n, fast, args in sample_calls(*_all_sets()) if n == name]
+    slow = [plain for n, plain, _ in sample_calls(*_all_sets(compiled=False)) if n == name]
+    assert calls and len(calls) == len(slow)
+    for (fast, args), plain in zip(calls, slow):
+        assert isinstance(fast, numba.core.registry.CPUDispatcher) and plain is fast.py_func
+        assert_same_bits(fast(*args), plain(*args))
 
 
 # -- the callees, compiled on their own ------------------------------------------------------------------------
@@ -231,7 +270,7 @@ def _segment_pairs() -> Iterator[tuple[np.ndarray, np.ndarray]]:
         yield a, np.array(b)  # crossing, touching, collinear, degenerate, identical
 
 
-def test_segment_geometry_gives_the_same_bits_jitted_and_interpreted() -> None:
+def test_segment_geometry_gives_the_same_bits_compiled_and_as_written() -> None:
     functions = (
         segments.segment_distance,
         segments.segments_cross,
@@ -240,7 +279,7 @@ def test_segment_geometry_gives_the_same_bits_jitted_and_interpreted() -> None:
         segments.orientation,
         segments.line_angle,
     )
-    jit = kernel_compiler(True, functions)
+    jit = {fn: numba.njit(fn) for fn in functions}  # compiled the way a kernel compiles its callees
     for a, b in _segment_pairs():
         for fn, args in (
             (segments.segment_distance, (a, b)),
@@ -250,23 +289,21 @@ def test_segment_geometry_gives_the_same_bits_jitted_and_interpreted() -> None:
             (segments.orientation, (a[0], a[1], a[2], a[3], b[0], b[1])),
             (segments.line_angle, (a[0] * 3.0 - b[1] * 5.0,)),
         ):
-            assert_same_bits(jit(fn)(*args), fn(*args))
+            assert_same_bits(jit[fn](*args), fn(*args))
 
 
-def test_wrap_and_stability_give_the_same_bits_jitted_and_interpreted() -> None:
-    jit = kernel_compiler(True, (se2.wrap_angle, endpoints.is_stable))
+def test_wrap_and_stability_give_the_same_bits_compiled_and_as_written() -> None:
+    wrap, stable = numba.njit(se2.wrap_angle), numba.njit(endpoints.is_stable)
     rng = np.random.default_rng(9)
     for a in [*rng.uniform(-20.0, 20.0, 500).tolist(), math.pi, -math.pi, 0.0, -0.0, 2 * math.pi, 1e-300]:
-        assert_same_bits(jit(se2.wrap_angle)(a), se2.wrap_angle(a))
+        assert_same_bits(wrap(a), se2.wrap_angle(a))
     for kind in range(4):
-        assert jit(endpoints.is_stable)(kind) == endpoints.is_stable(kind)
+        assert stable(kind) == endpoints.is_stable(kind)
 
 
-def test_point_to_line_term_gives_the_same_bits_jitted_and_interpreted() -> None:
+def test_point_to_line_term_gives_the_same_bits_compiled_and_as_written() -> None:
     """The landmark and scan terms of ``refine_pose`` share it: both Huber branches, and a degenerate normal."""
-    jit = kernel_compiler(True, (pose_kernels.add_point_to_line,))
-    compiled = jit(pose_kernels.add_point_to_line)
-    assert compiled is not pose_kernels.add_point_to_line
+    jitted = numba.njit(pose_kernels.add_point_to_line)
     rng = np.random.default_rng(10)
     inside = outside = 0
     for _ in range(400):
@@ -276,7 +313,7 @@ def test_point_to_line_term_gives_the_same_bits_jitted_and_interpreted() -> None
         ox, oy, dx, dy = rng.normal(0.0, 0.3, 4).tolist()
         threshold = float(rng.uniform(0.02, 0.4))
         args = (sums, nx, ny, ox, oy, dx, dy, float(rng.uniform(1.0, 2500.0)), threshold)
-        assert_same_bits(compiled(*args), pose_kernels.add_point_to_line(*args))
+        assert_same_bits(jitted(*args), pose_kernels.add_point_to_line(*args))
         if abs(nx * ox + ny * oy) <= threshold:
             inside += 1
         else:
@@ -287,28 +324,90 @@ def test_point_to_line_term_gives_the_same_bits_jitted_and_interpreted() -> None
 # -- the mechanism ------------------------------------------------------------------------------------------------
 
 
-def test_callees_are_found_transitively_and_compiled_with_their_caller() -> None:
-    found = {fn.__name__ for fn in callees(perception_source.recognise_landmarks)}
-    assert found == {"recognise_landmarks", "wrap_angle", "is_stable"}
-    mapping = mapping_kernels(True)
-    dispatcher: Any = mapping.best_correspondence  # a numba CPUDispatcher behind the typed field
-    namespace = dispatcher.py_func.__globals__
-    assert isinstance(namespace["segment_distance"], numba.core.registry.CPUDispatcher)
-    # Each cache entry carries the digest of its callees' source files (numba's internals: see jit.py).
-    stamp = dispatcher._cache._cache_file._source_stamp
-    assert isinstance(stamp, tuple) and len(stamp[1]) == 64
-    # The source modules keep their plain functions.
-    assert segments.segment_distance.__module__ == "albot1.geometry.segments"
-    assert not hasattr(segments.segment_distance, "py_func")
+def _python(code: str, **env: str) -> str:
+    """Run ``code`` in a fresh interpreter (this environment plus ``env``); its stdout."""
+    out = subprocess.run(
+        [sys.executable, "-c", code], env={**os.environ, **env}, capture_output=True, text=True, timeout=600
+    )
+    assert out.returncode == 0, out.stderr
+    return out.stdout
 
 
-def test_without_acceleration_the_kernels_are_the_functions_as_written() -> None:
-    plain = perception_kernels(False)
-    assert plain.build_view is perception_source.build_view and not plain.jitted
-    assert kernel_compiler(False, (se2.wrap_angle,))(se2.wrap_angle) is se2.wrap_angle
+def test_callees_stay_plain_functions_and_the_geometry_layer_does_not_import_numba() -> None:
+    assert not hasattr(segments.segment_distance, "py_func") and not hasattr(se2.wrap_angle, "py_func")
+    assert not hasattr(pose_kernels.add_point_to_line, "py_func")
+    assert _python("import sys, albot1.geometry.segments, albot1.data.model; print('numba' in sys.modules)") == (
+        "False\n"
+    )
+
+
+def test_kernels_are_cached_in_a_folder_named_by_the_code_version() -> None:
+    assert compiled.CACHE_DIR.name == versions.code_version()
+    assert os.environ["NUMBA_CACHE_DIR"] == str(compiled.CACHE_DIR)
+    PerceptionKernels().build_view(
+        *next(args for name, _, args in sample_calls(PerceptionKernels()) if name == "build_view")
+    )
+    assert compiled.is_cached() and any(compiled.CACHE_DIR.rglob("kernels.build_view-*.nbi"))
+
+
+def test_an_unwritable_user_cache_falls_back_to_a_per_user_temporary_folder() -> None:
+    """As for an installed wheel whose user cache cannot be written: numba still caches, elsewhere."""
+    code = (
+        "import tempfile\n"
+        "from albot1.methods.albot1 import compiled\n"
+        "from albot1.methods.albot1.places.kernels import PlacesKernels\n"
+        "from albot1.methods.albot1.warm_up import sample_calls\n"
+        "for name, kernel, args in sample_calls(PlacesKernels()):\n"
+        "    if name == 'same_any':\n"
+        "        kernel(*args)\n"
+        "print(compiled.CACHE_DIR.is_relative_to(tempfile.gettempdir()), compiled.is_cached())\n"
+    )
+    assert _python(code, XDG_CACHE_HOME="/proc/albot1-cannot-write-here").split() == ["True", "True"]
+
+
+def test_without_acceleration_a_mapper_calls_the_kernels_as_written() -> None:
+    plain = PerceptionKernels(False)
+    assert not plain.compiled and plain.build_view is perception_source.build_view.py_func
+    assert PlacesKernels(False).match_structure is as_written(PlacesKernels().match_structure)
+
+
+def test_numba_s_switch_runs_every_kernel_as_written_with_the_same_results() -> None:
+    """``NUMBA_DISABLE_JIT=1``: the decorators hand back the functions; a short run gives the same bits."""
+    code = (
+        "from albot1.methods.albot1.perception import kernels\n"
+        "print(type(kernels.build_view).__name__)\n"
+        f"{_FINGERPRINT}\n"
+        "print(fingerprint('albot1', 'plus', 'synthetic-office-startstop', 40))\n"
+    )
+    kind, fingerprint = _python(code, NUMBA_DISABLE_JIT="1").split()
+    assert kind == "function"
+    assert fingerprint == _fingerprint("albot1", "plus", "synthetic-office-startstop", 40)
 
 
 # -- whole runs ---------------------------------------------------------------------------------------------------
+
+#: source of ``fingerprint(method, preset, world, limit)``: sha256 of a run's poses, map and counters
+_FINGERPRINT = """
+import hashlib, json
+import numpy as np
+from albot1.data.synthetic.worlds import load_world
+from albot1.methods.registry import get_method, resolve_config
+
+def fingerprint(method, preset, world, limit):
+    mapper = get_method(method).load_class()(resolve_config(method, preset, None))
+    for k, frame in enumerate(load_world(world)):
+        if k == limit:
+            break
+        mapper.process(frame)
+    out = mapper.finish()
+    digest = hashlib.sha256(np.ascontiguousarray(out.poses).tobytes())
+    digest.update(np.ascontiguousarray(out.map.segments).tobytes())
+    digest.update(json.dumps(out.counters, sort_keys=True).encode())
+    return digest.hexdigest()
+"""
+_namespace: dict[str, Any] = {}
+exec(_FINGERPRINT, _namespace)
+_fingerprint: Callable[[str, str, str, int | None], str] = _namespace["fingerprint"]
 
 
 def _run(world: str, preset: str, accelerate: bool) -> Any:
@@ -328,12 +427,22 @@ def _assert_same_run(world: str, preset: str) -> None:
     assert fast.extras == slow.extras
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preset", list(Albot1Mapper.presets))
-def test_whole_startstop_run_is_identical_jitted_and_interpreted(preset: str) -> None:
+def test_whole_startstop_run_is_identical_compiled_and_as_written(preset: str) -> None:
     _assert_same_run("synthetic-office-startstop", preset)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("preset", list(Albot1Mapper.presets))
-def test_whole_loop_run_is_identical_jitted_and_interpreted(preset: str) -> None:
+def test_whole_loop_run_is_identical_compiled_and_as_written(preset: str) -> None:
     _assert_same_run("synthetic-office-loop", preset)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", ["albot1", "albot1-places"])
+def test_whole_loop_run_is_identical_with_numba_s_switch(method: str) -> None:
+    """Every kernel and callee as Python, process-wide (``NUMBA_DISABLE_JIT=1``), against the compiled run."""
+    code = f"{_FINGERPRINT}\nprint(fingerprint({method!r}, 'default', 'synthetic-office-loop', None))\n"
+    as_written = _python(code, NUMBA_DISABLE_JIT="1").strip()
+    assert as_written == _fingerprint(method, "default", "synthetic-office-loop", None)

@@ -1,0 +1,105 @@
+"""The CARMEN loader's options: every ``FILE?key=value`` the loader accepts, validated in one place.
+
+:func:`parse_options` splits what the loader is given into the catalog's
+fields (``relations``, ``license``, ``citation``), which every loader takes,
+and the CARMEN options proper (:class:`CarmenOptions`: pose sources, laser
+kind, range limit, time tolerance, name, parallel bzip2), each checked with
+a one-line error naming the file, the value found and what was expected.
+The describers say in words, for the sequence's metadata, which fields a
+chosen pose source reads.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from albot1.data.attach import COMMON_OPTIONS
+from albot1.data.errors import DataError
+from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
+
+ODOMETRY_SOURCES = ("laser-pose", "odom", "odom-segments")
+REFERENCE_SOURCES = ("none", "laser-pose", "truepos", "auto")
+
+
+@dataclass(frozen=True)
+class CarmenOptions:
+    """Validated loader options (see the loader module's docstring)."""
+
+    odometry: str = "laser-pose"
+    reference: str = "auto"
+    laser: str | None = None
+    max_range: float | None = None
+    time_tolerance: float = 1.0
+    name: str | None = None
+    parallel_bz2: bool = True
+
+    @staticmethod
+    def parse(path: Path, options: dict[str, Any]) -> CarmenOptions:
+        known = set(CarmenOptions.__dataclass_fields__)
+        unknown = sorted(set(options) - known)
+        if unknown:
+            raise DataError(
+                f"{path}: unknown CARMEN loader option(s) {', '.join(unknown)}; "
+                f"expected some of {', '.join(sorted(known) + list(COMMON_OPTIONS))}"
+            )
+        for key in ("max_range", "time_tolerance"):
+            if options.get(key) is not None:
+                try:
+                    options[key] = float(options[key])
+                except (TypeError, ValueError):
+                    raise DataError(f"{path}: {key}={options[key]!r}; expected a number") from None
+        opts = CarmenOptions(**options)
+        if opts.odometry not in ODOMETRY_SOURCES:
+            raise DataError(f"{path}: odometry={opts.odometry!r}; expected one of {', '.join(ODOMETRY_SOURCES)}")
+        if opts.reference not in REFERENCE_SOURCES:
+            raise DataError(f"{path}: reference={opts.reference!r}; expected one of {', '.join(REFERENCE_SOURCES)}")
+        if opts.laser is not None and opts.laser not in LASER_MESSAGES:
+            raise DataError(f"{path}: laser={opts.laser!r}; expected one of {', '.join(LASER_MESSAGES)}")
+        if opts.max_range is not None and not (math.isfinite(opts.max_range) and opts.max_range > 0):
+            raise DataError(f"{path}: max_range={opts.max_range!r}; expected a positive number of metres")
+        if not opts.time_tolerance >= 0:  # inf disables the check (logs whose stamps are garbage)
+            raise DataError(f"{path}: time_tolerance={opts.time_tolerance!r}; expected seconds >= 0 (or inf)")
+        return opts
+
+
+@dataclass(frozen=True)
+class LoadOptions:
+    """Everything :meth:`~albot1.data.loaders.carmen.loader.CarmenLoader.load` was given, sorted out."""
+
+    carmen: CarmenOptions
+    #: a relations file for the sequence (the catalog's, or ``FILE?relations=...``)
+    relations: str | Path | None
+    license: str
+    citation: str
+
+
+def parse_options(path: Path, options: dict[str, Any]) -> LoadOptions:
+    """The catalog's fields and the validated CARMEN options of ``options`` (a DataError names a bad one)."""
+    rest = dict(options)
+    relations = rest.pop("relations", None)
+    license_text = str(rest.pop("license", ""))
+    citation = str(rest.pop("citation", ""))
+    return LoadOptions(CarmenOptions.parse(path, rest), relations, license_text, citation)
+
+
+def describe_odometry(mode: str, laser: str) -> str:
+    """Which fields or lines the odometry source ``mode`` reads, for the metadata."""
+    if mode == "laser-pose":
+        fields = "odom_x odom_y odom_theta" if laser in OLD_LASERS else "robot_x robot_y robot_theta"
+        return f"{laser} {fields} fields"
+    if mode == "odom":
+        return "ODOM lines, SE(2)-interpolated at the scan ipc timestamp"
+    return "ODOM increments between scans, re-anchored at each corrected scan pose (GMapping log)"
+
+
+def describe_reference(mode: str, laser: str) -> str:
+    """Which fields or lines the (resolved) reference source ``mode`` reads, for the metadata; empty for none."""
+    if mode == "none":
+        return ""
+    if mode == "truepos":
+        return "TRUEPOS lines, SE(2)-interpolated at the scan ipc timestamp"
+    fields = "x y theta" if laser in OLD_LASERS else "robot_x robot_y robot_theta"
+    return f"{laser} {fields} fields"

@@ -1,0 +1,129 @@
+"""How Albot1's kernels are compiled: numba's own decorators, numba's own cache, numba's own off switch.
+
+A *kernel* is a loop over numpy arrays and scalars in the subset numba
+compiles, called from the mappers' Python code: it is decorated with
+:func:`kernel`, i.e. ``numba.njit(cache=True, nogil=True)``. A function a
+kernel calls is decorated with :func:`jitable` (``numba.extending.register_jitable``):
+it stays the plain Python function when Python calls it and is compiled into
+every kernel that calls it. The geometry helpers the kernels call live in a
+lower layer that must not import numba (every metric and loader imports
+them); they are registered here, in :data:`GEOMETRY_CALLEES`, which is the
+only list of this kind (a kernel calling an unregistered plain function fails
+to compile with numba's "Untyped global name" error, and the parity tests run
+every kernel).
+
+Nothing compiles at import: numba compiles a kernel on its first call, or
+loads it from its on-disk cache. Numba checks a cached kernel against the
+time stamp of the kernel's own source file only, not against the files of
+the functions compiled into it; the cache therefore lives in a folder named
+by the code version (:func:`albot1.versions.code_version`, a digest of every
+source file of the package), set as ``NUMBA_CACHE_DIR`` here, before the
+first kernel is decorated: any edit anywhere in the package starts a fresh
+folder, and every cell and run of the same code on the machine shares one.
+The folder is under the user's cache directory (``.../albot1-bench/numba/``),
+so an installed wheel in a read-only site-packages caches too; if that
+folder cannot be written, a per-user folder in the temporary directory is
+used. Old versions' folders are never read again and may be deleted.
+
+The pure-Python path is numba's documented switch: ``NUMBA_DISABLE_JIT=1`` in
+the environment makes every decorator here return the function as written,
+process-wide. A mapper with ``accelerate = false`` calls its kernels' Python
+source (:func:`as_written`, numba's ``py_func``) instead, so one process can
+run both; results are bit-identical either way (the parity tests check it).
+"""
+
+from __future__ import annotations
+
+import getpass
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar, cast
+
+import numba
+from numba.core import config as numba_config
+from numba.extending import register_jitable
+
+from albot1 import versions
+from albot1.geometry import se2, segments
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+#: numba's environment variable for its cache folder (read at import and again by every compilation)
+CACHE_DIR_ENV = "NUMBA_CACHE_DIR"
+
+
+def _writable(path: Path) -> bool:
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError:
+        return False
+    return True
+
+
+def cache_dir() -> Path:
+    """The folder numba caches this code version's kernels in (created; see the module docstring)."""
+    from platformdirs import user_cache_dir
+
+    version = versions.code_version()
+    path = Path(user_cache_dir("albot1-bench")) / "numba" / version
+    if _writable(path):
+        return path
+    return Path(tempfile.gettempdir()) / f"albot1-bench-numba-{getpass.getuser()}" / version
+
+
+def _use_cache_dir() -> Path:
+    path = cache_dir()
+    os.environ[CACHE_DIR_ENV] = str(path)  # numba re-reads its config from the environment when it compiles
+    # numba may have been imported (and have read its environment) before this module: read it again
+    reload_config: Callable[[], None] = numba_config.reload_config
+    reload_config()
+    return path
+
+
+#: where this process's kernels are cached
+CACHE_DIR: Path = _use_cache_dir()
+
+
+def kernel(fn: F) -> F:
+    """``numba.njit(cache=True, nogil=True)``: compiled on first call (or loaded from the cache), typed as written."""
+    return cast(F, numba.njit(cache=True, nogil=True)(fn))
+
+
+def jitable(fn: F) -> F:
+    """``numba.extending.register_jitable``: ``fn`` itself for Python callers, compiled into the kernels calling it."""
+    jitted: F = register_jitable(fn)
+    return jitted
+
+
+def as_written(fn: F) -> F:
+    """The Python source of kernel ``fn`` (numba's ``py_func``; ``fn`` itself when the JIT is disabled)."""
+    return cast(F, getattr(fn, "py_func", fn))
+
+
+def select(fn: F, compiled: bool) -> F:
+    """Kernel ``fn`` compiled, or as written (``accelerate = false``): the same source and the same results."""
+    return fn if compiled else as_written(fn)
+
+
+def is_cached() -> bool:
+    """Whether this code version's cache holds compiled kernels (False: the next warm-up compiles them)."""
+    return any(CACHE_DIR.rglob("*.nbi"))
+
+
+#: the functions of lower layers (which do not import numba) that kernels call
+GEOMETRY_CALLEES: tuple[Callable[..., Any], ...] = tuple(
+    jitable(fn)
+    for fn in (
+        se2.wrap_angle,
+        segments.orientation,
+        segments.closest_parameter,
+        segments.point_segment_distance,
+        segments.line_angle,
+        segments.segments_cross,
+        segments.segment_distance,
+    )
+)

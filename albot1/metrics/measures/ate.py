@@ -1,0 +1,54 @@
+"""``ate``: absolute trajectory error after a rigid alignment (:func:`albot1.metrics.ate.ate`)."""
+
+from __future__ import annotations
+
+from albot1.metrics.ate import ate
+from albot1.metrics.blocks import Alignment, AlignmentTransform, RotationStats, block_of, fmt
+from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
+from albot1.records import Record
+
+
+class AlignmentSummary(Record):
+    """ATE under another alignment, for comparison."""
+
+    rmse_m: float
+    mean_m: float
+    max_m: float
+
+
+class AteBlock(Record):
+    """``ate``: position error after ``alignment`` (m, population std), heading error under ``rotation``."""
+
+    alignment: Alignment
+    units: dict[str, str]
+    mean_m: float
+    std_m: float
+    median_m: float
+    min_m: float
+    max_m: float
+    rmse_m: float
+    n: int
+    std_ddof: int
+    rotation: RotationStats
+    alignment_transform: AlignmentTransform
+    other_alignments: dict[str, AlignmentSummary]
+
+
+def compute(inputs: MetricInputs) -> AteBlock:
+    assert inputs.reference is not None  # REFERENCE is a need
+    return block_of(AteBlock, ate(inputs.poses, inputs.reference))
+
+
+def headline(block: AteBlock) -> str:
+    return f"rmse {fmt(block.rmse_m)} m, max {fmt(block.max_m)} m ({block.alignment} alignment)"
+
+
+METRIC = Metric(
+    name="ate",
+    position=10,
+    models=(AteBlock,),
+    needs=(REFERENCE,),
+    compute=compute,
+    headline=headline,
+    columns=(ColumnSpec("ate_rmse_m", "rmse_m", "ATE RMSE (m)"),),
+)

@@ -1,0 +1,66 @@
+"""``ate_windows``: ATE of consecutive windows of reference travel (:func:`albot1.metrics.ate.windowed_ate`)."""
+
+from __future__ import annotations
+
+from albot1.metrics.ate import windowed_ate
+from albot1.metrics.blocks import block_of, fmt
+from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
+from albot1.records import Record
+
+
+class WindowStats(Record):
+    """:class:`albot1.metrics.blocks.Stats` of the windows' RMSE with the unit in the key (``_m``)."""
+
+    mean_m: float
+    std_m: float
+    median_m: float
+    min_m: float
+    max_m: float
+    rmse_m: float
+    n: int
+    std_ddof: int
+
+
+class AteWindow(Record):
+    """One window of ``ate_windows``: its scans (inclusive) and its ATE."""
+
+    first_scan: int
+    last_scan: int
+    rmse_m: float
+    max_m: float
+
+
+class AteWindowsBlock(Record):
+    """``ate_windows``: ATE of consecutive windows of ``window_m`` reference travel, each aligned on its own."""
+
+    alignment: str
+    window_m: float
+    windows: int
+    uncovered_m: float
+    units: dict[str, str]
+    mean_rmse_m: float
+    window_rmse: WindowStats
+    per_window: list[AteWindow]
+
+
+def compute(inputs: MetricInputs) -> AteWindowsBlock:
+    assert inputs.reference is not None  # REFERENCE is a need
+    return block_of(AteWindowsBlock, windowed_ate(inputs.poses, inputs.reference))
+
+
+def headline(block: AteWindowsBlock) -> str:
+    return (
+        f"mean rmse {fmt(block.mean_rmse_m)} m over {block.windows} windows of {block.window_m:g} m "
+        f"(max {fmt(block.window_rmse.max_m)} m)"
+    )
+
+
+METRIC = Metric(
+    name="ate_windows",
+    position=20,
+    models=(AteWindowsBlock,),
+    needs=(REFERENCE,),
+    compute=compute,
+    headline=headline,
+    columns=(ColumnSpec("ate_windows_m", "mean_rmse_m", "ATE per 50 m window, mean (m)"),),
+)

@@ -1,0 +1,129 @@
+"""``loop_gap``: the thesis's loop gap, route end vs start and every revisit pair (:mod:`albot1.metrics.loop_gap`).
+
+Two block shapes: with reference poses every revisit pair is scored
+(:class:`LoopGapBlock`); without them, on a route the dataset declares
+closed, only the route gap is (:class:`ClosedRouteGapBlock`).
+"""
+
+from __future__ import annotations
+
+from albot1.metrics.blocks import Stats, block_of, fmt
+from albot1.metrics.loop_gap import pair_gaps, route_gap
+from albot1.metrics.measures.drift import METRIC as DRIFT
+from albot1.metrics.unit import NO_REFERENCE, RETURNING_ROUTE, BlockLookup, ColumnSpec, Metric, MetricInputs
+from albot1.records import Record
+
+#: A loop gap applies to a route whose reference returns near its start: within this many metres ...
+ROUTE_RETURN_M = 1.0
+#: ... or this fraction of the route's length, whichever is larger (docs/metrics.md, "Loop gap").
+ROUTE_RETURN_FRACTION = 0.02
+
+
+class RouteGap(Record):
+    """``loop_gap.route``: start-to-end error (m, deg)."""
+
+    estimated_offset_m: float
+    reference_offset_m: float
+    reference: str
+    gap_m: float
+    heading_gap_deg: float
+
+
+class WorstPair(Record):
+    """The revisit pair with the largest gap."""
+
+    scans: list[int]
+    gap_m: float
+
+
+class LoopGapBlock(Record):
+    """``loop_gap`` with reference poses: the route gap and every revisit pair.
+
+    With ``pairs: 0`` the pair statistics and ``worst_pair`` are null.
+    """
+
+    units: dict[str, str]
+    alignment: str
+    route: RouteGap
+    radius_m: float
+    min_dt_s: float
+    min_travel_m: float
+    pairs: int
+    translation_m: Stats | None
+    rotation_deg: Stats | None
+    worst_pair: WorstPair | None
+
+
+class ClosedRouteGapBlock(Record):
+    """``loop_gap`` without reference poses on a route declared closed: the route gap only.
+
+    Revisit pairs need reference positions, so ``pairs`` is null and
+    ``pairs_reason`` says why.
+    """
+
+    units: dict[str, str]
+    alignment: str
+    route: RouteGap
+    pairs: None
+    pairs_reason: str
+
+
+Block = LoopGapBlock | ClosedRouteGapBlock
+
+UNITS = {"gap": "m", "heading": "deg"}
+ALIGNMENT = "none (relative poses)"
+
+
+def compute(inputs: MetricInputs) -> Block:
+    poses, reference = inputs.poses, inputs.reference
+    if reference is None:  # RETURNING_ROUTE is a need: the route is declared closed
+        return block_of(
+            ClosedRouteGapBlock,
+            {
+                "units": UNITS,
+                "alignment": ALIGNMENT,
+                "route": route_gap(poses, None),
+                "pairs": None,
+                "pairs_reason": NO_REFERENCE,
+            },
+        )
+    return block_of(
+        LoopGapBlock,
+        {
+            "units": UNITS,
+            "alignment": ALIGNMENT,
+            "route": route_gap(poses, reference),
+            **pair_gaps(inputs.timestamps, poses, reference),
+        },
+    )
+
+
+def headline(block: Block) -> str:
+    pairs = block.translation_m if isinstance(block, LoopGapBlock) else None
+    extra = f", {block.pairs} revisit pairs mean {fmt(pairs.mean)} m max {fmt(pairs.max)} m" if pairs else ""
+    return f"route gap {fmt(block.route.gap_m)} m{extra}"
+
+
+def route_returns(block: Block, others: BlockLookup) -> str | None:
+    """None when the route returns to its start (a loop gap means something), else why it does not apply."""
+    offset = block.route.reference_offset_m
+    drift = others.get(DRIFT)
+    route = drift.route_m if drift is not None else 0.0
+    allowed = max(ROUTE_RETURN_M, ROUTE_RETURN_FRACTION * route)
+    if offset <= allowed:
+        return None
+    return f"the route does not return to its start (it ends {offset:.1f} m away; a loop closes within {allowed:.1f} m)"
+
+
+METRIC: Metric[Block] = Metric(
+    name="loop_gap",
+    position=50,
+    models=(LoopGapBlock, ClosedRouteGapBlock),
+    needs=(RETURNING_ROUTE,),
+    compute=compute,
+    headline=headline,
+    columns=(
+        ColumnSpec("loop_gap_m", "route.gap_m", "loop gap (m)", applies=route_returns),
+        ColumnSpec("revisit_gap_m", "translation_m.mean", "revisit gap mean (m)"),
+    ),
+)

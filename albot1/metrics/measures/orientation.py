@@ -1,0 +1,61 @@
+"""``orientation``: the thesis's Table 3.1, bearing and distance to the start (:mod:`albot1.metrics.orientation`)."""
+
+from __future__ import annotations
+
+from albot1.metrics.blocks import block_of, fmt
+from albot1.metrics.orientation import orientation_table
+from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
+from albot1.records import OptFloat, Record
+
+
+class OrientationRow(Record):
+    """One stop point of the thesis's Table 3.1 (deg, m); the bearing error is null near the start."""
+
+    scan: int
+    timestamp: OptFloat
+    travel_m: float
+    estimate_bearing_deg: float
+    estimate_distance_m: float
+    reference_bearing_deg: float
+    reference_distance_m: float
+    bearing_error_deg: OptFloat
+    distance_error_m: float
+
+
+class OrientationBlock(Record):
+    """``orientation``: Table 3.1 rows and mean/max absolute differences (null when no row defines them)."""
+
+    alignment: str
+    units: dict[str, str]
+    every_m: float
+    min_distance_m: float
+    stops: int
+    bearing_undefined: int
+    bearing_abs_error_mean_deg: OptFloat
+    bearing_abs_error_max_deg: OptFloat
+    distance_abs_error_mean_m: OptFloat
+    distance_abs_error_max_m: OptFloat
+    rows: list[OrientationRow]
+
+
+def compute(inputs: MetricInputs) -> OrientationBlock:
+    assert inputs.reference is not None  # REFERENCE is a need
+    return block_of(OrientationBlock, orientation_table(inputs.poses, inputs.reference, inputs.timestamps))
+
+
+def headline(block: OrientationBlock) -> str:
+    return (
+        f"{block.stops} stops, bearing |err| mean {fmt(block.bearing_abs_error_mean_deg, '.2f')} deg, "
+        f"distance |err| mean {fmt(block.distance_abs_error_mean_m)} m"
+    )
+
+
+METRIC = Metric(
+    name="orientation",
+    position=60,
+    models=(OrientationBlock,),
+    needs=(REFERENCE,),
+    compute=compute,
+    headline=headline,
+    columns=(ColumnSpec("orientation_deg", "bearing_abs_error_mean_deg", "bearing error mean (deg)"),),
+)

@@ -1,0 +1,143 @@
+"""``places``: a network of places (thesis chapter 4) judged against the reference poses.
+
+The method's own claims (``places.json``: visits, claimed re-visits, exit
+crossings and predictions; :mod:`albot1.methods.albot1.places.network`) are
+scored after the run, when the run folder is evaluated: the mapper never sees
+the reference poses. :func:`albot1.metrics.places.judge_network` holds the
+rules; the dataset's metadata (the synthetic worlds' rooms, doorways and true
+doorway crossings) is read from the reopened dataset. A method without a
+network of places has no ``places.json``: the metric is not applicable, with
+that reason.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Literal
+
+from albot1.errors import Albot1Error
+from albot1.metrics.blocks import block_of, fmt
+from albot1.metrics.errors import MetricsError
+from albot1.metrics.places import PLACES_JSON, judge_network
+from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs, method_file
+from albot1.records import OmitsAbsentReasons, OptFloat, Record
+
+PLACES_FILE = method_file(PLACES_JSON, f"the method keeps no network of places (no {PLACES_JSON})")
+
+
+class VisitJudgement(Record):
+    """One visit: the earlier visits it was in the same place as, and whether the network recognised that."""
+
+    visit: int
+    same_place_as: list[int]
+    recognised: bool
+
+
+class ExitPrediction(Record):
+    """One exit prediction compared at a crossing, against the true doorway nearest the perceived exit (m)."""
+
+    scan: int
+    exit: int | str
+    doorway: str
+    perceived_error_m: float
+    aligned_error_m: float
+    not_aligned_error_m: float
+
+
+class ExitsJudgement(Record):
+    """Exit predictions against the true doorways, and detected crossings against the true ones."""
+
+    exit_predictions: list[ExitPrediction]
+    crossing_scans: int
+    exit_prediction_aligned_true_mean_m: OptFloat
+    exit_prediction_not_aligned_true_mean_m: OptFloat
+    crossings_true: int
+    crossings_false: int
+    crossings_missed: int
+
+
+class PlacesBlock(OmitsAbsentReasons):
+    """``places``: re-visits judged by the reference positions (``rule``), and exits when the dataset knows doorways.
+
+    ``rule`` is ``rooms`` (the dataset's rooms; ``rooms`` names each visit's)
+    or ``overlap`` (hulls of reference positions grown by ``buffer_m``
+    sharing ``min_overlap``). ``claims_true`` flags each claimed re-visit of
+    ``places.json`` in its order. Precision is null without a claim, recall
+    without a true re-visit. ``exits`` is null with ``exits_reason`` when the
+    dataset knows no doorways.
+    """
+
+    units: dict[str, str]
+    rule: Literal["rooms", "overlap"]
+    rooms: list[str] | None
+    buffer_m: float | None
+    min_overlap: float | None
+    claims: int
+    claims_true: list[bool]
+    revisits_true: int
+    revisits_false: int
+    revisits_missed: int
+    revisits_actual: int
+    revisit_precision: OptFloat
+    revisit_recall: OptFloat
+    visits: list[VisitJudgement]
+    exits: ExitsJudgement | None
+    exits_reason: str | None = None
+
+
+def compute(inputs: MetricInputs) -> PlacesBlock:
+    reference, read_file = inputs.reference, inputs.read_file
+    assert reference is not None and read_file is not None  # REFERENCE and PLACES_FILE are needs
+    record = read_file(PLACES_JSON)
+    if not isinstance(record, Mapping):
+        raise MetricsError(f"{PLACES_JSON}: expected a JSON object, found {type(record).__name__}")
+    try:
+        extra = inputs.open_dataset().metadata.extra
+    except Albot1Error as exc:
+        raise MetricsError(f"cannot reopen dataset {inputs.dataset!r} for its rooms and doorways: {exc}") from exc
+    try:
+        data = judge_network(record, inputs.poses, reference, extra)
+    except (KeyError, TypeError, IndexError) as exc:
+        raise MetricsError(f"{PLACES_JSON}: unexpected content ({type(exc).__name__}: {exc})") from None
+    return block_of(PlacesBlock, data)
+
+
+def headline(block: PlacesBlock) -> str:
+    text = (
+        f"{block.revisits_true} of {block.claims} claimed re-visits true (precision "
+        f"{fmt(block.revisit_precision, '.2f')}), recall {fmt(block.revisit_recall, '.2f')} "
+        f"of {block.revisits_actual} true re-visits ({block.rule})"
+    )
+    exits = block.exits
+    if exits is None:
+        return text
+    crossings = f"{exits.crossings_true} of {exits.crossings_true + exits.crossings_missed} true crossings found"
+    if not exits.exit_predictions:
+        return f"{text}; {crossings}, no exit prediction compared"
+    return (
+        f"{text}; {crossings}, exit predictions {fmt(exits.exit_prediction_aligned_true_mean_m)} m aligned, "
+        f"{fmt(exits.exit_prediction_not_aligned_true_mean_m)} m not"
+    )
+
+
+METRIC = Metric(
+    name="places",
+    position=110,
+    models=(PlacesBlock,),
+    needs=(PLACES_FILE, REFERENCE),
+    compute=compute,
+    headline=headline,
+    columns=(
+        # the network's size and its claims are the method's own counters (result.json), shown beside the judgement
+        ColumnSpec("places", "counters.places", "places", source="result"),
+        ColumnSpec("revisits_claimed", "counters.revisits_confirmed", "re-visits claimed", source="result"),
+        ColumnSpec(
+            "revisit_precision", "revisit_precision", "re-visit precision", undefined="no re-visit claimed (claims: 0)"
+        ),
+        ColumnSpec(
+            "revisit_recall", "revisit_recall", "re-visit recall", undefined="no true re-visit (revisits_actual: 0)"
+        ),
+        ColumnSpec("exit_aligned_m", "exits.exit_prediction_aligned_true_mean_m", "exit pred. aligned (m)"),
+        ColumnSpec("exit_not_aligned_m", "exits.exit_prediction_not_aligned_true_mean_m", "exit pred. not aligned (m)"),
+    ),
+)

@@ -1,0 +1,134 @@
+"""Figures whose inputs did not change are not drawn again.
+
+Drawing is nearly all of a report's time (matplotlib's layout and two file
+formats per figure: 18 of 20 s on the quick suite), and `make bench` rebuilds
+every report after every grid, most often with few or no new cells. Each
+group of figures (one dataset's figures, one figure of the thesis page) is
+stamped with a digest of everything it is drawn from: the code version (so a
+change of the plotting code redraws everything), the drawing options, and the
+bytes of every ``result.json`` and ``metrics.json`` the group reads (a cell
+that ran again rewrites both). A group is drawn again when its digest
+differs, when any file it made is missing, or when the stamp file cannot be
+read; a stamp is never trusted beyond that.
+
+The stamps are one JSON file (:data:`STAMPS`) beside the figures, written
+atomically once the figures are on disk.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from albot1 import versions
+from albot1.atomic import atomic_write
+from albot1.report.collect import CellRecord
+from albot1.runs.folder import METRICS_FILE, RESULT_FILE
+
+#: The stamp file, in the folder of the figures it describes.
+STAMPS = "figures.json"
+#: Bumped when the stamp file's layout changes: stamps of another version are ignored.
+STAMPS_VERSION = 1
+
+
+def _file_digest(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return "absent"
+
+
+def record_digest(record: CellRecord) -> list[str]:
+    """What of a cell a figure can show: its key, status and the bytes of its result and metrics records."""
+    if record.status != "done":
+        return [record.cell.key, record.status]
+    return [
+        record.cell.key,
+        record.status,
+        _file_digest(record.run_dir / RESULT_FILE),
+        _file_digest(record.run_dir / METRICS_FILE),
+    ]
+
+
+def inputs_digest(records: Iterable[CellRecord], *options: object) -> str:
+    """The digest of a group of figures: the code version, ``options`` (JSON-able) and ``records``."""
+    parts = [versions.code_version(), [record_digest(r) for r in records], list(options)]
+    text = json.dumps(parts, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class Cached:
+    """What a group of figures produced last time: the files it made and the caller's JSON-able ``payload``."""
+
+    files: list[Path]
+    payload: Any
+
+
+class FigureCache:
+    """The stamps of one folder of figures: look a group up before drawing it, store it after."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self.stamps = folder / STAMPS
+        self._groups: dict[str, dict[str, Any]] = self._read()
+        self._changed = False
+
+    def _read(self) -> dict[str, dict[str, Any]]:
+        try:
+            data = json.loads(self.stamps.read_text(encoding="utf-8"))
+        except (OSError, ValueError):  # absent or damaged: every group is drawn again
+            return {}
+        if not isinstance(data, dict) or data.get("version") != STAMPS_VERSION:
+            return {}
+        groups = data.get("groups")
+        if not isinstance(groups, dict):
+            return {}
+        return {k: v for k, v in groups.items() if isinstance(v, dict)}
+
+    def name(self, path: Path) -> str:
+        """How a file is stored: relative to the folder when inside it (the report can move), else absolute."""
+        try:
+            return str(path.relative_to(self.folder))
+        except ValueError:
+            return str(path.resolve())
+
+    def path(self, stored: str) -> Path:
+        """The file a stored name stands for (:meth:`name`'s inverse)."""
+        path = Path(stored)
+        return path if path.is_absolute() else self.folder / path
+
+    def lookup(self, group: str, digest: str) -> Cached | None:
+        """The group's files and payload when its digest is ``digest`` and every file it made still exists."""
+        entry = self._groups.get(group)
+        if entry is None or entry.get("digest") != digest:
+            return None
+        stored = entry.get("files")
+        if not isinstance(stored, list) or not all(isinstance(f, str) for f in stored):
+            return None
+        files = [self.path(f) for f in stored]
+        if not all(f.is_file() for f in files):
+            return None
+        return Cached(files, entry.get("payload"))
+
+    def store(self, group: str, digest: str, files: Iterable[Path], payload: Any = None) -> None:
+        """Remember that ``group`` drawn from ``digest`` made ``files`` (and their vector twins where they exist)."""
+        names: list[str] = []
+        for f in files:
+            for path in (f, f.with_suffix(".svg")):
+                if path.is_file():
+                    names.append(self.name(path))
+        self._groups[group] = {"digest": digest, "files": sorted(set(names)), "payload": payload}
+        self._changed = True
+
+    def save(self) -> None:
+        """Write the stamps (atomically) when a group was stored since they were read."""
+        if not self._changed:
+            return
+        document = {"version": STAMPS_VERSION, "groups": self._groups}
+        atomic_write(self.stamps, lambda tmp: tmp.write_text(json.dumps(document, indent=1, sort_keys=True)))
+        self._changed = False

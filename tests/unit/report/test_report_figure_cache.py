@@ -1,0 +1,108 @@
+"""A report drawn again draws only the figures whose inputs changed (albot1.report.figure_cache).
+
+A tiny store made by the real planner and cell executor (dead reckoning on two small synthetic worlds) is
+reported three times into one folder: the second report draws nothing; after one cell's metrics change, only
+its dataset's figures (and the cross-dataset runtime figure) are drawn again; a deleted figure is drawn again.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from albot1.bench.cells import execute_cell
+from albot1.bench.plan import plan_suite
+from albot1.bench.store import ResultsStore
+from albot1.bench.suite import parse_suite
+from albot1.report import index
+from albot1.report.figure_cache import STAMPS, FigureCache, inputs_digest
+from albot1.report.index import build_report
+from albot1.settings import get_settings
+
+DATASETS = ("synthetic-office-loop", "synthetic-corridor")
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    data = {
+        "description": "two worlds, dead reckoning",
+        "grid": {"degradations": ["gauss:0.05:1"], "seeds": [0]},
+        "methods": [{"name": "odometry"}],
+        "datasets": [{"name": name} for name in DATASETS],
+    }
+    suite = parse_suite(data, name="tiny", source="tiny.toml")
+    plan = plan_suite(suite, get_settings())
+    root = tmp_path_factory.mktemp("results") / "tiny"
+    store = ResultsStore(root)
+    store.write_plan(plan)
+    for cell in plan.cells:
+        execute_cell(cell, store.runs)
+    return root
+
+
+def _counting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    drawn: list[str] = []
+    original: Callable[..., list[Path]] = index._dataset_plots
+
+    def spy(dataset: str, *args: Any) -> list[Path]:
+        drawn.append(dataset)
+        return original(dataset, *args)
+
+    monkeypatch.setattr(index, "_dataset_plots", spy)
+    return drawn
+
+
+def test_a_second_report_draws_nothing_and_a_changed_cell_redraws_its_dataset_only(
+    results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    out = tmp_path / "report"
+    drawn = _counting(monkeypatch)
+    build_report(results, out)
+    assert sorted(drawn) == sorted(DATASETS)
+    first = {p.name: p.read_bytes() for p in (out / "plots").glob("*.png")}
+    readme = (out / "README.md").read_text(encoding="utf-8")
+
+    drawn.clear()
+    build_report(results, out)
+    assert drawn == []
+    assert {p.name: p.read_bytes() for p in (out / "plots").glob("*.png")} == first
+    assert (out / "README.md").read_text(encoding="utf-8") == readme  # the same figures are linked
+
+    # one cell of the corridor evaluated again (its metrics.json rewritten with other bytes)
+    metrics = next(
+        p for p in results.rglob("metrics.json") if '"synthetic-corridor' in (p.parent / "result.json").read_text()
+    )
+    metrics.write_text(json.dumps(json.loads(metrics.read_text()), indent=3))
+    drawn.clear()
+    build_report(results, out)
+    assert drawn == ["synthetic-corridor"]
+
+    # a figure deleted by hand is drawn again
+    next((out / "plots").glob("synthetic-office-loop-*.png")).unlink()
+    drawn.clear()
+    build_report(results, out)
+    assert drawn == ["synthetic-office-loop"]
+
+
+def test_damaged_or_foreign_stamps_are_ignored(tmp_path: Path) -> None:
+    figure = tmp_path / "a.png"
+    figure.write_bytes(b"png")
+    cache = FigureCache(tmp_path)
+    cache.store("group", "d1", [figure], ["a.png"])
+    cache.save()
+    again = FigureCache(tmp_path)
+    found = again.lookup("group", "d1")
+    assert found is not None and found.files == [figure] and found.payload == ["a.png"]
+    assert again.lookup("group", "d2") is None  # another digest: drawn again
+    for damaged in ("{", '{"version": 99, "groups": {}}', '{"version": 1, "groups": []}', "[]"):
+        (tmp_path / STAMPS).write_text(damaged)
+        assert FigureCache(tmp_path).lookup("group", "d1") is None
+
+
+def test_the_digest_names_the_options(results: Path) -> None:
+    assert inputs_digest([], "a", 1) == inputs_digest([], "a", 1)
+    assert inputs_digest([], "a", 1) != inputs_digest([], "a", 2)
