@@ -242,11 +242,14 @@ def _with_own_files(text: str, settings: Settings | None, format_name: str | Non
     views = rest.pop("views", None)
     if use_reference:
         del rest["odometry"]
+    own = {key: value for key, value in (("relations", relations), ("reference", reference)) if value is not None}
+    _check_option_files(own, text)  # a FIFO or device is refused before anything reads it
     sequence = open_sequence(text, settings=settings, format_name=format_name, **rest)
     if relations is not None:
         sequence = with_relations(sequence, relations, text)
     if reference is not None:
         sequence = with_reference(sequence, reference, text, max_dt)
+    sequence = _attach(sequence, _checksums(None, own))
     after: dict[str, Any] = {"odometry": REFERENCE} if use_reference else {}
     if views is not None:
         after["views"] = views

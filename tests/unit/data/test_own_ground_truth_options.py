@@ -88,7 +88,7 @@ def test_kitti_reference_needs_one_pose_per_scan(tmp_path: Path, sources: dict[s
     [
         ("relations=/no/such/file", "relations=/no/such/file: no such file"),
         ("reference=/no/such/file", "reference=/no/such/file: no such file"),
-        ("reference=/", "reference=/ is a folder"),
+        ("reference=/", "/: a folder, not a regular file; expected a regular file for the option reference="),
         ("reference_max_dt=1", "reference_max_dt goes with reference=FILE"),
     ],
 )
