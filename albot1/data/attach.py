@@ -40,8 +40,6 @@ from albot1.data.trajectory import read_trajectory
 REFERENCE_MAX_DT_S = 0.01
 #: Values of ``reference`` that a CARMEN log reads as a keyword, not as a file name.
 REFERENCE_KEYWORDS = ("none", "laser-pose", "truepos", "auto")
-#: The options of every source, handled here and in :mod:`albot1.data.open`; loaders list them in their errors.
-COMMON_OPTIONS = ("relations", "reference", "reference_max_dt", "odometry=reference", "views")
 
 
 def with_relations(sequence: Sequence, value: object, ref: str) -> Sequence:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.data.attach import COMMON_OPTIONS
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
 from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError

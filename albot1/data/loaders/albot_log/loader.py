@@ -37,7 +37,6 @@ from typing import IO, Any, ClassVar
 
 import numpy as np
 
-from albot1.data.attach import COMMON_OPTIONS
 from albot1.data.errors import DataError, ParseError, UnwritableError
 from albot1.data.loaders.albot_log.lines import (
     FRAME,
@@ -50,6 +49,7 @@ from albot1.data.loaders.albot_log.lines import (
     sensor_line,
     view_line,
 )
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.model import FloatArray, Frame, Sequence, SequenceMetadata

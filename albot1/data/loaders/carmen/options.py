@@ -16,8 +16,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from albot1.data.attach import COMMON_OPTIONS
 from albot1.data.errors import DataError
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 
 ODOMETRY_SOURCES = ("laser-pose", "odom", "odom-segments")

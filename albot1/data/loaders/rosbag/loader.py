@@ -29,8 +29,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from albot1.data.attach import COMMON_OPTIONS
 from albot1.data.errors import DataError, ParseError, TopicError
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.rosbag.bag1_check import version_problem
 from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, scan_arrays
 from albot1.data.loaders.rosbag.reader import header_stamp, odometry_track, opened_bag, tf_track, topic_messages
