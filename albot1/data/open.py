@@ -42,6 +42,7 @@ from albot1.data import catalog
 from albot1.data.attach import REFERENCE_KEYWORDS, with_reference, with_relations
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
 from albot1.data.filekind import check_input
+from albot1.data.finite import checked
 from albot1.data.identity import content_sha256
 from albot1.data.loaders.registry import load
 from albot1.data.model import Sequence
@@ -85,14 +86,14 @@ def open_sequence(
     _check_option_files(options, text)
     if text in catalog.names():
         checksums = _checksums(None, options)
-        return _attach(catalog.open_dataset(text, settings, **options), checksums)
+        return _attach(checked(catalog.open_dataset(text, settings, **options)), checksums)
     path = Path(text).expanduser()
     if _exists(text):
         # The file (or every file of a bag folder) is checked and hashed before a loader opens it: a FIFO
         # among a bag's files would block the loader, and the checksum is cached for every later use.
         check_input(path, "a log file or a ROS2 bag folder", folder_ok=True)
         checksums = _checksums(path, options)
-        return _attach(load(path, format_name, **options), checksums)
+        return _attach(checked(load(path, format_name, **options)), checksums)
     raise DatasetNotFoundError(
         f"{text!r} is neither a dataset name nor an existing file; known datasets: "
         f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
