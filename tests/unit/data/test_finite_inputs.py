@@ -66,7 +66,7 @@ def test_a_log_with_an_absurd_odometry_is_refused_at_that_scan(tmp_path: Path, f
 
 @pytest.mark.parametrize("spec", ["gauss:1e300:1", "bias:1e200:0"])
 def test_a_degradation_that_overflows_names_the_step(spec: str) -> None:
-    with pytest.raises(DataError, match=rf"degradation .* seed 3, step to scan 1 \(t = .*\): the degraded odometry"):
+    with pytest.raises(DataError, match=r"degradation .* seed 3, step to scan 1 \(t = .*\): the degraded odometry"):
         degrade(open_sequence(WORLD), spec, seed=3).arrays  # noqa: B018
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,7 @@ from albot1.metrics.record import MetricsRecord
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, severity_order
 from albot1.report.cost_plots import plot_scan_time
 from albot1.report.map_plots import occupancy, plot_maps
-from albot1.report.plots import Extent, log_floor, method_colors, panel_layout, representative, slug
+from albot1.report.plots import SLUG_CHARS, Extent, log_floor, method_colors, panel_layout, representative, slug
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes, segment_error_sets
 from albot1.report.tables import aggregate, cells_frame
@@ -34,8 +35,19 @@ def test_severity_order_puts_none_first_then_gaussian_by_sigma_then_thesis() -> 
 
 
 def test_slug_makes_dataset_labels_file_safe() -> None:
-    assert slug("aces[:2500:2]") == "aces_2500_2"
-    assert slug("/data/my log.clf") == "data_my_log.clf"
+    assert slug("aces") == "aces" and slug("synthetic-office-loop") == "synthetic-office-loop"
+    assert re.fullmatch(r"aces_2500_2-h[0-9a-f]{10}", slug("aces[:2500:2]"))
+    assert re.fullmatch(r"data_my_log.clf-h[0-9a-f]{10}", slug("/data/my log.clf"))
+
+
+def test_slugs_are_unique_and_short_for_every_label() -> None:
+    labels = ["büro", "båro", "b_ro", "b ro", "aces[:2500:2]", "aces_2500_2", "/x/" + "a" * 290 + ".clf", ".", "..", ""]
+    labels.append(slug("aces[:2500:2]"))  # a label that looks like a hashed slug is hashed too
+    slugs = [slug(label) for label in labels]
+    assert len(set(slugs)) == len(labels)
+    for name in slugs:
+        assert len(name) <= SLUG_CHARS + 12 and re.fullmatch(r"[A-Za-z0-9_.-]+", name)
+        assert not name.startswith(".")
 
 
 def _cell(method: str, degradation: str, seed: int, dataset: str = "w") -> Cell:
