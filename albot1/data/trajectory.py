@@ -308,13 +308,13 @@ def _refuse_duplicate_stamps(path: Path, stamps: NDArray[np.float64], *, by_line
         first_line, second_line = _line_of(path, first), _line_of(path, second)
         raise ParseError(
             path,
-            f"lines {first_line} and {second_line} both have timestamp {stamps[first]!r}; "
+            f"lines {first_line} and {second_line} both have timestamp {float(stamps[first])!r}; "
             "expected one pose per timestamp",
             line=second_line,
         )
     raise ParseError(
         path,
-        f"scans {first} and {second} (0-based laser lines) both have timestamp {stamps[first]!r}; "
+        f"scans {first} and {second} (0-based laser lines) both have timestamp {float(stamps[first])!r}; "
         "expected one pose per timestamp",
     )
 

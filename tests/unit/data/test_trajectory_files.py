@@ -61,3 +61,47 @@ def test_the_format_comes_from_the_name_or_the_first_line(tmp_path: Path) -> Non
         read_trajectory(tmp_path / "a.txt", "g2o")
     with pytest.raises(DataError, match="trajectory file not found"):
         read_trajectory(tmp_path / "missing.tum")
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "message"),
+    [
+        (
+            "dup.tum",
+            "0 0 0 0 0 0 0 1\n0.2 1 0 0 0 0 0 1\n# c\n0.2 2 0 0 0 0 0 1\n",
+            ":4: lines 2 and 4 both have timestamp 0.2",
+        ),
+        ("qs.tum", "0 0 0 0 0 0 0.00001 0.00001\n", ":1: quaternion (qx qy qz qw) has length 1.41421e-05"),
+        ("qb.tum", "0 0 0 0 0 0 300 400\n", ":1: quaternion (qx qy qz qw) has length 500"),
+        ("z.kitti", "0 0 0 0 0 0 0 0 0 0 0 0\n", ":1: the 3x3 part of [R | t] is not a rotation"),
+        (
+            "s.kitti",
+            "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 2 0 0 0 0 1 0\n",
+            ":2: the 3x3 part of [R | t] is not a rotation",
+        ),
+        ("m.kitti", "1 0 0 0 0 -1 0 0 0 0 1 0\n", ":1: the 3x3 part of [R | t] is not a rotation"),
+        ("big.tum", "0 0 0 0 0 0 0 1\n1 1e308 0 0 0 0 0 1\n", ":2: position (1e+308, 0) m is beyond 1e+08 m"),
+        ("ns.tum", "1.7e18 0 0 0 0 0 0 1\n", ":1: timestamp 1.7e+18 is beyond 1e+11; expected seconds"),
+    ],
+)
+def test_absurd_trajectories_are_refused_with_the_line(tmp_path: Path, name: str, text: str, message: str) -> None:
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(DataError) as caught:
+        read_trajectory(path)
+    assert str(caught.value).startswith(f"{path}{message}")
+
+
+def test_a_quaternion_close_to_unit_is_normalised(tmp_path: Path) -> None:
+    half = np.radians(73.7) / 2
+    qz, qw = float(1.005 * np.sin(half)), float(1.005 * np.cos(half))
+    (tmp_path / "n.tum").write_text(f"0 1 2 0 0 0 {qz!r} {qw!r}\n")
+    _, poses = read_tum(tmp_path / "n.tum")
+    assert np.degrees(poses[0, 2]) == pytest.approx(73.7, abs=1e-9)
+
+
+def test_a_folder_or_a_missing_file_is_named_as_such(tmp_path: Path) -> None:
+    with pytest.raises(DataError, match="is a folder; expected a trajectory file"):
+        read_trajectory(tmp_path)
+    with pytest.raises(DataError, match="trajectory file not found"):
+        read_trajectory(tmp_path / "nothing.tum")
