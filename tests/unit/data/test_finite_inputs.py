@@ -54,11 +54,7 @@ def test_a_log_with_an_absurd_odometry_is_refused_at_that_scan(tmp_path: Path, f
         )
     )
     out = tmp_path / {"carmen": "w.clf", "ros1": "w.bag", "ros2-mcap": "w2", "albot-log": "w.albotlog"}[fmt]
-    try:
-        convert(bad, out, fmt)
-    except DataError as exc:  # a writer that refuses it already is as good
-        assert "1e+300" in str(exc) or "finite" in str(exc) or "beyond" in str(exc)
-        return
+    convert(bad, out, fmt)  # the writers store what they are given; the reader refuses it
     options = "?odometry=odom" if fmt == "carmen" else ""
     with pytest.raises(DataError, match=r"scan 7 \(t = .* s\): odometry position \(1e\+300, .*\) m is beyond 1e\+08 m"):
         open_sequence(f"{out}{options}").arrays  # noqa: B018
