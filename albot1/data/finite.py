@@ -28,14 +28,13 @@ from albot1.data.trajectory import MAX_COORDINATE_M
 def pose_problem(pose: object, what: str) -> str | None:
     """Why ``pose`` (x, y, theta) is not a usable pose, or None."""
     values = np.asarray(pose, dtype=float).reshape(-1)
-    if not np.isfinite(values).all():
+    x, y, theta = (float(v) for v in values[:3]) if len(values) >= 3 else (math.nan,) * 3
+    # plain float arithmetic: a sum is finite only when every term is (this runs once per scan)
+    if math.isfinite(x + y + theta) and abs(x) <= MAX_COORDINATE_M and abs(y) <= MAX_COORDINATE_M:
+        return None
+    if not np.isfinite(values).all() or len(values) < 3:
         return f"{what} ({', '.join(f'{v:g}' for v in values)}) is not finite; expected finite numbers"
-    if np.abs(values[:2]).max(initial=0.0) > MAX_COORDINATE_M:
-        return (
-            f"{what} position ({values[0]:.6g}, {values[1]:.6g}) m is beyond {MAX_COORDINATE_M:g} m; "
-            "expected metres of a map"
-        )
-    return None
+    return f"{what} position ({x:.6g}, {y:.6g}) m is beyond {MAX_COORDINATE_M:g} m; expected metres of a map"
 
 
 def frame_problem(frame: Frame) -> str | None:
@@ -45,7 +44,8 @@ def frame_problem(frame: Frame) -> str | None:
     problem = pose_problem(frame.odometry, "odometry")
     if problem is None and frame.reference is not None:
         problem = pose_problem(frame.reference, "reference pose")
-    if problem is None and not np.isfinite(frame.scan.angles).all():
+    # radians sum to a finite number unless one of them is NaN or infinite
+    if problem is None and not math.isfinite(float(frame.scan.angles.sum())):
         problem = "a beam angle is not finite; expected finite radians"
     return problem
 
