@@ -315,7 +315,7 @@ def _refuse_duplicate_stamps(path: Path, stamps: NDArray[np.float64], *, by_line
     raise ParseError(
         path,
         f"scans {first} and {second} (0-based laser lines) both have timestamp {float(stamps[first])!r}; "
-        "expected one pose per timestamp",
+        "expected one pose per timestamp (a log whose timestamps repeat cannot place its poses in time)",
     )
 
 
