@@ -142,3 +142,22 @@ def test_written_with_nine_decimals_too(tmp_path: Path) -> None:
     record, _ = evaluate_pair(tmp_path / "a.tum", tmp_path / "b.tum", align="none")
     assert record.ate is not None and record.ate.rmse_m == 0.0
     assert record.trajectory is not None and record.trajectory.reference_without_pose == 0
+
+
+def test_align_and_time_offset_apply_to_dataset_scoring_too(tmp_path: Path) -> None:
+    from albot1.data.open import open_sequence
+    from albot1.runs.evaluate import evaluate_trajectory
+
+    world = "synthetic-corridor[:60]"
+    arrays = open_sequence(world).arrays
+    assert arrays.reference is not None
+    shifted = arrays.reference + [0.5, -0.25, 0.0]
+    write_tum(tmp_path / "est.tum", arrays.timestamps[4:] - 2.0, shifted[4:])
+    record, _ = evaluate_trajectory(tmp_path / "est.tum", world, time_offset_s=2.0, align="none")
+    assert record.ate is not None and record.ate.alignment == "none"
+    assert record.ate.rmse_m == pytest.approx(np.hypot(0.5, 0.25), abs=1e-8)
+    source = record.trajectory
+    assert source is not None
+    assert (source.reference_without_pose, source.time_offset_s, source.alignment) == (4, 2.0, "none")
+    record, _ = evaluate_trajectory(tmp_path / "est.tum", world, time_offset_s=2.0, align="origin")
+    assert record.ate is not None and record.ate.rmse_m == pytest.approx(0.0, abs=1e-8)
