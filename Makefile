@@ -5,8 +5,8 @@ PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
-# `make bench` runs both suites (the thesis page reads the default suite's results); SUITE=NAME runs one.
-SUITE  ?= default thesis
+# `make bench` runs the three suites (the thesis page reads the default suite's results; generalisation: issue 21); SUITE=NAME runs one.
+SUITE  ?= default thesis generalisation
 JOBS   ?= 2
 TEST_JOBS ?= auto
 

@@ -105,8 +105,8 @@ def evaluate(
     """
     # The runs layer is imported by the command, not by this module: see albot1.cli.app.
     from albot1.records import dump_record
-    from albot1.runs.evaluate import METRICS_FILE, evaluate_run, evaluate_trajectory
-    from albot1.runs.folder import read_run
+    from albot1.runs.evaluate import evaluate_run, evaluate_trajectory
+    from albot1.runs.folder import METRICS_FILE, read_run
     from albot1.runs.scored import scored_run
 
     settings = get_settings(data_dir=data_dir)

@@ -30,10 +30,19 @@ raised before any run starts.
 
 The precedence applied later by :func:`albot1.config.resolve.resolve`
 is: model < preset < env ``ALBOT1_<METHOD>_<FIELD>`` < ``--set``.
+
+Beside the presets a file records where its values came from: a
+``[tuned_on]`` table maps a preset to the dataset names its values were
+chosen on by looking at their scores (the *held-in* datasets; a preset the
+table does not name has ``default``'s). A number measured on one of them is
+not evidence of how the method generalises, so the reports mark it
+(:func:`tuned_on`, ``albot1.report.tuning``). The table is data, not config:
+it never enters a run's config or its key.
 """
 
 from __future__ import annotations
 
+import inspect
 import tomllib
 from importlib.resources import files
 from pathlib import Path
@@ -46,6 +55,11 @@ from albot1.errors import ConfigError
 from albot1.resources import find_resource
 
 PresetTable = dict[str, dict[str, Any]]
+#: preset name -> the datasets its values were tuned on (``[tuned_on]`` of a preset file)
+TunedOnTable = dict[str, tuple[str, ...]]
+
+#: The top-level table of a preset file that names the held-in datasets of each preset.
+TUNED_ON = "tuned_on"
 
 #: The file name of a package's own presets (``TomlPresets(package=...)``).
 PACKAGE_PRESETS = "presets.toml"
@@ -66,11 +80,13 @@ def parse_presets(data: dict[str, Any], model: type[BaseModel], source: str) -> 
     tables = data.get("presets")
     if not isinstance(tables, dict) or not isinstance(tables.get("default"), dict):
         raise ConfigError(f"{source}: expected a [presets.default] table (and optional [presets.NAME] tables)")
-    unknown_top = sorted(set(data) - {"presets"})
+    unknown_top = sorted(set(data) - {"presets", TUNED_ON})
     if unknown_top:
         raise ConfigError(
-            f"{source}: unexpected top-level key(s) {', '.join(unknown_top)}; only [presets.NAME] tables are read"
+            f"{source}: unexpected top-level key(s) {', '.join(unknown_top)}; only [presets.NAME] tables and "
+            f"[{TUNED_ON}] are read"
         )
+    parse_tuned_on(data, source)
     default = tables["default"]
     missing = [name for name in model.model_fields if name not in default]
     if missing:
@@ -92,6 +108,34 @@ def parse_presets(data: dict[str, Any], model: type[BaseModel], source: str) -> 
     return merged
 
 
+def parse_tuned_on(data: dict[str, Any], source: str) -> TunedOnTable | None:
+    """The ``[tuned_on]`` table of a parsed preset file (None when the file has none), validated.
+
+    Keys are preset names of the file (``default`` required), values lists of
+    distinct, non-empty dataset names (an empty list: tuned on no dataset).
+    """
+    table = data.get(TUNED_ON)
+    if table is None:
+        return None
+    expected = f"expected [{TUNED_ON}] PRESET = [dataset names its values were chosen on]"
+    if not isinstance(table, dict):
+        raise ConfigError(f"{source}: {TUNED_ON}: {expected}, got {type(table).__name__}")
+    declared = data.get("presets")
+    presets: dict[str, Any] = declared if isinstance(declared, dict) else {}
+    if "default" not in table:
+        raise ConfigError(f"{source}: [{TUNED_ON}] must name the datasets of preset 'default'; {expected}")
+    out: TunedOnTable = {}
+    for preset, names in table.items():
+        if preset not in presets:
+            raise ConfigError(f"{source}: [{TUNED_ON}] names preset {preset!r}, which the file does not define")
+        if not isinstance(names, list) or not all(isinstance(n, str) and n.strip() for n in names):
+            raise ConfigError(f"{source}: {TUNED_ON}.{preset}: {expected}, got {names!r}")
+        if len(set(names)) != len(names):
+            raise ConfigError(f"{source}: {TUNED_ON}.{preset}: a dataset is named twice in {names!r}")
+        out[preset] = tuple(names)
+    return out
+
+
 def parse_preset_text(text: str, model: type[BaseModel], source: str) -> PresetTable:
     """:func:`parse_presets` of TOML text; invalid TOML is a ConfigError naming ``source``."""
     try:
@@ -105,6 +149,13 @@ def load_presets(method: str, model: type[BaseModel]) -> PresetTable:
     """Read and validate ``baselines/<method>.toml``."""
     path = preset_file(method)
     return parse_preset_text(path.read_text(encoding="utf-8"), model, str(path))
+
+
+def _document(path_or_resource: Any, source: str) -> dict[str, Any]:
+    try:
+        return tomllib.loads(path_or_resource.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source}: not valid TOML: {exc}") from None
 
 
 def load_package_presets(package: str, model: type[BaseModel]) -> PresetTable:
@@ -128,6 +179,7 @@ class TomlPresets:
     def __init__(self, package: str | None = None) -> None:
         self.package = package
         self._cache: dict[type, PresetTable] = {}
+        self._tuned: dict[type, TunedOnTable | None] = {}
 
     def __get__(self, instance: object, owner: type) -> PresetTable:
         table = self._cache.get(owner)
@@ -140,8 +192,38 @@ class TomlPresets:
             self._cache[owner] = table
         return table
 
+    def tuned_on(self, owner: type) -> TunedOnTable | None:
+        """The owner file's ``[tuned_on]`` table (None: the file records none); read once per owner class."""
+        if owner not in self._tuned:
+            self.__get__(None, owner)  # validates the whole file first
+            resource: Any = preset_file(owner.name) if self.package is None else self._resource()  # type: ignore[attr-defined]
+            self._tuned[owner] = parse_tuned_on(_document(resource, str(resource)), str(resource))
+        return self._tuned[owner]
+
+    def _resource(self) -> Any:
+        assert self.package is not None
+        return files(self.package).joinpath(PACKAGE_PRESETS)
+
     def location(self, owner: type) -> str:
         """Where the owner's presets are read from (for listings and messages)."""
         if self.package is None:
             return str(preset_file(owner.name))  # type: ignore[attr-defined]
         return str(files(self.package).joinpath(PACKAGE_PRESETS))
+
+
+def tuned_on_table(owner: type) -> TunedOnTable | None:
+    """``owner``'s ``[tuned_on]`` table (preset -> datasets), or None when its presets record none."""
+    descriptor = inspect.getattr_static(owner, "presets", None)
+    return descriptor.tuned_on(owner) if isinstance(descriptor, TomlPresets) else None
+
+
+def tuned_on(owner: type, preset: str) -> tuple[str, ...] | None:
+    """The datasets ``owner``'s ``preset`` was tuned on; None when its preset file does not record them.
+
+    A preset that ``[tuned_on]`` does not name inherits ``default``'s list
+    (its values are ``default``'s but for what it changes).
+    """
+    table = tuned_on_table(owner)
+    if table is None:
+        return None
+    return table.get(preset, table["default"])

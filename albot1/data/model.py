@@ -27,8 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry import se2
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 class _BeamDirections:
@@ -82,17 +81,23 @@ class Scan:
         """Mask of beams with a return."""
         return np.isfinite(self.ranges)
 
-    def points(self, min_range_m: float | None = None, max_range_m: float | None = None) -> FloatArray:
+    def points(
+        self, min_range_m: float | None = None, max_range_m: float | None = None, *, keep_missing: bool = False
+    ) -> FloatArray:
         """Cartesian points ``(k, 2)`` of the beams with a return, in the sensor frame, in beam order.
 
         The one scan-to-points conversion of the package. Beams without a
-        return (NaN) are always dropped; ``min_range_m`` / ``max_range_m``
+        return (NaN) are dropped, unless ``keep_missing`` (one point per beam,
+        NaN where there is no return: what a format that stores every beam
+        as a point writes; no range limits then). ``min_range_m`` / ``max_range_m``
         also drop beams shorter / longer than the limit (a beam exactly at a
         limit is kept). Moving the points into the robot or map frame (the
         laser's mounting offset, a pose) is the caller's, with
         :func:`albot1.geometry.se2.transform_points`.
         """
-        mask = self.valid()
+        if keep_missing and (min_range_m is not None or max_range_m is not None):
+            raise ValueError("keep_missing keeps every beam: it takes no range limits")
+        mask = np.ones(self.beams, dtype=np.bool_) if keep_missing else self.valid()
         if min_range_m is not None:
             mask &= self.ranges >= min_range_m
         if max_range_m is not None:

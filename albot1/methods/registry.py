@@ -51,7 +51,8 @@ def load_mapper_class(target: str) -> type[Mapper]:
 
 def _static_attr(cls: type, name: str) -> object | None:
     try:
-        return inspect.getattr_static(cls, name)
+        found: object = inspect.getattr_static(cls, name)
+        return found
     except AttributeError:
         return None
 

@@ -28,15 +28,14 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.metrics.errors import MetricsError
 
 Alignment = Literal["none", "first", "rigid"]
 ALIGNMENTS: tuple[str, ...] = get_args(Alignment)
-
-FloatArray = NDArray[np.float64]
 
 
 def check_pair(estimate: ArrayLike, reference: ArrayLike, what: str = "trajectories") -> tuple[FloatArray, FloatArray]:

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.errors import Albot1Error
+from albot1.geometry.types import FloatArray
 from albot1.records import Record, Timing
 
 if TYPE_CHECKING:
@@ -42,7 +43,6 @@ if TYPE_CHECKING:
 
 BlockT = TypeVar("BlockT", bound=Record)
 OtherT = TypeVar("OtherT", bound=Record)
-FloatArray = NDArray[np.float64]
 
 NO_REFERENCE = "the dataset has no reference poses"
 

@@ -25,6 +25,7 @@ from albot1.report.collect import CellRecord, Column
 from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
+from albot1.report.tuning import LEGEND, marked
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -123,8 +124,10 @@ def table_html(group: pd.DataFrame, columns: dict[str, Column], colors: dict[str
     for _, row in group.iterrows():
         css = ' class="failed-row"' if row["status"] != "ok" else ""
         swatch = f'<span class="swatch" style="background:{colors.get(str(row["method"]), "#999")}"></span>'
+        tuned = bool(row.get("held_in", False))
+        tip = f' title="{_e(LEGEND)}"' if tuned else ""
         cells = [
-            f'<td class="label">{swatch}{_e(row["method"])}</td>',
+            f'<td class="label"{tip}>{swatch}{_e(marked(str(row["method"]), tuned))}</td>',
             f'<td class="label">{_e(row["degradation"])}</td>',
             f'<td class="num" data-v="{int(row["seeds"])}">{int(row["seeds"])}</td>',
             *[_number_cell(row, c) for c in present],

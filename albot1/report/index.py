@@ -22,6 +22,9 @@ from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
 from albot1.report.figure_cache import FigureCache, inputs_digest
+from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
+from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
+from albot1.report.generalisation import write_generalisation
 from albot1.report.html import INDEX_HTML, rel, write_html
 from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.markdown import code, text
@@ -33,8 +36,10 @@ from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
 from albot1.report.standard import write_standard
 from albot1.report.tables import aggregate, cells_frame, write_tables
-from albot1.report.thesis.page import THESIS_SUITE, own_records, write_thesis_page
+from albot1.report.thesis.experiments.datasets import THESIS_SUITE
+from albot1.report.thesis.page import own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
+from albot1.report.tuning import held_in
 
 REPORTS_ROOT = Path("reports")
 #: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
@@ -248,6 +253,14 @@ def write_index(
             if STANDARD_PAGE in tables
             else []
         ),
+        *(
+            [
+                f"- [every method against the odometry it was given (paired comparison, held-in marks)]"
+                f"({_rel(tables[GENERALISATION_PAGE], out)}) · [CSV]({_rel(tables[GENERALISATION_TABLE], out)})"
+            ]
+            if GENERALISATION_PAGE in tables
+            else []
+        ),
         "",
         "Cost numbers were measured with the suite's parallelism on a possibly shared machine; "
         "compare them within one report.",
@@ -321,6 +334,9 @@ def build_report(
     target.mkdir(parents=True, exist_ok=True)
     tables = write_tables(records, target)
     tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
+    generalisation = write_generalisation(plan, records, target)
+    if generalisation is not None:
+        tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
     colors = method_colors(r.cell.method_label for r in records)
     thesis = plan.suite == THESIS_SUITE
     pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default
@@ -328,6 +344,7 @@ def build_report(
     index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
     page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
     cells = cells_frame(records)
+    cells["held_in"] = [held_in(rec.cell) for rec in records]
     write_html(
         plan,
         records,

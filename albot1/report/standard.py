@@ -32,6 +32,7 @@ from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.report.collect import CellRecord
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import data_lines
+from albot1.report.tuning import LEGEND, held_in, marked
 
 #: The five logs of the standard benchmark, with the names the published tables use.
 STANDARD_LOGS: dict[str, str] = {
@@ -70,6 +71,8 @@ class Row:
     duration_s: float | None = None
     source: str = ""
     note: str = ""
+    #: measured on a dataset the method's values were tuned on (None: published, or the tuning is not recorded)
+    held_in: bool | None = None
 
     @property
     def speed(self) -> float | None:
@@ -127,16 +130,26 @@ def measured_rows(records: list[CellRecord]) -> list[Row]:
 
 def _measured(rec: CellRecord) -> Row:
     log, method = rec.cell.dataset_label, rec.cell.method_label
+    tuned = held_in(rec.cell)
     if rec.status != "done" or rec.metrics is None or rec.result is None:
         reason = rec.failure.reason if rec.failure is not None else "the runner did not reach this cell"
-        return Row(log, "measured", method, status=rec.status, note=reason.replace("\n", " "))
+        return Row(log, "measured", method, status=rec.status, note=reason.replace("\n", " "), held_in=tuned)
     timing = rec.result.timing
     stamps = rec.stored_run().timestamps
     duration = float(stamps.max() - stamps.min()) if len(stamps) > 1 else None
     block = rec.metrics.get(RELATIONS)
     if block is None:
         why = rec.metrics.reason(RELATIONS.name) or "no relation metric"
-        return Row(log, "measured", method, time_s=timing.wall_s, cpu_s=timing.cpu_s, duration_s=duration, note=why)
+        return Row(
+            log,
+            "measured",
+            method,
+            time_s=timing.wall_s,
+            cpu_s=timing.cpu_s,
+            duration_s=duration,
+            note=why,
+            held_in=tuned,
+        )
     t, r, loops = block.translation_m, block.rotation_deg, block.loops
     note = ""
     if block.relations_outside_run:
@@ -161,6 +174,7 @@ def _measured(rec: CellRecord) -> Row:
         duration_s=duration,
         source=f"this suite, run {rec.cell.key}",
         note=note,
+        held_in=tuned,
     )
 
 
@@ -209,9 +223,9 @@ def _pm(mean: float | None, std: float | None, digits: int) -> str:
 
 def _cell(row: Row) -> list[str]:
     if row.status != "done":
-        return [row.method, row.kind, f"**{row.status}**: {row.note}", *[""] * 8]
+        return [marked(row.method, row.held_in), row.kind, f"**{row.status}**: {row.note}", *[""] * 8]
     return [
-        row.method,
+        marked(row.method, row.held_in),
         f"**{row.kind}**" if row.kind == "published" else row.kind,
         _pm(row.translation_mean_m, row.translation_std_m, 4),
         _num(row.translation_max_m, 3),
@@ -294,9 +308,14 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
             elif entry.status != "done":
                 values.append(entry.status)
             else:
-                values.append(_num(entry.translation_mean_m, 4))
+                values.append(marked(_num(entry.translation_mean_m, 4), entry.held_in))
         lines.append(f"| {name} | " + " | ".join(values) + " |")
-    lines += ["", "`–`: no figure (not run here / not published for that log).", ""]
+    lines += ["", "`–`: no figure (not run here / not published for that log).", "", LEGEND, ""]
+    unrecorded = sorted(
+        {r.method for r in rows if r.kind == "measured" and r.status != "not measured" and r.held_in is None}
+    )
+    if unrecorded:
+        lines += [f"Tuning not recorded (no `[tuned_on]` table; numbers unmarked): {', '.join(unrecorded)}.", ""]
     if plan.skipped_methods:
         lines += [
             "Methods not run on this machine: "

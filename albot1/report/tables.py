@@ -39,6 +39,7 @@ from albot1.report.collect import (
 )
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import data_by_dataset, describe_data
+from albot1.report.tuning import LEGEND, held_in, marked
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -88,6 +89,7 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
             "failed": int(len(failed)),
             "not_run": int((group["status"] == "not run").sum()),
             "status": _status(group, failed),
+            "held_in": bool(group["held_in"].eq(True).any()) if "held_in" in group else False,
         }
         for column in columns:
             values = done[column].dropna().astype(float)
@@ -204,6 +206,8 @@ def markdown(
         f"seed or all seeds agree. {SIGNIFICANT} significant digits. `n/a`: the metric does not apply to that run "
         "(the reason is under the table); `failed`: no seed completed (the status column says why).",
         "",
+        LEGEND,
+        "",
     ]
     if table.empty:
         return "\n".join([*lines, "No planned cells.", ""])
@@ -219,7 +223,7 @@ def markdown(
         ]
         for _, row in group.iterrows():
             cells = [
-                md_text(row["method"]),
+                md_text(marked(str(row["method"]), bool(row.get("held_in", False)))),
                 md_text(row["degradation"]),
                 str(int(row["seeds"])),
                 *[cell_text(row, c) for c in present],
@@ -278,6 +282,7 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
     """Write cells.csv, metrics.{csv,md,tex} and cost.{csv,md,tex} (+ cells-cost.csv) into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     cells = cells_frame(records)
+    cells["held_in"] = [held_in(rec.cell) for rec in records]
     written = {"cells.csv": out / "cells.csv"}
     helper = [c for c in cells.columns if c.endswith("_na")]
     cells.drop(columns=[*COST_COLUMNS, *helper]).to_csv(written["cells.csv"], index=False, float_format="%.9g")

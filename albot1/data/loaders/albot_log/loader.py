@@ -52,7 +52,8 @@ from albot1.data.loaders.albot_log.lines import (
 from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
 from albot1.data.loaders.output import prepare_output, writing
-from albot1.data.model import FloatArray, Frame, Sequence, SequenceMetadata
+from albot1.data.model import Frame, Sequence, SequenceMetadata
+from albot1.geometry.types import FloatArray
 
 __all__ = ["AlbotLogLoader", "AlbotLogWriter"]
 

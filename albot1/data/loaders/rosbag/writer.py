@@ -36,9 +36,9 @@ import numpy as np
 
 from albot1.data.errors import UnwritableError, WriteError
 from albot1.data.loaders.base import reference_presence_problem
+from albot1.data.loaders.beams import even_spacing
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.loaders.rosbag.msg import (
-    even_spacing,
     laserscan_problem,
     pose_problem,
     quaternion_from_yaw,

@@ -39,6 +39,7 @@ from albot1.contract import MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
@@ -52,7 +53,6 @@ from albot1.methods.albot1.places.network import network_files
 from albot1.methods.albot1.places.presets import PlacesPresets
 from albot1.methods.albot1.warm_up import warm_up
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 

@@ -22,7 +22,14 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from albot1.config.presets import PACKAGE_PRESETS, PresetTable, TomlPresets, load_package_presets
+from albot1.config.presets import (
+    PACKAGE_PRESETS,
+    PresetTable,
+    TomlPresets,
+    TunedOnTable,
+    load_package_presets,
+    tuned_on_table,
+)
 from albot1.config.validation import describe_errors
 from albot1.errors import ConfigError
 
@@ -63,3 +70,16 @@ class PlacesPresets(TomlPresets):
         return (
             f"{files(CHAPTER3_PACKAGE).joinpath(PACKAGE_PRESETS)} + {files(PLACES_PACKAGE).joinpath(PACKAGE_PRESETS)}"
         )
+
+    def tuned_on(self, owner: type) -> TunedOnTable | None:
+        """Per preset, the chapter-3 preset's held-in datasets plus those of the places file."""
+        from albot1.methods.albot1.mapping.mapper import Albot1Mapper
+
+        own = super().tuned_on(owner)
+        base = tuned_on_table(Albot1Mapper)
+        if own is None or base is None:
+            return None
+        return {
+            name: tuple(dict.fromkeys([*base.get(name, base["default"]), *own.get(name, own["default"])]))
+            for name in [*base, *(n for n in own if n not in base)]
+        }

@@ -65,6 +65,12 @@ class GtsamGraphConfig(BaseModel):
         gt=0, description="a tracking match that fits clearly may rotate its guess up to this much (deg)"
     )
     track_wide_min_fitness: float = Field(ge=0, le=1, description="... where 'clearly' is this inlier fraction")
+    track_outlier_factor: float = Field(
+        ge=0,
+        description="a tracking correction beyond this many times the recent ones' median must fit clearly "
+        "(track_wide_min_fitness), else the odometry guess stands (0 = off)",
+    )
+    track_outlier_window: int = Field(ge=1, description="... the median over this many recent tracked scans")
     local_map_nodes: int = Field(
         ge=1, description="the last k node scans form the local map the new node is matched against"
     )

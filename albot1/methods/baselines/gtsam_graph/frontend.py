@@ -17,17 +17,16 @@ import math
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.data.model import Scan
 from albot1.geometry import se2
+from albot1.geometry.grid import first_per_cell
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
+from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
-from albot1.methods.baselines.point_map import first_per_cell
-
-FloatArray = NDArray[np.float64]
 
 
 def preprocess(config: GtsamGraphConfig, scan: Scan, index: int) -> FloatArray:
@@ -63,6 +62,9 @@ class FrontEnd:
         # The latest scan's pose in the frame of the newest node.
         self.track = np.zeros(3)
         self._velocity = np.zeros(3)  # the last tracked scan-to-scan motion
+        self._corrections = CorrectionScale(
+            config.track_outlier_window, config.match_sigma_floor_xy_m, config.match_sigma_floor_theta_deg
+        )
         self.last_odometry: FloatArray | None = None
         self._consecutive_fallbacks = 0
 
@@ -121,9 +123,21 @@ class FrontEnd:
             math.hypot(gap[0], gap[1]) > limits[1] / 2 or abs(gap[2]) > math.radians(limits[2] / 2)
         ):
             alt, alt_good, _ = self.attempt(target, points, coasting, *limits)
+            if alt_good and not velocity_match_allowed(alt.pose, guess, good, limits[3]):  # type: ignore[union-attr]
+                alt_good = False
+                self.counters["tracking_velocity_rejected"] += 1
             if alt_good and (not good or alt.fitness > reg.fitness):  # type: ignore[union-attr]
                 reg, good = alt, True
                 self.counters["tracking_velocity_guess"] += 1
+        if good:
+            correction = se2.between(guess, reg.pose)  # type: ignore[union-attr]
+            if reg.fitness < cfg.track_wide_min_fitness and self._corrections.is_outlier(  # type: ignore[union-attr]
+                correction, cfg.track_outlier_factor
+            ):
+                good = False
+                self.counters["tracking_outliers_rejected"] += 1
+            else:
+                self._corrections.add(correction)
         if good:
             self.counters["scans_tracked"] += 1
             return reg
@@ -141,7 +155,7 @@ class FrontEnd:
         one wrong turn through on seed 1 (ATE 0.42 m instead of 0.07 m).
         """
         cfg = self.config
-        share = min(
+        share: float = min(
             1.0,
             max(
                 math.hypot(increment[0], increment[1]) / cfg.node_translation_m,

@@ -1,0 +1,342 @@
+"""Every method against the odometry it was given: the generalisation page, with a paired comparison per cell.
+
+A mapper that is worse than its own odometry has made the robot's estimate
+worse than doing nothing; on held-out logs (no preset file lists them as
+tuned on) that is how a method that was fitted to its benchmark shows itself.
+This page compares, for each (dataset, method, degradation) over its seeds,
+the method's trajectory with the odometry *the same run was given* (the run
+folder stores both, after the degradation, and the reference poses), so the
+pair is exact: the same scans, the same noise.
+
+ATE ratio: ``sqrt(sum e_m^2 / sum e_o^2)`` over every scan of every seed,
+where ``e_m`` and ``e_o`` are the per-scan position errors of the method and
+of its odometry, each after its own rigid SE(2) alignment to the reference
+(:func:`albot1.metrics.ate.position_errors`), i.e. the ratio of the two
+ATE RMSEs pooled over the seeds. Its confidence interval is a paired
+moving-block bootstrap over scans (blocks of 1/20 of a run, resampled within
+each seed, the same indices for both errors; the alignment is kept fixed),
+:data:`RESAMPLES` resamples from a fixed seed, so the page is reproducible.
+A cell is **worse** when the whole interval is above 1, **better** when it
+is below 1, else **indistinguishable** at :data:`CONFIDENCE`. RPE@10 m and
+the loop gap are shown beside the odometry method's own cell of the same
+dataset, degradation and seed (when the suite ran it).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from dataclasses import dataclass, fields
+from pathlib import Path
+from statistics import median
+from typing import Any
+
+import numpy as np
+
+from albot1.atomic import atomic_write
+from albot1.bench.grid import GridPlan
+from albot1.metrics.ate import position_errors
+from albot1.metrics.measures.ate import METRIC as ATE
+from albot1.report.collect import METRIC_COLUMNS, CellRecord
+from albot1.report.tuning import LEGEND, MARK, held_in, marked
+
+PAGE = "generalisation.md"
+TABLE = "generalisation.csv"
+CONFIDENCE = 0.95
+RESAMPLES = 2000
+#: blocks per run of the moving-block bootstrap (per-scan errors are correlated along the route)
+BLOCKS = 20
+ODOMETRY = "odometry"
+NA = "n/a"
+#: An odometry ATE below this (m) is perfect odometry (the reference itself): a ratio to it means nothing, the
+#: method's own ATE is the figure (issue 21's target for gtsam-graph: <= 0.3 m).
+PERFECT_M = 1e-6
+PERFECT = "perfect odometry"
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """One (dataset, method, degradation) against its odometry, over its completed seeds."""
+
+    dataset: str
+    method: str
+    degradation: str
+    seeds: int
+    failed: int
+    ate_m: float
+    odometry_ate_m: float
+    ratio: float
+    ratio_low: float
+    ratio_high: float
+    verdict: str  # better | worse | indistinguishable | perfect odometry
+    rpe10_m: float | None
+    odometry_rpe10_m: float | None
+    loop_gap_m: float | None
+    odometry_loop_gap_m: float | None
+    held_in: bool | None
+
+
+def paired_errors(rec: CellRecord) -> tuple[np.ndarray, np.ndarray] | None:
+    """Per-scan position errors of the run's poses and of the odometry it was given, or None (no reference)."""
+    if rec.status != "done" or rec.metrics is None or rec.metrics.get(ATE) is None:
+        return None
+    run = rec.stored_run()
+    if run.reference is None:
+        return None
+    ok = np.isfinite(run.reference).all(axis=1)
+    if ok.sum() < 2:
+        return None
+    return (
+        position_errors(run.poses[ok], run.reference[ok]),
+        position_errors(run.odometry[ok], run.reference[ok]),
+    )
+
+
+def bootstrap_ratio(
+    pairs: list[tuple[np.ndarray, np.ndarray]], *, resamples: int = RESAMPLES, seed: int = 0
+) -> tuple[float, float, float]:
+    """``(ratio, low, high)``: the pooled ATE ratio and its paired moving-block bootstrap interval."""
+    sum_m = sum(float(np.sum(m**2)) for m, _ in pairs)
+    sum_o = sum(float(np.sum(o**2)) for _, o in pairs)
+    ratio = math.sqrt(sum_m / sum_o) if sum_o > 0 else math.inf
+    rng = np.random.default_rng(seed)
+    draws = np.empty(resamples)
+    indices = []
+    for m, _ in pairs:
+        n = len(m)
+        length = max(1, math.ceil(n / BLOCKS))
+        count = math.ceil(n / length)
+        indices.append((n, length, count))
+    for k in range(resamples):
+        num = den = 0.0
+        for (m, o), (n, length, count) in zip(pairs, indices, strict=True):
+            starts = rng.integers(0, n - length + 1, size=count)
+            idx = (starts[:, None] + np.arange(length)[None, :]).ravel()[:n]
+            num += float(np.sum(m[idx] ** 2))
+            den += float(np.sum(o[idx] ** 2))
+        draws[k] = math.sqrt(num / den) if den > 0 else math.inf
+    tail = (1.0 - CONFIDENCE) / 2
+    low, high = np.quantile(draws, [tail, 1.0 - tail])
+    return ratio, float(low), float(high)
+
+
+def _verdict(odometry_ate_m: float, low: float, high: float) -> str:
+    if odometry_ate_m < PERFECT_M:
+        return PERFECT
+    if low > 1.0:
+        return "worse"
+    if high < 1.0:
+        return "better"
+    return "indistinguishable"
+
+
+def _mean(values: list[float | None]) -> float | None:
+    present = [v for v in values if v is not None]
+    return sum(present) / len(present) if present else None
+
+
+def comparisons(records: list[CellRecord]) -> list[Comparison]:
+    """A :class:`Comparison` per (dataset, method, degradation) with at least one scored run, in plan order."""
+    rpe, gap = METRIC_COLUMNS["drift_10m_m"], METRIC_COLUMNS["loop_gap_m"]
+    odometry_cells = {
+        (r.cell.dataset_label, r.cell.degradation, r.cell.seed): r
+        for r in records
+        if r.cell.method == ODOMETRY and r.status == "done"
+    }
+    groups: dict[tuple[str, str, str], list[CellRecord]] = {}
+    for rec in records:
+        if rec.cell.method != ODOMETRY:
+            groups.setdefault((rec.cell.dataset_label, rec.cell.method_label, rec.cell.degradation), []).append(rec)
+    out: list[Comparison] = []
+    for (dataset, method, degradation), recs in groups.items():
+        scored = [(rec, errors) for rec in recs if (errors := paired_errors(rec)) is not None]
+        if not scored:
+            continue
+        pairs = [errors for _, errors in scored]
+        odometry_ate = math.sqrt(sum(float(np.sum(o**2)) for _, o in pairs) / sum(len(o) for _, o in pairs))
+        ratio, low, high = bootstrap_ratio(pairs) if odometry_ate >= PERFECT_M else (math.nan,) * 3
+        odo = [odometry_cells.get((dataset, degradation, rec.cell.seed)) for rec, _ in scored]
+        out.append(
+            Comparison(
+                dataset=dataset,
+                method=method,
+                degradation=degradation,
+                seeds=len(scored),
+                failed=sum(rec.status == "failed" for rec in recs),
+                ate_m=math.sqrt(sum(float(np.sum(m**2)) for m, _ in pairs) / sum(len(m) for m, _ in pairs)),
+                odometry_ate_m=odometry_ate,
+                ratio=ratio,
+                ratio_low=low,
+                ratio_high=high,
+                verdict=_verdict(odometry_ate, low, high),
+                rpe10_m=_mean([rpe.value(rec) for rec, _ in scored]),
+                odometry_rpe10_m=_mean([rpe.value(o) for o in odo if o is not None]),
+                loop_gap_m=_mean([gap.value(rec) for rec, _ in scored]),
+                odometry_loop_gap_m=_mean([gap.value(o) for o in odo if o is not None]),
+                held_in=held_in(scored[0][0].cell),
+            )
+        )
+    return out
+
+
+def _num(value: float | None, digits: int = 3) -> str:
+    return NA if value is None or not math.isfinite(value) else f"{value:.{digits}f}"
+
+
+def _ratio(value: float) -> str:
+    return NA if not math.isfinite(value) else f"{value:.3g}"
+
+
+def _interval(row: Comparison) -> str:
+    if row.verdict == PERFECT:
+        return NA
+    return f"{_ratio(row.ratio)} [{_ratio(row.ratio_low)}–{_ratio(row.ratio_high)}]"
+
+
+def _seeds(row: Comparison) -> str:
+    return str(row.seeds) + (f" ({row.failed} failed)" if row.failed else "")
+
+
+def _pair(value: float | None, odometry: float | None) -> str:
+    if value is None:
+        return NA
+    if odometry is None or odometry < PERFECT_M:
+        return f"{_num(value)} / {_num(odometry)}"
+    return f"{_num(value)} / {_num(odometry)} ({value / odometry:.2f}x)"
+
+
+def failed_groups(records: list[CellRecord]) -> list[str]:
+    """``method on dataset (degradation)`` for every group of the page's kind without one completed run."""
+    groups: dict[tuple[str, str, str], list[str]] = {}
+    for rec in records:
+        if rec.cell.method != ODOMETRY:
+            key = (rec.cell.method_label, rec.cell.dataset_label, rec.cell.degradation)
+            groups.setdefault(key, []).append(rec.status)
+    return [f"{m} on {d} ({g})" for (m, d, g), statuses in groups.items() if "done" not in statuses]
+
+
+def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None = None) -> str:
+    """The Markdown page (see the module docstring)."""
+    pct = f"{CONFIDENCE:.0%}"
+    lines = [
+        "# Every method against the odometry it was given",
+        "",
+        "For each dataset, method and odometry degradation (seeds pooled): the method's ATE and that of the "
+        "odometry the same runs were given, both after their own rigid SE(2) alignment to the reference; their "
+        f"ratio (< 1: the method improved on its odometry) with a {pct} paired moving-block bootstrap interval over "
+        f"scans ({RESAMPLES} resamples, blocks of 1/{BLOCKS} of a run, the same scans for both); **worse** / "
+        f"**better** when the whole interval is above / below 1, else *indistinguishable*. RPE@10 m and loop gap: "
+        "the method's / the odometry method's cell of the same data and seeds (ratio in brackets). Method: "
+        "`albot1/report/generalisation.py`.",
+        "",
+        LEGEND,
+        "",
+        f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}`.",
+        "",
+        "## Where a method is worse than its own odometry",
+        "",
+    ]
+    worse = [r for r in rows if r.verdict == "worse"]
+    if worse:
+        lines += ["| method | dataset | degradation | seeds | ATE (m) | odometry ATE (m) | ratio | interval |"]
+        lines += ["|---|---|---|---:|---:|---:|---:|---|"]
+        lines += [
+            f"| {marked(r.method, r.held_in)} | {r.dataset} | {r.degradation} | {_seeds(r)} | {_num(r.ate_m)} | "
+            f"{_num(r.odometry_ate_m)} | {_ratio(r.ratio)} | {_ratio(r.ratio_low)}–{_ratio(r.ratio_high)} |"
+            for r in worse
+        ]
+    else:
+        lines.append(f"Nowhere at {pct} confidence.")
+    above = [r for r in rows if r.verdict == "indistinguishable" and r.ratio > 1.0]
+    if above:
+        lines += [
+            "",
+            "Ratio above 1 but not significantly: "
+            + "; ".join(f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio)}" for r in above)
+            + ".",
+        ]
+    lines += [
+        "",
+        "## Per method",
+        "",
+        f"| method | cells | of them held-in ({MARK}) | better | indistinguishable | worse | median ATE ratio "
+        "| largest ratio (where) |",
+        "|---|---:|---:|---:|---:|---:|---:|---|",
+    ]
+    compared = [r for r in rows if r.verdict != PERFECT]
+    for method in dict.fromkeys(r.method for r in compared):
+        mine = [r for r in compared if r.method == method]
+        top = max(mine, key=lambda r: r.ratio)
+        counts = [sum(r.verdict == v for r in mine) for v in ("better", "indistinguishable", "worse")]
+        tuned = sum(bool(r.held_in) for r in mine)
+        lines.append(
+            f"| {method} | {len(mine)} | {tuned} | {counts[0]} | {counts[1]} | {counts[2]} | "
+            f"{_ratio(median(r.ratio for r in mine))} | {_ratio(top.ratio)} ({top.dataset}, {top.degradation}) |"
+        )
+    perfect = [r for r in rows if r.verdict == PERFECT]
+    if perfect:
+        logs = list(dict.fromkeys(r.dataset for r in perfect))
+        lines += [
+            "",
+            "## With perfect odometry",
+            "",
+            "ATE (m) of each method given the reference poses as odometry (no ratio: the odometry's is 0).",
+            "",
+            "| method | " + " | ".join(logs) + " |",
+            "|---|" + "---:|" * len(logs),
+        ]
+        for method in dict.fromkeys(r.method for r in perfect):
+            by = {r.dataset: r for r in perfect if r.method == method}
+            lines.append(
+                f"| {method} | "
+                + " | ".join(marked(_num(by[d].ate_m), by[d].held_in) if d in by else "–" for d in logs)
+                + " |"
+            )
+    for dataset in dict.fromkeys(r.dataset for r in rows):
+        lines += [
+            "",
+            f"## {dataset}",
+            "",
+            "| method | degradation | seeds | ATE (m) | odometry ATE (m) | ratio [interval] | verdict "
+            "| RPE@10 m (m), method / odometry | loop gap (m), method / odometry |",
+            "|---|---|---:|---:|---:|---|---|---|---|",
+        ]
+        for r in (r for r in rows if r.dataset == dataset):
+            lines.append(
+                f"| {marked(r.method, r.held_in)} | {r.degradation} | {_seeds(r)} | {_num(r.ate_m)} | "
+                f"{_num(r.odometry_ate_m)} | {_interval(r)} | {r.verdict} | "
+                f"{_pair(r.rpe10_m, r.odometry_rpe10_m)} | {_pair(r.loop_gap_m, r.odometry_loop_gap_m)} |"
+            )
+    if failed:
+        lines += [
+            "",
+            "## No completed run",
+            "",
+            "Every seed failed (reasons: the report's README): " + "; ".join(failed) + ".",
+        ]
+    lines.append("")
+    return "\n".join(lines)
+
+
+def _csv(rows: list[Comparison]) -> str:
+    names = [f.name for f in fields(Comparison)]
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(names)
+    for row in rows:
+        values: list[Any] = [getattr(row, name) for name in names]
+        writer.writerow(["" if v is None else (f"{v:.9g}" if isinstance(v, float) else v) for v in values])
+    return buffer.getvalue()
+
+
+def write_generalisation(plan: GridPlan, records: list[CellRecord], out: Path) -> tuple[Path, Path] | None:
+    """Write ``generalisation.md`` and ``.csv`` into ``out`` when any run can be compared with its odometry."""
+    rows = comparisons(records)
+    if not rows:
+        return None
+    page, table = out / PAGE, out / TABLE
+    text = render_page(plan, rows, failed_groups(records))
+    atomic_write(page, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    atomic_write(table, lambda tmp: tmp.write_text(_csv(rows), encoding="utf-8"))
+    return page, table

@@ -1,0 +1,120 @@
+"""The generalisation page (albot1.report.generalisation): paired ratio to the odometry, bootstrap verdicts."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from albot1.bench.grid import Cell, GridPlan
+from albot1.data.model import Frame, Scan, Sequence
+from albot1.metrics.record import MetricsRecord
+from albot1.records import ResultRecord, read_record
+from albot1.report.collect import CellRecord
+from albot1.report.generalisation import PERFECT, Comparison, bootstrap_ratio, comparisons, render_page
+from albot1.report.tuning import LEGEND, MARK
+from albot1.runs.evaluate import evaluate_run
+from albot1.runs.execute import run_method
+from albot1.runs.folder import write_run
+
+
+def test_the_ratio_is_the_pooled_rmse_ratio_and_a_clear_difference_is_significant() -> None:
+    rng = np.random.default_rng(1)
+    odo = [np.abs(rng.normal(1.0, 0.1, 200)), np.abs(rng.normal(1.0, 0.1, 150))]
+    worse = [(2.0 * o, o) for o in odo]
+    ratio, low, high = bootstrap_ratio(worse, resamples=200)
+    assert ratio == pytest.approx(2.0)
+    assert low == pytest.approx(2.0) and high == pytest.approx(2.0)  # paired: every resample has ratio 2
+    better = [(0.5 * o + rng.normal(0, 0.01, len(o)), o) for o in odo]
+    ratio, low, high = bootstrap_ratio(better, resamples=200)
+    assert high < 1.0 and low < ratio < high
+
+
+def test_equal_errors_up_to_noise_are_indistinguishable_and_the_draws_are_seeded() -> None:
+    rng = np.random.default_rng(2)
+    odo = np.abs(rng.normal(1.0, 0.5, 300))
+    method = odo[rng.permutation(300)]  # the same errors at other scans: the same RMSE, unpaired noise
+    first = bootstrap_ratio([(method, odo)], resamples=300)
+    assert first == bootstrap_ratio([(method, odo)], resamples=300)
+    assert first[1] < 1.0 < first[2]
+
+
+def _row(method: str, ratio: float, low: float, high: float, verdict: str, held: bool | None) -> Comparison:
+    return Comparison(
+        "fhw-corrected?odometry=laser-pose",
+        method,
+        "none",
+        1,
+        0,
+        ratio,
+        1.0,
+        ratio,
+        low,
+        high,
+        verdict,
+        0.2,
+        0.1,
+        None,
+        2.0,
+        held,
+    )
+
+
+def test_the_page_lists_where_a_method_is_worse_than_its_odometry_with_marks() -> None:
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    rows = [_row("gtsam-graph", 11.0, 9.0, 13.0, "worse", False), _row("albot1:plus", 0.2, 0.1, 0.3, "better", True)]
+    text = render_page(plan, rows, ["mrpt-icp on fhw-corrected (none)"])
+    assert LEGEND in text
+    assert "| gtsam-graph | fhw-corrected?odometry=laser-pose | none | 1 | 11.000 | 1.000 | 11 | 9–13 |" in text
+    assert f"| albot1:plus {MARK} | none | 1 | 0.200 | 1.000 | 0.2 [0.1–0.3] | better |" in text
+    assert "| gtsam-graph | 1 | 0 | 0 | 0 | 1 | 11 | 11 (fhw-corrected?odometry=laser-pose, none) |" in text
+    assert "0.200 / 0.100 (2.00x)" in text and "| n/a |" in text
+    assert "| albot1:plus | 1 | 1 | 1 | 0 | 0 | 0.2 |" in text  # its one cell is held-in
+    assert "Every seed failed (reasons: the report's README): mrpt-icp on fhw-corrected (none)." in text
+    assert "Nowhere" in render_page(plan, rows[1:])
+
+
+def test_with_perfect_odometry_the_method_ate_is_shown_without_a_ratio() -> None:
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    row = replace(_row("gtsam-graph", 0.0, 0.0, 0.0, PERFECT, False), ate_m=0.126, odometry_ate_m=0.0)
+    text = render_page(plan, [row])
+    assert "## With perfect odometry" in text
+    assert "| gtsam-graph | 0.126 |" in text
+    assert f"| gtsam-graph | none | 1 | 0.126 | 0.000 | n/a | {PERFECT} |" in text
+    assert "Nowhere" in text  # perfect odometry is not counted as "worse"
+
+
+def _drive(name: str) -> Sequence:
+    """A straight 40-scan drive with reference poses; the odometry is 10 % long and turns 0.5 deg per step."""
+    t = np.arange(40, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(40), np.zeros(40)])
+    odometry = np.column_stack([t * 0.55, np.zeros(40), np.radians(0.5) * t])
+    angles = np.radians(np.linspace(-90.0, 90.0, 181))
+    frames = [
+        Frame(i, Scan(np.full(181, 5.0), angles, 100.0 + t[i], 30.0), odometry[i], reference=truth[i])
+        for i in range(40)
+    ]
+    return Sequence.from_frames(name, frames)
+
+
+def _stored(tmp_path: Path, method_label: str, method: str) -> CellRecord:
+    result = run_method("odometry", _drive("drive"), dataset_name="drive")
+    run_dir = write_run(result, tmp_path)
+    evaluate_run(run_dir)
+    cell = Cell("t", "drive", "drive", method, method_label, "default", "none", 0, run_dir.name, "v", 1.0, 1.0)
+    metrics = read_record(MetricsRecord, run_dir / "metrics.json")
+    return CellRecord(cell, "done", run_dir, read_record(ResultRecord, run_dir / "result.json"), metrics, None)
+
+
+def test_a_run_whose_poses_are_its_odometry_has_ratio_one_from_its_own_run_folder(tmp_path: Path) -> None:
+    """The pair is read from one run folder: poses vs the odometry it was given, both against the reference."""
+    same = _stored(tmp_path / "a", "kiss-icp", "kiss-icp")  # an odometry run filed as another method's cell
+    odometry = _stored(tmp_path / "b", "odometry", "odometry")
+    rows = comparisons([odometry, same])
+    assert [(r.method, r.seeds, r.failed) for r in rows] == [("kiss-icp", 1, 0)]  # odometry is not compared
+    row = rows[0]
+    assert row.ratio == pytest.approx(1.0) and row.ratio_low == pytest.approx(1.0)
+    assert row.verdict == "indistinguishable" and row.ate_m == pytest.approx(row.odometry_ate_m) and row.ate_m > 0.1
+    assert row.held_in is False  # kiss-icp is not tuned on "drive"
