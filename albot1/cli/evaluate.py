@@ -42,7 +42,9 @@ def evaluate(
     ] = None,
     trajectory: Annotated[
         Path | None,
-        typer.Option(help="score this trajectory file of another tool instead of a run folder (needs --dataset)"),
+        typer.Option(
+            help="score this trajectory file of another tool instead of a run folder (needs --dataset or --reference)"
+        ),
     ] = None,
     dataset: Annotated[str | None, typer.Option(help=DATASET_HELP)] = None,
     format_name: Annotated[
@@ -88,6 +90,9 @@ def evaluate(
     as_json: Annotated[bool, typer.Option("--json", help="print the metrics as one JSON object")] = False,
 ) -> None:
     """Score a run, or any trajectory, against the dataset's reference poses and relations.
+
+    With --trajectory FILE --reference GT: score two trajectory files against each other,
+    like evo_ape/evo_rpe (--align se2|origin|first:N|none, --time-offset S), no dataset needed.
 
     With RUN_DIR: write RUN_DIR/metrics.json. With --trajectory FILE --dataset NAME: score a
     trajectory made by another tool (Cartographer, slam_toolbox, GMapping, ...) with the same
