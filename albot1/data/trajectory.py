@@ -241,7 +241,17 @@ def read_carmen_poses(path: Path) -> tuple[NDArray[np.float64], NDArray[np.float
     arrays = sequence.arrays
     if arrays.reference is None:  # pragma: no cover - laser-pose gives every scan a pose
         raise DataError(f"{path}: the log's laser lines carry no poses")
-    return arrays.timestamps, arrays.reference
+    poses = arrays.reference
+    bad = np.flatnonzero(~(np.isfinite(poses).all(axis=1) & (np.abs(poses[:, :2]).max(axis=1) <= MAX_COORDINATE_M)))
+    if len(bad):
+        row = int(bad[0])
+        raise ParseError(
+            path,
+            f"laser line {row} (0-based, t = {arrays.timestamps[row]:.6f} s): pose ({poses[row, 0]:.6g}, "
+            f"{poses[row, 1]:.6g}, {poses[row, 2]:.6g}) is not finite or beyond {MAX_COORDINATE_M:g} m; "
+            "expected metres of a map",
+        )
+    return arrays.timestamps, poses
 
 
 def guess_format(path: Path) -> TrajectoryFormat:

@@ -105,3 +105,13 @@ def test_a_folder_or_a_missing_file_is_named_as_such(tmp_path: Path) -> None:
         read_trajectory(tmp_path)
     with pytest.raises(DataError, match="trajectory file not found"):
         read_trajectory(tmp_path / "nothing.tum")
+
+
+def test_a_corrected_carmen_pose_beyond_the_bound_is_refused_with_its_laser_line(tmp_path: Path) -> None:
+    path = tmp_path / "c.clf"
+    path.write_text(
+        "FLASER 3 1.0 2.0 3.0 1.5 -2.25 0.3 1.5 -2.25 0.3 100.25 host 100.25\n"
+        "FLASER 3 1.0 2.0 3.0 1e308 -2.25 -3.1 2.5 -2.25 -3.1 100.5 host 100.5\n"
+    )
+    with pytest.raises(DataError, match=r"c.clf: laser line 1 \(0-based, t = 100.500000 s\): pose \(1e\+308"):
+        read_trajectory(path)
