@@ -23,6 +23,7 @@ from albot1.config.targets import resolve_target
 from albot1.data.open import open_sequence
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
+from albot1.runs.external_run import write_external_run
 from albot1.runs.folder import PreviewRenderer, is_complete, write_run
 from albot1.settings import Settings, get_settings
 
@@ -77,6 +78,21 @@ def execute_cell(
         register_plugin(cell.method, cell.target, cell.error_class, cell.requires)
     settings = settings or get_settings()
     run_dir = runs_root / cell.key
+    if cell.trajectory is not None:  # another system's output: scored, not run (albot1.bench.external)
+        written = write_external_run(
+            path=Path(cell.trajectory),
+            format_name=cell.trajectory_format,
+            dataset=cell.dataset_label,
+            method=cell.method,
+            config=cell.config or {},
+            seed=cell.seed,
+            runs_root=runs_root,
+            settings=settings,
+            preview=preview,
+        )
+        if written.name != cell.key:
+            raise BenchError(f"{cell.describe()}: stored under {written.name}, expected key {cell.key}")
+        return written
     if not is_complete(run_dir):
         sequence = open_sequence(cell.dataset_label, settings=settings)
         result = run_method(

@@ -48,6 +48,9 @@ class Cell:
     requires: tuple[str, ...] = ()
     allow_failure: bool = False
     """The suite counts this cell's own failure as a finding (not in ``key``: it changes no result)."""
+    trajectory: str | None = None
+    """Another system's trajectory file, scored instead of running a method (:mod:`albot1.runs.external_run`)."""
+    trajectory_format: str | None = None
 
     def describe(self) -> str:
         """One line naming the cell for humans (progress, failure lists)."""

@@ -20,6 +20,7 @@ from typing import Any
 
 from albot1 import versions
 from albot1.bench.errors import SuiteError
+from albot1.bench.external import external_cell
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
 from albot1.data import catalog
@@ -95,7 +96,14 @@ def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
 
 
 def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
-    entries = list(suite.methods)
+    entries = [e for e in suite.methods if e.trajectories is None]
+    external = [e for e in suite.methods if e.trajectories is not None]  # scored files: nothing to install
+    for entry in external:
+        if entry.name in METHODS:
+            raise SuiteError(
+                f"{suite.path or suite.name}: method {entry.name!r} with trajectories: {entry.name!r} is a method "
+                f"this project runs; name another system's output differently (e.g. {entry.name + '-theirs'!r})"
+            )
     for entry in entries:
         if entry.target is not None:
             register_plugin(entry.name, entry.target, entry.error_class, entry.requires)
@@ -114,7 +122,7 @@ def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
             usable.append(entry)
         else:
             skipped.append(Skipped(entry.display, f"unavailable: {spec.unavailable_reason()}", spec.install_command()))
-    return usable, skipped
+    return usable + external, skipped
 
 
 def _candidate_datasets(suite: Suite) -> list[str]:
@@ -230,7 +238,7 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
     """The cells of ``suite`` on this machine (datasets present, methods installed)."""
     code = versions.code_version()
     methods, skipped_methods = _methods(suite)
-    resolved = {entry.display: _resolve(entry) for entry in methods}
+    resolved = {entry.display: _resolve(entry) for entry in methods if entry.trajectories is None}
     cells: list[Cell] = []
     skipped_datasets: list[Skipped] = []
     config_failures: dict[str, str] = {}
@@ -255,6 +263,10 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
                 if opts.methods is not None and entry.display not in opts.methods:
                     continue
                 if not entry.runs_on(name):
+                    continue
+                if entry.trajectories is not None:
+                    if degradation == "none" and seed == sweep_seeds[0]:
+                        cells.append(external_cell(suite, entry, name, opts, seed, code))
                     continue
                 if seed != sweep_seeds[0] and _runs_once(degradation, entry.name):
                     continue

@@ -32,6 +32,12 @@ Format (every key optional except ``methods`` and ``datasets``)::
     # allow_failure = true           # its failed cells (divergence, crash, limits) are findings:
                                      # reported with their reason, not a non-zero exit of the bench
 
+    [[methods]]                      # another system's output, scored beside the methods run
+    name = "cartographer"
+    trajectories = "runs/carto/{dataset}.tum"   # one file per dataset (relative to the suite file);
+                                     # {dataset}: the dataset's name (a path's stem); see albot1/bench/external.py
+    # trajectory_format = "tum"      # tum | kitti | carmen (default: guessed from each file)
+
     [[datasets]]                     # applied in order; later entries override earlier ones
     name = "*"                       # a glob (* and [...]) over dataset and world names, a name, a
                                      # dataset reference with loader options (NAME?KEY=VALUE) or a
@@ -144,6 +150,31 @@ class MethodEntry(_Strict):
         "its reason like any failure, but does not make `albot1 bench` exit non-zero",
     )
 
+    trajectories: str | None = Field(
+        None,
+        description="a path with {dataset}: another system's trajectory files, scored instead of run (external)",
+    )
+    trajectory_format: Literal["tum", "kitti", "carmen"] | None = None
+
+    @model_validator(mode="after")
+    def _external_only(self) -> MethodEntry:
+        if self.trajectories is None:
+            if self.trajectory_format is not None:
+                raise ValueError(f"method {self.name!r}: trajectory_format without trajectories")
+            return self
+        if "{dataset}" not in self.trajectories:
+            raise ValueError(
+                f"method {self.name!r}: trajectories = {self.trajectories!r} has no {{dataset}}; expected one file "
+                f"per dataset, e.g. 'runs/{self.name}/{{dataset}}.tum'"
+            )
+        ran = [k for k in ("preset", "set", "target", "error_class", "requires") if k in self.model_fields_set]
+        if ran:
+            raise ValueError(
+                f"method {self.name!r}: {', '.join(ran)} cannot go with trajectories (the files are scored, "
+                "nothing is run)"
+            )
+        return self
+
     @field_validator("target", "error_class")
     @classmethod
     def _module_class(cls, value: str | None) -> str | None:
@@ -157,6 +188,8 @@ class MethodEntry(_Strict):
     @property
     def display(self) -> str:
         """The column name in reports: the label, else ``name`` or ``name:preset``."""
+        if self.trajectories is not None:
+            return f"{self.label or self.name} (external)"
         if self.label:
             return self.label
         return self.name if self.preset == "default" else f"{self.name}:{self.preset}"

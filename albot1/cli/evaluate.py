@@ -16,6 +16,7 @@ from albot1.settings import get_settings
 if TYPE_CHECKING:
     from albot1.metrics.record import MetricsRecord
     from albot1.runs.scored import Scored
+    from albot1.settings import Settings
 
 DATASET_HELP = (
     "the dataset the trajectory was made on: NAME, NAME[:N] (its first N scans), NAME?key=value "
@@ -88,6 +89,15 @@ def evaluate(
         Path | None, typer.Option(help="dataset folder for the reference (default: $ALBOT1_DATA_DIR)")
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print the metrics as one JSON object")] = False,
+    # --- plots (evo_ape --plot / evo_traj): albot1.report.evaluate_plots
+    plot: Annotated[
+        Path | None,
+        typer.Option(help="draw the trajectory coloured by error, error over time and distance, into this folder"),
+    ] = None,
+    plot_also: Annotated[
+        list[Path] | None,
+        typer.Option(help="with --plot: more trajectory files drawn beside it, scored against the same dataset"),
+    ] = None,
 ) -> None:
     """Score a run, or any trajectory, against the dataset's reference poses and relations.
 
@@ -135,6 +145,8 @@ def evaluate(
         written = run_dir / METRICS_FILE
         if evo is not None:
             _evo(scored_run(read_run(run_dir)), evo, f"{metrics.run.method}_{metrics.run.key}")
+        if plot is not None:
+            _plot(scored_run(read_run(run_dir)), metrics.run.dataset, plot, plot_also or [], max_dt, settings)
         if as_json:
             # Re-read what was written, so stdout and the file agree exactly (NaN -> null included).
             typer.echo(json.dumps(json.loads(written.read_text())))
@@ -178,6 +190,8 @@ def evaluate(
     _note_left_out(metrics)
     if evo is not None:
         _evo(scored, evo, _file_name(metrics.run.method))
+    if plot is not None:
+        _plot(scored, dataset, plot, plot_also or [], max_dt, settings)
     if as_json:
         typer.echo(json.dumps(dump_record(metrics)))
         return
@@ -261,6 +275,20 @@ def _evo(scored: Scored, folder: Path, name: str) -> None:
         typer.echo(f"note: no evo result files: {exc}", err=True)
         return
     typer.echo(f"evo results: {', '.join(str(p) for p in written)}", err=True)
+
+
+def _plot(
+    first: Scored, dataset: str, folder: Path, also: list[Path], max_dt: float | None, settings: Settings
+) -> None:
+    """``--plot``: the figures of :mod:`albot1.report.evaluate_plots`, listed on stderr."""
+    from albot1.report.evaluate_plots import plot_scored
+    from albot1.runs.external import load_external
+
+    items = [first] + [load_external(p, dataset, max_dt_s=max_dt, settings=settings) for p in also]
+    drawn = plot_scored(items, folder)
+    typer.echo(f"plots: {', '.join(str(p) for p in drawn.files)}", err=True)
+    if drawn.missing is not None:
+        typer.echo(f"note: {drawn.missing}", err=True)
 
 
 def _file_name(text: str) -> str:

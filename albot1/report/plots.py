@@ -40,7 +40,7 @@ from albot1.report.collect import CellRecord
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-#: Colours of methods, in plan order: matplotlib's tab10 then the light half of tab20.
+#: Colours of other method labels, chosen by a hash of the label: tab10 then the light half of tab20.
 PALETTE = (
     "#1f77b4",
     "#ff7f0e",
@@ -59,6 +59,20 @@ PALETTE = (
     "#c5b0d5",
     "#c49c94",
 )
+#: The colours of the project's own method labels (distinct; the first ten are matplotlib's tab10).
+FIXED_COLORS: dict[str, str] = {
+    "odometry": "#7f7f7f",
+    "albot1": "#1f77b4",
+    "albot1:thesis": "#17becf",
+    "albot1:plus": "#9467bd",
+    "albot1:literal": "#aec7e8",
+    "albot1:exact": "#bcbd22",
+    "albot1-places": "#e377c2",
+    "kiss-icp": "#ff7f0e",
+    "gtsam-graph": "#2ca02c",
+    "mrpt-icp": "#d62728",
+    "mrpt-rbpf": "#8c564b",
+}
 REFERENCE_COLOR = "black"
 DPI = 120
 #: Figure width limit (inches) and the widest/tallest panel shape drawn (a longer extent is padded).
@@ -102,9 +116,24 @@ def pyplot() -> Any:
 
 
 def method_colors(labels: Iterable[str]) -> dict[str, str]:
-    """method label -> colour, in the order given (the plan's), cycling the palette beyond 16 methods."""
-    unique = list(dict.fromkeys(labels))
-    return {label: PALETTE[i % len(PALETTE)] for i, label in enumerate(unique)}
+    """method label -> its colour, the same in every report and figure (first-seen order of ``labels`` kept).
+
+    The colour depends on the label alone, never on which other methods a
+    report holds: the project's own method labels have fixed, distinct
+    colours (:data:`FIXED_COLORS`); any other label (a plugin, a preset
+    variant, another system's output) gets one of :data:`PALETTE` chosen by
+    the sha256 of its text, so two such labels may share a colour (the
+    legend still tells them apart).
+    """
+    return {label: method_color(label) for label in dict.fromkeys(labels)}
+
+
+def method_color(label: str) -> str:
+    """The colour of one method label (see :func:`method_colors`)."""
+    if label in FIXED_COLORS:
+        return FIXED_COLORS[label]
+    digest = int.from_bytes(hashlib.sha256(label.encode("utf-8")).digest()[:8], "big")
+    return PALETTE[digest % len(PALETTE)]
 
 
 def representative(records: Iterable[CellRecord]) -> dict[str, CellRecord]:

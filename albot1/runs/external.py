@@ -37,12 +37,12 @@ from albot1.data.open import open_sequence
 from albot1.data.relations import match_stamps, read_relations, write_relations
 from albot1.data.trajectory import PoseFile, as_stored, read_trajectory
 from albot1.runs.errors import RunError
+from albot1.runs.folder import EXTERNAL_PRESET
 from albot1.runs.scored import Scored
 from albot1.settings import Settings
 
 #: Largest time between a pose and the scan it is matched to (s): evo's default ``t_max_diff``.
 MAX_DT_S = 0.01
-EXTERNAL_PRESET = "external"
 NO_MAP = "an external trajectory comes without a map"
 NO_COUNTERS = "an external trajectory comes without the method's counters (views, updates)"
 NO_TIMING = "an external trajectory comes without per-scan timings"

@@ -35,7 +35,8 @@ import numpy as np
 from albot1 import versions
 from albot1.data.trajectory import PoseFile, read_trajectory
 from albot1.runs.errors import RunError
-from albot1.runs.external import EXTERNAL_PRESET, MAX_DT_S, NO_COUNTERS, NO_MAP, NO_TIMING, Matching, match_by_time
+from albot1.runs.external import MAX_DT_S, NO_COUNTERS, NO_MAP, NO_TIMING, Matching, match_by_time
+from albot1.runs.folder import EXTERNAL_PRESET
 from albot1.runs.scored import Scored
 
 #: The alignment choices of ``--align`` (``first:N`` with a positive N), in the words evo users know.
