@@ -132,6 +132,8 @@ class Relations:
     t1: FloatArray
     t2: FloatArray
     poses: FloatArray  # (M, 3): x, y, yaw of the relation
+    #: How many lines of the file this was read from repeat an earlier line identically (kept, and counted).
+    repeats: int = 0
 
     def __len__(self) -> int:
         return int(self.t1.shape[0])

@@ -81,9 +81,28 @@ MAX_PANEL_ASPECT = 6.0
 VECTOR_FORMAT = "svg"
 
 
+#: Longest readable part of a :func:`slug` (plot names add a kind and a suffix; file systems allow 255 bytes).
+SLUG_CHARS = 48
+_HASHED = re.compile(r".*-h[0-9a-f]{10}")
+
+
 def slug(text: str) -> str:
-    """A file-name-safe version of a dataset or method label."""
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "x"
+    """A short file-name-safe name of a dataset or method label, different for different labels.
+
+    A label that is already safe (ASCII letters, digits, ``_.-``; at most
+    :data:`SLUG_CHARS` characters) is its own slug, so common plot names stay
+    readable (``aces-maps.png``). Any other label (a slice ``aces[:2500:2]``,
+    a path, non-ASCII characters, a 290-character path) gets its readable part
+    cut to :data:`SLUG_CHARS` characters plus ``-h`` and 10 hex digits of the
+    label's sha256: two labels differing only in characters that the readable
+    part drops (``büro`` and ``båro``) never share a file, and no name is too
+    long for the file system.
+    """
+    safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_.") or "x"
+    if safe == text and len(text) <= SLUG_CHARS and _HASHED.fullmatch(text) is None:
+        return text
+    digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:10]
+    return f"{safe[:SLUG_CHARS].rstrip('_.-')}-h{digest}"
 
 
 def pyplot() -> Any:

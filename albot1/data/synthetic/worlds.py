@@ -23,6 +23,7 @@ import functools
 import math
 from typing import Any
 
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
 from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError
@@ -186,7 +187,7 @@ def variant(name: str, options: dict[str, Any]) -> WorldSpec:
     if unknown:
         raise WorldOptionError(
             f"synthetic world {name!r}: unknown loader option(s) {', '.join(unknown)}; "
-            f"expected {' or '.join(WORLD_OPTIONS)}"
+            f"expected {' or '.join(WORLD_OPTIONS)} (and the options of every source: {', '.join(COMMON_OPTIONS)})"
         )
     if not options:
         return spec

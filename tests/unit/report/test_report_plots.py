@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,7 @@ from albot1.report.map_plots import occupancy, plot_maps
 from albot1.report.plots import (
     FIXED_COLORS,
     PALETTE,
+    SLUG_CHARS,
     Extent,
     log_floor,
     method_colors,
@@ -43,8 +45,19 @@ def test_severity_order_puts_none_first_then_gaussian_by_sigma_then_thesis() -> 
 
 
 def test_slug_makes_dataset_labels_file_safe() -> None:
-    assert slug("aces[:2500:2]") == "aces_2500_2"
-    assert slug("/data/my log.clf") == "data_my_log.clf"
+    assert slug("aces") == "aces" and slug("synthetic-office-loop") == "synthetic-office-loop"
+    assert re.fullmatch(r"aces_2500_2-h[0-9a-f]{10}", slug("aces[:2500:2]"))
+    assert re.fullmatch(r"data_my_log.clf-h[0-9a-f]{10}", slug("/data/my log.clf"))
+
+
+def test_slugs_are_unique_and_short_for_every_label() -> None:
+    labels = ["büro", "båro", "b_ro", "b ro", "aces[:2500:2]", "aces_2500_2", "/x/" + "a" * 290 + ".clf", ".", "..", ""]
+    labels.append(slug("aces[:2500:2]"))  # a label that looks like a hashed slug is hashed too
+    slugs = [slug(label) for label in labels]
+    assert len(set(slugs)) == len(labels)
+    for name in slugs:
+        assert len(name) <= SLUG_CHARS + 12 and re.fullmatch(r"[A-Za-z0-9_.-]+", name)
+        assert not name.startswith(".")
 
 
 def _cell(method: str, degradation: str, seed: int, dataset: str = "w") -> Cell:

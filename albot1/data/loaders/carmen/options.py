@@ -18,6 +18,7 @@ from typing import Any
 
 from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 
 ODOMETRY_SOURCES = ("laser-pose", "odom", "odom-segments")
@@ -43,7 +44,7 @@ class CarmenOptions:
         if unknown:
             raise DataError(
                 f"{path}: unknown CARMEN loader option(s) {', '.join(unknown)}; "
-                f"expected some of {', '.join(sorted(known))}"
+                f"expected some of {', '.join(sorted(known) + list(COMMON_OPTIONS))}"
             )
         for key in ("max_range", "time_tolerance"):
             if options.get(key) is not None:

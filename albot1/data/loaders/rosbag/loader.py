@@ -32,6 +32,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from albot1.data.errors import DataError, ParseError, TopicError
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.rosbag.bag1_check import version_problem
 from albot1.data.loaders.rosbag.mounting import bag_mounting
 from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, scan_arrays
@@ -131,7 +132,9 @@ class _BagSource:
 def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
     unknown = sorted(k for k, v in options.items() if k not in _OPTIONS and v is not None)
     if unknown:
-        raise DataError(f"{shown}: unknown bag option(s) {', '.join(unknown)}; expected: {', '.join(_OPTIONS)}")
+        raise DataError(
+            f"{shown}: unknown bag option(s) {', '.join(unknown)}; expected: {', '.join(_OPTIONS + COMMON_OPTIONS)}"
+        )
     opts = {k: options.get(k) for k in _OPTIONS}
     opts["outside_odometry"] = opts["outside_odometry"] or "error"
     if opts["outside_odometry"] not in _OUTSIDE:
