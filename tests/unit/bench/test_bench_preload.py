@@ -29,3 +29,29 @@ def test_failures_are_logged_once_each(monkeypatch: pytest.MonkeyPatch, caplog: 
     assert [r.getMessage() for r in caplog.records] == [
         "albot1 bench: preloading module x: ImportError: boom (each cell that needs it will fail with this reason)"
     ]
+
+
+_FORKED_CELL = """
+import json
+import albot1.bench.preload  # what the forkserver imports before it forks any cell
+from albot1.methods.registry import get_method, resolve_config
+from albot1.methods.albot1.warm_up import kernel_names
+
+mapper = get_method("albot1").load_class()(resolve_config("albot1", "plus", None))
+print(json.dumps({name: len(getattr(k, name).signatures) for k in mapper.kernels for name in kernel_names(k)}))
+"""
+
+
+def test_the_forkserver_compiles_every_kernel_before_any_cell_is_forked() -> None:
+    """A cell forked after the preload finds every Albot1 kernel compiled: its start-up compiles nothing."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "-c", _FORKED_CELL], env=dict(os.environ), capture_output=True, text=True, timeout=900
+    )
+    assert out.returncode == 0, out.stderr
+    counts = json.loads(out.stdout)
+    assert counts and all(n >= 1 for n in counts.values()), counts
