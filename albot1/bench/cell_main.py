@@ -79,19 +79,18 @@ def _apply_environment(env: dict[str, str]) -> None:
 
 
 def _apply_import_path(paths: list[str]) -> None:
-    """Make the child's import path the runner's, and read the method registry again when it changed.
+    """Make the child's import path the runner's, and read the method registry again.
 
-    The forkserver is started once per runner process, and it forks every
-    cell from its own state: a folder put on the runner's path after it
-    started (a plugin distribution installed into a running session, a
-    notebook's path) would otherwise be missing from the cells, and with it
-    the plugin's entry point. The registry is read once per process, so it
-    is read again when the path changed.
+    The forkserver is started once per runner process and forks every cell
+    from its own state: a folder put on the runner's path after it started (a
+    plugin distribution installed into a running session, a notebook's path)
+    would otherwise be missing from the cells, and the registry it read at its
+    start would miss a plugin installed since. Reading the entry points again
+    imports nothing and costs milliseconds.
     """
-    if not paths or paths == sys.path:
-        return
-    sys.path[:] = [*paths, *(p for p in sys.path if p not in paths)]
-    importlib.invalidate_caches()
+    if paths and paths != sys.path:
+        sys.path[:] = paths  # the runner's path, whole: a folder the runner dropped since (an old plugin) goes too
+        importlib.invalidate_caches()
     from albot1.methods.registry import method_registry
 
     method_registry.cache_clear()
