@@ -164,24 +164,22 @@ def run_grid(
         while waiting:
             done, waiting = cf.wait(waiting, return_when=cf.FIRST_COMPLETED)
             for future in done:
+                halt: str | None = None
                 if future.cancelled():  # not by the runner (it drops those from `waiting`): the executor lost it
-                    why = executor_lost(executor) or "the executor cancelled the cell (its Dask scheduler restarted?)"
-                    ended = _lost(futures[future], store, why, started_at)
+                    halt = executor_lost(executor) or "the executor cancelled the cell (its Dask scheduler restarted?)"
+                    ended = _lost(futures[future], store, halt, started_at)
                 else:
                     ended = _outcome(future, futures[future], store, executor)
                 if ended is None:
                     summary.not_started.append(futures[future])
-                    if future.cancelled() and summary.halted is None:
-                        summary.halted = why
-                        cancelled = {f for f in waiting if f.cancel()}
-                        summary.not_started += [futures[f] for f in futures if f in cancelled]
-                        waiting -= cancelled
-                    continue
-                summary.outcomes.append(ended)
-                if observer is not None:
-                    observer.finished(ended)
-                if ended.halts_grid and summary.halted is None:
-                    summary.halted = ended.reason
+                else:
+                    summary.outcomes.append(ended)
+                    if observer is not None:
+                        observer.finished(ended)
+                    if ended.halts_grid:
+                        halt = halt or ended.reason
+                if halt is not None and summary.halted is None:
+                    summary.halted = halt
                     cancelled = {f for f in waiting if f.cancel()}
                     summary.not_started += [futures[f] for f in futures if f in cancelled]
                     waiting -= cancelled
@@ -238,11 +236,12 @@ def _outcome(
             )
         return CellOutcome.of(cell, "failed", 0.0, reason, "executor", halts_grid=halts)
     if outcome is not None and outcome.status == "failed" and outcome.kind is not None:
+        reason = _recorded(outcome.reason) or ""
         if (
             store.failure(outcome.key, strict=False) is None
-            and store.record_failure(cell, outcome.reason or "", outcome.kind, elapsed_s=outcome.elapsed_s) is None
+            and store.record_failure(cell, reason, outcome.kind, elapsed_s=outcome.elapsed_s) is None
         ):
-            outcome = replace(outcome, reason=_recorded(outcome.reason))
+            outcome = replace(outcome, reason=reason)
     return outcome
 
 

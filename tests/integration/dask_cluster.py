@@ -54,11 +54,13 @@ class Cluster:
         assert self.address.startswith("tcp://127.0.0.1:"), self.address
         return self.address
 
-    def start_worker(self, *, wrap: list[str] | None = None) -> subprocess.Popen[bytes]:
+    def start_worker(
+        self, *, wrap: list[str] | None = None, env: dict[str, str] | None = None
+    ) -> subprocess.Popen[bytes]:
         """One single-threaded worker without a nanny; ``wrap`` prefixes the command (e.g. a mount namespace)."""
         command = [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads", "1"]
         command += ["--no-nanny", "--host", "127.0.0.1", "--no-dashboard", "--death-timeout", "30"]
-        worker = self._start([*(wrap or []), *command], f"worker{len(self.workers)}")
+        worker = self._start([*(wrap or []), *command], f"worker{len(self.workers)}", env)
         self.workers.append(worker)
         return worker
 
@@ -69,9 +71,12 @@ class Cluster:
         with Client(self.address, timeout="30s") as client:
             client.wait_for_workers(count, timeout=120)
 
-    def _start(self, command: list[str], name: str) -> subprocess.Popen[bytes]:
-        log = (self.folder / f"{name}.log").open("ab")
-        return subprocess.Popen(command, env=self.env, stdin=subprocess.DEVNULL, stdout=log, stderr=log)
+    def _start(self, command: list[str], name: str, env: dict[str, str] | None = None) -> subprocess.Popen[bytes]:
+        with (self.folder / f"{name}.log").open("ab") as log:
+            # cwd: `python -m` puts it first on sys.path, and the checkout's own albot1 must not win over PYTHONPATH.
+            return subprocess.Popen(
+                command, env=env or self.env, cwd=self.folder, stdin=subprocess.DEVNULL, stdout=log, stderr=log
+            )
 
     def kill_scheduler(self) -> None:
         assert self.scheduler is not None

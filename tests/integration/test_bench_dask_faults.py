@@ -213,3 +213,25 @@ def test_a_worker_that_cannot_write_the_results_fails_its_cell_naming_the_path(
     assert any("read-only file system" in r and str(results / "slow" / "runs") in r for r in reasons), reasons
     assert any(line.startswith("halted: ") for line in err.splitlines()), err
     resume_locally_and_compare(suite, tmp_path, results)
+
+
+def test_a_worker_with_other_code_runs_no_cell_and_says_so(suite: Path, cluster: Cluster, tmp_path: Path) -> None:
+    import albot1
+
+    other = tmp_path / "other-code"
+    shutil.copytree(Path(albot1.__file__).parent, other / "albot1", ignore=shutil.ignore_patterns("__pycache__"))
+    with (other / "albot1" / "versions.py").open("a") as handle:
+        handle.write("\n# an edit the planning machine does not have\n")
+    cluster.start_scheduler()
+    env = dict(cluster.env, PYTHONPATH=os.pathsep.join([str(other), cluster.env["PYTHONPATH"]]))
+    cluster.start_worker(env=env)
+    cluster.wait_for_workers(1)
+    results = tmp_path / "results"
+    runner = start_bench(bench_command(suite, results, "--scheduler", cluster.address), tmp_path)
+    out, err = runner.communicate(timeout=300)
+    assert runner.returncode == 1, err
+    store = ResultsStore(results / "slow")
+    reasons = check_recorded(store, err)
+    assert reasons and all("has albot1 code" in r and "install the same code on every worker" in r for r in reasons)
+    assert not any(store.is_complete(c.key) for c in store.read_plan().cells)
+    assert any(line.startswith("halted: ") for line in err.splitlines()), err
