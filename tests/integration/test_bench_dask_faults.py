@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -235,3 +236,22 @@ def test_a_worker_with_other_code_runs_no_cell_and_says_so(suite: Path, cluster:
     assert reasons and all("has albot1 code" in r and "install the same code on every worker" in r for r in reasons)
     assert not any(store.is_complete(c.key) for c in store.read_plan().cells)
     assert any(line.startswith("halted: ") for line in err.splitlines()), err
+
+
+def test_a_scheduler_that_does_not_answer_is_one_line(suite: Path, tmp_path: Path) -> None:
+    with socket.socket() as probe:  # a loopback port nobody listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    done = subprocess.run(
+        bench_command(suite, tmp_path / "results", "--scheduler", f"127.0.0.1:{port}"),
+        env=cluster_env(),
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 1
+    assert "Traceback" not in done.stderr
+    lines = [line for line in done.stderr.splitlines() if "Dask scheduler" in line]
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith(f"albot1: error: cannot reach the Dask scheduler at tcp://127.0.0.1:{port}: "), lines
