@@ -12,14 +12,17 @@ the derived list against the manifests folder and the datasets README.
 
 from __future__ import annotations
 
+import importlib
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import matplotlib
 import pytest
 
 from albot1.data import catalog
+from albot1.methods.plugins import ENTRY_POINT_GROUP
+from albot1.methods.registry import method_registry
 
 matplotlib.use("Agg")
 
@@ -63,3 +66,40 @@ def data_file() -> Callable[[str], Path]:
         return path
 
     return find
+
+
+#: Installs a distribution declaring ``{method name: "module:Class"}`` under the entry point group albot1.methods.
+PluginInstaller = Callable[[dict[str, str]], Path]
+
+
+@pytest.fixture
+def install_method_plugin(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[PluginInstaller]:
+    """Install a real plugin distribution (a ``*.dist-info`` with ``entry_points.txt``) for one test.
+
+    The folder goes first on ``sys.path`` (and ``PYTHONPATH``, for the CLI and
+    cell processes), exactly where an installed distribution's metadata is
+    found by :mod:`importlib.metadata`; the process's method registry is
+    built again from it, and again after the test without it.
+    """
+
+    def install(methods: dict[str, str]) -> Path:
+        site = tmp_path / "plugin-site"
+        info = site / "albot1_test_plugin-0.1.dist-info"
+        info.mkdir(parents=True, exist_ok=True)
+        (info / "METADATA").write_text("Metadata-Version: 2.1\nName: albot1-test-plugin\nVersion: 0.1\n")
+        lines = "".join(f"{name} = {target}\n" for name, target in methods.items())
+        (info / "entry_points.txt").write_text(f"[{ENTRY_POINT_GROUP}]\n{lines}")
+        monkeypatch.syspath_prepend(str(site))
+        monkeypatch.setenv("PYTHONPATH", os.pathsep.join(p for p in (str(site), os.environ.get("PYTHONPATH")) if p))
+        importlib.invalidate_caches()
+        method_registry.cache_clear()
+        return site
+
+    yield install
+    method_registry.cache_clear()
+
+
+@pytest.fixture
+def fault_plugin(install_method_plugin: PluginInstaller) -> None:
+    """The failure-injecting test mapper installed as the plugin method ``fault`` (tests/integration)."""
+    install_method_plugin({"fault": "bench_fault_mappers:FaultMapper"})

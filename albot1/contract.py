@@ -17,9 +17,8 @@ from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from albot1.data.model import Frame, Relations
+from albot1.geometry.types import FloatArray
 from albot1.records import Timing
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass

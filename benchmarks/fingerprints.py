@@ -30,7 +30,7 @@ import numpy as np
 
 from albot1.data import open_sequence
 from albot1.errors import Albot1Error
-from albot1.methods.registry import METHODS
+from albot1.methods.registry import method_registry
 from albot1.runs.execute import run_method
 
 #: Counters that are measurements of this machine (MRPT's wall time, peak memory), not outputs of the method.
@@ -49,7 +49,8 @@ def _digest(array: object) -> str:
 
 def runs() -> Iterator[tuple[str, str]]:
     """(method, preset) pairs: every Albot1 preset, the default of every other method."""
-    for name, spec in METHODS.items():
+    for spec in method_registry():
+        name = spec.name
         presets = sorted(spec.load_class().presets) if name == "albot1" else ["default"]
         for preset in presets:
             yield name, preset
@@ -69,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
         for method, preset in runs():
             if args.methods and method not in args.methods:
                 continue
-            spec = METHODS[method]
+            spec = method_registry().get(method)
             if not spec.available():
                 sys.stdout.write(f"{dataset} {method}:{preset}: skipped ({spec.unavailable_reason()})\n")
                 continue

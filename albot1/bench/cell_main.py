@@ -13,6 +13,7 @@ error file itself may not fit.
 from __future__ import annotations
 
 import errno
+import importlib
 import json
 import multiprocessing
 import os
@@ -77,6 +78,25 @@ def _apply_environment(env: dict[str, str]) -> None:
     os.environ.update(env)
 
 
+def _apply_import_path(paths: list[str]) -> None:
+    """Make the child's import path the runner's, and read the method registry again when it changed.
+
+    The forkserver is started once per runner process, and it forks every
+    cell from its own state: a folder put on the runner's path after it
+    started (a plugin distribution installed into a running session, a
+    notebook's path) would otherwise be missing from the cells, and with it
+    the plugin's entry point. The registry is read once per process, so it
+    is read again when the path changed.
+    """
+    if not paths or paths == sys.path:
+        return
+    sys.path[:] = [*paths, *(p for p in sys.path if p not in paths)]
+    importlib.invalidate_caches()
+    from albot1.methods.registry import method_registry
+
+    method_registry.cache_clear()
+
+
 def _write_error(run_dir: Path, kind: str, exc: BaseException) -> None:
     from albot1.runs.folder import write_json
 
@@ -106,6 +126,7 @@ def child_main(args: dict[str, Any]) -> int:
     try:
         _redirect_output(Path(args["log_path"]))
         _apply_environment(dict(args.get("env", {})))
+        _apply_import_path(list(args.get("sys_path", [])))
         # Imported here, inside the try: an import failure is this cell's recorded failure.
         from albot1.bench.cells import execute_cell, renderer_from_target
         from albot1.bench.grid import Cell

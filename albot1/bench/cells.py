@@ -18,11 +18,12 @@ from typing import Any, cast
 
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell
-from albot1.bench.plan import register_plugin
 from albot1.config.targets import resolve_target
 from albot1.data.open import open_sequence
+from albot1.methods.registry import MethodRegistry
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
+from albot1.runs.external_run import write_external_run
 from albot1.runs.folder import PreviewRenderer, is_complete, write_run
 from albot1.settings import Settings, get_settings
 
@@ -67,16 +68,35 @@ def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
 
 
 def execute_cell(
-    cell: Cell, runs_root: Path, settings: Settings | None = None, preview: PreviewRenderer | None = None
+    cell: Cell,
+    runs_root: Path,
+    settings: Settings | None = None,
+    preview: PreviewRenderer | None = None,
+    registry: MethodRegistry | None = None,
 ) -> Path:
     """Run, store and evaluate ``cell`` under ``runs_root/<key>``; returns the run folder.
 
-    ``preview`` draws the run's ``preview.png`` (see :func:`albot1.runs.folder.write_run`).
+    ``preview`` draws the run's ``preview.png`` (see :func:`albot1.runs.folder.write_run`);
+    ``registry`` is the method registry (default: this process's, built once from the same installed
+    entry points the planner read).
     """
-    if cell.target is not None:
-        register_plugin(cell.method, cell.target, cell.error_class, cell.requires)
     settings = settings or get_settings()
     run_dir = runs_root / cell.key
+    if cell.trajectory is not None:  # another system's output: scored, not run (albot1.bench.external)
+        written = write_external_run(
+            path=Path(cell.trajectory),
+            format_name=cell.trajectory_format,
+            dataset=cell.dataset_label,
+            method=cell.method,
+            config=cell.config or {},
+            seed=cell.seed,
+            runs_root=runs_root,
+            settings=settings,
+            preview=preview,
+        )
+        if written.name != cell.key:
+            raise BenchError(f"{cell.describe()}: stored under {written.name}, expected key {cell.key}")
+        return written
     if not is_complete(run_dir):
         sequence = open_sequence(cell.dataset_label, settings=settings)
         result = run_method(
@@ -87,6 +107,7 @@ def execute_cell(
             degradation=cell.degradation,
             seed=cell.seed,
             dataset_name=cell.dataset_label,
+            registry=registry,
         )
         if result.config != cell.config:
             raise BenchError(

@@ -152,6 +152,8 @@ def child_args(cell: Cell, runs_root: Path, log_path: Path, preview: str | None 
         "preview": preview,
         "parent_pid": os.getpid(),
         "env": env,
+        # a forkserver started earlier lacks folders put on the path since (an installed plugin's metadata)
+        "sys_path": list(sys.path),
     }
 
 

@@ -3,7 +3,7 @@
 Datasets that are not downloaded and methods whose libraries are missing are
 *skipped* with the command that fixes it, never failed: a fresh machine must
 still produce a complete report from the synthetic worlds. A method entry
-whose config does not resolve (a bad override, a module that does not
+whose config does not resolve (a bad override, a plugin module that does not
 import) is not skipped: its cells are planned and recorded as failed with the
 reason, so the report shows the problem next to the results that did run.
 """
@@ -14,21 +14,23 @@ import fnmatch
 import os
 import platform
 import sys
-from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 from albot1 import versions
 from albot1.bench.errors import SuiteError
+from albot1.bench.external import external_cell
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
+from albot1.config.suggest import unknown_name_message
 from albot1.data import catalog
 from albot1.data.degrade import parse_spec
 from albot1.data.errors import DatasetNotFoundError
 from albot1.data.open import open_sequence
 from albot1.data.synthetic import worlds
 from albot1.errors import Albot1Error
-from albot1.methods.registry import METHODS, MethodSpec, resolve_config
+from albot1.methods.plugins import ENTRY_POINT_GROUP
+from albot1.methods.registry import MethodRegistry, method_registry, resolve_config
 from albot1.runs.folder import run_key
 from albot1.settings import Settings
 
@@ -62,31 +64,10 @@ def cpu_model() -> str:
     return platform.processor() or platform.machine()
 
 
-def register_plugin(name: str, target: str, error_class: str | None, requires: Iterable[str] = ()) -> None:
-    """Add a suite-defined method (``target = "module:Class"``) to the registry of this process.
-
-    Called by the planner and again inside each cell's child process, which
-    starts from a fresh registry.
-    """
-    spec = MethodSpec(
-        name,
-        target,
-        requires=tuple(requires),
-        error_class=error_class or "albot1.methods.baselines.errors:BaselineError",
-        description=f"suite-defined method {target}",
-    )
-    existing = METHODS.get(name)
-    if existing is not None and existing.target != target:
-        raise SuiteError(
-            f"method {name!r} is registered as {existing.target}; the suite's target {target} needs a different name"
-        )
-    METHODS[name] = spec
-
-
-def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
+def _resolve(entry: MethodEntry, registry: MethodRegistry) -> tuple[dict[str, Any] | None, str | None]:
     """(resolved config as JSON, None) or (None, reason it does not resolve)."""
     try:
-        config = resolve_config(entry.name, entry.preset, dict(entry.set))
+        config = resolve_config(entry.name, entry.preset, dict(entry.set), registry)
     except Albot1Error as exc:
         return None, f"{type(exc).__name__}: {exc}"
     except Exception as exc:  # the method's module itself is broken: a cell failure, not a runner crash
@@ -94,27 +75,33 @@ def _resolve(entry: MethodEntry) -> tuple[dict[str, Any] | None, str | None]:
     return config.model_dump(mode="json"), None
 
 
-def _methods(suite: Suite) -> tuple[list[MethodEntry], list[Skipped]]:
-    entries = list(suite.methods)
-    for entry in entries:
-        if entry.target is not None:
-            register_plugin(entry.name, entry.target, entry.error_class, entry.requires)
-        elif entry.name not in METHODS:
+def _methods(suite: Suite, registry: MethodRegistry) -> tuple[list[MethodEntry], list[Skipped]]:
+    entries = [e for e in suite.methods if e.trajectories is None]
+    external = [e for e in suite.methods if e.trajectories is not None]  # scored files: nothing to install
+    for entry in external:
+        if entry.name in registry:
             raise SuiteError(
-                f"{suite.path or suite.name}: unknown method {entry.name!r}; "
-                f"expected one of: {', '.join(METHODS)} (or give a `target`)"
+                f"{suite.path or suite.name}: method {entry.name!r} with trajectories: {entry.name!r} is a method "
+                f"this project runs; name another system's output differently (e.g. {entry.name + '-theirs'!r})"
+            )
+    for entry in entries:
+        if entry.name not in registry:
+            raise SuiteError(
+                f"{suite.path or suite.name}: {unknown_name_message('method', entry.name, registry.names())} "
+                f"(a suite names registered methods only; a third-party method registers through the entry point "
+                f"group {ENTRY_POINT_GROUP}, see docs/benchmarking.md)"
             )
     if suite.registered_methods:
         named = {e.name for e in entries}
-        entries += [MethodEntry(name=n) for n, spec in METHODS.items() if n not in named and spec.auto_include]
+        entries += [MethodEntry(name=spec.name) for spec in registry if spec.name not in named and spec.auto_include]
     usable, skipped = [], []
     for entry in entries:
-        spec = METHODS[entry.name]
+        spec = registry.get(entry.name)
         if spec.available():
             usable.append(entry)
         else:
             skipped.append(Skipped(entry.display, f"unavailable: {spec.unavailable_reason()}", spec.install_command()))
-    return usable, skipped
+    return usable + external, skipped
 
 
 def _candidate_datasets(suite: Suite) -> list[str]:
@@ -191,14 +178,13 @@ def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tupl
     return runs
 
 
-def _runs_once(degradation: str, method: str) -> bool:
+def _runs_once(degradation: str, method: str, registry: MethodRegistry) -> bool:
     """A deterministic degradation of a deterministic method runs with the first seed only.
 
     The first seed keeps the run key such a cell always had, so stored results stay found; a
     stochastic method (its registry entry says so) keeps every seed, since its output varies with it.
     """
-    spec = METHODS.get(method)
-    return _deterministic(degradation) and not (spec is not None and spec.stochastic)
+    return _deterministic(degradation) and not (method in registry and registry.get(method).stochastic)
 
 
 def _limit(*values: float | None, default: float) -> float:
@@ -226,11 +212,16 @@ def _check_shared_folders(suite: Suite, cells: list[Cell]) -> None:
             )
 
 
-def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
-    """The cells of ``suite`` on this machine (datasets present, methods installed)."""
+def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None = None) -> GridPlan:
+    """The cells of ``suite`` on this machine (datasets present, methods installed).
+
+    ``registry`` (default: :func:`~albot1.methods.registry.method_registry`)
+    is only read; the cells read the same one in their own processes.
+    """
+    registry = registry or method_registry()
     code = versions.code_version()
-    methods, skipped_methods = _methods(suite)
-    resolved = {entry.display: _resolve(entry) for entry in methods}
+    methods, skipped_methods = _methods(suite, registry)
+    resolved = {entry.display: _resolve(entry, registry) for entry in methods if entry.trajectories is None}
     cells: list[Cell] = []
     skipped_datasets: list[Skipped] = []
     config_failures: dict[str, str] = {}
@@ -256,7 +247,11 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
                     continue
                 if not entry.runs_on(name):
                     continue
-                if seed != sweep_seeds[0] and _runs_once(degradation, entry.name):
+                if entry.trajectories is not None:
+                    if degradation == "none" and seed == sweep_seeds[0]:
+                        cells.append(external_cell(suite, entry, name, opts, seed, code))
+                    continue
+                if seed != sweep_seeds[0] and _runs_once(degradation, entry.name, registry):
                     continue
                 config, problem = resolved[entry.display]
                 key_config = (
@@ -285,9 +280,6 @@ def plan_suite(suite: Suite, settings: Settings) -> GridPlan:
                         stride=opts.stride,
                         overrides=dict(entry.set),
                         config=config,
-                        target=entry.target,
-                        error_class=entry.error_class,
-                        requires=entry.requires,
                         allow_failure=entry.allow_failure,
                     )
                 )

@@ -1,15 +1,29 @@
 """Imported once by the cell forkserver so that every forked cell starts warm.
 
-Each import is attempted separately and a failure is ignored *here*: the
-same import fails again inside the cell that needs it, where it is recorded
-as that cell's failure with its traceback, instead of stopping every cell.
+Each import is attempted separately, so one broken import does not stop
+every cell: the same import fails again inside the cell that needs it,
+where it is recorded as that cell's failure. A failure here is never
+swallowed: each is reported once, as one warning line on the runner's
+stderr naming the module and the error (:func:`warm` returns them).
+
+What is imported by name: the modules below (the bench's own layer and the
+layers under it; ``tests/unit/bench/test_bench_imports_by_name.py`` checks
+them against the layer contract), the loader of every registered data
+format and the mapper class of every available registered method.
 """
 
 from __future__ import annotations
 
+import functools
 import importlib
+import logging
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
 
 from albot1 import versions
+
+if TYPE_CHECKING:
+    from albot1.methods.registry import MethodRegistry
 
 # First, before the slow imports: every cell forked from this server shares this value, so the cells of
 # one grid agree on the code version the runner planned with (see albot1.bench.cells).
@@ -17,9 +31,12 @@ versions.code_version()
 
 import matplotlib  # noqa: E402
 
+_log = logging.getLogger(__name__)
+
 matplotlib.use("Agg")
 
-_MODULES = (
+#: The modules every cell uses, imported by name (see the module docstring).
+MODULES = (
     "numpy",
     "scipy.spatial",
     "shapely",
@@ -29,7 +46,6 @@ _MODULES = (
     "albot1.bench.cell_main",
     "albot1.runs.execute",
     "albot1.runs.folder",
-    "albot1.report.preview",
     "albot1.data.open",
     "albot1.data.catalog",
     "albot1.data.loaders.registry",
@@ -46,29 +62,38 @@ _MODULES = (
 )
 
 
-def _warm() -> None:
-    for name in _MODULES:
-        try:
-            importlib.import_module(name)
-        except Exception:  # noqa: BLE001 -- reported by the cell that needs the module
-            continue
+def _attempt(what: str, load: Callable[[], object], failures: list[str]) -> None:
+    try:
+        load()
+    except Exception as exc:  # noqa: BLE001 -- reported once here, recorded again by the cell that needs it
+        failures.append(f"{what}: {type(exc).__name__}: {exc}")
+
+
+def warm(modules: Iterable[str] = MODULES) -> list[str]:
+    """Import ``modules``, each data format's loader and each available method's class; the failures, one per line."""
     from albot1.config.targets import resolve_target
     from albot1.data.loaders.registry import FORMATS
-    from albot1.methods.registry import METHODS
+    from albot1.methods.registry import method_registry
 
+    failures: list[str] = []
+    for name in modules:
+        _attempt(f"module {name}", functools.partial(importlib.import_module, name), failures)
     for loader_target, _ in FORMATS.values():
-        try:
-            resolve_target(loader_target)
-        except Exception:  # noqa: BLE001 -- reported by the cell that reads this format
-            continue
+        _attempt(f"loader {loader_target}", functools.partial(resolve_target, loader_target), failures)
+    registry: MethodRegistry | None = None
+    try:
+        registry = method_registry()
+    except Exception as exc:  # noqa: BLE001 -- an installed plugin declares a bad entry point
+        failures.append(f"method registry: {type(exc).__name__}: {exc}")
+    for spec in registry or ():
+        if spec.available():
+            _attempt(f"method {spec.name} ({spec.target})", spec.load_class, failures)
+    return failures
 
-    for spec in METHODS.values():
-        if not spec.available():
-            continue
-        try:
-            spec.load_class()
-        except Exception:  # noqa: BLE001 -- reported by the cell that runs this method
-            continue
+
+def _warm() -> None:
+    for failure in warm():
+        _log.warning("albot1 bench: preloading %s (each cell that needs it will fail with this reason)", failure)
     _warm_matplotlib()
 
 

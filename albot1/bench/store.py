@@ -226,7 +226,8 @@ class ResultsStore:
     def read_json(self, key: str, name: str) -> dict[str, Any] | None:
         path = self.run_dir(key) / name
         try:
-            return json.loads(path.read_text())
+            loaded: dict[str, Any] | None = json.loads(path.read_text())
+            return loaded
         except (OSError, json.JSONDecodeError):
             return None
 

@@ -27,10 +27,15 @@ Format (every key optional except ``methods`` and ``datasets``)::
     preset = "thesis"
     set = { some_field = 1 }         # config overrides (highest precedence)
     # label = "albot1:thesis"        # defaults to name, or name:preset
-    # target = "pkg.mod:Class"       # a method that is not in the registry (your own mapper)
     # datasets = ["aces", "fr*"]     # only on the selected datasets these globs match; default: all
     # allow_failure = true           # its failed cells (divergence, crash, limits) are findings:
                                      # reported with their reason, not a non-zero exit of the bench
+
+    [[methods]]                      # another system's output, scored beside the methods run
+    name = "cartographer"
+    trajectories = "runs/carto/{dataset}.tum"   # one file per dataset (relative to the suite file);
+                                     # {dataset}: the dataset's name (a path's stem); see albot1/bench/external.py
+    # trajectory_format = "tum"      # tum | kitti | carmen (default: guessed from each file)
 
     [[datasets]]                     # applied in order; later entries override earlier ones
     name = "*"                       # a glob (* and [...]) over dataset and world names, a name, a
@@ -47,6 +52,11 @@ Format (every key optional except ``methods`` and ``datasets``)::
     # methods = ["albot1:thesis"]    # only these method entries (by label) run on it; default: all
     # tags = ["dense-views"]         # names a report finds this entry's datasets by (the thesis page's
                                      # experiments, docs/thesis-reproduction.md); not merged, no effect on runs
+
+A method entry names a registered method: a built-in one (``albot1 methods``)
+or one an installed distribution declares under the entry point group
+``albot1.methods`` (:mod:`albot1.methods.plugins`). A suite file cannot name
+a module to import: ``target``, ``error_class`` and ``requires`` are refused.
 
 A literal dataset entry (not a glob) that names no synthetic world, no
 registered dataset and no existing file, and a glob that matches no dataset,
@@ -73,7 +83,6 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from albot1.bench.errors import SuiteError
-from albot1.config.targets import TargetError, check_target
 from albot1.config.validation import describe_errors
 from albot1.data.degrade import MAX_SEED, DegradationSpecError, parse_spec
 from albot1.resources import list_resources, resource_dirs
@@ -94,6 +103,10 @@ MemoryMb = Annotated[
 Seed = Annotated[int, Field(ge=0, le=MAX_SEED)]
 #: A suite's name is the folder of its results (``RESULTS/<name>``): a plain name that cannot climb out of it.
 SUITE_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
+
+
+#: Keys a method entry once read to import a module of the suite's choosing (refused with a pointer to plugins).
+REMOVED_METHOD_KEYS = ("target", "error_class", "requires")
 
 
 class _Strict(BaseModel):
@@ -121,15 +134,12 @@ class GridSpec(_Strict):
 
 
 class MethodEntry(_Strict):
-    """One method column of the grid: a registered method (or a plugin target) with preset and overrides."""
+    """One method column of the grid: a registered method (built in or a plugin) with preset and overrides."""
 
     name: str = Field(min_length=1)
     preset: str = "default"
     set: dict[str, Any] = Field(default_factory=dict)
     label: str | None = None
-    target: str | None = Field(None, description="module:Class of a mapper outside the registry")
-    error_class: str | None = Field(None, description="module:Class of that mapper's exception")
-    requires: tuple[str, ...] = ()
     time_s: TimeS | None = None
     memory_mb: MemoryMb | None = None
     datasets: tuple[str, ...] | None = Field(
@@ -144,19 +154,36 @@ class MethodEntry(_Strict):
         "its reason like any failure, but does not make `albot1 bench` exit non-zero",
     )
 
-    @field_validator("target", "error_class")
-    @classmethod
-    def _module_class(cls, value: str | None) -> str | None:
-        if value is not None:
-            try:
-                check_target(value)
-            except TargetError as exc:
-                raise ValueError(str(exc)) from None
-        return value
+    trajectories: str | None = Field(
+        None,
+        description="a path with {dataset}: another system's trajectory files, scored instead of run (external)",
+    )
+    trajectory_format: Literal["tum", "kitti", "carmen"] | None = None
+
+    @model_validator(mode="after")
+    def _external_only(self) -> MethodEntry:
+        if self.trajectories is None:
+            if self.trajectory_format is not None:
+                raise ValueError(f"method {self.name!r}: trajectory_format without trajectories")
+            return self
+        if "{dataset}" not in self.trajectories:
+            raise ValueError(
+                f"method {self.name!r}: trajectories = {self.trajectories!r} has no {{dataset}}; expected one file "
+                f"per dataset, e.g. 'runs/{self.name}/{{dataset}}.tum'"
+            )
+        ran = [k for k in ("preset", "set") if k in self.model_fields_set]
+        if ran:
+            raise ValueError(
+                f"method {self.name!r}: {', '.join(ran)} cannot go with trajectories (the files are scored, "
+                "nothing is run)"
+            )
+        return self
 
     @property
     def display(self) -> str:
         """The column name in reports: the label, else ``name`` or ``name:preset``."""
+        if self.trajectories is not None:
+            return f"{self.label or self.name} (external)"
         if self.label:
             return self.label
         return self.name if self.preset == "default" else f"{self.name}:{self.preset}"
@@ -245,6 +272,21 @@ class Suite(_Strict):
     grid: GridSpec = Field(default_factory=GridSpec)
     methods: tuple[MethodEntry, ...] = Field(min_length=1)
     datasets: tuple[DatasetEntry, ...] = Field(min_length=1)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_imports(cls, data: Any) -> Any:
+        """A suite names methods; it never names code to import (an installed plugin does that)."""
+        methods = data.get("methods") if isinstance(data, dict) else None
+        for index, entry in enumerate(methods if isinstance(methods, list) else ()):
+            named = [key for key in REMOVED_METHOD_KEYS if isinstance(entry, dict) and key in entry]
+            if named:
+                raise ValueError(
+                    f"methods.{index} ({entry.get('name')!r}): `{named[0]}` is not read: a suite names registered "
+                    "methods only and imports no module; a mapper of your own registers through the entry point "
+                    "group albot1.methods (docs/benchmarking.md)"
+                )
+        return data
 
     @field_validator("name")
     @classmethod

@@ -7,6 +7,7 @@ Thin: every fact comes from :mod:`albot1.data.catalog` and
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -116,6 +117,28 @@ def fetch(
         raise typer.Exit(1)
 
 
+def geometry_lines(summary: dict[str, Any]) -> list[str]:
+    """Field of view, beam spacing (per distinct layout) and the laser's mount, as ``datasets info`` prints them."""
+    lines = []
+    layouts = summary.get("scan_geometry", [])
+    for layout in layouts[:5]:
+        share = f" ({layout['scans']} of {summary['scans']} scans)" if len(layouts) > 1 else ""
+        lines.append(
+            f"field of view: {layout['first_deg']:+.2f}..{layout['last_deg']:+.2f} deg "
+            f"({layout['last_deg'] - layout['first_deg']:.2f} deg), {layout['beams']} beams "
+            f"every {layout['spacing_deg']:.4g} deg{share}"
+        )
+    if len(layouts) > 5:
+        lines.append(f"... and {len(layouts) - 5} more beam layouts (see --json)")
+    offset = summary.get("sensor_offset", [0.0, 0.0, 0.0])
+    source = summary.get("sensor_offset_source") or ""
+    lines.append(
+        f"laser mount (x, y, yaw): ({offset[0]:.4g} m, {offset[1]:.4g} m, {math.degrees(offset[2]):.4g} deg)"
+        + (f"; {source}" if source else "")
+    )
+    return lines
+
+
 @app.command("info")
 def info(
     ref: Annotated[
@@ -158,6 +181,8 @@ def info(
         f"relations: {summary['relations']}"
     )
     typer.echo(f"  odometry: {summary.get('odometry_source', '')}")
+    for line in geometry_lines(summary):
+        typer.echo(f"  {line}")
     typer.echo(f"  source: {summary.get('source', '')} ({summary.get('format', '')})")
     checksums = summary["data_sha256"]
     typer.echo(

@@ -30,8 +30,8 @@ def methods(
     With --presets (or a METHOD), also each method's config fields with their
     unit (from the field name's suffix: _m metres, _deg degrees, _s seconds),
     type, value in the `default` preset and meaning, and which fields each
-    preset changes. Values come from the presets files (baselines/*.toml,
-    albot1/methods/albot1/presets.toml); override them per run with
+    preset changes. Values come from the presets files (baselines/<method>.toml,
+    every method's; a file in $ALBOT1_CONFIG_DIR/baselines/ replaces it); override them per run with
     `--set FIELD=VALUE` or ALBOT1_<METHOD>_<FIELD>.
 
     Examples:\n
@@ -40,9 +40,10 @@ def methods(
       albot1 methods kiss-icp --json
     """
     # The registry is imported by the command, not by this module: see albot1.cli.app.
-    from albot1.methods.registry import METHODS, get_method
+    from albot1.methods.registry import method_registry
 
-    specs = [get_method(method)] if method is not None else list(METHODS.values())
+    registry = method_registry()
+    specs = [registry.get(method)] if method is not None else list(registry)
     detail = presets or method is not None
     records = [_record(spec, detail) for spec in specs]
     if as_json:

@@ -8,17 +8,18 @@ from typing import Annotated
 
 import typer
 
+from albot1.cli.choices import METHOD_HELP, PRESET_HELP, RegistryHelpCommand
 from albot1.cli.progress import enabled, with_progress
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
 
 def register(app: typer.Typer) -> None:
-    app.command("run")(run)
+    app.command("run", cls=RegistryHelpCommand)(run)
 
 
 def run(
-    method: Annotated[str, typer.Argument(help="odometry | albot1 | kiss-icp | gtsam-graph (see `albot1 methods`)")],
+    method: Annotated[str, typer.Argument(help=METHOD_HELP)],
     dataset: Annotated[
         str,
         typer.Argument(
@@ -26,7 +27,7 @@ def run(
             "or a log file path; see `albot1 --help`"
         ),
     ],
-    preset: Annotated[str, typer.Option(help="config preset, e.g. albot1: thesis | exact")] = "default",
+    preset: Annotated[str, typer.Option(help=PRESET_HELP)] = "default",
     degrade: Annotated[str, typer.Option(help="none | thesis | gauss:SXY_M:STH_DEG | bias:DX_M:DTH_DEG")] = "none",
     seed: Annotated[int, typer.Option(help="seed of the degradation and of any random choice")] = 0,
     out: Annotated[
@@ -68,8 +69,6 @@ def run(
     # result.json: runs on different prefixes get different folders, and `albot1 evaluate` reopens the prefix.
     dataset = dataset if limit is None else f"{dataset}[:{limit}]"
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
-    if preset == "default" and method == "albot1":
-        preset = "thesis"
     sequence = with_progress(sequence, f"{method} on {dataset}")
     result = run_method(
         method,

@@ -1,4 +1,4 @@
-"""Every method's presets, read from a TOML file by one mechanism.
+"""Every method's presets, read from one TOML file per method by one mechanism.
 
 Why a TOML file and not a dict in the code: the numbers a method runs with
 (voxel sizes, thresholds, ...) are what a researcher reads, questions and
@@ -13,20 +13,26 @@ is therefore
   ``[presets.NAME]`` tables, each listing only what it changes relative to
   ``default``.
 
-Where the file lives depends on who owns the values. A wrapped baseline's
-file is ``baselines/<method>.toml`` (the project's editable config folder,
-found by :func:`albot1.resources.find_resource`); a method that is part of
-this package ships its file beside its code as package data
-(``albot1/methods/albot1/presets.toml``, the thesis's values).
+One place, one rule: the file of method ``M`` is ``baselines/M.toml`` (the
+project's config folder, shipped in the wheel and overridable file by file
+from ``ALBOT1_CONFIG_DIR``; :func:`albot1.resources.find_resource`), for a
+wrapped baseline and for Albot1 alike. The folder keeps its historical name.
 
-A mapper class opts in with ``presets: ClassVar[...] = TomlPresets()`` (a
-baseline) or ``TomlPresets(package="its.package")`` (package data). The
-descriptor reads the file the first time ``cls.presets`` is used (not at
-import, so importing a mapper never touches the disk), merges every preset
-onto ``default`` and validates each merged preset against
-``cls.config_model``: a typo or out-of-range value in the file is a
+A method that runs another inside it says so with a top-level
+``extends = "OTHER"``: its presets are then OTHER's presets with its own
+tables merged onto those of the same name (``albot1-places`` extends
+``albot1``: every chapter-3 preset is a places preset, with the places
+fields on top, so the two cannot drift apart).
+
+A mapper class opts in with ``presets = TomlPresets()``. The descriptor
+reads the file the first time ``cls.presets`` is used (not at import, so
+importing a mapper never touches the disk), merges every preset onto
+``default`` and validates each merged preset against ``cls.config_model``:
+a typo or out-of-range value in the file is a
 :class:`~albot1.errors.ConfigError` naming the file, preset and field,
-raised before any run starts.
+raised before any run starts. Every entry point (``albot1 run``, the bench,
+``albot1 evaluate``) resolves a preset name the same way
+(:func:`albot1.config.resolve.resolve`), with no per-command renaming.
 
 The precedence applied later by :func:`albot1.config.resolve.resolve`
 is: model < preset < env ``ALBOT1_<METHOD>_<FIELD>`` < ``--set``.
@@ -37,14 +43,14 @@ chosen on by looking at their scores (the *held-in* datasets; a preset the
 table does not name has ``default``'s). A number measured on one of them is
 not evidence of how the method generalises, so the reports mark it
 (:func:`tuned_on`, ``albot1.report.tuning``). The table is data, not config:
-it never enters a run's config or its key.
+it never enters a run's config or its key. A file that
+``extends`` another adds its held-in datasets to the other's, preset by preset.
 """
 
 from __future__ import annotations
 
 import inspect
 import tomllib
-from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
@@ -61,51 +67,31 @@ TunedOnTable = dict[str, tuple[str, ...]]
 #: The top-level table of a preset file that names the held-in datasets of each preset.
 TUNED_ON = "tuned_on"
 
-#: The file name of a package's own presets (``TomlPresets(package=...)``).
-PACKAGE_PRESETS = "presets.toml"
+#: The top-level key of a presets file that builds on another method's presets.
+EXTENDS = "extends"
 
 
 def preset_file(method: str) -> Path:
-    """The config file of a baseline: ``baselines/<method>.toml`` (the one place that looks it up)."""
+    """The presets file of ``method``: ``baselines/<method>.toml`` (the one place that looks it up)."""
     return find_resource("baselines", f"{method}.toml")
 
 
-def parse_presets(data: dict[str, Any], model: type[BaseModel], source: str) -> PresetTable:
-    """Merged, validated presets from a parsed TOML document.
-
-    ``source`` names the file in error messages. Each returned preset is
-    complete (``default`` merged with the preset's own values), so it can be
-    validated on its own and compared across presets.
-    """
+def _tables(data: dict[str, Any], source: str) -> dict[str, dict[str, Any]]:
+    """The ``[presets.NAME]`` tables of a parsed file (``default`` required), checked for shape."""
     tables = data.get("presets")
     if not isinstance(tables, dict) or not isinstance(tables.get("default"), dict):
         raise ConfigError(f"{source}: expected a [presets.default] table (and optional [presets.NAME] tables)")
-    unknown_top = sorted(set(data) - {"presets", TUNED_ON})
+    unknown_top = sorted(set(data) - {"presets", EXTENDS, TUNED_ON})
     if unknown_top:
         raise ConfigError(
-            f"{source}: unexpected top-level key(s) {', '.join(unknown_top)}; only [presets.NAME] tables and "
-            f"[{TUNED_ON}] are read"
+            f"{source}: unexpected top-level key(s) {', '.join(unknown_top)}; only [presets.NAME] tables, "
+            f'[{TUNED_ON}] and `{EXTENDS} = "METHOD"` are read'
         )
     parse_tuned_on(data, source)
-    default = tables["default"]
-    missing = [name for name in model.model_fields if name not in default]
-    if missing:
-        raise ConfigError(
-            f"{source}: [presets.default] must set every field of {model.__name__}; missing: {', '.join(missing)}"
-        )
-    merged: PresetTable = {}
     for name, values in tables.items():
         if not isinstance(values, dict):
             raise ConfigError(f"{source}: presets.{name} must be a table of FIELD = VALUE, got {type(values).__name__}")
-        preset = {**default, **values}
-        try:
-            model.model_validate(preset)
-        except ValidationError as exc:
-            raise ConfigError(
-                f"{source}: preset {name!r} is not a valid {model.__name__}: {describe_errors(exc)}"
-            ) from None
-        merged[name] = preset
-    return merged
+    return tables
 
 
 def parse_tuned_on(data: dict[str, Any], source: str) -> TunedOnTable | None:
@@ -136,6 +122,57 @@ def parse_tuned_on(data: dict[str, Any], source: str) -> TunedOnTable | None:
     return out
 
 
+def _merge(base: dict[str, dict[str, Any]], tables: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """Each preset of an extending file: the base preset of its name (else base ``default``), then the file's
+    ``default``, then its own preset of that name."""
+    return {
+        name: {**base.get(name, base["default"]), **tables["default"], **tables.get(name, {})}
+        for name in [*base, *(n for n in tables if n not in base)]
+    }
+
+
+def parse_presets(
+    data: dict[str, Any], model: type[BaseModel], source: str, base: dict[str, dict[str, Any]] | None = None
+) -> PresetTable:
+    """Merged, validated presets from a parsed TOML document.
+
+    ``source`` names the file in error messages. ``base`` holds the merged
+    presets of the method this file extends (``extends``): each preset is
+    then the base preset of its name (else the base ``default``) with this
+    file's preset of that name (else its ``default``) on top. Each returned
+    preset is complete, so it can be validated on its own and compared
+    across presets.
+    """
+    tables = _tables(data, source)
+    if base is None:
+        own_default = tables["default"]
+        layers = {name: {**own_default, **values} for name, values in tables.items()}
+    else:
+        layers = _merge(base, tables)
+    missing = [name for name in model.model_fields if name not in layers["default"]]
+    if missing:
+        raise ConfigError(
+            f"{source}: [presets.default] must set every field of {model.__name__}; missing: {', '.join(missing)}"
+        )
+    merged: PresetTable = {}
+    for name, preset in layers.items():
+        try:
+            model.model_validate(preset)
+        except ValidationError as exc:
+            raise ConfigError(
+                f"{source}: preset {name!r} is not a valid {model.__name__}: {describe_errors(exc)}"
+            ) from None
+        merged[name] = preset
+    return merged
+
+
+def _read(path: Path) -> dict[str, Any]:
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+
+
 def parse_preset_text(text: str, model: type[BaseModel], source: str) -> PresetTable:
     """:func:`parse_presets` of TOML text; invalid TOML is a ConfigError naming ``source``."""
     try:
@@ -145,70 +182,95 @@ def parse_preset_text(text: str, model: type[BaseModel], source: str) -> PresetT
     return parse_presets(data, model, source)
 
 
-def load_presets(method: str, model: type[BaseModel]) -> PresetTable:
-    """Read and validate ``baselines/<method>.toml``."""
+def _raw_chain(method: str, seen: tuple[str, ...] = ()) -> tuple[dict[str, dict[str, Any]], list[Path]]:
+    """The unvalidated merged tables of ``method`` (following ``extends``) and the files read, base first."""
+    if method in seen:
+        raise ConfigError(f"presets of {' -> '.join([*seen, method])}: `{EXTENDS}` goes round in a circle")
     path = preset_file(method)
-    return parse_preset_text(path.read_text(encoding="utf-8"), model, str(path))
+    data = _read(path)
+    tables = _tables(data, str(path))
+    parent = data.get(EXTENDS)
+    if parent is None:
+        return {name: {**tables["default"], **values} for name, values in tables.items()}, [path]
+    if not isinstance(parent, str):
+        raise ConfigError(f"{path}: {EXTENDS} must name a method (a string), got {parent!r}")
+    base, files = _raw_chain(parent, (*seen, method))
+    return _merge(base, tables), [*files, path]
 
 
-def _document(path_or_resource: Any, source: str) -> dict[str, Any]:
-    try:
-        return tomllib.loads(path_or_resource.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: not valid TOML: {exc}") from None
+def load_presets(method: str, model: type[BaseModel]) -> PresetTable:
+    """Read and validate the presets of ``method`` (``baselines/<method>.toml``, following ``extends``)."""
+    path = preset_file(method)
+    data = _read(path)
+    parent = data.get(EXTENDS)
+    if parent is None:
+        return parse_presets(data, model, str(path))
+    if not isinstance(parent, str):
+        raise ConfigError(f"{path}: {EXTENDS} must name a method (a string), got {parent!r}")
+    base, files = _raw_chain(parent, (method,))
+    return parse_presets(data, model, " + ".join(str(f) for f in [*files, path]), base)
 
 
-def load_package_presets(package: str, model: type[BaseModel]) -> PresetTable:
-    """Read and validate ``presets.toml`` shipped inside ``package``."""
-    resource = files(package).joinpath(PACKAGE_PRESETS)
-    if not resource.is_file():
-        raise ConfigError(f"{resource}: the presets of package {package} are missing (package data not installed?)")
-    return parse_preset_text(resource.read_text(encoding="utf-8"), model, str(resource))
+def preset_names(method: str) -> list[str]:
+    """The preset names of ``method`` read from its file(s) alone: no class imported, nothing validated."""
+    data = _read(preset_file(method))
+    names = list(_tables(data, str(preset_file(method))))
+    parent = data.get(EXTENDS)
+    if isinstance(parent, str):
+        base = preset_names(parent)
+        names = [*base, *(n for n in names if n not in base)]
+    return names
 
 
 class TomlPresets:
-    """Class attribute that loads ``presets`` lazily from the owner's TOML file.
+    """Class attribute that loads ``presets`` lazily from the owner's file, ``baselines/<owner.name>.toml``.
 
-    ``TomlPresets()`` reads ``baselines/<owner.name>.toml``;
-    ``TomlPresets(package="a.b")`` reads ``presets.toml`` of package ``a.b``.
     The owner class must define ``name`` and ``config_model`` (as every
     :class:`~albot1.contract.Mapper` does). The table is read once per owner
     class and process.
     """
 
-    def __init__(self, package: str | None = None) -> None:
-        self.package = package
+    def __init__(self) -> None:
         self._cache: dict[type, PresetTable] = {}
         self._tuned: dict[type, TunedOnTable | None] = {}
 
-    def __get__(self, instance: object, owner: type) -> PresetTable:
+    def __get__(self, instance: object, owner: type[Any]) -> PresetTable:
         table = self._cache.get(owner)
         if table is None:
-            model: type[BaseModel] = owner.config_model  # type: ignore[attr-defined]
-            if self.package is None:
-                table = load_presets(owner.name, model)  # type: ignore[attr-defined]
-            else:
-                table = load_package_presets(self.package, model)
+            table = load_presets(owner.name, owner.config_model)
             self._cache[owner] = table
         return table
 
-    def tuned_on(self, owner: type) -> TunedOnTable | None:
+    def location(self, owner: type[Any]) -> str:
+        """Where the owner's presets are read from (for listings and messages)."""
+        return str(preset_file(owner.name))
+
+    def tuned_on(self, owner: type[Any]) -> TunedOnTable | None:
         """The owner file's ``[tuned_on]`` table (None: the file records none); read once per owner class."""
         if owner not in self._tuned:
-            self.__get__(None, owner)  # validates the whole file first
-            resource: Any = preset_file(owner.name) if self.package is None else self._resource()  # type: ignore[attr-defined]
-            self._tuned[owner] = parse_tuned_on(_document(resource, str(resource)), str(resource))
+            self.__get__(None, owner)  # validates the whole file (and what it extends) first
+            self._tuned[owner] = load_tuned_on(owner.name)
         return self._tuned[owner]
 
-    def _resource(self) -> Any:
-        assert self.package is not None
-        return files(self.package).joinpath(PACKAGE_PRESETS)
 
-    def location(self, owner: type) -> str:
-        """Where the owner's presets are read from (for listings and messages)."""
-        if self.package is None:
-            return str(preset_file(owner.name))  # type: ignore[attr-defined]
-        return str(files(self.package).joinpath(PACKAGE_PRESETS))
+def load_tuned_on(method: str) -> TunedOnTable | None:
+    """``[tuned_on]`` of ``method``'s file; with ``extends``, the base's held-in datasets plus its own, per preset.
+
+    None when a file of the chain records none (the tuning is then not known).
+    """
+    path = preset_file(method)
+    data = _read(path)
+    own = parse_tuned_on(data, str(path))
+    parent = data.get(EXTENDS)
+    if own is None or not isinstance(parent, str):
+        return own
+    base = load_tuned_on(parent)
+    if base is None:
+        return None
+    return {
+        name: tuple(dict.fromkeys([*base.get(name, base["default"]), *own.get(name, own["default"])]))
+        for name in [*base, *(n for n in own if n not in base)]
+    }
 
 
 def tuned_on_table(owner: type) -> TunedOnTable | None:

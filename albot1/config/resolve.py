@@ -20,6 +20,7 @@ from typing import Any, Generic, TypeVar
 from pydantic import BaseModel, ValidationError
 
 from albot1.config.env import env_values
+from albot1.config.suggest import did_you_mean
 from albot1.config.validation import describe_errors
 from albot1.errors import ConfigError
 
@@ -82,7 +83,10 @@ def resolve(
     """
     label = owner or model.__name__
     if preset not in presets:
-        raise ConfigError(f"method {label!r} has no preset {preset!r}; expected one of: {', '.join(presets)}")
+        raise ConfigError(
+            f"method {label!r} has no preset {preset!r}{did_you_mean(preset, list(presets))}; "
+            f"expected one of: {', '.join(presets)}"
+        )
     sources = preset_sources(presets, preset, model.model_fields)
     values: dict[str, Any] = dict(presets[preset])
     for name, (variable, value) in env_values(model, env_prefix, other_prefixes=other_prefixes, owner=label).items():

@@ -19,6 +19,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from albot1.config.suggest import unknown_name_message
 from albot1.data.errors import ChecksumError, DatasetNotFoundError
 from albot1.data.fetch import ensure_file
 from albot1.data.identity import content_sha256
@@ -44,7 +45,9 @@ def get(name: str) -> DatasetManifest:
     try:
         return _manifests()[name]
     except KeyError:
-        raise DatasetNotFoundError(f"unknown dataset {name!r}; known datasets: {', '.join(names())}") from None
+        raise DatasetNotFoundError(
+            unknown_name_message("dataset", name, names(), listing="albot1 datasets list")
+        ) from None
 
 
 def find_file(data_file: DataFile, settings: Settings) -> Path | None:

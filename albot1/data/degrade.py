@@ -33,6 +33,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from albot1.data.errors import DataError
+from albot1.data.finite import pose_problem
 from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
@@ -125,6 +126,12 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
             else:
                 step = se2.between(prev_raw, frame.odometry)
                 current = se2.compose(current, deg.perturb(step, rng))
+                problem = pose_problem(current, "the degraded odometry")
+                if problem is not None:  # e.g. gauss:1e300:1 overflows: refused, never mapped
+                    raise DegradationSpecError(
+                        f"{sequence.name}: degradation {deg.spec} seed {seed}, step to scan {frame.index} "
+                        f"(t = {frame.scan.timestamp:.6f} s): {problem}"
+                    )
             prev_raw = np.asarray(frame.odometry, dtype=float)
             yield replace(frame, odometry=current)
 

@@ -128,7 +128,7 @@ def _valid_entry(key: str, value: object) -> bool:
         and all(isinstance(v, str) for v in value[4:])
     ):
         return False
-    return value[5] == _seal(key, value[:4], value[4])
+    return bool(value[5] == _seal(key, value[:4], value[4]))
 
 
 _CACHE = _Cache()

@@ -27,8 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry import se2
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 class _BeamDirections:
@@ -82,17 +81,23 @@ class Scan:
         """Mask of beams with a return."""
         return np.isfinite(self.ranges)
 
-    def points(self, min_range_m: float | None = None, max_range_m: float | None = None) -> FloatArray:
+    def points(
+        self, min_range_m: float | None = None, max_range_m: float | None = None, *, keep_missing: bool = False
+    ) -> FloatArray:
         """Cartesian points ``(k, 2)`` of the beams with a return, in the sensor frame, in beam order.
 
         The one scan-to-points conversion of the package. Beams without a
-        return (NaN) are always dropped; ``min_range_m`` / ``max_range_m``
+        return (NaN) are dropped, unless ``keep_missing`` (one point per beam,
+        NaN where there is no return: what a format that stores every beam
+        as a point writes; no range limits then). ``min_range_m`` / ``max_range_m``
         also drop beams shorter / longer than the limit (a beam exactly at a
         limit is kept). Moving the points into the robot or map frame (the
         laser's mounting offset, a pose) is the caller's, with
         :func:`albot1.geometry.se2.transform_points`.
         """
-        mask = self.valid()
+        if keep_missing and (min_range_m is not None or max_range_m is not None):
+            raise ValueError("keep_missing keeps every beam: it takes no range limits")
+        mask = np.ones(self.beams, dtype=np.bool_) if keep_missing else self.valid()
         if min_range_m is not None:
             mask &= self.ranges >= min_range_m
         if max_range_m is not None:
@@ -127,6 +132,8 @@ class Relations:
     t1: FloatArray
     t2: FloatArray
     poses: FloatArray  # (M, 3): x, y, yaw of the relation
+    #: How many lines of the file this was read from repeat an earlier line identically (kept, and counted).
+    repeats: int = 0
 
     def __len__(self) -> int:
         return int(self.t1.shape[0])
@@ -157,6 +164,9 @@ class SequenceArrays:
     odometry: FloatArray
     reference: FloatArray | None
     beams: NDArray[np.int64]
+    #: ``(N, 2)``: each scan's first and last beam angle (radians); with ``beams`` it gives the field of view
+    #: and the beam spacing (``albot1 datasets info``), which differ between recordings of one log.
+    angle_span: FloatArray | None = None
 
 
 class Sequence:
@@ -245,12 +255,14 @@ class Sequence:
     def arrays(self) -> SequenceArrays:
         """Timestamps, odometry, reference and beam counts (one full pass, cached)."""
         if self._arrays is None:
-            stamps, odom, ref, beams = [], [], [], []
+            stamps, odom, ref, beams, span = [], [], [], [], []
             has_ref = True
             for frame in self.frames():
                 stamps.append(frame.scan.timestamp)
                 odom.append(frame.odometry)
                 beams.append(frame.scan.beams)
+                angles = frame.scan.angles
+                span.append((angles[0], angles[-1]) if len(angles) else (np.nan, np.nan))
                 if frame.reference is None:
                     has_ref = False
                 elif has_ref:
@@ -260,6 +272,7 @@ class Sequence:
                 odometry=np.asarray(odom, dtype=float).reshape(-1, 3),
                 reference=np.asarray(ref, dtype=float).reshape(-1, 3) if has_ref and stamps else None,
                 beams=np.asarray(beams, dtype=np.int64),
+                angle_span=np.asarray(span, dtype=float).reshape(-1, 2),
             )
         return self._arrays
 
@@ -326,4 +339,30 @@ class Sequence:
             "odometry_source": self.metadata.odometry_source,
             "reference_source": self.metadata.reference_source,
             "license": self.metadata.license,
+            "scan_geometry": scan_geometry(arr.beams, arr.angle_span),
+            "sensor_offset": [float(v) for v in self.metadata.sensor_offset],
+            "sensor_offset_source": str(self.metadata.extra.get("sensor_offset_source", "")),
         }
+
+
+def scan_geometry(beams: NDArray[np.int64], span: FloatArray | None) -> list[dict[str, Any]]:
+    """The distinct beam layouts of a sequence, most frequent first, in degrees.
+
+    Each: ``first_deg``, ``last_deg`` (beam angles, so the field of view is
+    ``last - first``), ``beams``, ``spacing_deg`` (``(last - first) / (beams - 1)``,
+    NaN for one beam) and ``scans`` using it. Angles are rounded to 1e-6 deg
+    so float noise does not split one layout in two.
+    """
+    if span is None or not len(beams):
+        return []
+    rows = np.column_stack([np.round(np.degrees(span), 6), beams.astype(float)])
+    layouts, counts = np.unique(rows, axis=0, return_counts=True)
+    order = np.lexsort((layouts[:, 0], -counts))
+    out = []
+    for i in order:
+        first, last, n = (float(v) for v in layouts[i])
+        spacing = (last - first) / (n - 1) if n > 1 else float("nan")
+        out.append(
+            {"first_deg": first, "last_deg": last, "beams": int(n), "spacing_deg": spacing, "scans": int(counts[i])}
+        )
+    return out

@@ -14,7 +14,14 @@ options"):
     NAME?odometry=reference     the reference poses as odometry (perfect odometry)
     NAME?views=D_M:A_DEG        keep a scan once the odometry moved D_M metres or turned A_DEG degrees
 
-``odometry=reference`` is applied first, so ``views`` then spaces the views
+and, on every source alike (:mod:`albot1.data.attach`; the table of every
+option of every format is in ``docs/formats.md``):
+
+    NAME?relations=FILE         a relations file of one's own (replaces the source's)
+    NAME?reference=FILE         a reference trajectory of one's own (TUM, KITTI, corrected CARMEN log)
+    NAME?reference=FILE&reference_max_dt=S   largest scan-to-pose time gap (default 0.01 s)
+
+The own files are attached first, ``odometry=reference`` is applied next, so ``views`` then spaces the views
 by the reference poses; a degradation (applied by the runner) acts on the
 kept views' steps.
 
@@ -31,9 +38,12 @@ from pathlib import Path
 from typing import Any
 
 from albot1.config.keyvalue import KeyValueError, parse_query
+from albot1.config.suggest import did_you_mean
 from albot1.data import catalog
+from albot1.data.attach import REFERENCE_KEYWORDS, with_reference, with_relations
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
 from albot1.data.filekind import check_input
+from albot1.data.finite import checked
 from albot1.data.identity import content_sha256
 from albot1.data.loaders.registry import load
 from albot1.data.model import Sequence
@@ -67,25 +77,33 @@ def open_sequence(
         return open_sequence(
             name, settings=settings, format_name=format_name, **{**parse_options(query, text), **options}
         )
+    if _own_files(options):
+        return _with_own_files(text, settings, format_name, options)
     if options.get("odometry") == REFERENCE or "views" in options:
         return _with_reference_options(text, settings, format_name, options)
     if text in worlds.WORLDS:
+        if "odometry" in options:  # not REFERENCE (handled above): a world's odometry has no other source
+            raise DatasetNotFoundError(
+                f"{text!r}: odometry={options['odometry']!r}{did_you_mean(str(options['odometry']), [REFERENCE])}; "
+                f"a synthetic world takes odometry={REFERENCE} only (its odometry is simulated)"
+            )
         return worlds.load_world(text, **options)  # a world's own options (start=, laps=) or SyntheticWorldError
     settings = settings or get_settings()
     _check_option_files(options, text)
     if text in catalog.names():
         checksums = _checksums(None, options)
-        return _attach(catalog.open_dataset(text, settings, **options), checksums)
+        return _attach(checked(catalog.open_dataset(text, settings, **options)), checksums)
     path = Path(text).expanduser()
     if _exists(text):
         # The file (or every file of a bag folder) is checked and hashed before a loader opens it: a FIFO
         # among a bag's files would block the loader, and the checksum is cached for every later use.
         check_input(path, "a log file or a ROS2 bag folder", folder_ok=True)
         checksums = _checksums(path, options)
-        return _attach(load(path, format_name, **options), checksums)
+        return _attach(checked(load(path, format_name, **options)), checksums)
+    known = catalog.names() + sorted(worlds.WORLDS)
     raise DatasetNotFoundError(
-        f"{text!r} is neither a dataset name nor an existing file; known datasets: "
-        f"{', '.join(catalog.names() + sorted(worlds.WORLDS))} (see `albot1 datasets list`)"
+        f"{text!r} is neither a dataset name nor an existing file"
+        f"{did_you_mean(text, known)}; `albot1 datasets list` lists all {len(known)} datasets"
     )
 
 
@@ -188,6 +206,17 @@ def _with_reference_options(
         del rest["odometry"]
     views = rest.pop("views", None)
     sequence = open_sequence(text, settings=settings, format_name=format_name, **rest)
+    return _apply_reference_options(
+        sequence,
+        text,
+        {**({"odometry": REFERENCE} if use_reference else {}), **({"views": views} if views is not None else {})},
+    )
+
+
+def _apply_reference_options(sequence: Sequence, text: str, options: dict[str, Any]) -> Sequence:
+    """``odometry=reference`` then ``views=D_M:A_DEG`` on an opened sequence."""
+    use_reference = options.get("odometry") == REFERENCE
+    views = options.get("views")
     if use_reference:
         first = next(iter(sequence), None)
         if first is not None and first.reference is None:
@@ -197,6 +226,42 @@ def _with_reference_options(
         distance_m, angle_deg = parse_views(views, text)
         sequence = view_spacing(sequence, distance_m, angle_deg)
     return sequence
+
+
+def _own_files(options: dict[str, Any]) -> bool:
+    """Whether ``options`` name a relations or reference file (not a CARMEN ``reference`` keyword)."""
+    reference = options.get("reference")
+    return (
+        "relations" in options
+        or "reference_max_dt" in options
+        or (reference is not None and str(reference) not in REFERENCE_KEYWORDS)
+    )
+
+
+def _with_own_files(text: str, settings: Settings | None, format_name: str | None, options: dict[str, Any]) -> Sequence:
+    """Open ``text`` with the other options, then attach ``relations=FILE`` and ``reference=FILE``."""
+    rest = dict(options)
+    relations = rest.pop("relations", None)
+    max_dt = rest.pop("reference_max_dt", None)
+    reference = rest.pop("reference", None) if str(rest.get("reference")) not in REFERENCE_KEYWORDS else None
+    if max_dt is not None and reference is None:
+        raise ReferenceOptionError(f"{text!r}: reference_max_dt goes with reference=FILE, which is not given")
+    use_reference = rest.get("odometry") == REFERENCE
+    views = rest.pop("views", None)
+    if use_reference:
+        del rest["odometry"]
+    own = {key: value for key, value in (("relations", relations), ("reference", reference)) if value is not None}
+    _check_option_files(own, text)  # a FIFO or device is refused before anything reads it
+    sequence = open_sequence(text, settings=settings, format_name=format_name, **rest)
+    if relations is not None:
+        sequence = with_relations(sequence, relations, text)
+    if reference is not None:
+        sequence = with_reference(sequence, reference, text, max_dt)
+    sequence = _attach(sequence, _checksums(None, own))
+    after: dict[str, Any] = {"odometry": REFERENCE} if use_reference else {}
+    if views is not None:
+        after["views"] = views
+    return _apply_reference_options(sequence, text, after) if after else sequence
 
 
 def parse_views(value: Any, ref: str) -> tuple[float, float]:

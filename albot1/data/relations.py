@@ -23,6 +23,7 @@ neither swapped nor inverted.
 
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
@@ -34,6 +35,8 @@ from albot1.data.errors import ParseError
 from albot1.data.model import Relations
 from albot1.data.tokens import parse_floats
 
+log = logging.getLogger(__name__)
+
 _FIELDS = "t1 t2 x y z roll pitch yaw"
 _PLANAR_TOLERANCE = 1e-6
 
@@ -42,6 +45,10 @@ _PLANAR_TOLERANCE = 1e-6
 #: its log prints 6 (8 stamps differ by up to 5 us); the closest two scans of the five logs are 0.51 ms
 #: apart (Intel), so 0.1 ms accepts the rounding with a 20x margin and can never accept a neighbour scan.
 STAMP_TOLERANCE_S = 1e-4
+#: Largest accepted |x|, |y| (m) of a relation's motion.
+MAX_MOTION_M = 1e8
+#: Largest accepted |t1|, |t2| (s): Unix seconds until year 5138; nanosecond stamps are refused, not misread.
+MAX_TIMESTAMP_S = 1e11
 
 
 def read_relations(path: str | Path) -> Relations:
@@ -52,6 +59,8 @@ def read_relations(path: str | Path) -> Relations:
     except OSError as exc:
         raise ParseError(p, f"cannot read relations file ({exc.strerror or exc})") from None
     rows: list[list[float]] = []
+    seen: dict[tuple[float, float], tuple[int, list[float]]] = {}
+    repeats: list[str] = []
     for number, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("#"):
@@ -64,9 +73,50 @@ def read_relations(path: str | Path) -> Relations:
             raise ParseError(p, f"non-finite value; expected finite numbers ({_FIELDS})", line=number)
         if max(abs(values[4]), abs(values[5]), abs(values[6])) > _PLANAR_TOLERANCE:
             raise ParseError(p, "z, roll and pitch must be 0 for a planar (2D) relation", line=number)
+        _check_row(p, number, values)
+        pair = (values[0], values[1])
+        if pair in seen:
+            first, kept = seen[pair]
+            if kept != values:
+                raise ParseError(
+                    p,
+                    f"the relation t1={values[0]!r} t2={values[1]!r} is listed twice with different motions "
+                    f"(lines {first} and {number}); expected each relation once",
+                    line=number,
+                )
+            repeats.append(f"{number} (= {first})")
+        else:
+            seen[pair] = (number, values)
         rows.append(values)
+    if repeats:
+        log.warning(
+            "%s: %d relation line(s) repeat an earlier line identically; each is counted as listed: line %s",
+            p,
+            len(repeats),
+            ", ".join(repeats[:5]) + (", ..." if len(repeats) > 5 else ""),
+        )
     arr = np.asarray(rows, dtype=np.float64).reshape(-1, 8)
-    return Relations(t1=arr[:, 0].copy(), t2=arr[:, 1].copy(), poses=arr[:, [2, 3, 7]].copy())
+    return Relations(t1=arr[:, 0].copy(), t2=arr[:, 1].copy(), poses=arr[:, [2, 3, 7]].copy(), repeats=len(repeats))
+
+
+def _check_row(path: Path, number: int, values: list[float]) -> None:
+    """ParseError for an absurd or self-referencing relation (see the module docstring)."""
+    t1, t2, x, y = values[0], values[1], values[2], values[3]
+    if max(abs(t1), abs(t2)) > MAX_TIMESTAMP_S:
+        raise ParseError(
+            path, f"timestamp beyond {MAX_TIMESTAMP_S:g}; expected seconds (the scans' timestamps)", line=number
+        )
+    if max(abs(x), abs(y)) > MAX_MOTION_M:
+        raise ParseError(
+            path, f"motion ({x:.6g}, {y:.6g}) m is beyond {MAX_MOTION_M:g} m; expected metres", line=number
+        )
+    if t1 == t2:
+        raise ParseError(
+            path,
+            f"t1 and t2 are both {t1!r}: a relation from a pose to itself (motion {x:g}, {y:g}, {values[7]:g}); "
+            "expected two different scans",
+            line=number,
+        )
 
 
 def write_relations(path: str | Path, relations: Relations) -> None:

@@ -20,7 +20,21 @@ it with this suite's metrics:
     robot pose (the loader's ``reference="laser-pose"``) at its timestamp.
 
 Every parse error names the file and line, what was found and what was
-expected (:class:`~albot1.data.errors.ParseError`).
+expected (:class:`~albot1.data.errors.ParseError`). What is refused, and why:
+
+* a timestamp beyond :data:`MAX_TIMESTAMP_S` (not seconds);
+* a value that is not a finite number, or a coordinate beyond
+  :data:`MAX_COORDINATE_M` (1e8 m, 100 000 km: no planar map is that large,
+  and larger values overflow to infinity once squared in a metric);
+* a TUM quaternion whose length is not within :data:`QUATERNION_TOLERANCE`
+  of 1 (0.99-1.01): a small deviation (the rounding of a file written with
+  few decimals) is normalised away, a larger one means the four numbers are
+  not a unit quaternion (another column order, or no rotation at all) and
+  reading a heading from them would be a guess;
+* a KITTI matrix whose 3x3 part is not a rotation (``R R^T`` off the
+  identity by more than :data:`ROTATION_TOLERANCE`, or a reflection);
+* (:func:`read_trajectory`) two poses with one timestamp: which of the two
+  is meant cannot be told, so both line numbers are named.
 """
 
 from __future__ import annotations
@@ -42,6 +56,14 @@ TRAJECTORY_FORMATS: tuple[TrajectoryFormat, ...] = get_args(TrajectoryFormat)
 TUM_COLUMNS = "t x y z qx qy qz qw"
 #: Suffixes of CARMEN logs (plain or compressed) for :func:`guess_format`.
 CARMEN_SUFFIXES = (".clf", ".log", ".gfs", ".carmen")
+#: Largest accepted |x|, |y| (m) of a pose; beyond it a coordinate is refused as absurd.
+MAX_COORDINATE_M = 1e8
+#: Largest accepted |timestamp| (s): year 5138 in Unix time; nanosecond stamps (1.7e18) are refused, not misread.
+MAX_TIMESTAMP_S = 1e11
+#: Largest accepted | |q| - 1 | of a TUM quaternion; within it the quaternion is normalised.
+QUATERNION_TOLERANCE = 1e-2
+#: Largest accepted entry of ``R R^T - I`` of a KITTI rotation.
+ROTATION_TOLERANCE = 1e-2
 
 
 @dataclass(frozen=True)
@@ -131,16 +153,63 @@ def _locate_problem(path: Path, columns: int, expected: str) -> None:
 def read_tum(path: Path) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(timestamps, poses)`` of a TUM file; the heading is the yaw of the quaternion.
 
-    A quaternion of (near) zero length has no rotation: a ParseError naming its line.
+    A quaternion whose length is off 1 by more than :data:`QUATERNION_TOLERANCE`
+    is a ParseError naming its line; smaller deviations are normalised.
     """
     path = Path(path)
     rows = _rows(path, 8, f"TUM trajectory: {TUM_COLUMNS}")
-    bad = np.flatnonzero(np.linalg.norm(rows[:, 4:8], axis=1) < 1e-6)
+    late = np.flatnonzero(np.abs(rows[:, 0]) > MAX_TIMESTAMP_S)
+    if len(late):
+        raise ParseError(
+            path,
+            f"timestamp {rows[late[0], 0]:.6g} is beyond {MAX_TIMESTAMP_S:g}; expected seconds "
+            "(a timestamp in micro- or nanoseconds must be divided first)",
+            line=_line_of(path, int(late[0])),
+        )
+    _check_coordinates(path, rows[:, 1:3])
+    norm = np.linalg.norm(rows[:, 4:8], axis=1)
+    bad = np.flatnonzero(~(np.abs(norm - 1.0) <= QUATERNION_TOLERANCE))
     if len(bad):
         raise ParseError(
-            path, "quaternion (qx qy qz qw) has zero length, expected a rotation", line=_line_of(path, bad[0])
+            path,
+            f"quaternion (qx qy qz qw) has length {norm[bad[0]]:.6g}; expected a unit quaternion "
+            f"(length within {QUATERNION_TOLERANCE:g} of 1)",
+            line=_line_of(path, int(bad[0])),
         )
+    # Normalise only where it matters, so the files this module writes (|q| within ~1e-9 of 1) read back
+    # bit for bit as before (run folders, fingerprints).
+    rescale = np.abs(norm - 1.0) > 1e-6
+    rows[rescale, 4:8] /= norm[rescale, None]
     return rows[:, 0], _planar(rows)
+
+
+def _check_coordinates(path: Path, xy: NDArray[np.float64]) -> None:
+    """ParseError naming the first line whose x or y is beyond :data:`MAX_COORDINATE_M`."""
+    bad = np.flatnonzero(np.abs(xy).max(axis=1, initial=0.0) > MAX_COORDINATE_M)
+    if len(bad):
+        row = int(bad[0])
+        raise ParseError(
+            path,
+            f"position ({xy[row, 0]:.6g}, {xy[row, 1]:.6g}) m is beyond {MAX_COORDINATE_M:g} m; "
+            "expected coordinates of a map in metres",
+            line=_line_of(path, row),
+        )
+
+
+def _check_rotations(path: Path, rows: NDArray[np.float64]) -> None:
+    """ParseError naming the first KITTI line whose 3x3 part is not a rotation matrix."""
+    rotations = rows[:, [0, 1, 2, 4, 5, 6, 8, 9, 10]].reshape(-1, 3, 3)
+    off = np.abs(rotations @ rotations.transpose(0, 2, 1) - np.eye(3)).max(axis=(1, 2))
+    det = np.linalg.det(rotations)
+    bad = np.flatnonzero(~((off <= ROTATION_TOLERANCE) & (det > 0)))
+    if len(bad):
+        row = int(bad[0])
+        raise ParseError(
+            path,
+            f"the 3x3 part of [R | t] is not a rotation (R R^T differs from the identity by {off[row]:.3g}, "
+            f"det {det[row]:.3g}); expected an orthonormal matrix with determinant 1",
+            line=_line_of(path, row),
+        )
 
 
 def read_kitti(path: Path) -> NDArray[np.float64]:
@@ -149,6 +218,8 @@ def read_kitti(path: Path) -> NDArray[np.float64]:
     rows = _rows(path, 12, "KITTI poses: the 12 numbers of a 3x4 matrix [R | t] per line")
     if not len(rows):
         return np.empty((0, 3))
+    _check_coordinates(path, rows[:, [3, 7]])
+    _check_rotations(path, rows)
     tx, ty, tz = rows[:, 3], rows[:, 7], rows[:, 11]
     spread_y, spread_z = float(np.ptp(ty)), float(np.ptp(tz))
     if spread_z > 1e-3 and spread_y < 0.1 * spread_z:
@@ -170,7 +241,17 @@ def read_carmen_poses(path: Path) -> tuple[NDArray[np.float64], NDArray[np.float
     arrays = sequence.arrays
     if arrays.reference is None:  # pragma: no cover - laser-pose gives every scan a pose
         raise DataError(f"{path}: the log's laser lines carry no poses")
-    return arrays.timestamps, arrays.reference
+    poses = arrays.reference
+    bad = np.flatnonzero(~(np.isfinite(poses).all(axis=1) & (np.abs(poses[:, :2]).max(axis=1) <= MAX_COORDINATE_M)))
+    if len(bad):
+        row = int(bad[0])
+        raise ParseError(
+            path,
+            f"laser line {row} (0-based, t = {arrays.timestamps[row]:.6f} s): pose ({poses[row, 0]:.6g}, "
+            f"{poses[row, 1]:.6g}, {poses[row, 2]:.6g}) is not finite or beyond {MAX_COORDINATE_M:g} m; "
+            "expected metres of a map",
+        )
+    return arrays.timestamps, poses
 
 
 def guess_format(path: Path) -> TrajectoryFormat:
@@ -206,15 +287,46 @@ def guess_format(path: Path) -> TrajectoryFormat:
 def read_trajectory(path: str | Path, format_name: str | None = None) -> PoseFile:
     """Read a trajectory file in ``format_name`` (guessed from the file when None)."""
     file = Path(path)
-    if not file.is_file():
+    if file.is_dir():
+        raise DataError(f"{file}: is a folder; expected a trajectory file ({' | '.join(TRAJECTORY_FORMATS)})")
+    if not file.exists():
         raise DataError(f"{file}: trajectory file not found")
+    if not file.is_file():
+        raise DataError(f"{file}: not a regular file; expected a trajectory file ({' | '.join(TRAJECTORY_FORMATS)})")
     if format_name is not None and format_name not in TRAJECTORY_FORMATS:
         raise DataError(f"trajectory format {format_name!r} not known; expected {' | '.join(TRAJECTORY_FORMATS)}")
     fmt: TrajectoryFormat = format_name if format_name is not None else guess_format(file)
     if fmt == "kitti":
         return PoseFile(file, fmt, read_kitti(file), None)
     stamps, poses = read_tum(file) if fmt == "tum" else read_carmen_poses(file)
+    _refuse_duplicate_stamps(file, stamps, by_line=fmt == "tum")
     return PoseFile(file, fmt, poses, stamps)
+
+
+def _refuse_duplicate_stamps(path: Path, stamps: NDArray[np.float64], *, by_line: bool) -> None:
+    """ParseError naming both places of the first timestamp that two poses share.
+
+    Which of two poses at one time is meant cannot be told, and scoring
+    either silently can be far off; the file must be fixed.
+    """
+    order = np.argsort(stamps, kind="stable")
+    same = np.flatnonzero(np.diff(stamps[order]) == 0)
+    if not len(same):
+        return
+    first, second = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+    if by_line:
+        first_line, second_line = _line_of(path, first), _line_of(path, second)
+        raise ParseError(
+            path,
+            f"lines {first_line} and {second_line} both have timestamp {float(stamps[first])!r}; "
+            "expected one pose per timestamp",
+            line=second_line,
+        )
+    raise ParseError(
+        path,
+        f"scans {first} and {second} (0-based laser lines) both have timestamp {float(stamps[first])!r}; "
+        "expected one pose per timestamp (a log whose timestamps repeat cannot place its poses in time)",
+    )
 
 
 def _line_of(path: Path, row: int) -> int:

@@ -32,9 +32,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 #: A single pose ``(x, y, theta)`` as plain floats (the scalar API).
 Pose = tuple[float, float, float]
@@ -61,6 +61,22 @@ def between_pose(a: PoseLike, b: PoseLike) -> Pose:
     c, s = math.cos(a[2]), math.sin(a[2])
     dx, dy = b[0] - a[0], b[1] - a[1]
     return (c * dx + s * dy, -s * dx + c * dy, wrap_angle(b[2] - a[2]))
+
+
+def rotate(theta: float, x: float, y: float) -> tuple[float, float]:
+    """The point ``(x, y)`` rotated by ``theta`` about the origin: ``R(theta) @ (x, y)``."""
+    c, s = math.cos(theta), math.sin(theta)
+    return c * x - s * y, s * x + c * y
+
+
+def rows_rotation(theta: float) -> FloatArray:
+    """``R(theta).T``, the 2x2 matrix that rotates points stored as rows: ``points @ rows_rotation(theta)``.
+
+    For clouds ``(k, 2)`` whose row-vector form is what the matrix product
+    wants (one BLAS call per cloud rather than per coordinate).
+    """
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, s], [-s, c]])
 
 
 def pose_to_se3(pose: PoseLike) -> FloatArray:
@@ -160,29 +176,56 @@ def relative_steps(poses: ArrayLike) -> FloatArray:
 
 
 def integrate_steps(start: ArrayLike, steps: ArrayLike) -> FloatArray:
-    """A trajectory of ``len(steps) + 1`` poses from a start pose and increments."""
-    start_pose = as_poses(start)
-    increments = as_poses(steps)
-    out = np.empty((len(increments) + 1, 3))
-    out[0] = start_pose
-    for i, step in enumerate(increments):
-        out[i + 1] = compose(out[i], step)
+    """A trajectory of ``len(steps) + 1`` poses from a start pose and robot-frame increments.
+
+    Exact SE(2), vectorised as cumulative sums rather than composing the steps
+    one by one: the heading before each step is the start heading plus the
+    turns so far (wrapped once, at the end), and each step's translation is
+    rotated by that heading. This is the form the synthetic worlds' odometry
+    has always been integrated with, so their recorded results keep their bits.
+    """
+    p0 = as_poses(start).reshape(3)
+    s = as_poses(steps).reshape(-1, 3)
+    heading = p0[2] + np.concatenate([[0.0], np.cumsum(s[:, 2])])
+    before = heading[:-1]
+    c, si = np.cos(before), np.sin(before)
+    dx = c * s[:, 0] - si * s[:, 1]
+    dy = si * s[:, 0] + c * s[:, 1]
+    x = p0[0] + np.concatenate([[0.0], np.cumsum(dx)])
+    y = p0[1] + np.concatenate([[0.0], np.cumsum(dy)])
+    return np.column_stack([x, y, wrap(heading)])
+
+
+def unwrap_headings(poses: ArrayLike) -> FloatArray:
+    """A copy of a trajectory ``(N, 3)`` with its headings unwrapped (continuous, no 2 pi jumps).
+
+    What :func:`interpolate_unwrapped` blends; a caller that samples one
+    trajectory many times unwraps it once here.
+    """
+    p = as_poses(poses).reshape(-1, 3).copy()
+    p[:, 2] = np.unwrap(p[:, 2])
+    return p
+
+
+def interpolate_unwrapped(times: ArrayLike, unwrapped: ArrayLike, query: ArrayLike) -> FloatArray:
+    """Poses at ``query`` times from a trajectory whose headings are already unwrapped.
+
+    Linear in x, y and heading (``np.interp``), the heading wrapped after the
+    blend. ``times`` must be non-decreasing; queries outside
+    ``[times[0], times[-1]]`` take the nearest end pose (callers that must
+    not extrapolate check first).
+    """
+    t = np.asarray(times, dtype=float)
+    u = as_poses(unwrapped)
+    q = np.asarray(query, dtype=float)
+    out = np.stack([np.interp(q, t, u[:, 0]), np.interp(q, t, u[:, 1]), np.interp(q, t, u[:, 2])], axis=-1)
+    out[..., 2] = wrap(out[..., 2])
     return out
 
 
 def interpolate(times: ArrayLike, poses: ArrayLike, query: ArrayLike) -> FloatArray:
-    """Poses at ``query`` times, linear in x, y and the unwrapped heading.
-
-    ``times`` must be non-decreasing; queries outside ``[times[0], times[-1]]``
-    take the nearest end pose (callers that must not extrapolate check first).
-    """
-    t = np.asarray(times, dtype=float)
-    p = as_poses(poses)
-    q = np.asarray(query, dtype=float)
-    theta = np.unwrap(p[:, 2])
-    out = np.stack([np.interp(q, t, p[:, 0]), np.interp(q, t, p[:, 1]), np.interp(q, t, theta)], axis=-1)
-    out[..., 2] = wrap(out[..., 2])
-    return out
+    """Poses at ``query`` times, linear in x, y and the unwrapped heading (see :func:`interpolate_unwrapped`)."""
+    return interpolate_unwrapped(times, unwrap_headings(poses), query)
 
 
 def cumulative_length(poses: ArrayLike) -> FloatArray:

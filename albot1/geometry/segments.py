@@ -17,11 +17,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.geometry.se2 import PoseLike
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 def orientation(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> float:
@@ -45,7 +43,8 @@ def closest_parameter(x: float, y: float, ax: float, ay: float, bx: float, by: f
 def point_segment_distance(x: float, y: float, s: FloatArray) -> float:
     """Distance from the point (x, y) to segment ``s``."""
     t = closest_parameter(x, y, s[0], s[1], s[2], s[3])
-    return np.hypot(s[0] + t * (s[2] - s[0]) - x, s[1] + t * (s[3] - s[1]) - y)
+    distance: float = np.hypot(s[0] + t * (s[2] - s[0]) - x, s[1] + t * (s[3] - s[1]) - y)
+    return distance
 
 
 def line_angle(direction_difference: float) -> float:

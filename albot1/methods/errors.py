@@ -2,8 +2,16 @@
 
 from __future__ import annotations
 
-from albot1.errors import ConfigError
+from albot1.errors import Albot1Error, ConfigError
 
 
 class UnknownMethodError(ConfigError):
     """A method name is not registered, or its dependencies are missing."""
+
+
+class PluginError(ConfigError):
+    """An installed entry point of group ``albot1.methods`` does not declare a usable method."""
+
+
+class PluginMethodError(Albot1Error):
+    """A plugin method failed while running (the runner wraps the plugin's own exception in it)."""

@@ -12,10 +12,13 @@ method's prefix that names no field is an error), then explicit overrides
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import inspect
 import shutil
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, cast
 
 from pydantic import BaseModel
@@ -23,8 +26,10 @@ from pydantic import BaseModel
 from albot1.config.env import method_prefix
 from albot1.config.keyvalue import parse_key_values
 from albot1.config.resolve import ResolvedConfig, resolve
+from albot1.config.suggest import unknown_name_message
 from albot1.config.targets import TargetError, check_target, resolve_class
 from albot1.methods.errors import UnknownMethodError
+from albot1.methods.plugins import PLUGIN_ERROR_CLASS, installed_plugins
 
 if TYPE_CHECKING:
     # For the types only: the contract imports the data layer (numpy, the records), which listing the
@@ -51,7 +56,8 @@ def load_mapper_class(target: str) -> type[Mapper]:
 
 def _static_attr(cls: type, name: str) -> object | None:
     try:
-        return inspect.getattr_static(cls, name)
+        found: object = inspect.getattr_static(cls, name)
+        return found
     except AttributeError:
         return None
 
@@ -78,6 +84,9 @@ class MethodSpec:
     #: True when the method's output depends on its seed even on undegraded odometry (a particle filter):
     #: the bench then runs every seed under a deterministic degradation too, instead of the first only.
     stochastic: bool = False
+    #: The distribution that declares the method (an installed plugin), None for a method of this package,
+    #: whose presets are the file ``baselines/<name>.toml`` (:func:`albot1.config.presets.preset_names`).
+    plugin: str | None = None
 
     def __post_init__(self) -> None:
         check_target(self.target)
@@ -133,69 +142,145 @@ class MethodSpec:
         return method_prefix(self.name)
 
 
-METHODS: dict[str, MethodSpec] = {
-    spec.name: spec
-    for spec in (
-        MethodSpec(
-            "odometry",
-            "albot1.methods.baselines.odometry:OdometryMapper",
-            description="dead reckoning: the (possibly degraded) odometry, scans projected with it",
-        ),
-        MethodSpec(
-            "albot1",
-            "albot1.methods.albot1.mapping.mapper:Albot1Mapper",
-            error_class="albot1.methods.albot1.mapping.errors:MappingError",
-            description="the Albot1 perceptual mapper (thesis chapter 3)",
-        ),
-        MethodSpec(
-            "albot1-places",
-            "albot1.methods.albot1.places.mapper:Albot1PlacesMapper",
-            requires=("networkx",),
-            error_class="albot1.methods.albot1.mapping.errors:MappingError",
-            description="Albot1 with its network of places (thesis chapter 4: exits, places, re-visits, exit aid)",
-        ),
-        MethodSpec(
-            "kiss-icp",
-            "albot1.methods.baselines.kiss_icp:KissIcpMapper",
-            requires=("kiss_icp",),
-            description="KISS-ICP odometry on planar scans, odometry as initial guess",
-        ),
-        MethodSpec(
-            "gtsam-graph",
-            "albot1.methods.baselines.gtsam_graph:GtsamGraphMapper",
-            requires=("gtsam",),
-            description="graph SLAM: scan-matching edges, loop closures, ISAM2 + final LM (GTSAM)",
-        ),
-        MethodSpec(
-            "mrpt-icp",
-            "albot1.methods.baselines.mrpt:MrptIcpMapper",
-            executables=("icp-slam",),
-            install_hint="apt-get install mrpt-apps (or: make mrpt)",
-            auto_include=False,
-            description="MRPT icp-slam: incremental ICP scan matching against a point map, no loop closing",
-        ),
-        MethodSpec(
-            "mrpt-rbpf",
-            "albot1.methods.baselines.mrpt:MrptRbpfMapper",
-            executables=("rbpf-slam",),
-            stochastic=True,
-            install_hint="apt-get install mrpt-apps (or: make mrpt)",
-            auto_include=False,
-            description="MRPT rbpf-slam: Rao-Blackwellized particle filter grid SLAM (GMapping family)",
-        ),
-    )
-}
+#: The methods of this package, in the order listings show them.
+BUILTIN_METHODS: tuple[MethodSpec, ...] = (
+    MethodSpec(
+        "odometry",
+        "albot1.methods.baselines.odometry:OdometryMapper",
+        description="dead reckoning: the (possibly degraded) odometry, scans projected with it",
+    ),
+    MethodSpec(
+        "albot1",
+        "albot1.methods.albot1.mapping.mapper:Albot1Mapper",
+        error_class="albot1.methods.albot1.mapping.errors:MappingError",
+        description="the Albot1 perceptual mapper (thesis chapter 3)",
+    ),
+    MethodSpec(
+        "albot1-places",
+        "albot1.methods.albot1.places.mapper:Albot1PlacesMapper",
+        requires=("networkx",),
+        error_class="albot1.methods.albot1.mapping.errors:MappingError",
+        description="Albot1 with its network of places (thesis chapter 4: exits, places, re-visits, exit aid)",
+    ),
+    MethodSpec(
+        "kiss-icp",
+        "albot1.methods.baselines.kiss_icp:KissIcpMapper",
+        requires=("kiss_icp",),
+        description="KISS-ICP odometry on planar scans, odometry as initial guess",
+    ),
+    MethodSpec(
+        "gtsam-graph",
+        "albot1.methods.baselines.gtsam_graph:GtsamGraphMapper",
+        requires=("gtsam",),
+        description="graph SLAM: scan-matching edges, loop closures, ISAM2 + final LM (GTSAM)",
+    ),
+    MethodSpec(
+        "mrpt-icp",
+        "albot1.methods.baselines.mrpt:MrptIcpMapper",
+        executables=("icp-slam",),
+        install_hint="apt-get install mrpt-apps (or: make mrpt)",
+        auto_include=False,
+        description="MRPT icp-slam: incremental ICP scan matching against a point map, no loop closing",
+    ),
+    MethodSpec(
+        "mrpt-rbpf",
+        "albot1.methods.baselines.mrpt:MrptRbpfMapper",
+        executables=("rbpf-slam",),
+        stochastic=True,
+        install_hint="apt-get install mrpt-apps (or: make mrpt)",
+        auto_include=False,
+        description="MRPT rbpf-slam: Rao-Blackwellized particle filter grid SLAM (GMapping family)",
+    ),
+)
 
 
-def get_method(name: str) -> MethodSpec:
-    try:
-        return METHODS[name]
-    except KeyError:
-        raise UnknownMethodError(f"unknown method {name!r}; expected one of: {', '.join(METHODS)}") from None
+@dataclass(frozen=True)
+class MethodRegistry:
+    """Method names -> specs, immutable: built once (:func:`method_registry`) and handed to whoever runs methods.
+
+    The planner and every cell read the same registry instead of writing
+    into a module global; a test builds its own with :meth:`with_methods`.
+    """
+
+    specs: Mapping[str, MethodSpec]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "specs", MappingProxyType(dict(self.specs)))
+
+    @classmethod
+    def of(cls, specs: Iterable[MethodSpec]) -> MethodRegistry:
+        """A registry of ``specs``; a name given twice is a ConfigError."""
+        out: dict[str, MethodSpec] = {}
+        for spec in specs:
+            if spec.name in out:
+                raise UnknownMethodError(
+                    f"method {spec.name!r} is registered twice ({out[spec.name].target} and {spec.target})"
+                )
+            out[spec.name] = spec
+        return cls(out)
+
+    def with_methods(self, *specs: MethodSpec) -> MethodRegistry:
+        """A new registry with ``specs`` added or replacing those of the same name (this one is unchanged)."""
+        return MethodRegistry({**self.specs, **{spec.name: spec for spec in specs}})
+
+    def names(self) -> list[str]:
+        return list(self.specs)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.specs
+
+    def __iter__(self) -> Iterator[MethodSpec]:
+        return iter(self.specs.values())
+
+    def __len__(self) -> int:
+        return len(self.specs)
+
+    def get(self, name: str) -> MethodSpec:
+        """The spec of ``name``; UnknownMethodError (one line, with the closest names) otherwise."""
+        try:
+            return self.specs[name]
+        except KeyError:
+            raise UnknownMethodError(unknown_name_message("method", name, self.names())) from None
+
+    def other_prefixes(self, method: str) -> list[str]:
+        """The environment prefixes of every method but ``method`` (see :func:`resolve_method_config`)."""
+        return [spec.env_prefix for spec in self if spec.name != method]
+
+
+@functools.cache
+def method_registry() -> MethodRegistry:
+    """The registry of this process: the built-in methods and the installed plugins, read once.
+
+    Plugins are the entry points of group ``albot1.methods``
+    (:mod:`albot1.methods.plugins`); reading them imports nothing.
+    """
+    plugins = [
+        MethodSpec(
+            p.name,
+            p.target,
+            error_class=PLUGIN_ERROR_CLASS,
+            # its top-level module, found without importing it: a distribution whose code is gone is unavailable
+            requires=(p.target.partition(":")[0].split(".")[0],),
+            install_hint=f"reinstall {p.source.split()[0]}, which declares it",
+            auto_include=False,  # a suite runs an installed plugin where it names it
+            description=f"plugin {p.target} from {p.source}",
+            plugin=p.source,
+        )
+        for p in installed_plugins(spec.name for spec in BUILTIN_METHODS)
+    ]
+    return MethodRegistry.of([*BUILTIN_METHODS, *plugins])
+
+
+def get_method(name: str, registry: MethodRegistry | None = None) -> MethodSpec:
+    """The spec of ``name`` in ``registry`` (default: :func:`method_registry`)."""
+    return (registry or method_registry()).get(name)
 
 
 def resolve_method_config(
-    method: str, preset: str = "default", overrides: dict[str, Any] | None = None
+    method: str,
+    preset: str = "default",
+    overrides: dict[str, Any] | None = None,
+    registry: MethodRegistry | None = None,
 ) -> ResolvedConfig[BaseModel]:
     """The validated config of ``method`` for ``preset`` plus env and explicit overrides, with each value's origin.
 
@@ -203,22 +288,28 @@ def resolve_method_config(
     with nested prefixes (``albot1`` and a method ``albot1-places``) a
     variable belongs to the longest prefix it starts with.
     """
-    spec = get_method(method)
+    registry = registry or method_registry()
+    spec = registry.get(method)
     cls = spec.load_class()
     return resolve(
         cls.config_model,
         cls.presets,
         preset,
         env_prefix=spec.env_prefix,
-        other_prefixes=[other.env_prefix for other in METHODS.values() if other.name != method],
+        other_prefixes=registry.other_prefixes(method),
         overrides=overrides,
         owner=method,
     )
 
 
-def resolve_config(method: str, preset: str = "default", overrides: dict[str, Any] | None = None) -> BaseModel:
+def resolve_config(
+    method: str,
+    preset: str = "default",
+    overrides: dict[str, Any] | None = None,
+    registry: MethodRegistry | None = None,
+) -> BaseModel:
     """The validated config of ``method`` (see :func:`resolve_method_config`)."""
-    return resolve_method_config(method, preset, overrides).config
+    return resolve_method_config(method, preset, overrides, registry).config
 
 
 def parse_overrides(pairs: list[str]) -> dict[str, str]:

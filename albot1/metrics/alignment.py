@@ -17,7 +17,10 @@ every absolute metric names its alignment:
     the plane: the rotation angle is ``atan2(sum cross, sum dot)`` of the
     centred positions, which is the 2-D case of the SVD solution and can
     never return a reflection. Scale is never estimated: a metric map has
-    no free scale.
+    no free scale. With ``n_to_align = N`` the motion is estimated on the
+    first N pose pairs only and applied to all (evo's ``--align
+    --n_to_align N``): the error then shows how far the run strays from
+    where its beginning put it.
 """
 
 from __future__ import annotations
@@ -25,15 +28,14 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.metrics.errors import MetricsError
 
 Alignment = Literal["none", "first", "rigid"]
 ALIGNMENTS: tuple[str, ...] = get_args(Alignment)
-
-FloatArray = NDArray[np.float64]
 
 
 def check_pair(estimate: ArrayLike, reference: ArrayLike, what: str = "trajectories") -> tuple[FloatArray, FloatArray]:
@@ -70,9 +72,18 @@ def rigid_transform(estimate: ArrayLike, reference: ArrayLike) -> FloatArray:
     return np.array([t[0], t[1], se2.wrap(angle)])
 
 
-def alignment_transform(estimate: ArrayLike, reference: ArrayLike, method: Alignment) -> FloatArray:
-    """The pose ``T`` with which ``compose(T, estimate)`` is compared to the reference."""
+def alignment_transform(
+    estimate: ArrayLike, reference: ArrayLike, method: Alignment, n_to_align: int | None = None
+) -> FloatArray:
+    """The pose ``T`` with which ``compose(T, estimate)`` is compared to the reference.
+
+    ``n_to_align`` (``rigid`` only): estimate ``T`` on the first N pairs.
+    """
     est, ref = check_pair(estimate, reference, f"{method} alignment")
+    if n_to_align is not None:
+        if method != "rigid" or n_to_align < 1:
+            raise MetricsError(f"n_to_align={n_to_align} goes with the rigid alignment and a positive count")
+        return rigid_transform(est[:n_to_align], ref[:n_to_align])
     if method == "none":
         return np.zeros(3)
     if method == "first":
@@ -82,13 +93,23 @@ def alignment_transform(estimate: ArrayLike, reference: ArrayLike, method: Align
     raise MetricsError(f"unknown alignment {method!r}; expected one of {', '.join(ALIGNMENTS)}")
 
 
-def align(estimate: ArrayLike, reference: ArrayLike, method: Alignment) -> tuple[FloatArray, FloatArray]:
-    """``(aligned estimate, T)`` for one of :data:`ALIGNMENTS`."""
-    transform = alignment_transform(estimate, reference, method)
+def align(
+    estimate: ArrayLike, reference: ArrayLike, method: Alignment, n_to_align: int | None = None
+) -> tuple[FloatArray, FloatArray]:
+    """``(aligned estimate, T)`` for one of :data:`ALIGNMENTS` (``n_to_align``: see :func:`alignment_transform`)."""
+    transform = alignment_transform(estimate, reference, method, n_to_align)
     return se2.compose(transform, np.asarray(estimate, dtype=float)), transform
 
 
-def describe(transform: ArrayLike, method: Alignment) -> dict[str, object]:
-    """The JSON block naming an alignment and the motion it applied (m, deg)."""
+def describe(transform: ArrayLike, method: Alignment, n_to_align: int | None = None) -> dict[str, object]:
+    """The JSON block naming an alignment and the motion it applied (m, deg); ``n_to_align`` only when set."""
     t = np.asarray(transform, dtype=float)
-    return {"method": method, "x_m": float(t[0]), "y_m": float(t[1]), "theta_deg": float(np.degrees(t[2]))}
+    block: dict[str, object] = {
+        "method": method,
+        "x_m": float(t[0]),
+        "y_m": float(t[1]),
+        "theta_deg": float(np.degrees(t[2])),
+    }
+    if n_to_align is not None:
+        block["n_to_align"] = n_to_align
+    return block

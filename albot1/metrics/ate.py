@@ -29,7 +29,9 @@ def position_errors(estimate: ArrayLike, reference: ArrayLike, alignment: Alignm
     return np.hypot(aligned[:, 0] - ref[:, 0], aligned[:, 1] - ref[:, 1])
 
 
-def ate(estimate: ArrayLike, reference: ArrayLike, alignment: Alignment = "rigid") -> dict[str, Any]:
+def ate(
+    estimate: ArrayLike, reference: ArrayLike, alignment: Alignment = "rigid", n_to_align: int | None = None
+) -> dict[str, Any]:
     """The ``ate`` block of ``metrics.json``.
 
     Holds ``rmse_m, mean_m, median_m, std_m, min_m, max_m, n`` of the position
@@ -37,15 +39,17 @@ def ate(estimate: ArrayLike, reference: ArrayLike, alignment: Alignment = "rigid
     ``alignment`` (the method's name) and ``alignment_transform`` (the motion
     applied to the estimate), and ``other_alignments`` (rmse/mean/max under
     the two other alignments, so a reader sees how much the choice matters).
+    ``n_to_align`` (rigid only): the alignment is estimated on the first N
+    pairs (evo's ``--n_to_align``), named in ``alignment_transform``.
     """
     est, ref = check_pair(estimate, reference, "ATE")
-    aligned, transform = align(est, ref, alignment)
+    aligned, transform = align(est, ref, alignment, n_to_align)
     trans = np.hypot(aligned[:, 0] - ref[:, 0], aligned[:, 1] - ref[:, 1])
     rot = np.degrees(np.abs(se2.wrap(aligned[:, 2] - ref[:, 2])))
     block: dict[str, Any] = {"alignment": alignment, "units": {"translation": "m", "rotation": "deg"}}
     block.update(suffixed(summarize(trans, ddof=0), "m"))
     block["rotation"] = suffixed(summarize(rot, ddof=0), "deg")
-    block["alignment_transform"] = describe(transform, alignment)
+    block["alignment_transform"] = describe(transform, alignment, n_to_align)
     others: dict[str, Any] = {}
     for other in ALIGNMENTS:
         if other != alignment:

@@ -11,9 +11,9 @@ so a block in memory holds exactly what its file will hold.
 
 from __future__ import annotations
 
-from typing import Literal, TypeVar
+from typing import ClassVar, Literal, TypeVar
 
-from albot1.records import OptFloat, Record, parse_record
+from albot1.records import OmitsAbsentReasons, OptFloat, Record, parse_record
 
 BlockT = TypeVar("BlockT", bound=Record)
 
@@ -56,13 +56,20 @@ class RotationStats(Record):
     std_ddof: int
 
 
-class AlignmentTransform(Record):
-    """The rigid motion an alignment applied to the estimate (m, deg)."""
+class AlignmentTransform(OmitsAbsentReasons):
+    """The rigid motion an alignment applied to the estimate (m, deg).
+
+    ``n_to_align``: the motion was estimated on the first N pose pairs only
+    (``albot1 evaluate --align first:N``); absent when all pairs were used.
+    """
+
+    OMITTED_WHEN_NULL: ClassVar[frozenset[str]] = frozenset({"n_to_align"})
 
     method: Alignment
     x_m: float
     y_m: float
     theta_deg: float
+    n_to_align: int | None = None
 
 
 def fmt(value: float | None, spec: str = ".3f") -> str:

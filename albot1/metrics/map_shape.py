@@ -28,29 +28,24 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from albot1.geometry.grid import first_per_cell
+from albot1.geometry.types import FloatArray
 from albot1.metrics.errors import MetricsError
 
 TOLERANCE_M = 0.3
 VOXEL_M = 0.1
 MAX_POINTS = 200_000
 
-FloatArray = NDArray[np.float64]
-
 
 def thin(points: ArrayLike, voxel_m: float = VOXEL_M, max_points: int = MAX_POINTS) -> FloatArray:
     """Deterministic voxel thinning (first point per cell), then an even stride down to ``max_points``."""
-    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    pts: FloatArray = np.asarray(points, dtype=float).reshape(-1, 2)
     pts = pts[np.isfinite(pts).all(axis=1)]
     if len(pts) == 0:
         return pts
-    cells = np.floor(pts / voxel_m).astype(np.int64)
-    cells -= cells.min(axis=0)
-    # One integer per cell: a 1-D unique is several times faster than unique(axis=0).
-    keys = cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]
-    _, first = np.unique(keys, return_index=True)
-    kept = pts[np.sort(first)]
+    kept = first_per_cell(pts, voxel_m)
     if len(kept) > max_points:
         kept = kept[np.linspace(0, len(kept) - 1, max_points).astype(np.int64)]
     return kept

@@ -42,12 +42,10 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.metrics.errors import MetricsError
-
-FloatArray = NDArray[np.float64]
 
 PLACES_JSON = "places.json"
 
@@ -149,7 +147,8 @@ def believed_in_world(point: FloatArray, estimate: FloatArray, reference: FloatA
 
 def _midpoint(segment: Any) -> FloatArray:
     s = np.asarray(segment, dtype=float)
-    return 0.5 * (s[:2] + s[2:])
+    mid: FloatArray = 0.5 * (s[:2] + s[2:])
+    return mid
 
 
 def judge_exits(

@@ -57,7 +57,7 @@ class RunHeader(Record):
     data_sha256: dict[str, Sha256] = {}
 
 
-class TrajectorySource(Record):
+class TrajectorySource(OmitsAbsentReasons):
     """``metrics.json`` ``trajectory``: the external trajectory file an evaluation scored (absent for a run folder).
 
     Its poses are matched to the dataset's scans by time (the nearest scan
@@ -77,6 +77,30 @@ class TrajectorySource(Record):
     duplicates: int
     max_dt_s: float | None
     versions: dict[str, str | None]
+    #: reference poses (the dataset's scans, or the poses of ``reference_file``) that no pose of the file
+    #: was matched to: scored metrics cover the others only (absent in files written before it was counted)
+    reference_without_pose: int | None = None
+    #: ``albot1 evaluate --reference FILE``: the reference trajectory file, its format, sha256 and pose count
+    reference_file: str | None = None
+    reference_format: Literal["tum", "kitti", "carmen"] | None = None
+    reference_sha256: str | None = None
+    reference_poses: int | None = None
+    #: seconds added to the file's timestamps before matching (evo's ``--t_offset``); absent when 0
+    time_offset_s: float | None = None
+    #: the ATE alignment asked for on the command line (``se2``, ``origin``, ``first:N``, ``none``)
+    alignment: str | None = None
+
+    OMITTED_WHEN_NULL: ClassVar[frozenset[str]] = frozenset(
+        {
+            "reference_without_pose",
+            "reference_file",
+            "reference_format",
+            "reference_sha256",
+            "reference_poses",
+            "time_offset_s",
+            "alignment",
+        }
+    )
 
 
 class MetricsRecordBase(OmitsAbsentReasons):

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.errors import Albot1Error
+from albot1.geometry.types import FloatArray
 from albot1.records import Record, Timing
 
 if TYPE_CHECKING:
@@ -42,7 +43,6 @@ if TYPE_CHECKING:
 
 BlockT = TypeVar("BlockT", bound=Record)
 OtherT = TypeVar("OtherT", bound=Record)
-FloatArray = NDArray[np.float64]
 
 NO_REFERENCE = "the dataset has no reference poses"
 
@@ -76,6 +76,10 @@ class MetricInputs:
     #: a method's own output file of the run folder by name (``places.json``): its JSON content, or None
     #: when the run has no such file (None for a source without a run folder)
     read_file: Callable[[str], object | None] | None = None
+    #: how the ``ate`` metric aligns the estimate (``albot1 evaluate --align``; every other metric is
+    #: alignment-free or aligns on its own terms): the method, and the first N pairs it is estimated on
+    alignment: Literal["none", "first", "rigid"] = "rigid"
+    n_to_align: int | None = None
     #: answers worked out once per evaluation (whether the route is declared closed, ...)
     memo: dict[str, object] = field(default_factory=dict, compare=False, repr=False)
 

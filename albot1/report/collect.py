@@ -80,6 +80,8 @@ class Column:
 
     def value(self, record: CellRecord) -> float | None:
         """The cell's number (None: the run has none there, e.g. a metric that does not apply)."""
+        if self.source != "metrics" and _external(record):
+            return None
         if self.applies is not None and record.metrics is not None and self.applies(record.metrics) is not None:
             return None
         return number_at(self._record(record), self.path)
@@ -88,6 +90,8 @@ class Column:
         """Why a completed cell has no number here (None when it has one): the record's own words."""
         if record.status != "done" or self.value(record) is not None:
             return None
+        if self.source != "metrics" and _external(record):
+            return NOT_TIMED
         if self.applies is not None and record.metrics is not None:
             verdict = self.applies(record.metrics)
             if verdict is not None:
@@ -95,6 +99,15 @@ class Column:
         if self.source != "metrics" or record.metrics is None:
             return f"no {self.source}.json value"
         return _null_reason(record.metrics, self.path, self.undefined)
+
+
+#: Why an external run (another system's trajectory file, albot1.runs.external_run) has no cost numbers.
+NOT_TIMED = "an external trajectory comes without timings or counters (not measured)"
+
+
+def _external(record: CellRecord) -> bool:
+    """Whether the cell scored another system's file: its result.json timing is zeros by necessity, not data."""
+    return record.cell.trajectory is not None
 
 
 def _null_reason(metrics: MetricsRecord, path: str, undefined: str | None = None) -> str:

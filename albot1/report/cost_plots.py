@@ -21,6 +21,15 @@ if TYPE_CHECKING:
 PER_SCAN_FILE = "per_scan_ns.npy"
 
 
+#: The running median spans 1 % of the scans but at least this many, so it smooths even a short run.
+MIN_MEDIAN_WINDOW = 9
+
+
+def median_window(scans: int) -> int:
+    """The running median's window: 1 % of ``scans``, at least :data:`MIN_MEDIAN_WINDOW`, at most ``scans``."""
+    return max(1, min(scans, max(MIN_MEDIAN_WINDOW, scans // 100)))
+
+
 def running_median(values: NDArray[np.float64], window: int) -> NDArray[np.float64]:
     """The median of each ``window`` values around every position (edges padded with the end values)."""
     if window <= 1:
@@ -46,17 +55,21 @@ def plot_scan_time(records: list[CellRecord], dataset: str, path: Path, colors: 
         ms = np.load(ns_file).astype(float) / 1e6
         if not len(ms):
             continue
-        ax.plot(
-            np.arange(len(ms)), running_median(ms, max(1, len(ms) // 100)), color=colors.get(label), lw=0.9, label=label
-        )
+        scans = np.arange(len(ms))
+        ax.plot(scans, ms, color=colors.get(label), lw=0.4, alpha=0.25)  # raw, faint behind its median
+        ax.plot(scans, running_median(ms, median_window(len(ms))), color=colors.get(label), lw=1.6, label=label)
         drawn += 1
     if not drawn:
         pyplot().close(fig)
         return None
     ax.set_yscale("log")
     ax.set_xlabel("scan index")
-    ax.set_ylabel("per-scan time (ms), running median")
-    ax.set_title(f"{dataset}: per-scan processing time along the sequence", fontsize=9)
+    ax.set_ylabel("per-scan time (ms)")
+    ax.set_title(
+        f"{dataset}: per-scan processing time along the sequence\n(thick: running median over "
+        f"max({MIN_MEDIAN_WINDOW} scans, 1 % of them); faint: every scan)",
+        fontsize=9,
+    )
     ax.grid(alpha=0.3, which="both", lw=0.5)
     fig.legend(loc="outside right upper", fontsize=8, frameon=False)
     return save(fig, path)

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import CellRecord, Column
+from albot1.report.external_notes import external_html
 from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
@@ -232,7 +233,7 @@ def write_html(
         if figures:
             parts.append("<h3>Plots</h3>")
             parts += [_figure(p, out) for p in figures]
-    parts += ['<h2 id="failures">Failed cells</h2>', _failures(records, out)]
+    parts += [external_html(records), '<h2 id="failures">Failed cells</h2>', _failures(records, out)]
     not_run = [r for r in records if r.status == "not run"]
     if not_run:
         parts += [

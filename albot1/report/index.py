@@ -21,6 +21,7 @@ import pandas as pd
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
+from albot1.report.external_notes import external_markdown
 from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
 from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
@@ -30,13 +31,15 @@ from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.markdown import code, text
 from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.provenance import data_by_dataset, describe_data, separate_data
+from albot1.report.relation_plots import plot_relation_boxes
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
 from albot1.report.standard import write_standard
 from albot1.report.tables import aggregate, cells_frame, write_tables
-from albot1.report.thesis.page import THESIS_SUITE, own_records, write_thesis_page
+from albot1.report.thesis.experiments.datasets import THESIS_SUITE
+from albot1.report.thesis.page import own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 from albot1.report.tuning import held_in
 
@@ -141,6 +144,7 @@ def _dataset_plots(
         plot_ape_map(recs, dataset, at("ape"), colors),
         plot_error_vs_distance(recs, dataset, at("error-distance"), colors),
         plot_rpe_boxes(recs, dataset, at("rpe-boxes"), colors),
+        plot_relation_boxes(recs, dataset, at("relation-boxes"), colors),
         plot_maps(recs, dataset, at("maps"), colors, style=map_style),
         *[plot_robustness(metrics, dataset, column, label, at(kind), colors) for column, label, kind in ROBUSTNESS],
         plot_scan_time(recs, dataset, at("scan-time"), colors),
@@ -278,6 +282,7 @@ def write_index(
                 *[f"- [{f.stem}]({_rel(f, out)}) ([SVG]({_rel(vector_of(f), out)}))" for f in files],
                 "",
             ]
+    lines += external_markdown(records)
     lines += ["## Failed cells", "", *_failure_lines(records, out)]
     not_run = [r for r in records if r.status == "not run"]
     if not_run:

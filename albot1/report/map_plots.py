@@ -117,6 +117,9 @@ def plot_maps(
         xy = aligned_poses(run.poses, run.reference)
         ax.plot(xy[:, 0], xy[:, 1], color=colors.get(label, "C0"), lw=1.0, zorder=4)
         ax.set_title(f"{label} [{rec.cell.degradation}, seed {rec.cell.seed}]", fontsize=9)
+        if rec.cell.trajectory is not None:  # another system's file (albot1.bench.external): no map to draw
+            ax.text(0.5, 0.5, "no map: an external trajectory file", transform=ax.transAxes, ha="center", va="center",
+                    fontsize=8, color="0.35")  # fmt: skip
         extent.apply(ax)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.2, lw=0.5)

@@ -21,6 +21,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import math
 import re
 from collections.abc import Iterable, Sequence
@@ -39,7 +40,7 @@ from albot1.report.collect import CellRecord
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-#: Colours of methods, in plan order: matplotlib's tab10 then the light half of tab20.
+#: Colours of other method labels, chosen by a hash of the label: tab10 then the light half of tab20.
 PALETTE = (
     "#1f77b4",
     "#ff7f0e",
@@ -58,6 +59,20 @@ PALETTE = (
     "#c5b0d5",
     "#c49c94",
 )
+#: The colours of the project's own method labels (distinct; the first ten are matplotlib's tab10).
+FIXED_COLORS: dict[str, str] = {
+    "odometry": "#7f7f7f",
+    "albot1": "#1f77b4",
+    "albot1:thesis": "#17becf",
+    "albot1:plus": "#9467bd",
+    "albot1:literal": "#aec7e8",
+    "albot1:exact": "#bcbd22",
+    "albot1-places": "#e377c2",
+    "kiss-icp": "#ff7f0e",
+    "gtsam-graph": "#2ca02c",
+    "mrpt-icp": "#d62728",
+    "mrpt-rbpf": "#8c564b",
+}
 REFERENCE_COLOR = "black"
 DPI = 120
 #: Figure width limit (inches) and the widest/tallest panel shape drawn (a longer extent is padded).
@@ -66,9 +81,28 @@ MAX_PANEL_ASPECT = 6.0
 VECTOR_FORMAT = "svg"
 
 
+#: Longest readable part of a :func:`slug` (plot names add a kind and a suffix; file systems allow 255 bytes).
+SLUG_CHARS = 48
+_HASHED = re.compile(r".*-h[0-9a-f]{10}")
+
+
 def slug(text: str) -> str:
-    """A file-name-safe version of a dataset or method label."""
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "x"
+    """A short file-name-safe name of a dataset or method label, different for different labels.
+
+    A label that is already safe (ASCII letters, digits, ``_.-``; at most
+    :data:`SLUG_CHARS` characters) is its own slug, so common plot names stay
+    readable (``aces-maps.png``). Any other label (a slice ``aces[:2500:2]``,
+    a path, non-ASCII characters, a 290-character path) gets its readable part
+    cut to :data:`SLUG_CHARS` characters plus ``-h`` and 10 hex digits of the
+    label's sha256: two labels differing only in characters that the readable
+    part drops (``büro`` and ``båro``) never share a file, and no name is too
+    long for the file system.
+    """
+    safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_.") or "x"
+    if safe == text and len(text) <= SLUG_CHARS and _HASHED.fullmatch(text) is None:
+        return text
+    digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:10]
+    return f"{safe[:SLUG_CHARS].rstrip('_.-')}-h{digest}"
 
 
 def pyplot() -> Any:
@@ -82,9 +116,24 @@ def pyplot() -> Any:
 
 
 def method_colors(labels: Iterable[str]) -> dict[str, str]:
-    """method label -> colour, in the order given (the plan's), cycling the palette beyond 16 methods."""
-    unique = list(dict.fromkeys(labels))
-    return {label: PALETTE[i % len(PALETTE)] for i, label in enumerate(unique)}
+    """method label -> its colour, the same in every report and figure (first-seen order of ``labels`` kept).
+
+    The colour depends on the label alone, never on which other methods a
+    report holds: the project's own method labels have fixed, distinct
+    colours (:data:`FIXED_COLORS`); any other label (a plugin, a preset
+    variant, another system's output) gets one of :data:`PALETTE` chosen by
+    the sha256 of its text, so two such labels may share a colour (the
+    legend still tells them apart).
+    """
+    return {label: method_color(label) for label in dict.fromkeys(labels)}
+
+
+def method_color(label: str) -> str:
+    """The colour of one method label (see :func:`method_colors`)."""
+    if label in FIXED_COLORS:
+        return FIXED_COLORS[label]
+    digest = int.from_bytes(hashlib.sha256(label.encode("utf-8")).digest()[:8], "big")
+    return PALETTE[digest % len(PALETTE)]
 
 
 def representative(records: Iterable[CellRecord]) -> dict[str, CellRecord]:

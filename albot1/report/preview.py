@@ -40,6 +40,8 @@ def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> 
     ax.plot(result.poses[:, 0], result.poses[:, 1], color="tab:blue", lw=0.8, label=f"{result.method} estimate")
     ax.set_aspect("equal")
     ax.autoscale_view()
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
     ax.set_title(
         f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]", fontsize=9
     )

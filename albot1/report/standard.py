@@ -135,6 +135,8 @@ def _measured(rec: CellRecord) -> Row:
         reason = rec.failure.reason if rec.failure is not None else "the runner did not reach this cell"
         return Row(log, "measured", method, status=rec.status, note=reason.replace("\n", " "), held_in=tuned)
     timing = rec.result.timing
+    external = rec.cell.trajectory is not None  # another system's file: no timing measured (zeros in result.json)
+    wall_s, cpu_s = (None, None) if external else (timing.wall_s, timing.cpu_s)
     stamps = rec.stored_run().timestamps
     duration = float(stamps.max() - stamps.min()) if len(stamps) > 1 else None
     block = rec.metrics.get(RELATIONS)
@@ -144,8 +146,8 @@ def _measured(rec: CellRecord) -> Row:
             log,
             "measured",
             method,
-            time_s=timing.wall_s,
-            cpu_s=timing.cpu_s,
+            time_s=wall_s,
+            cpu_s=cpu_s,
             duration_s=duration,
             note=why,
             held_in=tuned,
@@ -169,10 +171,14 @@ def _measured(rec: CellRecord) -> Row:
         loop_translation_std_m=loops.translation_m.std,
         loop_rotation_mean_deg=loops.rotation_deg.mean,
         loop_relations=loops.translation_m.n,
-        time_s=timing.wall_s,
-        cpu_s=timing.cpu_s,
+        time_s=wall_s,
+        cpu_s=cpu_s,
         duration_s=duration,
-        source=f"this suite, run {rec.cell.key}",
+        source=(
+            f"external file {rec.cell.trajectory}, sha256 {(rec.cell.config or {}).get('sha256')}"
+            if external
+            else f"this suite, run {rec.cell.key}"
+        ),
         note=note,
         held_in=tuned,
     )

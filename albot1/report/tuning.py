@@ -26,7 +26,7 @@ from functools import cache
 from albot1.bench.grid import Cell
 from albot1.config.presets import tuned_on
 from albot1.errors import Albot1Error
-from albot1.methods.registry import METHODS, load_mapper_class
+from albot1.methods.registry import load_mapper_class, method_registry
 
 #: The mark beside a number measured on a dataset its method was tuned on.
 MARK = "†"
@@ -46,8 +46,8 @@ def dataset_name(reference: str) -> str:
 @cache
 def tuned_datasets(method: str, preset: str, target: str | None = None) -> tuple[str, ...] | None:
     """The datasets ``method``'s ``preset`` was tuned on; None when unknown (not recorded, class not loadable)."""
-    spec = METHODS.get(method)
-    where = target or (spec.target if spec is not None else None)
+    registry = method_registry()
+    where = target or (registry.get(method).target if method in registry else None)
     if where is None:
         return None
     try:
@@ -59,7 +59,7 @@ def tuned_datasets(method: str, preset: str, target: str | None = None) -> tuple
 
 def held_in(cell: Cell) -> bool | None:
     """Whether ``cell``'s dataset is one its method was tuned on (None: the method records no tuning)."""
-    names = tuned_datasets(cell.method, cell.preset, cell.target)
+    names = tuned_datasets(cell.method, cell.preset)
     if names is None:
         return None
     return dataset_name(cell.dataset) in names

@@ -41,6 +41,7 @@ from albot1.metrics.unit import MetricInputs
 from albot1.records import RecordError, dump_record, parse_record
 from albot1.runs.external import load_external
 from albot1.runs.folder import METRICS_FILE, read_run, write_record
+from albot1.runs.pair import check_time_offset, load_pair, parse_alignment, with_alignment
 from albot1.runs.scored import Scored, scored_run
 from albot1.settings import Settings
 
@@ -65,16 +66,46 @@ def evaluate_trajectory(
     settings: Settings | None = None,
     out: Path | None = None,
     wrap: Callable[[Sequence], Sequence] | None = None,
+    time_offset_s: float | None = None,
+    align: str | None = None,
 ) -> tuple[MetricsRecord, Scored]:
     """Score an external trajectory file against ``dataset``; write the metrics to ``out`` when given.
 
     Returns the record and what was scored (for evo result files and the
-    CLI's note on poses left out).
+    CLI's note on poses left out). ``time_offset_s`` and ``align``: see :mod:`albot1.runs.pair`.
     """
+    if align is not None:
+        parse_alignment(align)  # refuse a bad choice before the dataset is read
     scored = load_external(
-        path, dataset, format_name=format_name, label=label, max_dt_s=max_dt_s, settings=settings, wrap=wrap
+        path,
+        dataset,
+        format_name=format_name,
+        label=label,
+        max_dt_s=max_dt_s,
+        settings=settings,
+        wrap=wrap,
+        time_offset_s=check_time_offset(time_offset_s),
     )
+    scored = with_alignment(scored, align)
     record = score(scored, settings=settings, source=f"{out or path} (metrics being written)")
+    if out is not None:
+        write_record(out, record)
+    return record, scored
+
+
+def evaluate_pair(
+    path: Path,
+    reference: Path,
+    *,
+    out: Path | None = None,
+    **options: Any,
+) -> tuple[MetricsRecord, Scored]:
+    """Score the trajectory file ``path`` against the reference trajectory file ``reference`` (no dataset).
+
+    ``options``: those of :func:`albot1.runs.pair.load_pair`. Writes the metrics to ``out`` when given.
+    """
+    scored = load_pair(path, reference, **options)
+    record = score(scored, source=f"{out or path} (metrics being written)")
     if out is not None:
         write_record(out, record)
     return record, scored
@@ -129,6 +160,8 @@ def metric_inputs(scored: Scored, settings: Settings | None = None) -> MetricInp
         per_scan_ns=scored.per_scan_ns,
         timing=scored.timing,
         read_file=scored.read_file,
+        alignment=scored.alignment,
+        n_to_align=scored.n_to_align,
     )
 
 

@@ -22,12 +22,13 @@ from typing import Any
 import numpy as np
 
 from albot1 import versions
-from albot1.contract import MapperOutput, RunResult
+from albot1.contract import MapData, MapperOutput, RunResult
 from albot1.data.degrade import degrade
 from albot1.data.model import Frame, Sequence
+from albot1.data.trajectory import MAX_COORDINATE_M
 from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
-from albot1.methods.registry import get_method, resolve_config
+from albot1.methods.registry import MethodRegistry, get_method, resolve_config
 from albot1.runs.errors import RunError
 
 
@@ -59,15 +60,17 @@ def run_method(
     dataset_name: str | None = None,
     on_frame: Callable[[int], None] | None = None,
     announce: Callable[[str], None] | None = None,
+    registry: MethodRegistry | None = None,
 ) -> RunResult:
     """Degrade (seeded), run and check one method; raises the method's error class on failure.
 
     A mapper with a ``warm_up`` method (``Mapper.warm_up``) gets it called
     before the timed loop, with ``announce`` for what it has to say (e.g.
-    that it compiles); its time is the run's ``startup_s``.
+    that it compiles); its time is the run's ``startup_s``. ``registry``: where
+    ``method`` is looked up (default: this process's :func:`method_registry`).
     """
-    spec = get_method(method)
-    config = resolve_config(method, preset, overrides)
+    spec = get_method(method, registry)
+    config = resolve_config(method, preset, overrides, registry)
     error_class = spec.load_error_class()
     dataset = dataset_name or sequence.name
     seq = degrade(sequence, degradation, seed=seed)
@@ -170,6 +173,25 @@ def withhold_ground_truth(frame: Frame) -> Frame:
     return frame if frame.reference is None else Frame(frame.index, frame.scan, frame.odometry)
 
 
+def map_problem(data: MapData) -> str | None:
+    """Why a method's map cannot be kept (non-finite or absurd coordinates), or None.
+
+    The run boundary's own check: whatever a method did with its inputs, no
+    run ends with a map that a report or a metric cannot draw or measure.
+    """
+    for name, array in (("segment", data.segments), ("point", data.points)):
+        if array is None or not len(array):
+            continue
+        values = np.asarray(array, dtype=float)
+        bad = np.flatnonzero(~(np.isfinite(values).all(axis=1) & (np.abs(values).max(axis=1) <= MAX_COORDINATE_M)))
+        if len(bad):
+            return (
+                f"the map has {len(bad)} {name}(s) with non-finite or absurd coordinates (first: {name} {bad[0]}, "
+                f"{values[bad[0]].tolist()}); expected finite metres within {MAX_COORDINATE_M:g} m"
+            )
+    return None
+
+
 def _check_output(output: MapperOutput, n: int, method: str, dataset: str, error_class: type[Exception]) -> None:
     poses = np.asarray(output.poses, dtype=float)
     if poses.shape != (n, 3):
@@ -179,6 +201,9 @@ def _check_output(output: MapperOutput, n: int, method: str, dataset: str, error
     bad = np.flatnonzero(~np.isfinite(poses).all(axis=1))
     if len(bad):
         raise error_class(f"{method} on {dataset}: {len(bad)} non-finite poses, first at scan {bad[0]} (diverged)")
+    problem = map_problem(output.map)
+    if problem is not None:
+        raise error_class(f"{method} on {dataset}: {problem}")
     for key in ("views", "updates"):
         if key not in output.counters:
             raise RunError(f"{method} on {dataset}: counters lack the required key {key!r}")

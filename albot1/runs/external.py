@@ -25,7 +25,7 @@ from __future__ import annotations
 import hashlib
 import tempfile
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -37,12 +37,12 @@ from albot1.data.open import open_sequence
 from albot1.data.relations import match_stamps, read_relations, write_relations
 from albot1.data.trajectory import PoseFile, as_stored, read_trajectory
 from albot1.runs.errors import RunError
+from albot1.runs.folder import EXTERNAL_PRESET
 from albot1.runs.scored import Scored
 from albot1.settings import Settings
 
 #: Largest time between a pose and the scan it is matched to (s): evo's default ``t_max_diff``.
 MAX_DT_S = 0.01
-EXTERNAL_PRESET = "external"
 NO_MAP = "an external trajectory comes without a map"
 NO_COUNTERS = "an external trajectory comes without the method's counters (views, updates)"
 NO_TIMING = "an external trajectory comes without per-scan timings"
@@ -89,12 +89,18 @@ def load_external(
     max_dt_s: float | None = None,
     settings: Settings | None = None,
     wrap: Callable[[Sequence], Sequence] | None = None,
+    time_offset_s: float = 0.0,
 ) -> Scored:
     """The trajectory in ``path`` matched to ``dataset``'s scans, ready for :func:`albot1.runs.evaluate.score`.
 
-    ``wrap`` may wrap the opened dataset before its one decoding pass (the CLI's progress bar).
+    ``wrap`` may wrap the opened dataset before its one decoding pass (the CLI's progress bar);
+    ``time_offset_s`` is added to the file's timestamps before matching (evo's ``--t_offset``).
     """
     file = read_trajectory(path, format_name)
+    if time_offset_s and file.timestamps is None:
+        raise RunError(f"{file.path}: --time-offset needs timestamps; a {file.format} file has none")
+    if time_offset_s and file.timestamps is not None:
+        file = replace(file, timestamps=file.timestamps + time_offset_s)
     if max_dt_s is not None and not max_dt_s > 0:
         raise RunError(f"--max-dt is {max_dt_s} s; expected a positive number of seconds")
     if not len(file.poses):
@@ -161,6 +167,8 @@ def load_external(
                 "duplicates": matching.duplicates,
                 "max_dt_s": dt,
                 "versions": {"code": versions.code_version(), "git": versions.git_commit()},
+                "reference_without_pose": int(len(scan_times) - len(poses)) if reference is not None else None,
+                "time_offset_s": time_offset_s or None,
             }
         },
     )

@@ -76,6 +76,9 @@ STANDARD_FILES = frozenset(
 
 #: Draws a run's ``preview.png`` (``albot1.report.preview.render_preview``). The caller passes it in:
 #: storing a run must not depend on the plotting layer above it (docs/architecture.md, layers).
+#: ``preset`` of a run folder holding another system's trajectory file (albot1.runs.external), not a method's run.
+EXTERNAL_PRESET = "external"
+
 PreviewRenderer = Callable[[RunResult, Path], None]
 
 
@@ -285,7 +288,8 @@ def read_run(run_dir: str | Path) -> StoredRun:
     _, odom = read_tum(_required(path, "odometry.tum"))
     reference = read_tum(_required(path, "reference.tum"))[1] if info.has_reference else None
     relations = read_relations(_required(path, "relations.txt")) if info.relations else None
-    per_scan = _read_per_scan(_required(path, PER_SCAN_FILE), info.scans)
+    # another system's trajectory (albot1.runs.external_run) has no per-scan times: an empty array
+    per_scan = _read_per_scan(_required(path, PER_SCAN_FILE), 0 if info.preset == EXTERNAL_PRESET else info.scans)
     return StoredRun(path, info, stamps, poses, odom, reference, relations, per_scan)
 
 

@@ -13,7 +13,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -57,6 +57,9 @@ class Scored:
     #: for a source without a run folder)
     read_file: Callable[[str], object | None] | None = None
     absent: dict[str, str] = field(default_factory=dict)
+    #: the ``ate`` alignment and the first N pairs it is estimated on (``albot1 evaluate --align``)
+    alignment: Literal["none", "first", "rigid"] = "rigid"
+    n_to_align: int | None = None
     extra: dict[str, Any] = field(default_factory=dict)
 
 

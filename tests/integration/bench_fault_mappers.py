@@ -1,6 +1,6 @@
 """A mapper that fails on purpose, for the runner's failure-isolation tests.
 
-Suites register it with ``target = "bench_fault_mappers:FaultMapper"``; the
+Tests install it as the plugin method ``fault`` (the ``fault_plugin`` fixture); the
 cell child processes import it from the test folder (the runner hands them
 its ``sys.path``). Otherwise it behaves like dead reckoning, so ``mode = "ok"``
 and ``mode = "slow"`` give real, evaluable runs.

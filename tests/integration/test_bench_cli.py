@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from albot1.cli.app import app
@@ -59,8 +60,9 @@ def test_bench_exits_1_after_the_whole_grid_when_a_cell_failed(tmp_path: Path) -
     assert (tmp_path / "results" / "onefails" / "grid.json").is_file()
 
 
+@pytest.mark.usefixtures("fault_plugin")
 def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(tmp_path: Path) -> None:
-    fault = 'target = "bench_fault_mappers:FaultMapper"\n'
+    fault = ""  # the plugin method `fault` (fault_plugin fixture)
     suite = tmp_path / "allowed.toml"
     suite.write_text(
         '[[methods]]\nname = "odometry"\n\n'

@@ -2,7 +2,7 @@
 
 Every cell runs in its own child process, exactly as in `make bench`; the
 failing cells come from ``bench_fault_mappers.FaultMapper`` registered by
-the suite (``target``), so these tests depend on no other method.
+an installed plugin (the ``fault_plugin`` fixture), so these tests depend on no other method.
 """
 
 from __future__ import annotations
@@ -26,8 +26,10 @@ from albot1.bench.suite import load_suite
 from albot1.report.index import build_report
 from albot1.settings import Settings, get_settings
 
+pytestmark = pytest.mark.usefixtures("fault_plugin")
+
 WORLD = "synthetic-office-startstop"
-FAULT = 'target = "bench_fault_mappers:FaultMapper"'
+FAULT = ""  # the method `fault` is a plugin (the fault_plugin fixture installs its entry point)
 
 
 def suite_file(tmp_path: Path, body: str, name: str = "tiny") -> Path:

@@ -24,6 +24,8 @@ from albot1.bench.store import ResultsStore
 from albot1.bench.suite import load_suite
 from albot1.settings import get_settings
 
+pytestmark = pytest.mark.usefixtures("fault_plugin")
+
 WORLD = "synthetic-office-startstop"
 METHODS = ("odometry", "albot1", "kiss-icp", "gtsam-graph")
 
@@ -65,7 +67,6 @@ seeds = [0, 1, 2, 3, 4, 5]
 [[methods]]
 name = "fault"
 label = "slow"
-target = "bench_fault_mappers:FaultMapper"
 set = {{ mode = "slow", sleep_s = 0.1 }}
 
 [[datasets]]

@@ -13,6 +13,10 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 from albot1.data.model import Frame, Sequence
 
+#: The options every source takes besides its loader's own (applied by :mod:`albot1.data.open` and
+#: :mod:`albot1.data.attach`, not by a loader): loaders name them in their unknown-option errors.
+COMMON_OPTIONS = ("relations", "reference", "reference_max_dt", "odometry=reference", "views")
+
 
 @runtime_checkable
 class SequenceLoader(Protocol):

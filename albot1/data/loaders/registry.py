@@ -68,7 +68,8 @@ def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoad
     if found:  # a FIFO, a device, /proc/self/environ: refused by its stat, before a sniff could hang on it
         check_input(p, "a log file or a ROS2 bag folder", folder_ok=True)
     if format_name is not None:
-        return _import(_check_format(format_name)[0])()
+        chosen: SequenceLoader = _import(_check_format(format_name)[0])()
+        return chosen
     if not found:
         raise DataError(f"{p}: no such file or directory")
     seen: set[str] = set()
@@ -85,11 +86,13 @@ def loader_for(path: str | Path, format_name: str | None = None) -> SequenceLoad
 def writer_for(format_name: str) -> SequenceWriter:
     """The writer of a format name (see :data:`FORMATS` and :data:`WRITE_ONLY_FORMATS`)."""
     if format_name in WRITE_ONLY_FORMATS:
-        return _import(WRITE_ONLY_FORMATS[format_name])()
+        write_only: SequenceWriter = _import(WRITE_ONLY_FORMATS[format_name])()
+        return write_only
     writer_target = _check_format(format_name)[1]
     if writer_target is None:
         raise UnknownFormatError(f"format {format_name!r} can be read but not written")
-    return _import(writer_target)()
+    writer: SequenceWriter = _import(writer_target)()
+    return writer
 
 
 def load(path: str | Path, format_name: str | None = None, **options: Any) -> Sequence:

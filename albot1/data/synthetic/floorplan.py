@@ -28,14 +28,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from albot1.data.synthetic.errors import SyntheticWorldError
+from albot1.geometry.types import FloatArray
 
 if TYPE_CHECKING:
     from shapely.geometry.base import BaseGeometry
 
-FloatArray = NDArray[np.float64]
 Rect = tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
 #: A piece of furniture: an axis-aligned :data:`Rect`, or a polygon as its corners ``((x, y), ...)``.
 Obstacle = Rect | tuple[tuple[float, float], ...]

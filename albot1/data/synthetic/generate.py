@@ -25,8 +25,7 @@ from albot1.data.synthetic.lidar import LaserSpec
 from albot1.data.synthetic.odometry import OdometryErrorModel, simulate
 from albot1.data.synthetic.route import Route, Sampling, repeat_laps, sample, timestamps
 from albot1.geometry import se2
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 # Half the width of the thesis's Pioneer 3-DX (50 cm): every route must keep
 # this far from the walls, so it could be driven (through a 0.9 m doorway too).

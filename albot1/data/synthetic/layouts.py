@@ -23,6 +23,7 @@ import math
 
 from albot1.data.synthetic.floorplan import DoorwaySpec, FloorPlan, Obstacle, Rect, Space, build_plan
 from albot1.data.synthetic.route import Route
+from albot1.geometry import se2
 
 OFFICE_SPACES: tuple[Space, ...] = (
     Space("corridor", (0.0, 0.0, 24.0, 2.0)),
@@ -136,10 +137,10 @@ PLACES_DOOR_2_5 = DoorwaySpec("door-2-5", (9.3, 6.1), "x", 1.0)
 
 def askew(centre: tuple[float, float], size: tuple[float, float], degrees: float) -> tuple[tuple[float, float], ...]:
     """The corners of a ``size`` (length, depth) box centred at ``centre``, turned ``degrees`` counter-clockwise."""
-    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    frame = (centre[0], centre[1], math.radians(degrees))
     half = (size[0] / 2.0, size[1] / 2.0)
     corners = ((-half[0], -half[1]), (half[0], -half[1]), (half[0], half[1]), (-half[0], half[1]))
-    return tuple((centre[0] + c * x - s * y, centre[1] + s * x + c * y) for x, y in corners)
+    return tuple(se2.compose_pose(frame, (x, y, 0.0))[:2] for x, y in corners)
 
 
 PLACES_FURNITURE: tuple[Obstacle, ...] = (

@@ -25,8 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from albot1.data.synthetic.errors import SyntheticWorldError
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 # A hit closer than this to the ray origin is treated as the origin touching a
 # wall (the sensor is never placed inside a wall), not as a return.
@@ -90,7 +89,8 @@ def cast(walls: ArrayLike, pose: ArrayLike, angles: ArrayLike, max_range: float)
     it (zero-thickness walls have no end face); in a closed plan it stops at
     the next wall meeting that one at a corner.
     """
-    return cast_many(walls, np.asarray(pose, dtype=float).reshape(1, 3), angles, max_range)[0]
+    ranges: FloatArray = cast_many(walls, np.asarray(pose, dtype=float).reshape(1, 3), angles, max_range)[0]
+    return ranges
 
 
 def cast_many(
@@ -196,7 +196,7 @@ def add_noise(ranges: ArrayLike, sigma: float, max_range: float, rng: np.random.
     a wall moves. Negative results are clipped to 0.
     """
     r = np.asarray(ranges, dtype=float)
-    noisy = r + rng.normal(0.0, sigma, size=r.shape) if sigma > 0 else r.copy()
+    noisy: FloatArray = r + rng.normal(0.0, sigma, size=r.shape) if sigma > 0 else r.copy()
     noisy = np.maximum(noisy, 0.0)
     noisy[~(noisy <= max_range)] = np.nan
     return noisy

@@ -27,12 +27,11 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from albot1.data.synthetic.errors import SyntheticWorldError
 from albot1.geometry import se2
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 @dataclass(frozen=True)
@@ -97,25 +96,6 @@ def perturb_steps(steps: ArrayLike, model: OdometryErrorModel, rng: np.random.Ge
     return np.column_stack([ux * along - uy * across, uy * along + ux * across, dtheta])
 
 
-def integrate(start: ArrayLike, steps: ArrayLike) -> FloatArray:
-    """``len(steps) + 1`` poses from ``start`` and robot-frame increments (exact SE(2), vectorised).
-
-    Equivalent to composing the steps one by one, but as cumulative sums: the
-    heading before each step is the start heading plus the turns so far, and
-    each step's translation is rotated by that heading.
-    """
-    p0 = se2.as_poses(start).reshape(3)
-    s = se2.as_poses(steps).reshape(-1, 3)
-    heading = p0[2] + np.concatenate([[0.0], np.cumsum(s[:, 2])])
-    before = heading[:-1]
-    c, si = np.cos(before), np.sin(before)
-    dx = c * s[:, 0] - si * s[:, 1]
-    dy = si * s[:, 0] + c * s[:, 1]
-    x = p0[0] + np.concatenate([[0.0], np.cumsum(dx)])
-    y = p0[1] + np.concatenate([[0.0], np.cumsum(dy)])
-    return np.column_stack([x, y, se2.wrap(heading)])
-
-
 def simulate(true_poses: ArrayLike, model: OdometryErrorModel, *, seed: int | np.random.Generator) -> FloatArray:
     """Odometry poses ``(N, 3)`` for a true trajectory, starting at the true first pose."""
     truth = se2.as_poses(true_poses).reshape(-1, 3)
@@ -123,4 +103,4 @@ def simulate(true_poses: ArrayLike, model: OdometryErrorModel, *, seed: int | np
         return truth.copy()
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     measured = perturb_steps(se2.relative_steps(truth), model, rng)
-    return integrate(truth[0], measured)
+    return se2.integrate_steps(truth[0], measured)

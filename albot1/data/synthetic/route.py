@@ -27,12 +27,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from albot1.data.synthetic.errors import SyntheticWorldError
 from albot1.geometry import se2
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 # Legs or turns shorter than this are rounding noise, not motion.
 _TINY = 1e-9

@@ -23,9 +23,7 @@ import functools
 import math
 from typing import Any
 
-import numpy as np
-from numpy.typing import NDArray
-
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
 from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError
@@ -33,6 +31,7 @@ from albot1.data.synthetic.floorplan import DoorwayCrossing
 from albot1.data.synthetic.generate import WorldData, WorldSpec, generate, stream_frames, world_metadata
 from albot1.data.synthetic.odometry import OdometryErrorModel
 from albot1.data.synthetic.route import CONTINUOUS, START_STOP, START_STOP_10DEG, Route, start_at
+from albot1.geometry.types import FloatArray
 
 __all__ = [
     "OFFICE_ODOMETRY",
@@ -47,7 +46,6 @@ __all__ = [
     "world_geometry",
 ]
 
-FloatArray = NDArray[np.float64]
 
 # A Pioneer-class robot on carpet: about 1 % scale error on distance, turns
 # over-reported by 1 % (the caster wheel resists, the wheels slip), a slight
@@ -189,7 +187,7 @@ def variant(name: str, options: dict[str, Any]) -> WorldSpec:
     if unknown:
         raise WorldOptionError(
             f"synthetic world {name!r}: unknown loader option(s) {', '.join(unknown)}; "
-            f"expected {' or '.join(WORLD_OPTIONS)}"
+            f"expected {' or '.join(WORLD_OPTIONS)} (and the options of every source: {', '.join(COMMON_OPTIONS)})"
         )
     if not options:
         return spec

@@ -61,13 +61,13 @@ import math
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
-from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.point_map import ThinnedPointMap
 
@@ -75,7 +75,6 @@ if TYPE_CHECKING:
     from kiss_icp.mapping import VoxelHashMap
     from kiss_icp.registration import Registration
 
-FloatArray = NDArray[np.float64]
 
 #: How many scan indices of odometry fallbacks ``extras`` lists (the counter has the total).
 _LISTED_FALLBACKS = 200
@@ -151,7 +150,7 @@ class KissIcpMapper:
 
     name: ClassVar[str] = "kiss-icp"
     config_model: ClassVar[type[BaseModel]] = KissIcpConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: KissIcpConfig, *, seed: int = 0) -> None:
         # KISS-ICP is deterministic; ``seed`` is accepted for the protocol.
@@ -221,8 +220,7 @@ class KissIcpMapper:
             self._local_map.update(frame_down, se2.pose_to_se3(pose))
             self._last_inserted = pose
             self._counters["updates"] += 1
-        c, s = math.cos(pose[2]), math.sin(pose[2])
-        self._map.add(cloud[:, :2] @ np.array([[c, s], [-s, c]]) + pose[:2])
+        self._map.add(cloud[:, :2] @ se2.rows_rotation(pose[2]) + pose[:2])
 
     def _moved_since_insertion(self, pose: FloatArray) -> bool:
         """Whether the pose is far enough from the last one inserted into the voxel map."""

@@ -13,7 +13,7 @@ config can be built directly in code and tests, and equal that file's
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
@@ -37,7 +37,7 @@ class OdometryConfig(BaseModel):
 class OdometryMapper:
     name: ClassVar[str] = "odometry"
     config_model: ClassVar[type[BaseModel]] = OdometryConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: OdometryConfig, *, seed: int = 0) -> None:
         self.config = config

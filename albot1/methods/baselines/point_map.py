@@ -4,27 +4,16 @@ Every scan projected with its pose would give millions of points on a long
 log (13,631 Intel scans x 180 beams); keeping only the first point that
 falls into each grid cell bounds the map by the area covered, keeps the
 picture and the map-shape metrics meaningful, and is deterministic (the
-first scan to see a cell wins).
+first scan to see a cell wins). The one-shot form of the same thinning is
+:func:`albot1.geometry.grid.first_per_cell`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
-FloatArray = NDArray[np.float64]
-
-
-def cell_keys(points: FloatArray, cell_m: float) -> NDArray[np.int64]:
-    """One int64 key per ``cell_m`` grid cell of each point ``(K, 2)`` (x in the high, y in the low 32 bits)."""
-    cells = np.floor(points / cell_m).astype(np.int64)
-    return (cells[:, 0] << 32) | (cells[:, 1] & 0xFFFFFFFF)
-
-
-def first_per_cell(points: FloatArray, cell_m: float) -> FloatArray:
-    """The first point of ``points`` ``(K, 2)`` in each ``cell_m`` grid cell, in input order (one-shot thinning)."""
-    _, first = np.unique(cell_keys(points, cell_m), return_index=True)
-    return points[np.sort(first)]
+from albot1.geometry.grid import cell_keys
+from albot1.geometry.types import FloatArray
 
 
 class ThinnedPointMap:

@@ -1,4 +1,4 @@
-"""``ate``: absolute trajectory error after a rigid alignment (:func:`albot1.metrics.ate.ate`)."""
+"""``ate``: absolute trajectory error after an alignment (:func:`albot1.metrics.ate.ate`; rigid unless chosen)."""
 
 from __future__ import annotations
 
@@ -36,11 +36,13 @@ class AteBlock(Record):
 
 def compute(inputs: MetricInputs) -> AteBlock:
     assert inputs.reference is not None  # REFERENCE is a need
-    return block_of(AteBlock, ate(inputs.poses, inputs.reference))
+    return block_of(AteBlock, ate(inputs.poses, inputs.reference, inputs.alignment, inputs.n_to_align))
 
 
 def headline(block: AteBlock) -> str:
-    return f"rmse {fmt(block.rmse_m)} m, max {fmt(block.max_m)} m ({block.alignment} alignment)"
+    n = block.alignment_transform.n_to_align
+    on = f" on the first {n} pairs" if n is not None else ""
+    return f"rmse {fmt(block.rmse_m)} m, max {fmt(block.max_m)} m ({block.alignment} alignment{on})"
 
 
 METRIC = Metric(

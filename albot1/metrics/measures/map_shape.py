@@ -12,11 +12,12 @@ import numpy as np
 from albot1.data.transforms import head
 from albot1.errors import Albot1Error
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.metrics.alignment import describe, rigid_transform
 from albot1.metrics.blocks import AlignmentTransform, block_of, fmt
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.map_shape import map_agreement
-from albot1.metrics.unit import MAP, REFERENCE, ColumnSpec, FloatArray, Metric, MetricInputs
+from albot1.metrics.unit import MAP, REFERENCE, ColumnSpec, Metric, MetricInputs
 from albot1.records import Record
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.metrics.alignment import alignment_transform
 from albot1.metrics.errors import MetricsError
 from albot1.report.plots import (
@@ -35,7 +36,6 @@ from albot1.report.plots import (
 from albot1.report.thesis.replay import Replay
 from albot1.runs.folder import StoredRun
 
-FloatArray = NDArray[np.float64]
 #: Panels of the update trace at most (Figure 3.17 shows 24 maps in four parts); the strip shows every update.
 MAX_TRACE_PANELS = 24
 #: Frames of the animation at most, and the largest GIF written (bytes): the report folder stays light.

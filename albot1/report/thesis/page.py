@@ -98,7 +98,8 @@ class _Figures:
 
     def draw(self, request: FigureRequest) -> list[Drawn]:
         try:
-            return getattr(self, f"_{request.kind.replace('-', '_')}")(request)
+            drawn: list[Drawn] = getattr(self, f"_{request.kind.replace('-', '_')}")(request)
+            return drawn
         except (Albot1Error, OSError, ValueError) as exc:  # one figure's failure never stops the page
             return [Drawn(request.caption, None, f"{type(exc).__name__}: {exc}")]
 

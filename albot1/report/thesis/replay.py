@@ -20,12 +20,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.data.degrade import degrade
 from albot1.data.open import open_sequence
 from albot1.errors import Albot1Error
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
@@ -33,7 +33,6 @@ from albot1.report.errors import ReportError
 from albot1.runs.folder import StoredRun, read_run
 from albot1.settings import Settings
 
-FloatArray = NDArray[np.float64]
 #: Largest position difference (m) between the replayed and the stored trajectory (TUM files hold 1e-9 m digits).
 POSITION_TOLERANCE_M = 1e-6
 

@@ -7,7 +7,7 @@ import pytest
 from albot1.bench.plan import plan_suite
 from albot1.bench.suite import find_suite, load_suite
 from albot1.data import catalog
-from albot1.methods.registry import METHODS, load_mapper_class
+from albot1.methods.registry import load_mapper_class, method_registry
 from albot1.report.tuning import dataset_name, tuned_datasets
 from albot1.settings import get_settings
 
@@ -30,7 +30,7 @@ def test_no_method_of_the_suite_but_gtsam_graph_is_tuned_on_its_logs() -> None:
     """gtsam-graph's tracker gating (issue 21) was chosen on them: its rows there carry the held-in mark."""
     suite = load_suite(find_suite("generalisation"))
     for entry in suite.methods:
-        load_mapper_class(METHODS[entry.name].target)  # every entry names a registered method
+        load_mapper_class(method_registry().get(entry.name).target)  # every entry names a registered method
         tuned = tuned_datasets(entry.name, entry.preset)
         assert tuned is not None
         assert (HELD_OUT <= set(tuned)) if entry.name == "gtsam-graph" else not HELD_OUT & set(tuned), entry.display

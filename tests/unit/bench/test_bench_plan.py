@@ -11,16 +11,18 @@ from albot1.bench.errors import SuiteError
 from albot1.bench.grid import GridPlan
 from albot1.bench.plan import plan_suite
 from albot1.bench.suite import load_suite
-from albot1.methods.registry import METHODS
+from albot1.methods.registry import MethodRegistry, method_registry
 from albot1.settings import Settings
 
 WORLD = "synthetic-office-startstop"
 
 
-def _plan(tmp_path: Path, datasets: str, grid: str = "") -> tuple[Path, GridPlan]:
+def _plan(
+    tmp_path: Path, datasets: str, grid: str = "", registry: MethodRegistry | None = None
+) -> tuple[Path, GridPlan]:
     path = tmp_path / "tiny.toml"
     path.write_text(f'{grid}\n[[methods]]\nname = "odometry"\n\n[[datasets]]\nname = "{WORLD}"\n{datasets}')
-    return path, plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    return path, plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"), registry)
 
 
 def test_a_literal_dataset_that_names_nothing_is_an_error_naming_suite_and_entry(tmp_path: Path) -> None:
@@ -55,13 +57,12 @@ def test_deterministic_degradations_run_once_and_random_ones_once_per_seed(tmp_p
     )
 
 
-def test_a_stochastic_method_keeps_every_seed_under_a_deterministic_degradation(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_a_stochastic_method_keeps_every_seed_under_a_deterministic_degradation(tmp_path: Path) -> None:
     """A particle filter varies with its seed even on clean odometry: its seeds are not collapsed."""
-    monkeypatch.setitem(METHODS, "odometry", replace(METHODS["odometry"], stochastic=True))
+    registry = method_registry()
+    stochastic = registry.with_methods(replace(registry.get("odometry"), stochastic=True))
     grid = '[grid]\ndegradations = ["thesis"]\nseeds = [3, 4]\nundegraded_seeds = [7, 8]\n'
-    _, plan = _plan(tmp_path, "sweep = true\n", grid)
+    _, plan = _plan(tmp_path, "sweep = true\n", grid, stochastic)
     runs = sorted((c.degradation, c.seed) for c in plan.cells)
     assert runs == sorted([("none", 7), ("none", 8), ("thesis", 3), ("thesis", 4)])
 

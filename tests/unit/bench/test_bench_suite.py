@@ -79,7 +79,6 @@ def test_method_labels_include_non_default_presets_and_must_be_unique() -> None:
             'methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n[grid]\ndegradations = ["gauss:1"]\n',
             r"grid\.degradations.*gauss:SIGMA_XY_M",
         ),
-        ('methods = [{name = "odometry", target = "nocolon"}]\ndatasets = [{name = "*"}]\n', r"module:Class"),
         ('methods = [{name = "odometry"}]\nx = = 1\n', r"s\.toml: not valid TOML.*line 2"),
     ],
 )
@@ -209,3 +208,18 @@ def test_a_suite_file_that_is_not_utf8_text_is_one_error(tmp_path: Path) -> None
 def test_a_suite_cannot_set_its_own_path() -> None:
     with pytest.raises(SuiteError, match="path: unknown key"):
         parse_suite({**MINIMAL, "path": "/elsewhere"}, name="s", source="s.toml")
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("target", '"this:x"'), ("requires", '["this.x"]'), ("error_class", '"os:system"'), ("target", '"nocolon"')],
+)
+def test_a_suite_cannot_name_code_to_import(tmp_path: Path, key: str, value: str) -> None:
+    """``target`` / ``requires`` / ``error_class`` are refused with one line, before anything is imported."""
+    text = f'[[methods]]\nname = "odometry"\n\n[[methods]]\nname = "mine"\n{key} = {value}\n[[datasets]]\nname = "*"\n'
+    with pytest.raises(SuiteError) as caught:
+        load_suite(write(tmp_path, text))
+    message = str(caught.value)
+    assert "\n" not in message
+    assert message.startswith(f"{tmp_path / 's.toml'}: invalid suite: ")
+    assert f"methods.1 ('mine'): `{key}` is not read" in message and "entry point group albot1.methods" in message

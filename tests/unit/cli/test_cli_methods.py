@@ -7,7 +7,7 @@ import json
 from typer.testing import CliRunner
 
 from albot1.cli.app import app
-from albot1.methods.registry import METHODS
+from albot1.methods.registry import method_registry
 
 runner = CliRunner()
 
@@ -16,7 +16,7 @@ def test_plain_listing_is_one_line_per_method() -> None:
     result = runner.invoke(app, ["methods"])
     assert result.exit_code == 0, result.output
     lines = result.output.splitlines()
-    assert [line.split()[0] for line in lines] == list(METHODS)
+    assert [line.split()[0] for line in lines] == method_registry().names()
     assert lines[1].startswith("albot1       available    the Albot1 perceptual mapper")
 
 
@@ -26,7 +26,7 @@ def test_presets_table_of_one_method() -> None:
     lines = result.output.splitlines()
     assert lines[0] == "albot1: the Albot1 perceptual mapper (thesis chapter 3)"
     assert "environment prefix ALBOT1_ALBOT1_" in lines[1]
-    assert lines[2].startswith("  presets file ") and lines[2].endswith("albot1/methods/albot1/presets.toml")
+    assert lines[2].startswith("  presets file ") and lines[2].endswith("baselines/albot1.toml")
     header = next(line for line in lines if line.lstrip().startswith("field"))
     assert header.split() == ["field", "unit", "type", "default", "meaning"]
     row = next(line for line in lines if line.strip().startswith("corner_min_angle_deg"))
@@ -50,7 +50,7 @@ def test_presets_json_of_every_method() -> None:
     result = runner.invoke(app, ["methods", "--presets", "--json"])
     assert result.exit_code == 0, result.output
     records = {record["name"]: record for record in json.loads(result.output)["methods"]}
-    assert list(records) == list(METHODS)
+    assert list(records) == method_registry().names()
     albot1 = records["albot1"]
     assert albot1["config_model"] == "albot1.methods.albot1.mapping.config.Albot1Config"
     assert albot1["presets"] == {
@@ -84,7 +84,7 @@ def test_json_without_presets_has_no_fields() -> None:
         "name": "odometry",
         "available": True,
         "requires": [],
-        "description": METHODS["odometry"].description,
+        "description": method_registry().get("odometry").description,
         "env_prefix": "ALBOT1_ODOMETRY_",
     }
 

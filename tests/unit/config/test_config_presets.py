@@ -1,4 +1,4 @@
-"""Presets read from TOML (albot1.config.presets): baselines/<method>.toml and a package's presets.toml."""
+"""Presets read from TOML (albot1.config.presets): baselines/<method>.toml for every method, `extends`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import Any, ClassVar
 import pytest
 from pydantic import BaseModel, ConfigDict, Field
 
-from albot1.config.presets import TomlPresets, load_package_presets, load_presets, parse_presets, preset_file
+from albot1.config.presets import TomlPresets, load_presets, parse_presets, preset_file, preset_names
 from albot1.errors import ConfigError
 from albot1.methods.baselines.kiss_icp import KissIcpConfig, KissIcpMapper
 from albot1.methods.registry import resolve_config
@@ -63,7 +63,7 @@ def test_descriptor_reads_the_file_named_after_the_class(monkeypatch: pytest.Mon
     class Toy:
         name: ClassVar[str] = "toy"
         config_model: ClassVar[type[BaseModel]] = _Model
-        presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+        presets = TomlPresets()
 
     assert Toy.presets == {"default": {"size": 0.5, "count": 3}, "more": {"size": 0.5, "count": 9}}
     assert Toy.presets is Toy.presets  # read once
@@ -97,35 +97,51 @@ def test_kiss_icp_precedence_preset_env_override(monkeypatch: pytest.MonkeyPatch
         resolve_config("kiss-icp", overrides={"voxel_size_m": "-1"})
 
 
-def _package(tmp_path: Any, monkeypatch: pytest.MonkeyPatch, name: str, presets: str | None) -> None:
-    folder = tmp_path / name
-    folder.mkdir()
-    (folder / "__init__.py").write_text("")
-    if presets is not None:
-        (folder / "presets.toml").write_text(presets)
-    monkeypatch.syspath_prepend(str(tmp_path))
+class _Wide(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    size: float = Field(1.0, gt=0)
+    count: int = 1
+    extra_m: float = Field(1.0, gt=0)
 
 
-def test_package_presets_use_the_same_mechanism(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
-    _package(
-        tmp_path, monkeypatch, "toy_presets_pkg", "[presets.default]\nsize = 0.5\ncount = 3\n[presets.x]\nsize = 2.0\n"
-    )
-
-    class Toy:
-        name: ClassVar[str] = "toy"
-        config_model: ClassVar[type[BaseModel]] = _Model
-        presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets(package="toy_presets_pkg")  # type: ignore[assignment]
-
-    assert Toy.presets == {"default": {"size": 0.5, "count": 3}, "x": {"size": 2.0, "count": 3}}
-    assert Toy.__dict__["presets"].location(Toy) == str(tmp_path / "toy_presets_pkg" / "presets.toml")
+def _config_dir(tmp_path: Any, monkeypatch: pytest.MonkeyPatch, files: dict[str, str]) -> None:
+    (tmp_path / "baselines").mkdir(exist_ok=True)
+    for name, text in files.items():
+        (tmp_path / "baselines" / f"{name}.toml").write_text(text)
+    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path))
 
 
-def test_package_presets_errors_name_the_file(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
-    _package(tmp_path, monkeypatch, "toy_bad_pkg", "[presets.default]\nsize = 0.5\n")
-    _package(tmp_path, monkeypatch, "toy_empty_pkg", None)
-    with pytest.raises(ConfigError, match=r"toy_bad_pkg/presets.toml: \[presets.default\] must set every field"):
-        load_package_presets("toy_bad_pkg", _Model)
-    with pytest.raises(
-        ConfigError, match=r"toy_empty_pkg/presets.toml: the presets of package toy_empty_pkg are missing"
-    ):
-        load_package_presets("toy_empty_pkg", _Model)
+BASE = "[presets.default]\nsize = 0.5\ncount = 3\n[presets.x]\nsize = 2.0\n"
+
+
+def test_a_method_extends_another_methods_presets(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
+    """Every base preset is an extending preset with the extending file's values on top (albot1-places)."""
+    own = 'extends = "base"\n[presets.default]\nextra_m = 0.2\n[presets.x]\nextra_m = 0.7\n[presets.own]\ncount = 8\n'
+    _config_dir(tmp_path, monkeypatch, {"base": BASE, "wide": own})
+    assert load_presets("wide", _Wide) == {
+        "default": {"size": 0.5, "count": 3, "extra_m": 0.2},
+        "x": {"size": 2.0, "count": 3, "extra_m": 0.7},
+        "own": {"size": 0.5, "count": 8, "extra_m": 0.2},
+    }
+    assert preset_names("wide") == ["default", "x", "own"]
+
+
+def test_extends_errors_name_the_files(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
+    _config_dir(tmp_path, monkeypatch, {"base": BASE, "wide": 'extends = "base"\n[presets.default]\nextra_m = -1\n'})
+    with pytest.raises(ConfigError, match=r"base.toml \+ .*wide.toml: preset 'default' is not a valid _Wide.*extra_m"):
+        load_presets("wide", _Wide)
+    _config_dir(tmp_path, monkeypatch, {"a": 'extends = "b"\n' + BASE, "b": 'extends = "a"\n' + BASE})
+    with pytest.raises(ConfigError, match=r"presets of a -> b -> a: `extends` goes round in a circle"):
+        load_presets("a", _Model)
+    _config_dir(tmp_path, monkeypatch, {"c": "extends = 3\n" + BASE})
+    with pytest.raises(ConfigError, match=r"c.toml: extends must name a method"):
+        load_presets("c", _Model)
+
+
+def test_every_method_reads_its_presets_from_one_folder() -> None:
+    """One place, one rule: baselines/<method>.toml for every built-in method (Albot1 included)."""
+    from albot1.methods.registry import BUILTIN_METHODS
+
+    for spec in BUILTIN_METHODS:
+        assert preset_file(spec.name).name == f"{spec.name}.toml"
+        assert preset_file(spec.name).parent.name == "baselines"

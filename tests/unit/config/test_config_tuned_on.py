@@ -11,7 +11,7 @@ from albot1.config.presets import parse_presets, parse_tuned_on, tuned_on, tuned
 from albot1.data import catalog
 from albot1.data.synthetic import worlds
 from albot1.errors import ConfigError
-from albot1.methods.registry import METHODS, load_mapper_class
+from albot1.methods.registry import load_mapper_class, method_registry
 
 
 class _Model(BaseModel):
@@ -50,7 +50,7 @@ def test_a_bad_tuned_on_table_is_an_error_of_the_file(tuned: Any, message: str) 
 
 def test_every_registered_method_records_its_held_in_datasets_by_catalog_name() -> None:
     known = set(catalog.names()) | set(worlds.WORLDS)
-    for name, spec in METHODS.items():
+    for name, spec in method_registry().specs.items():
         cls = load_mapper_class(spec.target)
         table = tuned_on_table(cls)
         assert table is not None, f"{name}: its preset file has no [tuned_on] table"
@@ -63,16 +63,16 @@ def test_every_registered_method_records_its_held_in_datasets_by_catalog_name() 
 
 def test_what_the_issue_says_each_baseline_was_tuned_on_is_recorded() -> None:
     """The logs named in the comments of the preset files and docs/baselines.md (issue 21)."""
-    graph = load_mapper_class(METHODS["gtsam-graph"].target)
+    graph = load_mapper_class(method_registry().get("gtsam-graph").target)
     assert {"aces", "mit-csail", "fr-clinic", "intel-corrected"} <= set(tuned_on(graph, "default") or ())
     suite_logs = {"seattle-corrected", "edmonton-corrected", "belgioioso-corrected", "fhw-corrected"}
     # gtsam-graph's tracker gating (issue 21) was chosen by its scores on the generalisation suite's logs
     assert suite_logs <= set(tuned_on(graph, "default") or ())
-    for name, spec in METHODS.items():
+    for name, spec in method_registry().specs.items():
         if name != "gtsam-graph":
             tuned = set(tuned_on(load_mapper_class(spec.target), "default") or ())
             assert not suite_logs & tuned, f"{name} is tuned on {sorted(suite_logs & tuned)}"
-    places = load_mapper_class(METHODS["albot1-places"].target)
-    albot1 = load_mapper_class(METHODS["albot1"].target)
+    places = load_mapper_class(method_registry().get("albot1-places").target)
+    albot1 = load_mapper_class(method_registry().get("albot1").target)
     plus = tuned_on(places, "plus") or ()
     assert set(tuned_on(albot1, "plus") or ()) < set(plus) and "synthetic-places-loop" in plus

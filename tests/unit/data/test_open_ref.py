@@ -30,12 +30,15 @@ def test_slice_of_a_world() -> None:
 
 
 def test_world_rejects_loader_options() -> None:
-    with pytest.raises(DatasetNotFoundError, match="unknown loader option.s. odometry; expected start or laps"):
+    with pytest.raises(DatasetNotFoundError, match="unknown loader option.s. laps2; expected start or laps"):
+        open_sequence("synthetic-office-startstop?laps2=1")
+    # odometry is an option of every dataset, with the values its source has: a world's is `reference` only
+    with pytest.raises(DatasetNotFoundError, match="odometry='laser-pose'; a synthetic world takes odometry=reference"):
         open_sequence("synthetic-office-startstop?odometry=laser-pose")
 
 
-def test_unknown_name_lists_known_ones() -> None:
-    with pytest.raises(DatasetNotFoundError, match="synthetic-office-loop"):
+def test_unknown_name_points_to_the_listing() -> None:
+    with pytest.raises(DatasetNotFoundError, match=r"'no-such-dataset' is neither .*`albot1 datasets list` lists all"):
         open_sequence("no-such-dataset")
 
 

@@ -43,6 +43,28 @@ def test_steps_round_trip() -> None:
     np.testing.assert_allclose(rebuilt, poses, atol=1e-12)
 
 
+def test_integrate_steps_equals_composing_step_by_step() -> None:
+    rng = np.random.default_rng(9)
+    steps = np.column_stack([rng.normal(0.3, 0.2, 300), rng.normal(0, 0.1, 300), rng.normal(0, 0.5, 300)])
+    start = np.array([3.0, -1.0, 2.5])
+    composed = [start]
+    for step in steps:
+        composed.append(se2.compose(composed[-1], step))
+    got = se2.integrate_steps(start, steps)
+    assert got.shape == (301, 3)
+    np.testing.assert_allclose(got, np.array(composed), atol=1e-9)
+    np.testing.assert_array_equal(se2.integrate_steps(start, np.empty((0, 3))), start[None, :])
+
+
+def test_interpolate_is_interpolate_unwrapped_of_the_unwrapped_track() -> None:
+    t = np.array([0.0, 1.0, 2.5, 4.0])
+    poses = np.array([[0.0, 0.0, 3.0], [1.0, 2.0, -3.0], [2.0, 2.0, 2.9], [0.5, 1.0, -0.2]])
+    query = np.array([0.3, 1.0, 1.7, 3.9])
+    unwrapped = se2.unwrap_headings(poses)
+    assert np.all(np.abs(np.diff(unwrapped[:, 2])) <= math.pi)
+    assert np.array_equal(se2.interpolate(t, poses, query), se2.interpolate_unwrapped(t, unwrapped, query))
+
+
 def test_interpolate_across_the_angle_seam() -> None:
     t = np.array([0.0, 1.0])
     poses = np.array([[0.0, 0.0, math.pi - 0.1], [2.0, 0.0, -math.pi + 0.1]])

@@ -15,9 +15,10 @@ from albot1.methods import registry
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.errors import UnknownMethodError
 from albot1.methods.registry import (
-    METHODS,
+    MethodRegistry,
     MethodSpec,
     load_mapper_class,
+    method_registry,
     parse_overrides,
     resolve_config,
     resolve_method_config,
@@ -51,7 +52,7 @@ def _clean_environment(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def test_every_registered_method_has_toml_presets_with_a_complete_default() -> None:
-    for spec in METHODS.values():
+    for spec in method_registry():
         if not spec.available():
             continue
         cls = spec.load_class()
@@ -89,12 +90,12 @@ def test_nested_method_prefixes(monkeypatch: pytest.MonkeyPatch) -> None:
     assert resolve_config("albot1") == resolve_config("albot1", "default", {})
     with pytest.raises(UnknownEnvironmentVariableError, match="ALBOT1_ALBOT1_PLACES_RADIUS_M names no config field"):
         resolve_config("albot1-places")
-    monkeypatch.setitem(METHODS, "albot1-places", MethodSpec("albot1-places", f"{__name__}:PlacesMapper"))
-    assert resolve_config("albot1") == resolve_config("albot1", "default", {})
-    assert resolve_config("albot1-places") == PlacesConfig(radius_m=2.5)
+    stand_in = method_registry().with_methods(MethodSpec("albot1-places", f"{__name__}:PlacesMapper"))
+    assert resolve_config("albot1", registry=stand_in) == resolve_config("albot1", "default", {})
+    assert resolve_config("albot1-places", registry=stand_in) == PlacesConfig(radius_m=2.5)
     monkeypatch.setenv("ALBOT1_ALBOT1_MAX_RANGE_M", "12")
-    assert resolve_config("albot1").max_range_m == 12.0  # type: ignore[attr-defined]
-    assert resolve_config("albot1-places") == PlacesConfig(radius_m=2.5)
+    assert resolve_config("albot1", registry=stand_in).max_range_m == 12.0  # type: ignore[attr-defined]
+    assert resolve_config("albot1-places", registry=stand_in) == PlacesConfig(radius_m=2.5)
 
 
 def test_set_wins_over_env_wins_over_preset(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -132,3 +133,27 @@ def test_unknown_method_is_a_config_error() -> None:
     with pytest.raises(UnknownMethodError, match="unknown method 'nope'; expected one of: odometry, albot1"):
         registry.get_method("nope")
     assert issubclass(UnknownMethodError, ConfigError)
+
+
+@pytest.mark.parametrize(
+    ("typed", "suggested"),
+    [("kiss_icp", "kiss-icp"), ("KISS-ICP", "kiss-icp"), ("gtsam_grap", "gtsam-graph"), ("albot", "albot1")],
+)
+def test_unknown_method_suggests_the_closest(typed: str, suggested: str) -> None:
+    with pytest.raises(UnknownMethodError, match=rf"unknown method '{typed}' \(did you mean '{suggested}'"):
+        registry.get_method(typed)
+
+
+def test_the_registry_is_immutable_and_one_object_per_process() -> None:
+    built = method_registry()
+    assert method_registry() is built
+    with pytest.raises(TypeError):
+        built.specs["x"] = MethodSpec("x", f"{__name__}:PlacesMapper")  # type: ignore[index]
+    bigger = built.with_methods(MethodSpec("x", f"{__name__}:PlacesMapper"))
+    assert "x" in bigger and "x" not in built and len(bigger) == len(built) + 1
+
+
+def test_a_name_registered_twice_is_refused() -> None:
+    spec = MethodSpec("x", f"{__name__}:PlacesMapper")
+    with pytest.raises(UnknownMethodError, match="method 'x' is registered twice"):
+        MethodRegistry.of([spec, spec])

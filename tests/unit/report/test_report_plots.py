@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,17 @@ from albot1.metrics.record import MetricsRecord
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, severity_order
 from albot1.report.cost_plots import plot_scan_time
 from albot1.report.map_plots import occupancy, plot_maps
-from albot1.report.plots import Extent, log_floor, method_colors, panel_layout, representative, slug
+from albot1.report.plots import (
+    FIXED_COLORS,
+    PALETTE,
+    SLUG_CHARS,
+    Extent,
+    log_floor,
+    method_colors,
+    panel_layout,
+    representative,
+    slug,
+)
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes, segment_error_sets
 from albot1.report.tables import aggregate, cells_frame
@@ -34,8 +45,19 @@ def test_severity_order_puts_none_first_then_gaussian_by_sigma_then_thesis() -> 
 
 
 def test_slug_makes_dataset_labels_file_safe() -> None:
-    assert slug("aces[:2500:2]") == "aces_2500_2"
-    assert slug("/data/my log.clf") == "data_my_log.clf"
+    assert slug("aces") == "aces" and slug("synthetic-office-loop") == "synthetic-office-loop"
+    assert re.fullmatch(r"aces_2500_2-h[0-9a-f]{10}", slug("aces[:2500:2]"))
+    assert re.fullmatch(r"data_my_log.clf-h[0-9a-f]{10}", slug("/data/my log.clf"))
+
+
+def test_slugs_are_unique_and_short_for_every_label() -> None:
+    labels = ["büro", "båro", "b_ro", "b ro", "aces[:2500:2]", "aces_2500_2", "/x/" + "a" * 290 + ".clf", ".", "..", ""]
+    labels.append(slug("aces[:2500:2]"))  # a label that looks like a hashed slug is hashed too
+    slugs = [slug(label) for label in labels]
+    assert len(set(slugs)) == len(labels)
+    for name in slugs:
+        assert len(name) <= SLUG_CHARS + 12 and re.fullmatch(r"[A-Za-z0-9_.-]+", name)
+        assert not name.startswith(".")
 
 
 def _cell(method: str, degradation: str, seed: int, dataset: str = "w") -> Cell:
@@ -72,11 +94,14 @@ def test_representative_run_is_the_undegraded_lowest_seed_that_completed() -> No
     assert (chosen["b"].cell.degradation, chosen["b"].cell.seed) == ("gauss:0.1:1", 1)
 
 
-def test_one_colour_per_method_fixed_by_plan_order_whatever_failed() -> None:
+def test_one_colour_per_method_name_whatever_else_the_report_holds() -> None:
     colors = method_colors(["odometry", "albot1", "odometry", "kiss-icp"])
-    assert list(colors) == ["odometry", "albot1", "kiss-icp"]
-    assert len(set(colors.values())) == 3
-    assert method_colors(["odometry", "albot1"])["albot1"] == colors["albot1"]
+    assert colors == {"odometry": "#7f7f7f", "albot1": "#1f77b4", "kiss-icp": "#ff7f0e"}
+    assert method_colors(["kiss-icp"])["kiss-icp"] == "#ff7f0e"  # not from its place among the others
+    assert len(set(FIXED_COLORS.values())) == len(FIXED_COLORS)
+    other = method_colors(["cartographer (external)"])["cartographer (external)"]
+    assert other in PALETTE
+    assert method_colors(["albot1", "cartographer (external)", "x"])["cartographer (external)"] == other
 
 
 def test_panels_follow_the_data_aspect_ratio() -> None:

@@ -10,7 +10,7 @@ from albot1.report.tables import LEGEND, markdown
 from albot1.report.tuning import MARK, dataset_name, held_in, marked, tuned_datasets
 
 
-def _cell(dataset: str, method: str, preset: str = "default", target: str | None = None) -> Cell:
+def _cell(dataset: str, method: str, preset: str = "default") -> Cell:
     return Cell(
         suite="t",
         dataset=dataset,
@@ -24,7 +24,6 @@ def _cell(dataset: str, method: str, preset: str = "default", target: str | None
         code_version="v",
         time_s=1.0,
         memory_mb=1.0,
-        target=target,
     )
 
 

@@ -16,7 +16,7 @@ from albot1.data.model import Frame, Scan, Sequence
 from albot1.errors import ConfigError
 from albot1.methods import registry as methods
 from albot1.methods.baselines.errors import BaselineError
-from albot1.methods.registry import MethodSpec, parse_overrides, resolve_config
+from albot1.methods.registry import MethodRegistry, MethodSpec, parse_overrides, resolve_config
 from albot1.runs.errors import RunError, UnknownMethodError
 from albot1.runs.execute import run_method
 
@@ -81,27 +81,30 @@ class FakeMapper:
         return MapperOutput(poses=poses, map=MapData(points=np.zeros((1, 2))), counters=counters)
 
 
+FAKE = "fake"
+
+
 @pytest.fixture
-def fake_method(monkeypatch: pytest.MonkeyPatch) -> str:
-    monkeypatch.setitem(methods.METHODS, "fake", MethodSpec("fake", f"{__name__}:FakeMapper"))
-    return "fake"
+def fake_method() -> MethodRegistry:
+    """The process's registry plus the fake method (a new registry: the process's stays as it was)."""
+    return methods.method_registry().with_methods(MethodSpec(FAKE, f"{__name__}:FakeMapper"))
 
 
-def test_config_precedence(fake_method: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    assert resolve_config(fake_method).gain == 1.0
-    assert resolve_config(fake_method, "double").gain == 2.0
+def test_config_precedence(fake_method: MethodRegistry, monkeypatch: pytest.MonkeyPatch) -> None:
+    assert resolve_config(FAKE, registry=fake_method).gain == 1.0
+    assert resolve_config(FAKE, "double", registry=fake_method).gain == 2.0
     monkeypatch.setenv("ALBOT1_FAKE_GAIN", "3.5")
-    assert resolve_config(fake_method, "double").gain == 3.5
-    assert resolve_config(fake_method, "double", {"gain": "4"}).gain == 4.0
+    assert resolve_config(FAKE, "double", registry=fake_method).gain == 3.5
+    assert resolve_config(FAKE, "double", {"gain": "4"}, registry=fake_method).gain == 4.0
 
 
-def test_config_errors_say_what_was_expected(fake_method: str) -> None:
+def test_config_errors_say_what_was_expected(fake_method: MethodRegistry) -> None:
     with pytest.raises(ConfigError, match="no preset 'nope'; expected one of: default, double"):
-        resolve_config(fake_method, "nope")
+        resolve_config(FAKE, "nope", registry=fake_method)
     with pytest.raises(ConfigError, match="gain"):
-        resolve_config(fake_method, overrides={"gain": "abc"})
+        resolve_config(FAKE, overrides={"gain": "abc"}, registry=fake_method)
     with pytest.raises(ConfigError, match="unknown|extra|not permitted"):
-        resolve_config(fake_method, overrides={"typo": 1})
+        resolve_config(FAKE, overrides={"typo": 1}, registry=fake_method)
     with pytest.raises(ConfigError, match="FIELD=VALUE"):
         parse_overrides(["gain"])
 
@@ -111,16 +114,15 @@ def test_unknown_method() -> None:
         methods.get_method("nope")
 
 
-def test_missing_dependency_is_named(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_missing_dependency_is_named() -> None:
     spec = MethodSpec("ghost", "x:Y", requires=("no_such_module_xyz",))
-    monkeypatch.setitem(methods.METHODS, "ghost", spec)
     assert not spec.available()
     with pytest.raises(UnknownMethodError, match="no_such_module_xyz"):
         spec.load_class()
 
 
-def test_successful_run_records_everything(fake_method: str) -> None:
-    result = run_method(fake_method, _sequence(), degradation="gauss:0.1:1", seed=4)
+def test_successful_run_records_everything(fake_method: MethodRegistry) -> None:
+    result = run_method(FAKE, _sequence(), degradation="gauss:0.1:1", seed=4, registry=fake_method)
     assert result.poses.shape == (6, 3) and result.per_scan_ns.shape == (6,)
     assert result.reference is not None and result.reference.shape == (6, 3)
     assert result.config == {"mode": "ok", "gain": 1.0}
@@ -132,19 +134,19 @@ def test_successful_run_records_everything(fake_method: str) -> None:
     assert cpu_s is not None and 0.0 <= cpu_s
 
 
-def test_the_warm_up_runs_before_the_timed_loop_and_is_recorded_as_startup(fake_method: str) -> None:
+def test_the_warm_up_runs_before_the_timed_loop_and_is_recorded_as_startup(fake_method: MethodRegistry) -> None:
     said: list[str] = []
-    result = run_method(fake_method, _sequence(), overrides={"mode": "warm"}, announce=said.append)
+    result = run_method(FAKE, _sequence(), overrides={"mode": "warm"}, announce=said.append, registry=fake_method)
     timing = result.timing()
     assert said == ["fake: warmed up"]
     assert timing.startup_s is not None and timing.startup_s >= 0.2  # it slept 0.2 s
     assert timing.total_s == float(result.per_scan_ns.sum()) / 1e9 + timing.finish_s  # start-up is not scan time
     assert timing.wall_s >= timing.startup_s
-    assert run_method(fake_method, _sequence()).timing().startup_s is not None
+    assert run_method(FAKE, _sequence(), registry=fake_method).timing().startup_s is not None
 
 
-def test_the_cpu_time_counts_the_external_program_the_method_waited_for(fake_method: str) -> None:
-    cpu_s = run_method(fake_method, _sequence(), overrides={"mode": "child"}).timing().cpu_s
+def test_the_cpu_time_counts_the_external_program_the_method_waited_for(fake_method: MethodRegistry) -> None:
+    cpu_s = run_method(FAKE, _sequence(), overrides={"mode": "child"}, registry=fake_method).timing().cpu_s
     assert cpu_s is not None and cpu_s >= 0.3  # the child burnt 0.3 s of CPU; this process waited, idle
 
 
@@ -157,6 +159,6 @@ def test_the_cpu_time_counts_the_external_program_the_method_waited_for(fake_met
         ("nocount", RunError, r"counters lack the required key 'updates'"),
     ],
 )
-def test_contract_violations(fake_method: str, mode: str, error: type[Exception], match: str) -> None:
+def test_contract_violations(fake_method: MethodRegistry, mode: str, error: type[Exception], match: str) -> None:
     with pytest.raises(error, match=match):
-        run_method(fake_method, _sequence(), overrides={"mode": mode})
+        run_method(FAKE, _sequence(), overrides={"mode": mode}, registry=fake_method)

@@ -16,7 +16,7 @@ import pytest
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.data.open import open_sequence
-from albot1.methods.registry import METHODS, MethodSpec
+from albot1.methods.registry import MethodSpec, method_registry
 from albot1.runs import execute
 
 WORLD = "synthetic-office-startstop[:25]"
@@ -87,17 +87,17 @@ def trap(monkeypatch: pytest.MonkeyPatch) -> list[Frame]:
     monkeypatch.setattr(Frame, "reference", _Trap(Frame.__dict__["reference"]))
     real = execute.get_method
 
-    def get_method(name: str) -> Any:
-        spec = real(name)
+    def get_method(name: str, registry: Any = None) -> Any:
+        spec = real(name, registry)
         return _Spec(spec, _trapped(spec.load_class(), seen))
 
     monkeypatch.setattr(execute, "get_method", get_method)
     return seen
 
 
-@pytest.mark.parametrize("method", list(METHODS))
+@pytest.mark.parametrize("method", method_registry().names())
 def test_every_method_runs_without_ever_reading_ground_truth(method: str, trap: list[Frame]) -> None:
-    spec = METHODS[method]
+    spec = method_registry().get(method)
     if not spec.available():
         pytest.skip(f"{method} unavailable: {spec.unavailable_reason()}")
     sequence = open_sequence(WORLD)
@@ -121,8 +121,8 @@ class _Cheat:
 
 
 def test_a_mapper_that_reads_ground_truth_fails_loudly(trap: list[Frame], monkeypatch: pytest.MonkeyPatch) -> None:
-    spec = METHODS["odometry"]
-    monkeypatch.setattr(execute, "get_method", lambda name: _Spec(spec, _trapped(_Cheat, trap)))
+    spec = method_registry().get("odometry")
+    monkeypatch.setattr(execute, "get_method", lambda name, registry=None: _Spec(spec, _trapped(_Cheat, trap)))
     with pytest.raises(Exception, match=r"odometry on synthetic-office-startstop.* failed at scan 0: GroundTruthAccess"):
         execute.run_method("odometry", open_sequence(WORLD), seed=0)
 

@@ -24,7 +24,7 @@ from albot1.data.synthetic.lidar import cast_many
 from albot1.data.synthetic.worlds import world_data
 from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.geometry import se2
-from albot1.methods.registry import METHODS
+from albot1.methods.registry import method_registry
 from albot1.metrics.ate import ate
 from albot1.runs.execute import run_method
 
@@ -55,7 +55,7 @@ def _world(offset: tuple[float, float, float]) -> Sequence:
 
 
 def _available() -> list[str]:
-    return [name for name, spec in METHODS.items() if spec.unavailable_reason() is None]
+    return [spec.name for spec in method_registry() if spec.unavailable_reason() is None]
 
 
 def test_sensor_frame_moves_odometry_and_reference_onto_the_laser_and_back() -> None:

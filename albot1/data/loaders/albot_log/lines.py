@@ -17,9 +17,10 @@ from typing import Any
 import numpy as np
 
 from albot1.data.errors import ParseError, UnwritableError
-from albot1.data.loaders.rosbag.msg import even_spacing
-from albot1.data.model import FloatArray, Frame, Scan
+from albot1.data.loaders.beams import even_spacing
+from albot1.data.model import Frame, Scan
 from albot1.data.tokens import parse_floats
+from albot1.geometry.types import FloatArray
 
 MAGIC = "ALBOT1-LOG"
 VERSION = 1
@@ -253,7 +254,8 @@ def check_frame(frame: Frame) -> None:
 def view_line(frame: Frame) -> str:
     """One VIEW record (without newline) for a frame."""
     scan = frame.scan
-    rev_r, rev_a = scan.ranges[::-1], scan.angles[::-1]
-    points = np.column_stack([-rev_r * np.sin(rev_a), rev_r * np.cos(rev_a)])
+    # REP-103 points of every beam, reversed to the file's left-to-right order, turned into the thesis frame.
+    rep = scan.points(keep_missing=True)[::-1]
+    points = np.column_stack([-rep[:, 1], rep[:, 0]])
     ref = _fmt(frame.reference) if frame.reference is not None else "-"
     return f"VIEW {frame.index} {float(scan.timestamp)!r} {_fmt(frame.odometry)} {ref} {_fmt(points.ravel())}"

@@ -49,9 +49,11 @@ from albot1.data.loaders.albot_log.lines import (
     sensor_line,
     view_line,
 )
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
 from albot1.data.loaders.output import prepare_output, writing
-from albot1.data.model import FloatArray, Frame, Sequence, SequenceMetadata
+from albot1.data.model import Frame, Sequence, SequenceMetadata
+from albot1.geometry.types import FloatArray
 
 __all__ = ["AlbotLogLoader", "AlbotLogWriter"]
 
@@ -113,7 +115,10 @@ class AlbotLogLoader:
         path = Path(path)
         unknown = sorted(k for k, v in options.items() if v is not None)
         if unknown:
-            raise DataError(f"{path}: an albot log takes no loading options, got {', '.join(unknown)}")
+            raise DataError(
+                f"{path}: an albot log takes no loading options of its own, got {', '.join(unknown)}; "
+                f"expected only the options of every source: {', '.join(COMMON_OPTIONS)}"
+            )
         if not path.is_file():
             raise DataError(f"{path}: no such file")
         name, _ = read_header(path, _lines(path))

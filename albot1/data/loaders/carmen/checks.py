@@ -27,7 +27,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 #: More beams than this is not a planar laser but a corrupt count.
 MAX_BEAMS = 100_000

@@ -34,9 +34,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 #: SICK LMS 2xx maximum (8191 cm is its "no echo" code); used when a log states no maximum.
 DEFAULT_MAX_RANGE = 81.9

@@ -89,8 +89,10 @@ class PoseBuffer:
             lines = self.lines[exact]
             before = lines < line
             pick = exact[np.argmax(np.where(before, lines, -1))] if before.any() else exact[np.argmin(lines)]
-            return self.poses[pick].copy()
-        return se2.interpolate(self.times, self.poses, np.array([t]))[0]
+            stored: NDArray[np.float64] = self.poses[pick].copy()
+            return stored
+        blended: NDArray[np.float64] = se2.interpolate(self.times, self.poses, np.array([t]))[0]
+        return blended
 
     def trim(self, oldest_needed: float) -> None:
         """Drop poses older than the bracket of ``oldest_needed - tolerance``."""

@@ -16,7 +16,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 
 ODOMETRY_SOURCES = ("laser-pose", "odom", "odom-segments")
@@ -42,7 +44,7 @@ class CarmenOptions:
         if unknown:
             raise DataError(
                 f"{path}: unknown CARMEN loader option(s) {', '.join(unknown)}; "
-                f"expected some of {', '.join(sorted(known))}"
+                f"expected some of {', '.join(sorted(known) + list(COMMON_OPTIONS))}"
             )
         for key in ("max_range", "time_tolerance"):
             if options.get(key) is not None:
@@ -52,7 +54,10 @@ class CarmenOptions:
                     raise DataError(f"{path}: {key}={options[key]!r}; expected a number") from None
         opts = CarmenOptions(**options)
         if opts.odometry not in ODOMETRY_SOURCES:
-            raise DataError(f"{path}: odometry={opts.odometry!r}; expected one of {', '.join(ODOMETRY_SOURCES)}")
+            raise DataError(  # "reference" is taken by albot1.data.open before the loader runs
+                f"{path}: odometry={opts.odometry!r}{did_you_mean(opts.odometry, [*ODOMETRY_SOURCES, 'reference'])}; "
+                f"expected one of {', '.join(ODOMETRY_SOURCES)}, reference"
+            )
         if opts.reference not in REFERENCE_SOURCES:
             raise DataError(f"{path}: reference={opts.reference!r}; expected one of {', '.join(REFERENCE_SOURCES)}")
         if opts.laser is not None and opts.laser not in LASER_MESSAGES:

@@ -42,8 +42,7 @@ from numpy.typing import NDArray
 from albot1.data.errors import ParseError
 from albot1.data.loaders.carmen.checks import MAX_BEAMS, geometry_problem, ranges_problem
 from albot1.data.loaders.carmen.geometry import param_problem
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 OLD_LASERS = ("FLASER", "RLASER")
 NEW_LASERS = ("ROBOTLASER1", "RAWLASER1", "RAWLASER2", "RAWLASER3", "RAWLASER4")

@@ -10,7 +10,9 @@ What is read:
 * reference (optional): the ``nav_msgs/Odometry`` topic named by
   ``reference_topic`` (e.g. simulator ground truth), else ``/ground_truth``
   when present (the layout ``albot1 convert`` writes), interpolated the same
-  way. Topic choice rules live in :mod:`.rosbag_topics`.
+  way. Topic choice rules live in :mod:`.rosbag_topics`;
+* the laser's mount on the base (``metadata.sensor_offset``) from
+  ``/tf_static`` (else ``/tf``), a warning when absent: :mod:`.mounting`.
 
 A scan outside the odometry (or reference) time span is an error by default
 because extrapolating a pose would invent data; ``outside_odometry="drop"``
@@ -30,7 +32,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from albot1.data.errors import DataError, ParseError, TopicError
+from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.rosbag.bag1_check import version_problem
+from albot1.data.loaders.rosbag.mounting import bag_mounting
 from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, scan_arrays
 from albot1.data.loaders.rosbag.reader import header_stamp, odometry_track, opened_bag, tf_track, topic_messages
 from albot1.data.loaders.rosbag.topics import LASER_SCAN, TopicChoice, TopicInfo, choose_topics, normalize_type
@@ -128,7 +132,9 @@ class _BagSource:
 def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
     unknown = sorted(k for k, v in options.items() if k not in _OPTIONS and v is not None)
     if unknown:
-        raise DataError(f"{shown}: unknown bag option(s) {', '.join(unknown)}; expected: {', '.join(_OPTIONS)}")
+        raise DataError(
+            f"{shown}: unknown bag option(s) {', '.join(unknown)}; expected: {', '.join(_OPTIONS + COMMON_OPTIONS)}"
+        )
     opts = {k: options.get(k) for k in _OPTIONS}
     opts["outside_odometry"] = opts["outside_odometry"] or "error"
     if opts["outside_odometry"] not in _OUTSIDE:
@@ -149,6 +155,7 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
         if topic is not None and topics[topic].count == 0:
             raise TopicError(f"{shown}: topic {topic} ({role}) has no messages; expected at least one")
     source = _BagSource(bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"])
+    mounting = bag_mounting(bag, shown, topics, choice, opts["base_frame"], opts["odom_frame"])
     odom_desc = (
         f"{choice.odom} transforms {opts['odom_frame']} -> {opts['base_frame'] or '(its only child)'}"
         if choice.odom_is_tf
@@ -157,6 +164,7 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
     metadata = SequenceMetadata(
         source=str(shown),
         format=format_name,
+        sensor_offset=mounting.offset,
         odometry_source=f"{odom_desc}, SE(2)-interpolated to the {LASER_SCAN} header stamps of {choice.scan}",
         reference_source=(
             f"{choice.reference} (nav_msgs/msg/Odometry), SE(2)-interpolated to the scan stamps"
@@ -168,6 +176,7 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
             "odom_topic": choice.odom,
             "reference_topic": choice.reference,
             "outside_odometry": opts["outside_odometry"],
+            "sensor_offset_source": mounting.note,
         },
     )
     return Sequence(name, source.frames, metadata)

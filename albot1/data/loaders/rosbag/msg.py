@@ -14,15 +14,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 
-FloatArray = NDArray[np.float64]
-
-#: Beam angles that differ from ``angle_min + i * angle_increment`` by more
-#: than this cannot be written as a LaserScan (which only knows even spacing).
-ANGLE_SPACING_TOLERANCE = 1e-6
 #: How far ``len(ranges)`` may be from the beam count that ``angle_min``, ``angle_max`` and
 #: ``angle_increment`` describe. One beam: drivers disagree on whether ``angle_max`` is the last
 #: beam or one increment past it (pointcloud_to_laserscan, several 360-degree scanners), and the
@@ -149,29 +145,17 @@ def scan_arrays(
     return r, angles
 
 
-def even_spacing(angles: FloatArray, tolerance: float = ANGLE_SPACING_TOLERANCE) -> tuple[float, float] | None:
-    """``(angle_min, angle_increment)`` if the beams are evenly spaced (within ``tolerance`` rad), else None."""
-    n = angles.shape[0]
-    if n == 0 or not np.isfinite(angles).all():
-        return None
-    first = float(angles[0])
-    step = float(angles[-1] - angles[0]) / (n - 1) if n > 1 else 0.0
-    rebuilt = first + np.arange(n, dtype=np.float64) * step
-    with np.errstate(invalid="ignore", over="ignore"):
-        if not float(np.max(np.abs(rebuilt - angles))) <= tolerance:
-            return None
-    return first, step
-
-
 @dataclass(frozen=True)
 class PoseTrack:
     """A time-stamped SE(2) trajectory that can be sampled *between* its stamps.
 
-    Headings are unwrapped once at construction so that each query is a
-    binary search plus a linear blend (``se2.interpolate`` unwraps on every
-    call, which would make per-scan queries O(N)). Queries outside
-    ``[times[0], times[-1]]`` return None: the caller decides (error or drop),
-    never a silent extrapolation.
+    Headings are unwrapped once at construction (``se2.unwrap_headings``), so
+    that each query is a binary search plus ``se2.interpolate_unwrapped``, the
+    one interpolation of the package (``se2.interpolate`` unwraps on every
+    call, which would make per-scan queries O(N)). A query at a stored stamp
+    returns the stored pose as is. Queries outside ``[times[0], times[-1]]``
+    return None: the caller decides (error or drop), never a silent
+    extrapolation.
     """
 
     times: FloatArray
@@ -188,9 +172,7 @@ class PoseTrack:
             )
         order = np.argsort(t, kind="stable")
         t, p = t[order], p[order]
-        unwrapped = p.copy()
-        unwrapped[:, 2] = np.unwrap(p[:, 2])
-        return cls(t, p, unwrapped)
+        return cls(t, p, se2.unwrap_headings(p))
 
     @property
     def start(self) -> float:
@@ -209,9 +191,8 @@ class PoseTrack:
             return None
         i = int(np.searchsorted(self.times, t, side="left"))
         if self.times[i] == t:
-            return self.poses[i].copy()
-        t0, t1 = self.times[i - 1], self.times[i]
-        f = (t - t0) / (t1 - t0)
-        blended = self._unwrapped[i - 1] + f * (self._unwrapped[i] - self._unwrapped[i - 1])
-        blended[2] = float(se2.wrap(blended[2]))
+            stored: FloatArray = self.poses[i].copy()
+            return stored
+        bracket = slice(i - 1, i + 1)
+        blended: FloatArray = se2.interpolate_unwrapped(self.times[bracket], self._unwrapped[bracket], np.array([t]))[0]
         return blended

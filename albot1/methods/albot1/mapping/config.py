@@ -4,8 +4,8 @@ Defaults are the thesis's values; where the thesis gives none, the default
 is the resolution that worked in a prototype; ``docs/albot1-mapper.md``
 lists each choice with the thesis text it resolves, and the "note N" in a
 field's description is the number that page gives the resolution. The values a run uses come from
-the presets file ``albot1/methods/albot1/presets.toml`` (``default`` =
-``thesis``, ``exact``, ``literal``; read by
+the presets file ``baselines/albot1.toml`` (``default`` = ``thesis``,
+``exact``, ``literal``, ``plus``; read by
 :class:`albot1.config.presets.TomlPresets`); the defaults here equal its
 ``[presets.default]`` so the model can also be built directly in code.
 """

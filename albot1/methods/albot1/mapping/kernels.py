@@ -20,10 +20,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.segments import closest_parameter, line_angle, segment_distance
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import kernel, select
 from albot1.methods.albot1.mapping import pose_kernels
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 

@@ -25,11 +25,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.geometry.se2 import Pose, wrap_angle
+from albot1.geometry.se2 import Pose, rotate, wrap_angle
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.endpoints import is_stable
 from albot1.methods.albot1.perception.recognition import Tracked
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 #: Algorithm 2 step 2: the robot as a surface from (0, 0) to (0, 50 cm) in its own view.
@@ -83,10 +83,10 @@ def algorithm2_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pos
 def landmark_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pose:
     """The view's pose in the map that lays ``view_seg`` onto ``map_seg`` at the reference point ``side``."""
     phi = wrap_angle(_direction(map_seg) - _direction(view_seg))
-    c, s = math.cos(phi), math.sin(phi)
     mx, my = _reference(map_seg, side)
     vx, vy = _reference(view_seg, side)
-    return (mx - (c * vx - s * vy), my - (s * vx + c * vy), phi)
+    rx, ry = rotate(phi, vx, vy)
+    return (mx - rx, my - ry, phi)
 
 
 def outlier_keep(positions: Sequence[tuple[float, float]], min_candidates: int) -> list[bool]:

@@ -101,7 +101,7 @@ class Albot1Mapper:
 
     name: ClassVar[str] = "albot1"
     config_model: ClassVar[type[BaseModel]] = Albot1Config
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets(package="albot1.methods.albot1")  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: Albot1Config, *, seed: int = 0) -> None:
         # The method is deterministic; ``seed`` is accepted for the protocol.

@@ -19,7 +19,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
+
 IntArray = NDArray[np.int64]
 
 

@@ -40,10 +40,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.perception.endpoints import STABLE
-
-FloatArray = NDArray[np.float64]
 
 #: The odometry learner's fixed choices (``docs/albot1-mapper.md``, "Albot1+"): a view teaches it only when its
 #: measurement alone fixes the position to better than 5 cm and the heading to better than 0.05 rad (information

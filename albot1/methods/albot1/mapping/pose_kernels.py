@@ -34,9 +34,9 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import closest_parameter
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel
 
-FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 #: Levenberg-Marquardt damping of each Gauss-Newton step (1/m^2, 1/rad^2): negligible against any direction the

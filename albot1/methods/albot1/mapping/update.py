@@ -17,10 +17,10 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.kernels import DELETED, EXTENDED, TRIMMED, MappingKernels
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 

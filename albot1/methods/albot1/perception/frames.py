@@ -17,11 +17,9 @@ faces, only these conversions do.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, PoseLike
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 def rep_to_thesis_pose(pose: PoseLike) -> Pose:

@@ -22,10 +22,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel, select
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, UNSTABLE, is_stable
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
@@ -199,11 +199,11 @@ def _sparse_end(
     surface facing the robot (range times the angle between them), i.e. the
     beams meet the surface at a grazing angle, beyond ``arccos(1 / grazing)``.
     """
-    spacing = np.hypot(px[q] - px[e], py[q] - py[e])
+    spacing: float = np.hypot(px[q] - px[e], py[q] - py[e])
     if spacing <= spacing_max:
         return False
     if grazing > 0.0:
-        facing = ranges[beam[e]] * abs(angles[beam[q]] - angles[beam[e]])
+        facing: float = ranges[beam[e]] * abs(angles[beam[q]] - angles[beam[e]])
         return spacing > grazing * facing
     return True
 

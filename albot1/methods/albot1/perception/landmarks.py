@@ -12,10 +12,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, STABLE, UNSTABLE
 from albot1.methods.albot1.perception.view import View
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 __all__ = ["CORNER", "OCCLUDED", "OCCLUDING", "UNSTABLE", "Landmarks", "find_landmarks", "stable"]

@@ -17,9 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, PoseLike
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.kernels import PerceptionKernels
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 MotionModel = Literal["thesis", "exact"]

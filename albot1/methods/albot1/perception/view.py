@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.kernels import PerceptionKernels
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 

@@ -3,9 +3,9 @@
 The chapter-3 fields are inherited from
 :class:`~albot1.methods.albot1.mapping.config.Albot1Config` unchanged (the
 places layer wraps that mapper); the chapter-4 ones are :class:`PlacesFields`,
-whose values live in ``albot1/methods/albot1/places/presets.toml``
-(:mod:`albot1.methods.albot1.places.presets` puts each on the chapter-3
-preset of the same name). Where the thesis gives a value (the 40 cm surface
+whose values live in ``baselines/albot1-places.toml`` (which
+``extends = "albot1"``: :mod:`albot1.config.presets` puts each on the
+chapter-3 preset of the same name). Where the thesis gives a value (the 40 cm surface
 length, 40 cm gap and 5 degrees of Algorithm 6, "more than 4" matches, exits
 of about 1 m) it is the default; every other value is our reading, listed
 with its reason in ``docs/places.md``.
@@ -60,7 +60,7 @@ class MatchParams:
 
 
 class PlacesFields(BaseModel):
-    """The chapter-4 fields alone (lengths in metres, angles in degrees); ``places/presets.toml`` sets these."""
+    """The chapter-4 fields alone (lengths in metres, angles in degrees), set by ``baselines/albot1-places.toml``."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 

@@ -11,10 +11,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.segments import orientation, point_segment_distance
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import kernel
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDING
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 

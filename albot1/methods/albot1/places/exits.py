@@ -33,11 +33,11 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import segments_cross, transform_segments
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.view import View
 from albot1.methods.albot1.places.config import ExitParams
 from albot1.methods.albot1.places.kernels import PlacesKernels
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 #: How often (scans) unconfirmed tracks that have not been seen for ``_STALE_SCANS`` are dropped.
@@ -147,7 +147,8 @@ class ExitTracker:
         mids = 0.5 * (self._seg[:, :2] + self._seg[:, 2:])
         here = mids[row[0]]
         close = np.hypot(mids[:, 0] - here[0], mids[:, 1] - here[1]) <= self.params.twin_distance
-        return self._ids[close].tolist()
+        twins: list[int] = self._ids[close].tolist()
+        return twins
 
     def near(self, position: tuple[float, float], distance: float, scan: int) -> bool:
         """Whether ``position`` is within ``distance`` of a recently seen exit (standing in a doorway)."""

@@ -35,10 +35,12 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel
 
+from albot1.config.presets import TomlPresets
 from albot1.contract import MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
@@ -49,10 +51,8 @@ from albot1.methods.albot1.places.matcher import confirm, structural, trigger_th
 from albot1.methods.albot1.places.memory import Place, PlaceNetwork, Visit, invert, same_surfaces
 from albot1.methods.albot1.places.navigation import Prediction, align_at_exit, nearest_prediction, predict
 from albot1.methods.albot1.places.network import network_files
-from albot1.methods.albot1.places.presets import PlacesPresets
 from albot1.methods.albot1.warm_up import warm_up
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
@@ -65,7 +65,7 @@ class Albot1PlacesMapper:
 
     name: ClassVar[str] = "albot1-places"
     config_model: ClassVar[type[BaseModel]] = Albot1PlacesConfig
-    presets: ClassVar[dict[str, dict[str, Any]]] = PlacesPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: Albot1PlacesConfig, *, seed: int = 0) -> None:
         self.config = config

@@ -13,9 +13,9 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import closest_parameter, point_segment_distance
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 

@@ -26,11 +26,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.places.config import MatchParams
 from albot1.methods.albot1.places.kernels import PlacesKernels
-
-FloatArray = NDArray[np.float64]
-
 
 #: At most this many of a place's longest surfaces are merged into its structure (bounds the cost).
 _MERGE_AT_MOST = 1000

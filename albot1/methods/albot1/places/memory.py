@@ -35,8 +35,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
 from albot1.geometry.segments import transform_segments
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 def invert(pose: Pose) -> Pose:
@@ -320,4 +319,5 @@ def _point_segments(points: FloatArray, segments: FloatArray) -> FloatArray:
     l2 = np.maximum((e * e).sum(axis=-1), 1e-300)
     t = np.clip((rel * e).sum(axis=-1) / l2, 0.0, 1.0)
     near = a + t[..., None] * e
-    return np.hypot(points[:, None, 0] - near[..., 0], points[:, None, 1] - near[..., 1])
+    distances: FloatArray = np.hypot(points[:, None, 0] - near[..., 0], points[:, None, 1] - near[..., 1])
+    return distances

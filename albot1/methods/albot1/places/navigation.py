@@ -24,13 +24,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
-from albot1.geometry.se2 import Pose, wrap_angle
+from albot1.geometry.se2 import Pose, rotate, wrap_angle
 from albot1.geometry.segments import transform_segments
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.places.memory import ExitRecord
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,9 +56,9 @@ def align_at_exit(record: FloatArray, crossed: FloatArray) -> Pose:
         math.atan2(crossed[3] - crossed[1], crossed[2] - crossed[0])
         - math.atan2(record[3] - record[1], record[2] - record[0])
     )
-    c, s = math.cos(theta), math.sin(theta)
     rm, cm = midpoint(record), midpoint(crossed)
-    return (float(cm[0] - (c * rm[0] - s * rm[1])), float(cm[1] - (s * rm[0] + c * rm[1])), theta)
+    rx, ry = rotate(theta, rm[0], rm[1])
+    return (float(cm[0] - rx), float(cm[1] - ry), theta)
 
 
 def predict(

@@ -33,14 +33,12 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from albot1.geometry.se2 import Pose, compose_pose
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
 from albot1.methods.albot1.places.memory import Place, PlaceNetwork
-
-FloatArray = NDArray[np.float64]
 
 PLACES_JSON = "places.json"
 PLACES_GRAPHML = "places.graphml"
@@ -51,7 +49,8 @@ def _seg(segment: FloatArray) -> list[float]:
 
 
 def _segs(segments: FloatArray) -> list[list[float]]:
-    return thesis_to_rep_segments(np.asarray(segments, dtype=float).reshape(-1, 4)).tolist()
+    listed: list[list[float]] = thesis_to_rep_segments(np.asarray(segments, dtype=float).reshape(-1, 4)).tolist()
+    return listed
 
 
 def _pose(pose: Pose) -> list[float]:

@@ -12,10 +12,10 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import point_segment_distance
+from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import kernel
 from albot1.methods.albot1.mapping.kernels import classify_endpoints
 
-FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 

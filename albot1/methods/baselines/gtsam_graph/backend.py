@@ -19,9 +19,10 @@ import math
 from collections.abc import Iterable
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.geometry import se2
+from albot1.geometry.grid import first_per_cell
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.errors import GraphError
@@ -29,9 +30,6 @@ from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
 from albot1.methods.baselines.gtsam_graph.loop_closure import LoopMatch
 from albot1.methods.baselines.gtsam_graph.refine import RefineTests, accept, seed_poses
 from albot1.methods.baselines.gtsam_graph.registration import Target, line_normals, rotate, try_register
-from albot1.methods.baselines.point_map import first_per_cell
-
-FloatArray = NDArray[np.float64]
 
 
 class BackEnd:

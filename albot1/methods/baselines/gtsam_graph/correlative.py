@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 
 @dataclass(frozen=True)

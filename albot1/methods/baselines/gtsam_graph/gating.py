@@ -28,7 +28,7 @@ from collections import deque
 from statistics import median
 
 from albot1.geometry import se2
-from albot1.geometry.se2 import FloatArray
+from albot1.geometry.types import FloatArray
 
 
 def turn_agrees(pose: FloatArray, odometry_guess: FloatArray, max_turn_deg: float) -> bool:

@@ -34,11 +34,9 @@ from __future__ import annotations
 from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
 
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.errors import GraphError
-
-FloatArray = NDArray[np.float64]
 
 
 def body_frame_covariance(relative: FloatArray, covariance: FloatArray) -> FloatArray:
@@ -51,7 +49,7 @@ def body_frame_covariance(relative: FloatArray, covariance: FloatArray) -> Float
     """
     c, s = np.cos(relative[2]), np.sin(relative[2])
     a = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
-    out = a @ np.asarray(covariance, dtype=float) @ a.T
+    out: FloatArray = a @ np.asarray(covariance, dtype=float) @ a.T
     return 0.5 * (out + out.T)
 
 

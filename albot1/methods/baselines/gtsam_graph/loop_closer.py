@@ -16,9 +16,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.correlative import SearchWindow, correlative_search
@@ -31,8 +31,6 @@ from albot1.methods.baselines.gtsam_graph.loop_closure import (
     verify,
 )
 from albot1.methods.baselines.gtsam_graph.registration import Registration, try_register
-
-FloatArray = NDArray[np.float64]
 
 
 def loop_tests(config: GtsamGraphConfig) -> LoopTests:

@@ -23,12 +23,10 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.registration import Registration
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -36,12 +36,12 @@ import math
 from typing import ClassVar
 
 import numpy as np
-from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
@@ -51,15 +51,13 @@ from albot1.methods.baselines.gtsam_graph.loop_closer import LoopCloser
 from albot1.methods.baselines.gtsam_graph.place_recognition import PlaceRecognition
 from albot1.methods.baselines.gtsam_graph.registration import Registration
 
-FloatArray = NDArray[np.float64]
-
 
 class GtsamGraphMapper:
     """Pose-graph SLAM with scan-matching edges, verified loop closures, ISAM2 and a final LM."""
 
     name: ClassVar[str] = "gtsam-graph"
     config_model: ClassVar[type[BaseModel]] = GtsamGraphConfig
-    presets: ClassVar[dict[str, dict]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: GtsamGraphConfig, *, seed: int = 0) -> None:
         # Nothing here is random; the seed is kept for the protocol and the record.

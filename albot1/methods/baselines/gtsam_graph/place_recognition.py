@@ -16,13 +16,13 @@ from dataclasses import replace
 import numpy as np
 
 from albot1.geometry import se2
+from albot1.geometry.grid import first_per_cell
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.correlative import GlobalWindow, branch_and_bound_search
 from albot1.methods.baselines.gtsam_graph.loop_closer import LoopCloser, loop_match
 from albot1.methods.baselines.gtsam_graph.loop_closure import Confirmer, verify
 from albot1.methods.baselines.gtsam_graph.registration import try_register
-from albot1.methods.baselines.point_map import first_per_cell
 
 
 class PlaceRecognition:

@@ -31,8 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry import se2
-
-FloatArray = NDArray[np.float64]
+from albot1.geometry.types import FloatArray
 
 #: metres of translation that count as much progress as one radian of rotation along a segment
 PROGRESS_M_PER_RAD = 1.0

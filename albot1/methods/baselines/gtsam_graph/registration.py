@@ -22,11 +22,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -143,7 +141,8 @@ def rotate(vectors: FloatArray, angle: float) -> FloatArray:
     computed with this form.
     """
     c, s = math.cos(angle), math.sin(angle)
-    return vectors @ np.array([[c, s], [-s, c]])
+    rotated: FloatArray = vectors @ np.array([[c, s], [-s, c]])
+    return rotated
 
 
 def try_register(target: Target, points: FloatArray, guess: FloatArray, params: IcpParams) -> Registration | None:

@@ -42,7 +42,6 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
-from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from albot1.config.presets import TomlPresets
@@ -52,13 +51,12 @@ from albot1.data.loaders.rawlog.serialize import GaussianMotionModel
 from albot1.data.loaders.rawlog.writer import RawlogLayout, write_frames
 from albot1.data.model import Frame
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.mrpt import outputs
 from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig, MrptRunConfig
 from albot1.methods.baselines.mrpt.process import ProcessOutcome, run_limited
 from albot1.methods.baselines.mrpt.templates import render
-
-FloatArray = NDArray[np.float64]
 
 #: The Debian package that provides the applications (``make mrpt`` installs it).
 APT_PACKAGE = "mrpt-apps"
@@ -110,7 +108,7 @@ class _MrptMapper:
     app: ClassVar[str]
     layout: ClassVar[RawlogLayout]
     config_model: ClassVar[type[BaseModel]]
-    presets: ClassVar[dict[str, dict[str, Any]]] = TomlPresets()  # type: ignore[assignment]
+    presets = TomlPresets()
 
     def __init__(self, config: MrptRunConfig, *, seed: int = 0) -> None:
         self.config = config

@@ -33,9 +33,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry import se2
+from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
-
-FloatArray = NDArray[np.float64]
 
 ICP_POINT_MAP = "_finalmaps_.txt_mrpt__maps__CSimplePointsMap_00.txt"
 GRID_IMAGE = "finalMap_mrpt__maps__COccupancyGridMap2D_00.png"
@@ -199,7 +198,8 @@ class GridMap:
 
     @property
     def resolution_m(self) -> float:
-        return (self.x_max - self.x_min) / self.free.shape[1]
+        resolution: float = (self.x_max - self.x_min) / self.free.shape[1]
+        return resolution
 
     def occupied_points(self, probability: float) -> FloatArray:
         """Centres ``(K, 2)`` of the cells whose occupancy probability is at least ``probability``."""

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from albot1.data.synthetic.errors import SyntheticWorldError
-from albot1.data.synthetic.odometry import OdometryErrorModel, integrate, perturb_steps, simulate
+from albot1.data.synthetic.odometry import OdometryErrorModel, perturb_steps, simulate
 from albot1.data.synthetic.route import CONTINUOUS, START_STOP, Route, sample
 from albot1.geometry import se2
 
@@ -35,13 +35,6 @@ def test_exact_model_reproduces_the_truth() -> None:
 
 def test_odometry_starts_at_the_true_first_pose() -> None:
     np.testing.assert_array_equal(simulate(LOOP, NOISY, seed=4)[0], LOOP[0])
-
-
-def test_vectorised_integration_equals_composing_step_by_step() -> None:
-    rng = np.random.default_rng(9)
-    steps = np.column_stack([rng.normal(0.3, 0.2, 300), rng.normal(0, 0.1, 300), rng.normal(0, 0.5, 300)])
-    start = np.array([3.0, -1.0, 2.5])
-    np.testing.assert_allclose(integrate(start, steps), se2.integrate_steps(start, steps), atol=1e-9)
 
 
 def test_distance_scale_stretches_a_straight_line_exactly() -> None:

@@ -1,4 +1,4 @@
-"""Albot1's presets, read from albot1/methods/albot1/presets.toml, are exactly the documented values.
+"""Albot1's presets, read from baselines/albot1.toml, are exactly the documented values.
 
 The expected values below were a literal copy of what the presets resolved to
 when they were a dict in the mapping config module (every field of the model

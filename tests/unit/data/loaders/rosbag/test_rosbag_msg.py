@@ -9,7 +9,6 @@ import pytest
 
 from albot1.data.loaders.rosbag.msg import (
     PoseTrack,
-    even_spacing,
     quaternion_from_yaw,
     scan_arrays,
     seconds_to_ns,
@@ -54,16 +53,6 @@ def test_stamp_conversions() -> None:
     assert ns == 70_289_900_000
     assert split_ns(ns) == (70, 289_900_000)
     assert stamp_seconds(*split_ns(ns)) == pytest.approx(70.2899, abs=1e-12)
-
-
-def test_even_spacing_accepts_uniform_and_rejects_irregular_beams() -> None:
-    uniform = np.deg2rad(np.arange(-90.0, 90.0, 1.0))
-    first, step = even_spacing(uniform)  # type: ignore[misc]
-    assert first == uniform[0] and step == pytest.approx(math.radians(1.0), rel=1e-14)
-    irregular = uniform.copy()
-    irregular[10] += 1e-3
-    assert even_spacing(irregular) is None
-    assert even_spacing(np.array([0.3])) == (0.3, 0.0)
 
 
 def test_pose_track_returns_stored_poses_exactly_at_their_stamps() -> None:

@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from albot1.config.presets import TomlPresets
+from albot1.config.presets import preset_file
 from albot1.errors import ConfigError
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.places.config import Albot1PlacesConfig, PlacesFields
 from albot1.methods.albot1.places.mapper import Albot1PlacesMapper
-from albot1.methods.albot1.places.presets import PlacesPresets
 from albot1.methods.registry import get_method, resolve_method_config
 
 
@@ -50,17 +51,19 @@ def test_registry_environment_and_overrides(monkeypatch: pytest.MonkeyPatch) -> 
     assert cfg.corner_min_angle_deg == 30.0
 
 
-def test_a_bad_places_value_names_the_files_and_the_preset(monkeypatch: pytest.MonkeyPatch) -> None:
-    from albot1.methods.albot1.places import presets as module
-
-    good = module.load_package_presets(module.PLACES_PACKAGE, PlacesFields)
-    bad = {**good, "exact": {**good["default"], "exit_min_width_m": 2.0}}
-    monkeypatch.setattr(module, "load_package_presets", lambda package, model: bad)
+def test_a_bad_places_value_names_the_files_and_the_preset(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """A user's override of the places file (ALBOT1_CONFIG_DIR) is read the same way and its errors name both files."""
+    (tmp_path / "baselines").mkdir()
+    text = preset_file("albot1-places").read_text(encoding="utf-8")
+    (tmp_path / "baselines" / "albot1-places.toml").write_text(text + "\n[presets.exact]\nexit_min_width_m = 2.0\n")
+    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path))
 
     class Fresh(Albot1PlacesMapper):  # a new owner class: the descriptor reads the files again
         pass
 
-    presets = PlacesPresets()
-    with pytest.raises(ConfigError, match=r"presets.toml: preset 'exact' is not a valid Albot1PlacesConfig.*exit_min"):
-        presets.__get__(None, Fresh)
-    assert "presets.toml +" in presets.location(Fresh) and isinstance(presets, TomlPresets)
+    with pytest.raises(
+        ConfigError,
+        match=r"albot1.toml \+ .*albot1-places.toml: preset 'exact' is not a valid Albot1PlacesConfig.*exit_min",
+    ):
+        _ = Fresh.presets
+    assert Albot1PlacesMapper.__dict__["presets"].location(Fresh) == str(tmp_path / "baselines" / "albot1-places.toml")

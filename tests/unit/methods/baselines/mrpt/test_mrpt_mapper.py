@@ -20,7 +20,7 @@ from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.mrpt import MrptIcpMapper, MrptRbpfMapper
 from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig
 from albot1.methods.errors import UnknownMethodError
-from albot1.methods.registry import METHODS, resolve_config
+from albot1.methods.registry import method_registry, resolve_config
 
 ANGLES = np.radians(np.linspace(-90.0, 90.0, 19))
 SCANS = 6
@@ -156,7 +156,7 @@ def test_bad_input_and_seed_are_refused_before_running(fake_apps: Path) -> None:
 def test_missing_programs_make_the_methods_unavailable(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("PATH", str(tmp_path))
     for name, program in (("mrpt-icp", "icp-slam"), ("mrpt-rbpf", "rbpf-slam")):
-        spec = METHODS[name]
+        spec = method_registry().get(name)
         assert not spec.available()
         assert spec.unavailable_reason() == f"needs the program(s) {program}, not found on PATH"
         assert "apt-get install mrpt-apps" in spec.install_command()

@@ -1,0 +1,64 @@
+"""Non-finite and absurd numbers in a sequence's frames, refused with their location.
+
+A log (CARMEN, ROS bag, own log) can carry ``inf``, ``nan`` or ``1e308``
+where a pose is expected; such a value survives the parser (it is a
+number) and ends as non-finite points of a map or an overflow in a metric.
+Every frame a file loader yields passes :func:`checked` (applied by
+:func:`albot1.data.open.open_sequence`), so the first offending scan is named
+with its source, index and timestamp:
+
+* odometry and reference poses: every component finite, and ``|x|, |y|``
+  at most :data:`MAX_COORDINATE_M` (the bound of trajectory files);
+* the scan's timestamp finite, its beam angles finite. Ranges may be NaN or
+  infinite: loaders use those for "no return" (``docs/formats.md``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+import numpy as np
+
+from albot1.data.errors import ParseError
+from albot1.data.model import Frame, Sequence
+from albot1.data.trajectory import MAX_COORDINATE_M
+
+
+def pose_problem(pose: object, what: str) -> str | None:
+    """Why ``pose`` (x, y, theta) is not a usable pose, or None."""
+    values = np.asarray(pose, dtype=float).reshape(-1)
+    x, y, theta = (float(v) for v in values[:3]) if len(values) >= 3 else (math.nan,) * 3
+    # plain float arithmetic: a sum is finite only when every term is (this runs once per scan)
+    if math.isfinite(x + y + theta) and abs(x) <= MAX_COORDINATE_M and abs(y) <= MAX_COORDINATE_M:
+        return None
+    if not np.isfinite(values).all() or len(values) < 3:
+        return f"{what} ({', '.join(f'{v:g}' for v in values)}) is not finite; expected finite numbers"
+    return f"{what} position ({x:.6g}, {y:.6g}) m is beyond {MAX_COORDINATE_M:g} m; expected metres of a map"
+
+
+def frame_problem(frame: Frame) -> str | None:
+    """Why ``frame`` holds a value no method or metric can use, or None."""
+    if not math.isfinite(frame.scan.timestamp):
+        return f"timestamp {frame.scan.timestamp} is not finite"
+    problem = pose_problem(frame.odometry, "odometry")
+    if problem is None and frame.reference is not None:
+        problem = pose_problem(frame.reference, "reference pose")
+    # radians sum to a finite number unless one of them is NaN or infinite
+    if problem is None and not math.isfinite(float(frame.scan.angles.sum())):
+        problem = "a beam angle is not finite; expected finite radians"
+    return problem
+
+
+def checked(sequence: Sequence) -> Sequence:
+    """``sequence`` whose frames are checked as they stream by (ParseError naming source, scan and time)."""
+    source = sequence.metadata.source or sequence.name
+
+    def check(frames: Iterator[Frame]) -> Iterator[Frame]:
+        for frame in frames:
+            problem = frame_problem(frame)
+            if problem is not None:
+                raise ParseError(source, f"scan {frame.index} (t = {frame.scan.timestamp:.6f} s): {problem}")
+            yield frame
+
+    return sequence.with_frames(check, scan_count=sequence.known_scan_count)

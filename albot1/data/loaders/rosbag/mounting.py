@@ -1,0 +1,195 @@
+"""Where the laser sits on the robot, read from a bag's ``/tf_static`` (else ``/tf``).
+
+A LaserScan is measured in its header's frame (``laser``); odometry moves the
+robot's base frame (``base_link``). When the laser is mounted away from the
+base, treating the scan as if taken at the base bends every map, so the
+transform ``base -> laser`` becomes the sequence's ``sensor_offset``
+(x, y, yaw), which the runner applies once for every method
+(:func:`albot1.data.transforms.sensor_frame`).
+
+The chain is walked up from the laser frame through the transforms' parent
+links (``base_link -> laser_mount -> laser`` composes in 3D, then is
+projected onto the plane) until the base frame: the named or odometry's
+child frame, else the frame whose parent is ``odom_frame``, else the root of
+the tree. ``/tf_static`` is preferred; ``/tf`` is read only when the static
+tree does not reach the laser (older bags publish mounts on ``/tf``), taking
+each link's first transform (a mount is rigid). A laser tilted more than
+:data:`MAX_TILT_DEG` from the base's plane (mounted upside down, or looking
+at the floor) cannot be put on the plane by an (x, y, yaw) offset and is
+refused. When no transform is found the offset is zero and the result says
+so; the loader logs it as a warning and records it in the metadata.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from albot1.data.errors import DataError, ParseError
+from albot1.data.loaders.rosbag.msg import quaternion_problem
+from albot1.data.loaders.rosbag.reader import opened_bag, topic_messages
+from albot1.data.loaders.rosbag.topics import TF_MESSAGE, TopicChoice, TopicInfo
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+    from rosbags.highlevel import AnyReader
+
+log = logging.getLogger(__name__)
+
+#: Largest angle (degrees) between the laser's z axis and the base's for which the scan is taken as planar.
+MAX_TILT_DEG = 5.0
+STATIC_TOPIC = "/tf_static"
+DYNAMIC_TOPIC = "/tf"
+
+
+@dataclass(frozen=True)
+class Mounting:
+    """The laser's planar offset on the base and where it came from (``found`` False: assumed zero)."""
+
+    offset: tuple[float, float, float]
+    found: bool
+    note: str
+
+
+@dataclass(frozen=True)
+class _Link:
+    parent: str
+    translation: np.ndarray
+    rotation: Rotation
+
+
+def _first_frame_id(reader: AnyReader, topic: str, shown: Path) -> str:
+    for _, msg in topic_messages(reader, topic, shown):
+        return str(msg.header.frame_id).lstrip("/")
+    return ""
+
+
+def odometry_child_frame(reader: AnyReader, topic: str, shown: Path) -> str | None:
+    """The ``child_frame_id`` of an Odometry topic's first message (the robot's base), or None if empty."""
+    for _, msg in topic_messages(reader, topic, shown):
+        child = str(msg.child_frame_id).lstrip("/")
+        return child or None
+    return None
+
+
+def _links(reader: AnyReader, topic: str, shown: Path) -> dict[str, _Link]:
+    """``child -> first transform from its parent`` of a TFMessage topic."""
+    links: dict[str, _Link] = {}
+    for i, msg in topic_messages(reader, topic, shown):
+        for tf in msg.transforms:
+            child = str(tf.child_frame_id).lstrip("/")
+            if child in links:
+                continue
+            t, q = tf.transform.translation, tf.transform.rotation
+            quaternion = (float(q.x), float(q.y), float(q.z), float(q.w))
+            translation = np.array([float(t.x), float(t.y), float(t.z)])
+            problem = quaternion_problem(*quaternion)
+            if problem is not None or not np.isfinite(translation).all():
+                what = problem or f"translation {translation.tolist()}, expected finite numbers"
+                raise ParseError(shown, f"topic {topic} ({tf.header.frame_id} -> {child}): {what}", index=i)
+            links[child] = _Link(str(tf.header.frame_id).lstrip("/"), translation, Rotation.from_quat(quaternion))
+    return links
+
+
+def _chain(links: Mapping[str, _Link], laser: str, base: str | None, odom_frame: str) -> list[_Link] | None:
+    """The links from the base down to ``laser`` (base first; empty when ``laser`` is the base), or None.
+
+    None: ``base`` is not above the laser (or, with no base named, the laser
+    has no parent at all, or the links loop).
+    """
+    path: list[_Link] = []
+    frame, seen = laser, {laser}
+    while frame != base:
+        link = links.get(frame)
+        if link is None:  # the root of the tree: the base when none is named and the laser hangs below it
+            return path[::-1] if base is None and path else None
+        if base is None and link.parent == odom_frame:
+            return path[::-1]  # frame is the base: odometry moves it
+        path.append(link)
+        frame = link.parent
+        if frame in seen:
+            return None
+        seen.add(frame)
+    return path[::-1]
+
+
+def _planar(path: list[_Link], laser: str, base: str, shown: Path) -> tuple[float, float, float]:
+    translation, rotation = np.zeros(3), Rotation.identity()
+    for link in path:
+        translation = translation + rotation.apply(link.translation)
+        rotation = rotation * link.rotation
+    z_axis = rotation.apply([0.0, 0.0, 1.0])
+    tilt = math.degrees(math.acos(max(-1.0, min(1.0, float(z_axis[2])))))
+    if tilt > MAX_TILT_DEG:
+        raise DataError(
+            f"{shown}: the laser frame {laser!r} is tilted {tilt:.1f} deg from the base frame {base!r} "
+            f"(upside down or not level); expected at most {MAX_TILT_DEG} deg, as a 2D scan is taken in the "
+            f"base's plane"
+        )
+    x_axis = rotation.apply([1.0, 0.0, 0.0])
+    return float(translation[0]), float(translation[1]), math.atan2(float(x_axis[1]), float(x_axis[0]))
+
+
+def read_mounting(
+    reader: AnyReader,
+    topics: Mapping[str, TopicInfo],
+    scan_topic: str,
+    base_frame: str | None,
+    odom_frame: str,
+    shown: Path,
+) -> Mounting:
+    """The ``base -> laser`` offset of a bag (see the module docstring for the search rules)."""
+    laser = _first_frame_id(reader, scan_topic, shown)
+    if not laser:
+        return Mounting((0.0, 0.0, 0.0), False, f"{scan_topic} has no header frame_id, so no laser mount to look up")
+    if laser == base_frame:
+        return Mounting((0.0, 0.0, 0.0), True, f"the scans' frame {laser!r} is the base frame")
+    searched = []
+    for topic in (STATIC_TOPIC, DYNAMIC_TOPIC):
+        if topics.get(topic, TopicInfo("", 0)).msgtype != TF_MESSAGE:
+            continue
+        searched.append(topic)
+        path = _chain(_links(reader, topic, shown), laser, base_frame, odom_frame)
+        if path is not None and not path:
+            return Mounting((0.0, 0.0, 0.0), True, f"the scans' frame {laser!r} is the base frame ({topic})")
+        if path is not None:
+            base = base_frame or path[0].parent
+            offset = _planar(path, laser, base, shown)
+            shown_offset = ", ".join(f"{v:.6g}" for v in offset)
+            return Mounting(offset, True, f"{topic} {base} -> {laser}: (x, y, yaw) = ({shown_offset})")
+    where = " or ".join(searched) if searched else "the bag (it has no /tf_static or /tf topic)"
+    base = base_frame or "the base frame"
+    return Mounting(
+        (0.0, 0.0, 0.0),
+        False,
+        f"no transform {base} -> {laser!r} (the scans' frame) in {where}; the laser is taken to sit at the base's "
+        f"origin (sensor_offset 0)",
+    )
+
+
+def bag_mounting(
+    bag: Path,
+    shown: Path,
+    topics: Mapping[str, TopicInfo],
+    choice: TopicChoice,
+    base_frame: str | None,
+    odom_frame: str,
+) -> Mounting:
+    """:func:`read_mounting` for a bag with chosen topics; the base frame defaults to the odometry's child frame.
+
+    A missing mount is logged as a warning (and the caller records the note in the sequence metadata).
+    """
+    with opened_bag(bag, shown) as reader:
+        if base_frame is None and not choice.odom_is_tf:
+            base_frame = odometry_child_frame(reader, choice.odom, shown)
+        mounting = read_mounting(reader, topics, choice.scan, base_frame, odom_frame, shown)
+    if not mounting.found:
+        log.warning("%s: %s", shown, mounting.note)
+    return mounting

@@ -1,0 +1,81 @@
+"""Third-party methods: the installed entry points of group ``albot1.methods``.
+
+A distribution that ships a mapper declares it the way pytest plugins are
+declared, in its packaging metadata::
+
+    [project.entry-points."albot1.methods"]
+    my-slam = "my_slam.mapper:MySlamMapper"
+
+The entry point's name is the method name, its value the mapper class
+(``module:Class``). Reading the entry points imports nothing (they come
+from each distribution's ``entry_points.txt``); the class's module is
+imported only when the method is run or its config resolved, exactly as for
+a built-in method. A benchmark suite names methods only, so a suite file
+cannot make the tool import a module that no installed distribution
+declares (docs/benchmarking.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from importlib.metadata import EntryPoint, entry_points
+
+from albot1.config.targets import TargetError, check_target
+from albot1.methods.errors import PluginError
+
+#: The entry point group that registers a method.
+ENTRY_POINT_GROUP = "albot1.methods"
+
+#: The error class a plugin's failures are reported as (the runner wraps any other exception in it).
+PLUGIN_ERROR_CLASS = "albot1.methods.errors:PluginMethodError"
+
+
+def _distribution(point: EntryPoint) -> str:
+    dist = point.dist
+    return f"{dist.name} {dist.version}" if dist is not None else "an unknown distribution"
+
+
+@dataclass(frozen=True)
+class Plugin:
+    """One declared method: its name, its mapper class (``module:Class``) and the distribution declaring it."""
+
+    name: str
+    target: str
+    source: str
+
+
+def plugin(point: EntryPoint) -> Plugin:
+    """The method an entry point declares; PluginError (one line) when its value is not ``module:Class``."""
+    try:
+        check_target(point.value)
+    except TargetError:
+        raise PluginError(
+            f"entry point {point.name!r} of {_distribution(point)} (group {ENTRY_POINT_GROUP}): expected "
+            f"'module:Class' naming a mapper class, got {point.value!r}"
+        ) from None
+    return Plugin(point.name, point.value, _distribution(point))
+
+
+def installed_plugins(builtin: Iterable[str]) -> list[Plugin]:
+    """The installed plugins' methods, by name; PluginError when one takes a built-in method's name."""
+    taken = set(builtin)
+    seen: dict[str, EntryPoint] = {}
+    out = []
+    for point in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda p: p.name):
+        if point.name in taken:
+            raise PluginError(
+                f"entry point {point.name!r} of {_distribution(point)} (group {ENTRY_POINT_GROUP}) takes the name "
+                "of a built-in method; the plugin must choose another name"
+            )
+        if point.name in seen:
+            if seen[point.name].value == point.value:
+                continue  # one distribution found twice on sys.path
+            raise PluginError(
+                f"method {point.name!r} is declared by two entry points of group {ENTRY_POINT_GROUP}: "
+                f"{seen[point.name].value} ({_distribution(seen[point.name])}) and {point.value} "
+                f"({_distribution(point)}); uninstall one"
+            )
+        seen[point.name] = point
+        out.append(plugin(point))
+    return out

@@ -1,0 +1,211 @@
+"""The laser's mount read from /tf_static (or /tf), written by the bag writers, and its absence reported."""
+
+from __future__ import annotations
+
+import logging
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from albot1.data.errors import DataError
+from albot1.data.loaders.rosbag.loader import Ros1BagLoader, Ros2BagLoader
+from albot1.data.loaders.rosbag.msg import seconds_to_ns
+from albot1.data.loaders.rosbag.writer import Ros1BagWriter, Ros2McapWriter, Ros2Sqlite3Writer, RosMessages
+from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
+
+ANGLES = np.deg2rad(np.arange(-90.0, 90.0, 2.0))
+OFFSET = (0.25, -0.125, 0.5)
+
+
+def sequence(n: int = 5, offset: tuple[float, float, float] = OFFSET) -> Sequence:
+    frames = [
+        Frame(i, Scan(np.full(ANGLES.shape, 2.0 + i), ANGLES.copy(), 10.0 + i, 30.0), np.array([0.5 * i, 0.0, 0.1 * i]))
+        for i in range(n)
+    ]
+    return Sequence.from_frames("mounted", frames, metadata=SequenceMetadata(sensor_offset=offset))
+
+
+@pytest.mark.parametrize(
+    ("writer", "loader", "name"),
+    [
+        (Ros1BagWriter, Ros1BagLoader, "m.bag"),
+        (Ros2Sqlite3Writer, Ros2BagLoader, "m.db3"),
+        (Ros2McapWriter, Ros2BagLoader, "m.mcap"),
+    ],
+)
+def test_written_mount_reads_back_as_the_same_offset(
+    tmp_path: Path, writer: Any, loader: Any, name: str, caplog: pytest.LogCaptureFixture
+) -> None:
+    writer().write(sequence(), tmp_path / name)
+    with caplog.at_level(logging.WARNING):
+        loaded = loader().load(tmp_path / name)
+    assert loaded.metadata.sensor_offset == pytest.approx(OFFSET, abs=1e-12)
+    assert loaded.metadata.extra["sensor_offset_source"].startswith("/tf_static base_link -> laser: (x, y, yaw) = (")
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+    got = np.array([f.odometry for f in loaded.frames()])
+    assert np.abs(got - np.array([f.odometry for f in sequence().frames()])).max() < 1e-12
+
+
+def test_converted_bag_carries_tf_static_latched_and_tf_for_odometry(tmp_path: Path) -> None:
+    from rosbags.highlevel import AnyReader
+
+    Ros2McapWriter().write(sequence(n=4), tmp_path / "m.mcap")
+    Ros1BagWriter().write(sequence(n=4), tmp_path / "m.bag")
+    for bag in (tmp_path / "m.mcap", tmp_path / "m.bag"):
+        with AnyReader([bag]) as reader:
+            counts = {t: i.msgcount for t, i in reader.topics.items()}
+            assert counts == {"/scan": 4, "/odom": 4, "/tf": 4, "/tf_static": 1}
+            static = next(c for c in reader.connections if c.topic == "/tf_static")
+            if bag.suffix == ".bag":
+                assert static.ext.latching == 1
+            else:
+                assert static.ext.offered_qos_profiles[0].durability.name == "TRANSIENT_LOCAL"
+            tfs = [
+                reader.deserialize(raw, c.msgtype)
+                for c, _, raw in reader.messages(connections=[c for c in reader.connections if c.topic == "/tf"])
+            ]
+        last = tfs[-1].transforms[0]
+        assert (last.header.frame_id, last.child_frame_id) == ("odom", "base_link")
+        assert (last.transform.translation.x, last.transform.translation.y) == (1.5, 0.0)
+        assert 2 * math.atan2(last.transform.rotation.z, last.transform.rotation.w) == pytest.approx(0.3, abs=1e-15)
+
+
+def test_ros2_outputs_are_named_after_out(tmp_path: Path) -> None:
+    Ros2McapWriter().write(sequence(n=2), tmp_path / "intel.mcap")
+    Ros2Sqlite3Writer().write(sequence(n=2), tmp_path / "intel.db3")
+    Ros2McapWriter().write(sequence(n=2), tmp_path / "run")
+    assert sorted(p.name for p in (tmp_path / "intel.mcap").iterdir()) == ["intel.mcap", "metadata.yaml"]
+    assert sorted(p.name for p in (tmp_path / "intel.db3").iterdir()) == ["intel.db3", "metadata.yaml"]
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["metadata.yaml", "run.mcap"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["intel.db3", "intel.mcap", "run"]  # no staging left
+    assert len(list(Ros2BagLoader().load(tmp_path / "intel.mcap").frames())) == 2
+    assert len(list(Ros2BagLoader().load(tmp_path / "intel.mcap" / "intel.mcap").frames())) == 2
+
+
+def test_failed_ros2_write_leaves_nothing(tmp_path: Path) -> None:
+    bad = Sequence.from_frames("bad", [Frame(0, Scan(np.ones(3), np.array([0.0, 0.1, 0.3]), 1.0, 30.0), np.zeros(3))])
+    with pytest.raises(DataError, match="not evenly spaced"):
+        Ros2McapWriter().write(bad, tmp_path / "x.mcap")
+    assert list(tmp_path.iterdir()) == []
+
+
+def _tf(ts: Any, msgs: RosMessages, ns: int, links: list[tuple[str, str, tuple[float, ...], tuple[float, ...]]]) -> Any:
+    t = ts.types
+    transforms = [
+        t["geometry_msgs/msg/TransformStamped"](
+            header=msgs.header(ns, parent, 0),
+            child_frame_id=child,
+            transform=t["geometry_msgs/msg/Transform"](
+                translation=t["geometry_msgs/msg/Vector3"](x=xyz[0], y=xyz[1], z=xyz[2]),
+                rotation=t["geometry_msgs/msg/Quaternion"](x=q[0], y=q[1], z=q[2], w=q[3]),
+            ),
+        )
+        for parent, child, xyz, q in links
+    ]
+    return t["tf2_msgs/msg/TFMessage"](transforms=transforms)
+
+
+def write_bag(
+    path: Path, topic: str | None, links: list[tuple[str, str, tuple[float, ...], tuple[float, ...]]]
+) -> None:
+    """Scans in frame ``laser``, odometry of ``base_link``, and ``links`` on ``topic`` (None: no tf at all)."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    msgs = RosMessages(ts, ros1=False)
+    with Writer(path, version=9) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        odom = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
+        tf = bag.add_connection(topic, "tf2_msgs/msg/TFMessage", typestore=ts) if topic else None
+        for f in sequence(3).frames():
+            ns = seconds_to_ns(f.scan.timestamp)
+            if tf is not None:
+                bag.write(tf, ns, ts.serialize_cdr(_tf(ts, msgs, ns, links), "tf2_msgs/msg/TFMessage"))
+            bag.write(
+                odom, ns, ts.serialize_cdr(msgs.odometry(f.odometry, ns, "odom", f.index), "nav_msgs/msg/Odometry")
+            )
+            bag.write(scan, ns, ts.serialize_cdr(msgs.scan(f, ns), "sensor_msgs/msg/LaserScan"))
+
+
+def yaw_q(yaw: float) -> tuple[float, float, float, float]:
+    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+
+def test_bag_without_tf_says_the_mount_is_missing(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    write_bag(tmp_path / "bare", None, [])
+    with caplog.at_level(logging.WARNING):
+        loaded = Ros2BagLoader().load(tmp_path / "bare")
+    note = loaded.metadata.extra["sensor_offset_source"]
+    assert note == (
+        "no transform base_link -> 'laser' (the scans' frame) in the bag (it has no /tf_static or /tf topic); "
+        "the laser is taken to sit at the base's origin (sensor_offset 0)"
+    )
+    assert loaded.metadata.sensor_offset == (0.0, 0.0, 0.0)
+    assert [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING] == [f"{tmp_path / 'bare'}: {note}"]
+
+
+def test_chained_mount_on_tf_composes_to_the_base(tmp_path: Path) -> None:
+    """base_link -> mount (0.5, 0, yaw 90 deg) -> laser (0.2, 0, yaw 90 deg), on /tf beside odom -> base_link."""
+    links = [
+        ("odom", "base_link", (9.0, 9.0, 0.0), yaw_q(1.0)),
+        ("base_link", "mount", (0.5, 0.0, 0.3), yaw_q(math.pi / 2)),
+        ("mount", "laser", (0.2, 0.0, 0.1), yaw_q(math.pi / 2)),
+    ]
+    write_bag(tmp_path / "chain", "/tf", links)
+    loaded = Ros2BagLoader().load(tmp_path / "chain")
+    assert loaded.metadata.sensor_offset == pytest.approx((0.5, 0.2, math.pi), abs=1e-12)
+    assert loaded.metadata.extra["sensor_offset_source"].startswith("/tf base_link -> laser:")
+
+
+def test_small_tilt_is_projected_and_upside_down_refused(tmp_path: Path) -> None:
+    tilt = math.radians(2.0)  # 2 deg roll: projected onto the plane
+    write_bag(
+        tmp_path / "tilted",
+        "/tf_static",
+        [("base_link", "laser", (0.1, 0.0, 0.2), (math.sin(tilt / 2), 0, 0, math.cos(tilt / 2)))],
+    )
+    assert Ros2BagLoader().load(tmp_path / "tilted").metadata.sensor_offset == pytest.approx((0.1, 0.0, 0.0), abs=1e-12)
+    write_bag(tmp_path / "flipped", "/tf_static", [("base_link", "laser", (0.1, 0.0, 0.2), (1.0, 0.0, 0.0, 0.0))])
+    with pytest.raises(DataError, match=r"the laser frame 'laser' is tilted 180.0 deg from the base frame 'base_link'"):
+        Ros2BagLoader().load(tmp_path / "flipped")
+
+
+def test_static_mount_not_reaching_the_odometry_base_is_missing(tmp_path: Path) -> None:
+    write_bag(tmp_path / "other", "/tf_static", [("chassis", "laser", (0.1, 0.0, 0.0), yaw_q(0.0))])
+    loaded = Ros2BagLoader().load(tmp_path / "other")
+    assert loaded.metadata.sensor_offset == (0.0, 0.0, 0.0)
+    assert (
+        "no transform base_link -> 'laser' (the scans' frame) in /tf_static;"
+        in loaded.metadata.extra["sensor_offset_source"]
+    )
+    assert Ros2BagLoader().load(tmp_path / "other", base_frame="chassis").metadata.sensor_offset == pytest.approx(
+        (0.1, 0.0, 0.0)
+    )
+
+
+def test_scans_in_the_frame_odometry_moves_need_no_mount(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """Odometry from /tf (odom -> base_link) and scans stamped in base_link itself: offset 0, no warning."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    msgs = RosMessages(ts, ros1=False)
+    with Writer(tmp_path / "onbase", version=9) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        tf = bag.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=ts)
+        for f in sequence(3).frames():
+            ns = seconds_to_ns(f.scan.timestamp)
+            link = [("odom", "base_link", (float(f.odometry[0]), 0.0, 0.0), yaw_q(float(f.odometry[2])))]
+            bag.write(tf, ns, ts.serialize_cdr(_tf(ts, msgs, ns, link), "tf2_msgs/msg/TFMessage"))
+            message = msgs.scan(f, ns)
+            message.header.frame_id = "base_link"
+            bag.write(scan, ns, ts.serialize_cdr(message, "sensor_msgs/msg/LaserScan"))
+    with caplog.at_level(logging.WARNING):
+        loaded = Ros2BagLoader().load(tmp_path / "onbase")
+    assert loaded.metadata.sensor_offset == (0.0, 0.0, 0.0)
+    assert loaded.metadata.extra["sensor_offset_source"] == "the scans' frame 'base_link' is the base frame (/tf)"
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]

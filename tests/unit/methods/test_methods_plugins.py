@@ -1,0 +1,144 @@
+"""Third-party methods through package entry points (group ``albot1.methods``), with a real ``*.dist-info``."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any, ClassVar
+
+import pytest
+from pydantic import BaseModel, ConfigDict
+from typer.testing import CliRunner
+
+from albot1.bench.errors import SuiteError
+from albot1.bench.plan import plan_suite
+from albot1.bench.suite import load_suite
+from albot1.cli.app import app
+from albot1.contract import MapData, MapperOutput
+from albot1.data.model import Frame
+from albot1.methods.errors import PluginError
+from albot1.methods.plugins import PLUGIN_ERROR_CLASS
+from albot1.methods.registry import method_registry
+from albot1.settings import Settings
+from conftest import PluginInstaller
+
+WORLD = "synthetic-office-startstop"
+#: Set when this module's mapper class is imported by name (the test module itself is already imported).
+IMPORTED_BY_NAME: list[str] = []
+
+
+class EchoConfig(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    gain: float = 1.0
+
+
+class EchoMapper:
+    """A plugin mapper: reports the odometry it was given as its poses."""
+
+    name: ClassVar[str] = "echo"
+    config_model: ClassVar[type[BaseModel]] = EchoConfig
+    presets: ClassVar[dict[str, dict[str, Any]]] = {"default": {"gain": 1.0}, "double": {"gain": 2.0}}
+
+    def __init__(self, config: EchoConfig, seed: int = 0) -> None:
+        self.poses: list[Any] = []
+
+    def process(self, frame: Frame) -> None:
+        self.poses.append(frame.odometry)
+
+    def finish(self) -> MapperOutput:
+        import numpy as np
+
+        return MapperOutput(
+            poses=np.asarray(self.poses),
+            map=MapData(points=np.zeros((1, 2))),
+            counters={"views": len(self.poses), "updates": len(self.poses)},
+        )
+
+
+@pytest.fixture
+def echo(install_method_plugin: PluginInstaller) -> str:
+    install_method_plugin({"echo": f"{__name__}:EchoMapper"})
+    return "echo"
+
+
+def test_an_installed_entry_point_is_a_registered_method(echo: str) -> None:
+    spec = method_registry().get(echo)
+    assert spec.target == f"{__name__}:EchoMapper"
+    assert spec.error_class == PLUGIN_ERROR_CLASS
+    assert "albot1-test-plugin 0.1" in spec.description
+    assert not spec.auto_include  # a suite runs a plugin where it names it
+    assert spec.load_class() is EchoMapper
+
+
+def test_without_the_distribution_the_method_is_unknown() -> None:
+    assert "echo" not in method_registry()
+
+
+def test_a_plugin_runs_in_albot1_run(echo: str, tmp_path: Path) -> None:
+    result = CliRunner().invoke(app, ["run", echo, WORLD, "--out", str(tmp_path), "--json", "--preset", "double"])
+    assert result.exit_code == 0, result.output
+    assert '"method": "echo"' in result.output and '"preset": "double"' in result.output
+
+
+def test_a_plugin_runs_in_a_bench_suite(echo: str, tmp_path: Path) -> None:
+    suite = tmp_path / "plug.toml"
+    suite.write_text(f'[[methods]]\nname = "{echo}"\n\n[[datasets]]\nname = "{WORLD}"\n')
+    results = tmp_path / "results"
+    args = ["bench", str(suite), "-j", "1", "--results", str(results), "--no-progress"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    plan = (results / "plug" / "grid.json").read_text()
+    assert '"method": "echo"' in plan
+
+
+def test_a_plugin_installed_after_the_cell_forkserver_started_runs_in_its_cells(
+    install_method_plugin: PluginInstaller, tmp_path: Path
+) -> None:
+    """The forkserver forks cells from its own state: the runner's import path (and so the plugin) reaches them."""
+    from albot1.bench.limits import start_forkserver
+
+    start_forkserver()  # as an earlier grid of this process would have
+    install_method_plugin({"echo": f"{__name__}:EchoMapper"})
+    suite = tmp_path / "late.toml"
+    suite.write_text(f'[[methods]]\nname = "echo"\n\n[[datasets]]\nname = "{WORLD}"\n')
+    args = ["bench", str(suite), "-j", "1", "--results", str(tmp_path / "results"), "--no-progress"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+
+
+def test_planning_a_suite_imports_no_module_it_names(install_method_plugin: PluginInstaller, tmp_path: Path) -> None:
+    """Only the registry decides what is imported: a suite naming a method imports its registered class only."""
+    install_method_plugin({"lazy": "albot1_plugin_never_imported:Mapper"})
+    suite = tmp_path / "lazy.toml"
+    suite.write_text(f'[[methods]]\nname = "lazy"\n\n[[datasets]]\nname = "{WORLD}"\n')
+    plan = plan_suite(load_suite(suite), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    # the plugin's module is not installed: found out without importing it, the method is skipped with the reason
+    assert "albot1_plugin_never_imported" not in sys.modules
+    [skipped] = plan.skipped_methods
+    assert skipped.name == "lazy" and "needs albot1_plugin_never_imported, which is not installed" in skipped.reason
+    assert skipped.hint == "reinstall albot1-test-plugin, which declares it"
+
+
+def test_a_suite_naming_an_unregistered_method_fails_with_one_line(tmp_path: Path) -> None:
+    suite = tmp_path / "s.toml"
+    suite.write_text(f'[[methods]]\nname = "kiss_icp"\n\n[[datasets]]\nname = "{WORLD}"\n')
+    with pytest.raises(SuiteError) as caught:
+        plan_suite(load_suite(suite), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    message = str(caught.value)
+    assert "\n" not in message
+    assert message.startswith(f"{suite}: unknown method 'kiss_icp' (did you mean 'kiss-icp'?)")
+    assert "entry point group albot1.methods" in message
+    result = CliRunner().invoke(app, ["bench", str(suite), "--dry-run"])  # albot1.cli.app.main prints it as one line
+    assert isinstance(result.exception, SuiteError) and str(result.exception) == message
+
+
+def test_a_plugin_may_not_take_a_built_in_name(install_method_plugin: PluginInstaller) -> None:
+    install_method_plugin({"odometry": f"{__name__}:EchoMapper"})
+    with pytest.raises(PluginError, match=r"entry point 'odometry' of albot1-test-plugin 0.1 .* built-in method"):
+        method_registry()
+
+
+def test_a_malformed_entry_point_is_one_line(install_method_plugin: PluginInstaller) -> None:
+    install_method_plugin({"broken": "no colon here"})
+    with pytest.raises(PluginError, match=r"entry point 'broken' .*expected 'module:Class'"):
+        method_registry()
