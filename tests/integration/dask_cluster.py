@@ -18,7 +18,8 @@ import sys
 import time
 from pathlib import Path
 
-#: Where the fault mapper of the grid tests lives; the workers' cell processes import it from here.
+#: Where the fault mapper of the grid tests lives; the workers' cell processes import it from here
+#: (its plugin entry point is on ``sys.path`` once conftest's ``fault_plugin`` has run).
 TEST_DIR = Path(__file__).parent
 
 

@@ -41,14 +41,14 @@ seeds = [0, 1, 2, 3, 4, 5]
 [[methods]]
 name = "fault"
 label = "slow"
-target = "bench_fault_mappers:FaultMapper"
 set = {{ mode = "slow", sleep_s = 0.15 }}
 
 [[datasets]]
 name = "{WORLD}"
 """
 
-pytestmark = [pytest.mark.slow, pytest.mark.timeout(600)]
+# `fault`: the test-only mapper, installed as a plugin (conftest's fault_plugin) before the cluster starts.
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(600), pytest.mark.usefixtures("fault_plugin")]
 
 
 @pytest.fixture
@@ -59,7 +59,8 @@ def suite(tmp_path: Path) -> Path:
 
 
 @pytest.fixture
-def cluster(tmp_path: Path) -> Iterator[Cluster]:
+def cluster(tmp_path: Path, fault_plugin: None) -> Iterator[Cluster]:
+    """The cluster's processes get the plugin's folder on their path (from this process's ``sys.path``)."""
     folder = tmp_path / "cluster"
     folder.mkdir()
     # Any cell whose worker dies is lost at once (KilledWorker), rather than retried on another worker.
