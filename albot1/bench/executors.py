@@ -20,8 +20,11 @@ One code path: the runner only calls ``submit`` and ``concurrent.futures.as_comp
 from __future__ import annotations
 
 import concurrent.futures as cf
+import logging
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any
 
 from albot1.bench.errors import BenchError
 
@@ -37,6 +40,22 @@ def parse_executor(spec: str) -> tuple[str, str | None]:
         if text.startswith(prefix) and len(text) > len(prefix):
             return "dask", "tcp://" + text[len(prefix) :]
     raise BenchError(f"executor {spec!r} not understood; expected {EXECUTORS_HELP}")
+
+
+def scheduler_executor(address: str, executor: str = "local") -> str:
+    """``--scheduler ADDRESS`` as the executor it abbreviates: ``HOST:PORT`` or ``tcp://HOST:PORT`` -> ``dask://HOST:PORT``.
+
+    ``executor`` is the ``--executor`` given with it: only its default (or the same address) may be.
+    """
+    text = address.strip()
+    host_port = text.removeprefix("tcp://").removeprefix("dask://")
+    host, _, port = host_port.rpartition(":")
+    if not host or "/" in host_port or not port.isdigit() or not 0 < int(port) < 65536:
+        raise BenchError(f"--scheduler {address!r}: expected HOST:PORT (or tcp://HOST:PORT) of a Dask scheduler")
+    spec = f"dask://{host_port}"
+    if executor.strip() != "local" and parse_executor(executor) != parse_executor(spec):
+        raise BenchError(f"--scheduler {address} and --executor {executor} name two executors; give one of them")
+    return spec
 
 
 def check_jobs(jobs: int) -> int:
@@ -63,10 +82,11 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
             client = Client(address, timeout="10s")
         except OSError as exc:
             raise BenchError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
-        try:
-            yield client.get_executor(pure=False)
-        finally:
-            client.close()
+        with _quiet_client_logs():
+            try:
+                yield client.get_executor(pure=False)
+            finally:
+                client.close()
         return
     with dask.config.set({"distributed.worker.daemon": False}):
         cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=dask_processes, dashboard_address=None)
@@ -75,3 +95,76 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
             yield client.get_executor(pure=False)
     finally:
         cluster.close()
+
+
+@contextmanager
+def _quiet_client_logs() -> Iterator[None]:
+    """Keep distributed's own tracebacks (a lost scheduler, its failed reconnection) off the user's terminal.
+
+    The runner reports what they mean as one line (:func:`executor_lost`,
+    :func:`executor_failure`); the levels are restored afterwards.
+    """
+    loggers = [logging.getLogger(name) for name in ("distributed", "distributed.client", "distributed.core")]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels, strict=True):
+            logger.setLevel(level)
+
+
+def _dask_client(executor: cf.Executor) -> Any:
+    """The ``distributed.Client`` behind ``executor`` (from ``Client.get_executor``), or None."""
+    if "distributed" not in sys.modules:
+        return None
+    from distributed.cfexecutor import ClientExecutor
+
+    return executor._client if isinstance(executor, ClientExecutor) else None
+
+
+def _scheduler_name(client: Any) -> str:
+    address = getattr(getattr(client, "scheduler", None), "address", None)
+    return f"the Dask scheduler at {address}" if address else "the Dask scheduler"
+
+
+def executor_lost(executor: cf.Executor) -> str | None:
+    """Why ``executor`` can run no further cell (its Dask scheduler is gone), else None.
+
+    A client that lost its scheduler cancels every future it holds and tries
+    to reconnect for its connect timeout, then closes; a restarted scheduler
+    knows nothing of the lost futures either, so in every state but
+    ``running`` the grid cannot go on through this client.
+    """
+    client = _dask_client(executor)
+    if client is None or client.status == "running":
+        return None
+    return (
+        f"{_scheduler_name(client)} was lost (its client is {client.status}); start it again and run the same "
+        "command, or resume with --executor local"
+    )
+
+
+def executor_failure(exc: BaseException, executor: cf.Executor) -> tuple[str, bool]:
+    """One line on why the executor lost a cell's job with ``exc``, and whether that halts the grid.
+
+    A Dask worker that died with the cell (``KilledWorker``) loses that cell
+    only; a lost scheduler (a closed connection, a timeout talking to it)
+    loses every cell, so it halts the grid.
+    """
+    name = type(exc).__name__
+    first_line = (str(exc).strip().splitlines() or [""])[0]
+    detail = f"{name}: {first_line[:200]}" if first_line else name
+    lost = executor_lost(executor)
+    if name == "KilledWorker":
+        return (
+            "the Dask worker that ran the cell died while it ran the cell (killed, out of memory, or its machine "
+            f"went away; the scheduler gave up on the cell: {name}); run `albot1 bench` again to retry it",
+            False,
+        )
+    if lost is not None:
+        return f"{lost} ({detail})", True
+    if name in ("CommClosedError", "TimeoutError", "CancelledError", "FutureCancelledError"):
+        return f"the connection to the executor was lost: {detail}; run `albot1 bench` again to retry the cell", True
+    return f"executor error: {detail}", False

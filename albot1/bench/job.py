@@ -13,10 +13,12 @@ import json
 import os
 import signal
 import socket
+import sys
 import time
 import traceback
 from pathlib import Path
 
+from albot1 import versions
 from albot1.bench.cell_main import ERROR_FILE, EXIT_OK, EXIT_STORAGE, STORAGE_ERRNOS, storage_error
 from albot1.bench.grid import Cell, CellOutcome, FailureKind
 from albot1.bench.limits import ChildExit, run_limited
@@ -119,6 +121,11 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
     with kind ``storage`` and halts the grid; nothing about it raises.
     """
     store = ResultsStore(results_root)
+    mismatch = _worker_code_mismatch(cell)
+    if mismatch is not None:
+        problem = store.record_failure(cell, mismatch, "executor")
+        reason = mismatch if problem is None else f"{mismatch} [not recorded: {problem}]"
+        return CellOutcome.of(cell, "failed", 0.0, reason, "executor", halts_grid=True)
     try:
         run_dir = store.prepare(cell)
         ended = run_limited(cell, store.runs, run_dir / LOG, preview=preview)
@@ -144,6 +151,31 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
         reason = f"{reason} [not recorded: {problem}]"
     halts = kind == "storage" or ended.pool_lost is not None
     return CellOutcome.of(cell, "failed", ended.elapsed_s, reason, kind, halts_grid=halts)
+
+
+def _worker_code_mismatch(cell: Cell) -> str | None:
+    """Why this Dask worker must not run ``cell``: its albot1 code is not the code the cell's key names.
+
+    The key holds the planning machine's code version; a worker with other
+    code would store its results under a key that claims the wrong code.
+    Checked on Dask workers only: the local executor runs jobs in the
+    runner's own process, whose code planned the keys.
+    """
+    if "distributed" not in sys.modules:
+        return None
+    from distributed import get_worker
+
+    try:
+        worker = get_worker()
+    except ValueError:  # not inside a Dask task
+        return None
+    version = versions.code_version()
+    if version == cell.code_version:
+        return None
+    return (
+        f"the Dask worker {worker.address} on {socket.gethostname()} has albot1 code {version}, but the cells were "
+        f"planned with code {cell.code_version}; install the same code on every worker (see `albot1 --version`)"
+    )
 
 
 def _storage_failure(

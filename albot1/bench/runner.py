@@ -26,12 +26,12 @@ from typing import Protocol
 
 from albot1.bench.cells import renderer_target
 from albot1.bench.errors import BenchError
-from albot1.bench.executors import check_jobs, open_executor, parse_executor
+from albot1.bench.executors import check_jobs, executor_failure, executor_lost, open_executor, parse_executor
 from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.job import results_path, run_cell_job
 from albot1.bench.limits import start_forkserver
 from albot1.bench.plan import plan_suite
-from albot1.bench.store import UNREADABLE_FAILURE, ResultsStore
+from albot1.bench.store import LOG, UNREADABLE_FAILURE, ResultsStore
 from albot1.bench.suite import find_suite, load_suite
 from albot1.runs.folder import PreviewRenderer
 from albot1.runs.output import writable_folder
@@ -159,21 +159,27 @@ def run_grid(
     grid_id = uuid.uuid4().hex
     futures = {executor.submit(_unless_halted, job, grid_id, cell, root): cell for cell in pending}
     waiting = set(futures)
+    started_at = time.time()
     try:
         while waiting:
             done, waiting = cf.wait(waiting, return_when=cf.FIRST_COMPLETED)
             for future in done:
-                if future.cancelled():
-                    continue
-                ended = _outcome(future, futures[future], store)
+                halt: str | None = None
+                if future.cancelled():  # not by the runner (it drops those from `waiting`): the executor lost it
+                    halt = executor_lost(executor) or "the executor cancelled the cell (its Dask scheduler restarted?)"
+                    ended = _lost(futures[future], store, halt, started_at)
+                else:
+                    ended = _outcome(future, futures[future], store, executor)
                 if ended is None:
                     summary.not_started.append(futures[future])
-                    continue
-                summary.outcomes.append(ended)
-                if observer is not None:
-                    observer.finished(ended)
-                if ended.halts_grid and summary.halted is None:
-                    summary.halted = ended.reason
+                else:
+                    summary.outcomes.append(ended)
+                    if observer is not None:
+                        observer.finished(ended)
+                    if ended.halts_grid:
+                        halt = halt or ended.reason
+                if halt is not None and summary.halted is None:
+                    summary.halted = halt
                     cancelled = {f for f in waiting if f.cancel()}
                     summary.not_started += [futures[f] for f in futures if f in cancelled]
                     waiting -= cancelled
@@ -208,12 +214,19 @@ def kept_failure(store: ResultsStore, cell: Cell) -> CellOutcome | None:
     return replace(outcome, kept=True)
 
 
-def _outcome(future: cf.Future[CellOutcome | None], cell: Cell, store: ResultsStore) -> CellOutcome | None:
-    """The job's outcome, or a recorded executor failure when the executor lost the job."""
+def _outcome(
+    future: cf.Future[CellOutcome | None], cell: Cell, store: ResultsStore, executor: cf.Executor
+) -> CellOutcome | None:
+    """The job's outcome, or a recorded executor failure when the executor lost the job.
+
+    A failure the job could not record itself (a Dask worker that cannot
+    write the results folder the runner can) is recorded here, so that
+    every failed cell has its FAILED.json wherever it ran.
+    """
     try:
-        return future.result()
-    except Exception as exc:  # the executor lost the job (worker died, unpicklable, ...)
-        reason = f"executor error: {type(exc).__name__}: {exc}"
+        outcome = future.result()
+    except Exception as exc:  # the executor lost the job (worker died, scheduler lost, unpicklable, ...)
+        reason, halts = executor_failure(exc, executor)
         problem = store.record_failure(
             cell, reason, "executor", traceback_text="".join(traceback.format_exception(exc))
         )
@@ -221,7 +234,40 @@ def _outcome(future: cf.Future[CellOutcome | None], cell: Cell, store: ResultsSt
             return CellOutcome.of(
                 cell, "failed", 0.0, f"{reason} [not recorded: {problem}]", "storage", halts_grid=True
             )
-        return CellOutcome.of(cell, "failed", 0.0, reason, "executor")
+        return CellOutcome.of(cell, "failed", 0.0, reason, "executor", halts_grid=halts)
+    if outcome is not None and outcome.status == "failed" and outcome.kind is not None:
+        reason = _recorded(outcome.reason) or ""
+        if (
+            store.failure(outcome.key, strict=False) is None
+            and store.record_failure(cell, reason, outcome.kind, elapsed_s=outcome.elapsed_s) is None
+        ):
+            outcome = replace(outcome, reason=reason)
+    return outcome
+
+
+def _recorded(reason: str | None) -> str | None:
+    """``reason`` without the job's note that it could not record it (the runner just did)."""
+    if reason is None or " [not recorded: " not in reason:
+        return reason
+    return reason[: reason.index(" [not recorded: ")]
+
+
+def _lost(cell: Cell, store: ResultsStore, why: str, started_at: float) -> CellOutcome | None:
+    """A cell whose job the executor dropped: recorded as failed when it had started in this run, else None.
+
+    Started: its attempt's log (rewritten by every attempt) is newer than the grid's submission.
+    """
+    try:
+        started = (store.run_dir(cell.key) / LOG).stat().st_mtime >= started_at - 1.0
+    except OSError:
+        started = False
+    if not started or store.is_complete(cell.key):
+        return CellOutcome.of(cell, "done") if store.is_complete(cell.key) else None
+    reason = f"{why}; the cell was running"
+    problem = store.record_failure(cell, reason, "executor")
+    if problem is not None:
+        reason = f"{reason} [not recorded: {problem}]"
+    return CellOutcome.of(cell, "failed", 0.0, reason, "executor", halts_grid=True)
 
 
 def bench_results_root(results: Path, suite_name: str) -> Path:

@@ -23,6 +23,10 @@ def bench(
     ] = "default",
     jobs: Annotated[int, typer.Option("-j", "--jobs", help="cells run in parallel")] = 2,
     executor: Annotated[str, typer.Option(help="local | dask | dask://HOST:PORT")] = "local",
+    scheduler: Annotated[
+        str | None,
+        typer.Option(help="HOST:PORT (or tcp://HOST:PORT) of a running Dask scheduler: --executor dask://HOST:PORT"),
+    ] = None,
     results: Annotated[Path, typer.Option(help="results root; cells go to RESULTS/<suite>/runs/<key>")] = Path(
         "results"
     ),
@@ -57,17 +61,21 @@ def bench(
       albot1 bench                       # the default suite, 2 cells at a time\n
       albot1 bench quick -j 1\n
       albot1 bench default --executor dask -j 4\n
-      albot1 bench benchmarks/full.toml --executor dask://scheduler:8786
+      albot1 bench benchmarks/full.toml --executor dask://scheduler:8786\n
+      albot1 bench full --scheduler scheduler:8786     # the same
     """
     # The bench and report layers are imported by the command, not by this module: see albot1.cli.app.
     from tqdm import tqdm
 
+    from albot1.bench.executors import scheduler_executor
     from albot1.bench.plan import plan_suite
     from albot1.bench.progress import TqdmProgress, plan_table, summary_table
     from albot1.bench.runner import run_suite
     from albot1.bench.suite import find_suite, load_suite
     from albot1.report.preview import render_preview
 
+    if scheduler is not None:
+        executor = scheduler_executor(scheduler, executor)
     if dry_run:
         plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))

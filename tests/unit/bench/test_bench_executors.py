@@ -1,0 +1,114 @@
+"""Executors: ``--scheduler`` as an alias of ``dask://``, one-line reasons for lost jobs, cells the executor drops."""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+from collections.abc import Callable
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import pytest
+from distributed import KilledWorker
+from test_bench_failures import make_cell, plan_of
+
+from albot1.bench.errors import BenchError
+from albot1.bench.executors import executor_failure, parse_executor, scheduler_executor
+from albot1.bench.grid import Cell, CellOutcome
+from albot1.bench.runner import run_grid
+from albot1.bench.store import LOG, ResultsStore
+
+
+@pytest.mark.parametrize("address", ["127.0.0.1:8786", "tcp://127.0.0.1:8786", "dask://127.0.0.1:8786"])
+def test_scheduler_is_the_dask_url_of_its_address(address: str) -> None:
+    assert scheduler_executor(address) == "dask://127.0.0.1:8786"
+    assert parse_executor(scheduler_executor(address)) == ("dask", "tcp://127.0.0.1:8786")
+    assert scheduler_executor(address, "dask://127.0.0.1:8786") == "dask://127.0.0.1:8786"
+
+
+@pytest.mark.parametrize("address", ["", "127.0.0.1", "host:port", "host:0", "host:70000", ":8786", "a/b:1"])
+def test_a_scheduler_address_without_host_and_port_is_refused(address: str) -> None:
+    with pytest.raises(BenchError, match="expected HOST:PORT"):
+        scheduler_executor(address)
+
+
+def test_scheduler_and_another_executor_together_are_refused() -> None:
+    with pytest.raises(BenchError, match="name two executors; give one of them"):
+        scheduler_executor("127.0.0.1:8786", "dask")
+
+
+def test_a_killed_worker_fails_its_cell_only_with_one_line() -> None:
+    exc = KilledWorker("_unless_halted-1", SimpleNamespace(address="tcp://127.0.0.1:1"), allowed_failures=0)
+    with cf.ThreadPoolExecutor(1) as pool:
+        reason, halts = executor_failure(exc, pool)
+    assert not halts and "\n" not in reason
+    assert reason.startswith("the Dask worker that ran the cell died while it ran the cell")
+    assert reason.endswith("run `albot1 bench` again to retry it")
+
+
+def test_a_closed_connection_halts_and_other_errors_keep_their_first_line() -> None:
+    class CommClosedError(OSError):
+        pass
+
+    with cf.ThreadPoolExecutor(1) as pool:
+        assert executor_failure(CommClosedError("in <TCP>: Stream is closed"), pool) == (
+            "the connection to the executor was lost: CommClosedError: in <TCP>: Stream is closed; "
+            "run `albot1 bench` again to retry the cell",
+            True,
+        )
+        assert executor_failure(ValueError("first\nsecond"), pool) == ("executor error: ValueError: first", False)
+
+
+class DroppingExecutor(cf.Executor):
+    """Runs ``started`` jobs, then cancels every other job as a Dask client cancels them when its scheduler goes."""
+
+    def __init__(self, started: int) -> None:
+        self.started = started
+        self.submitted = 0
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> cf.Future[Any]:
+        future: cf.Future[Any] = cf.Future()
+        self.submitted += 1
+        if self.submitted <= self.started:
+            future.set_result(fn(*args, **kwargs))
+        else:
+            future.cancel()
+            future.set_running_or_notify_cancel()
+        return future
+
+
+def test_cells_the_executor_cancels_halt_the_grid_and_are_never_dropped(tmp_path: Path) -> None:
+    cells = [make_cell(f"k{i}") for i in range(4)]
+    store = ResultsStore(tmp_path)
+    store.prepare(cells[2])  # k2 had started when the executor lost it
+
+    def job(cell: Cell, root: str) -> CellOutcome:
+        return CellOutcome.of(cell, "done")
+
+    summary = run_grid(plan_of(cells), store, DroppingExecutor(started=2), job=job)
+    assert summary.halted == "the executor cancelled the cell (its Dask scheduler restarted?)"
+    assert summary.counts["done"] == 2
+    assert [o.key for o in summary.failures] == ["k2"]
+    assert (
+        summary.failures[0].reason
+        == "the executor cancelled the cell (its Dask scheduler restarted?); the cell was running"
+    )
+    failure = store.failure("k2")
+    assert failure is not None and failure.kind == "executor"
+    assert [c.key for c in summary.not_started] == ["k3"]
+    assert (store.run_dir("k2") / LOG).is_file()
+
+
+def test_a_failure_the_job_could_not_record_is_recorded_by_the_runner(tmp_path: Path) -> None:
+    cells = [make_cell("k0")]
+    store = ResultsStore(tmp_path)
+
+    def unwritable(cell: Cell, root: str) -> CellOutcome:
+        reason = "cannot write the results: read-only file system: /r/runs/k0 [not recorded: /r/runs/k0/FAILED.json]"
+        return CellOutcome.of(cell, "failed", 0.0, reason, "storage", halts_grid=True)
+
+    with cf.ThreadPoolExecutor(1) as pool:
+        summary = run_grid(plan_of(cells), store, pool, job=unwritable)
+    failure = store.failure("k0")
+    assert failure is not None and failure.kind == "storage"
+    assert failure.reason == summary.failures[0].reason == "cannot write the results: read-only file system: /r/runs/k0"
