@@ -51,8 +51,13 @@ MAX_MOTION_M = 1e8
 MAX_TIMESTAMP_S = 1e11
 
 
-def read_relations(path: str | Path) -> Relations:
-    """Parse a relations file; ParseError naming ``file:line`` on any malformed line."""
+def read_relations(path: str | Path, *, warn_repeats: bool = True) -> Relations:
+    """Parse a relations file; ParseError naming ``file:line`` on any malformed line.
+
+    ``warn_repeats=False`` for a copy this project wrote (a run folder's
+    ``relations.txt``): its repeats were reported when the dataset's own file
+    was read, and saying so again for the copy would double every warning.
+    """
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8", errors="replace")
@@ -88,7 +93,7 @@ def read_relations(path: str | Path) -> Relations:
         else:
             seen[pair] = (number, values)
         rows.append(values)
-    if repeats:
+    if repeats and warn_repeats:
         log.warning(
             "%s: %d relation line(s) repeat an earlier line identically; each is counted as listed: line %s",
             p,
