@@ -36,7 +36,7 @@ from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
-from albot1.report.standard import write_standard
+from albot1.report.standard import on_standard_logs, write_standard
 from albot1.report.tables import aggregate, cells_frame, write_tables
 from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
@@ -337,7 +337,8 @@ def build_report(
     records = separate_data(collected)  # runs of one dataset on different data never share a row
     target.mkdir(parents=True, exist_ok=True)
     tables = write_tables(records, target)
-    tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
+    if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
+        tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
     generalisation = write_generalisation(plan, records, target)
     if generalisation is not None:
         tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation

@@ -363,6 +363,13 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
     return "\n".join(lines)
 
 
+def on_standard_logs(plan: GridPlan, records: list[CellRecord]) -> bool:
+    """Whether the suite ran, or skipped for want of data, any of the five logs (else the page would be empty)."""
+    return any(rec.cell.dataset_label in STANDARD_LOGS for rec in records) or any(
+        s.name in STANDARD_LOGS for s in plan.skipped_datasets
+    )
+
+
 def write_standard(plan: GridPlan, records: list[CellRecord], out: Path) -> tuple[Path, Path]:
     """Write ``standard-benchmark.md`` and ``.csv`` into ``out``; returns both paths."""
     measured = measured_rows(records)
