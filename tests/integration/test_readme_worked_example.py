@@ -73,9 +73,7 @@ class Ran:
 
 def _run_part(part: int, folder: Path) -> Ran:
     """Run README part ``part`` in ``folder`` with an ``albot1`` on PATH that is this tree's CLI."""
-    script = subprocess.run(
-        [str(EXTRACT), str(part), str(README)], capture_output=True, text=True, check=True
-    ).stdout
+    script = subprocess.run([str(EXTRACT), str(part), str(README)], capture_output=True, text=True, check=True).stdout
     bindir = folder.parent / "bin"
     bindir.mkdir(exist_ok=True)
     shim = bindir / "albot1"
