@@ -39,6 +39,7 @@ from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
+from albot1.report.provenance import bench_argument
 from albot1.report.tuning import LEGEND, MARK, held_in, marked
 
 PAGE = "generalisation.md"
@@ -232,7 +233,7 @@ def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None
         "",
         LEGEND,
         "",
-        f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}`.",
+        f"Regenerate: `albot1 bench {bench_argument(plan)} && albot1 report results/{plan.suite}`.",
         "",
         "## Where a method is worse than its own odometry",
         "",

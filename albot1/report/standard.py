@@ -31,7 +31,7 @@ from albot1.methods.baselines.published import published_systems
 from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.report.collect import CellRecord
 from albot1.report.markdown import text as md_text
-from albot1.report.provenance import data_lines
+from albot1.report.provenance import bench_argument, data_lines
 from albot1.report.tuning import LEGEND, held_in, marked
 
 #: The five logs of the standard benchmark, with the names the published tables use.
@@ -293,8 +293,8 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
         "per CPU second. Published timings are Hess et al.'s (Table V), measured on "
         "an Intel Xeon E5-1650 at 3.2 GHz: compare the ratios, not the seconds.",
         "",
-        f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}` (`make bench` does this for "
-        "the default suite).",
+        f"Regenerate: `albot1 bench {bench_argument(plan)} && albot1 report results/{plan.suite}` "
+        "(`make bench` does this for the default suite).",
         "",
         "## Translational error, mean (m)",
         "",

@@ -124,6 +124,8 @@ def test_part1_runs_the_baselines_on_the_bag_and_reports_the_external_system(par
     for page in ("README.md", "metrics.md", "metrics.csv", "metrics.tex", "cost.md", "generalisation.md", "index.html"):
         assert EXTERNAL in (report / page).read_text(encoding="utf-8"), page
     assert not (report / "standard-benchmark.md").exists()  # no standard log in part 1: no empty page
+    suite = (part1.folder / "robot.toml").resolve()  # the pages say how to run it again: by its path
+    assert f"`albot1 bench {suite} && albot1 report results/robot`" in (report / "generalisation.md").read_text()
     plots = {p.name for p in (report / "plots").iterdir()}
     for kind in ("trajectories", "ape", "error-distance", "rpe-boxes", "maps"):
         (svg,) = [name for name in plots if name.endswith(f"-{kind}.svg") and name.startswith("robot.mcap")]
