@@ -61,7 +61,8 @@ def test_a_known_better_method_is_better_and_its_mirror_worse() -> None:
 def test_identical_errors_are_indistinguishable_with_ratio_exactly_one() -> None:
     errors = [np.abs(np.sin(np.arange(50.0))), np.arange(30.0)]
     found = compare([(e, e) for e in errors], resamples=100)
-    assert (found.verdict, found.ratio, found.low, found.high, found.pairs, found.groups) == (SAME, 1.0, 1.0, 1.0, 80, 2)
+    assert (found.verdict, found.ratio, found.low, found.high) == (SAME, 1.0, 1.0, 1.0)
+    assert (found.pairs, found.groups) == (80, 2)
     assert found.short() == "≈ 1"
 
 
