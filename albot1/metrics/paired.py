@@ -40,6 +40,9 @@ RESAMPLES: Final = 2000
 BLOCKS: Final = 20
 #: fewest pairs (over all groups) a comparison is made on
 MIN_PAIRS: Final = 10
+#: a pooled error below this (m or deg) is zero: a perfect reference (e.g. the reference poses given as odometry),
+#: to which a ratio is numerical noise
+ZERO_ERROR: Final = 1e-6
 #: resamples whose indices are built at once (memory: CHUNK x the longest group's length)
 CHUNK: Final = 250
 
@@ -47,6 +50,7 @@ BETTER: Final = "better"
 WORSE: Final = "worse"
 SAME: Final = "indistinguishable"
 NOT_APPLICABLE: Final = "n/a"
+PERFECT_REFERENCE: Final = f"the reference's error is below {ZERO_ERROR:g} (perfect): no ratio"
 #: the verdict read from the other side (B against A)
 MIRROR: Final = {BETTER: WORSE, WORSE: BETTER, SAME: SAME, NOT_APPLICABLE: NOT_APPLICABLE}
 #: one character per verdict, for compact matrices: A's error is smaller / larger / not told apart
@@ -185,7 +189,8 @@ def compare(
 
     Not applicable (with the reason) when the groups hold fewer than
     :data:`MIN_PAIRS` pairs, when a group's two arrays differ in length or
-    hold a non-finite error, or when B's error is zero everywhere (no ratio).
+    hold a non-finite error, or when B's pooled error is below
+    :data:`ZERO_ERROR` (a perfect reference: no ratio).
     """
     arrays: list[Pair] = []
     for a, b in pairs:
@@ -199,7 +204,8 @@ def compare(
         return not_applicable(f"{count} pairs, fewer than {MIN_PAIRS}", count, len(arrays))
     if not all(np.isfinite(x).all() and np.isfinite(y).all() for x, y in arrays):
         return not_applicable("a non-finite error", count, len(arrays))
-    if not any(float(np.sum(np.abs(y))) > 0 for _, y in arrays):
-        return not_applicable("the reference's error is zero: no ratio", count, len(arrays))
+    reference = _pooled(sum(float(np.sum(np.abs(y) ** power)) for _, y in arrays), float(count), power)
+    if reference < ZERO_ERROR:
+        return not_applicable(PERFECT_REFERENCE, count, len(arrays))
     ratio, low, high = bootstrap_ratio(arrays, power=power, resamples=resamples, seed=seed)
     return Comparison(ratio, low, high, verdict(low, high), count, len(arrays))

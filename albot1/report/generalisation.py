@@ -39,7 +39,7 @@ from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
-from albot1.metrics.paired import BLOCKS, CONFIDENCE, RESAMPLES, bootstrap_ratio, verdict
+from albot1.metrics.paired import BLOCKS, CONFIDENCE, RESAMPLES, ZERO_ERROR, bootstrap_ratio, verdict
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
 from albot1.report.tuning import LEGEND, MARK, held_in, marked
 
@@ -49,7 +49,7 @@ ODOMETRY = "odometry"
 NA = "n/a"
 #: An odometry ATE below this (m) is perfect odometry (the reference itself): a ratio to it means nothing, the
 #: method's own ATE is the figure (issue 21's target for gtsam-graph: <= 0.3 m).
-PERFECT_M = 1e-6
+PERFECT_M = ZERO_ERROR
 PERFECT = "perfect odometry"
 
 

@@ -11,6 +11,7 @@ from albot1.metrics.paired import (
     BETTER,
     MIN_PAIRS,
     NOT_APPLICABLE,
+    PERFECT_REFERENCE,
     SAME,
     WORSE,
     bootstrap_ratio,
@@ -71,7 +72,9 @@ def test_too_few_pairs_or_no_reference_error_is_not_applicable_with_its_reason()
     assert few.verdict == NOT_APPLICABLE and few.reason == f"{MIN_PAIRS - 1} pairs, fewer than {MIN_PAIRS}"
     assert few.text() == f"n/a ({MIN_PAIRS - 1} pairs, fewer than {MIN_PAIRS})" and few.short() == "–"
     zero = compare([(np.ones(20), np.zeros(20))])
-    assert zero.verdict == NOT_APPLICABLE and zero.reason == "the reference's error is zero: no ratio"
+    assert zero.verdict == NOT_APPLICABLE and zero.reason == PERFECT_REFERENCE
+    assert compare([(np.ones(20), np.full(20, 1e-9))]).reason == PERFECT_REFERENCE  # numerical noise: no ratio
+    assert compare([(np.full(20, 1e-9), np.ones(20))], resamples=20).verdict == BETTER  # a perfect method is better
     assert compare([(np.full(20, np.nan), np.ones(20))]).reason == "a non-finite error"
     with pytest.raises(ValueError, match="differ in length"):
         compare([(np.ones(20), np.ones(21))])

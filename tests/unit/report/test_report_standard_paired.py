@@ -11,7 +11,7 @@ import pytest
 from albot1.bench.grid import Cell, GridPlan
 from albot1.data.model import Frame, Relations, Scan, Sequence
 from albot1.geometry import se2
-from albot1.metrics.paired import BETTER, SAME, WORSE
+from albot1.metrics.paired import BETTER, PERFECT_REFERENCE, SAME, WORSE
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
@@ -54,7 +54,7 @@ def test_a_method_with_half_the_error_is_better_an_identical_one_indistinguishab
     trans, rot = paired.found[("kiss-icp", "odometry")]
     assert (trans.verdict, trans.pairs, trans.groups) == (BETTER, SCANS - 1, 1)
     assert trans.ratio == pytest.approx(0.5) and trans.low == pytest.approx(0.5) and trans.high == pytest.approx(0.5)
-    assert rot.verdict == "n/a" and rot.reason == "the reference's error is zero: no ratio"  # no rotation error
+    assert rot.verdict == "n/a" and rot.reason == PERFECT_REFERENCE  # no rotation error
     back = paired.found[("odometry", "kiss-icp")][0]
     assert back.verdict == WORSE and back.ratio == pytest.approx(2.0)
     same = paired.found[("gtsam-graph", "odometry")][0]
@@ -77,7 +77,7 @@ def test_the_page_shows_a_matrix_per_log_and_the_csv_every_interval(tmp_path: Pa
         ("odometry", "kiss-icp", "rotation", "n/a", "29"),
     ]
     assert float(rows[0]["ratio"]) == pytest.approx(2.0)
-    assert rows[1]["reason"] == "the reference's error is zero: no ratio"
+    assert rows[1]["reason"] == PERFECT_REFERENCE
 
 
 def test_a_run_folder_that_does_not_reproduce_its_metric_is_left_out_with_the_reason(tmp_path: Path) -> None:
