@@ -50,7 +50,7 @@ BETTER: Final = "better"
 WORSE: Final = "worse"
 SAME: Final = "indistinguishable"
 NOT_APPLICABLE: Final = "n/a"
-PERFECT_REFERENCE: Final = f"the reference's error is below {ZERO_ERROR:g} (perfect): no ratio"
+PERFECT_REFERENCE: Final = f"the reference error is below {ZERO_ERROR:g} (perfect): no ratio"
 #: the verdict read from the other side (B against A)
 MIRROR: Final = {BETTER: WORSE, WORSE: BETTER, SAME: SAME, NOT_APPLICABLE: NOT_APPLICABLE}
 #: one character per verdict, for compact matrices: A's error is smaller / larger / not told apart
@@ -113,7 +113,7 @@ def method_text(resamples: int = RESAMPLES) -> str:
     return (
         f"paired moving-block bootstrap ({resamples} resamples from a fixed seed, blocks of 1/{BLOCKS} of a "
         f"run resampled within each run, the same indices for both methods), {CONFIDENCE:.0%} interval of the "
-        "error ratio; **better** / **worse** when the whole interval is below / above 1, else indistinguishable; "
+        "error ratio; better / worse when the whole interval is below / above 1, else indistinguishable; "
         f"n/a (with the reason) under {MIN_PAIRS} pairs"
     )
 

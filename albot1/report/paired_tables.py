@@ -22,7 +22,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from html import escape
 from pathlib import Path
@@ -136,13 +135,23 @@ def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str,
     return rows
 
 
-def _cell(found: Comparison | None, role: str, escape_text: Callable[[str], str] = str) -> str:
-    """``better 0.42 [0.38–0.47]``, ``n/a: <reason>`` (the reason escaped by ``escape_text``), or the row's role."""
+def _cell(found: Comparison | None, role: str) -> str:
+    """``better 0.42 [0.38–0.47]``, ``n/a`` (the reason under the table), or the row's role."""
     if found is None:
         return role
-    if not found.applies:
-        return f"n/a: {escape_text(str(found.reason))}"
-    return f"{found.verdict} {found.text()}"
+    return f"{found.verdict} {found.text()}" if found.applies else "n/a"
+
+
+def _notes(rows: list[PairedRow]) -> list[str]:
+    """Why comparisons are n/a or runs left out, each reason once with the comparisons it applies to."""
+    why: dict[str, list[str]] = {}
+    for r in rows:
+        for other, found in ((r.reference, r.against_reference), (r.best, r.against_best)):
+            if found is not None and not found.applies:
+                why.setdefault(f"n/a: {found.reason}", []).append(f"{r.method} against {other} ({r.degradation})")
+        if r.missing is not None:
+            why.setdefault(f"a run not compared: {r.missing}", []).append(f"{r.method} ({r.degradation})")
+    return [f"{reason}: {'; '.join(dict.fromkeys(where))}" for reason, where in why.items()]
 
 
 def _counts(row: PairedRow) -> str:
@@ -178,20 +187,15 @@ def markdown_lines(rows: list[PairedRow], dataset: str) -> list[str]:
         "|---|---|---:|---|---|",
     ]
     for r in mine:
-        ref = _cell(r.against_reference, REFERENCE, md_text)
-        best = _cell(r.against_best, BEST, md_text)
+        ref = _cell(r.against_reference, REFERENCE)
+        best = _cell(r.against_best, BEST)
         lines.append(
             f"| {md_text(r.method)} | {md_text(r.degradation)} | {_counts(r)} | "
             f"{ref}{'' if r.against_reference is None else f' ({md_text(r.reference)})'} | "
             f"{best}{'' if r.against_best is None else f' ({md_text(r.best)})'} |"
         )
-    notes = [f"- {md_text(r.method)} ({md_text(r.degradation)}): {md_text(n)}" for r in mine if (n := _left_out(r))]
+    notes = [f"- {md_text(note)}" for note in _notes(mine)]
     return [*lines, "", *notes, *([""] if notes else [])]
-
-
-def _left_out(row: PairedRow) -> str | None:
-    """Why some of the row's runs are not in its comparisons (None when all are)."""
-    return None if row.missing is None else f"a run not compared: {row.missing}"
 
 
 def html_table(rows: list[PairedRow], dataset: str) -> str:
@@ -210,11 +214,13 @@ def html_table(rows: list[PairedRow], dataset: str) -> str:
             f"<tr><td>{escape(r.method)}</td><td>{escape(r.degradation)}</td><td>{escape(_counts(r))}</td>"
             f"<td>{escape(ref)}</td><td>{escape(best)}</td></tr>"
         )
+    notes = "".join(f"<li>{escape(note)}</li>" for note in _notes(mine))
     return (
         f'<p class="notes">Paired comparison, {escape(FIGURE[mine[0].kind])}: {escape(method_text())}.</p>'
         f'<div class="scroll"><table class="sortable"><thead><tr>{head}</tr></thead><tbody>'
         + "".join(body)
         + "</tbody></table></div>"
+        + (f'<ul class="notes">{notes}</ul>' if notes else "")
     )
 
 
