@@ -245,7 +245,9 @@ def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None
             "",
             "## With perfect odometry",
             "",
-            "ATE (m) of each method given the reference poses as odometry (no ratio: the odometry's is 0).",
+            "ATE (m) of each method given the reference poses as odometry (no ratio: the odometry's is 0). "
+            "Which of these differ significantly: the paired comparisons against the best method under each "
+            "dataset's table in `metrics.md` (`paired.csv`).",
             "",
             "| method | " + " | ".join(logs) + " |",
             "|---|" + "---:|" * len(logs),

@@ -10,7 +10,7 @@ import pytest
 
 from albot1.bench.grid import Cell
 from albot1.data.model import Frame, Scan, Sequence
-from albot1.metrics.paired import BETTER, SAME, WORSE
+from albot1.metrics.paired import BETTER, PERFECT_REFERENCE, SAME, WORSE
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
@@ -109,3 +109,14 @@ def test_the_tables_show_the_comparison_with_its_test_and_write_the_csv(
 def test_the_error_is_the_ate_with_reference_poses_else_none(records: list[CellRecord]) -> None:
     assert error_kind(records) == "position"
     assert error_kind([CellRecord(records[0].cell, "failed", records[0].run_dir, None, None, None)]) is None
+
+
+def test_with_perfect_odometry_the_best_is_the_best_imperfect_method(tmp_path: Path) -> None:
+    records = [_record(tmp_path, "odometry", 0.0, 0), _record(tmp_path, "kiss-icp", 0.02, 0)]
+    records.append(_record(tmp_path, "gtsam-graph", 0.10, 0))
+    rows = {r.method: r for r in paired_rows(records)}
+    assert {r.best for r in rows.values()} == {"kiss-icp"}
+    found = rows["kiss-icp"].against_reference
+    assert found is not None and found.reason == PERFECT_REFERENCE  # no ratio to a perfect odometry
+    against = rows["gtsam-graph"].against_best
+    assert against is not None and against.verdict == WORSE and against.ratio == pytest.approx(5.0, rel=0.05)
