@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Final
 
 import numpy as np
@@ -124,6 +125,30 @@ def _pooled(num: float, den: float, power: int) -> float:
     return math.sqrt(num / den) if power == 2 else (num / den) ** (1.0 / power)
 
 
+def _shape(n: int) -> tuple[int, int, int]:
+    """``(n, block length, blocks)`` of a group of ``n`` errors."""
+    length = max(1, math.ceil(n / BLOCKS))
+    return n, length, math.ceil(n / length)
+
+
+@lru_cache(maxsize=16)  # ~0.3 MB per group of a shape
+def _block_starts(shapes: tuple[tuple[int, int, int], ...], resamples: int, seed: int) -> list[NDArray[np.int64]]:
+    """Per group, the block starts of every resample (read-only: shared by every comparison of the same shapes).
+
+    They depend on the groups' lengths and the seed only, not on the errors, so the comparisons of one table
+    (the same runs' scans or relations) draw them once. Drawn resample by resample and group by group: that
+    order fixes the page's numbers.
+    """
+    rng = np.random.default_rng(seed)
+    starts = [np.empty((resamples, count), dtype=np.int64) for _, _, count in shapes]
+    for k in range(resamples):
+        for g, (n, length, count) in enumerate(shapes):
+            starts[g][k] = rng.integers(0, n - length + 1, size=count)
+    for first in starts:
+        first.setflags(write=False)
+    return starts
+
+
 def bootstrap_ratio(
     pairs: Sequence[Pair],
     *,
@@ -138,17 +163,8 @@ def bootstrap_ratio(
     """
     powered = [(np.asarray(a, dtype=float) ** power, np.asarray(b, dtype=float) ** power) for a, b in pairs]
     ratio = _pooled(sum(float(np.sum(a)) for a, _ in powered), sum(float(np.sum(b)) for _, b in powered), power)
-    rng = np.random.default_rng(seed)
-    shapes = []
-    for a, _ in powered:
-        n = len(a)
-        length = max(1, math.ceil(n / BLOCKS))
-        shapes.append((n, length, math.ceil(n / length)))
-    # the block starts, drawn resample by resample and group by group (the order fixes the page's numbers)
-    starts = [np.empty((resamples, count), dtype=np.int64) for _, _, count in shapes]
-    for k in range(resamples):
-        for g, (n, length, count) in enumerate(shapes):
-            starts[g][k] = rng.integers(0, n - length + 1, size=count)
+    shapes = tuple(_shape(len(a)) for a, _ in powered)
+    starts = _block_starts(shapes, resamples, seed)
     num = np.zeros(resamples)
     den = np.zeros(resamples)
     for (a, b), (n, length, _), first in zip(powered, shapes, starts, strict=True):
