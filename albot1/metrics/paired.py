@@ -106,7 +106,8 @@ def _reciprocal(value: float) -> float:
 
 
 def _g(value: float) -> str:
-    return "n/a" if not math.isfinite(value) else f"{value:.3g}"
+    """3 significant digits; ``inf`` is the mirror of a ratio of 0 (a method without error against one with)."""
+    return "n/a" if math.isnan(value) else f"{value:.3g}"
 
 
 def method_text(resamples: int = RESAMPLES) -> str:

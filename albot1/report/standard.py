@@ -220,7 +220,14 @@ def _paired_lines(paired: Paired | None) -> list[str]:
     if len(paired.labels) >= 2:
         lines += [*matrix_lines(paired.labels, paired.found, "row vs column"), ""]
     lines += [f"- {m}: not compared: {why}" for m, why in paired.left_out.items()]
-    return [*lines, ""] if paired.left_out else lines
+    why: dict[str, list[str]] = {}  # each n/a reason once, with the comparisons it applies to
+    for i, a in enumerate(paired.labels):
+        for b in paired.labels[i + 1 :]:
+            for kind, found in zip(("translation", "rotation"), paired.found[(a, b)], strict=True):
+                if not found.applies:
+                    why.setdefault(str(found.reason), []).append(f"{a} vs {b} ({kind})")
+    lines += [f"- `–` {reason}: {'; '.join(where)}" for reason, where in why.items()]
+    return [*lines, ""] if paired.left_out or why else lines
 
 
 def published_rows(durations: dict[str, float] | None = None) -> list[Row]:

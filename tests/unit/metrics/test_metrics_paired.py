@@ -74,7 +74,9 @@ def test_too_few_pairs_or_no_reference_error_is_not_applicable_with_its_reason()
     zero = compare([(np.ones(20), np.zeros(20))])
     assert zero.verdict == NOT_APPLICABLE and zero.reason == PERFECT_REFERENCE
     assert compare([(np.ones(20), np.full(20, 1e-9))]).reason == PERFECT_REFERENCE  # numerical noise: no ratio
-    assert compare([(np.full(20, 1e-9), np.ones(20))], resamples=20).verdict == BETTER  # a perfect method is better
+    perfect = compare([(np.zeros(20), np.ones(20))], resamples=20)
+    assert perfect.verdict == BETTER and perfect.short() == "< 0"  # a perfect method is better
+    assert perfect.mirrored().short() == "> inf" and perfect.mirrored().verdict == WORSE
     assert compare([(np.full(20, np.nan), np.ones(20))]).reason == "a non-finite error"
     with pytest.raises(ValueError, match="differ in length"):
         compare([(np.ones(20), np.ones(21))])

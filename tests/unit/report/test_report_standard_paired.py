@@ -70,6 +70,7 @@ def test_the_page_shows_a_matrix_per_log_and_the_csv_every_interval(tmp_path: Pa
     assert "paired moving-block bootstrap (2000 resamples" in text
     assert "| row vs column | odometry | kiss-icp |" in text
     assert "| odometry | · | > 2 / – |" in text and "| kiss-icp | < 0.5 / – | · |" in text
+    assert f"- `–` {PERFECT_REFERENCE}: odometry vs kiss-icp (rotation)" in text  # each n/a with its reason
     with (out / PAIRED_TABLE).open() as f:
         rows = list(csv.DictReader(f))
     assert [(r["method"], r["against"], r["error"], r["verdict"], r["relations"]) for r in rows] == [
