@@ -54,8 +54,9 @@ FIGURE: Final[dict[Kind, str]] = {
 #: relative tolerance of the check that the recomputed errors reproduce the run's metrics.json
 REPRODUCE_RTOL: Final = 1e-6
 NOT_REPRODUCED: Final = (
-    "its run folder does not reproduce its metrics.json (an external file's relations are looked up in every "
-    "pose of the file, the folder keeps the poses matched to scans)"
+    "its run folder does not reproduce its metrics.json (an external file is scored on every pose of the file, "
+    "the folder keeps the poses matched to scans; or the metrics were written by another version of the code: "
+    "albot1 evaluate the run again)"
 )
 
 
