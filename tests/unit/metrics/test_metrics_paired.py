@@ -85,3 +85,15 @@ def test_too_few_pairs_or_no_reference_error_is_not_applicable_with_its_reason()
 def test_the_verdict_reads_the_interval_against_one() -> None:
     assert [verdict(0.5, 0.9), verdict(1.1, 1.5), verdict(0.9, 1.1), verdict(1.0, 1.0)] == [BETTER, WORSE, SAME, SAME]
     assert "paired moving-block bootstrap" in method_text() and "95%" in method_text()
+
+
+def test_the_numbers_are_those_of_the_generalisation_page_before_the_move() -> None:
+    """Pinned: the bootstrap of ``albot1/report/generalisation.py`` (commit e309a8d) gave exactly these floats."""
+    a = np.abs(np.sin(np.arange(137.0))) + 0.1
+    b = np.abs(np.cos(np.arange(137.0) * 0.7)) + 0.2
+    c = np.linspace(0.1, 1.0, 61)
+    assert bootstrap_ratio([(a, b), (c, c[::-1].copy())], resamples=300, seed=3) == (
+        0.9105986048453787,
+        0.8409428987692522,
+        0.9821878188620228,
+    )
