@@ -141,7 +141,7 @@ def read_relations(path: str | Path, *, warn_repeats: bool = True, repeats: Repe
         t2=arr[:, 1].copy(),
         poses=arr[:, [2, 3, 7]].copy(),
         repeats=len(repeated) if repeats == "keep" or not noted else noted,
-        repeats_counted=repeats == "keep",
+        repeats_counted=repeats == "keep" and bool(repeated),  # without repeated lines both readings agree
     )
 
 
