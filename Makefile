@@ -33,7 +33,7 @@ $(STAMP): pyproject.toml
 # Every test (unit, property, integration on the public logs when ALBOT1_DATA_DIR has them, the slow
 # whole-world runs), spread over TEST_JOBS worker processes (pytest-xdist; auto = one per core).
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n $(TEST_JOBS)
+	$(BIN)/python -m pytest -q -n $(TEST_JOBS) --dist worksteal
 
 # The edit-test loop: unit and property tests without the slow ones and without the public logs.
 test-fast: $(STAMP)
