@@ -295,6 +295,9 @@ def write_results(data: ResultsData, page: Path, readme: Path | None) -> list[Pa
     """Write the figures, the record, the page and (when given) the README block; return what was written."""
     from albot1.report.results_figures import draw_figures
 
+    readme_text = None if readme is None else readme.read_text(encoding="utf-8")
+    if readme_text is not None:  # a README without the markers is refused before anything is written
+        replace_block(readme_text, "", str(readme))
     figures_dir = page.parent / "results"
     figures_dir.mkdir(parents=True, exist_ok=True)
     data.figures = draw_figures(data.standard, verdict_counts(data), figures_dir)
@@ -303,10 +306,8 @@ def write_results(data: ResultsData, page: Path, readme: Path | None) -> list[Pa
     _write_if_changed(record, data.to_json())
     _write_if_changed(page, render_page(data))
     written += [record, page]
-    if readme is not None:
-        _write_if_changed(
-            readme, replace_block(readme.read_text(encoding="utf-8"), render_readme_block(data), str(readme))
-        )
+    if readme is not None and readme_text is not None:
+        _write_if_changed(readme, replace_block(readme_text, render_readme_block(data), str(readme)))
         written.append(readme)
     return written
 

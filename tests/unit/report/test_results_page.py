@@ -162,3 +162,12 @@ def test_figures_without_numbers_are_removed(tmp_path: Path) -> None:
     write_results(empty, page, None)
     assert sorted(p.name for p in (tmp_path / "results").iterdir()) == ["results.json"]
     assert "## Figures" not in page.read_text(encoding="utf-8")
+
+
+def test_readme_without_markers_is_refused_before_writing(tmp_path: Path) -> None:
+    readme = tmp_path / "README.md"
+    readme.write_text("no block here\n", encoding="utf-8")
+    with pytest.raises(ReportError, match="README.md: expected one"):
+        write_results(_data(), tmp_path / "docs" / "results.md", readme)
+    assert not (tmp_path / "docs").exists()
+    assert readme.read_text(encoding="utf-8") == "no block here\n"
