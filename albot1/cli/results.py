@@ -26,9 +26,9 @@ def results_page(
 ) -> None:
     """Write docs/results.md, docs/results/*.svg and results.json from the stores `make bench` filled.
 
-    The page is stamped with each store's suite, code version and commit (no date: a run with
-    nothing new rewrites the same bytes). With --readme, the block between
-    `<!-- results:begin ... -->` and `<!-- results:end -->` is rewritten from the same numbers.
+    Stamped with each store's suite, code version and commit; no date, so nothing new means no change.
+
+    With --readme, the block between the results:begin and results:end markers is rewritten too.
 
     Example:\n
       albot1 results-page results/default --thesis results/thesis --readme README.md

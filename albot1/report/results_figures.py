@@ -37,7 +37,14 @@ class BarRow(Protocol):
 RELATIONS_SVG = "relation-metric.svg"
 SPEED_SVG = "speed.svg"
 VERDICTS_SVG = "thesis-verdicts.svg"
-PUBLISHED_GREYS = ("#444444", "#888888", "#bbbbbb", "#dddddd")
+#: Published systems: grey outlines, each its own hatch (never a measured method's colour).
+PUBLISHED_STYLES = (
+    ("#333333", "///"),
+    ("#777777", "\\\\\\"),
+    ("#555555", "xxx"),
+    ("#999999", "..."),
+    ("#444444", "---"),
+)
 VERDICT_COLORS = {"holds": "#2ca02c", "does not hold": "#d62728", "not comparable": "#bbbbbb"}
 
 
@@ -68,12 +75,14 @@ def _grouped_bars(
     logs = list(STANDARD_LOGS)
     fig, ax = plt.subplots(figsize=(8.0, 3.6))
     width = 0.8 / len(series)
-    greys = iter(PUBLISHED_GREYS * 4)
+    published = 0
     for i, (kind, method, values) in enumerate(series):
         xs = [j + (i - (len(series) - 1) / 2) * width for j, log in enumerate(logs) if log in values]
         ys = [values[log] for log in logs if log in values]
         if kind == "published":
-            ax.bar(xs, ys, width, label=f"{method} (published)", color="white", edgecolor=next(greys), hatch="///")
+            edge, hatch = PUBLISHED_STYLES[published % len(PUBLISHED_STYLES)]
+            published += 1
+            ax.bar(xs, ys, width, label=f"{method} (published)", color="white", edgecolor=edge, hatch=hatch)
         else:
             ax.bar(xs, ys, width, label=method, color=method_color(method))
     ax.set_xticks(range(len(logs)), logs)
