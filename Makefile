@@ -41,10 +41,16 @@ test-fast: $(STAMP)
 
 # Every suite runs first, then every report is built, even when cells failed (the reports list them); then
 # a non-zero status (the last one) is passed on. reports/thesis/README.md reads results/default too.
+# Last, docs/results.md (+ docs/results/) and the README's results block are rewritten from results/default
+# and results/thesis (no date in them: nothing new, no diff); commit them (docs/benchmarking.md).
 bench: $(STAMP)
 	status=0; \
 	for suite in $(SUITE); do $(BIN)/albot1 bench $$suite -j $(JOBS) || status=$$?; done; \
 	for suite in $(SUITE); do $(BIN)/albot1 report results/$$suite -j $(JOBS) || status=$$?; done; \
+	if [ -f results/default/grid.json ]; then \
+	  $(BIN)/albot1 results-page results/default --thesis results/thesis --out docs/results.md --readme README.md \
+	    || status=$$?; \
+	fi; \
 	exit $$status
 
 # pytest-benchmark timing suite (short real sequences); JSON kept for CI.

@@ -69,6 +69,7 @@ _COMMANDS: tuple[tuple[str, str, str | None], ...] = (
     ("albot1.cli.evaluate", "register", None),
     ("albot1.cli.runs", "register", None),
     ("albot1.cli.bench", "register", None),
+    ("albot1.cli.results", "register", None),
 )
 
 for _module_name, _attr, _group in _COMMANDS:

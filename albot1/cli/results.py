@@ -1,0 +1,45 @@
+"""``albot1 results-page``: the compact results page (docs/results.md) and the README's numbers, after a bench."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    app.command("results-page")(results_page)
+
+
+def results_page(
+    default: Annotated[Path, typer.Argument(help="the default suite's results folder (standard benchmark)")],
+    thesis: Annotated[
+        Path | None, typer.Option(help="the thesis suite's results folder (verdicts at a glance)")
+    ] = None,
+    out: Annotated[Path, typer.Option(help="the page to write (its figures and record go to <dir>/results/)")] = Path(
+        "docs/results.md"
+    ),
+    readme: Annotated[
+        Path | None, typer.Option(help="a README whose results block (between the markers) is rewritten")
+    ] = None,
+) -> None:
+    """Write docs/results.md, docs/results/*.svg and results.json from the stores `make bench` filled.
+
+    Stamped with each store's suite, code version and commit; no date, so nothing new means no change.
+
+    With --readme, the block between the results:begin and results:end markers is rewritten too.
+
+    Example:\n
+      albot1 results-page results/default --thesis results/thesis --readme README.md
+    """
+    # Imported by the command, not by this module: see albot1.cli.app.
+    from albot1.bench.store import ResultsStore
+    from albot1.report.results_data import build_data
+    from albot1.report.results_page import write_results
+
+    ResultsStore(default).read_plan()  # not a results folder: say so in one line
+    command = f"albot1 results-page {default.as_posix()}" + (f" --thesis {thesis.as_posix()}" if thesis else "")
+    data = build_data(default, thesis, command)
+    for path in write_results(data, out, readme):
+        typer.echo(f"results-page: {path}")

@@ -1,0 +1,259 @@
+"""The record behind ``docs/results.md`` and the README's results block: numbers and what produced them.
+
+Built from the stores ``make bench`` fills (the default suite: standard
+benchmark and key ATE cells; the thesis suite: verdicts), written as
+``docs/results/results.json`` and read back by :mod:`albot1.report.results_page`,
+which renders the page and the README block from it alone. Measured and
+published rows are kept apart by ``kind``; nothing here reads the clock.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from albot1.report.collect import collect
+from albot1.report.errors import ReportError
+from albot1.report.standard import Row, measured_rows, published_rows
+
+#: Layout of ``results.json``; a record of another version is not read.
+FORMAT = 1
+VARIANT_WORDS = ("holds", "does not hold", "not comparable")
+#: The (dataset, degradation) cells of the default suite whose ATE per seed the README quotes: the issue targets'
+#: "odometry about 4 m" setting on a real log, and the thesis's own degradation on its start-stop route.
+KEY_ATE: tuple[tuple[str, str], ...] = (
+    ("synthetic-office-startstop", "none"),
+    ("synthetic-office-startstop", "gauss:0.1:1"),
+    ("synthetic-office-startstop", "thesis"),
+    ("intel-corrected?odometry=laser-pose", "none"),
+    ("intel-corrected?odometry=laser-pose", "gauss:0.1:1"),
+    ("intel-corrected?odometry=laser-pose", "thesis"),
+)
+
+
+@dataclass(frozen=True)
+class StoreStamp:
+    """One results folder the page reads: where, which suite, which code produced it, how many cells."""
+
+    path: str
+    suite: str
+    code_version: str
+    git: str | None
+    cells: int
+    done: int
+    failed: int
+
+
+@dataclass(frozen=True)
+class StandardRow:
+    """One row of the standard table: a measured run or a published system (never mixed) on one log."""
+
+    log: str
+    kind: str  # measured | published
+    method: str
+    status: str
+    translation_mean_m: float | None
+    translation_std_m: float | None
+    rotation_mean_deg: float | None
+    relations: int | None
+    speed: float | None
+    held_in: bool | None
+    source: str
+    note: str
+
+
+@dataclass(frozen=True)
+class AteCell:
+    """ATE RMSE of one method on one key (dataset, degradation) for one seed, or why there is none."""
+
+    dataset: str
+    degradation: str
+    method: str
+    seed: int
+    rmse_m: float | None
+    note: str
+
+
+@dataclass(frozen=True)
+class VerdictRow:
+    """One thesis claim and its verdict tally per Albot1 variant (``""``: one verdict for every variant)."""
+
+    experiment: str
+    claim: str
+    thesis: str
+    tallies: dict[str, dict[str, int]]
+
+
+@dataclass
+class ResultsData:
+    """Everything the page and the README block show; written as JSON beside the page."""
+
+    command: str
+    stores: list[StoreStamp]
+    libraries: dict[str, str | None]
+    machine: str
+    standard: list[StandardRow]
+    ate: list[AteCell] = field(default_factory=list)
+    verdict_columns: dict[str, str] = field(default_factory=dict)
+    verdicts: list[VerdictRow] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    figures: dict[str, str] = field(default_factory=dict)  # file name -> caption
+
+    def to_json(self) -> str:
+        body = {"format": FORMAT, **asdict(self)}
+        return json.dumps(body, indent=1, allow_nan=False)  # key order is column order + "\n"
+
+    @classmethod
+    def from_json(cls, text: str, where: str) -> ResultsData:
+        try:
+            body = json.loads(text)
+            if body.get("format") != FORMAT:
+                raise ValueError(f"format {body.get('format')!r}, expected {FORMAT}")
+            return cls(
+                command=body["command"],
+                stores=[StoreStamp(**s) for s in body["stores"]],
+                libraries=body["libraries"],
+                machine=body["machine"],
+                standard=[StandardRow(**r) for r in body["standard"]],
+                ate=[AteCell(**a) for a in body["ate"]],
+                verdict_columns=body["verdict_columns"],
+                verdicts=[VerdictRow(**v) for v in body["verdicts"]],
+                notes=body["notes"],
+                figures=body["figures"],
+            )
+        except (ValueError, KeyError, TypeError, AttributeError) as exc:
+            raise ReportError(f"{where}: not a results record of format {FORMAT} ({exc})") from exc
+
+
+def _finite(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+def _standard_row(row: Row) -> StandardRow:
+    return StandardRow(
+        log=row.log,
+        kind=row.kind,
+        method=row.method,
+        status=row.status,
+        translation_mean_m=_finite(row.translation_mean_m),
+        translation_std_m=_finite(row.translation_std_m),
+        rotation_mean_deg=_finite(row.rotation_mean_deg),
+        relations=row.relations,
+        speed=_finite(row.speed) if row.kind == "measured" else None,
+        held_in=row.held_in,
+        source=row.source,
+        note=row.note,
+    )
+
+
+def _stamp(path: Path, shown: str) -> tuple[StoreStamp, Any, list[Any]]:
+    plan, records = collect(path)
+    machine = plan.machine
+    stamp = StoreStamp(
+        path=shown,
+        suite=plan.suite,
+        code_version=str(machine.get("code_version")),
+        git=machine.get("git"),
+        cells=len(records),
+        done=sum(r.status == "done" for r in records),
+        failed=sum(r.status == "failed" for r in records),
+    )
+    return stamp, plan, records
+
+
+def _tally(verdicts: list[Any]) -> dict[str, int]:
+    counts = dict.fromkeys(VARIANT_WORDS, 0)
+    for verdict in verdicts:
+        counts[verdict.word] += 1
+    return {word: n for word, n in counts.items() if n}
+
+
+def ate_cells(records: list[Any]) -> list[AteCell]:
+    """ATE RMSE per seed of every method on each :data:`KEY_ATE` pair the store holds (failed: why)."""
+    from albot1.metrics.measures.ate import METRIC as ATE
+
+    cells: list[AteCell] = []
+    for dataset, degradation in KEY_ATE:
+        for rec in records:
+            cell = rec.cell
+            if (cell.dataset_label, cell.degradation, cell.limit, cell.stride) != (dataset, degradation, None, None):
+                continue
+            block = rec.metrics.get(ATE) if rec.status == "done" and rec.metrics is not None else None
+            if block is not None:
+                note = ""
+            elif rec.status != "done":
+                note = rec.failure.reason if rec.failure is not None else rec.status
+            else:
+                note = (rec.metrics.reason(ATE.name) if rec.metrics is not None else None) or "no ATE"
+            rmse = _finite(block.rmse_m) if block is not None else None
+            cells.append(AteCell(dataset, degradation, cell.method_label, cell.seed, rmse, " ".join(note.split())))
+    return sorted(cells, key=lambda c: (KEY_ATE.index((c.dataset, c.degradation)), c.seed))
+
+
+def _verdicts(thesis_dir: Path) -> tuple[dict[str, str], list[VerdictRow], list[str]]:
+    """The thesis page's verdicts at a glance: one row per claim, verdicts counted per variant."""
+    from albot1.report.thesis.evidence import open_stores
+    from albot1.report.thesis.experiments import all_sections
+
+    ev = open_stores(thesis_dir)
+    rows: list[VerdictRow] = []
+    columns: dict[str, str] = {}
+    for section in all_sections(ev):
+        claims: dict[str, list[Any]] = {}
+        for row in section.claims:
+            claims.setdefault(row.claim, []).append(row)
+        for claim, group in claims.items():
+            text = group[0].text if len(group) == 1 else f"{claim} (on each dataset)"
+            if all("" in row.verdicts for row in group):
+                tallies = {"": _tally([row.verdicts[""] for row in group])}
+            else:
+                tallies = {
+                    label: _tally([row.verdicts[key] for row in group if key in row.verdicts])
+                    for key, label in section.columns.items()
+                }
+                columns.update({label: label for label in section.columns.values()})
+            rows.append(VerdictRow(section.title.split(":")[0], text, group[0].thesis, tallies))
+    return columns, rows, list(ev.notes)
+
+
+def build_data(
+    default_dir: Path, thesis_dir: Path | None, command: str, *, shown: dict[Path, str] | None = None
+) -> ResultsData:
+    """The record of ``default_dir`` (standard benchmark) and ``thesis_dir`` (verdicts; None: not shown)."""
+    names = shown or {}
+    stamp, plan, records = _stamp(default_dir, names.get(default_dir, default_dir.as_posix()))
+    stores = [stamp]
+    measured = [_standard_row(r) for r in measured_rows(records)]
+    published = [_standard_row(r) for r in published_rows()]
+    machine = plan.machine
+    model = machine.get("cpu_model") or machine.get("processor") or "unknown CPU"
+    data = ResultsData(
+        command=command,
+        stores=stores,
+        libraries=dict(sorted((machine.get("libraries") or {}).items())),
+        machine=f"{model}, {machine.get('cpu_count')} logical CPUs, Python {machine.get('python')}",
+        standard=measured + published,
+        ate=ate_cells(records),
+    )
+    if not measured:
+        data.notes.append(f"{stamp.path} holds no whole-log run on the five standard logs: no measured row.")
+    if thesis_dir is None:
+        data.notes.append("No thesis suite given: no verdicts.")
+    elif not (thesis_dir / "grid.json").is_file():
+        data.notes.append(f"{thesis_dir.as_posix()} is not a results folder (no grid.json): no verdicts.")
+    else:
+        tstamp, _, _ = _stamp(thesis_dir, names.get(thesis_dir, thesis_dir.as_posix()))
+        data.stores.append(tstamp)
+        data.verdict_columns, data.verdicts, notes = _verdicts(thesis_dir)
+        data.notes += notes
+    return data
+
+
+def load_data(record: Path) -> ResultsData | None:
+    """The record at ``record``, or None when it has not been written yet."""
+    if not record.is_file():
+        return None
+    return ResultsData.from_json(record.read_text(encoding="utf-8"), str(record))

@@ -1,0 +1,74 @@
+"""`albot1 results-page` on a real (small, synthetic) store: the numbers are the stored ones, re-runs are stable."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from albot1.report.results_data import load_data
+from albot1.report.results_page import readme_block, render_readme_block
+
+pytestmark = pytest.mark.slow
+
+SUITE = """
+[grid]
+degradations = ["gauss:0.1:1"]
+seeds = [0, 1]
+undegraded_seeds = [0]
+
+[[methods]]
+name = "odometry"
+
+[[datasets]]
+name = "synthetic-office-startstop"
+"""
+
+
+def _albot1(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", "from albot1.cli.app import main; main()", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=600,
+    )
+
+
+def test_results_page_quotes_the_stored_ate_and_is_byte_stable(tmp_path: Path) -> None:
+    (tmp_path / "small.toml").write_text(SUITE, encoding="utf-8")
+    done = _albot1("bench", "small.toml", "-j", "1", "--results", "results", "--no-progress", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    readme = tmp_path / "README.md"
+    readme.write_text(f"# mine\n\n{render_readme_block(None)}\n\nafter\n", encoding="utf-8")
+    args = ("results-page", "results/small", "--thesis", "results/none", "--out", "docs/results.md")
+    done = _albot1(*args, "--readme", "README.md", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    data = load_data(tmp_path / "docs" / "results" / "results.json")
+    assert data is not None
+    stored: dict[tuple[str, int], list[float]] = {}
+    for folder in (tmp_path / "results" / "small" / "runs").iterdir():
+        result = json.loads((folder / "result.json").read_text(encoding="utf-8"))
+        metrics = json.loads((folder / "metrics.json").read_text(encoding="utf-8"))
+        stored.setdefault((result["degradation"], result["seed"]), []).append(metrics["ate"]["rmse_m"])
+    got: dict[tuple[str, int], list[float]] = {}
+    for cell in data.ate:
+        assert cell.dataset == "synthetic-office-startstop" and cell.rmse_m is not None
+        got.setdefault((cell.degradation, cell.seed), []).append(cell.rmse_m)
+    assert {k: sorted(v) for k, v in got.items()} == {k: sorted(v) for k, v in stored.items()}
+    assert set(got) == {("none", 0), ("gauss:0.1:1", 0), ("gauss:0.1:1", 1)}
+    block = readme_block(readme.read_text(encoding="utf-8"), "README.md")
+    assert block == render_readme_block(data)
+    for values in stored.values():
+        for value in values:
+            assert f"{value:.4f}" in block
+    assert any("results/none is not a results folder" in note for note in data.notes)
+    assert data.standard and all(row.kind == "published" for row in data.standard)  # no standard log in this suite
+    stamp = data.stores[0]
+    assert (stamp.suite, stamp.cells, stamp.done, stamp.failed) == ("small", 3, 3, 0)
+    before = {p: p.read_bytes() for p in (tmp_path / "docs").rglob("*") if p.is_file()}
+    assert _albot1(*args, "--readme", "README.md", cwd=tmp_path).returncode == 0
+    assert {p: p.read_bytes() for p in (tmp_path / "docs").rglob("*") if p.is_file()} == before
