@@ -36,7 +36,8 @@ from albot1.report.html import INDEX_HTML
 from albot1.report.index import build_report
 from albot1.report.interactive import MAX_POSES, dataset_figure, figure_json, shown_indices, stored_errors
 from albot1.report.interactive_page import VIEWS_DIR, write_views
-from albot1.report.plots import method_colors
+from albot1.report.map_plots import occupancy
+from albot1.report.plots import Extent, method_colors
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
@@ -163,6 +164,17 @@ def test_the_figure_carries_each_poses_index_time_and_stored_error_exactly(resul
     # the first method's map is shown, the other a legend click away; the reference is dashed and not hovered
     assert traces["noisy map (occupied 0.05 m cells)"]["visible"] is True and line_map["visible"] == "legendonly"
     assert traces["reference"]["line"]["dash"] == "dash" and traces["reference"]["hoverinfo"] == "skip"
+    # the point map: one byte per cell of the static figure's occupancy grid, in the same aligned frame
+    noisy_rec = next(r for r in records if r.cell.method_label == "noisy")
+    poses, reference, _ = _files(noisy_rec.run_dir)
+    _, transform = align(poses, reference, "rigid")
+    points = se2.transform_points(transform, noisy_rec.stored_run().load_map().points)
+    extent = Extent(figure["layout"]["xaxis"]["range"][0], figure["layout"]["xaxis"]["range"][1],
+                    figure["layout"]["yaxis"]["range"][0], figure["layout"]["yaxis"]["range"][1])  # fmt: skip
+    image, cell = occupancy(points, extent)
+    grid = traces["noisy map (occupied 0.05 m cells)"]
+    assert grid["z"].dtype == np.uint8 and np.array_equal(grid["z"], (~np.ma.getmaskarray(image)).astype(np.uint8))
+    assert grid["x0"] == extent.x0 + cell / 2 and grid["dx"] == cell and int(grid["z"].sum()) > 20
     assert figure["layout"]["yaxis"]["scaleanchor"] == "x" and figure["layout"]["dragmode"] == "pan"
 
 
