@@ -22,10 +22,16 @@ from albot1.metrics.errors import MetricsError
 from albot1.metrics.stats import suffixed, summarize
 
 
-def position_errors(estimate: ArrayLike, reference: ArrayLike, alignment: Alignment = "rigid") -> np.ndarray:
-    """Per-scan position error (m) after ``alignment``."""
+def position_errors(
+    estimate: ArrayLike, reference: ArrayLike, alignment: Alignment = "rigid", n_to_align: int | None = None
+) -> np.ndarray:
+    """Per-scan position error (m) after ``alignment`` (``n_to_align``: as for :func:`ate`).
+
+    The numbers :func:`ate` summarises: the report's per-pose pictures and
+    hover values (``albot1.report.interactive``) take them from here.
+    """
     est, ref = check_pair(estimate, reference, "ATE")
-    aligned, _ = align(est, ref, alignment)
+    aligned, _ = align(est, ref, alignment, n_to_align)
     return np.hypot(aligned[:, 0] - ref[:, 0], aligned[:, 1] - ref[:, 1])
 
 

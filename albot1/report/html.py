@@ -7,6 +7,11 @@ tables, the failed cells' logs in the results folder), and nothing is
 fetched from elsewhere. ``tests/unit/report/test_report_html.py`` checks
 that every link and image resolves; a browser test opens it headless.
 
+Each dataset has an interactive view (:mod:`albot1.report.interactive`):
+its trajectories and maps over the reference, zoom and pan, the stored
+per-pose error on hover, drawn by plotly from ``interactive/`` in the report
+folder (plotly's bundle included, so still no network).
+
 Tables are sortable: a click on a column header sorts its rows (numbers by
 value, ``n/a``/``failed`` last), another click reverses the order.
 """
@@ -24,6 +29,7 @@ from albot1.bench.grid import GridPlan
 from albot1.report.collect import CellRecord, Column
 from albot1.report.external_notes import external_html
 from albot1.report.paired_tables import PairedRow, html_table
+from albot1.report.interactive_page import VIEWS_DIR, View, view_html, views_scripts
 from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
@@ -166,8 +172,14 @@ def write_html(
     results_dir: Path,
     extra_links: list[tuple[str, Path]] | None = None,
     paired: list[PairedRow] | None = None,
+    views: tuple[Path | None, dict[str, View]] | None = None,
 ) -> Path:
-    """Write ``out/index.html`` (see module doc); returns its path. ``paired``: the accuracy tables' comparisons."""
+    """Write ``out/index.html`` (see module doc); returns its path.
+
+    ``paired``: the accuracy tables' comparisons. ``views``: plotly's bundle and each dataset's interactive view
+    (:func:`albot1.report.interactive_page.write_views`), shown after the dataset's tables.
+    """
+    bundle, dataset_views = views if views is not None else (None, {})
     metric_columns, cost_columns = columns
     counts: dict[str, int] = {"done": 0, "failed": 0, "not run": 0}
     for rec in records:
@@ -233,6 +245,8 @@ def write_html(
             parts += [f"<h3>{title}</h3>", table_html(group, cols, colors)]
             if title == "Accuracy":
                 parts.append(html_table(paired or [], dataset))
+        if dataset in dataset_views:
+            parts.append(view_html(dataset_views[dataset]))
         figures = plots.get(dataset, [])
         if figures:
             parts.append("<h3>Plots</h3>")
@@ -247,7 +261,7 @@ def write_html(
             "</ul>",
         ]
     parts += ['<h2 id="skipped">Skipped datasets and methods</h2>', _skipped(plan)]
-    parts += [f"<script>{SCRIPT}</script>", "</body></html>", ""]
+    parts += [f"<script>{SCRIPT}</script>", *views_scripts(bundle, dataset_views, VIEWS_DIR), "</body></html>", ""]
     page = out / INDEX_HTML
     page.write_text("\n".join(p for p in parts if p), encoding="utf-8")
     return page

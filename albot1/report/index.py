@@ -27,6 +27,7 @@ from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
 from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
 from albot1.report.generalisation import write_generalisation
 from albot1.report.html import INDEX_HTML, rel, write_html
+from albot1.report.interactive_page import write_views
 from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.markdown import code, text
 from albot1.report.paired_tables import paired_rows
@@ -238,8 +239,8 @@ def write_index(
         "",
         *[f"- {text(d)}: {text(describe_data(files))}" for d, files in data_by_dataset(records).items()],
         "",
-        f"**[The whole report on one page: {INDEX_HTML}]({INDEX_HTML})** (tables and every plot; open it in a "
-        "browser, it needs no network).",
+        f"**[The whole report on one page: {INDEX_HTML}]({INDEX_HTML})** (tables, every plot and an interactive "
+        "view per dataset: zoom, pan, the error of each pose on hover; open it in a browser, it needs no network).",
         "",
         "## Tables",
         "",
@@ -348,6 +349,7 @@ def build_report(
     thesis = plan.suite == THESIS_SUITE
     pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default
     made = render_plots(pictured, target, colors, map_style=map_style, jobs=jobs) if plots else {}
+    views = write_views(pictured, target, colors) if plots else None
     index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
     page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
     cells = cells_frame(records)
@@ -365,5 +367,6 @@ def build_report(
         results,
         extra_links=[("the thesis's experiments, reproduced (README.md)", page)] if page is not None else None,
         paired=paired,
+        views=views,
     )
     return page if page is not None else index
