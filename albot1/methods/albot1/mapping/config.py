@@ -177,6 +177,24 @@ class Albot1Config(BaseModel):
         le=1,
         description="Albot1+: weight of the newest view in the adaptive prior's estimate (exponential forgetting)",
     )
+    degenerate_sd_m: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ (adaptive prior): a direction of the pose (a turn of 1 rad counting prior_m_per_rad m) that"
+            " the view's fit knows worse than this standard deviation is degenerate and keeps the odometry's"
+            " component (0 = off)"
+        ),
+    )
+    gate_probability: float = Field(
+        0.0,
+        ge=0,
+        lt=1,
+        description=(
+            "Albot1+ (adaptive prior): a view's pose whose disagreement with the odometry's prediction exceeds"
+            " this chi-square quantile of their stated uncertainties is rejected for the odometry (0 = off)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -245,4 +263,6 @@ class Albot1Config(BaseModel):
             rad_per_sqrt_m=math.radians(self.prior_deg_per_sqrt_m),
             m_per_rad=self.prior_m_per_rad,
             learning_rate=self.prior_learning_rate,
+            degenerate_sd=self.degenerate_sd_m,
+            gate_probability=self.gate_probability,
         )

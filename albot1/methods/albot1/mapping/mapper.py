@@ -430,6 +430,11 @@ class Albot1Mapper:
             )
         }
         counters["map_surfaces"] = len(self.map)
+        if self._plus is not None and (self.config.degenerate_sd_m > 0.0 or self.config.gate_probability > 0.0):
+            # Albot1+'s degeneracy screen (docs/albot1-mapper.md, "Albot1+"): only when it is on, so the other
+            # presets' counters stay as they were.
+            counters["plus_degenerate_views"] = self._plus.degenerate_views
+            counters["plus_gate_rejections"] = self._plus.gate_rejections
         counters["updates_per_view"] = c.updates / c.views if c.views else 0.0
         counters["landmarks_recognised_mean"] = float(rec[1:].mean()) if len(rec) > 1 else 0.0
         return MapperOutput(

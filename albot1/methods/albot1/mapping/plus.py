@@ -24,7 +24,11 @@ pose is computed:
    ``fixed`` uses the configured growth; ``adaptive`` learns it online from
    how far the odometry and the view disagree (:class:`OdometryNoise`), so
    bad odometry is out-voted and good odometry carries the robot through
-   featureless corridors.
+   featureless corridors;
+5. with ``degenerate_sd_m`` / ``gate_probability``,
+   :func:`screen_measurement` keeps the odometry's component along the
+   directions the fit does not fix, and rejects a fit that disagrees with the
+   odometry beyond their stated uncertainties.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -72,6 +76,8 @@ class PlusParams:
     rad_per_sqrt_m: float  # rad per sqrt(m of motion)
     m_per_rad: float  # a turn of 1 rad counts as this much motion
     learning_rate: float
+    degenerate_sd: float = 0.0  # m (a turn of 1 rad counting m_per_rad m); 0 = off
+    gate_probability: float = 0.0  # chi-square quantile of the disagreement with the odometry; 0 = off
 
 
 class OdometryNoise:
@@ -143,6 +149,9 @@ class PlusLocaliser:
         self._ref = np.empty((0, 4))
         self._anchor: Pose = (0.0, 0.0, 0.0)
         self.noise = OdometryNoise(params)
+        #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
+        self.degenerate_views = 0
+        self.gate_rejections = 0
 
     def reset(self, view_map: FloatArray, pose: Pose) -> None:
         """A map update placed a view at ``pose``; ``view_map`` are its surfaces in the map (the new reference)."""
@@ -240,6 +249,17 @@ class PlusLocaliser:
             nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
             noise.learn(nu2_xy, d_phi * d_phi, motion)
         v_xy, v_phi = noise.prior_variance(motion)
+        if self.params.degenerate_sd > 0.0 or self.params.gate_probability > 0.0:
+            screened = screen_measurement(measured, info, predicted, (v_xy, v_phi), self.params)
+            if screened.degenerate:
+                self.degenerate_views += 1
+            if screened.rejected:
+                self.gate_rejections += 1
+                return predicted
+            measured, info = screened.pose, screened.info
+            h00, h01, h02 = float(info[0, 0]), float(info[0, 1]), float(info[0, 2])
+            h11, h12, h22 = float(info[1, 1]), float(info[1, 2]), float(info[2, 2])
+            d_phi = wrap_angle(measured[2] - predicted[2])
         p_xy, p_phi = 1.0 / v_xy, 1.0 / v_phi
         # The prediction's heading unwrapped next to the measured one, so the average does not jump by 2 pi.
         t0, t1, t2 = predicted[0], predicted[1], measured[2] - d_phi
@@ -258,3 +278,61 @@ class PlusLocaliser:
         y = (c01 * r0 + c11 * r1 + c12 * r2) / det
         phi = (c02 * r0 + c12 * r1 + c22 * r2) / det
         return (x, y, wrap_angle(phi))
+
+
+@dataclass(frozen=True, slots=True)
+class Screened:
+    """A view's measured pose after :func:`screen_measurement`."""
+
+    pose: Pose  # the odometry's component kept along the degenerate directions
+    info: FloatArray  # 3x3, zero along the degenerate directions
+    degenerate: bool  # at least one direction was left to the odometry
+    rejected: bool  # the disagreement with the odometry exceeds the gate: use the prediction
+    kept: int = 0  # directions the fit fixes
+    mahalanobis: float = 0.0  # squared disagreement with the prediction along them, in their stated uncertainty
+
+
+def screen_measurement(
+    measured: Pose, info: FloatArray, predicted: Pose, prior_variance: tuple[float, float], params: PlusParams
+) -> Screened:
+    """Degeneracy-aware use of a view's pose fit (after Zhang, Kaess and Singh, ICRA 2016).
+
+    The fit's information matrix ``info`` (``J^T W J`` of its residuals, 3x3,
+    position in m, heading in rad) is decomposed in units where a turn of
+    1 rad counts ``m_per_rad`` metres. Along an eigenvector whose eigenvalue
+    is below ``1 / degenerate_sd^2`` the landmarks and the scan do not fix
+    the pose (a corridor whose lines are all parallel: its axis); there the
+    measured pose is replaced by the odometry's prediction and the
+    information is dropped, so the fusion keeps the odometry's component
+    exactly, however a damped solver left that direction. Along the other
+    directions the disagreement with the prediction is tested against the
+    sum of the two stated covariances (the fit's inverse information and the
+    odometry's ``prior_variance``, m^2 per axis and rad^2): beyond the
+    ``gate_probability`` quantile of chi-square with as many degrees of
+    freedom as directions kept, the fit is taken for a wrong association and
+    rejected (the odometry's prediction is used). With no direction kept the
+    view says nothing and the prediction is the pose.
+    """
+    from scipy.stats import chi2  # noqa: PLC0415 -- scipy's import cost only when Albot1+ screens a view
+
+    scale = np.asarray([1.0, 1.0, params.m_per_rad])
+    info_u = np.asarray(info, dtype=float) / np.outer(scale, scale)
+    eigval, eigvec = np.linalg.eigh(0.5 * (info_u + info_u.T))
+    floor = 1.0 / params.degenerate_sd**2 if params.degenerate_sd > 0.0 else 0.0
+    keep = eigval > max(floor, 0.0)
+    basis = eigvec[:, keep]
+    degenerate = bool(not keep.all())
+    if not keep.any():
+        return Screened(predicted, np.zeros((3, 3)), degenerate, False)
+    delta = np.asarray([measured[0] - predicted[0], measured[1] - predicted[1], wrap_angle(measured[2] - predicted[2])])
+    z = basis.T @ (scale * delta)  # the disagreement along the kept directions (m)
+    prior_u = np.diag([prior_variance[0], prior_variance[0], prior_variance[1] * params.m_per_rad**2])
+    cov = np.diag(1.0 / eigval[keep]) + basis.T @ prior_u @ basis
+    mahalanobis = float(z @ np.linalg.solve(cov, z))
+    kept_n = int(keep.sum())
+    if params.gate_probability > 0.0 and mahalanobis > float(chi2.ppf(params.gate_probability, kept_n)):
+        return Screened(predicted, np.zeros((3, 3)), degenerate, True, kept_n, mahalanobis)
+    kept = (basis @ z) / scale
+    pose = (predicted[0] + float(kept[0]), predicted[1] + float(kept[1]), wrap_angle(predicted[2] + float(kept[2])))
+    info_kept = (basis * eigval[keep]) @ basis.T * np.outer(scale, scale)
+    return Screened(pose, np.ascontiguousarray(info_kept), degenerate, False, kept_n, mahalanobis)

@@ -58,6 +58,8 @@ OLD_DEFAULT: dict[str, Any] = {
     "prior_deg_per_sqrt_m": 2.0,
     "prior_m_per_rad": 1.0,
     "prior_learning_rate": 0.02,
+    "degenerate_sd_m": 0.0,
+    "gate_probability": 0.0,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
@@ -83,6 +85,8 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "pose_estimate": "robust",
         "scan_refinement": True,
         "odometry_prior": "adaptive",
+        "degenerate_sd_m": 0.05,
+        "gate_probability": 0.0,
     },
 }
 

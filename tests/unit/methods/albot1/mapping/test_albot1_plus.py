@@ -18,6 +18,7 @@ from albot1.methods.albot1.mapping.plus import (
     ODOMETRY_TURNS_DEG,
     OdometryNoise,
     PlusLocaliser,
+    screen_measurement,
     start_poses,
 )
 from albot1.methods.albot1.perception.endpoints import CORNER, UNSTABLE
@@ -165,7 +166,7 @@ def test_the_odometry_learner_finds_the_random_walk_rate() -> None:
 
 
 def test_fusion_weighs_the_measurement_and_the_prediction_by_their_information() -> None:
-    loc = PlusLocaliser(plus_params(), KERNELS, 30.0)
+    loc = PlusLocaliser(plus_params(degenerate_sd_m=0.0, gate_probability=0.0), KERNELS, 30.0)
     predicted = (1.0, 0.0, 0.0)
     measured = (1.2, 0.1, math.radians(2.0))
     motion = 0.5
@@ -205,3 +206,81 @@ def test_a_view_with_an_unstable_end_gives_no_point_term() -> None:
         (0.0, 0.0, 0.0),
     )
     np.testing.assert_allclose(pose, TRUE_POSE, atol=1e-6)
+
+
+CORRIDOR = np.array([[-1.0, 0.0, -1.0, 8.0], [1.0, 8.0, 1.0, 0.0]])  # two parallel walls along thesis +y
+
+
+def corridor_fit(start: tuple[float, float, float]) -> tuple[tuple[float, float, float], np.ndarray]:
+    """The scan-only fit in the corridor from ``start``: exact across it, left at the start along it."""
+    x, y, phi, info = solve(
+        [start], np.empty((0, 4)), np.empty((0, 4)), np.empty((0, 2)), sampled_points(CORRIDOR), CORRIDOR
+    )
+    return (x, y, phi), info
+
+
+def test_the_screen_keeps_the_odometrys_component_along_a_corridor() -> None:
+    measured, info = corridor_fit((0.1, 0.7, math.radians(2.0)))  # the damped solver left y at the start, 0.7
+    predicted = (0.02, 0.25, math.radians(0.5))  # the odometry's prediction
+    params = plus_params(degenerate_sd_m=0.05, gate_probability=0.0)
+    screened = screen_measurement(measured, info, predicted, (1e-2, 1e-3), params)
+    assert screened.degenerate and not screened.rejected and screened.kept == 2
+    # Along the corridor (thesis y) the odometry's component exactly; across it and in heading the fit's.
+    assert screened.pose[1] == pytest.approx(0.25, abs=1e-12)
+    assert screened.pose[0] == pytest.approx(0.0, abs=1e-6) and screened.pose[2] == pytest.approx(0.0, abs=1e-6)
+    assert abs(screened.info[1, 1]) < 1e-9 * info[0, 0]  # no information is left along the axis
+    assert screened.info[0, 0] == pytest.approx(info[0, 0], rel=1e-9)
+
+
+def test_the_fused_pose_follows_the_odometry_along_a_corridor_and_the_fit_across_it() -> None:
+    loc = PlusLocaliser(plus_params(degenerate_sd_m=0.05, gate_probability=0.999), KERNELS, 30.0)
+    loc.reset(CORRIDOR, (0.0, 0.0, 0.0))
+    since = (0.03, 0.4, math.radians(0.2))  # odometry since the update: 3 cm and 0.2 degrees off across
+    pose = loc.pose(
+        np.array([[0.03, 0.9, math.radians(0.2)]]),  # a start 50 cm ahead along the corridor (e.g. a mismatch)
+        np.empty((0, 4)),
+        np.empty((0, 4)),
+        (np.empty((0, 2), dtype=np.int64), np.empty((0, 2), dtype=np.int64)),
+        sampled_points(CORRIDOR),
+        since,
+    )
+    assert pose[1] == pytest.approx(0.4, abs=1e-9)  # along: the odometry's, not the start's 0.9
+    assert abs(pose[0]) < 0.005 and abs(pose[2]) < math.radians(0.05)  # across and heading: mostly the walls'
+    assert loc.degenerate_views == 1 and loc.gate_rejections == 0
+
+
+def test_without_the_screen_a_corridor_view_still_fuses_its_unconstrained_direction() -> None:
+    """The same view unscreened: the fit's damped y (0.9) leaks into the pose by its rounding-level information."""
+    measured, info = corridor_fit((0.03, 0.9, math.radians(0.2)))
+    screened = screen_measurement(measured, info, (0.03, 0.4, 0.0), (1e-2, 1e-3), plus_params(gate_probability=0.0))
+    assert measured[1] == pytest.approx(0.9, abs=1e-3) and screened.pose[1] == pytest.approx(0.4, abs=1e-12)
+
+
+def test_the_gate_rejects_a_fit_that_disagrees_with_the_odometry_beyond_their_uncertainty() -> None:
+    lm_map = transform_segments(TRUE_POSE, VIEW_SURFACES)
+    points = sampled_points(VIEW_SURFACES)
+    ok = np.ones((len(VIEW_SURFACES), 2), dtype=bool)
+    x, y, phi, info = solve([[0.35, -0.15, 0.05]], VIEW_SURFACES, lm_map, ok, points, lm_map)
+    params = plus_params(degenerate_sd_m=0.05, gate_probability=0.999)
+    variance = (0.01**2, math.radians(0.5) ** 2)  # the odometry's prediction known to 1 cm and 0.5 degrees
+    near = (TRUE_POSE[0] + 0.005, TRUE_POSE[1] - 0.004, TRUE_POSE[2] + math.radians(0.3))
+    kept = screen_measurement((x, y, phi), info, near, variance, params)
+    assert not kept.rejected and not kept.degenerate and kept.kept == 3
+    np.testing.assert_allclose(kept.pose, (x, y, phi), atol=1e-12)  # all directions fixed: the fit unchanged
+    # Chi-square(3) at 0.999 is 16.27: a prediction 20 cm off (20 sigma of the odometry) is a wrong association.
+    far = (TRUE_POSE[0] + 0.2, TRUE_POSE[1], TRUE_POSE[2])
+    rejected = screen_measurement((x, y, phi), info, far, variance, params)
+    assert rejected.rejected and rejected.pose == far
+    # The squared disagreement in the sum of the stated covariances (prior_m_per_rad = 1: no rescaling).
+    d = np.array([x - far[0], y - far[1], phi - far[2]])
+    expected = d @ np.linalg.solve(np.linalg.inv(info) + np.diag([variance[0], variance[0], variance[1]]), d)
+    assert rejected.mahalanobis == pytest.approx(expected, rel=1e-9) and expected > 16.27
+    loc = PlusLocaliser(params, KERNELS, 30.0)
+    # After 1 cm of motion the start values of the learnt spread give the prediction ~1 cm: 20 cm is rejected.
+    assert loc._fuse((x, y, phi), info, far, 0.01) == far and loc.gate_rejections == 1
+
+
+def test_the_thesis_presets_leave_the_screen_off() -> None:
+    for name in ("default", "thesis", "exact", "literal"):
+        config = Albot1Config.model_validate({**Albot1Mapper.presets["default"], **Albot1Mapper.presets[name]})
+        assert config.degenerate_sd_m == 0.0 and config.gate_probability == 0.0
