@@ -28,8 +28,8 @@ from typing import TYPE_CHECKING, Any
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import CellRecord, Column
 from albot1.report.external_notes import external_html
-from albot1.report.paired_tables import PairedRow, html_table
 from albot1.report.interactive_page import VIEWS_DIR, View, view_html, views_scripts
+from albot1.report.paired_tables import PairedRow, html_table
 from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
