@@ -20,6 +20,7 @@ from typing import Annotated
 import typer
 
 from albot1 import __version__
+from albot1.cli.helptext import install as install_help
 from albot1.errors import Albot1Error
 
 HELP = """Albot1 perceptual mapping vs SLAM baselines on 2D laser datasets.
@@ -77,6 +78,7 @@ for _module_name, _attr, _group in _COMMANDS:
         getattr(_module, _attr)(app)
     else:
         app.add_typer(getattr(_module, _attr), name=_group)
+install_help(app)
 
 
 def main() -> None:

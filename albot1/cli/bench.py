@@ -146,7 +146,7 @@ def report(
     only: open it from the report folder in any browser, no network needed.
 
     Examples:\n
-      albot1 report results/default -j 2     # -> reports/default/README.md, reports/default/index.html\n
+      albot1 report results/default -j 2   # -> reports/default/index.html\n
       albot1 report results/quick --out /tmp/quick-report --map-style points
     """
     # Imported by the command, not by this module: see albot1.cli.app.

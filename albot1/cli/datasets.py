@@ -155,7 +155,8 @@ def info(
 
     Decodes the whole log once. Examples:\n
       albot1 datasets info intel --json\n
-      albot1 datasets info recording.bag --scan-topic /base_scan --odom-topic /odom_raw
+      albot1 datasets info recording.bag \\
+          --scan-topic /base_scan --odom-topic /odom_raw
     """
     from albot1.data.open import open_sequence
 
