@@ -45,9 +45,9 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
-        from albot1.versions import code_version  # importlib.metadata: only for --version
+        from albot1.versions import code_version, commit_label, git_commit  # only for --version
 
-        typer.echo(f"albot1 {__version__} (code {code_version()})")
+        typer.echo(f"albot1 {__version__} (code {code_version()}, {commit_label(git_commit())})")
         raise typer.Exit()
 
 
@@ -55,7 +55,7 @@ def _version(value: bool) -> None:
 def _root(
     version: Annotated[
         bool,
-        typer.Option("--version", callback=_version, is_eager=True, help="print the version and the code digest, exit"),
+        typer.Option("--version", callback=_version, is_eager=True, help="print the version, the code digest and the git commit, exit"),
     ] = False,
 ) -> None:
     """The options of ``albot1`` itself (the commands are added below)."""

@@ -42,6 +42,7 @@ from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 from albot1.report.tuning import held_in
+from albot1.versions import commit_label
 
 REPORTS_ROOT = Path("reports")
 #: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
@@ -159,7 +160,7 @@ def _machine_lines(plan: GridPlan) -> list[str]:
         f"- CPUs: {text(m.get('cpu_count'))} logical ({text(m.get('cpu_count_physical'))} physical), "
         f"memory {text(m.get('memory_gb'))} GB; {text(m.get('processor'))}",
         f"- platform: {text(m.get('platform'))}; Python {text(m.get('python'))}",
-        f"- code version: {code(m.get('code_version'))} (git {code(m.get('git'))})",
+        f"- code version: {code(m.get('code_version'))} ({commit_label(m.get('git'))})",
         f"- libraries: {text(libraries)}",
     ]
 
