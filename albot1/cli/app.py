@@ -55,7 +55,12 @@ def _version(value: bool) -> None:
 def _root(
     version: Annotated[
         bool,
-        typer.Option("--version", callback=_version, is_eager=True, help="print the version, the code digest and the git commit, exit"),
+        typer.Option(
+            "--version",
+            callback=_version,
+            is_eager=True,
+            help="print the version, the code digest and the git commit, exit",
+        ),
     ] = False,
 ) -> None:
     """The options of ``albot1`` itself (the commands are added below)."""

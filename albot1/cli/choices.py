@@ -14,7 +14,6 @@ from typing import Any
 from typer.core import TyperArgument, TyperOption
 
 from albot1.cli.helptext import HelpCommand
-
 from albot1.errors import Albot1Error
 
 #: Shown until ``--help`` fills in the names (never seen by a user).
