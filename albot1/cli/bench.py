@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from albot1.cli.progress import enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
@@ -80,7 +81,8 @@ def bench(
         plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))
         return
-    view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not progress)
+    # The bar (cells done of the total, with an ETA) only on a terminal: piped output and CI logs stay clean.
+    view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not (progress and enabled()))
     try:
         plan, summary, store = run_suite(
             suite,
