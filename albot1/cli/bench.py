@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from albot1.cli.progress import enabled
+from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
@@ -161,5 +161,9 @@ def report(
     ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
     writable_folder(out if out is not None else default_out(results_dir), "--out")
     style: MapStyle = "grid" if map_style == "grid" else "points"
-    index = build_report(results_dir, out, plots=plots, map_style=style, jobs=jobs)
+    bar = FigureBar()
+    try:
+        index = build_report(results_dir, out, plots=plots, map_style=style, jobs=jobs, progress=bar.update)
+    finally:
+        bar.close()
     typer.echo(f"report: {index}")

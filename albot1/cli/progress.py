@@ -1,4 +1,4 @@
-"""Progress bars of the long single-log commands (``run``, ``convert``, ``datasets info``, ``evaluate``).
+"""Progress bars of the long commands (``run``, ``convert``, ``datasets info``, ``evaluate``, ``report``).
 
 Shown on stderr and only when stderr is a terminal: piped or captured
 output (``--json | jq``, CI logs, tests) stays free of bar redraws. A log's
@@ -69,3 +69,37 @@ def with_progress(sequence: Sequence, desc: str, at_most: int | None = None) -> 
             bar.close()
 
     return sequence.with_frames(frames, scan_count=known)
+
+
+class FigureBar:
+    """The bar of ``albot1 report``: datasets whose figures are drawn, of those to draw, with an ETA.
+
+    Drawing is most of a report's time (30-40 s for the quick suite, minutes
+    for the default one). Created on the first :meth:`update` (the report
+    knows the count only once it has read the results), never when stderr is
+    not a terminal, nor when every figure comes from the cache.
+    """
+
+    def __init__(self) -> None:
+        self._bar: Any = None
+
+    def update(self, done: int, total: int) -> None:
+        if not enabled() or total == 0:
+            return
+        if self._bar is None:
+            from tqdm import tqdm
+
+            self._bar = tqdm(
+                total=total,
+                desc="report: drawing",
+                unit="dataset",
+                file=sys.stderr,
+                dynamic_ncols=True,
+                leave=False,
+                mininterval=0,  # one update per dataset: every one is shown
+            )
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()

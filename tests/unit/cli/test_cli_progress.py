@@ -46,3 +46,20 @@ def test_on_a_terminal_the_bar_has_a_total_and_an_eta(
     assert sum(1 for _ in wrapped.frames()) == 30
     shown = terminal.getvalue()
     assert "odometry on it" in shown and "/30 [" in shown and "<" in shown  # n/total [elapsed<remaining
+
+
+def test_report_bar_counts_datasets_drawn_on_a_terminal_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    bar = progress.FigureBar()
+    for done in range(4):
+        bar.update(done, 3)
+    bar.close()
+    assert "report: drawing" in terminal.getvalue() and "3/3 [" in terminal.getvalue()
+    quiet = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", quiet)
+    bar = progress.FigureBar()
+    bar.update(0, 3)
+    bar.update(3, 3)
+    bar.close()
+    assert quiet.getvalue() == ""
