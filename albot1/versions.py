@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import subprocess
 from functools import lru_cache
 from importlib import metadata
@@ -37,21 +38,52 @@ def code_version() -> str:
     return f"{__version__}+{digest.hexdigest()[:12]}"
 
 
+#: Written by the build step (``setup.py``) into the wheel's bundle: the commit the wheel was built from.
+BUILD_FILE = "build.json"
+#: What a record says when the commit is not known (a wheel built outside a git checkout, a copied tree).
+UNKNOWN_COMMIT = "commit unknown (not run from a git checkout, and no commit recorded when the wheel was built)"
+
+
 @lru_cache(maxsize=1)
 def git_commit() -> str | None:
-    """The checkout's commit (with ``-dirty`` when modified), or None outside git."""
+    """The commit of the running code, or None when it cannot be known.
+
+    From a checkout (the package's parent holds ``.git``): ``git describe``,
+    with ``-dirty`` when modified. From an installed wheel: the commit the
+    build step recorded in ``_bundled/build.json`` (it runs ``git describe``
+    on the checkout it builds from, or takes ``ALBOT1_BUILD_COMMIT``). Git is
+    not asked about a package that merely sits inside some repository (a
+    virtualenv in a clone): that repository's commit is not the wheel's.
+    """
+    if (_PACKAGE_DIR.parent / ".git").exists():
+        try:
+            out = subprocess.run(
+                ["git", "describe", "--always", "--dirty", "--abbrev=12"],
+                cwd=_PACKAGE_DIR,
+                capture_output=True,
+                text=True,
+                timeout=5,
+                check=True,
+            )
+        except (OSError, subprocess.SubprocessError):
+            return None
+        return out.stdout.strip() or None
+    return _built_commit()
+
+
+def _built_commit() -> str | None:
+    """The commit recorded in the wheel at build time, or None (no record, or not a record this build wrote)."""
     try:
-        out = subprocess.run(
-            ["git", "describe", "--always", "--dirty", "--abbrev=12"],
-            cwd=_PACKAGE_DIR,
-            capture_output=True,
-            text=True,
-            timeout=5,
-            check=True,
-        )
-    except (OSError, subprocess.SubprocessError):
+        record = json.loads((_PACKAGE_DIR / _BUNDLE_DIR_NAME / BUILD_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
         return None
-    return out.stdout.strip() or None
+    commit = record.get("commit") if isinstance(record, dict) else None
+    return commit if isinstance(commit, str) and commit else None
+
+
+def commit_label(commit: str | None) -> str:
+    """``commit e309a8d0c1f2`` or :data:`UNKNOWN_COMMIT`: how a version line names the commit (never "None")."""
+    return f"commit {commit}" if commit else UNKNOWN_COMMIT
 
 
 def library_versions(

@@ -20,6 +20,7 @@ from typing import Annotated
 import typer
 
 from albot1 import __version__
+from albot1.cli.helptext import install as install_help
 from albot1.errors import Albot1Error
 
 HELP = """Albot1 perceptual mapping vs SLAM baselines on 2D laser datasets.
@@ -44,9 +45,9 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
-        from albot1.versions import code_version  # importlib.metadata: only for --version
+        from albot1.versions import code_version, commit_label, git_commit  # only for --version
 
-        typer.echo(f"albot1 {__version__} (code {code_version()})")
+        typer.echo(f"albot1 {__version__} (code {code_version()}, {commit_label(git_commit())})")
         raise typer.Exit()
 
 
@@ -54,7 +55,12 @@ def _version(value: bool) -> None:
 def _root(
     version: Annotated[
         bool,
-        typer.Option("--version", callback=_version, is_eager=True, help="print the version and the code digest, exit"),
+        typer.Option(
+            "--version",
+            callback=_version,
+            is_eager=True,
+            help="print the version, the code digest and the git commit, exit",
+        ),
     ] = False,
 ) -> None:
     """The options of ``albot1`` itself (the commands are added below)."""
@@ -78,6 +84,7 @@ for _module_name, _attr, _group in _COMMANDS:
         getattr(_module, _attr)(app)
     else:
         app.add_typer(getattr(_module, _attr), name=_group)
+install_help(app)
 
 
 def main() -> None:

@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
@@ -80,7 +81,8 @@ def bench(
         plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))
         return
-    view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not progress)
+    # The bar (cells done of the total, with an ETA) only on a terminal: piped output and CI logs stay clean.
+    view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not (progress and enabled()))
     try:
         plan, summary, store = run_suite(
             suite,
@@ -146,7 +148,7 @@ def report(
     only: open it from the report folder in any browser, no network needed.
 
     Examples:\n
-      albot1 report results/default -j 2     # -> reports/default/README.md, reports/default/index.html\n
+      albot1 report results/default -j 2   # -> reports/default/index.html\n
       albot1 report results/quick --out /tmp/quick-report --map-style points
     """
     # Imported by the command, not by this module: see albot1.cli.app.
@@ -159,5 +161,9 @@ def report(
     ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
     writable_folder(out if out is not None else default_out(results_dir), "--out")
     style: MapStyle = "grid" if map_style == "grid" else "points"
-    index = build_report(results_dir, out, plots=plots, map_style=style, jobs=jobs)
+    bar = FigureBar()
+    try:
+        index = build_report(results_dir, out, plots=plots, map_style=style, jobs=jobs, progress=bar.update)
+    finally:
+        bar.close()
     typer.echo(f"report: {index}")

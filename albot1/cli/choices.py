@@ -11,8 +11,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from typer.core import TyperArgument, TyperCommand, TyperOption
+from typer.core import TyperArgument, TyperOption
 
+from albot1.cli.helptext import HelpCommand
 from albot1.errors import Albot1Error
 
 #: Shown until ``--help`` fills in the names (never seen by a user).
@@ -48,7 +49,7 @@ def preset_choices() -> str:
     return "; ".join(parts)
 
 
-class RegistryHelpCommand(TyperCommand):
+class RegistryHelpCommand(HelpCommand):
     """A command whose ``method`` / ``preset`` help lists the registry's names when help is shown."""
 
     def format_help(self, ctx: Any, formatter: Any) -> None:

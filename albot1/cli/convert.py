@@ -54,7 +54,8 @@ def convert(
     Examples:\n
       albot1 convert aces aces.bag\n
       albot1 convert radish/aces.clf.bz2 aces.mcap\n
-      albot1 convert run1/ aces.albotlog --scan-topic /base_scan --odom-topic /odom_raw
+      albot1 convert run1/ aces.albotlog \\
+          --scan-topic /base_scan --odom-topic /odom_raw
     """
     # The data layer is imported by the command, not by this module: see albot1.cli.app.
     from albot1.data.convert import convert as run_conversion

@@ -13,6 +13,7 @@ from typing import Annotated, Any
 
 import typer
 
+from albot1.cli.columns import aligned
 from albot1.cli.progress import with_progress
 from albot1.settings import get_settings
 
@@ -75,6 +76,7 @@ def list_(
     if as_json:
         typer.echo(json.dumps({"datasets": rows, "search_roots": [str(r) for r in settings.search_roots()]}))
         return
+    lines: list[tuple[str, str, str]] = []
     for row in rows:
         state = (
             "synthetic"
@@ -83,7 +85,9 @@ def list_(
         )
         if row.get("checksum_problem"):
             state = "wrong copy (sha256)"  # `albot1 datasets info NAME` says which file and how to fix it
-        typer.echo(f"{row['name']:30s} {state:21s} {_first_sentence(row['description'])}")
+        lines.append((row["name"], state, _first_sentence(row["description"])))
+    for line in aligned(lines):
+        typer.echo(line)
     typer.echo(f"searched: {', '.join(str(r) for r in settings.search_roots())}")
 
 
@@ -155,7 +159,8 @@ def info(
 
     Decodes the whole log once. Examples:\n
       albot1 datasets info intel --json\n
-      albot1 datasets info recording.bag --scan-topic /base_scan --odom-topic /odom_raw
+      albot1 datasets info recording.bag \\
+          --scan-topic /base_scan --odom-topic /odom_raw
     """
     from albot1.data.open import open_sequence
 

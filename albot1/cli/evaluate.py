@@ -114,9 +114,12 @@ def evaluate(
     Examples:\n
       albot1 evaluate runs/3f2a9c0d11e4b7a2\n
       albot1 evaluate runs/3f2a9c0d11e4b7a2 --json | jq .ate.rmse_m\n
-      albot1 evaluate --trajectory cartographer.tum --dataset intel-corrected --out carto.json\n
-      albot1 evaluate --trajectory intel.gfs.log --format carmen --dataset aces --evo evo-results/\n
-      albot1 evaluate --trajectory est.tum --reference gt.tum --align origin --time-offset 0.05
+      albot1 evaluate --trajectory cartographer.tum --dataset intel-corrected \\
+          --out carto.json\n
+      albot1 evaluate --trajectory intel.gfs.log --format carmen --dataset aces \\
+          --evo evo-results/\n
+      albot1 evaluate --trajectory est.tum --reference gt.tum \\
+          --align origin --time-offset 0.05
     """
     # The runs layer is imported by the command, not by this module: see albot1.cli.app.
     from albot1.records import dump_record

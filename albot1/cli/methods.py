@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from albot1.cli.columns import aligned
+
 if TYPE_CHECKING:
     from albot1.methods.registry import MethodSpec
 
@@ -50,11 +52,13 @@ def methods(
         typer.echo(json.dumps({"methods": records}, indent=2, default=str))
         return
     if not detail:
+        rows: list[tuple[str, ...]] = []
         for record in records:
             state = "available" if record["available"] else "unavailable"
-            typer.echo(f"{record['name']:12s} {state:12s} {record['description']}")
+            rows.append((record["name"], state, record["description"]))
             if not record["available"]:
-                typer.echo(f"{'':12s} {'':12s} -> {record['unavailable']}")
+                rows.append(("", "", f"-> {record['unavailable']}"))
+        typer.echo("\n".join(aligned(rows)))
         return
     typer.echo("\n\n".join(_human(record) for record in records))
 

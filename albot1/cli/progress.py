@@ -1,4 +1,4 @@
-"""Progress bars of the long single-log commands (``run``, ``convert``, ``datasets info``, ``evaluate``).
+"""Progress bars of the long commands (``run``, ``convert``, ``datasets info``, ``evaluate``, ``report``).
 
 Shown on stderr and only when stderr is a terminal: piped or captured
 output (``--json | jq``, CI logs, tests) stays free of bar redraws. A log's
@@ -28,11 +28,36 @@ def _bar(total: int | None, desc: str) -> Any:
     return tqdm(total=total, desc=desc, unit="scan", file=sys.stderr, dynamic_ncols=True, leave=False)
 
 
-def with_progress(sequence: Sequence, desc: str) -> Sequence:
-    """``sequence`` whose every pass over the frames advances a bar (unchanged when bars are off)."""
+def slice_bound(ref: str) -> int | None:
+    """At most how many scans ``NAME[:STOP]`` / ``NAME[:STOP:STEP]`` yields (None without a STOP).
+
+    A CARMEN log's length is unknown until it is decoded, but a slice's stop
+    bounds it: the bar of ``run 'intel[:3000]'`` gets a total and an ETA
+    (it ends early only when the log is shorter than the slice).
+    """
+    import re
+
+    from albot1.data.open import parse_slice
+
+    sliced = re.fullmatch(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]", ref)
+    if sliced is None:
+        return None
+    stop, step = parse_slice(sliced["body"], ref)
+    if stop is None:
+        return None
+    return -(-stop // step) if step is not None else stop
+
+
+def with_progress(sequence: Sequence, desc: str, at_most: int | None = None) -> Sequence:
+    """``sequence`` whose every pass over the frames advances a bar (unchanged when bars are off).
+
+    The bar's total is the scan count when known without decoding, else
+    ``at_most`` (a slice's bound, :func:`slice_bound`), else none (a rate).
+    """
     if not enabled():
         return sequence
-    total = sequence.known_scan_count
+    known = sequence.known_scan_count
+    total = known if known is not None else at_most
 
     def frames(source: Iterator[Frame]) -> Iterator[Frame]:
         bar = _bar(total, desc)
@@ -43,4 +68,38 @@ def with_progress(sequence: Sequence, desc: str) -> Sequence:
         finally:
             bar.close()
 
-    return sequence.with_frames(frames, scan_count=total)
+    return sequence.with_frames(frames, scan_count=known)
+
+
+class FigureBar:
+    """The bar of ``albot1 report``: datasets whose figures are drawn, of those to draw, with an ETA.
+
+    Drawing is most of a report's time (30-40 s for the quick suite, minutes
+    for the default one). Created on the first :meth:`update` (the report
+    knows the count only once it has read the results), never when stderr is
+    not a terminal, nor when every figure comes from the cache.
+    """
+
+    def __init__(self) -> None:
+        self._bar: Any = None
+
+    def update(self, done: int, total: int) -> None:
+        if not enabled() or total == 0:
+            return
+        if self._bar is None:
+            from tqdm import tqdm
+
+            self._bar = tqdm(
+                total=total,
+                desc="report: drawing",
+                unit="dataset",
+                file=sys.stderr,
+                dynamic_ncols=True,
+                leave=False,
+                mininterval=0,  # one update per dataset: every one is shown
+            )
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from albot1.cli.choices import METHOD_HELP, PRESET_HELP, RegistryHelpCommand
-from albot1.cli.progress import enabled, with_progress
+from albot1.cli.progress import enabled, slice_bound, with_progress
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
@@ -69,7 +69,7 @@ def run(
     # result.json: runs on different prefixes get different folders, and `albot1 evaluate` reopens the prefix.
     dataset = dataset if limit is None else f"{dataset}[:{limit}]"
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
-    sequence = with_progress(sequence, f"{method} on {dataset}")
+    sequence = with_progress(sequence, f"{method} on {dataset}", at_most=slice_bound(dataset))
     result = run_method(
         method,
         sequence,

@@ -28,7 +28,8 @@ def runs(
 
     Examples:\n
       albot1 runs\n
-      albot1 runs results/quick/runs --json | jq '.runs[] | select(.status == "failed")'
+      albot1 runs results/quick/runs --json \\
+          | jq '.runs[] | select(.status == "failed")'
     """
     # The runs layer is imported by the command, not by this module: see albot1.cli.app.
     from albot1.runs.folder import LATEST, list_runs

@@ -34,6 +34,7 @@ from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
 from albot1.report.tuning import LEGEND, marked
+from albot1.versions import commit_label
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -216,7 +217,7 @@ def write_html(
         f"<li>machine: {_e(m.get('cpu_count'))} logical CPUs ({_e(m.get('cpu_count_physical'))} physical), "
         f"{_e(m.get('memory_gb'))} GB; {_e(m.get('processor'))}; {_e(m.get('platform'))}; "
         f"Python {_e(m.get('python'))}</li>",
-        f"<li>code version <code>{_e(m.get('code_version'))}</code> (git <code>{_e(m.get('git'))}</code>); "
+        f"<li>code version <code>{_e(m.get('code_version'))}</code> (<code>{_e(commit_label(m.get('git')))}</code>); "
         f"libraries: {_e(libraries)}</li>",
         "</ul>",
         '<h2 id="tables">Tables</h2>',

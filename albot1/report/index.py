@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import multiprocessing
 import time
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -44,6 +45,7 @@ from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 from albot1.report.tuning import held_in
+from albot1.versions import commit_label
 
 REPORTS_ROOT = Path("reports")
 #: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
@@ -52,6 +54,10 @@ ROBUSTNESS = (
     ("drift_10m_m", "RPE per 10 m, translation (m)", "robustness-drift"),
     ("loop_gap_m", "loop gap (m)", "robustness-loop-gap"),
 )
+
+
+#: Told ``(datasets whose figures are drawn, datasets to draw)`` while the report draws its figures.
+PlotProgress = Callable[[int, int], None]
 
 
 def default_out(results_dir: Path) -> Path:
@@ -70,13 +76,16 @@ def render_plots(
     *,
     map_style: MapStyle = "grid",
     jobs: int = 1,
+    progress: PlotProgress | None = None,
 ) -> dict[str, list[Path]]:
     """Every plot of the report (PNG, each with an SVG twin); dataset label -> its PNGs ("" for cross-dataset).
 
     Drawing is most of a report's time (matplotlib's layout and two file
     formats per figure) and each dataset's figures depend on its records
     alone, so with ``jobs`` > 1 the datasets are drawn in that many worker
-    processes; the figures are the same files either way.
+    processes; the figures are the same files either way. ``progress`` is
+    told ``(datasets drawn, datasets to draw)`` before the first and after each
+    (the CLI's bar; figures found in the cache are not counted).
     """
     colors = colors or method_colors(r.cell.method_label for r in records)
     cells = cells_frame(records)
@@ -98,12 +107,19 @@ def render_plots(
             made[dataset] = [cache.path(name) for name in cached.payload]
         else:
             tasks.append((dataset, recs, metrics, plots_dir, colors, map_style))
+    tell = progress or (lambda done, total: None)
+    tell(0, len(tasks))
+    drawn: list[list[Path]] = []
     if jobs > 1 and len(tasks) > 1:
         # spawn: a fresh interpreter per worker, whatever threads or matplotlib state this process holds.
         with ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=multiprocessing.get_context("spawn")) as pool:
-            drawn = list(pool.map(_dataset_plots, *zip(*tasks, strict=True)))
+            for files in pool.map(_dataset_plots, *zip(*tasks, strict=True)):
+                drawn.append(files)
+                tell(len(drawn), len(tasks))
     else:
-        drawn = [_dataset_plots(*task) for task in tasks]
+        for task in tasks:
+            drawn.append(_dataset_plots(*task))
+            tell(len(drawn), len(tasks))
     for task, files in zip(tasks, drawn, strict=True):
         dataset = task[0]
         made[dataset] = files
@@ -161,7 +177,7 @@ def _machine_lines(plan: GridPlan) -> list[str]:
         f"- CPUs: {text(m.get('cpu_count'))} logical ({text(m.get('cpu_count_physical'))} physical), "
         f"memory {text(m.get('memory_gb'))} GB; {text(m.get('processor'))}",
         f"- platform: {text(m.get('platform'))}; Python {text(m.get('python'))}",
-        f"- code version: {code(m.get('code_version'))} (git {code(m.get('git'))})",
+        f"- code version: {code(m.get('code_version'))} ({commit_label(m.get('git'))})",
         f"- libraries: {text(libraries)}",
     ]
 
@@ -325,10 +341,11 @@ def build_report(
     plots: bool = True,
     map_style: MapStyle = "grid",
     jobs: int = 1,
+    progress: PlotProgress | None = None,
 ) -> Path:
     """Tables, plots, README.md and index.html for ``results_dir``; returns the README path.
 
-    ``jobs``: worker processes drawing the plots (:func:`render_plots`).
+    ``jobs``: worker processes drawing the plots (:func:`render_plots`, which tells ``progress``).
 
     For the ``thesis`` suite README.md is the thesis reproduction page
     (:mod:`albot1.report.thesis.page`) and the benchmark index is ``benchmark.md``.
@@ -348,7 +365,7 @@ def build_report(
     colors = method_colors(r.cell.method_label for r in records)
     thesis = plan.suite == THESIS_SUITE
     pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default
-    made = render_plots(pictured, target, colors, map_style=map_style, jobs=jobs) if plots else {}
+    made = render_plots(pictured, target, colors, map_style=map_style, jobs=jobs, progress=progress) if plots else {}
     views = write_views(pictured, target, colors) if plots else None
     index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
     page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None

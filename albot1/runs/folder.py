@@ -8,7 +8,8 @@ degradation, seed, code version)::
     reference.tum    reference poses, when the dataset has them
     relations.txt    ground-truth relations, when the dataset has them
     result.json      method, dataset, config, versions, counters, timing (albot1.records.ResultRecord)
-    map.geojson      line surfaces (Albot1) -- or map.npz (points) for baselines
+    map.geojson      the map, every method: line surfaces (Albot1) or points (baselines); runs.map_files
+    map.npz          a point map's points again (float32), the file its result.json names
     extras.json      method-specific records (update trace, ...)
     <extra files>    a mapper's own files (``MapperOutput.files``: places.json, places.graphml, ...)
     preview.png      the map with the trajectory (drawn by the caller's renderer, if given)
@@ -43,6 +44,7 @@ from albot1.data.trajectory import read_tum, write_tum
 from albot1.errors import Albot1Error
 from albot1.records import Record, ResultRecord, dump_record, json_value, parse_record, read_record
 from albot1.runs.errors import RunError
+from albot1.runs.map_files import write_map
 
 DONE = "DONE"
 RESULT_FILE = "result.json"
@@ -155,7 +157,7 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
         atomic_write(run_dir / "reference.tum", lambda p: write_tum(p, result.timestamps, reference))
     if result.relations is not None:
         write_relations(run_dir / "relations.txt", result.relations)  # atomic itself
-    map_file = _write_map(run_dir, result.map)
+    map_file = write_map(run_dir, result.map)
     write_json(run_dir / "extras.json", result.extras)
     _write_files(run_dir, result.files)
     info = {
@@ -202,33 +204,6 @@ def _write_files(run_dir: Path, files: dict[str, Any]) -> None:
             atomic_write(run_dir / name, partial(Path.write_bytes, data=content))
         else:
             write_json(run_dir / name, content)
-
-
-def _write_map(run_dir: Path, data: MapData) -> str:
-    if data.segments is not None:
-        features = []
-        props = data.segment_properties or [{} for _ in range(len(data.segments))]
-        for seg, prop in zip(np.asarray(data.segments, dtype=float), props):
-            features.append(
-                {
-                    "type": "Feature",
-                    "properties": prop,
-                    "geometry": {"type": "LineString", "coordinates": [[seg[0], seg[1]], [seg[2], seg[3]]]},
-                }
-            )
-        if data.points is not None and len(data.points):
-            features.append(
-                {
-                    "type": "Feature",
-                    "properties": {"kind": "points"},
-                    "geometry": {"type": "MultiPoint", "coordinates": np.asarray(data.points).tolist()},
-                }
-            )
-        write_json(run_dir / "map.geojson", {"type": "FeatureCollection", "features": features})
-        return "map.geojson"
-    points = np.asarray(data.points if data.points is not None else np.empty((0, 2)), dtype=np.float32)
-    atomic_write(run_dir / "map.npz", lambda p: np.savez_compressed(p.open("wb"), points=points))
-    return "map.npz"
 
 
 @dataclass

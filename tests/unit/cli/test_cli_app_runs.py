@@ -9,14 +9,15 @@ from typer.testing import CliRunner
 
 from albot1 import __version__
 from albot1.cli.app import app
-from albot1.versions import code_version
+from albot1.versions import code_version, commit_label, git_commit
 
 runner = CliRunner()
 
 
 def test_version_prints_the_package_version_and_the_code_digest() -> None:
     done = runner.invoke(app, ["--version"])
-    assert done.exit_code == 0 and done.stdout.strip() == f"albot1 {__version__} (code {code_version()})"
+    expected = f"albot1 {__version__} (code {code_version()}, {commit_label(git_commit())})"
+    assert done.exit_code == 0 and done.stdout.strip() == expected
 
 
 def test_help_documents_the_dataset_reference_syntax() -> None:

@@ -17,7 +17,9 @@ def test_plain_listing_is_one_line_per_method() -> None:
     assert result.exit_code == 0, result.output
     lines = result.output.splitlines()
     assert [line.split()[0] for line in lines] == method_registry().names()
-    assert lines[1].startswith("albot1       available    the Albot1 perceptual mapper")
+    assert lines[1] == "albot1         available  the Albot1 perceptual mapper (thesis chapter 3)"
+    # every row's columns start at the same place, the longest name included
+    assert {line.index(" available") for line in lines} == {len("albot1-places") + 1}
 
 
 def test_presets_table_of_one_method() -> None:

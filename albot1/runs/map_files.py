@@ -1,0 +1,72 @@
+"""A run's map on disk: ``map.geojson`` for every method, ``map.npz`` beside it for point maps.
+
+Every method writes ``map.geojson`` (the README promises it for every run,
+and GIS tools, QGIS or shapely read it): line surfaces (Albot1) are one
+``LineString`` feature each, with the surface's properties; a point map (the
+scan-projecting baselines' grid-thinned points, see
+:mod:`albot1.methods.baselines.point_map`) is one ``MultiPoint`` feature with
+``kind = "points"``. A point map also keeps ``map.npz`` (compact, and the
+file its ``result.json`` names and the metrics read), so existing results
+read the same numbers; the GeoJSON coordinates are those very float32
+values, written in their shortest decimal form. This is the one writer of
+GeoJSON maps in the project.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from albot1.atomic import atomic_write
+from albot1.contract import MapData
+from albot1.records import json_value
+
+GEOJSON = "map.geojson"
+NPZ = "map.npz"
+
+
+def map_geojson(data: MapData) -> dict[str, Any]:
+    """The GeoJSON FeatureCollection of ``data``: a LineString per segment, one MultiPoint of the points."""
+    features: list[dict[str, Any]] = []
+    if data.segments is not None:
+        props = data.segment_properties or [{} for _ in range(len(data.segments))]
+        for seg, prop in zip(np.asarray(data.segments, dtype=float), props):
+            features.append(
+                {
+                    "type": "Feature",
+                    "properties": prop,
+                    "geometry": {"type": "LineString", "coordinates": [[seg[0], seg[1]], [seg[2], seg[3]]]},
+                }
+            )
+        points = np.asarray(data.points, dtype=float).reshape(-1, 2) if data.points is not None else None
+    else:
+        # a point map is stored as float32 (map.npz); the GeoJSON holds the same values
+        points = _stored_points(data)
+        points = np.array([[float(x) for x in pair] for pair in points.astype(str)]).reshape(-1, 2)
+    if points is not None and len(points):
+        features.append(
+            {
+                "type": "Feature",
+                "properties": {"kind": "points"},
+                "geometry": {"type": "MultiPoint", "coordinates": points.tolist()},
+            }
+        )
+    return {"type": "FeatureCollection", "features": features}
+
+
+def _stored_points(data: MapData) -> np.ndarray:
+    return np.asarray(data.points if data.points is not None else np.empty((0, 2)), dtype=np.float32).reshape(-1, 2)
+
+
+def write_map(run_dir: Path, data: MapData) -> str:
+    """Write the map files of ``data`` into ``run_dir``; the name of the one ``result.json`` points to."""
+    text = json.dumps(json_value(map_geojson(data)), separators=(",", ":")) + "\n"  # compact: maps are large
+    atomic_write(run_dir / GEOJSON, lambda p: p.write_text(text, encoding="utf-8"))
+    if data.segments is not None:
+        return GEOJSON
+    points = _stored_points(data)
+    atomic_write(run_dir / NPZ, lambda p: np.savez_compressed(p.open("wb"), points=points))
+    return NPZ

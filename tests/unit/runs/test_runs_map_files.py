@@ -1,0 +1,66 @@
+"""Every method's run folder holds map.geojson (and a point map also map.npz with the same values)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely.geometry
+
+from albot1.contract import MapData
+from albot1.data.open import open_sequence
+from albot1.methods.registry import method_registry
+from albot1.runs.execute import run_method
+from albot1.runs.folder import read_run, write_run
+from albot1.runs.map_files import map_geojson, write_map
+
+
+def test_segments_are_linestrings_with_their_properties() -> None:
+    data = MapData(segments=np.array([[0.0, 0.0, 1.0, 0.5]]), segment_properties=[{"id": 3}])
+    assert map_geojson(data) == {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "properties": {"id": 3},
+                "geometry": {"type": "LineString", "coordinates": [[0.0, 0.0], [1.0, 0.5]]},
+            }
+        ],
+    }
+
+
+def test_points_are_one_multipoint_of_the_stored_float32_values(tmp_path: Path) -> None:
+    points = np.array([[0.1, -2.3], [1e-3, 4.0]])
+    assert write_map(tmp_path, MapData(points=points)) == "map.npz"
+    collection = json.loads((tmp_path / "map.geojson").read_text())
+    (feature,) = collection["features"]
+    assert feature["properties"] == {"kind": "points"}
+    assert feature["geometry"]["coordinates"] == [[0.1, -2.3], [0.001, 4.0]]  # shortest form of the float32 values
+    with np.load(tmp_path / "map.npz") as npz:
+        np.testing.assert_array_equal(np.asarray(feature["geometry"]["coordinates"], dtype=np.float32), npz["points"])
+    assert write_map(tmp_path, MapData(points=np.empty((0, 2)))) == "map.npz"
+    assert json.loads((tmp_path / "map.geojson").read_text())["features"] == []
+
+
+@pytest.mark.slow  # the Albot1 kernels compile on a code version's first run
+@pytest.mark.parametrize("method", method_registry().names())
+def test_every_method_writes_map_geojson(method: str, tmp_path: Path) -> None:
+    spec = method_registry().get(method)
+    if not spec.available():
+        pytest.skip(f"{method} is not installed here: {spec.unavailable_reason()}")
+    result = run_method(method, open_sequence("synthetic-office-loop[:40]"))
+    run_dir = write_run(result, tmp_path)
+    collection = json.loads((run_dir / "map.geojson").read_text())
+    geometries = [shapely.geometry.shape(f["geometry"]) for f in collection["features"]]
+    assert geometries, f"{method}: empty map.geojson"
+    stored = read_run(run_dir).load_map()
+    if result.map.segments is not None:
+        assert not (run_dir / "map.npz").exists()
+        assert [g.geom_type for g in geometries] == ["LineString"] * len(result.map.segments)
+    else:
+        assert [g.geom_type for g in geometries] == ["MultiPoint"]
+        assert stored.points is not None
+        assert len(geometries[0].geoms) == len(stored.points)
+        np.testing.assert_allclose(np.array([(p.x, p.y) for p in geometries[0].geoms]), stored.points, atol=1e-6)

@@ -1,0 +1,85 @@
+"""The commit a version line names: the checkout's, the one a wheel recorded at build time, or an honest unknown."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from albot1 import versions
+from albot1.cli.app import app
+
+
+@pytest.fixture
+def package_at(monkeypatch: pytest.MonkeyPatch) -> Iterator[Callable[[Path], None]]:
+    def place(path: Path) -> None:
+        path.mkdir(parents=True, exist_ok=True)
+        monkeypatch.setattr(versions, "_PACKAGE_DIR", path)
+        versions.git_commit.cache_clear()
+
+    yield place
+    versions.git_commit.cache_clear()
+
+
+def test_the_label_never_says_none() -> None:
+    assert versions.commit_label("e309a8d0c1f2") == "commit e309a8d0c1f2"
+    assert versions.commit_label(None) == versions.UNKNOWN_COMMIT
+    assert "None" not in versions.UNKNOWN_COMMIT and "unknown" in versions.UNKNOWN_COMMIT
+
+
+def test_an_installed_package_reads_the_commit_recorded_at_build(
+    tmp_path: Path, package_at: Callable[[Path], None]
+) -> None:
+    package = tmp_path / "site-packages" / "albot1"
+    package_at(package)
+    assert versions.git_commit() is None  # no checkout, no record
+    (package / "_bundled").mkdir()
+    (package / "_bundled" / versions.BUILD_FILE).write_text(json.dumps({"commit": "0123456789ab"}))
+    versions.git_commit.cache_clear()
+    assert versions.git_commit() == "0123456789ab"
+    (package / "_bundled" / versions.BUILD_FILE).write_text(json.dumps({"commit": None}))
+    versions.git_commit.cache_clear()
+    assert versions.git_commit() is None
+    (package / "_bundled" / versions.BUILD_FILE).write_text("{not json")
+    versions.git_commit.cache_clear()
+    assert versions.git_commit() is None
+
+
+def test_a_package_inside_another_repository_does_not_take_its_commit(
+    tmp_path: Path, package_at: Callable[[Path], None]
+) -> None:
+    subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
+    package_at(tmp_path / "venv" / "site-packages" / "albot1")  # a virtualenv inside a clone
+    assert versions.git_commit() is None
+
+
+def test_a_checkout_names_its_commit(tmp_path: Path, package_at: Callable[[Path], None]) -> None:
+    git = ["git", "-C", str(tmp_path), "-c", "user.name=t", "-c", "user.email=t@t"]
+    subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
+    package_at(tmp_path / "albot1")
+    (tmp_path / "albot1" / "__init__.py").write_text("")
+    subprocess.run([*git, "add", "-A"], check=True)
+    subprocess.run([*git, "commit", "-q", "-m", "c"], check=True)
+    head = subprocess.run([*git, "rev-parse", "HEAD"], check=True, capture_output=True, text=True).stdout.strip()
+    assert versions.git_commit() == head[:12]
+    (tmp_path / "albot1" / "__init__.py").write_text("x = 1\n")
+    versions.git_commit.cache_clear()
+    assert versions.git_commit() == f"{head[:12]}-dirty"
+
+
+def test_version_line_names_the_commit_or_says_it_is_unknown(
+    tmp_path: Path, package_at: Callable[[Path], None]
+) -> None:
+    package_at(tmp_path / "albot1")  # outside git, no build record: a wheel built from a copy without a commit
+    versions.code_version.cache_clear()
+    try:
+        result = CliRunner().invoke(app, ["--version"])
+    finally:
+        versions.code_version.cache_clear()
+    assert result.exit_code == 0, result.output
+    assert result.output.endswith(f", {versions.UNKNOWN_COMMIT})\n")
+    assert "None" not in result.output
