@@ -17,14 +17,15 @@ import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-import matplotlib
 import pytest
 
 from albot1.data import catalog
 from albot1.methods.plugins import ENTRY_POINT_GROUP
 from albot1.methods.registry import method_registry
 
-matplotlib.use("Agg")
+# The plotting backend without importing matplotlib here (half a second of every collection): it reads this
+# variable when a test first imports it, and the CLI and cell processes the tests start inherit it.
+os.environ.setdefault("MPLBACKEND", "Agg")
 
 #: What marks a SLAM-corrected log in the catalog: its name is ``<site>-corrected`` (datasets/README.md).
 CORRECTED_SUFFIX = "-corrected"
@@ -33,6 +34,22 @@ CORRECTED_SUFFIX = "-corrected"
 def corrected_names() -> list[str]:
     """The registered SLAM-corrected logs (``acapulco-corrected``, ...), sorted."""
     return [name for name in catalog.names() if name.endswith(CORRECTED_SUFFIX)]
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Modules holding a ``slow`` test run first, each module kept together, the rest in collection order.
+
+    pytest-xdist hands tests out in this order; a long test handed out last keeps one worker busy while
+    the others have finished (with two workers, most of a minute of ``make test``). Keeping a module's
+    tests together keeps its module-scoped fixtures built once per worker.
+    """
+    slow_modules = {_module(item) for item in items if item.get_closest_marker("slow")} - {None}
+    items.sort(key=lambda item: _module(item) not in slow_modules)
+
+
+def _module(item: pytest.Item) -> str | None:
+    module = getattr(item, "module", None)
+    return module.__name__ if module is not None else None
 
 
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:

@@ -154,6 +154,7 @@ def test_a_results_folder_whose_grid_planned_no_cell_still_gets_a_report(tmp_pat
     assert (tmp_path / "report" / INDEX_HTML).is_file()
 
 
+@pytest.mark.slow
 def test_plots_drawn_by_worker_processes_are_the_same_files(tmp_path: Path) -> None:
     root = tmp_path / "two"
     store = ResultsStore(root)
