@@ -120,3 +120,14 @@ def install_method_plugin(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> It
 def fault_plugin(install_method_plugin: PluginInstaller) -> None:
     """The failure-injecting test mapper installed as the plugin method ``fault`` (tests/integration)."""
     install_method_plugin({"fault": "bench_fault_mappers:FaultMapper"})
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Run the slow tests first (stable order otherwise).
+
+    With several xdist workers (``make test``), a whole-log test of a minute
+    or two that starts last keeps the other workers idle until it ends; the
+    workers steal queued tests from each other (``--dist worksteal``), so the
+    short ones started after the slow ones fill the gaps instead.
+    """
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)

@@ -188,3 +188,32 @@ def info(
     typer.echo(
         "  data: " + (", ".join(f"{n} sha256 {sha}" for n, sha in checksums.items()) or "generated (no data file)")
     )
+
+
+@app.command("reference")
+def reference(
+    ref: Annotated[
+        str,
+        typer.Argument(help="NAME, NAME[:N], NAME?key=value (see `albot1 --help`), a synthetic world or a log path"),
+    ],
+    output: Annotated[Path, typer.Argument(metavar="OUT", help="the TUM file to create (t x y z qx qy qz qw)")],
+    retime: Annotated[
+        bool,
+        typer.Option(help="move stamps that repeat or go backwards as `albot1 convert --retime` does"),
+    ] = False,
+    data_dir: DataDir = None,
+) -> None:
+    """Write the reference pose of every scan as a TUM trajectory file (OUT must not exist).
+
+    The reference trajectory of a log, for `?reference=FILE`, `albot1 evaluate
+    --reference` or evo. Examples:\n
+      albot1 datasets reference aces-corrected gt.tum\n
+      albot1 datasets reference 'synthetic-office-loop[:200]' loop-gt.tum
+    """
+    from albot1.data.open import open_sequence
+    from albot1.data.reference_tum import write_reference_tum
+
+    sequence = open_sequence(ref, settings=get_settings(data_dir=data_dir))
+    done = write_reference_tum(with_progress(sequence, f"reading {ref}"), output, retime=retime)
+    shifted = f"; {done.retimed} timestamps shifted by --retime" if done.retimed else ""
+    typer.echo(f"wrote {done.poses} reference poses from {done.source} to {done.output} (tum){shifted}")

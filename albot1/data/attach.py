@@ -8,6 +8,9 @@ the same everywhere (``docs/formats.md``, "Options of every source"):
 ``relations=FILE``
     a relations file (:mod:`albot1.data.relations`) replaces the source's own
     relations (if any); the relation metric then scores against it.
+    ``relations_repeats=drop|keep`` says how its identically repeated lines
+    count: once (drop, the default) or as listed (keep, the published
+    evaluator's reading).
 ``reference=FILE``
     a reference trajectory (TUM, KITTI or a corrected CARMEN log;
     :mod:`albot1.data.trajectory`, format from the file) gives every scan its
@@ -33,7 +36,7 @@ import numpy as np
 
 from albot1.data.errors import DataError, ReferenceOptionError
 from albot1.data.model import Frame, Sequence
-from albot1.data.relations import read_relations
+from albot1.data.relations import read_relations, repeat_policy
 from albot1.data.trajectory import read_trajectory
 
 #: Largest gap (s) between a scan and the reference pose it takes (evo's default ``t_max_diff``).
@@ -42,10 +45,13 @@ REFERENCE_MAX_DT_S = 0.01
 REFERENCE_KEYWORDS = ("none", "laser-pose", "truepos", "auto")
 
 
-def with_relations(sequence: Sequence, value: object, ref: str) -> Sequence:
-    """``sequence`` whose relations are read from the file ``value`` (the ``relations=FILE`` option)."""
+def with_relations(sequence: Sequence, value: object, ref: str, repeats: object = None) -> Sequence:
+    """``sequence`` whose relations are read from the file ``value`` (the ``relations=FILE`` option).
+
+    ``repeats`` is the ``relations_repeats`` option (how identical repeated lines count), default drop.
+    """
     path = _file(value, "relations", ref)
-    relations = read_relations(path)
+    relations = read_relations(path, repeats="drop" if repeats is None else repeat_policy(repeats, repr(ref)))
     extra = {**sequence.metadata.extra, "relations_file": str(path)}
     out = sequence.with_frames(
         lambda frames: frames, metadata=replace(sequence.metadata, extra=extra), scan_count=sequence.known_scan_count

@@ -138,6 +138,8 @@ def open_dataset(name: str, settings: Settings, **options: Any) -> Sequence:
         found = verified_file(manifest, relations, settings)
         merged["relations"] = found
         checksums[found.name] = relations.sha256
+        if relations.repeats is not None:
+            merged.setdefault("relations_repeats", relations.repeats)
     if manifest.format == "carmen":
         merged.setdefault("name", manifest.name)
         merged.setdefault("license", manifest.license)

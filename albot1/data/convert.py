@@ -69,7 +69,7 @@ class Conversion:
 RETIME_STEP_S = 1e-6
 
 
-def _retimed(frames: Iterator[Frame], shifted: list[int]) -> Iterator[Frame]:
+def retimed(frames: Iterator[Frame], shifted: list[int]) -> Iterator[Frame]:
     """Frames whose timestamp is at least ``RETIME_STEP_S`` after the previous one's.
 
     Only stamps that repeat or go backwards move, and only as far as needed;
@@ -124,7 +124,7 @@ def convert(
 
     def counted(frames: Iterator[Frame]) -> Iterator[Frame]:
         count[0] = shifted[0] = 0  # per pass: a writer may read the sequence more than once
-        for frame in _retimed(frames, shifted) if retime else frames:
+        for frame in retimed(frames, shifted) if retime else frames:
             count[0] += 1
             yield frame
 

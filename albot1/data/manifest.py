@@ -19,6 +19,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
 from albot1.data.errors import DataError
+from albot1.data.relations import RepeatPolicy, repeat_policy
 
 #: The roles a file of a dataset may have.
 ROLES = ("log", "relations")
@@ -33,6 +34,9 @@ class DataFile:
     sha256: str
     size: int | None = None
     urls: tuple[str, ...] = ()
+    #: a relations file's reading of identically repeated lines (``relations_repeats``): ``keep`` where the
+    #: published figures count them as listed; None = the default (drop)
+    repeats: RepeatPolicy | None = None
 
 
 @dataclass(frozen=True)
@@ -136,6 +140,11 @@ def parse_manifest(path: Path) -> DatasetManifest:
         sha = _require(entry, "sha256", str, where).lower()
         if len(sha) != 64 or any(c not in "0123456789abcdef" for c in sha):
             raise DataError(f"{where}: sha256 must be 64 hex digits")
+        repeats = _optional(entry, "repeats", str, where, None)
+        if repeats is not None:
+            if role != "relations":
+                raise DataError(f'{where}: repeats goes with role = "relations", not {role!r}')
+            repeats = repeat_policy(repeats, str(where))
         files.append(
             DataFile(
                 role=role,
@@ -143,6 +152,7 @@ def parse_manifest(path: Path) -> DatasetManifest:
                 sha256=sha,
                 size=_size(_optional(entry, "size", int, where, None), where),
                 urls=_strings(entry, "urls", where),
+                repeats=repeats,
             )
         )
     if sum(f.role == "log" for f in files) != 1:

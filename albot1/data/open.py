@@ -242,6 +242,7 @@ def _with_own_files(text: str, settings: Settings | None, format_name: str | Non
     """Open ``text`` with the other options, then attach ``relations=FILE`` and ``reference=FILE``."""
     rest = dict(options)
     relations = rest.pop("relations", None)
+    repeats = rest.pop("relations_repeats", None) if relations is not None else None
     max_dt = rest.pop("reference_max_dt", None)
     reference = rest.pop("reference", None) if str(rest.get("reference")) not in REFERENCE_KEYWORDS else None
     if max_dt is not None and reference is None:
@@ -254,7 +255,7 @@ def _with_own_files(text: str, settings: Settings | None, format_name: str | Non
     _check_option_files(own, text)  # a FIFO or device is refused before anything reads it
     sequence = open_sequence(text, settings=settings, format_name=format_name, **rest)
     if relations is not None:
-        sequence = with_relations(sequence, relations, text)
+        sequence = with_relations(sequence, relations, text, repeats)
     if reference is not None:
         sequence = with_reference(sequence, reference, text, max_dt)
     sequence = _attach(sequence, _checksums(None, own))

@@ -12,12 +12,13 @@ ATE ratio: ``sqrt(sum e_m^2 / sum e_o^2)`` over every scan of every seed,
 where ``e_m`` and ``e_o`` are the per-scan position errors of the method and
 of its odometry, each after its own rigid SE(2) alignment to the reference
 (:func:`albot1.metrics.ate.position_errors`), i.e. the ratio of the two
-ATE RMSEs pooled over the seeds. Its confidence interval is a paired
+ATE RMSEs pooled over the seeds. Its confidence interval and verdict are
+the project's one paired comparison (:mod:`albot1.metrics.paired`): a paired
 moving-block bootstrap over scans (blocks of 1/20 of a run, resampled within
-each seed, the same indices for both errors; the alignment is kept fixed),
-:data:`RESAMPLES` resamples from a fixed seed, so the page is reproducible.
-A cell is **worse** when the whole interval is above 1, **better** when it
-is below 1, else **indistinguishable** at :data:`CONFIDENCE`. RPE@10 m and
+each seed, the same indices for both errors; the alignment is kept fixed)
+from a fixed seed, so the page is reproducible. A cell is **worse** when the
+whole interval is above 1, **better** when it is below 1, else
+**indistinguishable** at :data:`~albot1.metrics.paired.CONFIDENCE`. RPE@10 m and
 the loop gap are shown beside the odometry method's own cell of the same
 dataset, degradation and seed (when the suite ran it).
 """
@@ -38,20 +39,18 @@ from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
+from albot1.metrics.paired import BLOCKS, CONFIDENCE, RESAMPLES, ZERO_ERROR, bootstrap_ratio, verdict
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
+from albot1.report.provenance import bench_argument
 from albot1.report.tuning import LEGEND, MARK, held_in, marked
 
 PAGE = "generalisation.md"
 TABLE = "generalisation.csv"
-CONFIDENCE = 0.95
-RESAMPLES = 2000
-#: blocks per run of the moving-block bootstrap (per-scan errors are correlated along the route)
-BLOCKS = 20
 ODOMETRY = "odometry"
 NA = "n/a"
 #: An odometry ATE below this (m) is perfect odometry (the reference itself): a ratio to it means nothing, the
 #: method's own ATE is the figure (issue 21's target for gtsam-graph: <= 0.3 m).
-PERFECT_M = 1e-6
+PERFECT_M = ZERO_ERROR
 PERFECT = "perfect odometry"
 
 
@@ -93,42 +92,8 @@ def paired_errors(rec: CellRecord) -> tuple[np.ndarray, np.ndarray] | None:
     )
 
 
-def bootstrap_ratio(
-    pairs: list[tuple[np.ndarray, np.ndarray]], *, resamples: int = RESAMPLES, seed: int = 0
-) -> tuple[float, float, float]:
-    """``(ratio, low, high)``: the pooled ATE ratio and its paired moving-block bootstrap interval."""
-    sum_m = sum(float(np.sum(m**2)) for m, _ in pairs)
-    sum_o = sum(float(np.sum(o**2)) for _, o in pairs)
-    ratio = math.sqrt(sum_m / sum_o) if sum_o > 0 else math.inf
-    rng = np.random.default_rng(seed)
-    draws = np.empty(resamples)
-    indices = []
-    for m, _ in pairs:
-        n = len(m)
-        length = max(1, math.ceil(n / BLOCKS))
-        count = math.ceil(n / length)
-        indices.append((n, length, count))
-    for k in range(resamples):
-        num = den = 0.0
-        for (m, o), (n, length, count) in zip(pairs, indices, strict=True):
-            starts = rng.integers(0, n - length + 1, size=count)
-            idx = (starts[:, None] + np.arange(length)[None, :]).ravel()[:n]
-            num += float(np.sum(m[idx] ** 2))
-            den += float(np.sum(o[idx] ** 2))
-        draws[k] = math.sqrt(num / den) if den > 0 else math.inf
-    tail = (1.0 - CONFIDENCE) / 2
-    low, high = np.quantile(draws, [tail, 1.0 - tail])
-    return ratio, float(low), float(high)
-
-
 def _verdict(odometry_ate_m: float, low: float, high: float) -> str:
-    if odometry_ate_m < PERFECT_M:
-        return PERFECT
-    if low > 1.0:
-        return "worse"
-    if high < 1.0:
-        return "better"
-    return "indistinguishable"
+    return PERFECT if odometry_ate_m < PERFECT_M else verdict(low, high)
 
 
 def _mean(values: list[float | None]) -> float | None:
@@ -232,7 +197,7 @@ def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None
         "",
         LEGEND,
         "",
-        f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}`.",
+        f"Regenerate: `albot1 bench {bench_argument(plan)} && albot1 report results/{plan.suite}`.",
         "",
         "## Where a method is worse than its own odometry",
         "",
@@ -281,7 +246,9 @@ def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None
             "",
             "## With perfect odometry",
             "",
-            "ATE (m) of each method given the reference poses as odometry (no ratio: the odometry's is 0).",
+            "ATE (m) of each method given the reference poses as odometry (no ratio: the odometry's is 0). "
+            "Which of these differ significantly: the paired comparisons against the best method under each "
+            "dataset's table in `metrics.md` (`paired.csv`).",
             "",
             "| method | " + " | ".join(logs) + " |",
             "|---|" + "---:|" * len(logs),

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import CellRecord, Column
 from albot1.report.external_notes import external_html
+from albot1.report.paired_tables import PairedRow, html_table
 from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tables import cell_text, columns_present, na_notes
@@ -164,8 +165,9 @@ def write_html(
     out: Path,
     results_dir: Path,
     extra_links: list[tuple[str, Path]] | None = None,
+    paired: list[PairedRow] | None = None,
 ) -> Path:
-    """Write ``out/index.html`` (see module doc); returns its path."""
+    """Write ``out/index.html`` (see module doc); returns its path. ``paired``: the accuracy tables' comparisons."""
     metric_columns, cost_columns = columns
     counts: dict[str, int] = {"done": 0, "failed": 0, "not run": 0}
     for rec in records:
@@ -229,6 +231,8 @@ def write_html(
             if group.empty:
                 continue
             parts += [f"<h3>{title}</h3>", table_html(group, cols, colors)]
+            if title == "Accuracy":
+                parts.append(html_table(paired or [], dataset))
         figures = plots.get(dataset, [])
         if figures:
             parts.append("<h3>Plots</h3>")

@@ -29,6 +29,7 @@ from albot1.report.generalisation import write_generalisation
 from albot1.report.html import INDEX_HTML, rel, write_html
 from albot1.report.map_plots import MapStyle, plot_maps
 from albot1.report.markdown import code, text
+from albot1.report.paired_tables import paired_rows
 from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.provenance import data_by_dataset, describe_data, separate_data
 from albot1.report.relation_plots import plot_relation_boxes
@@ -36,7 +37,7 @@ from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
-from albot1.report.standard import write_standard
+from albot1.report.standard import on_standard_logs, write_standard
 from albot1.report.tables import aggregate, cells_frame, write_tables
 from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
@@ -336,8 +337,10 @@ def build_report(
     plan, collected = collect(results)
     records = separate_data(collected)  # runs of one dataset on different data never share a row
     target.mkdir(parents=True, exist_ok=True)
-    tables = write_tables(records, target)
-    tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
+    paired = paired_rows(records)  # the accuracy tables' paired comparisons (metrics.md, paired.csv, index.html)
+    tables = write_tables(records, target, paired)
+    if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
+        tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
     generalisation = write_generalisation(plan, records, target)
     if generalisation is not None:
         tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
@@ -361,5 +364,6 @@ def build_report(
         target,
         results,
         extra_links=[("the thesis's experiments, reproduced (README.md)", page)] if page is not None else None,
+        paired=paired,
     )
     return page if page is not None else index

@@ -13,7 +13,11 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import replace
+from pathlib import Path
 
+from albot1.bench.errors import SuiteError
+from albot1.bench.grid import GridPlan
+from albot1.bench.suite import find_suite
 from albot1.data.identity import short
 from albot1.report.collect import CellRecord
 
@@ -94,3 +98,19 @@ def data_lines(records: list[CellRecord]) -> list[str]:
             files = {name: short(sha) for name, sha in data_checksums(rec).items()}
             seen[key] = f"{rec.cell.dataset_label}: {describe_data(files)}"
     return list(seen.values())
+
+
+def bench_argument(plan: GridPlan) -> str:
+    """What to give ``albot1 bench`` to run the plan's suite again: its name when that finds its file, else the path.
+
+    A page's "Regenerate" line used to say ``albot1 bench robot`` for a
+    user's own ``robot.toml``, which ``albot1 bench`` looks up among the
+    shipped suites and does not find.
+    """
+    if plan.suite_path is None:
+        return plan.suite
+    try:
+        same = find_suite(plan.suite).resolve() == Path(plan.suite_path).resolve()
+    except SuiteError:
+        same = False
+    return plan.suite if same else plan.suite_path

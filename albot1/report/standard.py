@@ -29,9 +29,11 @@ from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.methods.baselines.published import published_systems
 from albot1.metrics.measures.relations import METRIC as RELATIONS
+from albot1.metrics.paired import CONFIDENCE, method_text
 from albot1.report.collect import CellRecord
+from albot1.report.comparisons import Cell, Errors, all_pairs, matrix_lines, relation_errors_of
 from albot1.report.markdown import text as md_text
-from albot1.report.provenance import data_lines
+from albot1.report.provenance import bench_argument, data_lines
 from albot1.report.tuning import LEGEND, held_in, marked
 
 #: The five logs of the standard benchmark, with the names the published tables use.
@@ -44,6 +46,7 @@ STANDARD_LOGS: dict[str, str] = {
 }
 PAGE = "standard-benchmark.md"
 TABLE = "standard-benchmark.csv"
+PAIRED_TABLE = "standard-benchmark-paired.csv"
 NA = "n/a"
 
 
@@ -184,6 +187,49 @@ def _measured(rec: CellRecord) -> Row:
     )
 
 
+@dataclass(frozen=True)
+class Paired:
+    """One log's paired comparisons: every two measured methods on the same relations (translation, rotation)."""
+
+    labels: list[str]
+    found: dict[tuple[str, str], Cell]
+    #: method -> why its run is not compared (its relation errors cannot be read back)
+    left_out: dict[str, str]
+
+
+def paired_by_log(records: list[CellRecord]) -> dict[str, Paired]:
+    """Per standard log, the measured runs of the page (first whole-log cell per method) compared pairwise."""
+    first: dict[str, dict[str, CellRecord]] = {}
+    for rec in records:
+        if _full_log_cell(rec):
+            first.setdefault(rec.cell.dataset_label, {}).setdefault(rec.cell.method_label, rec)
+    out: dict[str, Paired] = {}
+    for log, by_method in first.items():
+        errors: dict[str, Errors] = {m: relation_errors_of(r) for m, r in by_method.items() if r.status == "done"}
+        labels = [m for m, e in errors.items() if e.missing is None]
+        left_out = {m: str(e.missing) for m, e in errors.items() if e.missing is not None}
+        found = all_pairs(labels, errors, ("relation translation", "relation rotation"))
+        out[log] = Paired(labels, found, left_out)
+    return out
+
+
+def _paired_lines(paired: Paired | None) -> list[str]:
+    if paired is None or len(paired.labels) + len(paired.left_out) < 2:
+        return []
+    lines = ["Paired comparison (row against column, the same relations; translation / rotation):", ""]
+    if len(paired.labels) >= 2:
+        lines += [*matrix_lines(paired.labels, paired.found, "row vs column"), ""]
+    lines += [f"- {m}: not compared: {why}" for m, why in paired.left_out.items()]
+    why: dict[str, list[str]] = {}  # each n/a reason once, with the comparisons it applies to
+    for i, a in enumerate(paired.labels):
+        for b in paired.labels[i + 1 :]:
+            for kind, found in zip(("translation", "rotation"), paired.found[(a, b)], strict=True):
+                if not found.applies:
+                    why.setdefault(str(found.reason), []).append(f"{a} vs {b} ({kind})")
+    lines += [f"- `–` {reason}: {'; '.join(where)}" for reason, where in why.items()]
+    return [*lines, ""] if paired.left_out or why else lines
+
+
 def published_rows(durations: dict[str, float] | None = None) -> list[Row]:
     """A row per (standard log, published system) with at least one figure on it."""
     rows: list[Row] = []
@@ -274,7 +320,9 @@ def _unpublished() -> list[str]:
     ]
 
 
-def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str:
+def render_page(
+    plan: GridPlan, rows: list[Row], skipped: dict[str, str], paired: dict[str, Paired] | None = None
+) -> str:
     """The Markdown page (see the module docstring)."""
     lines = [
         "# The standard benchmark: relation metric on five Freiburg logs",
@@ -293,8 +341,16 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
         "per CPU second. Published timings are Hess et al.'s (Table V), measured on "
         "an Intel Xeon E5-1650 at 3.2 GHz: compare the ratios, not the seconds.",
         "",
-        f"Regenerate: `albot1 bench {plan.suite} && albot1 report results/{plan.suite}` (`make bench` does this for "
-        "the default suite).",
+        f"Regenerate: `albot1 bench {bench_argument(plan)} && albot1 report results/{plan.suite}` "
+        "(`make bench` does this for the default suite).",
+        "",
+        f"**Paired comparisons.** Under each log, every two measured methods are compared on the same "
+        f"ground-truth relations: the ratio of the row method's mean relation error to the column method's, "
+        f"translation / rotation, with a {method_text()}. In the matrices `<` means the row's error is lower "
+        f"(the whole {CONFIDENCE:.0%} interval of the ratio below 1), `>` higher, `≈` indistinguishable, `–` not "
+        f"applicable; the number is the ratio. Every ratio with its interval and number of relations: "
+        f"[{PAIRED_TABLE}]({PAIRED_TABLE}). A claim that one method beats another on a log holds only where the "
+        "matrix says `<` or `>`. Method: `albot1/metrics/paired.py`, `albot1/report/comparisons.py`.",
         "",
         "## Translational error, mean (m)",
         "",
@@ -342,6 +398,7 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
         lines += ["| " + " | ".join(_cell(r)) + " |" for r in log_rows]
         sources = [f"- {r.method}: {r.source}" + (f" ({r.note})" if r.note else "") for r in log_rows if r.source]
         lines += ["", *sources, ""]
+        lines += _paired_lines((paired or {}).get(log))
     lines += [
         "## Reading the figures",
         "",
@@ -363,6 +420,13 @@ def render_page(plan: GridPlan, rows: list[Row], skipped: dict[str, str]) -> str
     return "\n".join(lines)
 
 
+def on_standard_logs(plan: GridPlan, records: list[CellRecord]) -> bool:
+    """Whether the suite ran, or skipped for want of data, any of the five logs (else the page would be empty)."""
+    return any(rec.cell.dataset_label in STANDARD_LOGS for rec in records) or any(
+        s.name in STANDARD_LOGS for s in plan.skipped_datasets
+    )
+
+
 def write_standard(plan: GridPlan, records: list[CellRecord], out: Path) -> tuple[Path, Path]:
     """Write ``standard-benchmark.md`` and ``.csv`` into ``out``; returns both paths."""
     measured = measured_rows(records)
@@ -372,13 +436,29 @@ def write_standard(plan: GridPlan, records: list[CellRecord], out: Path) -> tupl
     rows.sort(key=lambda r: (order.index(r.log), r.kind != "measured"))
     skipped = {s.name: s.reason + (f" (`{s.hint}`)" if s.hint else "") for s in plan.skipped_datasets}
     page, table = out / PAGE, out / TABLE
-    text = render_page(plan, rows, {k: v for k, v in skipped.items() if k in STANDARD_LOGS})
+    paired = paired_by_log(records)
+    text = render_page(plan, rows, {k: v for k, v in skipped.items() if k in STANDARD_LOGS}, paired)
     data = data_lines([r for r in records if r.cell.dataset_label in STANDARD_LOGS])
     if data:  # which data the measured rows come from (albot1.report.provenance)
         text = text.rstrip("\n") + "\n\n## Data\n\n" + "".join(f"- {md_text(line)}\n" for line in data)
     atomic_write(page, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     atomic_write(table, lambda tmp: tmp.write_text(_csv(rows), encoding="utf-8"))
+    atomic_write(out / PAIRED_TABLE, lambda tmp: tmp.write_text(_paired_csv(paired), encoding="utf-8"))
     return page, table
+
+
+def _paired_csv(paired: dict[str, Paired]) -> str:
+    """Each unordered pair of measured methods per log once (row before column in the page's order)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["log", "method", "against", "error", "relations", "ratio", "low", "high", "verdict", "reason"])
+    for log, entry in paired.items():
+        for i, a in enumerate(entry.labels):
+            for b in entry.labels[i + 1 :]:
+                for kind, c in zip(("translation", "rotation"), entry.found[(a, b)], strict=True):
+                    numbers = ["" if math.isnan(v) else f"{v:.9g}" for v in (c.ratio, c.low, c.high)]
+                    writer.writerow([log, a, b, kind, c.pairs, *numbers, c.verdict, c.reason or ""])
+    return buffer.getvalue()
 
 
 def _csv(rows: list[Row]) -> str:

@@ -38,6 +38,7 @@ from albot1.report.collect import (
     severity_order,
 )
 from albot1.report.markdown import text as md_text
+from albot1.report.paired_tables import PairedRow, intro, markdown_lines, paired_rows, write_paired_csv
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tuning import LEGEND, held_in, marked
 
@@ -192,12 +193,17 @@ def na_notes(group: pd.DataFrame, columns: dict[str, Column], present: list[str]
 
 
 def markdown(
-    table: pd.DataFrame, columns: dict[str, Column], title: str, data: dict[str, dict[str, str]] | None = None
+    table: pd.DataFrame,
+    columns: dict[str, Column],
+    title: str,
+    data: dict[str, dict[str, str]] | None = None,
+    paired: list[PairedRow] | None = None,
 ) -> str:
-    """One Markdown table per dataset, each followed by its not-applicable notes.
+    """One Markdown table per dataset, each followed by its not-applicable notes and its paired comparisons.
 
     ``data``: dataset label -> {file: short sha256} (:func:`albot1.report.provenance.data_by_dataset`), stated
-    under each dataset's heading. Names are written as text (:mod:`albot1.report.markdown`), never as HTML.
+    under each dataset's heading. ``paired``: the rows of :func:`albot1.report.paired_tables.paired_rows`.
+    Names are written as text (:mod:`albot1.report.markdown`), never as HTML.
     """
     lines = [
         f"# {title}",
@@ -208,6 +214,7 @@ def markdown(
         "",
         LEGEND,
         "",
+        *([intro(), ""] if paired else []),
     ]
     if table.empty:
         return "\n".join([*lines, "No planned cells.", ""])
@@ -232,6 +239,7 @@ def markdown(
             lines.append("| " + " | ".join(cells) + " |")
         notes = na_notes(group, columns, present, absent)
         lines += [""] + [f"- n/a: {md_text(note)}" for note in notes] + ([""] if notes else [])
+        lines += markdown_lines(paired or [], str(dataset))
     return "\n".join(lines)
 
 
@@ -278,9 +286,13 @@ def _csv_frame(table: pd.DataFrame) -> pd.DataFrame:
     return table[[c for c in table.columns if not c.endswith("_n")]]
 
 
-def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
-    """Write cells.csv, metrics.{csv,md,tex} and cost.{csv,md,tex} (+ cells-cost.csv) into ``out``."""
+def write_tables(records: list[CellRecord], out: Path, paired: list[PairedRow] | None = None) -> dict[str, Path]:
+    """Write cells.csv, metrics.{csv,md,tex}, paired.csv and cost.{csv,md,tex} (+ cells-cost.csv) into ``out``.
+
+    ``paired``: the metrics tables' paired comparisons when the caller has them (computed here otherwise).
+    """
     out.mkdir(parents=True, exist_ok=True)
+    paired = paired_rows(records) if paired is None else paired
     cells = cells_frame(records)
     cells["held_in"] = [held_in(rec.cell) for rec in records]
     written = {"cells.csv": out / "cells.csv"}
@@ -293,7 +305,8 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
         table = aggregate(cells, columns)
         paths = {ext: out / f"{name}.{ext}" for ext in ("csv", "md", "tex")}
         _csv_frame(table).to_csv(paths["csv"], index=False, float_format="%.9g")
-        paths["md"].write_text(markdown(table, columns, title, data_by_dataset(records)), encoding="utf-8")
+        shown = paired if name == "metrics" else None
+        paths["md"].write_text(markdown(table, columns, title, data_by_dataset(records), shown), encoding="utf-8")
         paths["tex"].write_text(latex(table, columns, title), encoding="utf-8")
         written.update({f"{name}.{ext}": path for ext, path in paths.items()})
     cost_cells = out / "cells-cost.csv"
@@ -301,4 +314,5 @@ def write_tables(records: list[CellRecord], out: Path) -> dict[str, Path]:
         cost_cells, index=False, float_format="%.9g"
     )
     written["cells-cost.csv"] = cost_cells
+    written["paired.csv"] = write_paired_csv(paired, out)
     return written

@@ -287,7 +287,12 @@ def read_run(run_dir: str | Path) -> StoredRun:
     stamps, poses = read_tum(_required(path, "trajectory.tum"))
     _, odom = read_tum(_required(path, "odometry.tum"))
     reference = read_tum(_required(path, "reference.tum"))[1] if info.has_reference else None
-    relations = read_relations(_required(path, "relations.txt"), warn_repeats=False) if info.relations else None
+    # The copy holds the relations as they were scored: a repeated line in it is one its source counted (this
+    # code writes a note saying how it read its source, which wins; copies written before the note counted every
+    # line as listed), so "keep" reads every copy back as scored.
+    relations = (
+        read_relations(_required(path, "relations.txt"), warn_repeats=False, repeats="keep") if info.relations else None
+    )
     # another system's trajectory (albot1.runs.external_run) has no per-scan times: an empty array
     per_scan = _read_per_scan(_required(path, PER_SCAN_FILE), 0 if info.preset == EXTERNAL_PRESET else info.scans)
     return StoredRun(path, info, stamps, poses, odom, reference, relations, per_scan)

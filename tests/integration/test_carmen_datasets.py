@@ -38,6 +38,13 @@ def test_aces_relations_match_flaser_stamps(data_file: DataFile) -> None:
     stamps = set(np.round(seq.timestamps, 6).tolist())
     assert seq.relations is not None
     assert all(round(t, 6) in stamps for t in np.r_[seq.relations.t1, seq.relations.t2])
+    assert (seq.relations.repeats, seq.relations.repeats_counted) == (9, True)  # the manifest's published reading
+
+
+def test_aces_relations_counted_once_on_request(data_file: DataFile) -> None:
+    seq = catalog.open_dataset("aces", settings_for(data_file, "radish/aces.clf.bz2"), relations_repeats="drop")
+    assert seq.relations is not None
+    assert (len(seq.relations), seq.relations.repeats, seq.relations.repeats_counted) == (1270, 9, False)
 
 
 def test_mit_csail_max_range_readings_are_no_return(data_file: DataFile) -> None:

@@ -2,7 +2,9 @@
 
 Kuemmerle et al. (2009) relations; the datasets README records 0.549 +/-
 2.675 m (max 18.9 m) and 2.33 +/- 6.51 deg over N = 1279 for the raw
-odometry. Our relation metric must reproduce these to the printed digits.
+odometry. Our relation metric must reproduce these to the printed digits
+when the file's 9 identically repeated lines are counted as listed (the
+published reading, which datasets/aces.toml declares).
 """
 
 from __future__ import annotations
@@ -25,7 +27,10 @@ def test_raw_aces_odometry_against_the_published_relation_numbers(data_file: Cal
     relations_file = data_file("radish/aces.relations")
     sequence = load(log)
     block = relation_metric(
-        sequence.timestamps, sequence.odometry, read_relations(relations_file), source=str(relations_file)
+        sequence.timestamps,
+        sequence.odometry,
+        read_relations(relations_file, repeats="keep"),
+        source=str(relations_file),
     )
     trans, rot = block["translation_m"], block["rotation_deg"]
     assert trans["n"] == rot["n"] == 1279
@@ -50,7 +55,7 @@ def test_the_pipeline_scores_a_prefix_run_like_the_direct_call(
     from albot1.data.transforms import head
 
     log = data_file("radish/aces.clf.bz2")
-    relations = read_relations(data_file("radish/aces.relations"))
+    relations = read_relations(data_file("radish/aces.relations"), repeats="keep")  # as the aces manifest declares
     monkeypatch.setenv("ALBOT1_DATA_DIR", str(log.parent.parent))
     runner = CliRunner()
     ran = runner.invoke(

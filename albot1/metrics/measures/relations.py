@@ -31,6 +31,10 @@ class RelationsBlock(Record):
     ``relations_total`` counts the dataset's relations, ``relations_used`` those scored and
     ``relations_outside_run`` those left out because an end names a scan the run did not see (a slice of
     the log; :func:`albot1.data.relations.relations_in_run`), so a slice never drops relations silently.
+    ``relations_repeated_lines`` counts the lines of the relations file that repeat an earlier line
+    identically, and ``relations_repeats_counted`` says whether they were counted as listed (the
+    published evaluator's reading) or once (:mod:`albot1.data.relations`); files written before these
+    fields existed read as 0 and false.
     """
 
     alignment: str
@@ -39,6 +43,8 @@ class RelationsBlock(Record):
     relations_total: int
     relations_used: int
     relations_outside_run: int
+    relations_repeated_lines: int = 0
+    relations_repeats_counted: bool = False
     max_time_gap_s: float
     translation_m: Stats
     rotation_deg: Stats
@@ -63,6 +69,10 @@ def headline(block: RelationsBlock) -> str:
     t, r = block.translation_m, block.rotation_deg
     outside, total = block.relations_outside_run, block.relations_total
     left_out = f" ({outside} of {total} relations left out: they name scans the run did not see)" if outside else ""
+    repeats = block.relations_repeated_lines
+    if repeats:
+        reading = "counted as listed, the published reading" if block.relations_repeats_counted else "counted once"
+        left_out += f" ({repeats} repeated line(s) of the relations file {reading})"
     return f"{fmt(t.mean)} +/- {fmt(t.std)} m, {fmt(r.mean, '.2f')} +/- {fmt(r.std, '.2f')} deg, N = {t.n}{left_out}"
 
 

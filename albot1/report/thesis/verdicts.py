@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Final, Literal
 
+from albot1.metrics.paired import BETTER, CONFIDENCE, Comparison
 from albot1.report.tables import decimals, fmt
 
 HOLDS: Final = "holds"
@@ -159,6 +160,25 @@ def lower_than(ours: Number, theirs: Number, *, thesis: str | None = None) -> Ve
         HOLDS if ok else FAILS,
         f"{ours.label} {ours.text()} {'<' if ok else '>='} {theirs.label} {theirs.text()}{_thesis(thesis)}",
     )
+
+
+def with_paired_test(point: Verdict, paired: Comparison) -> Verdict:
+    """A "lower than" verdict (``point``) with its paired evidence: it holds only when the paired test says better.
+
+    A mean below another is not yet "A beats B": the paired comparison of the
+    two runs' errors at the same scans or relations
+    (:func:`albot1.metrics.paired.compare`) must put the whole interval of
+    the ratio below 1. When that test does not apply (too few pairs, errors
+    not readable back from a run folder), the point comparison stands and
+    the reason says that no paired test was made, and why.
+    """
+    if point.word == NOT_COMPARABLE:
+        return point
+    if not paired.applies:
+        return Verdict(point.word, f"{point.reason}; no paired test ({paired.reason})")
+    evidence = f"paired ratio {paired.text()} over {paired.pairs} pairs: {paired.verdict} at {CONFIDENCE:.0%}"
+    word: Word = HOLDS if point.word == HOLDS and paired.verdict == BETTER else FAILS
+    return Verdict(word, f"{point.reason}; {evidence}")
 
 
 def all_of(verdicts: Sequence[Verdict]) -> Verdict:

@@ -13,6 +13,15 @@ SHA = "ab" * 32
 GOOD = f'name = "lab"\nformat = "carmen"\n\n[[files]]\nrole = "log"\npath = "mine/lab.clf"\nsha256 = "{SHA}"\n'
 
 
+RELATIONS = f'[[files]]\nrole = "relations"\npath = "mine/lab.relations"\nsha256 = "{SHA}"\n'
+
+
+def test_a_relations_file_may_declare_how_repeated_lines_count(tmp_path: Path) -> None:
+    assert parse_manifest(write(tmp_path, GOOD + RELATIONS)).file("relations").repeats is None  # type: ignore[union-attr]
+    declared = parse_manifest(write(tmp_path, GOOD + RELATIONS + 'repeats = "keep"\n')).file("relations")
+    assert declared is not None and declared.repeats == "keep"
+
+
 def write(tmp_path: Path, text: str, name: str = "lab") -> Path:
     path = tmp_path / f"{name}.toml"
     path.write_text(text, encoding="utf-8")
@@ -43,6 +52,8 @@ def test_minimal_manifest_gets_the_documented_defaults(tmp_path: Path) -> None:
         ('local_only = "yes"\n' + GOOD, r"lab.toml: key 'local_only' must be a boolean, found a string"),
         ('loader = "carmen"\n' + GOOD, r"lab.toml: key 'loader' must be a table, found a string"),
         ("description = 3\n" + GOOD, r"lab.toml: key 'description' must be a string, found a integer"),
+        (GOOD + 'repeats = "keep"\n', r"files\[0\]: repeats goes with role = \"relations\", not 'log'"),
+        (GOOD + RELATIONS + 'repeats = "twice"\n', r"files\[1\]: relations_repeats='twice'; expected drop"),
     ],
 )
 def test_bad_manifests_name_file_entry_and_key(tmp_path: Path, text: str, message: str) -> None:

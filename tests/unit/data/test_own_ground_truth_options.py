@@ -113,3 +113,17 @@ def test_unknown_option_errors_list_the_options_of_every_source(sources: dict[st
 
 def test_carmen_reference_keywords_still_reach_the_loader(sources: dict[str, Path]) -> None:
     assert open_sequence(f"{sources['carmen']}?reference=none").arrays.reference is None
+
+
+def test_relations_repeats_goes_with_a_relations_file_on_every_source(sources: dict[str, Path], tmp_path: Path) -> None:
+    """`?relations=FILE&relations_repeats=keep` counts a repeated line as listed; the default counts it once."""
+    relations = tmp_path / "twice.relations"
+    relations.write_text("0 0.2 1 0 0 0 0 0\n0 0.2 1 0 0 0 0 0\n")
+    for path in sources.values():
+        default = open_sequence(f"{path}?relations={relations}")
+        kept = open_sequence(f"{path}?relations={relations}&relations_repeats=keep")
+        assert default.relations is not None and kept.relations is not None
+        assert (len(default.relations), default.relations.repeats, default.relations.repeats_counted) == (1, 1, False)
+        assert (len(kept.relations), kept.relations.repeats, kept.relations.repeats_counted) == (2, 1, True)
+        with pytest.raises(DataError, match=r"relations_repeats='twice'; expected drop"):
+            open_sequence(f"{path}?relations={relations}&relations_repeats=twice")

@@ -5,11 +5,13 @@ from __future__ import annotations
 import logging
 import warnings
 from pathlib import Path
+from typing import Literal
 
+import numpy as np
 import pytest
 
 from albot1.data.errors import DataError
-from albot1.data.relations import read_relations
+from albot1.data.relations import read_relations, repeat_policy, write_relations
 
 
 @pytest.mark.parametrize(
@@ -36,13 +38,79 @@ def test_bad_relations_are_refused_with_the_line(tmp_path: Path, text: str, mess
     assert str(caught.value).startswith(f"{path}{message}")
 
 
-def test_identical_repeated_lines_are_counted_as_listed_and_said(
+_REPEATED = "0 0.2 1 0 0 0 0 0\n0.2 0.4 1 0 0 0 0 0\n0 0.2 1 0 0 0 0 0\n0.2 0.4 1 0 0 0 0 0\n"
+
+
+def test_identical_repeated_lines_are_counted_once_by_default_and_said(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
     path = tmp_path / "r.relations"
-    path.write_text("0 0.2 1 0 0 0 0 0\n0.2 0.4 1 0 0 0 0 0\n0 0.2 1 0 0 0 0 0\n0.2 0.4 1 0 0 0 0 0\n")
+    path.write_text(_REPEATED)
     with caplog.at_level(logging.WARNING):
         relations = read_relations(path)
-    assert len(relations) == 4 and relations.repeats == 2
-    assert "2 relation line(s) repeat an earlier line identically" in caplog.text
+    assert len(relations) == 2 and relations.repeats == 2 and not relations.repeats_counted
+    assert relations.t1.tolist() == [0.0, 0.2] and relations.t2.tolist() == [0.2, 0.4]
+    assert "2 relation line(s) repeat an earlier line identically; each relation is counted once" in caplog.text
     assert "line 3 (= 1), 4 (= 2)" in caplog.text
+
+
+def test_keep_counts_identical_repeated_lines_as_listed_and_says_so(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    path = tmp_path / "r.relations"
+    path.write_text(_REPEATED)
+    with caplog.at_level(logging.WARNING):
+        relations = read_relations(path, repeats="keep")
+    assert len(relations) == 4 and relations.repeats == 2 and relations.repeats_counted
+    assert relations.t1.tolist() == [0.0, 0.2, 0.0, 0.2]
+    assert "each is counted as listed (relations_repeats=keep)" in caplog.text
+
+
+@pytest.mark.parametrize("policy", ["drop", "keep"])
+def test_a_written_copy_reads_back_with_its_sources_reading_and_count(
+    tmp_path: Path, policy: Literal["drop", "keep"], caplog: pytest.LogCaptureFixture
+) -> None:
+    source = tmp_path / "r.relations"
+    source.write_text(_REPEATED)
+    relations = read_relations(source, repeats=policy)
+    copy = tmp_path / "copy.txt"
+    write_relations(copy, relations)
+    caplog.clear()
+    assert copy.read_text().splitlines()[0] == f"# albot1: relations_repeats={policy} repeated_lines=2"
+    with caplog.at_level(logging.WARNING):
+        back = read_relations(copy, warn_repeats=False)  # the default (drop) does not override the copy's note
+    assert caplog.text == ""
+    assert (len(back), back.repeats, back.repeats_counted) == (len(relations), 2, policy == "keep")
+    assert np.array_equal(back.poses, relations.poses)
+
+
+def test_a_copy_without_repeats_has_no_note(tmp_path: Path) -> None:
+    source = tmp_path / "r.relations"
+    source.write_text("0 0.2 1 0 0 0 0 0\n")
+    copy = tmp_path / "copy.txt"
+    write_relations(copy, read_relations(source))
+    assert not copy.read_text().startswith("#")
+
+
+@pytest.mark.parametrize(
+    "note",
+    [
+        "# albot1: relations_repeats=twice repeated_lines=2",
+        "# albot1: relations_repeats=drop repeated_lines=x",
+        "# albot1: relations_repeats=drop",
+    ],
+)
+def test_a_broken_note_is_refused_with_its_line(tmp_path: Path, note: str) -> None:
+    path = tmp_path / "r.relations"
+    path.write_text(note + "\n0 0.2 1 0 0 0 0 0\n")
+    with pytest.raises(DataError) as caught:
+        read_relations(path)
+    assert str(caught.value).startswith(f"{path}:1:")
+
+
+def test_an_unknown_reading_is_refused_in_one_line() -> None:
+    with pytest.raises(DataError) as caught:
+        repeat_policy("twice", "x.clf")
+    assert str(caught.value) == (
+        "x.clf: relations_repeats='twice'; expected drop (count each relation once) or keep (as listed)"
+    )

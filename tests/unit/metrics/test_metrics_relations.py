@@ -129,3 +129,24 @@ def test_rpe_of_a_constant_per_step_heading_bias() -> None:
     block = rpe_set(est, ref)
     assert [d["delta_unit"] for d in block["deltas"]] == ["frames", "m", "m"]
     assert block["translation_m"] == block["deltas"][0]["translation_m"]
+
+
+@pytest.mark.parametrize(("counted", "n", "reading"), [(False, 1, "counted once"), (True, 2, "counted as listed")])
+def test_the_block_records_repeated_lines_and_how_they_were_read(counted: bool, n: int, reading: str) -> None:
+    from albot1.metrics.blocks import block_of
+    from albot1.metrics.measures.relations import RelationsBlock, headline
+
+    times = np.array([0.0, 1.0])
+    poses = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    rows = n
+    relations = Relations(
+        t1=np.zeros(rows),
+        t2=np.ones(rows),
+        poses=np.tile([1.1, 0.0, 0.0], (rows, 1)),
+        repeats=1,
+        repeats_counted=counted,
+    )
+    block = relation_metric(times, poses, relations)
+    assert (block["relations_repeated_lines"], block["relations_repeats_counted"]) == (1, counted)
+    assert block["translation_m"]["n"] == n
+    assert f"(1 repeated line(s) of the relations file {reading}" in headline(block_of(RelationsBlock, block))

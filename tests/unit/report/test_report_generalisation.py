@@ -13,32 +13,11 @@ from albot1.data.model import Frame, Scan, Sequence
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
-from albot1.report.generalisation import PERFECT, Comparison, bootstrap_ratio, comparisons, render_page
+from albot1.report.generalisation import PERFECT, Comparison, comparisons, render_page
 from albot1.report.tuning import LEGEND, MARK
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
-
-
-def test_the_ratio_is_the_pooled_rmse_ratio_and_a_clear_difference_is_significant() -> None:
-    rng = np.random.default_rng(1)
-    odo = [np.abs(rng.normal(1.0, 0.1, 200)), np.abs(rng.normal(1.0, 0.1, 150))]
-    worse = [(2.0 * o, o) for o in odo]
-    ratio, low, high = bootstrap_ratio(worse, resamples=200)
-    assert ratio == pytest.approx(2.0)
-    assert low == pytest.approx(2.0) and high == pytest.approx(2.0)  # paired: every resample has ratio 2
-    better = [(0.5 * o + rng.normal(0, 0.01, len(o)), o) for o in odo]
-    ratio, low, high = bootstrap_ratio(better, resamples=200)
-    assert high < 1.0 and low < ratio < high
-
-
-def test_equal_errors_up_to_noise_are_indistinguishable_and_the_draws_are_seeded() -> None:
-    rng = np.random.default_rng(2)
-    odo = np.abs(rng.normal(1.0, 0.5, 300))
-    method = odo[rng.permutation(300)]  # the same errors at other scans: the same RMSE, unpaired noise
-    first = bootstrap_ratio([(method, odo)], resamples=300)
-    assert first == bootstrap_ratio([(method, odo)], resamples=300)
-    assert first[1] < 1.0 < first[2]
 
 
 def _row(method: str, ratio: float, low: float, high: float, verdict: str, held: bool | None) -> Comparison:

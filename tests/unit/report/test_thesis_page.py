@@ -180,6 +180,8 @@ def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path) -> None
     assert f"`{FAILED_METHOD}` on `{SQUARE}`: failed in" in why[0] and "the mapper diverged" in why[0]
     assert f"`mrpt-rbpf` on `{SQUARE}`: no mrpt-rbpf run" in why[0]  # planned nowhere here: said so, too
     assert "`odometry` on" not in why[0] and "`albot1:literal` on" not in why[0]  # measured: no note
+    verdicts = [v for claim in section.claims for v in claim.verdicts.values() if v.word != "not comparable"]
+    assert verdicts and all("paired ratio" in v.reason for v in verdicts)  # "below the odometry's": with its test
 
 
 @pytest.mark.slow

@@ -144,3 +144,23 @@ def test_quantity_has_three_significant_digits() -> None:
     assert quantity(123.4, "deg") == "123 deg"
     assert quantity(106.0, "views") == "106 views"
     assert quantity(1.0) == "1"
+
+
+def test_a_lower_mean_holds_only_when_the_paired_test_says_better() -> None:
+    import numpy as np
+
+    from albot1.metrics.paired import compare, not_applicable
+    from albot1.report.thesis.verdicts import with_paired_test
+
+    point = lower_than(Number("albot1", 0.4, "m"), Number("odometry", 0.5, "m"))
+    assert point.word == HOLDS
+    base = np.linspace(1.0, 2.0, 60)
+    better = with_paired_test(point, compare([(0.8 * base, base)], power=1, resamples=50))
+    assert better.word == HOLDS and better.reason.endswith("over 60 pairs: better at 95%")
+    noise = np.where(np.arange(60) % 2 == 0, 1.6, 0.4) * base  # lower on average, but not on every stretch
+    tied = with_paired_test(point, compare([(noise, base)], power=1, resamples=50))
+    assert tied.word == FAILS and "indistinguishable at 95%" in tied.reason
+    untested = with_paired_test(point, not_applicable("4 pairs, fewer than 10"))
+    assert untested.word == HOLDS and untested.reason.endswith("; no paired test (4 pairs, fewer than 10)")
+    missing = lower_than(Number("albot1", None, "m", "failed"), Number("odometry", 0.5, "m"))
+    assert with_paired_test(missing, compare([(0.8 * base, base)], power=1, resamples=50)) == missing

@@ -32,6 +32,25 @@ def _sequence() -> Sequence:
     return Sequence.from_frames("toy", frames, relations=relations)
 
 
+@pytest.mark.parametrize(("counted", "note"), [(True, True), (False, True), (True, False)])
+def test_a_run_folders_relations_read_back_as_they_were_scored(tmp_path: Path, counted: bool, note: bool) -> None:
+    """A repeated relation line counts in a run folder as it did when scored; copies from before the reading
+    note (``note=False``) counted every line."""
+    twice = Relations(
+        np.array([100.0, 100.0]), np.array([101.0, 101.0]), np.array([[0.6, 0.2, 0.1]] * 2), 1, counted
+    )
+    once = Relations(np.array([100.0]), np.array([101.0]), np.array([[0.6, 0.2, 0.1]]), 1, counted)
+    sequence = _sequence()
+    sequence.relations = twice if counted else once
+    run_dir = write_run(run_method("odometry", sequence, seed=1), tmp_path)
+    copy = run_dir / "relations.txt"
+    if not note:
+        copy.write_text("\n".join(copy.read_text().splitlines()[1:]) + "\n")
+    stored = read_run(run_dir)
+    assert stored.relations is not None and len(stored.relations) == (2 if counted else 1)
+    assert stored.relations.repeats == 1
+
+
 def test_tum_round_trip_keeps_micrometres(tmp_path: Path) -> None:
     stamps = np.array([1.123456789, 2.5])
     poses = np.array([[1.0000004, -2.0, 3.1], [0.1234567, 5.0, -3.1]])

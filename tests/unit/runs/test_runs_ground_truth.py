@@ -8,6 +8,8 @@ reference, and the result must still carry the reference poses.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -134,3 +136,24 @@ def test_the_runner_hands_a_method_the_scan_and_odometry_only() -> None:
     assert (blind.index, blind.scan, blind.reference) == (3, scan, None)
     assert np.array_equal(blind.odometry, frame.odometry)
     assert frame.reference is not None  # the runner's own frame keeps it for the evaluation
+
+
+@pytest.mark.parametrize("method", method_registry().names())
+def test_albot1_run_on_the_command_line_never_hands_ground_truth_to_a_method(
+    method: str, trap: list[Frame], tmp_path: Path
+) -> None:
+    """The user's path (`albot1 run METHOD WORLD`): the method runs blind, the run folder is scored on the reference."""
+    from typer.testing import CliRunner
+
+    from albot1.cli.app import app
+
+    spec = method_registry().get(method)
+    if not spec.available():
+        pytest.skip(f"{method} unavailable: {spec.unavailable_reason()}")
+    ran = CliRunner().invoke(app, ["run", method, WORLD, "--out", str(tmp_path), "--json"], catch_exceptions=False)
+    assert ran.exit_code == 0, ran.output
+    assert len(trap) == 25 and all(frame.reference is None for frame in trap)
+    run_dir = Path(json.loads(ran.stdout)["run_dir"])
+    evaluated = CliRunner().invoke(app, ["evaluate", str(run_dir), "--json"], catch_exceptions=False)
+    assert evaluated.exit_code == 0, evaluated.output
+    assert json.loads(evaluated.stdout)["ate"]["n"] == 25  # the reference reached the evaluation

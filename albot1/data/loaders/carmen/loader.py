@@ -155,7 +155,9 @@ class CarmenLoader:
                 "ignored_messages": sorted(head.ignored),
             },
         )
-        relations = read_relations(given.relations) if given.relations is not None else None
+        relations = (
+            read_relations(given.relations, repeats=given.relations_repeats) if given.relations is not None else None
+        )
         name = opts.name or _stem(path)
         stream = FrameStream(path, opts, laser, reference)
         return Sequence(name, stream.frames, metadata, relations)

@@ -20,6 +20,7 @@ from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
 from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
+from albot1.data.relations import RepeatPolicy, repeat_policy
 
 ODOMETRY_SOURCES = ("laser-pose", "odom", "odom-segments")
 REFERENCE_SOURCES = ("none", "laser-pose", "truepos", "auto")
@@ -76,6 +77,8 @@ class LoadOptions:
     carmen: CarmenOptions
     #: a relations file for the sequence (the catalog's, or ``FILE?relations=...``)
     relations: str | Path | None
+    #: how its identically repeated lines count (``relations_repeats``; :mod:`albot1.data.relations`)
+    relations_repeats: RepeatPolicy
     license: str
     citation: str
 
@@ -84,9 +87,13 @@ def parse_options(path: Path, options: dict[str, Any]) -> LoadOptions:
     """The catalog's fields and the validated CARMEN options of ``options`` (a DataError names a bad one)."""
     rest = dict(options)
     relations = rest.pop("relations", None)
+    repeats = rest.pop("relations_repeats", None)
+    if repeats is not None and relations is None:
+        raise DataError(f"{path}: relations_repeats={repeats!r} goes with a relations file, and there is none")
+    policy = "drop" if repeats is None else repeat_policy(repeats, str(path))
     license_text = str(rest.pop("license", ""))
     citation = str(rest.pop("citation", ""))
-    return LoadOptions(CarmenOptions.parse(path, rest), relations, license_text, citation)
+    return LoadOptions(CarmenOptions.parse(path, rest), relations, policy, license_text, citation)
 
 
 def describe_odometry(mode: str, laser: str) -> str:

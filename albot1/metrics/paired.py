@@ -1,0 +1,228 @@
+"""Paired comparison of two methods' errors: a ratio, its bootstrap interval and a verdict.
+
+Why one implementation: a page that says "A beats B" must carry the evidence,
+and every page (the generalisation page, the standard benchmark, the metrics
+tables, the thesis page) must mean the same thing by it. The errors of A and
+B are *paired*: the same scans or the same ground-truth relations of the
+same runs (same dataset, degradation and seed), so the noise the two share
+cancels and only their difference is tested.
+
+The statistic is the ratio of A's pooled error to B's,
+``(sum a^p / sum b^p) ** (1/p)`` over every pair of every group: ``p = 2``
+is the ratio of two RMSEs (ATE), ``p = 1`` the ratio of two means (the
+relation metric). Below 1, A's error is the smaller.
+
+Its interval is a paired **moving-block bootstrap**: errors along a route are
+correlated (one bad stretch spoils many consecutive scans or relations), so
+each group (a run: one seed) is resampled as blocks of ``1/BLOCKS`` of its
+length, with the same indices for A and B, within the group (the groups are
+strata; their number is kept). :data:`RESAMPLES` resamples from a fixed seed
+make the interval reproducible: the same errors give the same page. A is
+**better** when the whole ``CONFIDENCE`` interval is below 1, **worse** when
+it is above 1, else **indistinguishable**. A comparison with fewer than
+:data:`MIN_PAIRS` pairs, or where B's error is zero, does not apply and says
+why (a bootstrap over a handful of values claims more than it knows).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Final
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+CONFIDENCE: Final = 0.95
+RESAMPLES: Final = 2000
+#: blocks per group of the moving-block bootstrap (errors are correlated along the route)
+BLOCKS: Final = 20
+#: fewest pairs (over all groups) a comparison is made on
+MIN_PAIRS: Final = 10
+#: a pooled error below this (m or deg) is zero: a perfect reference (e.g. the reference poses given as odometry),
+#: to which a ratio is numerical noise
+ZERO_ERROR: Final = 1e-6
+#: resamples whose indices are built at once (memory: CHUNK x the longest group's length)
+CHUNK: Final = 250
+
+BETTER: Final = "better"
+WORSE: Final = "worse"
+SAME: Final = "indistinguishable"
+NOT_APPLICABLE: Final = "n/a"
+PERFECT_REFERENCE: Final = f"the reference error is below {ZERO_ERROR:g} (perfect): no ratio"
+#: the verdict read from the other side (B against A)
+MIRROR: Final = {BETTER: WORSE, WORSE: BETTER, SAME: SAME, NOT_APPLICABLE: NOT_APPLICABLE}
+#: one character per verdict, for compact matrices: A's error is smaller / larger / not told apart
+SYMBOL: Final = {BETTER: "<", WORSE: ">", SAME: "≈", NOT_APPLICABLE: "–"}
+
+Pair = tuple[NDArray[np.float64], NDArray[np.float64]]
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """A against B: the pooled error ratio, its bootstrap interval and the verdict (or why there is none)."""
+
+    ratio: float
+    low: float
+    high: float
+    verdict: str  # better | worse | indistinguishable | n/a
+    pairs: int
+    groups: int
+    reason: str | None = None
+
+    @property
+    def applies(self) -> bool:
+        return self.verdict != NOT_APPLICABLE
+
+    def mirrored(self) -> Comparison:
+        """B against A: the reciprocal ratio and interval, the opposite verdict (the same evidence)."""
+        return Comparison(
+            _reciprocal(self.ratio),
+            _reciprocal(self.high),
+            _reciprocal(self.low),
+            MIRROR[self.verdict],
+            self.pairs,
+            self.groups,
+            self.reason,
+        )
+
+    def text(self) -> str:
+        """``0.42 [0.38–0.47]`` (3 significant digits), or ``n/a`` with the reason."""
+        if not self.applies:
+            return f"n/a ({self.reason})"
+        return f"{_g(self.ratio)} [{_g(self.low)}–{_g(self.high)}]"
+
+    def short(self) -> str:
+        """``< 0.42``: the verdict's symbol and the ratio (a matrix cell); ``–`` when it does not apply."""
+        return SYMBOL[NOT_APPLICABLE] if not self.applies else f"{SYMBOL[self.verdict]} {_g(self.ratio)}"
+
+
+def _reciprocal(value: float) -> float:
+    if math.isnan(value):
+        return value
+    return math.inf if value == 0 else 1.0 / value
+
+
+def _g(value: float) -> str:
+    """3 significant digits; ``inf`` is the mirror of a ratio of 0 (a method without error against one with)."""
+    return "n/a" if math.isnan(value) else f"{value:.3g}"
+
+
+def method_text(resamples: int = RESAMPLES) -> str:
+    """One sentence a page states beside its paired comparisons: which test, which confidence."""
+    return (
+        f"paired moving-block bootstrap ({resamples} resamples from a fixed seed, blocks of 1/{BLOCKS} of a "
+        f"run resampled within each run, the same indices for both methods), {CONFIDENCE:.0%} interval of the "
+        "error ratio; better / worse when the whole interval is below / above 1, else indistinguishable; "
+        f"n/a (with the reason) under {MIN_PAIRS} pairs"
+    )
+
+
+def _pooled(num: float, den: float, power: int) -> float:
+    if den <= 0:
+        return math.inf
+    return math.sqrt(num / den) if power == 2 else (num / den) ** (1.0 / power)
+
+
+def _shape(n: int) -> tuple[int, int, int]:
+    """``(n, block length, blocks)`` of a group of ``n`` errors."""
+    length = max(1, math.ceil(n / BLOCKS))
+    return n, length, math.ceil(n / length)
+
+
+@lru_cache(maxsize=16)  # ~0.3 MB per group of a shape
+def _block_starts(shapes: tuple[tuple[int, int, int], ...], resamples: int, seed: int) -> list[NDArray[np.int64]]:
+    """Per group, the block starts of every resample (read-only: shared by every comparison of the same shapes).
+
+    They depend on the groups' lengths and the seed only, not on the errors, so the comparisons of one table
+    (the same runs' scans or relations) draw them once. Drawn resample by resample and group by group: that
+    order fixes the page's numbers.
+    """
+    rng = np.random.default_rng(seed)
+    starts = [np.empty((resamples, count), dtype=np.int64) for _, _, count in shapes]
+    for k in range(resamples):
+        for g, (n, length, count) in enumerate(shapes):
+            starts[g][k] = rng.integers(0, n - length + 1, size=count)
+    for first in starts:
+        first.setflags(write=False)
+    return starts
+
+
+def bootstrap_ratio(
+    pairs: Sequence[Pair],
+    *,
+    power: int = 2,
+    resamples: int = RESAMPLES,
+    seed: int = 0,
+    confidence: float = CONFIDENCE,
+) -> tuple[float, float, float]:
+    """``(ratio, low, high)``: the pooled error ratio of A to B and its paired moving-block bootstrap interval.
+
+    ``pairs``: per group (a run), A's and B's errors at the same scans or relations, in route order.
+    """
+    powered = [(np.asarray(a, dtype=float) ** power, np.asarray(b, dtype=float) ** power) for a, b in pairs]
+    ratio = _pooled(sum(float(np.sum(a)) for a, _ in powered), sum(float(np.sum(b)) for _, b in powered), power)
+    shapes = tuple(_shape(len(a)) for a, _ in powered)
+    starts = _block_starts(shapes, resamples, seed)
+    num = np.zeros(resamples)
+    den = np.zeros(resamples)
+    for (a, b), (n, length, _), first in zip(powered, shapes, starts, strict=True):
+        offsets = np.arange(length)
+        for lo in range(0, resamples, CHUNK):
+            idx = (first[lo : lo + CHUNK, :, None] + offsets).reshape(len(first[lo : lo + CHUNK]), -1)[:, :n]
+            num[lo : lo + CHUNK] += a[idx].sum(axis=1)
+            den[lo : lo + CHUNK] += b[idx].sum(axis=1)
+    draws = np.array([_pooled(float(x), float(y), power) for x, y in zip(num, den, strict=True)])
+    tail = (1.0 - confidence) / 2
+    low, high = np.quantile(draws, [tail, 1.0 - tail])
+    return ratio, float(low), float(high)
+
+
+def verdict(low: float, high: float) -> str:
+    """better / worse / indistinguishable from the interval of A's error ratio to B's."""
+    if low > 1.0:
+        return WORSE
+    if high < 1.0:
+        return BETTER
+    return SAME
+
+
+def not_applicable(reason: str, pairs: int = 0, groups: int = 0) -> Comparison:
+    """A comparison that cannot be made, with the reason the page shows."""
+    nan = math.nan
+    return Comparison(nan, nan, nan, NOT_APPLICABLE, pairs, groups, reason)
+
+
+def compare(
+    pairs: Sequence[tuple[ArrayLike, ArrayLike]],
+    *,
+    power: int = 2,
+    resamples: int = RESAMPLES,
+    seed: int = 0,
+) -> Comparison:
+    """A's errors against B's (per group, the same scans or relations): ratio, interval and verdict.
+
+    Not applicable (with the reason) when the groups hold fewer than
+    :data:`MIN_PAIRS` pairs, when a group's two arrays differ in length or
+    hold a non-finite error, or when B's pooled error is below
+    :data:`ZERO_ERROR` (a perfect reference: no ratio).
+    """
+    arrays: list[Pair] = []
+    for a, b in pairs:
+        x, y = np.asarray(a, dtype=float).ravel(), np.asarray(b, dtype=float).ravel()
+        if len(x) != len(y):
+            raise ValueError(f"paired errors differ in length ({len(x)} vs {len(y)})")
+        if len(x):
+            arrays.append((x, y))
+    count = sum(len(x) for x, _ in arrays)
+    if count < MIN_PAIRS:
+        return not_applicable(f"{count} pairs, fewer than {MIN_PAIRS}", count, len(arrays))
+    if not all(np.isfinite(x).all() and np.isfinite(y).all() for x, y in arrays):
+        return not_applicable("a non-finite error", count, len(arrays))
+    reference = _pooled(sum(float(np.sum(np.abs(y) ** power)) for _, y in arrays), float(count), power)
+    if reference < ZERO_ERROR:
+        return not_applicable(PERFECT_REFERENCE, count, len(arrays))
+    ratio, low, high = bootstrap_ratio(arrays, power=power, resamples=resamples, seed=seed)
+    return Comparison(ratio, low, high, verdict(low, high), count, len(arrays))

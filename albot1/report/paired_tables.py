@@ -1,0 +1,250 @@
+"""The metrics tables' paired comparisons: each method against a reference method and against the best, over seeds.
+
+The accuracy tables (``metrics.md``, ``index.html``) rank methods by a mean
+over seeds; whether one method beats another there is a question about the
+pairs of runs, not about two means. Per dataset and degradation, every
+method's runs are paired with the reference method's runs of the same seed
+(same dataset, degradation and seed: the same scans and the same noise) and
+with those of the *best* method there (the lowest pooled error), and each
+pair of runs contributes its paired errors (:mod:`albot1.report.comparisons`)
+to one comparison (:func:`albot1.metrics.paired.compare`; the seeds are its
+strata).
+
+Which error: the per-scan position error (ATE, a ratio of RMSEs) on a dataset
+whose runs have reference poses, else the relation metric's translation error
+(a ratio of means) on one with ground-truth relations, else none (said so).
+The reference is ``odometry`` when the suite ran it on that data (does the
+method improve on doing nothing?), else the first method of the suite there.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from dataclasses import dataclass
+from html import escape
+from pathlib import Path
+
+import numpy as np
+
+from albot1.atomic import atomic_write
+from albot1.metrics.measures.ate import METRIC as ATE
+from albot1.metrics.measures.relations import METRIC as RELATIONS
+from albot1.metrics.paired import CONFIDENCE, MIN_PAIRS, ZERO_ERROR, Comparison, method_text
+from albot1.report.collect import CellRecord
+from albot1.report.comparisons import (
+    FIGURE,
+    POWER,
+    Errors,
+    Kind,
+    compare_runs,
+    position_errors_of,
+    relation_errors_of,
+    seeds_paired,
+)
+from albot1.report.markdown import text as md_text
+
+TABLE = "paired.csv"
+ODOMETRY = "odometry"
+REFERENCE = "reference"
+BEST = "best"
+
+
+@dataclass(frozen=True)
+class PairedRow:
+    """One method on one dataset and degradation, against the reference method and against the best."""
+
+    dataset: str
+    degradation: str
+    method: str
+    kind: Kind
+    runs: int
+    reference: str
+    best: str
+    #: None: this method is the reference / the best
+    against_reference: Comparison | None
+    against_best: Comparison | None
+    #: why the method's runs give no errors to compare (every comparison of the row is then n/a)
+    missing: str | None = None
+
+
+def error_kind(records: list[CellRecord]) -> Kind | None:
+    """ATE errors when a completed run of these has an ATE, else relation errors when one has relations."""
+    done = [r.metrics for r in records if r.status == "done" and r.metrics is not None]
+    if any(m.block(ATE.name) is not None for m in done):
+        return "position"
+    if any(m.block(RELATIONS.name) is not None for m in done):
+        return "relation translation"
+    return None
+
+
+def _pooled(errors: list[Errors], kind: Kind) -> float:
+    values = [e.values[kind] for e in errors if e.missing is None]
+    if not values or not sum(len(v) for v in values):
+        return math.inf
+    flat = np.concatenate(values)
+    return float(np.sqrt(np.mean(flat**2))) if POWER[kind] == 2 else float(np.mean(flat))
+
+
+def paired_rows(records: list[CellRecord]) -> list[PairedRow]:
+    """A :class:`PairedRow` per method of every (dataset, degradation) with at least two methods that completed."""
+    groups: dict[tuple[str, str], list[CellRecord]] = {}
+    for rec in records:
+        if rec.status == "done":
+            groups.setdefault((rec.cell.dataset_label, rec.cell.degradation), []).append(rec)
+    kinds = {
+        dataset: error_kind([r for r in records if r.cell.dataset_label == dataset])
+        for dataset in dict.fromkeys(r.cell.dataset_label for r in records)
+    }
+    out: list[PairedRow] = []
+    for (dataset, degradation), recs in groups.items():
+        kind = kinds[dataset]
+        by_method: dict[str, list[CellRecord]] = {}
+        for rec in recs:
+            by_method.setdefault(rec.cell.method_label, []).append(rec)
+        if kind is not None and len(by_method) >= 2:
+            out += _group_rows(dataset, degradation, kind, by_method)
+    return out
+
+
+def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str, list[CellRecord]]) -> list[PairedRow]:
+    """The rows of one dataset and degradation: every method against the reference and the best there."""
+    read = position_errors_of if kind == "position" else relation_errors_of
+    errors = {rec.cell.key: read(rec) for recs in by_method.values() for rec in recs}
+    pooled = {m: _pooled([errors[r.cell.key] for r in rs], kind) for m, rs in by_method.items()}
+    reference = ODOMETRY if ODOMETRY in by_method else next(iter(by_method))
+    # the first of equals, in suite order; a perfect method (the reference poses given as odometry) is no yardstick
+    rated = [m for m in by_method if pooled[m] >= ZERO_ERROR] or list(by_method)
+    best = min(rated, key=lambda m: pooled[m])
+    rows = []
+    for method, mine in by_method.items():
+        missing = next((errors[r.cell.key].missing for r in mine if errors[r.cell.key].missing), None)
+        rows.append(
+            PairedRow(
+                dataset,
+                degradation,
+                method,
+                kind,
+                len(mine),
+                reference,
+                best,
+                None if method == reference else compare_runs(seeds_paired(mine, by_method[reference], errors), kind),
+                None if method == best else compare_runs(seeds_paired(mine, by_method[best], errors), kind),
+                missing,
+            )
+        )
+    return rows
+
+
+def _cell(found: Comparison | None, role: str) -> str:
+    """``better 0.42 [0.38–0.47]``, ``n/a`` (the reason under the table), or the row's role."""
+    if found is None:
+        return role
+    return f"{found.verdict} {found.text()}" if found.applies else "n/a"
+
+
+def _notes(rows: list[PairedRow]) -> list[str]:
+    """Why comparisons are n/a or runs left out, each reason once with the comparisons it applies to."""
+    why: dict[str, list[str]] = {}
+    for r in rows:
+        for other, found in ((r.reference, r.against_reference), (r.best, r.against_best)):
+            if found is not None and not found.applies:
+                why.setdefault(f"n/a: {found.reason}", []).append(f"{r.method} against {other} ({r.degradation})")
+        if r.missing is not None:
+            why.setdefault(f"a run not compared: {r.missing}", []).append(f"{r.method} ({r.degradation})")
+    return [f"{reason}: {'; '.join(dict.fromkeys(where))}" for reason, where in why.items()]
+
+
+def _counts(row: PairedRow) -> str:
+    found = row.against_reference or row.against_best
+    if found is None or not found.pairs:
+        return "–"
+    return f"{found.pairs} ({found.groups})"
+
+
+def intro() -> str:
+    """What every paired table of the metrics pages means (stated once, above the tables)."""
+    return (
+        "**Paired comparisons** (under each dataset's table): each method against the reference method (odometry "
+        "where the suite ran it, else the suite's first method there) and against the best method of the same "
+        "degradation (lowest pooled error, a perfect one aside), on runs of the same dataset, degradation and "
+        "seed (the same scans or relations), seeds pooled as strata; the number is the ratio of the method's "
+        "error to the other's "
+        f"(< 1: lower) with its {CONFIDENCE:.0%} interval; test: {method_text()}. *pairs (runs)*: the errors "
+        f"paired and the pairs of runs they come from. Fewer than {MIN_PAIRS} pairs, or a run whose errors cannot "
+        "be read back, is n/a with the reason. A claim that one method beats another holds only where its row "
+        "says better or worse."
+    )
+
+
+def markdown_lines(rows: list[PairedRow], dataset: str) -> list[str]:
+    """The paired table of one dataset (no lines when it has none)."""
+    mine = [r for r in rows if r.dataset == dataset]
+    if not mine:
+        return []
+    lines = [
+        f"Paired comparison, {md_text(FIGURE[mine[0].kind])}:",
+        "",
+        "| method | degradation | pairs (runs) | against the reference | against the best |",
+        "|---|---|---:|---|---|",
+    ]
+    for r in mine:
+        ref = _cell(r.against_reference, REFERENCE)
+        best = _cell(r.against_best, BEST)
+        lines.append(
+            f"| {md_text(r.method)} | {md_text(r.degradation)} | {_counts(r)} | "
+            f"{ref}{'' if r.against_reference is None else f' ({md_text(r.reference)})'} | "
+            f"{best}{'' if r.against_best is None else f' ({md_text(r.best)})'} |"
+        )
+    notes = [f"- {md_text(note)}" for note in _notes(mine)]
+    return [*lines, "", *notes, *([""] if notes else [])]
+
+
+def html_table(rows: list[PairedRow], dataset: str) -> str:
+    """The same table for ``index.html`` (empty when the dataset has none)."""
+    mine = [r for r in rows if r.dataset == dataset]
+    if not mine:
+        return ""
+    head = "".join(
+        f"<th>{h}</th>" for h in ("method", "degradation", "pairs (runs)", "against the reference", "against the best")
+    )
+    body = []
+    for r in mine:
+        ref = _cell(r.against_reference, REFERENCE) + ("" if r.against_reference is None else f" ({r.reference})")
+        best = _cell(r.against_best, BEST) + ("" if r.against_best is None else f" ({r.best})")
+        body.append(
+            f"<tr><td>{escape(r.method)}</td><td>{escape(r.degradation)}</td><td>{escape(_counts(r))}</td>"
+            f"<td>{escape(ref)}</td><td>{escape(best)}</td></tr>"
+        )
+    notes = "".join(f"<li>{escape(note)}</li>" for note in _notes(mine))
+    return (
+        f'<p class="notes">Paired comparison, {escape(FIGURE[mine[0].kind])}: {escape(method_text())}.</p>'
+        f'<div class="scroll"><table class="sortable"><thead><tr>{head}</tr></thead><tbody>'
+        + "".join(body)
+        + "</tbody></table></div>"
+        + (f'<ul class="notes">{notes}</ul>' if notes else "")
+    )
+
+
+def write_paired_csv(rows: list[PairedRow], out: Path) -> Path:
+    """``paired.csv``: one line per comparison (method against the reference, against the best)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(
+        ["dataset", "degradation", "method", "against", "role", "error", "pairs", "runs", "ratio", "low", "high"]
+        + ["verdict", "reason"]
+    )
+    for r in rows:
+        for role, other, found in ((REFERENCE, r.reference, r.against_reference), (BEST, r.best, r.against_best)):
+            if found is None:
+                continue
+            numbers = ["" if math.isnan(v) else f"{v:.9g}" for v in (found.ratio, found.low, found.high)]
+            writer.writerow(
+                [r.dataset, r.degradation, r.method, other, role, r.kind, found.pairs, found.groups, *numbers]
+                + [found.verdict, found.reason or ""]
+            )
+    path = out / TABLE
+    text = buffer.getvalue()
+    atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return path

@@ -1,0 +1,99 @@
+"""The one paired comparison (albot1.metrics.paired): pooled ratio, seeded block bootstrap, verdicts, n/a."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from albot1.metrics.paired import (
+    BETTER,
+    MIN_PAIRS,
+    NOT_APPLICABLE,
+    PERFECT_REFERENCE,
+    SAME,
+    WORSE,
+    bootstrap_ratio,
+    compare,
+    method_text,
+    verdict,
+)
+
+
+def test_the_ratio_is_the_pooled_rmse_ratio_and_a_clear_difference_is_significant() -> None:
+    rng = np.random.default_rng(1)
+    odo = [np.abs(rng.normal(1.0, 0.1, 200)), np.abs(rng.normal(1.0, 0.1, 150))]
+    worse = [(2.0 * o, o) for o in odo]
+    ratio, low, high = bootstrap_ratio(worse, resamples=200)
+    assert ratio == pytest.approx(2.0)
+    assert low == pytest.approx(2.0) and high == pytest.approx(2.0)  # paired: every resample has ratio 2
+    better = [(0.5 * o + rng.normal(0, 0.01, len(o)), o) for o in odo]
+    ratio, low, high = bootstrap_ratio(better, resamples=200)
+    assert high < 1.0 and low < ratio < high
+
+
+def test_equal_errors_up_to_noise_are_indistinguishable_and_the_draws_are_seeded() -> None:
+    rng = np.random.default_rng(2)
+    odo = np.abs(rng.normal(1.0, 0.5, 300))
+    method = odo[rng.permutation(300)]  # the same errors at other scans: the same RMSE, unpaired noise
+    first = bootstrap_ratio([(method, odo)], resamples=300)
+    assert first == bootstrap_ratio([(method, odo)], resamples=300)
+    assert first[1] < 1.0 < first[2]
+    assert first != bootstrap_ratio([(method, odo)], resamples=300, seed=1)  # the seed is what fixes the draws
+
+
+def test_power_one_is_the_ratio_of_means() -> None:
+    a, b = np.array([1.0, 2.0, 3.0, 6.0]), np.array([2.0, 2.0, 2.0, 2.0])
+    assert bootstrap_ratio([(a, b)], power=1, resamples=10)[0] == pytest.approx(12.0 / 8.0)
+    assert bootstrap_ratio([(a, b)], power=2, resamples=10)[0] == pytest.approx(math.sqrt(50.0 / 16.0))
+
+
+def test_a_known_better_method_is_better_and_its_mirror_worse() -> None:
+    b = np.linspace(1.0, 2.0, 100)
+    found = compare([(0.5 * b, b)], power=1, resamples=100)
+    assert (found.verdict, found.ratio, found.low, found.high) == (BETTER, 0.5, 0.5, 0.5)
+    assert (found.pairs, found.groups, found.reason) == (100, 1, None)
+    back = found.mirrored()
+    assert (back.verdict, back.ratio, back.low, back.high) == (WORSE, 2.0, 2.0, 2.0)
+    assert found.text() == "0.5 [0.5–0.5]" and found.short() == "< 0.5" and back.short() == "> 2"
+
+
+def test_identical_errors_are_indistinguishable_with_ratio_exactly_one() -> None:
+    errors = [np.abs(np.sin(np.arange(50.0))), np.arange(30.0)]
+    found = compare([(e, e) for e in errors], resamples=100)
+    assert (found.verdict, found.ratio, found.low, found.high) == (SAME, 1.0, 1.0, 1.0)
+    assert (found.pairs, found.groups) == (80, 2)
+    assert found.short() == "≈ 1"
+
+
+def test_too_few_pairs_or_no_reference_error_is_not_applicable_with_its_reason() -> None:
+    few = compare([(np.ones(MIN_PAIRS - 1), np.ones(MIN_PAIRS - 1))])
+    assert few.verdict == NOT_APPLICABLE and few.reason == f"{MIN_PAIRS - 1} pairs, fewer than {MIN_PAIRS}"
+    assert few.text() == f"n/a ({MIN_PAIRS - 1} pairs, fewer than {MIN_PAIRS})" and few.short() == "–"
+    zero = compare([(np.ones(20), np.zeros(20))])
+    assert zero.verdict == NOT_APPLICABLE and zero.reason == PERFECT_REFERENCE
+    assert compare([(np.ones(20), np.full(20, 1e-9))]).reason == PERFECT_REFERENCE  # numerical noise: no ratio
+    perfect = compare([(np.zeros(20), np.ones(20))], resamples=20)
+    assert perfect.verdict == BETTER and perfect.short() == "< 0"  # a perfect method is better
+    assert perfect.mirrored().short() == "> inf" and perfect.mirrored().verdict == WORSE
+    assert compare([(np.full(20, np.nan), np.ones(20))]).reason == "a non-finite error"
+    with pytest.raises(ValueError, match="differ in length"):
+        compare([(np.ones(20), np.ones(21))])
+
+
+def test_the_verdict_reads_the_interval_against_one() -> None:
+    assert [verdict(0.5, 0.9), verdict(1.1, 1.5), verdict(0.9, 1.1), verdict(1.0, 1.0)] == [BETTER, WORSE, SAME, SAME]
+    assert "paired moving-block bootstrap" in method_text() and "95%" in method_text()
+
+
+def test_the_numbers_are_those_of_the_generalisation_page_before_the_move() -> None:
+    """Pinned: the bootstrap of ``albot1/report/generalisation.py`` (commit e309a8d) gave exactly these floats."""
+    a = np.abs(np.sin(np.arange(137.0))) + 0.1
+    b = np.abs(np.cos(np.arange(137.0) * 0.7)) + 0.2
+    c = np.linspace(0.1, 1.0, 61)
+    assert bootstrap_ratio([(a, b), (c, c[::-1].copy())], resamples=300, seed=3) == (
+        0.9105986048453787,
+        0.8409428987692522,
+        0.9821878188620228,
+    )

@@ -1,0 +1,122 @@
+"""The metrics tables' paired comparisons (albot1.report.paired_tables): against the reference and the best."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from albot1.bench.grid import Cell
+from albot1.data.model import Frame, Scan, Sequence
+from albot1.metrics.paired import BETTER, PERFECT_REFERENCE, SAME, WORSE
+from albot1.metrics.record import MetricsRecord
+from albot1.records import ResultRecord, read_record
+from albot1.report.collect import CellRecord
+from albot1.report.paired_tables import TABLE, error_kind, markdown_lines, paired_rows
+from albot1.report.tables import write_tables
+from albot1.runs.evaluate import evaluate_run
+from albot1.runs.execute import run_method
+from albot1.runs.folder import write_run
+
+SCANS = 40
+
+
+def _drive(error: float) -> Sequence:
+    """A straight drive with reference poses; the odometry is ``error`` too long and turns ``error`` deg per step."""
+    t = np.arange(SCANS, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(SCANS), np.zeros(SCANS)])
+    odometry = np.column_stack([t * 0.5 * (1 + error), np.zeros(SCANS), np.radians(error) * t])
+    angles = np.radians(np.linspace(-90.0, 90.0, 181))
+    frames = [
+        Frame(i, Scan(np.full(181, 5.0), angles, 100.0 + t[i], 30.0), odometry[i], reference=truth[i])
+        for i in range(SCANS)
+    ]
+    return Sequence.from_frames("drive", frames)
+
+
+def _record(tmp_path: Path, method: str, error: float, seed: int) -> CellRecord:
+    """An odometry run of the drive filed as ``method``'s cell of seed ``seed`` (its poses: that odometry)."""
+    run_dir = write_run(run_method("odometry", _drive(error), dataset_name="drive"), tmp_path / f"{method}-{seed}")
+    evaluate_run(run_dir)
+    key = f"{method}-{seed}"  # unique per cell, as in a suite
+    cell = Cell("t", "drive", "drive", method, method, "default", "gauss:0.1:1", seed, key, "v", 1.0, 1.0)
+    metrics = read_record(MetricsRecord, run_dir / "metrics.json")
+    return CellRecord(cell, "done", run_dir, read_record(ResultRecord, run_dir / "result.json"), metrics, None)
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory: pytest.TempPathFactory) -> list[CellRecord]:
+    root = tmp_path_factory.mktemp("paired")
+    out = []
+    for seed in (0, 1):
+        out += [
+            _record(root, "odometry", 0.10, seed),
+            _record(root, "kiss-icp", 0.02, seed),  # a known better method: a fifth of the odometry's error
+            _record(root, "gtsam-graph", 0.10, seed),  # the odometry's errors exactly
+        ]
+    return out
+
+
+def test_a_better_method_is_better_an_identical_one_indistinguishable(records: list[CellRecord]) -> None:
+    rows = {r.method: r for r in paired_rows(records)}
+    assert {(r.reference, r.best, r.kind, r.runs) for r in rows.values()} == {("odometry", "kiss-icp", "position", 2)}
+    good, odo, twin = rows["kiss-icp"], rows["odometry"], rows["gtsam-graph"]
+    assert good.against_best is None and odo.against_reference is None  # each is the other's reference point
+    assert good.against_reference is not None and good.against_reference.verdict == BETTER
+    assert (good.against_reference.pairs, good.against_reference.groups) == (2 * SCANS, 2)  # seeds pooled as strata
+    assert good.against_reference.high < 0.5
+    assert twin.against_reference is not None
+    found = twin.against_reference
+    assert (found.verdict, found.ratio, found.low, found.high) == (SAME, 1.0, 1.0, 1.0)
+    assert odo.against_best is not None and odo.against_best.verdict == WORSE
+    assert odo.against_best.ratio == pytest.approx(1.0 / good.against_reference.ratio)
+    assert paired_rows(records) == paired_rows(records)  # seeded: the same page every time
+
+
+def test_runs_without_a_partner_seed_are_not_compared_and_say_why(records: list[CellRecord]) -> None:
+    alone = [r for r in records if not (r.cell.method == "kiss-icp" and r.cell.seed == 0)]
+    alone = [r for r in alone if not (r.cell.method == "odometry" and r.cell.seed == 1)]
+    rows = {r.method: r for r in paired_rows(alone)}
+    found = rows["kiss-icp"].against_reference
+    assert found is not None and (found.verdict, found.reason) == ("n/a", "no run of both on the same data")
+    assert paired_rows([r for r in records if r.cell.method == "odometry"]) == []  # one method: nothing to compare
+
+
+def test_the_tables_show_the_comparison_with_its_test_and_write_the_csv(
+    records: list[CellRecord], tmp_path: Path
+) -> None:
+    lines = markdown_lines(paired_rows(records), "drive")
+    assert lines[0] == "Paired comparison, ATE (ratio of RMSEs over the paired scans):"
+    assert "| odometry | gauss:0.1:1 | 80 (2) | reference | worse " in "\n".join(lines)
+    assert "| gtsam-graph | gauss:0.1:1 | 80 (2) | indistinguishable 1 [1–1] (odometry) | worse " in "\n".join(lines)
+    written = write_tables(records, tmp_path)
+    text = written["metrics.md"].read_text()
+    assert "**Paired comparisons**" in text and "paired moving-block bootstrap (2000 resamples" in text
+    assert "**Paired comparisons**" not in written["cost.md"].read_text()
+    with written["paired.csv"].open() as f:
+        rows = list(csv.DictReader(f))
+    assert written["paired.csv"].name == TABLE
+    assert [(r["method"], r["against"], r["role"], r["verdict"], r["pairs"]) for r in rows] == [
+        ("odometry", "kiss-icp", "best", WORSE, "80"),
+        ("kiss-icp", "odometry", "reference", BETTER, "80"),
+        ("gtsam-graph", "odometry", "reference", SAME, "80"),
+        ("gtsam-graph", "kiss-icp", "best", WORSE, "80"),
+    ]
+
+
+def test_the_error_is_the_ate_with_reference_poses_else_none(records: list[CellRecord]) -> None:
+    assert error_kind(records) == "position"
+    assert error_kind([CellRecord(records[0].cell, "failed", records[0].run_dir, None, None, None)]) is None
+
+
+def test_with_perfect_odometry_the_best_is_the_best_imperfect_method(tmp_path: Path) -> None:
+    records = [_record(tmp_path, "odometry", 0.0, 0), _record(tmp_path, "kiss-icp", 0.02, 0)]
+    records.append(_record(tmp_path, "gtsam-graph", 0.10, 0))
+    rows = {r.method: r for r in paired_rows(records)}
+    assert {r.best for r in rows.values()} == {"kiss-icp"}
+    found = rows["kiss-icp"].against_reference
+    assert found is not None and found.reason == PERFECT_REFERENCE  # no ratio to a perfect odometry
+    against = rows["gtsam-graph"].against_best
+    assert against is not None and against.verdict == WORSE and against.ratio == pytest.approx(5.0, rel=0.05)
