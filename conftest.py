@@ -36,22 +36,6 @@ def corrected_names() -> list[str]:
     return [name for name in catalog.names() if name.endswith(CORRECTED_SUFFIX)]
 
 
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Modules holding a ``slow`` test run first, each module kept together, the rest in collection order.
-
-    pytest-xdist hands tests out in this order; a long test handed out last keeps one worker busy while
-    the others have finished (with two workers, most of a minute of ``make test``). Keeping a module's
-    tests together keeps its module-scoped fixtures built once per worker.
-    """
-    slow_modules = {_module(item) for item in items if item.get_closest_marker("slow")} - {None}
-    items.sort(key=lambda item: _module(item) not in slow_modules)
-
-
-def _module(item: pytest.Item) -> str | None:
-    module = getattr(item, "module", None)
-    return module.__name__ if module is not None else None
-
-
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     """A test that takes ``corrected_name`` runs once for each corrected log of the catalog."""
     if "corrected_name" in metafunc.fixturenames:
@@ -123,11 +107,20 @@ def fault_plugin(install_method_plugin: PluginInstaller) -> None:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Run the slow tests first (stable order otherwise).
+    """Run the modules holding a slow test first, each module kept together (stable order otherwise).
 
     With several xdist workers (``make test``), a whole-log test of a minute
     or two that starts last keeps the other workers idle until it ends; the
     workers steal queued tests from each other (``--dist worksteal``), so the
-    short ones started after the slow ones fill the gaps instead.
+    short ones started after the slow ones fill the gaps instead. A module is
+    moved whole, not test by test, so that its module-scoped fixtures (a
+    report built once for several tests) are not built a second time when its
+    slow and quick tests would otherwise run far apart.
     """
-    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+    slow_modules = {_module(item) for item in items if item.get_closest_marker("slow")} - {None}
+    items.sort(key=lambda item: _module(item) not in slow_modules)
+
+
+def _module(item: pytest.Item) -> str | None:
+    module = getattr(item, "module", None)
+    return module.__name__ if module is not None else None
