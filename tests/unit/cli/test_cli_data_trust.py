@@ -121,6 +121,7 @@ def test_an_unrecognised_file_is_described_not_quoted(tmp_path: Path) -> None:
     assert f"{secret}:1: the first line that is not a comment (text, 31 characters) begins no known format" in line
 
 
+@pytest.mark.slow
 def test_hand_edited_store_files_are_one_line_naming_file_and_field(tmp_path: Path) -> None:
     results = tmp_path / "results" / "s"
     results.mkdir(parents=True)

@@ -93,6 +93,7 @@ def test_the_child_dies_with_its_parent(tmp_path: Path) -> None:
     child.wait(timeout=10)  # raises TimeoutExpired if the child outlived its parent
 
 
+@pytest.mark.slow
 def test_the_peak_is_the_programs_own_not_the_forked_python_image(tmp_path: Path) -> None:
     """ru_maxrss would carry this process's resident set (forked before exec) into the child's peak."""
     held = np.ones(300 * 2**20 // 8)  # 300 MB resident here, in the parent
