@@ -32,12 +32,18 @@ $(STAMP): pyproject.toml
 
 # Every test (unit, property, integration on the public logs when ALBOT1_DATA_DIR has them, the slow
 # whole-world runs), spread over TEST_JOBS worker processes (pytest-xdist; auto = one per core).
+# --dist worksteal: a worker that runs out of tests takes half of another's queue, so the long tests
+# (run first, conftest.py) never leave one worker busy alone at the end; docs/benchmarking.md has the times.
+# Bytecode is written (PYTHONDONTWRITEBYTECODE dropped) so that a second run reuses the assertion-rewritten
+# test modules and the compiled package instead of compiling ~300 modules again in every worker.
+XDIST := -n $(TEST_JOBS) --dist worksteal
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n $(TEST_JOBS) --dist worksteal
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST)
 
-# The edit-test loop: unit and property tests without the slow ones and without the public logs.
+# The edit-test loop (under a minute on 2 cores): unit and property tests without the slow ones
+# (marked `slow`: over about 1.5 s each) and without the public logs. `make test` runs them all.
 test-fast: $(STAMP)
-	$(BIN)/python -m pytest -q -n $(TEST_JOBS) -m "not slow and not integration" tests/unit tests/property
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not slow and not integration" tests/unit tests/property
 
 # Every suite runs first, then every report is built, even when cells failed (the reports list them); then
 # a non-zero status (the last one) is passed on. reports/thesis/README.md reads results/default too.

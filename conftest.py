@@ -17,14 +17,15 @@ import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-import matplotlib
 import pytest
 
 from albot1.data import catalog
 from albot1.methods.plugins import ENTRY_POINT_GROUP
 from albot1.methods.registry import method_registry
 
-matplotlib.use("Agg")
+# The plotting backend without importing matplotlib here (half a second of every collection): it reads this
+# variable when a test first imports it, and the CLI and cell processes the tests start inherit it.
+os.environ.setdefault("MPLBACKEND", "Agg")
 
 #: What marks a SLAM-corrected log in the catalog: its name is ``<site>-corrected`` (datasets/README.md).
 CORRECTED_SUFFIX = "-corrected"
@@ -106,11 +107,20 @@ def fault_plugin(install_method_plugin: PluginInstaller) -> None:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Run the slow tests first (stable order otherwise).
+    """Run the modules holding a slow test first, each module kept together (stable order otherwise).
 
     With several xdist workers (``make test``), a whole-log test of a minute
     or two that starts last keeps the other workers idle until it ends; the
     workers steal queued tests from each other (``--dist worksteal``), so the
-    short ones started after the slow ones fill the gaps instead.
+    short ones started after the slow ones fill the gaps instead. A module is
+    moved whole, not test by test, so that its module-scoped fixtures (a
+    report built once for several tests) are not built a second time when its
+    slow and quick tests would otherwise run far apart.
     """
-    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+    slow_modules = {_module(item) for item in items if item.get_closest_marker("slow")} - {None}
+    items.sort(key=lambda item: _module(item) not in slow_modules)
+
+
+def _module(item: pytest.Item) -> str | None:
+    module = getattr(item, "module", None)
+    return module.__name__ if module is not None else None

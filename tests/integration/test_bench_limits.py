@@ -59,6 +59,8 @@ def test_a_cell_over_its_memory_limit_is_reported_as_such_not_as_an_import_error
         assert reason.endswith("over the cell's limit of 40 MB (killed)")
 
 
+#: Seven cells of about 3 s each (30 scans at 0.1 s): long enough that two are running when the pool is
+#: killed, short enough that the resume does not wait on the whole world (106 scans) seven times.
 SLOW = f"""
 [grid]
 degradations = ["gauss:0.1:1"]
@@ -70,7 +72,7 @@ label = "slow"
 set = {{ mode = "slow", sleep_s = 0.1 }}
 
 [[datasets]]
-name = "{WORLD}"
+name = "{WORLD}[:30]"
 """
 
 

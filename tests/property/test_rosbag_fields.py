@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -103,6 +104,7 @@ def write_bag(
             bag.write(pose_conn, sec * 10**9, ts.serialize_cdr(message, pose_type))
 
 
+@pytest.mark.slow
 @settings(max_examples=50, deadline=None)
 @given(
     scans=st.lists(laser_fields(), min_size=1, max_size=3),

@@ -7,6 +7,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -20,6 +21,7 @@ metres = st.floats(-5.0, 5.0, allow_nan=False)
 yaw = st.floats(-math.pi, math.pi, allow_nan=False)
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None)
 @given(x=metres, y=metres, theta=yaw, ros1=st.booleans())
 def test_mount_round_trips(x: float, y: float, theta: float, ros1: bool) -> None:

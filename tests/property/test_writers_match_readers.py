@@ -68,6 +68,7 @@ def sequences(draw: st.DrawFn) -> Sequence:
     return Sequence.from_frames("fuzz", frames)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", list(NAMES))
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(seq=sequences())

@@ -42,6 +42,7 @@ print(json.dumps({name: len(getattr(k, name).signatures) for k in mapper.kernels
 """
 
 
+@pytest.mark.slow
 def test_the_forkserver_compiles_every_kernel_before_any_cell_is_forked() -> None:
     """A cell forked after the preload finds every Albot1 kernel compiled: its start-up compiles nothing."""
     import json

@@ -94,6 +94,7 @@ def test_a_manifest_cannot_write_outside_the_cache_or_fill_the_disk(
     assert not (tmp_path / "escaped.clf").exists() and not Path("/tmp/escaped.clf").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(120)
 def test_special_files_are_refused_up_front_and_never_hang(tmp_path: Path) -> None:
     fifo = tmp_path / "log.clf"
@@ -120,6 +121,7 @@ def test_an_unrecognised_file_is_described_not_quoted(tmp_path: Path) -> None:
     assert f"{secret}:1: the first line that is not a comment (text, 31 characters) begins no known format" in line
 
 
+@pytest.mark.slow
 def test_hand_edited_store_files_are_one_line_naming_file_and_field(tmp_path: Path) -> None:
     results = tmp_path / "results" / "s"
     results.mkdir(parents=True)
@@ -146,6 +148,7 @@ def test_hand_edited_store_files_are_one_line_naming_file_and_field(tmp_path: Pa
     )
 
 
+@pytest.mark.slow
 def test_a_report_names_the_data_and_escapes_names(tmp_path: Path) -> None:
     log = carmen_log(tmp_path / "<b>bold.clf")
     suite = tmp_path / "s.toml"
@@ -168,6 +171,7 @@ def test_a_report_names_the_data_and_escapes_names(tmp_path: Path) -> None:
     assert json.loads((result.parent / "metrics.json").read_text())["run"]["data_sha256"] == checksums
 
 
+@pytest.mark.slow
 def test_a_dataset_edited_after_its_cell_ran_is_run_again_not_kept(tmp_path: Path) -> None:
     log = carmen_log(tmp_path / "t.clf")
     suite = tmp_path / "s.toml"

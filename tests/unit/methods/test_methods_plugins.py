@@ -80,6 +80,7 @@ def test_a_plugin_runs_in_albot1_run(echo: str, tmp_path: Path) -> None:
     assert '"method": "echo"' in result.output and '"preset": "double"' in result.output
 
 
+@pytest.mark.slow
 def test_a_plugin_runs_in_a_bench_suite(echo: str, tmp_path: Path) -> None:
     suite = tmp_path / "plug.toml"
     suite.write_text(f'[[methods]]\nname = "{echo}"\n\n[[datasets]]\nname = "{WORLD}"\n')

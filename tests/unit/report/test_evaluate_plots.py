@@ -77,6 +77,7 @@ def test_without_reference_only_the_trajectories_are_drawn(tmp_path: Path) -> No
     assert (tmp_path / "trajectories.svg").is_file()
 
 
+@pytest.mark.slow
 def test_cli_plot_writes_the_figures(tmp_path: Path) -> None:
     arrays = open_sequence("synthetic-office-loop[:40]").arrays
     assert arrays.reference is not None

@@ -56,6 +56,7 @@ def _counting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     return drawn
 
 
+@pytest.mark.slow
 def test_a_second_report_draws_nothing_and_a_changed_cell_redraws_its_dataset_only(
     results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

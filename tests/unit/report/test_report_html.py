@@ -85,6 +85,7 @@ class _Links(HTMLParser):
                 self.links.append(str(values[name]))
 
 
+@pytest.mark.slow
 def test_every_link_and_image_of_index_html_resolves_inside_the_report(report: Path) -> None:
     page = report / INDEX_HTML
     parser = _Links()
@@ -102,6 +103,7 @@ def test_every_link_and_image_of_index_html_resolves_inside_the_report(report: P
     assert "<script>" in text and "sortable" in text and "failed (exception: RuntimeError: injected)" in text
 
 
+@pytest.mark.slow
 def test_the_readme_links_the_page_and_every_table_format(report: Path) -> None:
     readme = (report / "README.md").read_text(encoding="utf-8")
     assert "(index.html)" in readme and "[LaTeX](metrics.tex)" in readme and ".svg)" in readme
@@ -154,6 +156,7 @@ def test_a_results_folder_whose_grid_planned_no_cell_still_gets_a_report(tmp_pat
     assert (tmp_path / "report" / INDEX_HTML).is_file()
 
 
+@pytest.mark.slow
 def test_plots_drawn_by_worker_processes_are_the_same_files(tmp_path: Path) -> None:
     root = tmp_path / "two"
     store = ResultsStore(root)

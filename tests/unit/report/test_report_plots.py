@@ -167,6 +167,7 @@ def _check_png(path: Path | None) -> tuple[int, int]:
     return pixels.shape[1], pixels.shape[0]
 
 
+@pytest.mark.slow
 def test_every_plot_of_a_corridor_is_wide_png_and_svg(tmp_path: Path, corridor: list[CellRecord]) -> None:
     records = corridor
     colors = method_colors(r.cell.method_label for r in records)

@@ -118,6 +118,7 @@ def test_experiments_without_runs_are_not_comparable_with_the_reason(results: Pa
     assert all(v.word == NOT_COMPARABLE for row in places.claims for v in row.verdicts.values())
 
 
+@pytest.mark.slow
 def test_the_page_renders_and_every_linked_figure_exists(page: Path) -> None:
     text = page.read_text(encoding="utf-8")
     assert page.name == "README.md"
@@ -183,6 +184,7 @@ def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path) -> None
     assert verdicts and all("paired ratio" in v.reason for v in verdicts)  # "below the odometry's": with its test
 
 
+@pytest.mark.slow
 def test_a_page_written_again_draws_no_figure_whose_runs_did_not_change(
     results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

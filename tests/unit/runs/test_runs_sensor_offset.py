@@ -71,6 +71,7 @@ def test_sensor_frame_moves_odometry_and_reference_onto_the_laser_and_back() -> 
     assert sensor_frame(plain) is plain
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", _available())
 def test_a_known_offset_gives_the_zero_offset_ate(method: str) -> None:
     plain = _world((0.0, 0.0, 0.0))

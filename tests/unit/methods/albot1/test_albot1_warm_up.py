@@ -14,6 +14,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 _CODE = """
 import json
 from albot1.data.synthetic.worlds import load_world
@@ -44,6 +46,7 @@ print(json.dumps({"warmed": warmed, "added": added}))
 """
 
 
+@pytest.mark.slow
 def test_whole_runs_after_the_warm_up_compile_nothing_new() -> None:
     out = subprocess.run(
         [sys.executable, "-c", _CODE], env=dict(os.environ), capture_output=True, text=True, timeout=900

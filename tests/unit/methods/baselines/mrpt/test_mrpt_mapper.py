@@ -128,6 +128,7 @@ def test_rbpf_short_log_is_a_failure(fake_apps: Path, monkeypatch: pytest.Monkey
         _run(_rbpf())
 
 
+@pytest.mark.slow
 def test_limits_stop_the_application_and_say_which(fake_apps: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("FAKE_MRPT_MODE", "sleep")
     with pytest.raises(BaselineError, match=r"stopped by its time limit \(timeout_s = 1\.5\)"):

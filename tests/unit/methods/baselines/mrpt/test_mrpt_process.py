@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from albot1.methods.baselines.mrpt.process import ProcessOutcome, run_limited
 
@@ -62,6 +63,7 @@ def test_the_memory_of_the_childs_own_children_counts_and_the_group_is_killed(tm
     assert outcome.peak_rss_mb is not None and outcome.peak_rss_mb > 120.0 and outcome.wall_s < 10
 
 
+@pytest.mark.slow
 def test_the_child_dies_with_its_parent(tmp_path: Path) -> None:
     """A parent killed mid-run (a benchmark cell over its limit) leaves no orphan behind."""
     import os
@@ -91,6 +93,7 @@ def test_the_child_dies_with_its_parent(tmp_path: Path) -> None:
     child.wait(timeout=10)  # raises TimeoutExpired if the child outlived its parent
 
 
+@pytest.mark.slow
 def test_the_peak_is_the_programs_own_not_the_forked_python_image(tmp_path: Path) -> None:
     """ru_maxrss would carry this process's resident set (forked before exec) into the child's peak."""
     held = np.ones(300 * 2**20 // 8)  # 300 MB resident here, in the parent
