@@ -103,3 +103,12 @@ def install_method_plugin(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> It
 def fault_plugin(install_method_plugin: PluginInstaller) -> None:
     """The failure-injecting test mapper installed as the plugin method ``fault`` (tests/integration)."""
     install_method_plugin({"fault": "bench_fault_mappers:FaultMapper"})
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _decoded_cache_of_the_session(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Decoded logs go to one folder per test session (not the user's cache), unless ALBOT1_DECODED_CACHE says."""
+    with pytest.MonkeyPatch.context() as patch:
+        if not os.environ.get("ALBOT1_DECODED_CACHE"):
+            patch.setenv("ALBOT1_DECODED_CACHE", str(tmp_path_factory.mktemp("decoded")))
+        yield

@@ -114,9 +114,7 @@ def cached(sequence: Sequence, path: Path, format_name: str, loader_module: str,
             held["arrays"] = arrays
         return decode(held["arrays"])
 
-    return Sequence(
-        sequence.name, frames, sequence.metadata, sequence.relations, scan_count=sequence.known_scan_count
-    )
+    return Sequence(sequence.name, frames, sequence.metadata, sequence.relations, scan_count=sequence.known_scan_count)
 
 
 def encode(frames: Iterator[Frame]) -> dict[str, np.ndarray] | None:
@@ -254,7 +252,8 @@ def write_entry(entry: Path, arrays: dict[str, np.ndarray]) -> bool:
 
     def write(tmp: Path) -> None:
         buffer = io.BytesIO()
-        np.savez(buffer, **arrays)
+        members: dict[str, Any] = dict(arrays)
+        np.savez(buffer, **members)
         tmp.write_bytes(buffer.getvalue())
 
     try:
@@ -278,4 +277,3 @@ def clear(folder: Path | None = None) -> int:
         except OSError:
             continue
     return removed
-
