@@ -124,3 +124,12 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
 def _module(item: pytest.Item) -> str | None:
     module = getattr(item, "module", None)
     return module.__name__ if module is not None else None
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _decoded_cache_of_the_session(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Decoded logs go to one folder per test session (not the user's cache), unless ALBOT1_DECODED_CACHE says."""
+    with pytest.MonkeyPatch.context() as patch:
+        if not os.environ.get("ALBOT1_DECODED_CACHE"):
+            patch.setenv("ALBOT1_DECODED_CACHE", str(tmp_path_factory.mktemp("decoded")))
+        yield

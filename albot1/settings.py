@@ -15,6 +15,10 @@ from pathlib import Path
 
 DATA_DIR_ENV = "ALBOT1_DATA_DIR"
 CACHE_DIR_ENV = "ALBOT1_CACHE_DIR"
+#: Where decoded logs are cached (:mod:`albot1.data.decoded`): a folder, or ``off`` to decode every time.
+DECODED_CACHE_ENV = "ALBOT1_DECODED_CACHE"
+#: Values of :data:`DECODED_CACHE_ENV` that switch the decoded-log cache off.
+DISABLED = frozenset(("off", "0", "no", "false", "none"))
 
 
 def _user_cache_dir() -> Path:
@@ -41,6 +45,18 @@ def checksum_cache_file() -> Path:
     if cache:
         return Path(cache).expanduser() / f".{CHECKSUM_CACHE}"
     return _user_cache_dir() / CHECKSUM_CACHE
+
+
+def decoded_cache_dir() -> Path | None:
+    """The folder of decoded logs: ``ALBOT1_DECODED_CACHE``, else ``<user cache>/albot1-bench/decoded``; None = off.
+
+    Decoding a raw log costs seconds and every benchmark cell opens one, so
+    each log is decoded once per machine (``docs/benchmarking.md``, "Decoded-log cache").
+    """
+    value = os.environ.get(DECODED_CACHE_ENV, "").strip()
+    if value.lower() in DISABLED:
+        return None
+    return Path(value).expanduser() if value else _user_cache_dir() / "decoded"
 
 
 @dataclass(frozen=True)

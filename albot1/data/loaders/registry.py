@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from albot1.config.targets import TargetError, resolve_class
+from albot1.data import decoded
 from albot1.data.errors import DataError, UnknownFormatError
 from albot1.data.filekind import check_input
 from albot1.data.loaders.base import SequenceLoader, SequenceWriter
@@ -96,5 +97,7 @@ def writer_for(format_name: str) -> SequenceWriter:
 
 
 def load(path: str | Path, format_name: str | None = None, **options: Any) -> Sequence:
-    """Open a file of any known format as a Sequence."""
-    return loader_for(path, format_name).load(Path(path), **options)
+    """Open a file of any known format as a Sequence (its frames through the decoded-log cache)."""
+    loader = loader_for(path, format_name)
+    sequence = loader.load(Path(path), **options)
+    return decoded.cached(sequence, Path(path), loader.format_name, type(loader).__module__, options)
