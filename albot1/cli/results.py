@@ -31,7 +31,8 @@ def results_page(
     With --readme, the block between the results:begin and results:end markers is rewritten too.
 
     Example:\n
-      albot1 results-page results/default --thesis results/thesis --readme README.md
+      albot1 results-page results/default --thesis results/thesis \\
+          --readme README.md
     """
     # Imported by the command, not by this module: see albot1.cli.app.
     from albot1.bench.store import ResultsStore
