@@ -91,7 +91,7 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
     with dask.config.set({"distributed.worker.daemon": False}):
         cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=dask_processes, dashboard_address=None)
     try:
-        with Client(cluster) as client:
+        with Client(cluster) as client, _quiet_cancellations():
             yield client.get_executor(pure=False)
     finally:
         cluster.close()
@@ -109,10 +109,38 @@ def _quiet_client_logs() -> Iterator[None]:
     for logger in loggers:
         logger.setLevel(logging.CRITICAL)
     try:
-        yield
+        with _quiet_cancellations():
+            yield
     finally:
         for logger, level in zip(loggers, levels, strict=True):
             logger.setLevel(level)
+
+
+class _DropCancellations(logging.Filter):
+    """Drop tornado's "Exception in callback" records whose exception is a cancelled future.
+
+    When the runner halts a grid it cancels the queued cells;
+    ``distributed.cfexecutor`` then re-raises each cancellation inside a
+    tornado callback, and tornado logs it with a traceback on the user's
+    terminal. The cancellation is the runner's own doing and is reported as
+    ``halted: ...`` with the cells not started; every other record passes.
+    """
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        exc = record.exc_info[1] if record.exc_info else None
+        return not (exc is not None and type(exc).__name__ in ("FutureCancelledError", "CancelledError"))
+
+
+@contextmanager
+def _quiet_cancellations() -> Iterator[None]:
+    """:class:`_DropCancellations` on tornado's callback logger while a Dask executor is in use."""
+    logger = logging.getLogger("tornado.application")
+    drop = _DropCancellations()
+    logger.addFilter(drop)
+    try:
+        yield
+    finally:
+        logger.removeFilter(drop)
 
 
 def _dask_client(executor: cf.Executor) -> Any:

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import concurrent.futures as cf
+import logging
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
@@ -13,7 +15,7 @@ from distributed import KilledWorker
 from test_bench_failures import make_cell, plan_of
 
 from albot1.bench.errors import BenchError
-from albot1.bench.executors import executor_failure, parse_executor, scheduler_executor
+from albot1.bench.executors import _quiet_cancellations, executor_failure, parse_executor, scheduler_executor
 from albot1.bench.grid import Cell, CellOutcome
 from albot1.bench.runner import run_grid
 from albot1.bench.store import LOG, ResultsStore
@@ -112,3 +114,28 @@ def test_a_failure_the_job_could_not_record_is_recorded_by_the_runner(tmp_path: 
     failure = store.failure("k0")
     assert failure is not None and failure.kind == "storage"
     assert failure.reason == summary.failures[0].reason == "cannot write the results: read-only file system: /r/runs/k0"
+
+
+def _callback_record(exc: BaseException) -> logging.LogRecord:
+    """The record tornado logs for an exception raised in an event-loop callback."""
+    try:
+        raise exc
+    except BaseException:
+        return logging.getLogger("tornado.application").makeRecord(
+            "tornado.application", logging.ERROR, __file__, 1, "Exception in callback %r", ("cb",), sys.exc_info()
+        )
+
+
+def test_the_runner_s_own_cancellations_never_print_a_traceback_and_other_errors_still_do(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    from distributed.client import FutureCancelledError
+
+    logger = logging.getLogger("tornado.application")
+    with caplog.at_level(logging.ERROR, logger="tornado.application"), _quiet_cancellations():
+        logger.handle(_callback_record(FutureCancelledError("k", "halted")))
+        logger.handle(_callback_record(RuntimeError("a real fault")))
+    assert [record.getMessage() for record in caplog.records] == ["Exception in callback 'cb'"]
+    assert caplog.records[0].exc_info is not None
+    assert isinstance(caplog.records[0].exc_info[1], RuntimeError)
+    assert logger.filters == []
