@@ -141,29 +141,45 @@ def report(
         str, typer.Option(help="point maps drawn as an occupancy grid (grid) or as their points (points)")
     ] = "grid",
     jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="processes drawing the plots")] = 1,
+    columns: Annotated[
+        str | None,
+        typer.Option(
+            help="KEY,KEY,...: the number columns of the accuracy and cost tables, in this order (method, "
+            "degradation, seeds and status always show; cells.csv keeps every column)"
+        ),
+    ] = None,
 ) -> None:
     """Build tables (Markdown, CSV, LaTeX), plots (PNG and SVG), README.md and index.html from a results folder.
 
-    index.html is the whole report on one page (sortable tables, every plot), with relative links
-    only: open it from the report folder in any browser, no network needed.
+    index.html is the whole report on one page (sortable tables whose columns can be hidden, every
+    plot), with relative links only: open it from the report folder in any browser, no network needed.
+
+    --columns narrows the tables (Markdown, CSV, LaTeX and HTML) to the named columns; a wrong key
+    is an error that lists the valid ones (docs/benchmarking.md, "Tables").
 
     Examples:\n
       albot1 report results/default -j 2   # -> reports/default/index.html\n
-      albot1 report results/quick --out /tmp/quick-report --map-style points
+      albot1 report results/quick --out /tmp/quick-report --map-style points\n
+      albot1 report results/default --columns ate_rmse_m,relation_m,per_scan_ms_median
     """
     # Imported by the command, not by this module: see albot1.cli.app.
     from albot1.bench.store import ResultsStore
+    from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS
+    from albot1.report.column_selection import ALL_COLUMNS, parse_columns
     from albot1.report.index import build_report, default_out
     from albot1.report.map_plots import MapStyle
 
     if map_style not in ("grid", "points"):
         raise typer.BadParameter(f"--map-style {map_style!r}: expected grid or points")
+    selection = ALL_COLUMNS if columns is None else parse_columns(columns, {**METRIC_COLUMNS, **COST_COLUMNS})
     ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
     writable_folder(out if out is not None else default_out(results_dir), "--out")
     style: MapStyle = "grid" if map_style == "grid" else "points"
     bar = FigureBar()
     try:
-        index = build_report(results_dir, out, plots=plots, map_style=style, jobs=jobs, progress=bar.update)
+        index = build_report(
+            results_dir, out, plots=plots, map_style=style, jobs=jobs, progress=bar.update, columns=selection
+        )
     finally:
         bar.close()
     typer.echo(f"report: {index}")
