@@ -160,7 +160,7 @@ def report(
     Examples:\n
       albot1 report results/default -j 2   # -> reports/default/index.html\n
       albot1 report results/quick --out /tmp/quick-report --map-style points\n
-      albot1 report results/default --columns ate_rmse_m,relation_m,per_scan_ms_median
+      albot1 report results/quick --columns ate_rmse_m,loop_gap_m,total_s
     """
     # Imported by the command, not by this module: see albot1.cli.app.
     from albot1.bench.store import ResultsStore

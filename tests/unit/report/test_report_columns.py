@@ -279,3 +279,10 @@ def test_chromium_hides_a_column_header_and_every_cell_and_shows_it_again(whole:
     assert set(probe["sorted"]) == {"none"}  # sorting the rows keeps the column hidden
     assert set(probe["other"]) == {"table-cell"}  # another table's column of the same place stays
     assert set(probe["again"]) == {"table-cell"} and probe["checked"] is True  # "show all"
+
+
+def test_the_docs_list_every_valid_key_in_order() -> None:
+    docs = Path(__file__).resolve().parents[3] / "docs" / "benchmarking.md"
+    bullet = docs.read_text(encoding="utf-8").split("- **Column selection**")[1].split("\n- **")[0]
+    keys = bullet.split("by key: ")[1].split(" (cost)")[0]
+    assert re.findall(r"`(\w+)`", keys) == list(KNOWN)
