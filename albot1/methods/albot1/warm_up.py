@@ -46,8 +46,8 @@ def _update_sample(seg: NDArray[np.float64]) -> tuple[Any, ...]:
     state = (np.resize(seg, (cap, 4)), np.arange(cap) < 2, np.zeros(cap, dtype=np.int64))
     slots = (np.where(np.arange(cap) < 2, np.arange(cap), -1), np.arange(cap, dtype=np.int64), box)
     view = seg + 20.0
-    poly = np.ascontiguousarray(np.vstack([[20.0, 20.0], view.reshape(-1, 2)]))
-    return (*state, *slots, np.zeros((cap, 3), dtype=np.int64), 2, 2, 0, view, poly, 1, 0.4, 0.1, 0.4, True, True)
+    log = np.zeros((cap, 3), dtype=np.int64)
+    return (*state, *slots, log, 2, 2, 0, view, 20.0, 20.0, True, 1, 0.4, 0.1, 0.4, True, True)
 
 
 def _samples() -> dict[str, list[tuple[Any, ...]]]:
@@ -71,6 +71,8 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         "classify_endpoints": [(poly, seg, points, 0.4, True)],
         "resolve_partial": [(seg, taken, seg + 0.01, taken, poly, math.radians(5.0), 0.4, True, 0.4, False)],
         "update_surfaces": [_update_sample(seg)],
+        "place_segments": [(seg, 0.5, -0.2, math.cos(0.3), math.sin(0.3))],
+        "landmark_rows": [(seg, kinds, 0.4)],
         "refine_pose": [
             (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
         ],

@@ -29,6 +29,25 @@ BoolArray = NDArray[np.bool_]
 
 
 @jitable
+def polygon_points(view: FloatArray, x: float, y: float, with_robot: bool) -> FloatArray:
+    """Algorithm 3 line 7: the robot ``(x, y)`` (when ``with_robot``), then every surface's P1 and P2 in order.
+
+    See :func:`albot1.methods.albot1.mapping.update.view_polygon` for why.
+    """
+    first = 1 if with_robot else 0
+    poly = np.empty((first + 2 * view.shape[0], 2))
+    if with_robot:
+        poly[0, 0] = x
+        poly[0, 1] = y
+    for j in range(view.shape[0]):
+        poly[first + 2 * j, 0] = view[j, 0]
+        poly[first + 2 * j, 1] = view[j, 1]
+        poly[first + 2 * j + 1, 0] = view[j, 2]
+        poly[first + 2 * j + 1, 1] = view[j, 3]
+    return poly
+
+
+@jitable
 def covered(poly: FloatArray, view: FloatArray, x: float, y: float, margin: float, surfaces_only: bool) -> bool:
     """Whether the point ``(x, y)`` is inside the closed polygon (even-odd) or within ``margin`` of it.
 
@@ -92,19 +111,27 @@ def classify_endpoints(
     return out
 
 
-@kernel
-def best_correspondence(
-    seg: FloatArray, view: FloatArray, taken: BoolArray, max_angle: float, max_distance: float
+@jitable
+def view_angles(view: FloatArray) -> FloatArray:
+    """Direction (P1 -> P2, radians) of each view surface ``(m, 4)``."""
+    out = np.empty(view.shape[0])
+    for j in range(view.shape[0]):
+        out[j] = math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0])
+    return out
+
+
+@jitable
+def closest_parallel(
+    seg: FloatArray, view: FloatArray, angles: FloatArray, taken: BoolArray, max_angle: float, max_distance: float
 ) -> int:
-    """Index of the free view surface closest to ``seg`` (segment distance) among those parallel
-    to it within ``max_angle`` (undirected) and nearer than ``max_distance``; -1 if none."""
+    """:func:`best_correspondence` given the view's :func:`view_angles` (computed once per update)."""
     best = -1
     best_d = max_distance
     a0 = math.atan2(seg[3] - seg[1], seg[2] - seg[0])
     for j in range(view.shape[0]):
         if taken[j]:
             continue
-        da = line_angle(math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0]) - a0)
+        da = line_angle(angles[j] - a0)
         if da >= max_angle:
             continue
         d = segment_distance(seg, view[j])
@@ -112,6 +139,15 @@ def best_correspondence(
             best = j
             best_d = d
     return best
+
+
+@kernel
+def best_correspondence(
+    seg: FloatArray, view: FloatArray, taken: BoolArray, max_angle: float, max_distance: float
+) -> int:
+    """Index of the free view surface closest to ``seg`` (segment distance) among those parallel
+    to it within ``max_angle`` (undirected) and nearer than ``max_distance``; -1 if none."""
+    return closest_parallel(seg, view, view_angles(view), taken, max_angle, max_distance)
 
 
 @kernel
@@ -133,6 +169,23 @@ def clip_parameter(
         else:
             lo = mid
     return lo
+
+
+@kernel
+def place_segments(segments: FloatArray, x: float, y: float, c: float, s: float) -> FloatArray:
+    """Segments ``(m, 4)`` of a view placed in the map at ``(x, y)`` with heading cosine/sine ``c``/``s``.
+
+    :func:`albot1.geometry.segments.transform_segments` operation for operation
+    (``x + c * x1 - s * y1``, ...), as a loop: one call per update instead of
+    a dozen numpy ones (the unit tests compare the bits).
+    """
+    out = np.empty((segments.shape[0], 4))
+    for i in range(segments.shape[0]):
+        out[i, 0] = x + c * segments[i, 0] - s * segments[i, 1]
+        out[i, 1] = y + s * segments[i, 0] + c * segments[i, 1]
+        out[i, 2] = x + c * segments[i, 2] - s * segments[i, 3]
+        out[i, 3] = y + s * segments[i, 2] + c * segments[i, 3]
+    return out
 
 
 #: Actions of :func:`resolve_partial` on a map surface with one end inside the view.
@@ -172,6 +225,7 @@ def resolve_partial(
     new = np.empty((k, 4))
     match = np.full(k, -1, dtype=np.int64)
     used = taken.copy()
+    angles = view_angles(view)
     for r in range(k):
         seg = segs[r]
         if p1_inside[r]:
@@ -184,7 +238,7 @@ def resolve_partial(
             oy = seg[1]
             ix = seg[2]
             iy = seg[3]
-        best = best_correspondence(seg, view, used, max_angle, max_distance)
+        best = closest_parallel(seg, view, angles, used, max_angle, max_distance)
         if best >= 0:
             v = view[best]
             if np.hypot(v[0] - ox, v[1] - oy) >= np.hypot(v[2] - ox, v[3] - oy):
@@ -257,7 +311,9 @@ def update_surfaces(
     live: int,
     n_events: int,
     view: FloatArray,
-    poly: FloatArray,
+    robot_x: float,
+    robot_y: float,
+    with_robot: bool,
     scan: int,
     margin: float,
     max_angle: float,
@@ -271,7 +327,8 @@ def update_surfaces(
     (``n`` ids so far), ``live_id``/``live_box`` by slot (``live`` in use),
     ``events`` rows ``(id, action, scan)`` (``n_events`` so far); the caller
     has made room for ``len(view)`` more ids and ``live`` more events. The
-    view ``(m, 4)`` is in the map, ``poly`` its polygon. In order: the live
+    view ``(m, 4)`` is in the map, seen from ``(robot_x, robot_y)``; its polygon
+    (:func:`polygon_points`) includes that point when ``with_robot``. In order: the live
     surfaces whose bounding box meets the polygon's grown box (ascending id)
     have their endpoints classified (:func:`covered`); those with both ends covered
     are deleted, those with one are resolved (:func:`resolve_partial`) and
@@ -288,6 +345,7 @@ def update_surfaces(
     n_ext = 0
     n_trim = 0
     if m > 0:
+        poly = polygon_points(view, robot_x, robot_y, with_robot)
         lo_x = poly[0, 0]
         lo_y = poly[0, 1]
         hi_x = poly[0, 0]
@@ -442,5 +500,6 @@ class MappingKernels:
         self.classify_endpoints = select(classify_endpoints, compiled)
         self.resolve_partial = select(resolve_partial, compiled)
         self.update_surfaces = select(update_surfaces, compiled)
+        self.place_segments = select(place_segments, compiled)
         self.refine_pose = select(pose_kernels.refine_pose, compiled)
         self.scan_points = select(pose_kernels.scan_points, compiled)

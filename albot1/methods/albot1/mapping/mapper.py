@@ -29,7 +29,6 @@ from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
-from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernels import MappingKernels
@@ -191,7 +190,7 @@ class Albot1Mapper:
             view = construct_view(scan.ranges, scan.angles, self._view_params, self._pk)
         except (ValueError, TypeError) as exc:
             raise MappingError(f"scan {frame.index}: cannot build a view: {exc}") from exc
-        lms = find_landmarks(view, self.config.landmark_min_length_m)
+        lms = find_landmarks(view, self.config.landmark_min_length_m, self._pk)
         odo = (float(frame.odometry[0]), float(frame.odometry[1]), float(frame.odometry[2]))
         if not all(map(math.isfinite, odo)):
             raise MappingError(f"scan {frame.index}: odometry {odo} is not finite")
@@ -362,7 +361,7 @@ class Albot1Mapper:
         since the update from it.
         """
         c = self._counts
-        view_map = transform_segments(pose, view.surfaces)
+        view_map = self._mk.place_segments(view.surfaces, pose[0], pose[1], math.cos(pose[2]), math.sin(pose[2]))
         self._update_odometry = odometry
         if self._plus is not None:
             self._plus.reset(view_map, pose)

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernels import MappingKernels, polygon_points
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 
 IntArray = NDArray[np.int64]
@@ -55,10 +55,8 @@ def view_polygon(view_map: FloatArray, robot_xy: tuple[float, float], polygon: s
     360 degrees; without the robot vertex the space between the robot and
     the view would never be cleared.
     """
-    pts = view_map.reshape(-1, 2)
-    if polygon == "robot_and_endpoints":
-        pts = np.vstack([np.asarray(robot_xy, dtype=float).reshape(1, 2), pts])
-    return np.ascontiguousarray(pts)
+    view = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
+    return polygon_points(view, float(robot_xy[0]), float(robot_xy[1]), polygon == "robot_and_endpoints")
 
 
 def update_map(
@@ -81,7 +79,6 @@ def update_map(
     k = kernels or MappingKernels()
     view_map = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
     m = view_map.shape[0]
-    poly = view_polygon(view_map, robot_xy, params.polygon) if m else np.empty((0, 2))
     pmap.reserve(m, pmap.live)
     view_ids, deleted, extended, trimmed, added, pmap.n, pmap.live, pmap.n_events = k.update_surfaces(
         pmap.seg,
@@ -95,7 +92,9 @@ def update_map(
         pmap.live,
         pmap.n_events,
         view_map,
-        poly,
+        float(robot_xy[0]),
+        float(robot_xy[1]),
+        params.polygon == "robot_and_endpoints",
         scan,
         params.delete_margin,
         params.correspond_angle,

@@ -153,12 +153,13 @@ def _partial_args() -> Iterator[tuple[Any, ...]]:
                 yield (near_view, inside, view, taken, poly, math.radians(5.0), 0.4, clip, 0.4, surfaces_only)
 
 
-def _update_state(segs: np.ndarray, view: np.ndarray, poly: np.ndarray, surfaces_only: bool) -> tuple[Any, ...]:
+def _update_state(segs: np.ndarray, view: np.ndarray, with_robot: bool, surfaces_only: bool) -> tuple[Any, ...]:
     pmap = PerceptualMap()
     pmap.add(segs, scan=0)
     pmap.reserve(len(view), pmap.live)
     state = (pmap.seg, pmap.alive, pmap.added_at, pmap.slot_of, pmap.live_id, pmap.live_box, pmap.events)
-    return (*state, pmap.n, pmap.live, pmap.n_events, view, poly, 3, 0.4, math.radians(5.0), 0.4, False, surfaces_only)
+    tail = (3, 0.4, math.radians(5.0), 0.4, False, surfaces_only)
+    return (*state, pmap.n, pmap.live, pmap.n_events, view, 0.0, 0.0, with_robot, *tail)
 
 
 def _update_args() -> Iterator[tuple[Any, ...]]:
@@ -170,12 +171,34 @@ def _update_args() -> Iterator[tuple[Any, ...]]:
         for surfaces_only in (True, False):
             kept = segs
             for _ in range(5):
-                args = _update_state(kept, view, poly, surfaces_only)
+                args = _update_state(kept, view, len(poly) > 2 * len(view), surfaces_only)
                 edited = np.concatenate(plain(*copy.deepcopy(args))[1:4])
                 if edited.size == 0:
                     yield args
                     break
                 kept = np.ascontiguousarray(np.delete(kept, edited, axis=0))
+
+
+def _place_args() -> Iterator[tuple[Any, ...]]:
+    rng = np.random.default_rng(12)
+    for view in _views():
+        theta = float(rng.uniform(-4.0, 4.0))
+        yield (view.surfaces, *rng.normal(0.0, 30.0, 2).tolist(), math.cos(theta), math.sin(theta))
+
+
+def _landmark_args() -> Iterator[tuple[Any, ...]]:
+    for view in _views():
+        for min_length in (0.0, 0.4, 1.5):
+            yield (view.surfaces, view.kinds, min_length)
+
+
+def test_placing_a_view_is_transform_segments_bit_for_bit() -> None:
+    for surfaces, x, y, c, s in _place_args():
+        theta = math.atan2(s, c)
+        pose = (x, y, theta)
+        expected = segments.transform_segments(pose, surfaces)
+        got = mapping_source.place_segments(surfaces, x, y, math.cos(theta), math.sin(theta))
+        assert_same_bits(got, expected)
 
 
 def _scan_points_args() -> Iterator[tuple[Any, ...]]:
@@ -233,13 +256,15 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "refine_pose": _refine_args,
     "resolve_partial": _partial_args,
     "update_surfaces": _update_args,
+    "place_segments": _place_args,
+    "landmark_rows": _landmark_args,
     "scan_points": _scan_points_args,
 }
 
 
 #: the kernels by name, as compiled (module attributes: numba dispatchers)
 KERNELS: dict[str, Any] = {
-    **{name: getattr(perception_source, name) for name in ("build_view", "recognise_landmarks")},
+    **{name: getattr(perception_source, name) for name in ("build_view", "recognise_landmarks", "landmark_rows")},
     **{
         name: getattr(mapping_source, name)
         for name in (
@@ -248,6 +273,7 @@ KERNELS: dict[str, Any] = {
             "clip_parameter",
             "resolve_partial",
             "update_surfaces",
+            "place_segments",
         )
     },
     **{name: getattr(pose_kernels, name) for name in ("refine_pose", "scan_points")},
