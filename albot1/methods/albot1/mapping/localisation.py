@@ -152,7 +152,7 @@ class Localisation:
 
 def localise(
     tracked: Tracked,
-    landmark_map: Mapping[int, tuple[FloatArray, IntArray]],
+    landmark_map: Mapping[int, tuple[FloatArray | Sequence[float], IntArray | Sequence[int]]],
     *,
     min_candidates: int,
     gap_floor: float,
@@ -183,7 +183,7 @@ def localise(
         record = landmark_map.get(sid)
         if record is None:
             continue
-        map_kinds = record[1].tolist()
+        map_seg, map_kinds = record
         matched = sides[k]
         side = -1
         for s in (matched, 1 - matched) if matched >= 0 else (0, 1):
@@ -194,7 +194,7 @@ def localise(
             continue
         seg = surfaces[k]
         ids.append(sid)
-        poses.append(landmark_pose(record[0].tolist(), seg, side))
+        poses.append(landmark_pose(map_seg, seg, side))
         length = math.hypot(seg[2] - seg[0], seg[3] - seg[1])
         # NaN (x != x) marks a list freshly reset from a view: no match data.
         d_r = d_prev[k] if d_prev[k] == d_prev[k] else 1.0

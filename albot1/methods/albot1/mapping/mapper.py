@@ -120,7 +120,7 @@ class Albot1Mapper:
         self._angle_floor = math.radians(config.goodness_angle_floor_deg)
         self._stationary_rad = math.radians(config.stationary_deg)
         self.map = PerceptualMap()
-        self._landmark_map: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._landmark_map: dict[int, tuple[list[float], list[int]]] = {}
         self._poses: list[Pose] = []
         self._prev: _Step | None = None
         self._u_step = -1
@@ -309,8 +309,8 @@ class Albot1Mapper:
             compose_pose(prev_pose, step), None if loc is None else loc.pose, None if loc is None else loc.candidates
         )
         rows: list[int] = []
-        maps: list[np.ndarray] = []
-        map_kinds: list[np.ndarray] = []
+        maps: list[list[float]] = []
+        map_kinds: list[list[int]] = []
         for r, sid in enumerate(rl.ids.tolist()):
             record = self._landmark_map.get(sid)
             if record is not None:
@@ -371,7 +371,8 @@ class Albot1Mapper:
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]
-        self._landmark_map = {int(i): (lm_map[r], lms.kinds[r]) for r, i in enumerate(ids.tolist())}
+        # As Python lists: localisation reads them as scalars every scan.
+        self._landmark_map = dict(zip(ids.tolist(), zip(lm_map.tolist(), lms.kinds.tolist())))
         self._u_step = view_scan
         c.surfaces_added += len(out.added)
         c.surfaces_deleted += len(out.deleted)
