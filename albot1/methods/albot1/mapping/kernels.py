@@ -30,10 +30,7 @@ BoolArray = NDArray[np.bool_]
 
 @jitable
 def polygon_points(view: FloatArray, x: float, y: float, with_robot: bool) -> FloatArray:
-    """Algorithm 3 line 7: the robot ``(x, y)`` (when ``with_robot``), then every surface's P1 and P2 in order.
-
-    See :func:`albot1.methods.albot1.mapping.update.view_polygon` for why.
-    """
+    """Algorithm 3 line 7: the robot ``(x, y)`` if ``with_robot``, then each surface's P1, P2 (see ``view_polygon``)."""
     first = 1 if with_robot else 0
     poly = np.empty((first + 2 * view.shape[0], 2))
     if with_robot:
@@ -173,12 +170,8 @@ def clip_parameter(
 
 @kernel
 def place_segments(segments: FloatArray, x: float, y: float, c: float, s: float) -> FloatArray:
-    """Segments ``(m, 4)`` of a view placed in the map at ``(x, y)`` with heading cosine/sine ``c``/``s``.
-
-    :func:`albot1.geometry.segments.transform_segments` operation for operation
-    (``x + c * x1 - s * y1``, ...), as a loop: one call per update instead of
-    a dozen numpy ones (the unit tests compare the bits).
-    """
+    """Segments ``(m, 4)`` placed at ``(x, y)``, heading cosine/sine ``c``/``s``: ``transform_segments``'s
+    arithmetic operation for operation, one call instead of a dozen numpy ones (the tests compare the bits)."""
     out = np.empty((segments.shape[0], 4))
     for i in range(segments.shape[0]):
         out[i, 0] = x + c * segments[i, 0] - s * segments[i, 1]
