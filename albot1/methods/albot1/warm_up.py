@@ -36,6 +36,20 @@ def _readonly(a: NDArray[Any]) -> NDArray[Any]:
     return a
 
 
+def _update_sample(seg: NDArray[np.float64]) -> tuple[Any, ...]:
+    """A two-surface map and a view far from it: only additions, so a second call repeats the first exactly."""
+    cap = 8
+    box = np.zeros((cap, 4))
+    box[:2] = np.column_stack(
+        [seg[:, [0, 2]].min(1), seg[:, [1, 3]].min(1), seg[:, [0, 2]].max(1), seg[:, [1, 3]].max(1)]
+    )
+    state = (np.resize(seg, (cap, 4)), np.arange(cap) < 2, np.zeros(cap, dtype=np.int64))
+    slots = (np.where(np.arange(cap) < 2, np.arange(cap), -1), np.arange(cap, dtype=np.int64), box)
+    view = seg + 20.0
+    log = np.zeros((cap, 3), dtype=np.int64)
+    return (*state, *slots, log, 2, 2, 0, view, 20.0, 20.0, True, 1, 0.4, 0.1, 0.4, True, True)
+
+
 def _samples() -> dict[str, list[tuple[Any, ...]]]:
     """Argument tuples per kernel name, typed as the mappers call them (scan arrays may be read-only)."""
     angles = np.radians(np.arange(90.0, -90.5, -10.0))
@@ -56,6 +70,9 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         "recognise_landmarks": [(seg, kinds, seg + 0.01, kinds, 0.05, 0.3, 0.04, math.radians(5.0), 0.4, True)],
         "classify_endpoints": [(poly, seg, points, 0.4, True)],
         "resolve_partial": [(seg, taken, seg + 0.01, taken, poly, math.radians(5.0), 0.4, True, 0.4, False)],
+        "update_surfaces": [_update_sample(seg)],
+        "place_segments": [(seg, 0.5, -0.2, math.cos(0.3), math.sin(0.3))],
+        "landmark_rows": [(seg, kinds, 0.4)],
         "refine_pose": [
             (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
         ],
