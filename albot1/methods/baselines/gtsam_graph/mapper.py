@@ -41,6 +41,7 @@ from pydantic import BaseModel
 from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
+from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
@@ -74,6 +75,7 @@ class GtsamGraphMapper:
             "tracking_velocity_rejected": 0,
             "tracking_outliers_rejected": 0,
             "odometry_fallbacks": 0,
+            "odometry_fused": 0,
             "loop_candidates": 0,
             "loop_coarse_searches": 0,
             "loop_closures_accepted": 0,
@@ -122,7 +124,8 @@ class GtsamGraphMapper:
     ) -> None:
         """A new node at ``step`` from the newest; then loop closure and place recognition when they are due."""
         cfg = self.config
-        relative, covariance = self.front.sequential_edge(step, points, index, tracked)
+        odometry_step = se2.between(self.back.odometry[-1], odometry)
+        relative, covariance = self.front.sequential_edge(step, points, index, tracked, odometry_step)
         key = self.back.add_node(odometry, step, relative, covariance, points, index)
         self.front.new_node()
         self.loops.travelled(math.hypot(relative[0], relative[1]))
