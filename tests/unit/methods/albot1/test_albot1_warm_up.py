@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -55,3 +56,67 @@ def test_whole_runs_after_the_warm_up_compile_nothing_new() -> None:
     found = json.loads(out.stdout)
     assert found["added"] == {}
     assert all(len(sigs) >= 1 for sigs in found["warmed"].values()), found["warmed"]  # every kernel warmed
+
+
+def _python(code: str, cache: str, **env: str) -> str:
+    """Run ``code`` in a fresh interpreter whose user cache (numba's cache folder with it) is ``cache``."""
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        env={**os.environ, "XDG_CACHE_HOME": cache, **env},
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    assert out.returncode == 0, out.stderr
+    return out.stdout
+
+
+_LOAD = """
+import json
+from albot1.methods.albot1 import compiled
+from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
+from albot1.methods.albot1.warm_up import sample_calls
+sets = (PerceptionKernels(), MappingKernels())
+cached = {name: compiled.is_cached(kernel) for name, kernel, _ in sample_calls(*sets)}
+for name, kernel, args in sample_calls(*sets):
+    if cached[name]:
+        kernel(*args)
+stats = {name: [sum(kernel.stats.cache_hits.values()), sum(kernel.stats.cache_misses.values())]
+         for name, kernel, _ in sample_calls(*sets) if cached[name]}
+print(json.dumps({"cached": cached, "stats": stats}))
+"""
+
+
+def test_a_helper_s_kernels_are_loaded_from_numba_s_cache_by_the_next_process(tmp_path: Path) -> None:
+    """The mechanism of a parallel warm-up: what a helper compiles for its claims, another process loads."""
+    claims = tmp_path / "claims"
+    claims.mkdir()
+    (claims / "refine_pose").touch()  # claimed by another process: the helper leaves it
+    code = (
+        "from albot1.methods.albot1.warm_up import compile_claimed\n"
+        f"compile_claimed({str(claims)!r}, ['albot1.methods.albot1.mapping.kernels:MappingKernels'], "
+        "['refine_pose', 'scan_points'])\n"
+    )
+    _python(code, str(tmp_path))
+    found = json.loads(_python(_LOAD, str(tmp_path)))
+    assert {name for name, cached in found["cached"].items() if cached} == {"scan_points"}
+    assert found["stats"] == {"scan_points": [2, 0]}  # both warm-up signatures loaded, none compiled
+    assert sorted(p.name for p in claims.iterdir()) == ["refine_pose", "scan_points"]
+
+
+@pytest.mark.slow
+def test_a_cold_warm_up_in_two_processes_fills_the_cache_with_every_kernel(tmp_path: Path) -> None:
+    """``ALBOT1_COMPILE_PROCESSES=2`` on an empty cache: every kernel cached once, the next process compiles nothing."""
+    code = (
+        "from albot1.methods.albot1.mapping.kernels import MappingKernels\n"
+        "from albot1.methods.albot1.perception.kernels import PerceptionKernels\n"
+        "from albot1.methods.albot1.warm_up import warm_up\n"
+        "warm_up((PerceptionKernels(), MappingKernels()), print)\n"
+    )
+    said = _python(code, str(tmp_path), ALBOT1_COMPILE_PROCESSES="2").splitlines()
+    assert said[0].startswith("albot1: compiling the numba kernels once") and said[1].startswith("albot1: kernels")
+    found = json.loads(_python(_LOAD, str(tmp_path)))
+    assert all(found["cached"].values()), found["cached"]
+    assert all(misses == 0 and hits >= 1 for hits, misses in found["stats"].values()), found["stats"]
+    assert _python(code, str(tmp_path)) == ""  # a warm warm-up says nothing
