@@ -133,7 +133,7 @@ def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) ->
     otherwise spawned (a fresh interpreter imports them, about a second).
     """
     count = min(compiled.compile_processes(), len(names)) - 1
-    if count < 1:
+    if count < 1 or multiprocessing.current_process().daemon:  # a daemonic process (a Dask worker) has no children
         return []
     forking = "fork" in multiprocessing.get_all_start_methods() and threading.active_count() == 1
     context = multiprocessing.get_context("fork") if forking else multiprocessing.get_context("spawn")
