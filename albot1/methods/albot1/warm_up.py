@@ -10,6 +10,10 @@ compiled and as written gives the same bits.
 
 Changing a kernel's argument types means changing its sample here; the
 tests name the kernel whose sample no longer fits.
+
+A cold warm-up (this code version's first on the machine) spreads the
+compile over processes, as numba compiles under one lock per process; see
+:func:`warm_up` and ``docs/albot1-mapper.md`` ("Kernels", "Compile time").
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ import os
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from multiprocessing.process import BaseProcess
 from pathlib import Path
 from typing import Any
@@ -146,7 +150,9 @@ def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) ->
     return helpers
 
 
-def warm_up(kernel_sets: tuple[object, ...], announce: Callable[[str], None] | None = None) -> None:
+def warm_up(
+    kernel_sets: tuple[object, ...], announce: Callable[[str], None] | None = None, skip: Collection[str] = ()
+) -> None:
     """Call every kernel of ``kernel_sets`` once with its mappers' argument types: numba compiles them now.
 
     With numba's cache filled (any earlier run of this code version on this
@@ -157,9 +163,10 @@ def warm_up(kernel_sets: tuple[object, ...], announce: Callable[[str], None] | N
     helpers compiled. Whatever a helper did not deliver (it failed, or was
     slower) this process compiles itself, so a helper changes only the time.
     ``announce`` receives a line before and after a real compilation, none
-    for a cache load.
+    for a cache load. ``skip``: kernels the caller's configuration never
+    calls (``MappingKernels.not_called``), neither compiled nor loaded.
     """
-    calls = list(sample_calls(*kernel_sets))
+    calls = [call for call in sample_calls(*kernel_sets) if call[0] not in skip]
     kernels = {name: kernel for name, kernel, _ in calls}
     cold = sorted((name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -_size(kernels[n]))
     if cold and announce is not None:
@@ -172,6 +179,10 @@ def warm_up(kernel_sets: tuple[object, ...], announce: Callable[[str], None] | N
             helpers = _helpers(Path(folder), kernel_sets, cold[:-1])
             try:
                 _compile(Path(folder), calls, cold)
+            except BaseException:  # a failed compile or an interrupt: the helpers' work is no longer wanted
+                for helper in helpers:
+                    helper.terminate()
+                raise
             finally:
                 for helper in helpers:
                     helper.join()
