@@ -145,3 +145,17 @@ def test_a_cold_warm_up_in_two_processes_fills_the_cache_with_every_kernel(tmp_p
     assert all(found["cached"].values()), found["cached"]
     assert all(misses == 0 and hits >= 1 for hits, misses in found["stats"].values()), found["stats"]
     assert _python(code, str(tmp_path)) == ""  # a warm warm-up says nothing
+
+
+def test_the_number_of_compile_processes_comes_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None:
+    from albot1.errors import ConfigError
+    from albot1.methods.albot1 import compiled
+
+    monkeypatch.setenv(compiled.PROCESSES_ENV, " 3 ")
+    assert compiled.compile_processes() == 3
+    for bad in ("0", "-1", "two", "1.5"):
+        monkeypatch.setenv(compiled.PROCESSES_ENV, bad)
+        with pytest.raises(ConfigError, match=f"ALBOT1_COMPILE_PROCESSES='{bad}': expected a whole number"):
+            compiled.compile_processes()
+    monkeypatch.delenv(compiled.PROCESSES_ENV)
+    assert compiled.compile_processes() >= 1
