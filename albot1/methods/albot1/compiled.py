@@ -117,7 +117,7 @@ def is_cached(fn: Callable[..., Any] | None = None) -> bool:
     """Whether this code version's cache holds kernel ``fn`` (any kernel when None; False: a warm-up compiles it).
 
     Numba names a kernel's cache index ``<module file stem>.<qualname>-<line>.py<version>.nbi``
-    (its documented cache layout); the folder is this code version's alone.
+    (numba's own file naming); the folder is this code version's alone.
     """
     if fn is None:
         return any(CACHE_DIR.rglob("*.nbi"))
