@@ -488,6 +488,15 @@ def update_surfaces(
 class MappingKernels:
     """The map-update and Albot1+ pose kernels a mapper calls: each compiled, or its Python source."""
 
+    @staticmethod
+    def not_called(pose_estimate: str) -> tuple[str, ...]:
+        """The kernels a mapper with this ``pose_estimate`` never calls: Albot1+'s pose unless it is ``robust``.
+
+        A warm-up leaves them out (:func:`albot1.methods.albot1.warm_up.warm_up`),
+        which spares a first run of the thesis presets their compile.
+        """
+        return () if pose_estimate == "robust" else ("refine_pose", "scan_points")
+
     def __init__(self, compiled: bool = True) -> None:
         self.compiled = compiled
         self.classify_endpoints = select(classify_endpoints, compiled)

@@ -181,7 +181,7 @@ class Albot1Mapper:
     def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
         """Compile every kernel now (or load numba's cache), before the runner's timed loop (``Mapper.warm_up``)."""
         if self.config.accelerate:
-            warm_up(self.kernels, announce)
+            warm_up(self.kernels, announce, skip=MappingKernels.not_called(self.config.pose_estimate))
 
     def process(self, frame: Frame) -> None:
         n = self._n

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel, select
+from albot1.methods.albot1.ordering import stable_order
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, UNSTABLE, is_stable
 
 IntArray = NDArray[np.int64]
@@ -422,7 +423,7 @@ def recognise_landmarks(
     owner = np.full(q, -1, dtype=np.int64)
     if greedy:
         used = np.zeros(p, dtype=np.bool_)
-        order = np.argsort(gg[:n], kind="mergesort")
+        order = stable_order(gg[:n])
         for o in order:
             if used[ii[o]] or owner[jj[o]] >= 0:
                 continue
