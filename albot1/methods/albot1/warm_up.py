@@ -72,7 +72,6 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
     ids = np.arange(2, dtype=np.int64)
     poly = np.array([[0.0, 0.0], [-3.0, 3.0], [3.0, 3.0]])
     points = np.ascontiguousarray(seg.reshape(-1, 2))
-    taken = np.zeros(2, dtype=np.bool_)
     starts = np.zeros((1, 3))
     ok = np.ones((2, 2), dtype=np.bool_)
     scan_angles = np.radians(np.arange(-90.0, 90.5, 10.0))
@@ -80,8 +79,6 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
     return {
         "build_view": [(ranges, angles, 30.0, 0.6, 0.2, 0.1, 0.1, math.radians(30.0), 0.0, 0.1, 0.0, 0.0, False)],
         "recognise_landmarks": [(seg, kinds, seg + 0.01, kinds, 0.05, 0.3, 0.04, math.radians(5.0), 0.4, True)],
-        "classify_endpoints": [(poly, seg, points, 0.4, True)],
-        "resolve_partial": [(seg, taken, seg + 0.01, taken, poly, math.radians(5.0), 0.4, True, 0.4, False)],
         "update_surfaces": [_update_sample(seg)],
         "place_segments": [(seg, 0.5, -0.2, math.cos(0.3), math.sin(0.3))],
         "landmark_rows": [(seg, kinds, 0.4)],

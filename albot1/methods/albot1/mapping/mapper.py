@@ -31,7 +31,7 @@ from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses

@@ -2,7 +2,7 @@
 
 Everything lives in preallocated numpy arrays whose capacity doubles when
 full, so a map update is one compiled call on them
-(:func:`~albot1.methods.albot1.mapping.kernels.update_surfaces`) with no
+(:func:`~albot1.methods.albot1.mapping.update_kernels.update_surfaces`) with no
 Python object per surface. Surfaces are indexed by id (ids are never
 reused, so an id names one surface for its whole life). The surfaces
 currently in the map also sit in a compact table of *slots* with their

@@ -45,7 +45,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.perception.endpoints import STABLE
 
 #: The odometry learner's fixed choices (``docs/albot1-mapper.md``, "Albot1+"): a view teaches it only when its

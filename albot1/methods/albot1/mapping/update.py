@@ -18,7 +18,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.mapping.kernels import MappingKernels, polygon_points
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+from albot1.methods.albot1.mapping.kernels import polygon_points
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 
 IntArray = NDArray[np.int64]
@@ -72,7 +73,7 @@ def update_map(
     Lines 1-6 (placing the view with the reference landmark) are the
     caller's: that is the localisation pose applied to every surface. The
     rest is one compiled call on the map's arrays
-    (:func:`~albot1.methods.albot1.mapping.kernels.update_surfaces`): the
+    (:func:`~albot1.methods.albot1.mapping.update_kernels.update_surfaces`): the
     box query, the classification of the candidates' endpoints, the
     deletions, extensions and trims (lines 8-12) and the additions (line 13).
     """

@@ -41,7 +41,7 @@ from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.places.config import Albot1PlacesConfig

@@ -28,9 +28,9 @@ from albot1.geometry import se2, segments
 from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import as_written
 from albot1.methods.albot1.mapping import kernels as mapping_source
-from albot1.methods.albot1.mapping import pose_kernels
+from albot1.methods.albot1.mapping import pose_kernels, update_kernels
 from albot1.methods.albot1.mapping.config import Albot1Config
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.update import view_polygon
@@ -166,7 +166,7 @@ def _update_args() -> Iterator[tuple[Any, ...]]:
     """Maps around real views, less the surfaces the update would edit: the kernel edits the map's arrays in
     place, and a map it only adds to is left so that a second call repeats the first (the edits are compared
     compiled and as written on copies in ``test_albot1_update.py``)."""
-    plain = as_written(mapping_source.update_surfaces)
+    plain = as_written(update_kernels.update_surfaces)
     for poly, view, segs in _map_inputs():
         for surfaces_only in (True, False):
             kept = segs
@@ -272,10 +272,10 @@ KERNELS: dict[str, Any] = {
             "best_correspondence",
             "clip_parameter",
             "resolve_partial",
-            "update_surfaces",
             "place_segments",
         )
     },
+    "update_surfaces": update_kernels.update_surfaces,
     **{name: getattr(pose_kernels, name) for name in ("refine_pose", "scan_points")},
 }
 

@@ -79,7 +79,13 @@ def test_a_thesis_preset_s_warm_up_leaves_out_the_kernels_only_albot1_plus_calls
     )
     assert out.returncode == 0, out.stderr
     found = json.loads(out.stdout)
-    assert found["thesis"] == ["build_view", "classify_endpoints", "recognise_landmarks", "resolve_partial"]
+    assert found["thesis"] == [
+        "build_view",
+        "landmark_rows",
+        "place_segments",
+        "recognise_landmarks",
+        "update_surfaces",
+    ]
     assert found["plus"] == sorted([*found["thesis"], "refine_pose", "scan_points"])
 
 
@@ -99,7 +105,7 @@ def _python(code: str, cache: str, **env: str) -> str:
 _LOAD = """
 import json
 from albot1.methods.albot1 import compiled
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.warm_up import sample_calls
 sets = (PerceptionKernels(), MappingKernels())
@@ -120,7 +126,7 @@ def test_a_helper_s_kernels_are_loaded_from_numba_s_cache_by_the_next_process(tm
     (claims / "refine_pose").touch()  # claimed by another process: the helper leaves it
     code = (
         "from albot1.methods.albot1.warm_up import compile_claimed\n"
-        f"compile_claimed({str(claims)!r}, ['albot1.methods.albot1.mapping.kernels:MappingKernels'], "
+        f"compile_claimed({str(claims)!r}, ['albot1.methods.albot1.mapping.kernel_set:MappingKernels'], "
         "['refine_pose', 'scan_points'])\n"
     )
     _python(code, str(tmp_path))
@@ -134,7 +140,7 @@ def test_a_helper_s_kernels_are_loaded_from_numba_s_cache_by_the_next_process(tm
 def test_a_cold_warm_up_in_two_processes_fills_the_cache_with_every_kernel(tmp_path: Path) -> None:
     """``ALBOT1_COMPILE_PROCESSES=2`` on an empty cache: every kernel cached once, the next process compiles nothing."""
     code = (
-        "from albot1.methods.albot1.mapping.kernels import MappingKernels\n"
+        "from albot1.methods.albot1.mapping.kernel_set import MappingKernels\n"
         "from albot1.methods.albot1.perception.kernels import PerceptionKernels\n"
         "from albot1.methods.albot1.warm_up import warm_up\n"
         "warm_up((PerceptionKernels(), MappingKernels()), print)\n"

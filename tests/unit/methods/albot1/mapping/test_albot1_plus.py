@@ -11,7 +11,7 @@ from albot1.data.open import open_sequence
 from albot1.geometry import se2
 from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.config import Albot1Config
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.plus import (
     CHI2_1_MEDIAN,

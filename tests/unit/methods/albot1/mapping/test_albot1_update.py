@@ -8,7 +8,7 @@ from typing import Literal
 import numpy as np
 import pytest
 
-from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.update import UpdateParams, update_map, view_polygon
 

@@ -1,0 +1,34 @@
+"""The kernels an Albot1 mapper calls, compiled or as written, in one object.
+
+A mapper holds one :class:`MappingKernels` so that the same mapper code runs
+the numba-compiled kernels or their Python source (``accelerate = false``,
+and the parity tests), and so that a warm-up can list what it must compile
+(:func:`albot1.methods.albot1.warm_up.warm_up`).
+"""
+
+from __future__ import annotations
+
+from albot1.methods.albot1.compiled import select
+from albot1.methods.albot1.mapping import pose_kernels
+from albot1.methods.albot1.mapping.kernels import place_segments
+from albot1.methods.albot1.mapping.update_kernels import update_surfaces
+
+
+class MappingKernels:
+    """The map-update and Albot1+ pose kernels a mapper calls: each compiled, or its Python source."""
+
+    @staticmethod
+    def not_called(pose_estimate: str) -> tuple[str, ...]:
+        """The kernels a mapper with this ``pose_estimate`` never calls: Albot1+'s pose unless it is ``robust``.
+
+        A warm-up leaves them out (:func:`albot1.methods.albot1.warm_up.warm_up`),
+        which spares a first run of the thesis presets their compile.
+        """
+        return () if pose_estimate == "robust" else ("refine_pose", "scan_points")
+
+    def __init__(self, compiled: bool = True) -> None:
+        self.compiled = compiled
+        self.update_surfaces = select(update_surfaces, compiled)
+        self.place_segments = select(place_segments, compiled)
+        self.refine_pose = select(pose_kernels.refine_pose, compiled)
+        self.scan_points = select(pose_kernels.scan_points, compiled)
