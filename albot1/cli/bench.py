@@ -141,29 +141,44 @@ def report(
         str, typer.Option(help="point maps drawn as an occupancy grid (grid) or as their points (points)")
     ] = "grid",
     jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="processes drawing the plots")] = 1,
+    force: Annotated[
+        bool, typer.Option("--force", help="build everything again, trusting no stamp of an earlier build")
+    ] = False,
 ) -> None:
     """Build tables (Markdown, CSV, LaTeX), plots (PNG and SVG), README.md and index.html from a results folder.
 
     index.html is the whole report on one page (sortable tables, every plot), with relative links
     only: open it from the report folder in any browser, no network needed.
 
+    Incremental: when nothing the report is built from changed since its last build (the store's
+    files by content, the code, the options) and its files are untouched, nothing is rebuilt;
+    otherwise only the figures whose own runs changed are drawn again. --force rebuilds it all
+    (same bytes).
+
     Examples:\n
       albot1 report results/default -j 2   # -> reports/default/index.html\n
       albot1 report results/quick --out /tmp/quick-report --map-style points
     """
     # Imported by the command, not by this module: see albot1.cli.app.
-    from albot1.bench.store import ResultsStore
-    from albot1.report.index import build_report, default_out
-    from albot1.report.map_plots import MapStyle
+    from albot1.report import rebuild
 
     if map_style not in ("grid", "points"):
         raise typer.BadParameter(f"--map-style {map_style!r}: expected grid or points")
+    target = out if out is not None else rebuild.default_out(results_dir)
+    if not force:  # the check reads the stamp and the store's files, and imports nothing heavy
+        page = rebuild.current_report(results_dir, target, plots=plots, map_style=map_style)
+        if page is not None:
+            typer.echo(f"report: {page} (up to date: nothing it is built from changed)")
+            return
+    from albot1.bench.store import ResultsStore
+
     ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
-    writable_folder(out if out is not None else default_out(results_dir), "--out")
-    style: MapStyle = "grid" if map_style == "grid" else "points"
+    writable_folder(target, "--out")
     bar = FigureBar()
     try:
-        index = build_report(results_dir, out, plots=plots, map_style=style, jobs=jobs, progress=bar.update)
+        index = rebuild.report(
+            results_dir, out, plots=plots, map_style=map_style, jobs=jobs, progress=bar.update, force=force
+        )
     finally:
         bar.close()
     typer.echo(f"report: {index}")

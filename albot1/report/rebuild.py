@@ -1,0 +1,149 @@
+"""Build a report or the results page only when something it is built from changed.
+
+The stamp itself is :mod:`albot1.report.build_stamp`; this module says, for
+each kind of build, what it reads (its :class:`Source` folders), which of
+its options change what it writes, and what it wrote. The builders are
+imported only when a build runs: the check that skips one costs a walk of
+the stores and no plotting import.
+
+What each build reads:
+
+* ``albot1 report results/<suite>``: the store; for the thesis suite also
+  the companion stores it reads beside its own (``results/default``) and the
+  figures of their reports that its page links (``reports/default/plots/
+  *-maps.png``).
+* ``albot1 results-page``: the default store, the thesis store and the
+  thesis store's companions; its outputs include the README it rewrites, so
+  an edited README is rewritten again.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from albot1.report.build_stamp import BuildStamp, Source, folder_files, forget_all, unsettled
+
+if TYPE_CHECKING:
+    from albot1.report.map_plots import MapStyle
+
+REPORTS_ROOT = Path("reports")
+#: Told ``(datasets whose figures are drawn, datasets to draw)`` while a report draws its figures.
+PlotProgress = Callable[[int, int], None]
+
+
+def default_out(results_dir: Path) -> Path:
+    """``results/<suite>`` -> ``reports/<suite>`` (relative to the working directory, as `make bench` runs)."""
+    return REPORTS_ROOT / Path(results_dir).resolve().name
+
+
+def report_options(results_dir: Path, out: Path, *, plots: bool, map_style: str) -> dict[str, Any]:
+    """What of a report's command changes its bytes (``jobs`` does not: the figures are the same files)."""
+    return {
+        "kind": "report",
+        "results": str(results_dir),  # as given: the pages print it and link relative to it
+        "out": os.path.abspath(out),
+        "plots": plots,
+        "map_style": map_style,
+    }
+
+
+def report_sources(results_dir: Path, out: Path, suite: str) -> list[Source]:
+    """The folders a report of ``suite`` reads (see the module docstring)."""
+    from albot1.report.thesis.evidence import COMPANION_SUITES
+    from albot1.report.thesis.experiments.datasets import THESIS_SUITE
+
+    sources = [Source(Path(results_dir))]
+    if suite == THESIS_SUITE:
+        sources += [Source(Path(results_dir).parent / name) for name in COMPANION_SUITES]
+        sources += [Source(out.parent / name / "plots", "*-maps.png") for name in COMPANION_SUITES]
+    return sources
+
+
+def current_report(results_dir: Path, out: Path, *, plots: bool = True, map_style: str = "grid") -> Path | None:
+    """The page of the report in ``out`` when its last build is still what a build would write, else None."""
+    page = BuildStamp(out).fresh(report_options(results_dir, out, plots=plots, map_style=map_style))
+    return out / page if isinstance(page, str) else None
+
+
+def report(
+    results_dir: Path,
+    out: Path | None = None,
+    *,
+    plots: bool = True,
+    map_style: str = "grid",
+    jobs: int = 1,
+    progress: PlotProgress | None = None,
+    force: bool = False,
+) -> Path:
+    """Build the report (:func:`albot1.report.index.build_report`) and stamp it; returns its page.
+
+    Its figures still come from the figure cache when their own runs did
+    not change; ``force`` trusts no stamp (the report's, and every figure
+    cache's in its folder), so everything is read and drawn again. Check
+    :func:`current_report` first to skip a build that would change nothing.
+    """
+    target = Path(out) if out is not None else default_out(results_dir)
+    stamp = BuildStamp(target)
+    if force:
+        forget_all(target)
+    stamp.forget()  # a build that stops half-way leaves no stamp
+    from albot1.bench.store import ResultsStore
+    from albot1.report.index import build_report
+
+    style: MapStyle = "points" if map_style == "points" else "grid"
+    index = build_report(results_dir, target, plots=plots, map_style=style, jobs=jobs, progress=progress)
+    if not unsettled(target):  # a figure that failed is tried again next time: no skipping until it is drawn
+        suite = ResultsStore(results_dir).read_plan().suite
+        options = report_options(results_dir, target, plots=plots, map_style=map_style)
+        page = index.relative_to(target).as_posix()
+        stamp.record(report_sources(results_dir, target, suite), options, folder_files(target), page)
+    return index
+
+
+def results_options(default: Path, thesis: Path | None, page: Path, readme: Path | None) -> dict[str, Any]:
+    """What of `albot1 results-page`'s command changes its bytes."""
+    return {
+        "kind": "results-page",
+        "default": str(default),
+        "thesis": None if thesis is None else str(thesis),
+        "page": os.path.abspath(page),
+        "readme": None if readme is None else os.path.abspath(readme),
+    }
+
+
+def results_stamp(page: Path) -> BuildStamp:
+    """The results page's stamp: beside its figures (``docs/results/build.json``, ignored by git)."""
+    return BuildStamp(page.parent / "results")
+
+
+def current_results_page(default: Path, thesis: Path | None, page: Path, readme: Path | None) -> list[Path] | None:
+    """The files the last `albot1 results-page` wrote when they are still what it would write, else None."""
+    written = results_stamp(page).fresh(results_options(default, thesis, page, readme))
+    if isinstance(written, list) and all(isinstance(w, str) for w in written):
+        return [Path(w) for w in written]
+    return None
+
+
+def results_page(default: Path, thesis: Path | None, page: Path, readme: Path | None) -> list[Path]:
+    """Write the results page (:func:`albot1.report.results_page.write_results`) and stamp it; what it wrote.
+
+    Check :func:`current_results_page` first to skip a run that would change nothing.
+    """
+    stamp = results_stamp(page)
+    stamp.forget()
+    from albot1.report.results_data import build_data
+    from albot1.report.results_page import write_results
+    from albot1.report.thesis.evidence import COMPANION_SUITES
+
+    command = f"albot1 results-page {default.as_posix()}" + (f" --thesis {thesis.as_posix()}" if thesis else "")
+    data = build_data(default, thesis, command)
+    written = write_results(data, page, readme)
+    sources = [Source(default)]
+    if thesis is not None:
+        sources += [Source(thesis), *[Source(thesis.parent / name) for name in COMPANION_SUITES]]
+    unique = list({(s.root, s.pattern): s for s in sources}.values())
+    stamp.record(unique, results_options(default, thesis, page, readme), written, [str(w) for w in written])
+    return written
