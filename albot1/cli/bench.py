@@ -161,10 +161,11 @@ def report(
     """
     # Imported by the command, not by this module: see albot1.cli.app.
     from albot1.report import rebuild
+    from albot1.report.folders import default_out
 
     if map_style not in ("grid", "points"):
         raise typer.BadParameter(f"--map-style {map_style!r}: expected grid or points")
-    target = out if out is not None else rebuild.default_out(results_dir)
+    target = out if out is not None else default_out(results_dir)
     if not force:  # the check reads the stamp and the store's files, and imports nothing heavy
         page = rebuild.current_report(results_dir, target, plots=plots, map_style=map_style)
         if page is not None:

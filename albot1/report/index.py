@@ -12,6 +12,7 @@ with the tables and every plot, for a browser.
 from __future__ import annotations
 
 import multiprocessing
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, as_o
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
 from albot1.report.external_notes import external_markdown
 from albot1.report.figure_cache import FigureCache, inputs_digest
+from albot1.report.folders import default_out
 from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
 from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
 from albot1.report.generalisation import write_generalisation
@@ -32,7 +34,6 @@ from albot1.report.markdown import code, text
 from albot1.report.paired_tables import paired_rows
 from albot1.report.plots import method_colors, slug, vector_of
 from albot1.report.provenance import data_by_dataset, describe_data, separate_data
-from albot1.report.rebuild import PlotProgress, default_out
 from albot1.report.relation_plots import plot_relation_boxes
 from albot1.report.robustness_plots import plot_robustness
 from albot1.report.rpe_plots import plot_rpe_boxes
@@ -46,6 +47,8 @@ from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance,
 from albot1.report.tuning import held_in
 from albot1.versions import commit_label
 
+#: Told ``(datasets whose figures are drawn, datasets to draw)`` while the report draws its figures.
+PlotProgress = Callable[[int, int], None]
 #: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
 ROBUSTNESS = (
     ("ate_rmse_m", "ATE RMSE (m)", "robustness-ate"),

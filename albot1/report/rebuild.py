@@ -20,23 +20,15 @@ What each build reads:
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from albot1.report.build_stamp import BuildStamp, Source, folder_files, forget_all, unsettled
+from albot1.report.folders import default_out
 
 if TYPE_CHECKING:
+    from albot1.report.index import PlotProgress
     from albot1.report.map_plots import MapStyle
-
-REPORTS_ROOT = Path("reports")
-#: Told ``(datasets whose figures are drawn, datasets to draw)`` while a report draws its figures.
-PlotProgress = Callable[[int, int], None]
-
-
-def default_out(results_dir: Path) -> Path:
-    """``results/<suite>`` -> ``reports/<suite>`` (relative to the working directory, as `make bench` runs)."""
-    return REPORTS_ROOT / Path(results_dir).resolve().name
 
 
 def report_options(results_dir: Path, out: Path, *, plots: bool, map_style: str) -> dict[str, Any]:
