@@ -197,9 +197,12 @@ class BuildStamp:
         """Remove the stamp (before a build: a build that stops half-way leaves none)."""
         self.path.unlink(missing_ok=True)
 
-    def record(self, sources: Sequence[Source], options: dict[str, Any], outputs: Iterable[Path], payload: Any) -> None:
-        """Stamp a finished build: what it read, with ``options``, and the files it wrote (``payload``: JSON-able)."""
-        digest = self.digest(sources, options)
+    def record(self, sources: Sequence[Source], digest: str, outputs: Iterable[Path], payload: Any) -> None:
+        """Stamp a finished build: what it read, its :meth:`digest` and the files it wrote (``payload``: JSON-able).
+
+        The digest is taken before the build starts: a store changed while
+        the build read it then leaves a stamp that the next check refuses.
+        """
         written: dict[str, list[int]] = {}
         for path in outputs:
             stat = _stat(path)

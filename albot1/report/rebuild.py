@@ -86,12 +86,11 @@ def report(
     from albot1.report.index import build_report
 
     style: MapStyle = "points" if map_style == "points" else "grid"
+    sources = report_sources(results_dir, target, ResultsStore(results_dir).read_plan().suite)
+    digest = stamp.digest(sources, report_options(results_dir, target, plots=plots, map_style=map_style))
     index = build_report(results_dir, target, plots=plots, map_style=style, jobs=jobs, progress=progress)
     if not unsettled(target):  # a figure that failed is tried again next time: no skipping until it is drawn
-        suite = ResultsStore(results_dir).read_plan().suite
-        options = report_options(results_dir, target, plots=plots, map_style=map_style)
-        page = index.relative_to(target).as_posix()
-        stamp.record(report_sources(results_dir, target, suite), options, folder_files(target), page)
+        stamp.record(sources, digest, folder_files(target), index.relative_to(target).as_posix())
     return index
 
 
@@ -130,12 +129,12 @@ def results_page(default: Path, thesis: Path | None, page: Path, readme: Path | 
     from albot1.report.results_page import write_results
     from albot1.report.thesis.evidence import COMPANION_SUITES
 
-    command = f"albot1 results-page {default.as_posix()}" + (f" --thesis {thesis.as_posix()}" if thesis else "")
-    data = build_data(default, thesis, command)
-    written = write_results(data, page, readme)
     sources = [Source(default)]
     if thesis is not None:
         sources += [Source(thesis), *[Source(thesis.parent / name) for name in COMPANION_SUITES]]
     unique = list({(s.root, s.pattern): s for s in sources}.values())
-    stamp.record(unique, results_options(default, thesis, page, readme), written, [str(w) for w in written])
+    digest = stamp.digest(unique, results_options(default, thesis, page, readme))
+    command = f"albot1 results-page {default.as_posix()}" + (f" --thesis {thesis.as_posix()}" if thesis else "")
+    written = write_results(build_data(default, thesis, command), page, readme)
+    stamp.record(unique, digest, written, [str(w) for w in written])
     return written

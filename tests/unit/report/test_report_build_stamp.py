@@ -46,7 +46,8 @@ def _build(store: Path, out: Path, options: dict[str, Any] = OPTIONS) -> None:
     (out / "README.md").write_text("report")
     (out / "plots").mkdir(exist_ok=True)
     (out / "plots" / "a.png").write_bytes(b"png")
-    BuildStamp(out).record([Source(store)], options, folder_files(out), "README.md")
+    stamp = BuildStamp(out)
+    stamp.record([Source(store)], stamp.digest([Source(store)], options), folder_files(out), "README.md")
 
 
 @pytest.fixture()
