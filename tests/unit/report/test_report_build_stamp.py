@@ -199,3 +199,14 @@ def test_a_report_is_dated_by_its_newest_cell_not_by_the_clock() -> None:
     records = [_record("2026-11-27T02:34:33Z"), _record(None), _record("2026-11-28T00:01:59Z")]
     assert as_of(records) == "newest cell finished 2026-11-28 00:01 UTC"
     assert as_of([_record(None)]) == "no cell has finished"
+
+
+def test_a_store_changed_during_the_build_is_built_again(tmp_path: Path) -> None:
+    store, out = _store(tmp_path / "store"), tmp_path / "report"
+    out.mkdir()
+    stamp = BuildStamp(out)
+    digest = stamp.digest([Source(store)], OPTIONS)  # taken before the build reads the store
+    (store / "runs" / "a" / "metrics.json").write_text('{"ate": 3.5}')  # a cell finished meanwhile
+    (out / "README.md").write_text("report")
+    stamp.record([Source(store)], digest, folder_files(out), "README.md")
+    assert BuildStamp(out).fresh(OPTIONS) is None
