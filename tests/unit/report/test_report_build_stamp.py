@@ -210,3 +210,35 @@ def test_a_store_changed_during_the_build_is_built_again(tmp_path: Path) -> None
     (out / "README.md").write_text("report")
     stamp.record([Source(store)], digest, folder_files(out), "README.md")
     assert BuildStamp(out).fresh(OPTIONS) is None
+
+
+def test_the_results_page_is_written_again_only_when_a_store_or_a_written_file_changed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from albot1.report import rebuild, results_data, results_page
+
+    default, thesis = _store(tmp_path / "results" / "default"), _store(tmp_path / "results" / "thesis")
+    page, readme = tmp_path / "docs" / "results.md", tmp_path / "README.md"
+    readme.write_text("before")
+    runs: list[str] = []
+
+    def write(data: object, page_: Path, readme_: Path | None) -> list[Path]:
+        runs.append(str(data))
+        (page_.parent / "results").mkdir(parents=True, exist_ok=True)  # as the real one: its figures' folder
+        page_.write_text("page")
+        assert readme_ is not None
+        readme_.write_text("block")
+        return [page_, readme_]
+
+    monkeypatch.setattr(results_data, "build_data", lambda d, t, command: command)
+    monkeypatch.setattr(results_page, "write_results", write)
+    assert rebuild.current_results_page(default, thesis, page, readme) is None
+    assert rebuild.results_page(default, thesis, page, readme) == [page, readme]
+    assert runs == [f"albot1 results-page {default.as_posix()} --thesis {thesis.as_posix()}"]
+    assert rebuild.current_results_page(default, thesis, page, readme) == [page, readme]
+    assert rebuild.current_results_page(default, None, page, readme) is None  # other options
+    readme.write_text("edited by hand")
+    assert rebuild.current_results_page(default, thesis, page, readme) is None
+    rebuild.results_page(default, thesis, page, readme)
+    (thesis / "runs" / "a" / "metrics.json").write_text('{"ate": 0.5}')
+    assert rebuild.current_results_page(default, thesis, page, readme) is None
