@@ -16,9 +16,9 @@ log, and a median on a 20x longer route within 1.5x of the short one.
   KISS-ICP on the full Intel log in one process, per-scan time on the
   thread's CPU clock (the three run one after the other, so a loaded machine
   slows them alike); ``extra_info`` holds each one's mean, median and p95 and
-  the ratios of the means to KISS-ICP's (issue targets: ``thesis`` at most
-  1/5, ``plus`` at most 1/2). Means, not only medians: the median hides the
-  update scans.
+  the ratios of the means to KISS-ICP's (issue 24's targets: ``thesis`` at
+  most 1/5, ``plus`` at most 1/3). Means, not only medians: the median hides
+  the update scans.
 """
 
 from __future__ import annotations

@@ -106,7 +106,8 @@ def _warm_up(method: str, registry: MethodRegistry | None) -> None:
     warm = getattr(cls, "warm_up", None)
     if warm is None:
         return
-    cls(resolve_config(method, "default", registry=registry), seed=0).warm_up(None)  # type: ignore[attr-defined]
+    for preset in cls.presets:  # every preset: a preset's warm-up may leave out kernels only others call
+        cls(resolve_config(method, preset, registry=registry), seed=0).warm_up(None)  # type: ignore[attr-defined]
 
 
 def _warm() -> None:

@@ -141,14 +141,24 @@ def report(
         str, typer.Option(help="point maps drawn as an occupancy grid (grid) or as their points (points)")
     ] = "grid",
     jobs: Annotated[int, typer.Option("--jobs", "-j", min=1, help="processes drawing the plots")] = 1,
+    columns: Annotated[
+        str | None,
+        typer.Option(
+            help="KEY,KEY,...: the number columns of the accuracy and cost tables, in this order (method, "
+            "degradation, seeds and status always show; cells.csv keeps every column)"
+        ),
+    ] = None,
     force: Annotated[
         bool, typer.Option("--force", help="build everything again, trusting no stamp of an earlier build")
     ] = False,
 ) -> None:
     """Build tables (Markdown, CSV, LaTeX), plots (PNG and SVG), README.md and index.html from a results folder.
 
-    index.html is the whole report on one page (sortable tables, every plot), with relative links
-    only: open it from the report folder in any browser, no network needed.
+    index.html is the whole report on one page (sortable tables whose columns can be hidden, every
+    plot), with relative links only: open it from the report folder in any browser, no network needed.
+
+    --columns narrows the tables (Markdown, CSV, LaTeX and HTML) to the named columns; a wrong key
+    is an error that lists the valid ones (docs/benchmarking.md, "Tables").
 
     Incremental: when nothing the report is built from changed since its last build (the store's
     files by content, the code, the options) and its files are untouched, nothing is rebuilt;
@@ -157,7 +167,8 @@ def report(
 
     Examples:\n
       albot1 report results/default -j 2   # -> reports/default/index.html\n
-      albot1 report results/quick --out /tmp/quick-report --map-style points
+      albot1 report results/quick --out /tmp/quick-report --map-style points\n
+      albot1 report results/quick --columns ate_rmse_m,loop_gap_m,total_s
     """
     # Imported by the command, not by this module: see albot1.cli.app.
     from albot1.report import rebuild
@@ -167,18 +178,26 @@ def report(
         raise typer.BadParameter(f"--map-style {map_style!r}: expected grid or points")
     target = out if out is not None else default_out(results_dir)
     if not force:  # the check reads the stamp and the store's files, and imports nothing heavy
-        page = rebuild.current_report(results_dir, target, plots=plots, map_style=map_style)
+        page = rebuild.current_report(results_dir, target, plots=plots, map_style=map_style, columns=columns)
         if page is not None:
             typer.echo(f"report: {page} (up to date: nothing it is built from changed)")
             return
     from albot1.bench.store import ResultsStore
 
+    rebuild.column_selection(columns)  # a wrong key: say so first
     ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
     writable_folder(target, "--out")
     bar = FigureBar()
     try:
         index = rebuild.report(
-            results_dir, out, plots=plots, map_style=map_style, jobs=jobs, progress=bar.update, force=force
+            results_dir,
+            out,
+            plots=plots,
+            map_style=map_style,
+            columns=columns,
+            jobs=jobs,
+            progress=bar.update,
+            force=force,
         )
     finally:
         bar.close()

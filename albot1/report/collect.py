@@ -96,6 +96,12 @@ class Column:
             verdict = self.applies(record.metrics)
             if verdict is not None:
                 return verdict
+        if self.source == "result" and self.metric and record.metrics is not None:
+            # a method's counter beside the metric that judges it: absent for the metric's own reason
+            # (a method without a network of places has neither its counters nor the places metric)
+            missing = record.metrics.reason(self.metric)
+            if missing is not None:
+                return missing
         if self.source != "metrics" or record.metrics is None:
             return f"no {self.source}.json value"
         return _null_reason(record.metrics, self.path, self.undefined)

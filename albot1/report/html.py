@@ -13,7 +13,11 @@ per-pose error on hover, drawn by plotly from ``interactive/`` in the report
 folder (plotly's bundle included, so still no network).
 
 Tables are sortable: a click on a column header sorts its rows (numbers by
-value, ``n/a``/``failed`` last), another click reverses the order.
+value, ``n/a``/``failed`` last), another click reverses the order. Each
+results table has a "Columns" menu above it: a checkbox per number column
+hides or shows that column, header and every cell, in the browser (nothing
+is stored; a reload shows every column again). ``albot1 report --columns``
+chooses the columns before that (:mod:`albot1.report.column_selection`).
 """
 
 from __future__ import annotations
@@ -26,12 +30,13 @@ from typing import TYPE_CHECKING, Any
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import CellRecord, Column, as_of
+from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.external_notes import external_html
 from albot1.report.interactive_page import VIEWS_DIR, View, view_html, views_scripts
 from albot1.report.paired_tables import PairedRow, html_table
 from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data
-from albot1.report.tables import cell_text, columns_present, na_notes
+from albot1.report.tables import cell_text, columns_present, na_notes, na_outline
 from albot1.report.tuning import LEGEND, marked
 from albot1.versions import commit_label
 
@@ -58,6 +63,9 @@ figcaption { font-size: 0.85em; color: #444; }
 .notes { font-size: 0.85em; color: #444; } .meta { font-size: 0.9em; }
 nav a { margin-right: 0.8em; }
 .scroll { overflow-x: auto; max-width: 100%; } td.label { white-space: nowrap; }
+details.colpick { font-size: 0.85em; margin: 0.4em 0 0 0; } details.colpick summary { cursor: pointer; color: #333; }
+details.colpick label { display: inline-block; margin: 0.15em 0.9em 0.15em 0; white-space: nowrap; }
+th[hidden], td[hidden] { display: none; }
 """
 
 #: Click-to-sort for every table of class "sortable" (numbers by data-v, text otherwise; n/a and failed last).
@@ -81,6 +89,17 @@ document.querySelectorAll("table.sortable").forEach(function (table) {
       });
       rows.forEach(function (r) { body.appendChild(r); });
     });
+  });
+});
+document.querySelectorAll("details.colpick").forEach(function (pick) {
+  var table = pick.parentNode.querySelector("table"), boxes = pick.querySelectorAll("input[data-col]");
+  function show(box) {
+    var col = parseInt(box.dataset.col, 10);
+    Array.prototype.forEach.call(table.rows, function (row) { row.cells[col].hidden = !box.checked; });
+  }
+  boxes.forEach(function (box) { box.addEventListener("change", function () { show(box); }); });
+  pick.querySelector("button").addEventListener("click", function () {
+    boxes.forEach(function (box) { box.checked = true; show(box); });
   });
 });
 """
@@ -120,11 +139,33 @@ def _number_cell(row: pd.Series, column: str) -> str:
     return f'<td class="num" data-v="{float(mean):.12g}">{_e(text)}</td>'
 
 
+#: The columns before the number columns (method, degradation, seeds): always shown, so never in the menu.
+IDENTITY = ("method", "degradation", "seeds")
+
+
+def column_menu(columns: dict[str, Column], present: list[str]) -> str:
+    """The "Columns" menu of one table: a checkbox per number column (its cells are at IDENTITY + i)."""
+    boxes = "".join(
+        f'<label title="{_e(key)}"><input type="checkbox" data-col="{len(IDENTITY) + i}" checked> '
+        f"{_e(columns[key].header)}</label>"
+        for i, key in enumerate(present)
+    )
+    return (
+        '<details class="colpick"><summary>Columns: hide or show</summary>'
+        f'{boxes}<button type="button">show all</button></details>'
+    )
+
+
 def table_html(group: pd.DataFrame, columns: dict[str, Column], colors: dict[str, str]) -> str:
-    """One dataset's aggregated rows as a sortable HTML table, with its not-applicable notes."""
+    """One dataset's aggregated rows as a sortable HTML table with its column menu and not-applicable notes.
+
+    ``columns``: the number columns to show (a selection's pick); those that apply to no row are left out.
+    """
     present, absent = columns_present(group, columns)
-    head = ["method", "degradation", "seeds", *[columns[c].header for c in present], "status"]
+    head = [*IDENTITY, *[columns[c].header for c in present], "status"]
     lines = [
+        '<div class="table-box">',
+        *([column_menu(columns, present)] if present else []),
         '<div class="scroll"><table class="sortable">',
         "<thead><tr>" + "".join(f"<th>{_e(h)}</th>" for h in head) + "</tr></thead>",
     ]
@@ -142,10 +183,16 @@ def table_html(group: pd.DataFrame, columns: dict[str, Column], colors: dict[str
             f"<td>{_e(row['status'])}</td>",
         ]
         lines.append(f"<tr{css}>" + "".join(cells) + "</tr>")
-    lines.append("</tbody></table></div>")
+    lines.append("</tbody></table></div></div>")
     notes = na_notes(group, columns, present, absent)
     if notes:
-        lines.append('<ul class="notes">' + "".join(f"<li>n/a: {_e(n)}</li>" for n in notes) + "</ul>")
+        items = [
+            f"<li>{_e(item)}"
+            + ("<ul>" + "".join(f"<li>{_e(sub)}</li>" for sub in subs) + "</ul>" if subs else "")
+            + "</li>"
+            for item, subs in na_outline(notes)
+        ]
+        lines.append('<ul class="notes">' + "".join(items) + "</ul>")
     return "\n".join(lines)
 
 
@@ -173,14 +220,21 @@ def write_html(
     extra_links: list[tuple[str, Path]] | None = None,
     paired: list[PairedRow] | None = None,
     views: tuple[Path | None, dict[str, View]] | None = None,
+    selection: ColumnSelection = ALL_COLUMNS,
 ) -> Path:
     """Write ``out/index.html`` (see module doc); returns its path.
 
     ``paired``: the accuracy tables' comparisons. ``views``: plotly's bundle and each dataset's interactive view
-    (:func:`albot1.report.interactive_page.write_views`), shown after the dataset's tables.
+    (:func:`albot1.report.interactive_page.write_views`), shown after the dataset's tables. ``selection``: the
+    number columns the tables show (``columns`` are every column; the selection is stated once above them).
     """
     bundle, dataset_views = views if views is not None else (None, {})
-    metric_columns, cost_columns = columns
+    every_metric, every_cost = columns
+    metric_columns, cost_columns = selection.pick(every_metric), selection.pick(every_cost)
+    selected = [
+        selection.note(every_metric, "metrics.csv", "cells.csv"),
+        selection.note(every_cost, "cost.csv", "cells-cost.csv"),
+    ]
     counts: dict[str, int] = {"done": 0, "failed": 0, "not run": 0}
     for rec in records:
         counts[rec.status] = counts.get(rec.status, 0) + 1
@@ -224,7 +278,8 @@ def write_html(
         "Files: "
         + ", ".join(f'<a href="{_e(rel(p, out))}">{_e(name)}</a>' for name, p in tables.items())
         + ". Cost was measured with the suite's parallelism on a possibly shared machine: compare it within "
-        "one report.</p>",
+        "one report. The menu above each table hides or shows its columns.</p>",
+        *[f'<p class="notes">{title}: {_e(note)}</p>' for title, note in zip(("Accuracy", "Cost"), selected) if note],
     ]
     if extra_links:
         parts.append("<ul>" + "".join(f'<li><a href="{_e(rel(p, out))}">{_e(t)}</a></li>' for t, p in extra_links))

@@ -20,6 +20,7 @@ import pandas as pd
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, as_of, collect
+from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
 from albot1.report.external_notes import external_markdown
 from albot1.report.figure_cache import FigureCache, inputs_digest
@@ -333,10 +334,12 @@ def build_report(
     map_style: MapStyle = "grid",
     jobs: int = 1,
     progress: PlotProgress | None = None,
+    columns: ColumnSelection = ALL_COLUMNS,
 ) -> Path:
     """Tables, plots, README.md and index.html for ``results_dir``; returns the README path.
 
     ``jobs``: worker processes drawing the plots (:func:`render_plots`, which tells ``progress``).
+    ``columns``: the number columns of the metrics and cost tables (:mod:`albot1.report.column_selection`).
 
     For the ``thesis`` suite README.md is the thesis reproduction page
     (:mod:`albot1.report.thesis.page`) and the benchmark index is ``benchmark.md``.
@@ -347,7 +350,7 @@ def build_report(
     records = separate_data(collected)  # runs of one dataset on different data never share a row
     target.mkdir(parents=True, exist_ok=True)
     paired = paired_rows(records)  # the accuracy tables' paired comparisons (metrics.md, paired.csv, index.html)
-    tables = write_tables(records, target, paired)
+    tables = write_tables(records, target, paired, columns)
     if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
         tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
     generalisation = write_generalisation(plan, records, target)
@@ -376,5 +379,6 @@ def build_report(
         extra_links=[("the thesis's experiments, reproduced (README.md)", page)] if page is not None else None,
         paired=paired,
         views=views,
+        selection=columns,
     )
     return page if page is not None else index

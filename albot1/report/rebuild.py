@@ -27,11 +27,14 @@ from albot1.report.build_stamp import BuildStamp, Source, folder_files, forget_a
 from albot1.report.folders import default_out
 
 if TYPE_CHECKING:
+    from albot1.report.column_selection import ColumnSelection
     from albot1.report.index import PlotProgress
     from albot1.report.map_plots import MapStyle
 
 
-def report_options(results_dir: Path, out: Path, *, plots: bool, map_style: str) -> dict[str, Any]:
+def report_options(
+    results_dir: Path, out: Path, *, plots: bool, map_style: str, columns: str | None = None
+) -> dict[str, Any]:
     """What of a report's command changes its bytes (``jobs`` does not: the figures are the same files)."""
     return {
         "kind": "report",
@@ -39,7 +42,16 @@ def report_options(results_dir: Path, out: Path, *, plots: bool, map_style: str)
         "out": os.path.abspath(out),
         "plots": plots,
         "map_style": map_style,
+        "columns": columns,  # as given (``--columns``; None: every column)
     }
+
+
+def column_selection(columns: str | None) -> ColumnSelection:
+    """``--columns`` as the tables' selection (ReportError naming a wrong key); None: every column."""
+    from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS
+    from albot1.report.column_selection import ALL_COLUMNS, parse_columns
+
+    return ALL_COLUMNS if columns is None else parse_columns(columns, {**METRIC_COLUMNS, **COST_COLUMNS})
 
 
 def report_sources(results_dir: Path, out: Path, suite: str) -> list[Source]:
@@ -54,9 +66,12 @@ def report_sources(results_dir: Path, out: Path, suite: str) -> list[Source]:
     return sources
 
 
-def current_report(results_dir: Path, out: Path, *, plots: bool = True, map_style: str = "grid") -> Path | None:
+def current_report(
+    results_dir: Path, out: Path, *, plots: bool = True, map_style: str = "grid", columns: str | None = None
+) -> Path | None:
     """The page of the report in ``out`` when its last build is still what a build would write, else None."""
-    page = BuildStamp(out).fresh(report_options(results_dir, out, plots=plots, map_style=map_style))
+    options = report_options(results_dir, out, plots=plots, map_style=map_style, columns=columns)
+    page = BuildStamp(out).fresh(options)
     return out / page if isinstance(page, str) else None
 
 
@@ -66,6 +81,7 @@ def report(
     *,
     plots: bool = True,
     map_style: str = "grid",
+    columns: str | None = None,
     jobs: int = 1,
     progress: PlotProgress | None = None,
     force: bool = False,
@@ -87,8 +103,12 @@ def report(
 
     style: MapStyle = "points" if map_style == "points" else "grid"
     sources = report_sources(results_dir, target, ResultsStore(results_dir).read_plan().suite)
-    digest = stamp.digest(sources, report_options(results_dir, target, plots=plots, map_style=map_style))
-    index = build_report(results_dir, target, plots=plots, map_style=style, jobs=jobs, progress=progress)
+    options = report_options(results_dir, target, plots=plots, map_style=map_style, columns=columns)
+    digest = stamp.digest(sources, options)
+    selection = column_selection(columns)
+    index = build_report(
+        results_dir, target, plots=plots, map_style=style, jobs=jobs, progress=progress, columns=selection
+    )
     if not unsettled(target):  # a figure that failed is tried again next time: no skipping until it is drawn
         stamp.record(sources, digest, folder_files(target), index.relative_to(target).as_posix())
     return index

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -37,6 +38,7 @@ from albot1.report.collect import (
     cell_rows,
     severity_order,
 )
+from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.markdown import text as md_text
 from albot1.report.paired_tables import PairedRow, intro, markdown_lines, paired_rows, write_paired_csv
 from albot1.report.provenance import data_by_dataset, describe_data
@@ -182,14 +184,59 @@ def columns_present(group: pd.DataFrame, columns: dict[str, Column]) -> tuple[li
     return present, absent
 
 
-def na_notes(group: pd.DataFrame, columns: dict[str, Column], present: list[str], absent: list[str]) -> list[str]:
-    notes = []
+@dataclass(frozen=True)
+class NaNote:
+    """Why some columns of one dataset's table read ``n/a``: one reason, said once for all the columns it explains.
+
+    A dataset without reference poses has a dozen columns that are n/a for
+    the same reason; one line per column repeated it a dozen times.
+    ``everywhere``: no completed run of the dataset has a number in these
+    columns, so the table leaves them out.
+    """
+
+    headers: tuple[str, ...]
+    reason: str
+    everywhere: bool
+
+    def text(self) -> str:
+        """The columns and their reason as one line of text (Markdown and HTML escape it their way)."""
+        return f"{'; '.join(self.headers)} — {self.reason}"
+
+
+#: The lead of the notes on columns a dataset's table leaves out.
+LEFT_OUT = "left out, n/a in every run of this dataset"
+
+
+def na_outline(notes: list[NaNote]) -> list[tuple[str, list[str]]]:
+    """The notes as list items with sub-items: ``n/a: ...`` each, then the left-out columns under one lead.
+
+    One left-out reason is one line (``left out, ...: columns — reason``); several are sub-items of the lead,
+    so that the lead is said once.
+    """
+    items: list[tuple[str, list[str]]] = [(f"n/a: {n.text()}", []) for n in notes if not n.everywhere]
+    left_out = [n.text() for n in notes if n.everywhere]
+    if len(left_out) == 1:
+        items.append((f"{LEFT_OUT}: {left_out[0]}", []))
+    elif left_out:
+        items.append((f"{LEFT_OUT}:", left_out))
+    return items
+
+
+def na_notes(group: pd.DataFrame, columns: dict[str, Column], present: list[str], absent: list[str]) -> list[NaNote]:
+    """The not-applicable notes of one dataset's table: the columns of each reason together, in column order.
+
+    A column shown with some ``n/a`` cells gives the reasons of those cells;
+    a column left out (:func:`columns_present`) the reasons of its runs.
+    """
+    grouped: dict[tuple[str, bool], list[str]] = {}
     for c in present:
         reasons = [str(r) for r in dict.fromkeys(group[f"{c}_na"].dropna())]
         if reasons and (group[f"{c}_mean"].isna() & (group["seeds"] > 0)).any():
-            notes.append(f"{columns[c].header}: {'; '.join(reasons)}")
-    notes += [f"{columns[c].header}: {group[f'{c}_na'].dropna().iloc[0]} (every run of this dataset)" for c in absent]
-    return notes
+            grouped.setdefault(("; ".join(reasons), False), []).append(columns[c].header)
+    for c in absent:
+        reasons = [str(r) for r in dict.fromkeys(group[f"{c}_na"].dropna())]
+        grouped.setdefault(("; ".join(reasons), True), []).append(columns[c].header)
+    return [NaNote(tuple(headers), reason, everywhere) for (reason, everywhere), headers in grouped.items()]
 
 
 def markdown(
@@ -198,9 +245,12 @@ def markdown(
     title: str,
     data: dict[str, dict[str, str]] | None = None,
     paired: list[PairedRow] | None = None,
+    selected: str | None = None,
 ) -> str:
     """One Markdown table per dataset, each followed by its not-applicable notes and its paired comparisons.
 
+    ``columns``: the number columns to show (a selection's :meth:`~ColumnSelection.pick`); ``selected``: the
+    selection's note (:meth:`~albot1.report.column_selection.ColumnSelection.note`), stated under the title.
     ``data``: dataset label -> {file: short sha256} (:func:`albot1.report.provenance.data_by_dataset`), stated
     under each dataset's heading. ``paired``: the rows of :func:`albot1.report.paired_tables.paired_rows`.
     Names are written as text (:mod:`albot1.report.markdown`), never as HTML.
@@ -212,8 +262,8 @@ def markdown(
         f"seed or all seeds agree. {SIGNIFICANT} significant digits. `n/a`: the metric does not apply to that run "
         "(the reason is under the table); `failed`: no seed completed (the status column says why).",
         "",
-        LEGEND,
-        "",
+        *([md_text(selected), ""] if selected else []),
+        *([LEGEND, ""] if any_held_in(table) else []),
         *([intro(), ""] if paired else []),
     ]
     if table.empty:
@@ -238,7 +288,10 @@ def markdown(
             ]
             lines.append("| " + " | ".join(cells) + " |")
         notes = na_notes(group, columns, present, absent)
-        lines += [""] + [f"- n/a: {md_text(note)}" for note in notes] + ([""] if notes else [])
+        lines.append("")
+        for item, subitems in na_outline(notes):
+            lines += [f"- {md_text(item)}", *[f"  - {md_text(sub)}" for sub in subitems]]
+        lines += [""] if notes else []
         lines += markdown_lines(paired or [], str(dataset))
     return "\n".join(lines)
 
@@ -249,11 +302,15 @@ def _latex_escape(text: str) -> str:
     return "".join(table.get(ch, ch) for ch in str(text))
 
 
-def latex(table: pd.DataFrame, columns: dict[str, Column], title: str) -> str:
-    """One booktabs ``table`` per dataset (``\\usepackage{booktabs}``), numbers as in the Markdown tables."""
+def latex(table: pd.DataFrame, columns: dict[str, Column], title: str, selected: str | None = None) -> str:
+    """One booktabs ``table`` per dataset (``\\usepackage{booktabs}``), numbers as in the Markdown tables.
+
+    ``columns`` and ``selected`` as for :func:`markdown` (the note becomes a comment line).
+    """
     lines = [
         f"% {title}: mean $\\pm$ sample std over seeds (min--max); {SIGNIFICANT} significant digits.",
         "% Needs \\usepackage{booktabs}. n/a: the metric does not apply (see the Markdown table for the reason).",
+        *([f"% {' '.join(selected.split())}"] if selected else []),
         "",
     ]
     for dataset, group in table.groupby("dataset", sort=False):
@@ -286,10 +343,22 @@ def _csv_frame(table: pd.DataFrame) -> pd.DataFrame:
     return table[[c for c in table.columns if not c.endswith("_n")]]
 
 
-def write_tables(records: list[CellRecord], out: Path, paired: list[PairedRow] | None = None) -> dict[str, Path]:
+def any_held_in(table: pd.DataFrame) -> bool:
+    """Whether some row of an aggregated table is marked held-in (then the mark's legend is stated)."""
+    return "held_in" in table and bool(table["held_in"].eq(True).any())
+
+
+def write_tables(
+    records: list[CellRecord],
+    out: Path,
+    paired: list[PairedRow] | None = None,
+    selection: ColumnSelection = ALL_COLUMNS,
+) -> dict[str, Path]:
     """Write cells.csv, metrics.{csv,md,tex}, paired.csv and cost.{csv,md,tex} (+ cells-cost.csv) into ``out``.
 
     ``paired``: the metrics tables' paired comparisons when the caller has them (computed here otherwise).
+    ``selection``: the number columns the metrics and cost tables show (all formats, CSV included); the
+    one-row-per-cell files keep every column (:mod:`albot1.report.column_selection`).
     """
     out.mkdir(parents=True, exist_ok=True)
     paired = paired_rows(records) if paired is None else paired
@@ -298,16 +367,18 @@ def write_tables(records: list[CellRecord], out: Path, paired: list[PairedRow] |
     written = {"cells.csv": out / "cells.csv"}
     helper = [c for c in cells.columns if c.endswith("_na")]
     cells.drop(columns=[*COST_COLUMNS, *helper]).to_csv(written["cells.csv"], index=False, float_format="%.9g")
-    for name, columns, title in (
-        ("metrics", METRIC_COLUMNS, "Accuracy per dataset, method and degradation"),
-        ("cost", COST_COLUMNS, "Cost per dataset, method and degradation"),
+    for name, every, every_cell, title in (
+        ("metrics", METRIC_COLUMNS, "cells.csv", "Accuracy per dataset, method and degradation"),
+        ("cost", COST_COLUMNS, "cells-cost.csv", "Cost per dataset, method and degradation"),
     ):
+        columns, selected = selection.pick(every), selection.note(every, f"{name}.csv", every_cell)
         table = aggregate(cells, columns)
         paths = {ext: out / f"{name}.{ext}" for ext in ("csv", "md", "tex")}
         _csv_frame(table).to_csv(paths["csv"], index=False, float_format="%.9g")
         shown = paired if name == "metrics" else None
-        paths["md"].write_text(markdown(table, columns, title, data_by_dataset(records), shown), encoding="utf-8")
-        paths["tex"].write_text(latex(table, columns, title), encoding="utf-8")
+        page = markdown(table, columns, title, data_by_dataset(records), shown, selected)
+        paths["md"].write_text(page, encoding="utf-8")
+        paths["tex"].write_text(latex(table, columns, title, selected), encoding="utf-8")
         written.update({f"{name}.{ext}": path for ext, path in paths.items()})
     cost_cells = out / "cells-cost.csv"
     cells[["dataset", "method", "degradation", "seed", "status", *COST_COLUMNS]].to_csv(

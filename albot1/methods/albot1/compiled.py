@@ -35,6 +35,7 @@ run both; results are bit-identical either way (the parity tests check it).
 from __future__ import annotations
 
 import getpass
+import inspect
 import os
 import tempfile
 from collections.abc import Callable
@@ -46,12 +47,15 @@ from numba.core import config as numba_config
 from numba.extending import register_jitable
 
 from albot1 import versions
+from albot1.errors import ConfigError
 from albot1.geometry import se2, segments
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 #: numba's environment variable for its cache folder (read at import and again by every compilation)
 CACHE_DIR_ENV = "NUMBA_CACHE_DIR"
+#: how many processes a cold warm-up compiles in (default: the CPUs this process may use; 1 = this process only)
+PROCESSES_ENV = "ALBOT1_COMPILE_PROCESSES"
 
 
 def _writable(path: Path) -> bool:
@@ -109,9 +113,35 @@ def select(fn: F, compiled: bool) -> F:
     return fn if compiled else as_written(fn)
 
 
-def is_cached() -> bool:
-    """Whether this code version's cache holds compiled kernels (False: the next warm-up compiles them)."""
-    return any(CACHE_DIR.rglob("*.nbi"))
+def is_cached(fn: Callable[..., Any] | None = None) -> bool:
+    """Whether this code version's cache holds kernel ``fn`` (any kernel when None; False: a warm-up compiles it).
+
+    Numba names a kernel's cache index ``<module file stem>.<qualname>-<line>.py<version>.nbi``
+    (numba's own file naming); the folder is this code version's alone.
+    """
+    if fn is None:
+        return any(CACHE_DIR.rglob("*.nbi"))
+    source = as_written(fn)
+    return any(CACHE_DIR.rglob(f"{Path(inspect.getfile(source)).stem}.{source.__qualname__}-*.nbi"))
+
+
+def compile_processes() -> int:
+    """How many processes may compile kernels at once: ``ALBOT1_COMPILE_PROCESSES``, else the CPUs this process may use.
+
+    Numba compiles under one lock per process (threads do not help), so a
+    cold warm-up spreads its kernels over processes (:mod:`.warm_up`).
+    """
+    value = os.environ.get(PROCESSES_ENV, "").strip()
+    if value:
+        try:
+            count = int(value)
+        except ValueError:
+            raise ConfigError(f"{PROCESSES_ENV}={value!r}: expected a whole number of processes (1 or more)") from None
+        if count < 1:
+            raise ConfigError(f"{PROCESSES_ENV}={value!r}: expected a whole number of processes (1 or more)")
+        return count
+    affinity = getattr(os, "sched_getaffinity", None)
+    return len(affinity(0)) if affinity is not None else os.cpu_count() or 1
 
 
 #: the functions of lower layers (which do not import numba) that kernels call

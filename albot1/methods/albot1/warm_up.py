@@ -10,13 +10,25 @@ compiled and as written gives the same bits.
 
 Changing a kernel's argument types means changing its sample here; the
 tests name the kernel whose sample no longer fits.
+
+A cold warm-up (this code version's first on the machine) spreads the
+compile over processes, as numba compiles under one lock per process; see
+:func:`warm_up` and ``docs/albot1-mapper.md`` ("Kernels", "Compile time").
 """
 
 from __future__ import annotations
 
+import importlib
+import inspect
 import math
+import multiprocessing
+import os
+import tempfile
+import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
+from multiprocessing.process import BaseProcess
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -34,6 +46,20 @@ def _readonly(a: NDArray[Any]) -> NDArray[Any]:
     a = np.array(a)
     a.flags.writeable = False
     return a
+
+
+def _update_sample(seg: NDArray[np.float64]) -> tuple[Any, ...]:
+    """A two-surface map and a view far from it: only additions, so a second call repeats the first exactly."""
+    cap = 8
+    box = np.zeros((cap, 4))
+    box[:2] = np.column_stack(
+        [seg[:, [0, 2]].min(1), seg[:, [1, 3]].min(1), seg[:, [0, 2]].max(1), seg[:, [1, 3]].max(1)]
+    )
+    state = (np.resize(seg, (cap, 4)), np.arange(cap) < 2, np.zeros(cap, dtype=np.int64))
+    slots = (np.where(np.arange(cap) < 2, np.arange(cap), -1), np.arange(cap, dtype=np.int64), box)
+    view = seg + 20.0
+    log = np.zeros((cap, 3), dtype=np.int64)
+    return (*state, *slots, log, 2, 2, 0, view, 20.0, 20.0, True, 1, 0.4, 0.1, 0.4, True, True)
 
 
 def _samples() -> dict[str, list[tuple[Any, ...]]]:
@@ -56,6 +82,9 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         "recognise_landmarks": [(seg, kinds, seg + 0.01, kinds, 0.05, 0.3, 0.04, math.radians(5.0), 0.4, True)],
         "classify_endpoints": [(poly, seg, points, 0.4, True)],
         "resolve_partial": [(seg, taken, seg + 0.01, taken, poly, math.radians(5.0), 0.4, True, 0.4, False)],
+        "update_surfaces": [_update_sample(seg)],
+        "place_segments": [(seg, 0.5, -0.2, math.cos(0.3), math.sin(0.3))],
+        "landmark_rows": [(seg, kinds, 0.4)],
         "refine_pose": [
             (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
         ],
@@ -89,18 +118,105 @@ def sample_calls(*kernel_sets: object) -> Iterator[tuple[str, Callable[..., Any]
                 yield name, getattr(kernels, name), args
 
 
-def warm_up(kernel_sets: tuple[object, ...], announce: Callable[[str], None] | None = None) -> None:
+def _claim(claims: Path, name: str) -> bool:
+    """Whether this process takes kernel ``name`` (the first process to create its claim file does)."""
+    try:
+        os.close(os.open(claims / name, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        return False
+    return True
+
+
+def compile_claimed(claims: str, kernel_sets: list[str], names: list[str]) -> None:
+    """A helper process's part of a cold warm-up: compile every kernel of ``names`` no other process claimed first.
+
+    ``kernel_sets`` are ``module:Class`` of the kernel sets; numba writes
+    each kernel compiled here into this code version's cache, which the
+    process that started this one then loads.
+    """
+    sets = [getattr(importlib.import_module(spec.partition(":")[0]), spec.partition(":")[2])() for spec in kernel_sets]
+    _compile(Path(claims), list(sample_calls(*sets)), names)
+
+
+def _compile(claims: Path, calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]], names: list[str]) -> None:
+    for name in names:
+        if _claim(claims, name):
+            for called, kernel, args in calls:
+                if called == name:
+                    kernel(*args)
+
+
+def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) -> list[BaseProcess]:
+    """Start the helper processes of a cold warm-up (none when one process may compile or one kernel is cold).
+
+    Forked where the platform can and this process runs no other thread: a
+    fork starts in milliseconds with numba and the kernels already imported;
+    otherwise spawned (a fresh interpreter imports them, about a second).
+    """
+    count = min(compiled.compile_processes(), len(names)) - 1
+    if count < 1 or multiprocessing.current_process().daemon:  # a daemonic process (a Dask worker) has no children
+        return []
+    forking = "fork" in multiprocessing.get_all_start_methods() and threading.active_count() == 1
+    context = multiprocessing.get_context("fork") if forking else multiprocessing.get_context("spawn")
+    specs = [f"{type(k).__module__}:{type(k).__qualname__}" for k in kernel_sets]
+    helpers: list[BaseProcess] = [
+        context.Process(target=compile_claimed, args=(str(claims), specs, names), daemon=True) for _ in range(count)
+    ]
+    for helper in helpers:
+        helper.start()
+    return helpers
+
+
+def warm_up(
+    kernel_sets: tuple[object, ...], announce: Callable[[str], None] | None = None, skip: Collection[str] = ()
+) -> None:
     """Call every kernel of ``kernel_sets`` once with its mappers' argument types: numba compiles them now.
 
     With numba's cache filled (any earlier run of this code version on this
-    machine) this is a cache load. ``announce`` receives a line before and
-    after a real compilation, none for a cache load.
+    machine) this is a cache load. Kernels missing from the cache are
+    compiled by up to :func:`compiled.compile_processes` processes at once:
+    helper processes and this one take the cold kernels one by one, heaviest
+    first (a claim file each), and numba's cache hands this process what the
+    helpers compiled. Whatever a helper did not deliver (it failed, or was
+    slower) this process compiles itself, so a helper changes only the time.
+    ``announce`` receives a line before and after a real compilation, none
+    for a cache load. ``skip``: kernels the caller's configuration never
+    calls (``MappingKernels.not_called``), neither compiled nor loaded.
     """
-    cold = not compiled.is_cached()
+    calls = [call for call in sample_calls(*kernel_sets) if call[0] not in skip]
+    kernels = {name: kernel for name, kernel, _ in calls}
+    cold = sorted((name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -_size(kernels[n]))
     if cold and announce is not None:
         announce(f"albot1: compiling the numba kernels once for this code version (cache: {compiled.CACHE_DIR})")
     start = time.perf_counter()
-    for _, kernel, args in sample_calls(*kernel_sets):
+    if cold:
+        with tempfile.TemporaryDirectory(prefix="albot1-compile-") as folder:
+            # The smallest first, here: it pays numba's one-time set-up, which forked helpers then inherit.
+            _compile(Path(folder), calls, cold[-1:])
+            helpers = _helpers(Path(folder), kernel_sets, cold[:-1])
+            try:
+                _compile(Path(folder), calls, cold)
+            except BaseException:  # a failed compile or an interrupt: the helpers' work is no longer wanted
+                for helper in helpers:
+                    helper.terminate()
+                raise
+            finally:
+                for helper in helpers:
+                    helper.join()
+    for _, kernel, args in calls:
         kernel(*args)
     if cold and announce is not None:
         announce(f"albot1: kernels compiled in {time.perf_counter() - start:.1f} s")
+
+
+def _cold(kernel: Callable[..., Any]) -> bool:
+    """Whether ``kernel`` still has to be compiled (numba's dispatcher has no signature and no cache index)."""
+    signatures = getattr(kernel, "signatures", None)
+    if signatures is None:  # NUMBA_DISABLE_JIT: the function as written, nothing to compile
+        return False
+    return not signatures and not compiled.is_cached(kernel)
+
+
+def _size(kernel: Callable[..., Any]) -> int:
+    """Lines of the kernel's source: the order of the cold kernels, longest (slowest to compile) first."""
+    return len(inspect.getsourcelines(compiled.as_written(kernel))[0])

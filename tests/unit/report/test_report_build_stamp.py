@@ -242,3 +242,18 @@ def test_the_results_page_is_written_again_only_when_a_store_or_a_written_file_c
     rebuild.results_page(default, thesis, page, readme)
     (thesis / "runs" / "a" / "metrics.json").write_text('{"ate": 0.5}')
     assert rebuild.current_results_page(default, thesis, page, readme) is None
+
+
+def test_every_option_that_changes_a_report_is_in_its_digest_and_jobs_is_not(tmp_path: Path) -> None:
+    from albot1.report.rebuild import report_options
+
+    base = report_options(tmp_path / "results", tmp_path / "out", plots=True, map_style="grid")
+    assert base == {
+        "kind": "report",
+        "results": str(tmp_path / "results"),
+        "out": str(tmp_path / "out"),
+        "plots": True,
+        "map_style": "grid",
+        "columns": None,
+    }
+    assert report_options(tmp_path / "results", tmp_path / "out", plots=True, map_style="grid", columns="a") != base

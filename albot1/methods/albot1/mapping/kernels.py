@@ -21,66 +21,121 @@ from numpy.typing import NDArray
 
 from albot1.geometry.segments import closest_parameter, line_angle, segment_distance
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import kernel, select
+from albot1.methods.albot1.compiled import jitable, kernel, select
 from albot1.methods.albot1.mapping import pose_kernels
 
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
 
-@kernel
-def classify_endpoints(
-    poly: FloatArray, view: FloatArray, pts: FloatArray, margin: float, surfaces_only: bool
-) -> BoolArray:
-    """For each point: inside the closed polygon (even-odd) or within ``margin`` of it.
+@jitable
+def polygon_points(view: FloatArray, x: float, y: float, with_robot: bool) -> FloatArray:
+    """Algorithm 3 line 7: the robot ``(x, y)`` if ``with_robot``, then each surface's P1, P2 (see ``view_polygon``)."""
+    first = 1 if with_robot else 0
+    poly = np.empty((first + 2 * view.shape[0], 2))
+    if with_robot:
+        poly[0, 0] = x
+        poly[0, 1] = y
+    for j in range(view.shape[0]):
+        poly[first + 2 * j, 0] = view[j, 0]
+        poly[first + 2 * j, 1] = view[j, 1]
+        poly[first + 2 * j + 1, 0] = view[j, 2]
+        poly[first + 2 * j + 1, 1] = view[j, 3]
+    return poly
+
+
+@jitable
+def covered(poly: FloatArray, view: FloatArray, x: float, y: float, margin: float, surfaces_only: bool) -> bool:
+    """Whether the point ``(x, y)`` is inside the closed polygon (even-odd) or within ``margin`` of it.
 
     ``poly`` is ``(v, 2)`` (implicitly closed); the view polygon is
     star-shaped around the robot, so even-odd is its exact interior. With
     ``surfaces_only`` the margin is measured from the view's surfaces
     (``view`` ``(m, 4)``), perpendicular to each and within its extent, not
     from the polygon's sides through unperceived space (field-of-view edges,
-    gaps); otherwise from every polygon edge.
+    gaps); otherwise from every polygon edge. A scalar function, so the
+    bisection of :func:`clip_parameter` allocates nothing per probe.
     """
     v = poly.shape[0]
-    out = np.zeros(pts.shape[0], dtype=np.bool_)
     m2 = margin * margin
+    inside = False
+    near = False
+    for e in range(v):
+        ax = poly[e, 0]
+        ay = poly[e, 1]
+        if e + 1 < v:
+            bx = poly[e + 1, 0]
+            by = poly[e + 1, 1]
+        else:
+            bx = poly[0, 0]
+            by = poly[0, 1]
+        if (ay > y) != (by > y):
+            xc = ax + (y - ay) * (bx - ax) / (by - ay)
+            if x < xc:
+                inside = not inside
+        if not near and not surfaces_only:
+            t = closest_parameter(x, y, ax, ay, bx, by)
+            dx = ax + t * (bx - ax) - x
+            dy = ay + t * (by - ay) - y
+            if dx * dx + dy * dy < m2:
+                near = True
+    if surfaces_only and not inside:
+        for j in range(view.shape[0]):
+            ex = view[j, 2] - view[j, 0]
+            ey = view[j, 3] - view[j, 1]
+            l2 = ex * ex + ey * ey
+            if l2 <= 0.0:
+                continue
+            t = ((x - view[j, 0]) * ex + (y - view[j, 1]) * ey) / l2
+            if t < 0.0 or t > 1.0:
+                continue
+            dx = view[j, 0] + t * ex - x
+            dy = view[j, 1] + t * ey - y
+            if dx * dx + dy * dy < m2:
+                near = True
+                break
+    return inside or near
+
+
+@kernel
+def classify_endpoints(
+    poly: FloatArray, view: FloatArray, pts: FloatArray, margin: float, surfaces_only: bool
+) -> BoolArray:
+    """For each point ``(n, 2)``: inside the view polygon or within ``margin`` of it (:func:`covered`)."""
+    out = np.zeros(pts.shape[0], dtype=np.bool_)
     for k in range(pts.shape[0]):
-        x = pts[k, 0]
-        y = pts[k, 1]
-        inside = False
-        near = False
-        for e in range(v):
-            ax = poly[e, 0]
-            ay = poly[e, 1]
-            bx = poly[(e + 1) % v, 0]
-            by = poly[(e + 1) % v, 1]
-            if (ay > y) != (by > y):
-                xc = ax + (y - ay) * (bx - ax) / (by - ay)
-                if x < xc:
-                    inside = not inside
-            if not near and not surfaces_only:
-                t = closest_parameter(x, y, ax, ay, bx, by)
-                dx = ax + t * (bx - ax) - x
-                dy = ay + t * (by - ay) - y
-                if dx * dx + dy * dy < m2:
-                    near = True
-        if surfaces_only and not inside:
-            for j in range(view.shape[0]):
-                ex = view[j, 2] - view[j, 0]
-                ey = view[j, 3] - view[j, 1]
-                l2 = ex * ex + ey * ey
-                if l2 <= 0.0:
-                    continue
-                t = ((x - view[j, 0]) * ex + (y - view[j, 1]) * ey) / l2
-                if t < 0.0 or t > 1.0:
-                    continue
-                dx = view[j, 0] + t * ex - x
-                dy = view[j, 1] + t * ey - y
-                if dx * dx + dy * dy < m2:
-                    near = True
-                    break
-        out[k] = inside or near
+        out[k] = covered(poly, view, pts[k, 0], pts[k, 1], margin, surfaces_only)
     return out
+
+
+@jitable
+def view_angles(view: FloatArray) -> FloatArray:
+    """Direction (P1 -> P2, radians) of each view surface ``(m, 4)``."""
+    out = np.empty(view.shape[0])
+    for j in range(view.shape[0]):
+        out[j] = math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0])
+    return out
+
+
+@jitable
+def closest_parallel(
+    seg: FloatArray, view: FloatArray, angles: FloatArray, taken: BoolArray, max_angle: float, max_distance: float
+) -> int:
+    """:func:`best_correspondence` given the view's :func:`view_angles` (computed once per update)."""
+    best = -1
+    best_d = max_distance
+    a0 = math.atan2(seg[3] - seg[1], seg[2] - seg[0])
+    for j in range(view.shape[0]):
+        if taken[j]:
+            continue
+        da = line_angle(angles[j] - a0)
+        if da >= max_angle:
+            continue
+        d = segment_distance(seg, view[j])
+        if d < best_d:
+            best = j
+            best_d = d
+    return best
 
 
 @kernel
@@ -89,20 +144,7 @@ def best_correspondence(
 ) -> int:
     """Index of the free view surface closest to ``seg`` (segment distance) among those parallel
     to it within ``max_angle`` (undirected) and nearer than ``max_distance``; -1 if none."""
-    best = -1
-    best_d = max_distance
-    a0 = math.atan2(seg[3] - seg[1], seg[2] - seg[0])
-    for j in range(view.shape[0]):
-        if taken[j]:
-            continue
-        da = line_angle(math.atan2(view[j, 3] - view[j, 1], view[j, 2] - view[j, 0]) - a0)
-        if da >= max_angle:
-            continue
-        d = segment_distance(seg, view[j])
-        if d < best_d:
-            best = j
-            best_d = d
-    return best
+    return closest_parallel(seg, view, view_angles(view), taken, max_angle, max_distance)
 
 
 @kernel
@@ -117,16 +159,26 @@ def clip_parameter(
     """
     lo = 0.0
     hi = 1.0
-    probe = np.empty((1, 2))
     for _ in range(14):
         mid = 0.5 * (lo + hi)
-        probe[0, 0] = x0 + mid * (x1 - x0)
-        probe[0, 1] = y0 + mid * (y1 - y0)
-        if classify_endpoints(poly, view, probe, margin, surfaces_only)[0]:
+        if covered(poly, view, x0 + mid * (x1 - x0), y0 + mid * (y1 - y0), margin, surfaces_only):
             hi = mid
         else:
             lo = mid
     return lo
+
+
+@kernel
+def place_segments(segments: FloatArray, x: float, y: float, c: float, s: float) -> FloatArray:
+    """Segments ``(m, 4)`` placed at ``(x, y)``, heading cosine/sine ``c``/``s``: ``transform_segments``'s
+    arithmetic operation for operation, one call instead of a dozen numpy ones (the tests compare the bits)."""
+    out = np.empty((segments.shape[0], 4))
+    for i in range(segments.shape[0]):
+        out[i, 0] = x + c * segments[i, 0] - s * segments[i, 1]
+        out[i, 1] = y + s * segments[i, 0] + c * segments[i, 1]
+        out[i, 2] = x + c * segments[i, 2] - s * segments[i, 3]
+        out[i, 3] = y + s * segments[i, 2] + c * segments[i, 3]
+    return out
 
 
 #: Actions of :func:`resolve_partial` on a map surface with one end inside the view.
@@ -166,6 +218,7 @@ def resolve_partial(
     new = np.empty((k, 4))
     match = np.full(k, -1, dtype=np.int64)
     used = taken.copy()
+    angles = view_angles(view)
     for r in range(k):
         seg = segs[r]
         if p1_inside[r]:
@@ -178,7 +231,7 @@ def resolve_partial(
             oy = seg[1]
             ix = seg[2]
             iy = seg[3]
-        best = best_correspondence(seg, view, used, max_angle, max_distance)
+        best = closest_parallel(seg, view, angles, used, max_angle, max_distance)
         if best >= 0:
             v = view[best]
             if np.hypot(v[0] - ox, v[1] - oy) >= np.hypot(v[2] - ox, v[3] - oy):
@@ -220,12 +273,235 @@ def resolve_partial(
     return action, new, match
 
 
+@jitable
+def _drop_surface(
+    sid: int, alive: BoolArray, slot_of: IntArray, live_id: IntArray, live_box: FloatArray, live: int
+) -> int:
+    """Take ``sid`` out of the live table (the last live surface fills its slot); returns the new live count."""
+    slot = slot_of[sid]
+    last = live - 1
+    if slot != last:
+        moved = live_id[last]
+        live_id[slot] = moved
+        for c in range(4):
+            live_box[slot, c] = live_box[last, c]
+        slot_of[moved] = slot
+    slot_of[sid] = -1
+    alive[sid] = False
+    return last
+
+
+@kernel
+def update_surfaces(
+    seg: FloatArray,
+    alive: BoolArray,
+    added_at: IntArray,
+    slot_of: IntArray,
+    live_id: IntArray,
+    live_box: FloatArray,
+    events: IntArray,
+    n: int,
+    live: int,
+    n_events: int,
+    view: FloatArray,
+    robot_x: float,
+    robot_y: float,
+    with_robot: bool,
+    scan: int,
+    margin: float,
+    max_angle: float,
+    max_distance: float,
+    clip: bool,
+    surfaces_only: bool,
+) -> tuple[IntArray, IntArray, IntArray, IntArray, IntArray, int, int, int]:
+    """Algorithm 3 on the arrays of a :class:`~albot1.methods.albot1.mapping.perceptual_map.PerceptualMap`.
+
+    ``seg``/``alive``/``added_at``/``slot_of`` are indexed by surface id
+    (``n`` ids so far), ``live_id``/``live_box`` by slot (``live`` in use),
+    ``events`` rows ``(id, action, scan)`` (``n_events`` so far); the caller
+    has made room for ``len(view)`` more ids and ``live`` more events. The
+    view ``(m, 4)`` is in the map, seen from ``(robot_x, robot_y)``; its polygon
+    (:func:`polygon_points`) includes that point when ``with_robot``. In order: the live
+    surfaces whose bounding box meets the polygon's grown box (ascending id)
+    have their endpoints classified (:func:`covered`); those with both ends covered
+    are deleted, those with one are resolved (:func:`resolve_partial`) and
+    deleted, extended or trimmed; every view surface no map surface took is
+    added. Returns the map id of each view surface, the deleted, extended,
+    trimmed and added ids, and the new ``n``, ``live`` and ``n_events``.
+    """
+    m = view.shape[0]
+    view_ids = np.full(m, -1, dtype=np.int64)
+    deleted = np.empty(live, dtype=np.int64)
+    extended = np.empty(live, dtype=np.int64)
+    trimmed = np.empty(live, dtype=np.int64)
+    n_del = 0
+    n_ext = 0
+    n_trim = 0
+    if m > 0:
+        poly = polygon_points(view, robot_x, robot_y, with_robot)
+        lo_x = poly[0, 0]
+        lo_y = poly[0, 1]
+        hi_x = poly[0, 0]
+        hi_y = poly[0, 1]
+        for v in range(1, poly.shape[0]):
+            lo_x = min(lo_x, poly[v, 0])
+            lo_y = min(lo_y, poly[v, 1])
+            hi_x = max(hi_x, poly[v, 0])
+            hi_y = max(hi_y, poly[v, 1])
+        lo_x -= margin
+        lo_y -= margin
+        hi_x += margin
+        hi_y += margin
+        hits = np.empty(live, dtype=np.int64)
+        k = 0
+        for slot in range(live):
+            if (
+                live_box[slot, 2] >= lo_x
+                and live_box[slot, 0] <= hi_x
+                and live_box[slot, 3] >= lo_y
+                and live_box[slot, 1] <= hi_y
+            ):
+                hits[k] = live_id[slot]
+                k += 1
+        cand = np.sort(hits[:k])
+        if k > 0:
+            segs = np.empty((k, 4))
+            for r in range(k):
+                for c in range(4):
+                    segs[r, c] = seg[cand[r], c]
+            p1_covered = np.empty(k, dtype=np.bool_)
+            partial = np.empty(k, dtype=np.int64)
+            n_partial = 0
+            for r in range(k):
+                c1 = covered(poly, view, segs[r, 0], segs[r, 1], margin, surfaces_only)
+                c2 = covered(poly, view, segs[r, 2], segs[r, 3], margin, surfaces_only)
+                p1_covered[r] = c1
+                inside = int(c1) + int(c2)
+                if inside == 2:
+                    sid = cand[r]
+                    live = _drop_surface(sid, alive, slot_of, live_id, live_box, live)
+                    events[n_events, 0] = sid
+                    events[n_events, 1] = DELETED
+                    events[n_events, 2] = scan
+                    n_events += 1
+                    deleted[n_del] = sid
+                    n_del += 1
+                elif inside == 1:
+                    partial[n_partial] = r
+                    n_partial += 1
+            if n_partial > 0:
+                p_segs = np.empty((n_partial, 4))
+                p1_inside = np.empty(n_partial, dtype=np.bool_)
+                for q in range(n_partial):
+                    for c in range(4):
+                        p_segs[q, c] = segs[partial[q], c]
+                    p1_inside[q] = p1_covered[partial[q]]
+                action, new_segs, match = resolve_partial(
+                    p_segs,
+                    p1_inside,
+                    view,
+                    view_ids >= 0,
+                    poly,
+                    max_angle,
+                    max_distance,
+                    clip,
+                    margin,
+                    surfaces_only,
+                )
+                for q in range(n_partial):
+                    sid = cand[partial[q]]
+                    if match[q] >= 0:
+                        view_ids[match[q]] = sid
+                    act = action[q]
+                    if act == KEEP:
+                        continue
+                    events[n_events, 0] = sid
+                    events[n_events, 1] = act
+                    events[n_events, 2] = scan
+                    n_events += 1
+                    if act == DELETED:
+                        live = _drop_surface(sid, alive, slot_of, live_id, live_box, live)
+                        deleted[n_del] = sid
+                        n_del += 1
+                        continue
+                    x1 = new_segs[q, 0]
+                    y1 = new_segs[q, 1]
+                    x2 = new_segs[q, 2]
+                    y2 = new_segs[q, 3]
+                    seg[sid, 0] = x1
+                    seg[sid, 1] = y1
+                    seg[sid, 2] = x2
+                    seg[sid, 3] = y2
+                    slot = slot_of[sid]
+                    live_box[slot, 0] = min(x1, x2)
+                    live_box[slot, 1] = min(y1, y2)
+                    live_box[slot, 2] = max(x1, x2)
+                    live_box[slot, 3] = max(y1, y2)
+                    if act == EXTENDED:
+                        extended[n_ext] = sid
+                        n_ext += 1
+                    else:
+                        trimmed[n_trim] = sid
+                        n_trim += 1
+    n_fresh = 0
+    for j in range(m):
+        if view_ids[j] < 0:
+            n_fresh += 1
+    added = np.empty(n_fresh, dtype=np.int64)
+    a = 0
+    for j in range(m):
+        if view_ids[j] >= 0:
+            continue
+        sid = n + a
+        x1 = view[j, 0]
+        y1 = view[j, 1]
+        x2 = view[j, 2]
+        y2 = view[j, 3]
+        seg[sid, 0] = x1
+        seg[sid, 1] = y1
+        seg[sid, 2] = x2
+        seg[sid, 3] = y2
+        alive[sid] = True
+        added_at[sid] = scan
+        slot_of[sid] = live
+        live_id[live] = sid
+        live_box[live, 0] = min(x1, x2)
+        live_box[live, 1] = min(y1, y2)
+        live_box[live, 2] = max(x1, x2)
+        live_box[live, 3] = max(y1, y2)
+        live += 1
+        view_ids[j] = sid
+        added[a] = sid
+        a += 1
+    return (
+        view_ids,
+        deleted[:n_del].copy(),
+        extended[:n_ext].copy(),
+        trimmed[:n_trim].copy(),
+        added,
+        n + a,
+        live,
+        n_events,
+    )
+
+
 class MappingKernels:
     """The map-update and Albot1+ pose kernels a mapper calls: each compiled, or its Python source."""
+
+    @staticmethod
+    def not_called(pose_estimate: str) -> tuple[str, ...]:
+        """The kernels a mapper with this ``pose_estimate`` never calls: Albot1+'s pose unless it is ``robust``.
+
+        A warm-up leaves them out (:func:`albot1.methods.albot1.warm_up.warm_up`),
+        which spares a first run of the thesis presets their compile.
+        """
+        return () if pose_estimate == "robust" else ("refine_pose", "scan_points")
 
     def __init__(self, compiled: bool = True) -> None:
         self.compiled = compiled
         self.classify_endpoints = select(classify_endpoints, compiled)
         self.resolve_partial = select(resolve_partial, compiled)
+        self.update_surfaces = select(update_surfaces, compiled)
+        self.place_segments = select(place_segments, compiled)
         self.refine_pose = select(pose_kernels.refine_pose, compiled)
         self.scan_points = select(pose_kernels.scan_points, compiled)

@@ -27,10 +27,13 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, rotate, wrap_angle
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.perception.endpoints import is_stable
+from albot1.methods.albot1.perception.endpoints import STABLE
 from albot1.methods.albot1.perception.recognition import Tracked
 
 IntArray = NDArray[np.int64]
+
+#: :data:`~albot1.methods.albot1.perception.endpoints.STABLE` as a Python list (the loop below runs on Python scalars).
+STABLE_KINDS: list[bool] = STABLE.tolist()
 
 #: Algorithm 2 step 2: the robot as a surface from (0, 0) to (0, 50 cm) in its own view.
 ROBOT_AHEAD_M = 0.5
@@ -46,11 +49,11 @@ def eq_3_6_3_7(x1: float, y1: float, x2: float, y2: float, d_p: float, theta: fl
     )
 
 
-def _reference(seg: FloatArray, side: int) -> tuple[float, float]:
+def _reference(seg: FloatArray | Sequence[float], side: int) -> tuple[float, float]:
     return (float(seg[2 * side]), float(seg[2 * side + 1]))
 
 
-def _direction(seg: FloatArray) -> float:
+def _direction(seg: FloatArray | Sequence[float]) -> float:
     return math.atan2(float(seg[3] - seg[1]), float(seg[2] - seg[0]))
 
 
@@ -80,7 +83,7 @@ def algorithm2_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pos
     return (p[0][0], p[0][1], wrap_angle(heading))
 
 
-def landmark_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pose:
+def landmark_pose(map_seg: FloatArray | Sequence[float], view_seg: FloatArray | Sequence[float], side: int) -> Pose:
     """The view's pose in the map that lays ``view_seg`` onto ``map_seg`` at the reference point ``side``."""
     phi = wrap_angle(_direction(map_seg) - _direction(view_seg))
     mx, my = _reference(map_seg, side)
@@ -113,19 +116,43 @@ def goodness(length: float, d_r: float, g_diff: float, a_diff: float, gap_floor:
 
 @dataclass(frozen=True, slots=True)
 class Localisation:
-    """The chosen pose, the landmark id it came from and every candidate (for traces and tests)."""
+    """The chosen pose, the landmark id it came from and every candidate (for traces and tests).
+
+    The candidates are kept as the lists localisation built; their arrays are
+    made on demand (the thesis path reads only the pose and its landmark).
+    """
 
     pose: Pose
     reference_id: int
-    candidate_ids: IntArray
-    candidates: FloatArray
-    kept: NDArray[np.bool_]
-    goodness: FloatArray
+    ids: list[int]
+    poses: list[Pose]
+    keep: list[bool]
+    scores: list[float]
+
+    @property
+    def candidate_ids(self) -> IntArray:
+        """The landmark id of every candidate."""
+        return np.asarray(self.ids, dtype=np.int64)
+
+    @property
+    def candidates(self) -> FloatArray:
+        """Every candidate pose ``(c, 3)``."""
+        return np.asarray(self.poses, dtype=float)
+
+    @property
+    def kept(self) -> NDArray[np.bool_]:
+        """Which candidates the outlier rule kept."""
+        return np.asarray(self.keep, dtype=bool)
+
+    @property
+    def goodness(self) -> FloatArray:
+        """Each candidate's goodness (eq. 3.5)."""
+        return np.asarray(self.scores, dtype=float)
 
 
 def localise(
     tracked: Tracked,
-    landmark_map: Mapping[int, tuple[FloatArray, IntArray]],
+    landmark_map: Mapping[int, tuple[FloatArray | Sequence[float], IntArray | Sequence[int]]],
     *,
     min_candidates: int,
     gap_floor: float,
@@ -151,7 +178,7 @@ def localise(
     d_prev = (tracked.prev_distance if distance_view == "previous" else tracked.prev_distance_current).tolist()
     gaps = tracked.gap.tolist()
     adiffs = tracked.angle_diff.tolist()
-    surfaces = tracked.surfaces
+    surfaces = tracked.surfaces.tolist()
     for k, sid in enumerate(tracked.ids.tolist()):
         record = landmark_map.get(sid)
         if record is None:
@@ -160,7 +187,7 @@ def localise(
         matched = sides[k]
         side = -1
         for s in (matched, 1 - matched) if matched >= 0 else (0, 1):
-            if is_stable(kinds[k][s]) and is_stable(int(map_kinds[s])):
+            if STABLE_KINDS[kinds[k][s]] and STABLE_KINDS[map_kinds[s]]:
                 side = s
                 break
         if side < 0:
@@ -168,7 +195,7 @@ def localise(
         seg = surfaces[k]
         ids.append(sid)
         poses.append(landmark_pose(map_seg, seg, side))
-        length = math.hypot(float(seg[2] - seg[0]), float(seg[3] - seg[1]))
+        length = math.hypot(seg[2] - seg[0], seg[3] - seg[1])
         # NaN (x != x) marks a list freshly reset from a view: no match data.
         d_r = d_prev[k] if d_prev[k] == d_prev[k] else 1.0
         g = gaps[k] if gaps[k] == gaps[k] else gap_floor
@@ -179,11 +206,4 @@ def localise(
     n = len(poses)
     kept = outlier_keep([(p[0], p[1]) for p in poses], min_candidates)
     best = max((k for k in range(n) if kept[k]), key=lambda k: scores[k])
-    return Localisation(
-        poses[best],
-        ids[best],
-        np.asarray(ids, dtype=np.int64),
-        np.asarray(poses, dtype=float),
-        np.asarray(kept, dtype=bool),
-        np.asarray(scores, dtype=float),
-    )
+    return Localisation(poses[best], ids[best], ids, poses, kept, scores)

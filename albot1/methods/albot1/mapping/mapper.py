@@ -29,7 +29,6 @@ from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
-from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernels import MappingKernels
@@ -121,7 +120,7 @@ class Albot1Mapper:
         self._angle_floor = math.radians(config.goodness_angle_floor_deg)
         self._stationary_rad = math.radians(config.stationary_deg)
         self.map = PerceptualMap()
-        self._landmark_map: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._landmark_map: dict[int, tuple[list[float], list[int]]] = {}
         self._poses: list[Pose] = []
         self._prev: _Step | None = None
         self._u_step = -1
@@ -182,7 +181,7 @@ class Albot1Mapper:
     def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
         """Compile every kernel now (or load numba's cache), before the runner's timed loop (``Mapper.warm_up``)."""
         if self.config.accelerate:
-            warm_up(self.kernels, announce)
+            warm_up(self.kernels, announce, skip=MappingKernels.not_called(self.config.pose_estimate))
 
     def process(self, frame: Frame) -> None:
         n = self._n
@@ -191,7 +190,7 @@ class Albot1Mapper:
             view = construct_view(scan.ranges, scan.angles, self._view_params, self._pk)
         except (ValueError, TypeError) as exc:
             raise MappingError(f"scan {frame.index}: cannot build a view: {exc}") from exc
-        lms = find_landmarks(view, self.config.landmark_min_length_m)
+        lms = find_landmarks(view, self.config.landmark_min_length_m, self._pk)
         odo = (float(frame.odometry[0]), float(frame.odometry[1]), float(frame.odometry[2]))
         if not all(map(math.isfinite, odo)):
             raise MappingError(f"scan {frame.index}: odometry {odo} is not finite")
@@ -310,8 +309,8 @@ class Albot1Mapper:
             compose_pose(prev_pose, step), None if loc is None else loc.pose, None if loc is None else loc.candidates
         )
         rows: list[int] = []
-        maps: list[np.ndarray] = []
-        map_kinds: list[np.ndarray] = []
+        maps: list[list[float]] = []
+        map_kinds: list[list[int]] = []
         for r, sid in enumerate(rl.ids.tolist()):
             record = self._landmark_map.get(sid)
             if record is not None:
@@ -362,7 +361,7 @@ class Albot1Mapper:
         since the update from it.
         """
         c = self._counts
-        view_map = transform_segments(pose, view.surfaces)
+        view_map = self._mk.place_segments(view.surfaces, pose[0], pose[1], math.cos(pose[2]), math.sin(pose[2]))
         self._update_odometry = odometry
         if self._plus is not None:
             self._plus.reset(view_map, pose)
@@ -372,7 +371,8 @@ class Albot1Mapper:
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]
-        self._landmark_map = {int(i): (lm_map[r], lms.kinds[r]) for r, i in enumerate(ids.tolist())}
+        # As Python lists: localisation reads them as scalars every scan.
+        self._landmark_map = dict(zip(ids.tolist(), zip(lm_map.tolist(), lms.kinds.tolist())))
         self._u_step = view_scan
         c.surfaces_added += len(out.added)
         c.surfaces_deleted += len(out.deleted)

@@ -120,6 +120,8 @@ class OdometryNoise:
 #: off by tens of degrees on a turn, beyond the reach of the scan refinement's nearest-surface matching.
 ODOMETRY_TURNS_DEG = (0.0, -3.0, 3.0, -6.0, 6.0, -10.0, 10.0, -15.0, 15.0, -20.0, 20.0, -30.0, 30.0)
 
+_ODOMETRY_TURNS = np.radians(np.asarray(ODOMETRY_TURNS_DEG))
+
 
 def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | None) -> FloatArray:
     """The poses the solver starts from (it keeps the cheapest): ``(c, 3)``, contiguous.
@@ -130,7 +132,7 @@ def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | No
     :data:`ODOMETRY_TURNS_DEG`.
     """
     if thesis is None or candidates is None:
-        turns = np.radians(np.asarray(ODOMETRY_TURNS_DEG))
+        turns = _ODOMETRY_TURNS
         starts = np.column_stack(
             [np.full(turns.size, odometry[0]), np.full(turns.size, odometry[1]), odometry[2] + turns]
         )
@@ -289,7 +291,7 @@ class Screened:
     degenerate: bool  # at least one direction was left to the odometry
     rejected: bool  # the disagreement with the odometry exceeds the gate: use the prediction
     kept: int = 0  # directions the fit fixes
-    mahalanobis: float = 0.0  # squared disagreement with the prediction along them, in their stated uncertainty
+    mahalanobis: float = 0.0  # squared disagreement with the prediction along them (computed when the gate is on)
 
 
 def screen_measurement(
@@ -313,10 +315,9 @@ def screen_measurement(
     rejected (the odometry's prediction is used). With no direction kept the
     view says nothing and the prediction is the pose.
     """
-    from scipy.stats import chi2  # noqa: PLC0415 -- scipy's import cost only when Albot1+ screens a view
-
     scale = np.asarray([1.0, 1.0, params.m_per_rad])
-    info_u = np.asarray(info, dtype=float) / np.outer(scale, scale)
+    scale2 = np.outer(scale, scale)
+    info_u = np.asarray(info, dtype=float) / scale2
     eigval, eigvec = np.linalg.eigh(0.5 * (info_u + info_u.T))
     floor = 1.0 / params.degenerate_sd**2 if params.degenerate_sd > 0.0 else 0.0
     keep = eigval > max(floor, 0.0)
@@ -326,13 +327,18 @@ def screen_measurement(
         return Screened(predicted, np.zeros((3, 3)), degenerate, False)
     delta = np.asarray([measured[0] - predicted[0], measured[1] - predicted[1], wrap_angle(measured[2] - predicted[2])])
     z = basis.T @ (scale * delta)  # the disagreement along the kept directions (m)
-    prior_u = np.diag([prior_variance[0], prior_variance[0], prior_variance[1] * params.m_per_rad**2])
-    cov = np.diag(1.0 / eigval[keep]) + basis.T @ prior_u @ basis
-    mahalanobis = float(z @ np.linalg.solve(cov, z))
     kept_n = int(keep.sum())
-    if params.gate_probability > 0.0 and mahalanobis > float(chi2.ppf(params.gate_probability, kept_n)):
-        return Screened(predicted, np.zeros((3, 3)), degenerate, True, kept_n, mahalanobis)
+    mahalanobis = 0.0
+    if params.gate_probability > 0.0:
+        # scipy's import (and the test) only when the gate is on: the statement costs ~0.1 ms a call.
+        from scipy.stats import chi2  # noqa: PLC0415
+
+        prior_u = np.diag([prior_variance[0], prior_variance[0], prior_variance[1] * params.m_per_rad**2])
+        cov = np.diag(1.0 / eigval[keep]) + basis.T @ prior_u @ basis
+        mahalanobis = float(z @ np.linalg.solve(cov, z))
+        if mahalanobis > float(chi2.ppf(params.gate_probability, kept_n)):
+            return Screened(predicted, np.zeros((3, 3)), degenerate, True, kept_n, mahalanobis)
     kept = (basis @ z) / scale
     pose = (predicted[0] + float(kept[0]), predicted[1] + float(kept[1]), wrap_angle(predicted[2] + float(kept[2])))
-    info_kept = (basis * eigval[keep]) @ basis.T * np.outer(scale, scale)
+    info_kept = (basis * eigval[keep]) @ basis.T * scale2
     return Screened(pose, np.ascontiguousarray(info_kept), degenerate, False, kept_n, mahalanobis)

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.mapping.kernels import DELETED, EXTENDED, TRIMMED, MappingKernels
+from albot1.methods.albot1.mapping.kernels import MappingKernels, polygon_points
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 
 IntArray = NDArray[np.int64]
@@ -55,10 +55,8 @@ def view_polygon(view_map: FloatArray, robot_xy: tuple[float, float], polygon: s
     360 degrees; without the robot vertex the space between the robot and
     the view would never be cleared.
     """
-    pts = view_map.reshape(-1, 2)
-    if polygon == "robot_and_endpoints":
-        pts = np.vstack([np.asarray(robot_xy, dtype=float).reshape(1, 2), pts])
-    return np.ascontiguousarray(pts)
+    view = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
+    return polygon_points(view, float(robot_xy[0]), float(robot_xy[1]), polygon == "robot_and_endpoints")
 
 
 def update_map(
@@ -72,69 +70,36 @@ def update_map(
     """``updatePM`` for a view already transformed into the map (``view_map``, left to right).
 
     Lines 1-6 (placing the view with the reference landmark) are the
-    caller's: that is the localisation pose applied to every surface.
+    caller's: that is the localisation pose applied to every surface. The
+    rest is one compiled call on the map's arrays
+    (:func:`~albot1.methods.albot1.mapping.kernels.update_surfaces`): the
+    box query, the classification of the candidates' endpoints, the
+    deletions, extensions and trims (lines 8-12) and the additions (line 13).
     """
     k = kernels or MappingKernels()
     view_map = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
     m = view_map.shape[0]
-    view_ids = np.full(m, -1, dtype=np.int64)
-    deleted: list[int] = []
-    extended: list[int] = []
-    trimmed: list[int] = []
-    if m:
-        poly = view_polygon(view_map, robot_xy, params.polygon)
-        lo = poly.min(axis=0) - params.delete_margin
-        hi = poly.max(axis=0) + params.delete_margin
-        cand = pmap.query(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
-        if len(cand):
-            segs = pmap.segments(cand)
-            near = k.classify_endpoints(
-                poly,
-                view_map,
-                np.ascontiguousarray(segs.reshape(-1, 2)),
-                params.delete_margin,
-                params.margin_from == "surfaces",
-            )
-            near = near.reshape(-1, 2)
-            inside_count = near.sum(axis=1)
-            for row in np.flatnonzero(inside_count == 2).tolist():
-                sid = int(cand[row])
-                pmap.delete(sid, scan)
-                deleted.append(sid)
-            partial = np.flatnonzero(inside_count == 1)
-            if len(partial):
-                action, new_segs, match = k.resolve_partial(
-                    np.ascontiguousarray(segs[partial]),
-                    np.ascontiguousarray(near[partial, 0]),
-                    view_map,
-                    view_ids >= 0,
-                    poly,
-                    params.correspond_angle,
-                    params.correspond_distance,
-                    params.partial_without_match == "clip",
-                    params.delete_margin,
-                    params.margin_from == "surfaces",
-                )
-                for r, (row, act, taken) in enumerate(zip(partial.tolist(), action.tolist(), match.tolist())):
-                    sid = int(cand[row])
-                    if taken >= 0:
-                        view_ids[taken] = sid
-                    if act == DELETED:
-                        pmap.delete(sid, scan)
-                        deleted.append(sid)
-                    elif act == EXTENDED:
-                        pmap.replace(sid, new_segs[r], scan, "extended")
-                        extended.append(sid)
-                    elif act == TRIMMED:
-                        pmap.replace(sid, new_segs[r], scan, "trimmed")
-                        trimmed.append(sid)
-    fresh = np.flatnonzero(view_ids < 0)
-    added = pmap.add(view_map[fresh], scan) if len(fresh) else np.empty(0, dtype=np.int64)
-    view_ids[fresh] = added
-    return UpdateOutcome(
-        view_ids,
-        np.asarray(deleted, dtype=np.int64),
-        np.asarray(extended, dtype=np.int64),
-        np.asarray(trimmed, dtype=np.int64),
-        added,
+    pmap.reserve(m, pmap.live)
+    view_ids, deleted, extended, trimmed, added, pmap.n, pmap.live, pmap.n_events = k.update_surfaces(
+        pmap.seg,
+        pmap.alive,
+        pmap.added_at,
+        pmap.slot_of,
+        pmap.live_id,
+        pmap.live_box,
+        pmap.events,
+        pmap.n,
+        pmap.live,
+        pmap.n_events,
+        view_map,
+        float(robot_xy[0]),
+        float(robot_xy[1]),
+        params.polygon == "robot_and_endpoints",
+        scan,
+        params.delete_margin,
+        params.correspond_angle,
+        params.correspond_distance,
+        params.partial_without_match == "clip",
+        params.margin_from == "surfaces",
     )
+    return UpdateOutcome(view_ids, deleted, extended, trimmed, added)

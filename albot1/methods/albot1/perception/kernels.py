@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel, select
+from albot1.methods.albot1.ordering import stable_order
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, UNSTABLE, is_stable
 
 IntArray = NDArray[np.int64]
@@ -422,7 +423,7 @@ def recognise_landmarks(
     owner = np.full(q, -1, dtype=np.int64)
     if greedy:
         used = np.zeros(p, dtype=np.bool_)
-        order = np.argsort(gg[:n], kind="mergesort")
+        order = stable_order(gg[:n])
         for o in order:
             if used[ii[o]] or owner[jj[o]] >= 0:
                 continue
@@ -460,6 +461,20 @@ def recognise_landmarks(
     return oi, oj, os_, og, oa, od, odc
 
 
+@kernel
+def landmark_rows(surfaces: FloatArray, kinds: IntArray, min_length: float) -> tuple[IntArray, FloatArray, IntArray]:
+    """``findLandmark`` (3.1.4): rows at least ``min_length`` long with a stable end, their surfaces and labels."""
+    keep = np.empty(surfaces.shape[0], dtype=np.int64)
+    n = 0
+    for i in range(surfaces.shape[0]):
+        length = np.hypot(surfaces[i, 2] - surfaces[i, 0], surfaces[i, 3] - surfaces[i, 1])
+        if length >= min_length and (is_stable(kinds[i, 0]) or is_stable(kinds[i, 1])):
+            keep[n] = i
+            n += 1
+    rows = keep[:n].copy()
+    return rows, surfaces[rows], kinds[rows]
+
+
 class PerceptionKernels:
     """The perception kernels a mapper calls: each compiled, or its Python source when ``compiled`` is False."""
 
@@ -467,3 +482,4 @@ class PerceptionKernels:
         self.compiled = compiled
         self.build_view = select(build_view, compiled)
         self.recognise_landmarks = select(recognise_landmarks, compiled)
+        self.landmark_rows = select(landmark_rows, compiled)

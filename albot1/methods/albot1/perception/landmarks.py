@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, STABLE, UNSTABLE
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.perception.view import View
 
 IntArray = NDArray[np.int64]
@@ -38,8 +39,7 @@ class Landmarks:
         return int(self.index.shape[0])
 
 
-def find_landmarks(view: View, min_length: float) -> Landmarks:
-    """``findLandmark``: surfaces at least ``min_length`` long with an occluding or corner end."""
-    keep = (view.lengths >= min_length) & stable(view.kinds).any(axis=1)
-    idx = np.flatnonzero(keep)
-    return Landmarks(idx, view.surfaces[idx], view.kinds[idx])
+def find_landmarks(view: View, min_length: float, kernels: PerceptionKernels | None = None) -> Landmarks:
+    """``findLandmark``: surfaces at least ``min_length`` long with an occluding or corner end (one kernel call)."""
+    k = kernels or PerceptionKernels()
+    return Landmarks(*k.landmark_rows(view.surfaces, view.kinds, min_length))

@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 from albot1.geometry.segments import orientation, point_segment_distance
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import kernel
+from albot1.methods.albot1.ordering import stable_order
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDING
 
 IntArray = NDArray[np.int64]
@@ -85,7 +86,7 @@ def detect_exits(
                 cj[n] = j
                 cw[n] = w
                 n += 1
-    order = np.argsort(cw[:n], kind="mergesort")
+    order = stable_order(cw[:n])
     used_left = np.zeros(m, dtype=np.bool_)
     used_right = np.zeros(m, dtype=np.bool_)
     out_i = np.empty(n, dtype=np.int64)

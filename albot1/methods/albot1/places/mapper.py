@@ -41,6 +41,7 @@ from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose
 from albot1.geometry.segments import transform_segments
 from albot1.geometry.types import FloatArray
+from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper, UpdateEvent
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.places.config import Albot1PlacesConfig
@@ -103,7 +104,7 @@ class Albot1PlacesMapper:
     def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
         """Compile every kernel, the places layer's too, before the timed loop (:meth:`Albot1Mapper.warm_up`)."""
         if self.config.accelerate:
-            warm_up((*self.inner.kernels, self._k), announce)
+            warm_up((*self.inner.kernels, self._k), announce, skip=MappingKernels.not_called(self.config.pose_estimate))
 
     # -- per scan ----------------------------------------------------------------------------------------------
     def process(self, frame: Frame) -> None:

@@ -15,6 +15,7 @@ from albot1.geometry.segments import point_segment_distance
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import kernel
 from albot1.methods.albot1.mapping.kernels import classify_endpoints
+from albot1.methods.albot1.ordering import stable_order
 
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
@@ -33,7 +34,7 @@ def merge_collinear(surfaces: FloatArray, max_angle: float, max_offset: float, m
     length = np.empty(n)
     for i in range(n):
         length[i] = np.hypot(surfaces[i, 2] - surfaces[i, 0], surfaces[i, 3] - surfaces[i, 1])
-    order = np.argsort(-length, kind="mergesort")
+    order = stable_order(-length)
     gx = np.empty(n)
     gy = np.empty(n)
     gux = np.empty(n)

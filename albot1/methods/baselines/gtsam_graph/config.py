@@ -80,6 +80,18 @@ class GtsamGraphConfig(BaseModel):
     odometry_sigma_theta_deg: float = Field(
         gt=0, description="prior std dev of the odometry guess per node step (theta)"
     )
+    odometry_trust: bool = Field(
+        description="fuse each node's odometry step into its matched sequential edge, weighted by the odometry's "
+        "variance learnt from its disagreement with recent matches (unbiased components only; odometry_trust.py)"
+    )
+    odometry_trust_translation: bool = Field(description="... in translation too (else: the heading alone)")
+    odometry_trust_window: int = Field(ge=2, description="... learnt from this many recent matched node steps")
+    odometry_trust_bias_z: float = Field(
+        gt=0, description="... a component whose median disagreement is this many standard errors from 0 is not fused"
+    )
+    odometry_trust_gate_chi2: float = Field(
+        gt=0, description="... nor a step whose odometry and match disagree beyond this Mahalanobis distance squared"
+    )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
         gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"

@@ -7,7 +7,9 @@ scan, or from the last tracked motion when the two disagree
 when the robot moved far enough for a new node (:meth:`FrontEnd.moved_enough`),
 and the tracking match becomes the new node's sequential edge, or the
 odometry increment with a larger covariance when the match is poor
-(:meth:`FrontEnd.sequential_edge`). All of the tracking logic lives here; the
+(:meth:`FrontEnd.sequential_edge`); with ``odometry_trust`` (off in the
+default preset) a good match is fused with the odometry's heading where the
+odometry has shown itself the better of the two (:mod:`.odometry_trust`). All of the tracking logic lives here; the
 local map itself is the back end's (:meth:`.BackEnd.local_map`).
 """
 
@@ -26,6 +28,7 @@ from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
+from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryTrust
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
 
 
@@ -61,9 +64,18 @@ class FrontEnd:
         )
         # The latest scan's pose in the frame of the newest node.
         self.track = np.zeros(3)
-        self._velocity = np.zeros(3)  # the last tracked scan-to-scan motion
+        # The last tracked scan-to-scan motion; None until a scan has been tracked: before that the velocity is
+        # unknown, not zero (edmonton-corrected[::3] moves 3 m between its first scans, and a "standing still"
+        # guess matched a corridor 3 m short and won because the odometry guess's match failed).
+        self._velocity: FloatArray | None = None
         self._corrections = CorrectionScale(
             config.track_outlier_window, config.match_sigma_floor_xy_m, config.match_sigma_floor_theta_deg
+        )
+        self._odometry_trust = OdometryTrust(
+            config.odometry_trust_window,
+            config.odometry_trust_bias_z,
+            config.odometry_trust_gate_chi2,
+            (0, 1, 2) if config.odometry_trust_translation else (2,),
         )
         self.last_odometry: FloatArray | None = None
         self._consecutive_fallbacks = 0
@@ -83,7 +95,7 @@ class FrontEnd:
         guess = se2.compose(self.track, increment)
         reg = self.follow(guess, increment, points)
         pose = guess if reg is None else reg.pose
-        if self.config.track_scans:
+        if self.config.track_scans and (reg is not None or self._velocity is not None):
             self._velocity = se2.between(self.track, pose)
         return pose, reg
 
@@ -117,10 +129,12 @@ class FrontEnd:
         target = self._back.local_map()
         limits = self.track_limits(increment)
         reg, good, _ = self.attempt(target, points, guess, *limits)
-        coasting = se2.compose(self.track, self._velocity)
+        coasting = se2.compose(self.track, np.zeros(3) if self._velocity is None else self._velocity)
         gap = se2.between(guess, coasting)
-        if cfg.track_velocity_guess and (
-            math.hypot(gap[0], gap[1]) > limits[1] / 2 or abs(gap[2]) > math.radians(limits[2] / 2)
+        if (
+            cfg.track_velocity_guess
+            and self._velocity is not None
+            and (math.hypot(gap[0], gap[1]) > limits[1] / 2 or abs(gap[2]) > math.radians(limits[2] / 2))
         ):
             alt, alt_good, _ = self.attempt(target, points, coasting, *limits)
             if alt_good and not velocity_match_allowed(alt.pose, guess, good, limits[3]):  # type: ignore[union-attr]
@@ -240,14 +254,22 @@ class FrontEnd:
         return math.hypot(corr[0], corr[1]) <= max_m and abs(corr[2]) <= math.radians(max_deg)
 
     def sequential_edge(
-        self, step: FloatArray, points: FloatArray, index: int, tracked: Registration | None
+        self,
+        step: FloatArray,
+        points: FloatArray,
+        index: int,
+        tracked: Registration | None,
+        odometry_step: FloatArray | None = None,
     ) -> tuple[FloatArray, FloatArray]:
         """The edge from the newest node to a new one: its scan match, or the guess ``step`` when the match is poor.
 
         With tracking the match is the tracking registration itself (or
         nothing: tracking failed and ``step`` is odometry since the last
         tracked scan). Without it, the node scan is matched from the odometry
-        step, retried from rotated guesses (:meth:`attempt`).
+        step, retried from rotated guesses (:meth:`attempt`). With
+        ``odometry_trust`` and the node's ``odometry_step`` (the odometry
+        increment between the two nodes), a match is fused with that step as
+        far as the odometry has earned it (:mod:`.odometry_trust`).
         """
         cfg = self.config
         if cfg.track_scans:
@@ -266,8 +288,14 @@ class FrontEnd:
         if good and reg is not None:
             self.counters["sequential_matches"] += 1
             self._consecutive_fallbacks = 0
-            covariance = np.linalg.inv(reg.information + self._seq_prior) + self._floor
-            return reg.pose, np.asarray(covariance, dtype=np.float64)
+            covariance = np.asarray(np.linalg.inv(reg.information + self._seq_prior) + self._floor, dtype=np.float64)
+            if cfg.odometry_trust and odometry_step is not None:
+                fused = self._odometry_trust.fuse(odometry_step, reg.pose, covariance)
+                self._odometry_trust.add(odometry_step, reg.pose)
+                if fused is not None:
+                    self.counters["odometry_fused"] += 1
+                    return fused
+            return reg.pose, covariance
         self.counters["odometry_fallbacks"] += 1
         self._consecutive_fallbacks += 1
         if self._consecutive_fallbacks >= cfg.max_consecutive_fallbacks:

@@ -9,6 +9,9 @@ The method of Grisetti et al. (2010), the thesis's section 2.2.3:
   increment being the initial guess and a weak prior; when the match is poor
   (not converged, low inlier fraction, large residual or an implausible
   correction) the edge is the odometry increment with a larger covariance;
+  with ``odometry_trust`` (off in the default preset) a good match is fused
+  with the odometry's heading where the odometry has shown itself the better
+  of the two (:mod:`.odometry_trust`);
 * **loop-closure edges** from ICP against the submaps of earlier nodes near
   the current estimate (:mod:`.loop_closure`), added only after strict tests
   and with a robust kernel;
@@ -41,6 +44,7 @@ from pydantic import BaseModel
 from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
+from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
@@ -74,6 +78,7 @@ class GtsamGraphMapper:
             "tracking_velocity_rejected": 0,
             "tracking_outliers_rejected": 0,
             "odometry_fallbacks": 0,
+            "odometry_fused": 0,
             "loop_candidates": 0,
             "loop_coarse_searches": 0,
             "loop_closures_accepted": 0,
@@ -122,7 +127,8 @@ class GtsamGraphMapper:
     ) -> None:
         """A new node at ``step`` from the newest; then loop closure and place recognition when they are due."""
         cfg = self.config
-        relative, covariance = self.front.sequential_edge(step, points, index, tracked)
+        odometry_step = se2.between(self.back.odometry[-1], odometry)
+        relative, covariance = self.front.sequential_edge(step, points, index, tracked, odometry_step)
         key = self.back.add_node(odometry, step, relative, covariance, points, index)
         self.front.new_node()
         self.loops.travelled(math.hypot(relative[0], relative[1]))

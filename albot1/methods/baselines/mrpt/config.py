@@ -123,6 +123,13 @@ class MrptRbpfConfig(MrptRunConfig):
             "(PF_algorithm 2); finite differences give a long axis along corridors"
         )
     )
+    icp_covariance_var_points_m2: float = Field(
+        gt=0,
+        description=(
+            "covariance_varPoints: variance of one matched point (m^2), the scale of the icpCovLinealMSE covariance "
+            "each particle is drawn from; unused by icpCovFiniteDifferences"
+        ),
+    )
     icp_max_iterations: int = Field(ge=1, description="maxIterations of the proposal's ICP (PF_algorithm 2)")
     icp_threshold_dist_m: float = Field(gt=0, description="thresholdDist of the proposal's ICP")
     icp_threshold_ang_deg: float = Field(ge=0, description="thresholdAng_DEG of the proposal's ICP")

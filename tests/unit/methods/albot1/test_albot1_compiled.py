@@ -10,6 +10,7 @@ compared in the ``slow`` lane (CI runs it).
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 import subprocess
@@ -31,6 +32,7 @@ from albot1.methods.albot1.mapping import pose_kernels
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
+from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.update import view_polygon
 from albot1.methods.albot1.perception import endpoints
 from albot1.methods.albot1.perception import kernels as perception_source
@@ -151,6 +153,54 @@ def _partial_args() -> Iterator[tuple[Any, ...]]:
                 yield (near_view, inside, view, taken, poly, math.radians(5.0), 0.4, clip, 0.4, surfaces_only)
 
 
+def _update_state(segs: np.ndarray, view: np.ndarray, with_robot: bool, surfaces_only: bool) -> tuple[Any, ...]:
+    pmap = PerceptualMap()
+    pmap.add(segs, scan=0)
+    pmap.reserve(len(view), pmap.live)
+    state = (pmap.seg, pmap.alive, pmap.added_at, pmap.slot_of, pmap.live_id, pmap.live_box, pmap.events)
+    tail = (3, 0.4, math.radians(5.0), 0.4, False, surfaces_only)
+    return (*state, pmap.n, pmap.live, pmap.n_events, view, 0.0, 0.0, with_robot, *tail)
+
+
+def _update_args() -> Iterator[tuple[Any, ...]]:
+    """Maps around real views, less the surfaces the update would edit: the kernel edits the map's arrays in
+    place, and a map it only adds to is left so that a second call repeats the first (the edits are compared
+    compiled and as written on copies in ``test_albot1_update.py``)."""
+    plain = as_written(mapping_source.update_surfaces)
+    for poly, view, segs in _map_inputs():
+        for surfaces_only in (True, False):
+            kept = segs
+            for _ in range(5):
+                args = _update_state(kept, view, len(poly) > 2 * len(view), surfaces_only)
+                edited = np.concatenate(plain(*copy.deepcopy(args))[1:4])
+                if edited.size == 0:
+                    yield args
+                    break
+                kept = np.ascontiguousarray(np.delete(kept, edited, axis=0))
+
+
+def _place_args() -> Iterator[tuple[Any, ...]]:
+    rng = np.random.default_rng(12)
+    for view in _views():
+        theta = float(rng.uniform(-4.0, 4.0))
+        yield (view.surfaces, *rng.normal(0.0, 30.0, 2).tolist(), math.cos(theta), math.sin(theta))
+
+
+def _landmark_args() -> Iterator[tuple[Any, ...]]:
+    for view in _views():
+        for min_length in (0.0, 0.4, 1.5):
+            yield (view.surfaces, view.kinds, min_length)
+
+
+def test_placing_a_view_is_transform_segments_bit_for_bit() -> None:
+    for surfaces, x, y, c, s in _place_args():
+        theta = math.atan2(s, c)
+        pose = (x, y, theta)
+        expected = segments.transform_segments(pose, surfaces)
+        got = mapping_source.place_segments(surfaces, x, y, math.cos(theta), math.sin(theta))
+        assert_same_bits(got, expected)
+
+
 def _scan_points_args() -> Iterator[tuple[Any, ...]]:
     for ranges, angles in _scans():
         for max_range, stride in ((30.0, 2), (5.0, 1), (8.0, 3)):
@@ -205,16 +255,26 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "clip_parameter": _clip_args,
     "refine_pose": _refine_args,
     "resolve_partial": _partial_args,
+    "update_surfaces": _update_args,
+    "place_segments": _place_args,
+    "landmark_rows": _landmark_args,
     "scan_points": _scan_points_args,
 }
 
 
 #: the kernels by name, as compiled (module attributes: numba dispatchers)
 KERNELS: dict[str, Any] = {
-    **{name: getattr(perception_source, name) for name in ("build_view", "recognise_landmarks")},
+    **{name: getattr(perception_source, name) for name in ("build_view", "recognise_landmarks", "landmark_rows")},
     **{
         name: getattr(mapping_source, name)
-        for name in ("classify_endpoints", "best_correspondence", "clip_parameter", "resolve_partial")
+        for name in (
+            "classify_endpoints",
+            "best_correspondence",
+            "clip_parameter",
+            "resolve_partial",
+            "update_surfaces",
+            "place_segments",
+        )
     },
     **{name: getattr(pose_kernels, name) for name in ("refine_pose", "scan_points")},
 }

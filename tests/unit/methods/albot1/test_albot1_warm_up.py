@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -28,13 +29,14 @@ def signatures(mapper):
 
 runs = [("albot1-places", "default", "synthetic-office-loop"), ("albot1", "plus", "synthetic-office-startstop"),
         ("albot1", "default", "synthetic-office-startstop")]
-warmed = None
+warmed = {}
 added = {}
 for method, preset, world in runs:
     mapper = get_method(method).load_class()(resolve_config(method, preset, None))
     mapper.warm_up()
     before = signatures(mapper)
-    warmed = warmed or before
+    for name, sigs in before.items():
+        warmed[name] = sorted(set(warmed.get(name, [])) | set(sigs))
     for frame in load_world(world):
         mapper.process(frame)
     mapper.finish()
@@ -54,4 +56,106 @@ def test_whole_runs_after_the_warm_up_compile_nothing_new() -> None:
     assert out.returncode == 0, out.stderr
     found = json.loads(out.stdout)
     assert found["added"] == {}
-    assert all(len(sigs) >= 1 for sigs in found["warmed"].values()), found["warmed"]  # every kernel warmed
+    assert all(len(sigs) >= 1 for sigs in found["warmed"].values()), found["warmed"]  # every kernel warmed by one
+
+
+_SKIPPED = """
+import json
+from albot1.methods.registry import get_method, resolve_config
+from albot1.methods.albot1.warm_up import kernel_names
+found = {}
+for preset in ("thesis", "plus"):
+    mapper = get_method("albot1").load_class()(resolve_config("albot1", preset, None))
+    mapper.warm_up()
+    found[preset] = sorted(name for k in mapper.kernels for name in kernel_names(k) if getattr(k, name).signatures)
+print(json.dumps(found))
+"""
+
+
+def test_a_thesis_preset_s_warm_up_leaves_out_the_kernels_only_albot1_plus_calls() -> None:
+    """The first run of a thesis preset does not pay for Albot1+'s pose kernels; ``plus`` warms them (in that order)."""
+    out = subprocess.run(
+        [sys.executable, "-c", _SKIPPED], env=dict(os.environ), capture_output=True, text=True, timeout=900
+    )
+    assert out.returncode == 0, out.stderr
+    found = json.loads(out.stdout)
+    assert found["thesis"] == ["build_view", "classify_endpoints", "recognise_landmarks", "resolve_partial"]
+    assert found["plus"] == sorted([*found["thesis"], "refine_pose", "scan_points"])
+
+
+def _python(code: str, cache: str, **env: str) -> str:
+    """Run ``code`` in a fresh interpreter whose user cache (numba's cache folder with it) is ``cache``."""
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        env={**os.environ, "XDG_CACHE_HOME": cache, **env},
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    assert out.returncode == 0, out.stderr
+    return out.stdout
+
+
+_LOAD = """
+import json
+from albot1.methods.albot1 import compiled
+from albot1.methods.albot1.mapping.kernels import MappingKernels
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
+from albot1.methods.albot1.warm_up import sample_calls
+sets = (PerceptionKernels(), MappingKernels())
+cached = {name: compiled.is_cached(kernel) for name, kernel, _ in sample_calls(*sets)}
+for name, kernel, args in sample_calls(*sets):
+    if cached[name]:
+        kernel(*args)
+stats = {name: [sum(kernel.stats.cache_hits.values()), sum(kernel.stats.cache_misses.values())]
+         for name, kernel, _ in sample_calls(*sets) if cached[name]}
+print(json.dumps({"cached": cached, "stats": stats}))
+"""
+
+
+def test_a_helper_s_kernels_are_loaded_from_numba_s_cache_by_the_next_process(tmp_path: Path) -> None:
+    """The mechanism of a parallel warm-up: what a helper compiles for its claims, another process loads."""
+    claims = tmp_path / "claims"
+    claims.mkdir()
+    (claims / "refine_pose").touch()  # claimed by another process: the helper leaves it
+    code = (
+        "from albot1.methods.albot1.warm_up import compile_claimed\n"
+        f"compile_claimed({str(claims)!r}, ['albot1.methods.albot1.mapping.kernels:MappingKernels'], "
+        "['refine_pose', 'scan_points'])\n"
+    )
+    _python(code, str(tmp_path))
+    found = json.loads(_python(_LOAD, str(tmp_path)))
+    assert {name for name, cached in found["cached"].items() if cached} == {"scan_points"}
+    assert found["stats"] == {"scan_points": [2, 0]}  # both warm-up signatures loaded, none compiled
+    assert sorted(p.name for p in claims.iterdir()) == ["refine_pose", "scan_points"]
+
+
+@pytest.mark.slow
+def test_a_cold_warm_up_in_two_processes_fills_the_cache_with_every_kernel(tmp_path: Path) -> None:
+    """``ALBOT1_COMPILE_PROCESSES=2`` on an empty cache: every kernel cached once, the next process compiles nothing."""
+    code = (
+        "from albot1.methods.albot1.mapping.kernels import MappingKernels\n"
+        "from albot1.methods.albot1.perception.kernels import PerceptionKernels\n"
+        "from albot1.methods.albot1.warm_up import warm_up\n"
+        "warm_up((PerceptionKernels(), MappingKernels()), print)\n"
+    )
+    said = _python(code, str(tmp_path), ALBOT1_COMPILE_PROCESSES="2").splitlines()
+    assert said[0].startswith("albot1: compiling the numba kernels once") and said[1].startswith("albot1: kernels")
+    found = json.loads(_python(_LOAD, str(tmp_path)))
+    assert all(found["cached"].values()), found["cached"]
+    assert all(misses == 0 and hits >= 1 for hits, misses in found["stats"].values()), found["stats"]
+    assert _python(code, str(tmp_path)) == ""  # a warm warm-up says nothing
+
+
+def test_the_number_of_compile_processes_comes_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None:
+    from albot1.errors import ConfigError
+    from albot1.methods.albot1 import compiled
+
+    monkeypatch.setenv(compiled.PROCESSES_ENV, " 3 ")
+    assert compiled.compile_processes() == 3
+    for bad in ("0", "-1", "two", "1.5"):
+        monkeypatch.setenv(compiled.PROCESSES_ENV, bad)
+        with pytest.raises(ConfigError, match=f"ALBOT1_COMPILE_PROCESSES='{bad}': expected a whole number"):
+            compiled.compile_processes()
+    monkeypatch.delenv(compiled.PROCESSES_ENV)
+    assert compiled.compile_processes() >= 1

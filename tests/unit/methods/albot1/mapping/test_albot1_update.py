@@ -8,6 +8,7 @@ from typing import Literal
 import numpy as np
 import pytest
 
+from albot1.methods.albot1.mapping.kernels import MappingKernels
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.update import UpdateParams, update_map, view_polygon
 
@@ -134,3 +135,55 @@ def test_perceptual_map_grows_past_its_initial_capacity() -> None:
     ids = pmap.add(segs, scan=0)
     assert ids[-1] == 599 and len(pmap) == 600
     np.testing.assert_array_equal(pmap.segments(), segs)
+
+
+def _random_view(rng: np.random.Generator, robot: np.ndarray) -> np.ndarray:
+    """Surfaces around ``robot``, left to right like a view: a chain of endpoints at decreasing bearings."""
+    bearings = np.sort(rng.uniform(-1.4, 1.4, 2 * int(rng.integers(1, 8))))[::-1] + math.pi / 2
+    ranges = rng.uniform(0.5, 4.0, bearings.size)
+    pts = robot + np.column_stack([ranges * np.cos(bearings), ranges * np.sin(bearings)])
+    return np.ascontiguousarray(pts.reshape(-1, 4))
+
+
+@pytest.mark.parametrize("clip", ["clip", "keep"])
+@pytest.mark.parametrize("margin_from", ["surfaces", "boundary"])
+@pytest.mark.parametrize("polygon", ["robot_and_endpoints", "endpoints"])
+def test_update_compiled_and_as_written_edit_the_map_identically(clip: str, margin_from: str, polygon: str) -> None:
+    """The update kernel edits the map's arrays in place: 40 updates on two copies, compared bit for bit."""
+    params = UpdateParams(partial_without_match=clip, margin_from=margin_from, polygon=polygon)  # type: ignore[arg-type]
+    rng = np.random.default_rng(3)
+    maps = (PerceptualMap(), PerceptualMap())
+    for pmap in maps:
+        pmap.add(np.random.default_rng(4).uniform(-4.0, 4.0, (60, 4)), scan=0)
+    kernel_sets = (MappingKernels(True), MappingKernels(False))
+    edits = 0
+    for scan in range(1, 41):
+        robot = rng.uniform(-3.0, 3.0, 2)
+        view = _random_view(rng, robot)
+        fast, slow = (update_map(p, view, (robot[0], robot[1]), scan, params, k) for p, k in zip(maps, kernel_sets))
+        for name in ("view_ids", "deleted", "extended", "trimmed", "added"):
+            np.testing.assert_array_equal(getattr(fast, name), getattr(slow, name))
+        edits += len(fast.deleted) + len(fast.extended) + len(fast.trimmed)
+    a, b = maps
+    assert (a.n, a.live, a.n_events) == (b.n, b.live, b.n_events)
+    np.testing.assert_array_equal(a.seg[: a.n].view(np.int64), b.seg[: b.n].view(np.int64))
+    np.testing.assert_array_equal(a.live_id[: a.live], b.live_id[: b.live])
+    np.testing.assert_array_equal(a.events[: a.n_events], b.events[: b.n_events])
+    assert a.properties() == b.properties()
+    assert edits > 40  # the updates did delete, extend or trim
+
+
+def test_update_matches_the_per_surface_operations() -> None:
+    """The compiled update leaves the map as deleting, replacing and adding surface by surface would."""
+    pmap, _ = build_map()
+    ref, _ = build_map()
+    out = update_map(pmap, VIEW, (0.0, 0.0), scan=7, params=UpdateParams())
+    for sid in out.deleted.tolist():
+        ref.delete(sid, 7)
+    for event, ids in (("extended", out.extended), ("trimmed", out.trimmed)):
+        for sid in ids.tolist():
+            ref.replace(sid, pmap.segments(np.array([sid]))[0], 7, event)
+    assert ref.add(VIEW[out.view_ids >= len(MAP)], 7).tolist() == out.added.tolist()
+    assert ref.ids().tolist() == pmap.ids().tolist() and ref.properties() == pmap.properties()
+    for box in ((-5.0, -5.0, 5.0, 5.0), (-0.6, 1.9, 0.6, 2.1), (0.0, 3.0, 0.0, 3.0)):
+        assert ref.query(*box).tolist() == pmap.query(*box).tolist()

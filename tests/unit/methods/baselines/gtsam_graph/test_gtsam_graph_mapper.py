@@ -233,3 +233,28 @@ def test_place_recognition_searches_far_along_the_graph_and_keeps_the_room_strai
         np.testing.assert_allclose(mapper.back.graph_distances(last), path[last] - path, atol=1e-5)
     else:
         assert (mapper.back.graph_distances(last) <= path[last] - path + 1e-5).all()
+
+
+def test_no_velocity_guess_before_a_motion_was_tracked(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The first scans' velocity is unknown, not zero: only the odometry guess is tried until one scan is tracked.
+
+    edmonton-corrected[::3] moves 3 m between its first scans; a "standing still" guess matched the corridor 3 m
+    short and won because the odometry guess's match had failed.
+    """
+    seq = list(room_sequence(scans=3, odometry_bias_deg=0.0).frames())
+    mapper = GtsamGraphMapper(config())
+    tried: list[np.ndarray] = []
+    attempt = mapper.front.attempt
+
+    def record(target: object, points: object, guess: np.ndarray, *args: object, **kw: object) -> object:
+        tried.append(np.array(guess))
+        return attempt(target, points, guess, *args, **kw)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(mapper.front, "attempt", record)
+    mapper.process(seq[0])
+    # scan 1 arrives with an odometry jump of 3 m (the robot was not seen moving): one guess only
+    jumped = Frame(1, seq[1].scan, se2.compose(seq[0].odometry, np.array([3.0, 0.0, 0.0])), seq[1].reference)
+    mapper.process(jumped)
+    assert len(tried) == 1
+    assert np.allclose(tried[0], [3.0, 0.0, 0.0])
+    assert mapper.counters["tracking_velocity_guess"] == 0

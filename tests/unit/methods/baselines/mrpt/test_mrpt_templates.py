@@ -39,6 +39,14 @@ def test_rbpf_ini_has_one_update_threshold_and_the_seed() -> None:
     assert ini["resolution"] == "0.07" and ini["SHOW_PROGRESS_IN_WINDOW"] == "0"
 
 
+def test_rbpf_ini_carries_the_proposal_and_weight_settings() -> None:
+    config = MrptRbpfConfig.model_validate(MrptRbpfMapper.presets["default"])
+    changed = config.model_copy(update={"icp_covariance_var_points_m2": 0.01, "pow_factor": 1.0})
+    ini = _ini(render("rbpf-slam", changed, rawlog_file="in.rawlog", output_dir="out", seed=0))
+    assert ini["covariance_varPoints"] == "0.01" and ini["powFactor"] == "1.0"
+    assert ini["ICP_covariance_method"] == "icpCovFiniteDifferences" and ini["PF_algorithm"] == "2"
+
+
 class _Extra(BaseModel):
     surplus_m: float = 1.0
 
