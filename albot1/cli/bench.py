@@ -148,6 +148,9 @@ def report(
             "degradation, seeds and status always show; cells.csv keeps every column)"
         ),
     ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="build everything again, trusting no stamp of an earlier build")
+    ] = False,
 ) -> None:
     """Build tables (Markdown, CSV, LaTeX), plots (PNG and SVG), README.md and index.html from a results folder.
 
@@ -157,28 +160,44 @@ def report(
     --columns narrows the tables (Markdown, CSV, LaTeX and HTML) to the named columns; a wrong key
     is an error that lists the valid ones (docs/benchmarking.md, "Tables").
 
+    Incremental: when nothing the report is built from changed since its last build (the store's
+    files by content, the code, the options) and its files are untouched, nothing is rebuilt;
+    otherwise only the figures whose own runs changed are drawn again. --force rebuilds it all
+    (same bytes).
+
     Examples:\n
       albot1 report results/default -j 2   # -> reports/default/index.html\n
       albot1 report results/quick --out /tmp/quick-report --map-style points\n
       albot1 report results/quick --columns ate_rmse_m,loop_gap_m,total_s
     """
     # Imported by the command, not by this module: see albot1.cli.app.
-    from albot1.bench.store import ResultsStore
-    from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS
-    from albot1.report.column_selection import ALL_COLUMNS, parse_columns
-    from albot1.report.index import build_report, default_out
-    from albot1.report.map_plots import MapStyle
+    from albot1.report import rebuild
+    from albot1.report.folders import default_out
 
     if map_style not in ("grid", "points"):
         raise typer.BadParameter(f"--map-style {map_style!r}: expected grid or points")
-    selection = ALL_COLUMNS if columns is None else parse_columns(columns, {**METRIC_COLUMNS, **COST_COLUMNS})
+    target = out if out is not None else default_out(results_dir)
+    if not force:  # the check reads the stamp and the store's files, and imports nothing heavy
+        page = rebuild.current_report(results_dir, target, plots=plots, map_style=map_style, columns=columns)
+        if page is not None:
+            typer.echo(f"report: {page} (up to date: nothing it is built from changed)")
+            return
+    from albot1.bench.store import ResultsStore
+
+    rebuild.column_selection(columns)  # a wrong key: say so first
     ResultsStore(results_dir).read_plan()  # not a results folder: say so before making the report folder
-    writable_folder(out if out is not None else default_out(results_dir), "--out")
-    style: MapStyle = "grid" if map_style == "grid" else "points"
+    writable_folder(target, "--out")
     bar = FigureBar()
     try:
-        index = build_report(
-            results_dir, out, plots=plots, map_style=style, jobs=jobs, progress=bar.update, columns=selection
+        index = rebuild.report(
+            results_dir,
+            out,
+            plots=plots,
+            map_style=map_style,
+            columns=columns,
+            jobs=jobs,
+            progress=bar.update,
+            force=force,
         )
     finally:
         bar.close()

@@ -23,6 +23,9 @@ def results_page(
     readme: Annotated[
         Path | None, typer.Option(help="a README whose results block (between the markers) is rewritten")
     ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="write everything again, trusting no stamp of an earlier run")
+    ] = False,
 ) -> None:
     """Write docs/results.md, docs/results/*.svg and results.json from the stores `make bench` filled.
 
@@ -30,17 +33,24 @@ def results_page(
 
     With --readme, the block between the results:begin and results:end markers is rewritten too.
 
+    Incremental: when neither store, the code, the options nor the written files changed since the
+    last run (stamp: <dir>/results/build.json), nothing is read or drawn again.
+
     Example:\n
       albot1 results-page results/default --thesis results/thesis \\
           --readme README.md
     """
     # Imported by the command, not by this module: see albot1.cli.app.
+    from albot1.report import rebuild
+
+    if not force:  # the check reads the stamp and the stores' files, and imports nothing heavy
+        current = rebuild.current_results_page(default, thesis, out, readme)
+        if current is not None:
+            for path in current:
+                typer.echo(f"results-page: {path} (up to date)")
+            return
     from albot1.bench.store import ResultsStore
-    from albot1.report.results_data import build_data
-    from albot1.report.results_page import write_results
 
     ResultsStore(default).read_plan()  # not a results folder: say so in one line
-    command = f"albot1 results-page {default.as_posix()}" + (f" --thesis {thesis.as_posix()}" if thesis else "")
-    data = build_data(default, thesis, command)
-    for path in write_results(data, out, readme):
+    for path in rebuild.results_page(default, thesis, out, readme):
         typer.echo(f"results-page: {path}")

@@ -232,6 +232,20 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
     return plan, records
 
 
+def as_of(records: list[CellRecord]) -> str:
+    """When the newest of ``records``' cells finished (``attempt.json``), as a report's date line says it.
+
+    A report states the date of its data, not the clock's: a report built
+    again from the same store is then the same bytes (a re-run of `make bench`
+    with nothing new changes nothing, and skips the build: albot1.report.build_stamp).
+    """
+    finished = [r.attempt.finished for r in records if r.attempt is not None and r.attempt.finished]
+    if not finished:
+        return "no cell has finished"
+    newest = max(finished)  # ISO 8601 UTC (2026-11-27T02:34:33Z): the text order is the time order
+    return f"newest cell finished {newest[:10]} {newest[11:16]} UTC"
+
+
 def cell_columns() -> list[str]:
     """The keys of a :func:`cell_rows` row, in order (the columns of an empty table too)."""
     columns = ["dataset", "method", "degradation", "seed", "status", "key", "scans"]

@@ -12,7 +12,10 @@ differs, when any file it made is missing, or when the stamp file cannot be
 read; a stamp is never trusted beyond that.
 
 The stamps are one JSON file (:data:`STAMPS`) beside the figures, written
-atomically once the figures are on disk.
+atomically once the figures are on disk. A group whose drawing could not be
+kept (a figure that failed: its reason is worked out again next time) is
+named in the stamps as unsettled, so that the report it belongs to is not
+skipped as a whole next time (:mod:`albot1.report.build_stamp`).
 """
 
 from __future__ import annotations
@@ -77,6 +80,8 @@ class FigureCache:
         self.stamps = folder / STAMPS
         self._groups: dict[str, dict[str, Any]] = self._read()
         self._changed = False
+        self._unsettled: set[str] = set()
+        self._was_unsettled = self._read_unsettled()
 
     def _read(self) -> dict[str, dict[str, Any]]:
         try:
@@ -89,6 +94,14 @@ class FigureCache:
         if not isinstance(groups, dict):
             return {}
         return {k: v for k, v in groups.items() if isinstance(v, dict)}
+
+    def _read_unsettled(self) -> set[str]:
+        try:
+            data = json.loads(self.stamps.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return set()
+        found = data.get("unsettled") if isinstance(data, dict) else None
+        return {str(g) for g in found} if isinstance(found, list) else set()
 
     def name(self, path: Path) -> str:
         """How a file is stored: relative to the folder when inside it (the report can move), else absolute."""
@@ -123,12 +136,19 @@ class FigureCache:
                 if path.is_file():
                     names.append(self.name(path))
         self._groups[group] = {"digest": digest, "files": sorted(set(names)), "payload": payload}
+        self._unsettled.discard(group)
         self._changed = True
 
+    def unsettled(self, group: str) -> None:
+        """Say that ``group`` was drawn but could not be kept (a failed drawing): the next build must try again."""
+        self._groups.pop(group, None)
+        self._unsettled.add(group)
+
     def save(self) -> None:
-        """Write the stamps (atomically) when a group was stored since they were read."""
-        if not self._changed:
+        """Write the stamps (atomically) when a group was stored or the unsettled groups changed since read."""
+        if not self._changed and self._unsettled == self._was_unsettled:
             return
-        document = {"version": STAMPS_VERSION, "groups": self._groups}
+        document = {"version": STAMPS_VERSION, "groups": self._groups, "unsettled": sorted(self._unsettled)}
         atomic_write(self.stamps, lambda tmp: tmp.write_text(json.dumps(document, indent=1, sort_keys=True)))
         self._changed = False
+        self._was_unsettled = set(self._unsettled)

@@ -25,12 +25,11 @@ from __future__ import annotations
 import html
 import math
 import os
-import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from albot1.bench.grid import GridPlan
-from albot1.report.collect import CellRecord, Column
+from albot1.report.collect import CellRecord, Column, as_of
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.external_notes import external_html
 from albot1.report.interactive_page import VIEWS_DIR, View, view_html, views_scripts
@@ -250,8 +249,8 @@ def write_html(
         f"<style>{STYLE}</style></head><body>",
         f"<h1>Benchmark report: suite <code>{_e(plan.suite)}</code></h1>",
         f"<p>{_e(plan.description.strip())}</p>" if plan.description.strip() else "",
-        f'<p class="meta">Generated {_e(time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()))} from '
-        f"<code>{_e(results_dir)}</code> (suite file <code>{_e(plan.suite_path)}</code>). "
+        f'<p class="meta">Generated from <code>{_e(results_dir)}</code> ({_e(as_of(records))}; '
+        f"suite file <code>{_e(plan.suite_path)}</code>). "
         f"Cells: {len(records)} planned, {counts['done']} complete, {counts['failed']} failed, "
         f"{counts['not run']} not run.</p>",
         "<nav>"

@@ -12,7 +12,6 @@ with the tables and every plot, for a browser.
 from __future__ import annotations
 
 import multiprocessing
-import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -20,11 +19,12 @@ from pathlib import Path
 import pandas as pd
 
 from albot1.bench.grid import GridPlan
-from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, collect
+from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, as_of, collect
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
 from albot1.report.external_notes import external_markdown
 from albot1.report.figure_cache import FigureCache, inputs_digest
+from albot1.report.folders import default_out
 from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
 from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
 from albot1.report.generalisation import write_generalisation
@@ -48,22 +48,14 @@ from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance,
 from albot1.report.tuning import held_in
 from albot1.versions import commit_label
 
-REPORTS_ROOT = Path("reports")
+#: Told ``(datasets whose figures are drawn, datasets to draw)`` while the report draws its figures.
+PlotProgress = Callable[[int, int], None]
 #: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
 ROBUSTNESS = (
     ("ate_rmse_m", "ATE RMSE (m)", "robustness-ate"),
     ("drift_10m_m", "RPE per 10 m, translation (m)", "robustness-drift"),
     ("loop_gap_m", "loop gap (m)", "robustness-loop-gap"),
 )
-
-
-#: Told ``(datasets whose figures are drawn, datasets to draw)`` while the report draws its figures.
-PlotProgress = Callable[[int, int], None]
-
-
-def default_out(results_dir: Path) -> Path:
-    """``results/<suite>`` -> ``reports/<suite>`` (relative to the working directory, as `make bench` runs)."""
-    return REPORTS_ROOT / Path(results_dir).resolve().name
 
 
 def _rel(path: Path, start: Path) -> str:
@@ -230,8 +222,7 @@ def write_index(
         "",
         text(plan.description.strip()) if plan.description.strip() else "",
         "",
-        f"Generated {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from {code(results_dir)} "
-        f"(suite file {code(plan.suite_path)}).",
+        f"Generated from {code(results_dir)} ({as_of(records)}; suite file {code(plan.suite_path)}).",
         "",
         f"Cells: {len(records)} planned, {counts['done']} complete, {counts['failed']} failed, "
         f"{counts['not run']} not run.",

@@ -12,14 +12,13 @@ link of the page resolves.
 from __future__ import annotations
 
 import json
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from albot1.errors import Albot1Error
 from albot1.metrics.measures.map_shape import METRIC as MAP_SHAPE
 from albot1.metrics.measures.orientation import METRIC as ORIENTATION
-from albot1.report.collect import CellRecord
+from albot1.report.collect import CellRecord, as_of
 from albot1.report.errors import ReportError
 from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.html import rel
@@ -216,6 +215,8 @@ def _cached_draw(figures: _Figures, cache: FigureCache, request: FigureRequest) 
             [d.path for d in drawn if d.path],
             [[d.caption, cache.name(d.path), d.reason] for d in drawn if d.path],
         )
+    else:
+        cache.unsettled(group)  # the report is not skipped as a whole until this figure is drawn
     return drawn
 
 
@@ -410,8 +411,10 @@ def write_thesis_page(
         "**not comparable** (with the reason: a metric that does not apply, a method not installed, a run not "
         "made). How each verdict is computed: docs/thesis-reproduction.md.",
         "",
-        f"Generated {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from "
-        + ", ".join(f"`{s.path}` (suite `{s.plan.suite}`, code `{s.code_version}`)" for s in ev.stores)
+        "Generated from "
+        + ", ".join(
+            f"`{s.path}` (suite `{s.plan.suite}`, code `{s.code_version}`, {as_of(s.records)})" for s in ev.stores
+        )
         + ".",
         "",
         f"Verdicts: {_counts(sections)}.",

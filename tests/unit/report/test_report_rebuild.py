@@ -1,0 +1,91 @@
+"""An incremental report is the report a full rebuild gives, and is built only when something changed.
+
+A tiny store made by the real planner and cell executor (dead reckoning on a
+small synthetic world, two seeds) is reported into one folder: the second
+`albot1 report` builds nothing; after one cell's metrics change the report is
+built again and is byte for byte what ``--force`` (everything read and drawn
+again) gives; a deleted output is written again (albot1.report.rebuild).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from albot1.bench.cells import execute_cell
+from albot1.bench.plan import plan_suite
+from albot1.bench.store import ResultsStore
+from albot1.bench.suite import parse_suite
+from albot1.cli.app import app
+from albot1.report import rebuild
+from albot1.report.build_stamp import STAMP
+from albot1.report.figure_cache import STAMPS
+from albot1.settings import get_settings
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    data = {
+        "description": "one world, dead reckoning",
+        "grid": {"degradations": ["gauss:0.05:1"], "seeds": [0, 1]},
+        "methods": [{"name": "odometry"}],
+        "datasets": [{"name": "synthetic-corridor"}],
+    }
+    plan = plan_suite(parse_suite(data, name="tiny", source="tiny.toml"), get_settings())
+    root = tmp_path_factory.mktemp("results") / "tiny"
+    store = ResultsStore(root)
+    store.write_plan(plan)
+    for cell in plan.cells:
+        execute_cell(cell, store.runs)
+    return root
+
+
+def _contents(folder: Path) -> dict[str, bytes]:
+    """Every file of a report but the stamps (they hold modification times)."""
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and p.name not in (STAMP, STAMPS)
+    }
+
+
+@pytest.mark.slow
+def test_an_incremental_report_equals_a_full_rebuild(results: Path, tmp_path: Path) -> None:
+    out = tmp_path / "report"
+    runner = CliRunner()
+    first = runner.invoke(app, ["report", str(results), "--out", str(out)])
+    assert first.exit_code == 0, first.output
+    assert "up to date" not in first.output
+    assert rebuild.current_report(results, out) == out / "README.md"
+
+    again = runner.invoke(app, ["report", str(results), "--out", str(out)])
+    assert again.exit_code == 0, again.output
+    assert f"report: {out / 'README.md'} (up to date: nothing it is built from changed)" in again.output
+    before = _contents(out)
+
+    ResultsStore(results).write_plan(ResultsStore(results).read_plan())  # what every `albot1 bench` does
+    assert rebuild.current_report(results, out) == out / "README.md"
+    assert rebuild.current_report(results, out, map_style="points") is None
+
+    # one cell evaluated again with another number
+    metrics = sorted(results.rglob("metrics.json"))[0]
+    record = json.loads(metrics.read_text())
+    record["ate"]["rmse_m"] = record["ate"]["rmse_m"] * 2 + 1
+    metrics.write_text(json.dumps(record, indent=2))
+    assert rebuild.current_report(results, out) is None
+    rebuild.report(results, out)
+    incremental = _contents(out)
+    assert incremental != before
+    assert incremental["cells.csv"] != before["cells.csv"]
+
+    rebuild.report(results, out, force=True)
+    assert _contents(out) == incremental
+
+    (out / "metrics.tex").unlink()
+    assert rebuild.current_report(results, out) is None
+    rebuild.report(results, out)
+    assert _contents(out) == incremental
+    assert rebuild.current_report(results, out) == out / "README.md"
