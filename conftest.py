@@ -150,8 +150,9 @@ def _decoded_cache_of_the_session(tmp_path_factory: pytest.TempPathFactory) -> I
 
 #: the decoded-log cache's variable (albot1.settings; not imported here, to keep the controller's start-up light)
 DECODED_CACHE_ENV = "ALBOT1_DECODED_CACHE"
-#: set by the controller for its workers: a file kept locked while the Albot1 kernels are being compiled
-KERNELS_LOCK_ENV = "ALBOT1_TEST_KERNELS_LOCK"
+#: set by the controller for its workers: a file kept locked while the Albot1 kernels are being compiled (not
+#: an ALBOT1_ name: those are read as method settings)
+KERNELS_LOCK_ENV = "PYTEST_ALBOT1_KERNELS_LOCK"
 #: the longest a worker waits for the controller's compilation before it goes on (and compiles what it needs)
 KERNELS_WAIT_S = 600.0
 
