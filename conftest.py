@@ -12,15 +12,10 @@ the derived list against the manifests folder and the datasets README.
 
 from __future__ import annotations
 
-import contextlib
-import fcntl
 import importlib
 import os
 import shutil
-import subprocess
-import sys
 import tempfile
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -146,44 +141,17 @@ def _decoded_cache_of_the_session(tmp_path_factory: pytest.TempPathFactory) -> I
         yield
 
 
-# -- what the xdist controller does once before its workers start ---------------------------------------------------
+# -- what the xdist controller does before its workers start ---------------------------------------------------
 
 #: the decoded-log cache's variable (albot1.settings; not imported here, to keep the controller's start-up light)
 DECODED_CACHE_ENV = "ALBOT1_DECODED_CACHE"
-#: set by the controller for its workers: a file kept locked while the Albot1 kernels are being compiled (not
-#: an ALBOT1_ name: those are read as method settings)
-KERNELS_LOCK_ENV = "PYTEST_ALBOT1_KERNELS_LOCK"
-#: the longest a worker waits for the controller's compilation before it goes on (and compiles what it needs)
-KERNELS_WAIT_S = 600.0
-
-#: One share of the Albot1 kernels, called once each with the mappers' argument types (the warm-up's own samples):
-#: numba compiles it into its on-disk cache, or loads it when the cache already holds it. Run as a script.
-_COMPILE_SHARE = """
-import sys
-from albot1.methods.albot1.mapping.kernels import MappingKernels
-from albot1.methods.albot1.perception.kernels import PerceptionKernels
-from albot1.methods.albot1.places.kernels import PlacesKernels
-from albot1.methods.albot1.warm_up import sample_calls
-
-share, shares = int(sys.argv[1]), int(sys.argv[2])
-sets = (PerceptionKernels(), MappingKernels(), PlacesKernels())
-names = sorted({name for name, _, _ in sample_calls(*sets)})[share::shares]
-for name, kernel, args in sample_calls(*sets):
-    if name in names:
-        kernel(*args)
-"""
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """On the xdist controller of a run with workers: one decoded-log folder for all, and the kernels compiled once.
+    """On the xdist controller of a run with workers: one decoded-log folder for all of them.
 
-    Numba's cache is keyed by the code version and by the kernels' source file stamps, so on a fresh clone it is
-    cold: every process that needs a kernel before it is cached compiles it again (~15 CPU-seconds for all of
-    them), i.e. each worker and each bench forkserver or CLI process started early in the run. Here the
-    kernels are compiled once, split over one process per worker, while the workers start and collect; each
-    worker waits for them before its first test (:func:`_kernels_compiled`). With a warm cache the processes
-    only load it (about a second). A compilation that fails is not an error of the run: the tests that need
-    the kernels then compile them, and the kernels' own tests report what is wrong.
+    Each worker would otherwise decode the public logs it opens into a folder of its own
+    (:func:`_decoded_cache_of_the_session`); the workers inherit the controller's environment.
     """
     workers = getattr(config.option, "numprocesses", None) or 0
     if hasattr(config, "workerinput") or workers < 1 or config.option.collectonly:
@@ -192,56 +160,12 @@ def pytest_configure(config: pytest.Config) -> None:
     config.stash[_SESSION_FOLDER] = folder
     if not os.environ.get(DECODED_CACHE_ENV):
         os.environ[DECODED_CACHE_ENV] = str(folder / "decoded")
-    lock = folder / "kernels.lock"
-    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o600)
-    try:
-        # The lock belongs to the open file, which the compiling processes inherit: it is released when the
-        # last of them ends, however it ends.
-        fcntl.flock(fd, fcntl.LOCK_EX)
-        shares = min(workers, os.cpu_count() or 1)
-        config.stash[_COMPILERS] = [
-            subprocess.Popen(
-                [sys.executable, "-c", _COMPILE_SHARE, str(share), str(shares)],
-                pass_fds=(fd,),
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL,
-            )
-            for share in range(shares)
-        ]
-    finally:
-        os.close(fd)
-    os.environ[KERNELS_LOCK_ENV] = str(lock)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    for process in config.stash.get(_COMPILERS, []):
-        with contextlib.suppress(subprocess.TimeoutExpired):
-            process.wait(timeout=KERNELS_WAIT_S)
-        if process.poll() is None:
-            process.kill()
-            process.wait()
     folder = config.stash.get(_SESSION_FOLDER, None)
     if folder is not None:
         shutil.rmtree(folder, ignore_errors=True)
 
 
 _SESSION_FOLDER = pytest.StashKey[Path]()
-_COMPILERS = pytest.StashKey[list[subprocess.Popen[bytes]]]()
-
-
-@pytest.fixture(scope="session", autouse=True)
-def _kernels_compiled() -> None:
-    """An xdist worker starts its first test once the controller's compilation of the kernels has ended."""
-    path = os.environ.get(KERNELS_LOCK_ENV)
-    if not path or not Path(path).exists():
-        return
-    deadline = time.monotonic() + KERNELS_WAIT_S
-    with open(path, "rb") as lock:
-        while time.monotonic() < deadline:
-            try:
-                fcntl.flock(lock, fcntl.LOCK_SH | fcntl.LOCK_NB)
-            except BlockingIOError:
-                time.sleep(0.1)
-                continue
-            fcntl.flock(lock, fcntl.LOCK_UN)
-            return
