@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import importlib
 import os
+import shutil
+import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -128,8 +130,42 @@ def _module(item: pytest.Item) -> str | None:
 
 @pytest.fixture(scope="session", autouse=True)
 def _decoded_cache_of_the_session(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
-    """Decoded logs go to one folder per test session (not the user's cache), unless ALBOT1_DECODED_CACHE says."""
+    """Decoded logs go to one folder per test session (not the user's cache), unless ALBOT1_DECODED_CACHE says.
+
+    Under pytest-xdist the controller makes that folder (:func:`pytest_configure`) and every worker inherits it, so
+    a log decoded by one worker is read back by the others instead of being decoded once per worker.
+    """
     with pytest.MonkeyPatch.context() as patch:
-        if not os.environ.get("ALBOT1_DECODED_CACHE"):
-            patch.setenv("ALBOT1_DECODED_CACHE", str(tmp_path_factory.mktemp("decoded")))
+        if not os.environ.get(DECODED_CACHE_ENV):
+            patch.setenv(DECODED_CACHE_ENV, str(tmp_path_factory.mktemp("decoded")))
         yield
+
+
+# -- what the xdist controller does before its workers start ---------------------------------------------------
+
+#: the decoded-log cache's variable (albot1.settings; not imported here, to keep the controller's start-up light)
+DECODED_CACHE_ENV = "ALBOT1_DECODED_CACHE"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """On the xdist controller of a run with workers: one decoded-log folder for all of them.
+
+    Each worker would otherwise decode the public logs it opens into a folder of its own
+    (:func:`_decoded_cache_of_the_session`); the workers inherit the controller's environment.
+    """
+    workers = getattr(config.option, "numprocesses", None) or 0
+    if hasattr(config, "workerinput") or workers < 1 or config.option.collectonly:
+        return
+    folder = Path(tempfile.mkdtemp(prefix="albot1-test-session-"))
+    config.stash[_SESSION_FOLDER] = folder
+    if not os.environ.get(DECODED_CACHE_ENV):
+        os.environ[DECODED_CACHE_ENV] = str(folder / "decoded")
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    folder = config.stash.get(_SESSION_FOLDER, None)
+    if folder is not None:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+_SESSION_FOLDER = pytest.StashKey[Path]()

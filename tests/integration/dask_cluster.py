@@ -56,11 +56,14 @@ class Cluster:
         return self.address
 
     def start_worker(
-        self, *, wrap: list[str] | None = None, env: dict[str, str] | None = None
+        self, *, wrap: list[str] | None = None, env: dict[str, str] | None = None, death_timeout_s: int = 30
     ) -> subprocess.Popen[bytes]:
-        """One single-threaded worker without a nanny; ``wrap`` prefixes the command (e.g. a mount namespace)."""
+        """One single-threaded worker without a nanny; ``wrap`` prefixes the command (e.g. a mount namespace).
+
+        ``death_timeout_s``: how long the worker tries to reach a scheduler it lost (or never reached) before it stops.
+        """
         command = [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads", "1"]
-        command += ["--no-nanny", "--host", "127.0.0.1", "--no-dashboard", "--death-timeout", "30"]
+        command += ["--no-nanny", "--host", "127.0.0.1", "--no-dashboard", "--death-timeout", str(death_timeout_s)]
         worker = self._start([*(wrap or []), *command], f"worker{len(self.workers)}", env)
         self.workers.append(worker)
         return worker

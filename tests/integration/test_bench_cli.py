@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from albot1.cli.app import app
+from albot1.cli.app import app, main
 
 
 def test_dry_run_lists_the_planned_cells_without_running_them(tmp_path: Path) -> None:
@@ -116,6 +116,25 @@ def _albot1(tmp_path: Path, *args: str) -> subprocess.CompletedProcess[str]:
     )
 
 
+def _albot1_in_process(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], *args: str
+) -> subprocess.CompletedProcess[str]:
+    """The console entry :func:`main` run in this process (in ``tmp_path``): its exit status and its output.
+
+    For the refusals that happen before any cell starts, where what is checked is the message and the
+    exit status of :func:`main`'s error handling, not the process around it (a fresh interpreter per case
+    costs ~1.5 s of imports; ``test_errors_are_one_line_on_stderr_with_exit_1`` runs the real process).
+    """
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["albot1", *args])
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exited:
+        main()
+    out, err = capsys.readouterr()
+    code = exited.value.code
+    return subprocess.CompletedProcess(["albot1", *args], code if isinstance(code, int) else 1, out, err)
+
+
 def _one_line(done: subprocess.CompletedProcess[str]) -> str:
     assert done.returncode == 1, done.stderr
     lines = done.stderr.strip().splitlines()
@@ -123,7 +142,9 @@ def _one_line(done: subprocess.CompletedProcess[str]) -> str:
     return lines[0]
 
 
-def test_suites_that_name_nothing_or_escape_the_results_folder_are_one_line_errors(tmp_path: Path) -> None:
+def test_suites_that_name_nothing_or_escape_the_results_folder_are_one_line_errors(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     body = '[[methods]]\nname = "odometry"\n[[datasets]]\nname = "{}"\n'
     for name, text, words in (
         ("glob", body.format("synthetic-offce-*"), "dataset entry 0 ('synthetic-offce-*') matches no dataset"),
@@ -137,18 +158,25 @@ def test_suites_that_name_nothing_or_escape_the_results_folder_are_one_line_erro
     ):
         suite = tmp_path / f"{name}.toml"
         suite.write_text(text)
-        assert words in _one_line(_albot1(tmp_path, "bench", str(suite), "--results", "results", "--no-progress"))
+        done = _albot1_in_process(
+            tmp_path, monkeypatch, capsys, "bench", str(suite), "--results", "results", "--no-progress"
+        )
+        assert words in _one_line(done)
     assert not (tmp_path / "grid.json").exists() and not (tmp_path / "results").exists()
 
 
-def test_results_that_cannot_be_a_folder_are_refused_before_planning(tmp_path: Path) -> None:
+def test_results_that_cannot_be_a_folder_are_refused_before_planning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     (tmp_path / "results").write_text("a file")
-    line = _one_line(_albot1(tmp_path, "bench", "quick", "--results", "results", "--no-progress"))
+    line = _one_line(
+        _albot1_in_process(tmp_path, monkeypatch, capsys, "bench", "quick", "--results", "results", "--no-progress")
+    )
     assert line == (
         "albot1: error: --results results: is a file, not a folder; expected a folder this user can write to "
         "(it is made when missing)"
     )
-    line = _one_line(_albot1(tmp_path, "report", "results"))
+    line = _one_line(_albot1_in_process(tmp_path, monkeypatch, capsys, "report", "results"))
     assert "not a results folder" in line or "no grid.json" in line
 
 

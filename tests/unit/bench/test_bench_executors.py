@@ -11,7 +11,6 @@ from types import SimpleNamespace
 from typing import Any
 
 import pytest
-from distributed import KilledWorker
 from test_bench_failures import make_cell, plan_of
 
 from albot1.bench.errors import BenchError
@@ -40,6 +39,8 @@ def test_scheduler_and_another_executor_together_are_refused() -> None:
 
 
 def test_a_killed_worker_fails_its_cell_only_with_one_line() -> None:
+    from distributed import KilledWorker  # here, not at collection: distributed takes ~0.4 s to import
+
     exc = KilledWorker("_unless_halted-1", SimpleNamespace(address="tcp://127.0.0.1:1"), allowed_failures=0)
     with cf.ThreadPoolExecutor(1) as pool:
         reason, halts = executor_failure(exc, pool)

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import pytest
 
-from albot1.bench import preload
 from albot1.bench.cells import renderer_target
 from albot1.data.loaders.registry import FORMATS, WRITE_ONLY_FORMATS
 from albot1.methods.registry import MethodRegistry, MethodSpec, method_registry
@@ -67,6 +66,10 @@ def by_name_imports(registry: MethodRegistry) -> list[tuple[str, str, str]]:
     for loader, writer in FORMATS.values():
         out += [("albot1.data.loaders.registry", _module(t), "format") for t in (loader, writer) if t]
     out += [("albot1.data.loaders.registry", _module(t), "format") for t in WRITE_ONLY_FORMATS.values()]
+    # Imported here, not at collection: importing the preload module preloads every method (its purpose in the
+    # forkserver), a cost every xdist worker would pay while collecting.
+    from albot1.bench import preload
+
     out += [("albot1.bench.preload", name, "preload") for name in preload.MODULES]
     # The metric registry imports every module of its measures package by name (pkgutil).
     out += [

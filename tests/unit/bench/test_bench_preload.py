@@ -3,13 +3,20 @@
 from __future__ import annotations
 
 import logging
+from types import ModuleType
 
 import pytest
 
-from albot1.bench import preload
+
+@pytest.fixture
+def preload() -> ModuleType:
+    """The preload module, imported when a test runs rather than at collection (importing it preloads every method)."""
+    from albot1.bench import preload
+
+    return preload
 
 
-def test_a_failed_import_is_returned_with_module_and_reason() -> None:
+def test_a_failed_import_is_returned_with_module_and_reason(preload: ModuleType) -> None:
     failures = preload.warm(["json", "albot1_no_such_module_xyz"])
     assert [f for f in failures if "albot1_no_such_module_xyz" in f] == [
         "module albot1_no_such_module_xyz: ModuleNotFoundError: No module named 'albot1_no_such_module_xyz'"
@@ -17,11 +24,13 @@ def test_a_failed_import_is_returned_with_module_and_reason() -> None:
     assert not any(f.startswith("module json") for f in failures)
 
 
-def test_the_shipped_list_imports_cleanly() -> None:
+def test_the_shipped_list_imports_cleanly(preload: ModuleType) -> None:
     assert [f for f in preload.warm() if f.startswith("module ")] == []
 
 
-def test_failures_are_logged_once_each(monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture) -> None:
+def test_failures_are_logged_once_each(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
     monkeypatch.setattr(preload, "warm", lambda: ["module x: ImportError: boom"])
     monkeypatch.setattr(preload, "_warm_matplotlib", lambda: None)
     with caplog.at_level(logging.WARNING, logger=preload.__name__):
