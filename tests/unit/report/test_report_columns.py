@@ -14,10 +14,10 @@ from __future__ import annotations
 import html
 import json
 import re
-import shutil
 import subprocess
 from pathlib import Path
 
+import headless_chromium
 import numpy as np
 import pandas as pd
 import pytest
@@ -37,7 +37,6 @@ from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
 
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
-BROWSER_NAMES = ("chromium", "chromium-browser")
 KNOWN = {**METRIC_COLUMNS, **COST_COLUMNS}
 SELECTION = ColumnSelection(("loop_gap_m", "ate_rmse_m", "per_scan_ms_median"))
 NO_REFERENCE = "the dataset has no reference poses"
@@ -209,10 +208,6 @@ def test_the_quick_report_says_once_why_a_block_is_absent_and_writes_no_empty_pa
     assert not (whole / STANDARD_PAGE).exists()  # a page of five "not measured" logs says nothing
 
 
-def _browser() -> str | None:
-    return next((found for name in BROWSER_NAMES if (found := shutil.which(name))), None)
-
-
 #: Run after the page's own scripts: hide the first table's RPE column, sort the rows, show all columns again.
 PROBE = """
 <script>
@@ -246,28 +241,16 @@ PROBE = """
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(_browser() is None, reason="no chromium on PATH (.ci/run installs Debian's chromium with apt)")
+@pytest.mark.skipif(headless_chromium.browser() is None, reason=headless_chromium.NO_BROWSER)
 def test_chromium_hides_a_column_header_and_every_cell_and_shows_it_again(whole: Path, tmp_path: Path) -> None:
-    browser = _browser()
+    browser = headless_chromium.browser()
     assert browser is not None
     page = whole / "probed.html"  # in the report folder: the same relative links as index.html
     page.write_text(
         (whole / INDEX_HTML).read_text(encoding="utf-8").replace("</body>", PROBE + "</body>"), encoding="utf-8"
     )
-    flags = [
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--proxy-server=127.0.0.1:9",  # every network request fails: the page must need none
-        "--host-resolver-rules=MAP * ~NOTFOUND",
-        f"--user-data-dir={tmp_path / 'profile'}",
-        "--window-size=1280,1000",
-    ]
-    done = subprocess.run([browser, *flags, "--dump-dom", page.as_uri()], capture_output=True, text=True, timeout=120)
+    offline = headless_chromium.flags(tmp_path / "profile")  # every network request fails: the page needs none
+    done = subprocess.run([browser, *offline, "--dump-dom", page.as_uri()], capture_output=True, text=True, timeout=120)
     found = re.search(r'<pre id="probe">(.*?)</pre>', done.stdout, re.S)
     assert found is not None, done.stderr[-2000:]
     probe = json.loads(html.unescape(found.group(1)))

@@ -8,11 +8,11 @@ installed (``.ci/run`` installs it) and is skipped with the reason otherwise.
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from html.parser import HTMLParser
 from pathlib import Path
 
+import headless_chromium
 import numpy as np
 import pytest
 from matplotlib.image import imread
@@ -28,7 +28,6 @@ from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
 
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
-BROWSER_NAMES = ("chromium", "chromium-browser")
 
 
 def _loop() -> Sequence:
@@ -109,26 +108,12 @@ def test_the_readme_links_the_page_and_every_table_format(report: Path) -> None:
     assert "(index.html)" in readme and "[LaTeX](metrics.tex)" in readme and ".svg)" in readme
 
 
-def _browser() -> str | None:
-    return next((found for name in BROWSER_NAMES if (found := shutil.which(name))), None)
-
-
 @pytest.mark.slow
-@pytest.mark.skipif(_browser() is None, reason="no chromium on PATH (.ci/run installs Debian's chromium with apt)")
+@pytest.mark.skipif(headless_chromium.browser() is None, reason=headless_chromium.NO_BROWSER)
 def test_a_headless_browser_renders_the_page_with_its_tables(report: Path, tmp_path: Path) -> None:
-    browser = _browser()
+    browser = headless_chromium.browser()
     assert browser is not None
-    flags = [
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        f"--user-data-dir={tmp_path / 'profile'}",
-    ]
+    flags = [*headless_chromium.flags(tmp_path / "profile", offline=False, window=None), "--disable-quic"]
     url = (report / INDEX_HTML).resolve().as_uri()
     shot = tmp_path / "page.png"
     done = subprocess.run(

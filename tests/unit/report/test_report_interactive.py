@@ -20,6 +20,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import headless_chromium
 import numpy as np
 import pytest
 
@@ -43,7 +44,6 @@ from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
 
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
-BROWSER_NAMES = ("chromium", "chromium-browser")
 SEGMENTS = np.array([[0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 1.0, 2.0], [-3.0, 4.0, 5.0, 6.5]])
 
 
@@ -251,32 +251,14 @@ def test_index_html_has_a_view_per_dataset_and_loads_plotly_from_the_report_fold
 # --- the browser test -------------------------------------------------------------------------------------------
 
 
-def _browser() -> str | None:
-    return next((found for name in BROWSER_NAMES if (found := shutil.which(name))), None)
-
-
 class DevTools:
     """The DevTools protocol over ``--remote-debugging-pipe`` (fd 3 in, fd 4 out; NUL-separated JSON)."""
 
     def __init__(self, browser: str, profile: Path) -> None:
         to_browser_r, self._to_browser = os.pipe()
         self._from_browser, from_browser_w = os.pipe()
-        flags = [
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--remote-debugging-pipe",
-            # every network request fails: the page must need none
-            "--proxy-server=127.0.0.1:9",
-            "--host-resolver-rules=MAP * ~NOTFOUND",
-            f"--user-data-dir={profile}",
-            "--window-size=1280,1000",
-            "about:blank",
-        ]
+        # every network request fails: the page must need none
+        flags = [*headless_chromium.flags(profile), "--remote-debugging-pipe", "about:blank"]
 
         def plumb() -> None:  # in the child: the pipe ends at fds 3 and 4 (copied first: they may be 3 or 4 now)
             read_end, write_end = os.dup(to_browser_r), os.dup(from_browser_w)
@@ -363,11 +345,11 @@ albot1ShowView("loop").then(function (gd) {
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(_browser() is None, reason="no chromium on PATH (.ci/run installs Debian's chromium with apt)")
+@pytest.mark.skipif(headless_chromium.browser() is None, reason=headless_chromium.NO_BROWSER)
 def test_chromium_offline_renders_the_view_and_hovering_a_pose_shows_its_stored_error(
     report: Path, results: Path, tmp_path: Path
 ) -> None:
-    browser = _browser()
+    browser = headless_chromium.browser()
     assert browser is not None
     rec = next(r for r in _records(results, "loop") if r.cell.method_label == "noisy")
     poses, reference, ate = _files(rec.run_dir)
