@@ -57,18 +57,27 @@ def git_commit() -> str | None:
     """
     if (_PACKAGE_DIR.parent / ".git").exists():
         try:
-            out = subprocess.run(
-                ["git", "describe", "--always", "--dirty", "--abbrev=12"],
-                cwd=_PACKAGE_DIR,
-                capture_output=True,
-                text=True,
-                timeout=5,
-                check=True,
-            )
+            described = _git("describe", "--always", "--abbrev=12")
+            changed = _git("status", "--porcelain", "--", *_CODE_PATHS)
         except (OSError, subprocess.SubprocessError):
             return None
-        return out.stdout.strip() or None
+        if not described:
+            return None
+        return f"{described}-dirty" if changed else described
     return _built_commit()
+
+
+#: What "dirty" looks at, relative to the checkout: the package, its build files and the project's TOML folders
+#: (``albot1.resources.FOLDERS``). Not the whole tree: ``make bench`` rewrites ``README.md`` and
+#: ``docs/results.md`` from the results, and that must not relabel the code that computed them (a relabelled
+#: plan makes every report rebuild once on the next, otherwise idle, ``make bench``).
+_CODE_PATHS = (_PACKAGE_DIR.name, "pyproject.toml", "setup.py", "datasets", "baselines", "benchmarks")
+
+
+def _git(*args: str) -> str:
+    """``git ARGS`` in the checkout the package sits in: its stripped output (raises when git fails)."""
+    out = subprocess.run(["git", *args], cwd=_PACKAGE_DIR.parent, capture_output=True, text=True, timeout=5, check=True)
+    return out.stdout.strip()
 
 
 def _built_commit() -> str | None:

@@ -66,7 +66,19 @@ def test_a_checkout_names_its_commit(tmp_path: Path, package_at: Callable[[Path]
     subprocess.run([*git, "commit", "-q", "-m", "c"], check=True)
     head = subprocess.run([*git, "rev-parse", "HEAD"], check=True, capture_output=True, text=True).stdout.strip()
     assert versions.git_commit() == head[:12]
+    (tmp_path / "README.md").write_text("numbers rewritten by make bench\n")  # untracked, outside the code
+    versions.git_commit.cache_clear()
+    assert versions.git_commit() == head[:12]
     (tmp_path / "albot1" / "__init__.py").write_text("x = 1\n")
+    versions.git_commit.cache_clear()
+    assert versions.git_commit() == f"{head[:12]}-dirty"
+    subprocess.run([*git, "checkout", "-q", "--", "albot1"], check=True)
+    (tmp_path / "albot1" / "new_module.py").write_text("")  # a module not added yet is code too
+    versions.git_commit.cache_clear()
+    assert versions.git_commit() == f"{head[:12]}-dirty"
+    (tmp_path / "albot1" / "new_module.py").unlink()
+    (tmp_path / "baselines").mkdir()
+    (tmp_path / "baselines" / "odometry.toml").write_text("")  # a method's config decides its results
     versions.git_commit.cache_clear()
     assert versions.git_commit() == f"{head[:12]}-dirty"
 
