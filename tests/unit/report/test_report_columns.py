@@ -18,15 +18,13 @@ import subprocess
 from pathlib import Path
 
 import headless_chromium
-import numpy as np
 import pandas as pd
 import pytest
+from loop_sequence import loop
 
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ResultsStore
-from albot1.data.model import Frame, Scan, Sequence
 from albot1.errors import Albot1Error
-from albot1.geometry import se2
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection, parse_columns
 from albot1.report.html import INDEX_HTML
@@ -36,19 +34,9 @@ from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
 
-ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
 KNOWN = {**METRIC_COLUMNS, **COST_COLUMNS}
 SELECTION = ColumnSelection(("loop_gap_m", "ate_rmse_m", "per_scan_ms_median"))
 NO_REFERENCE = "the dataset has no reference poses"
-
-
-def _loop(name: str, with_reference: bool) -> Sequence:
-    truth = se2.integrate_steps(np.zeros(3), np.tile([[0.7, 0.0, np.radians(6.0)]], (59, 1)))
-    frames = [
-        Frame(i, Scan(np.full(len(ANGLES), 1.5), ANGLES, 10.0 + i, 5.0), truth[i], truth[i] if with_reference else None)
-        for i in range(60)
-    ]
-    return Sequence.from_frames(name, frames)
 
 
 def _cell(dataset: str, key: str, degradation: str, seed: int) -> Cell:
@@ -68,7 +56,7 @@ def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ("loop", True, "gauss:0.05:1", 1),
         ("bare", False, "none", 0),
     ):
-        result = run_method("odometry", _loop(dataset, reference), degradation=degradation, seed=seed)
+        result = run_method("odometry", loop(dataset, reference), degradation=degradation, seed=seed)
         run_dir = write_run(result, store.runs)
         evaluate_run(run_dir)
         cells.append(_cell(dataset, run_dir.name, degradation, seed))

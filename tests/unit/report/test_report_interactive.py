@@ -23,11 +23,11 @@ from typing import Any
 import headless_chromium
 import numpy as np
 import pytest
+from loop_sequence import loop
 
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ResultsStore
 from albot1.contract import MapData
-from albot1.data.model import Frame, Scan, Sequence
 from albot1.data.trajectory import read_tum
 from albot1.geometry import se2
 from albot1.metrics.alignment import align
@@ -43,17 +43,7 @@ from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
 from albot1.runs.folder import write_run
 
-ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
 SEGMENTS = np.array([[0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 1.0, 2.0], [-3.0, 4.0, 5.0, 6.5]])
-
-
-def _loop(name: str, with_reference: bool) -> Sequence:
-    truth = se2.integrate_steps(np.zeros(3), np.tile([[0.7, 0.0, np.radians(6.0)]], (59, 1)))
-    frames = [
-        Frame(i, Scan(np.full(len(ANGLES), 1.5), ANGLES, 10.0 + i, 5.0), truth[i], truth[i] if with_reference else None)
-        for i in range(60)
-    ]
-    return Sequence.from_frames(name, frames)
 
 
 def _cell(dataset: str, key: str, label: str, degradation: str, seed: int) -> Cell:
@@ -67,11 +57,11 @@ def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
     store = ResultsStore(root)
     store.runs.mkdir(parents=True)
     cells = []
-    noisy = run_method("odometry", _loop("loop", True), degradation="gauss:0.05:1", seed=0)
+    noisy = run_method("odometry", loop("loop", True), degradation="gauss:0.05:1", seed=0)
     lines = replace(
-        run_method("odometry", _loop("loop", True), degradation="gauss:0.05:1", seed=1), map=MapData(segments=SEGMENTS)
+        run_method("odometry", loop("loop", True), degradation="gauss:0.05:1", seed=1), map=MapData(segments=SEGMENTS)
     )
-    bare = run_method("odometry", _loop("bare", False), degradation="gauss:0.05:1", seed=0)
+    bare = run_method("odometry", loop("bare", False), degradation="gauss:0.05:1", seed=0)
     for result, dataset, label in ((noisy, "loop", "noisy"), (lines, "loop", "lines"), (bare, "bare", "noisy")):
         run_dir = write_run(result, store.runs)
         evaluate_run(run_dir)
