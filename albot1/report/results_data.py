@@ -202,11 +202,7 @@ def _verdicts(thesis_dir: Path) -> tuple[dict[str, str], list[VerdictRow], list[
     rows: list[VerdictRow] = []
     columns: dict[str, str] = {}
     for section in all_sections(ev):
-        claims: dict[str, list[Any]] = {}
-        for row in section.claims:
-            claims.setdefault(row.claim, []).append(row)
-        for claim, group in claims.items():
-            text = group[0].text if len(group) == 1 else f"{claim} (on each dataset)"
+        for text, group in section.claim_groups():
             if all("" in row.verdicts for row in group):
                 tallies = {"": _tally([row.verdicts[""] for row in group])}
             else:

@@ -251,11 +251,7 @@ def _summary(sections: list[Section]) -> list[str]:
         "|---|---|---|---|---|---|",
     ]
     for section in sections:
-        claims: dict[str, list[ClaimRow]] = {}
-        for row in section.claims:
-            claims.setdefault(row.claim, []).append(row)
-        for claim, rows in claims.items():
-            text = rows[0].text if len(rows) == 1 else f"{claim} (on each dataset)"
+        for text, rows in section.claim_groups():
             if all("" in row.verdicts for row in rows):
                 cells = [_tally([row.verdicts[""] for row in rows])]
                 cells += ["(setup check: same for every variant)"] * (len(section.columns) - 1)

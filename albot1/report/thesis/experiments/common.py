@@ -98,6 +98,20 @@ class Section:
     notes: list[str] = field(default_factory=list)
     columns: dict[str, str] = field(default_factory=lambda: dict(VARIANTS))
 
+    def claim_groups(self) -> list[tuple[str, list[ClaimRow]]]:
+        """The claims' rows grouped by claim (first-seen order), each with its label for a summary row.
+
+        A claim tested on one dataset keeps its own text; one tested on
+        several reads "<claim> (on each dataset)". The thesis page's summary
+        and the results page count verdicts over the same groups.
+        """
+        groups: dict[str, list[ClaimRow]] = {}
+        for row in self.claims:
+            groups.setdefault(row.claim, []).append(row)
+        return [
+            (rows[0].text if len(rows) == 1 else f"{claim} (on each dataset)", rows) for claim, rows in groups.items()
+        ]
+
 
 # --------------------------------------------------------------------------- reading and laying out numbers
 
