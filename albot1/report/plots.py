@@ -24,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import math
 import re
+import textwrap
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -304,22 +305,20 @@ def log_floor(series: Iterable[Iterable[float]], *, decades: float = 2.0) -> flo
 
 
 def value_axis(ax: Any, floor: float | None, clipped: list[str], unit: str) -> None:
-    """A log axis from ``floor`` (noting the series drawn at the floor), or a linear one from zero."""
+    """A log axis from ``floor`` (noting the series drawn at the floor), or a linear one from zero.
+
+    The note is wrapped and left out of the layout: a long one (every method of a log clipped) once made
+    constrained layout shrink the axes to nothing; more than three series are counted, not listed.
+    """
     if floor is None:
         ax.set_ylim(bottom=0)
         return
     ax.set_yscale("log")
     ax.set_ylim(bottom=floor * 0.8)
     if clipped:
-        ax.text(
-            0.01,
-            0.01,
-            f"values below {floor:.2g} {unit} drawn at {floor:.2g} ({', '.join(clipped)})",
-            transform=ax.transAxes,
-            fontsize=7,
-            color="0.3",
-            va="bottom",
-        )
+        which = ", ".join(clipped) if len(clipped) <= 3 else f"{len(clipped)} series"
+        note = textwrap.fill(f"values below {floor:.2g} {unit} drawn at {floor:.2g} ({which})", width=48)
+        ax.text(0.01, 0.01, note, transform=ax.transAxes, fontsize=7, color="0.3", va="bottom", in_layout=False)
 
 
 def save(fig: Figure, png: Path) -> Path:

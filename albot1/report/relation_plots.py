@@ -74,7 +74,9 @@ def plot_relation_boxes(records: list[CellRecord], dataset: str, path: Path, col
     marks = published_marks(dataset)
     plt = pyplot()
     slots = len(sets) + max(len(v) for v in marks.values())
-    fig, axes = plt.subplots(1, 2, figsize=(min(13.0, 3.0 + 1.1 * slots), 4.6), layout="constrained")
+    contexts = {sets[label][0] for label in sets}
+    common = contexts.pop() if len(contexts) == 1 else None  # said once in the title, not under every box
+    fig, axes = plt.subplots(1, 2, figsize=(min(18.0, 3.0 + 1.0 * slots), 5.2), layout="constrained")
     for ax, (column, (metric, axis_label)) in zip(axes, enumerate(PANELS)):
         labels = list(sets)
         raw: list[NDArray[np.float64]] = [sets[label][2] if column else sets[label][1] for label in labels]
@@ -91,20 +93,25 @@ def plot_relation_boxes(records: list[CellRecord], dataset: str, path: Path, col
         for patch, label in zip(boxes["boxes"], labels):
             patch.set_facecolor(colors.get(label, "C0"))
             patch.set_alpha(0.75)
-        ticks = [f"{label}\n{sets[label][0]}\nN = {len(sets[label][1])}" for label in labels]
+        ticks = [
+            f"{label}\n{sets[label][0]}\nN = {len(sets[label][1])}"
+            if common is None
+            else f"{label}\nN = {len(sets[label][1])}"
+            for label in labels
+        ]
         for i, (system, mean, std) in enumerate(marks[metric], start=len(labels)):
             ax.errorbar(
                 [i], [mean], yerr=None if std is None else [[min(std, mean * 0.99)], [std]], fmt="D", color="black",
                 markersize=6, capsize=4, lw=1.0,
             )  # fmt: skip
             ticks.append(f"{system}\npublished")
-        ax.set_xticks(range(len(ticks)), ticks, fontsize=6.5, rotation=30, ha="right")
+        ax.set_xticks(range(len(ticks)), ticks, fontsize=6.5, rotation=45, ha="right", rotation_mode="anchor")
         ax.set_ylabel(axis_label)
         value_axis(ax, floor, clipped, axis_label.split("(")[-1].rstrip(")"))
         ax.grid(alpha=0.3, axis="y", lw=0.5)
     fig.suptitle(
-        f"{dataset}: relation errors per method (boxes: quartiles, whiskers 1.5 IQR, white diamond: mean; "
-        "black diamond: published mean ± std)",
+        f"{dataset}{'' if common is None else ' ' + common}: relation errors per method (boxes: quartiles, "
+        "whiskers 1.5 IQR, white diamond: mean; black diamond: published mean ± std)",
         fontsize=9,
     )
     return save(fig, path)

@@ -127,3 +127,25 @@ def test_relation_boxes_hold_each_relation_error_and_the_published_marks(tmp_pat
     }
     assert plot_relation_boxes(records, "aces", tmp_path / "r.png", {"odometry": "#7f7f7f"}) == tmp_path / "r.png"
     assert "published" in (tmp_path / "r.svg").read_text()
+
+
+def test_a_floor_note_naming_many_series_is_counted_and_does_not_collapse_the_layout(tmp_path: Path) -> None:
+    import warnings
+
+    from albot1.report.plots import pyplot, save, value_axis
+
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(8.0, 4.0), layout="constrained")
+    labels = [f"method-with-a-long-name-{i}" for i in range(8)]
+    for ax in axes:
+        ax.boxplot([np.array([1e-4, 0.1, 1.0])] * 8, positions=range(8))
+        value_axis(ax, 0.0023, labels, "m")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # matplotlib warns when constrained layout collapses an axes
+        save(fig, tmp_path / "f.png")
+    svg = (tmp_path / "f.svg").read_text()
+    assert "(8 series)" in svg and "method-with-a-long-name-0" not in svg
+    fig, ax = plt.subplots(layout="constrained")
+    value_axis(ax, 0.01, ["a", "b"], "deg")
+    assert [t.get_text() for t in ax.texts] == ["values below 0.01 deg drawn at 0.01 (a, b)"]
+    plt.close(fig)
