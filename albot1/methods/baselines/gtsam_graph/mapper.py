@@ -129,7 +129,7 @@ class GtsamGraphMapper:
         cfg = self.config
         odometry_step = se2.between(self.back.odometry[-1], odometry)
         relative, covariance = self.front.sequential_edge(step, points, index, tracked, odometry_step)
-        key = self.back.add_node(odometry, step, relative, covariance, points, index)
+        key = self.back.add_node(odometry, step, relative, covariance, points, index, self.front.odometry_factors)
         self.front.new_node()
         self.loops.travelled(math.hypot(relative[0], relative[1]))
         if key % cfg.loop_every_nodes == 0:
