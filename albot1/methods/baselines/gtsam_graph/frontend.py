@@ -7,8 +7,8 @@ scan, or from the last tracked motion when the two disagree
 when the robot moved far enough for a new node (:meth:`FrontEnd.moved_enough`),
 and the tracking match becomes the new node's sequential edge, or the
 odometry increment with a larger covariance when the match is poor
-(:meth:`FrontEnd.sequential_edge`); with ``odometry_trust`` (off in the
-default preset) a good match is fused with the odometry's heading where the
+(:meth:`FrontEnd.sequential_edge`); with ``odometry_trust`` the odometry's heading
+joins the graph as its own factor (or fused into the edge) where the
 odometry has shown itself the better of the two (:mod:`.odometry_trust`). All of the tracking logic lives here; the
 local map itself is the back end's (:meth:`.BackEnd.local_map`).
 """

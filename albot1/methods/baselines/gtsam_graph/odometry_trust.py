@@ -1,9 +1,10 @@
 """How much to trust the odometry of a node step, learnt from its disagreement with the scan matches.
 
-Off in the default preset (``odometry_trust = false``): measured on the
-standard logs it broke fr-clinic (0.154 -> 3.95 m mean relation error) and
-its result on short logs swung with when fusion starts (docs/baselines.md,
-gtsam-graph, "Held-out logs ... continued").
+On in the default preset, as separate odometry factors
+(:class:`OdometryFactors`, ``odometry_trust_factors``); the fused edge
+(:meth:`OdometryTrust.fuse`) is the earlier variant, whose result on short
+logs swung with when fusion starts (docs/baselines.md, gtsam-graph,
+"Held-out logs ... the odometry as its own factor").
 
 A node's sequential edge is its scan match; the odometry only enters as the
 match's weak start prior (``odometry_sigma_*``, 5 deg per node step). Where
