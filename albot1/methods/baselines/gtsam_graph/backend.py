@@ -16,7 +16,7 @@ offsets and refined, :mod:`.refine`) and projects the map.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -28,6 +28,7 @@ from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.errors import GraphError
 from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
 from albot1.methods.baselines.gtsam_graph.loop_closure import LoopMatch
+from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor
 from albot1.methods.baselines.gtsam_graph.refine import RefineTests, accept, seed_poses
 from albot1.methods.baselines.gtsam_graph.registration import Target, line_normals, rotate, try_register
 
@@ -81,20 +82,29 @@ class BackEnd:
         covariance: FloatArray,
         points: FloatArray,
         index: int,
+        odometry_factors: Sequence[OdometryFactor] = (),
     ) -> int:
         """A node at ``step`` from the newest, joined to it by the sequential edge ``relative``; its key.
 
-        ISAM2 updates the graph, and the estimates of the nodes a local map
-        can reach are refreshed from it.
+        ``odometry_factors`` (each from node ``key - 1`` to ``key``, this new
+        node's included) go into the same update. ISAM2 updates the graph,
+        and the estimates of the nodes a local map can reach are refreshed
+        from it; all of them when an odometry factor reached further back.
         """
         prev = self.newest
         key = self.graph.add_node(se2.compose(self.estimates[prev], step))
         self.graph.add_edge(prev, key, relative, covariance)
+        for factor in odometry_factors:
+            self.graph.add_edge(factor.key - 1, factor.key, factor.step, factor.covariance)
         self.graph.update()
         self._remember_node(odometry, relative, points, index)
         self.estimates = np.vstack([self.estimates, se2.compose(self.estimates[prev], relative)])
-        for k in range(max(0, key - self.config.local_map_nodes), key + 1):
-            self.estimates[k] = self.graph.estimate(k)
+        first = max(0, key - self.config.local_map_nodes)
+        if any(factor.key - 1 < first for factor in odometry_factors):
+            self.estimates = self.graph.estimates()
+        else:
+            for k in range(first, key + 1):
+                self.estimates[k] = self.graph.estimate(k)
         return key
 
     def _remember_node(self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int) -> None:

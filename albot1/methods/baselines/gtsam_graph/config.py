@@ -84,6 +84,10 @@ class GtsamGraphConfig(BaseModel):
         description="fuse each node's odometry step into its matched sequential edge, weighted by the odometry's "
         "variance learnt from its disagreement with recent matches (unbiased components only; odometry_trust.py)"
     )
+    odometry_trust_factors: bool = Field(
+        description="... as its own between factor per node step instead of a fused edge, every matched step judged "
+        "once the variance can be learnt, the first ones too (odometry_trust.OdometryFactors)"
+    )
     odometry_trust_translation: bool = Field(description="... in translation too (else: the heading alone)")
     odometry_trust_window: int = Field(ge=2, description="... learnt from this many recent matched node steps")
     odometry_trust_bias_z: float = Field(

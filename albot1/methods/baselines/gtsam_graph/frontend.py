@@ -7,8 +7,8 @@ scan, or from the last tracked motion when the two disagree
 when the robot moved far enough for a new node (:meth:`FrontEnd.moved_enough`),
 and the tracking match becomes the new node's sequential edge, or the
 odometry increment with a larger covariance when the match is poor
-(:meth:`FrontEnd.sequential_edge`); with ``odometry_trust`` (off in the
-default preset) a good match is fused with the odometry's heading where the
+(:meth:`FrontEnd.sequential_edge`); with ``odometry_trust`` the odometry's heading
+joins the graph as its own factor (or fused into the edge) where the
 odometry has shown itself the better of the two (:mod:`.odometry_trust`). All of the tracking logic lives here; the
 local map itself is the back end's (:meth:`.BackEnd.local_map`).
 """
@@ -28,7 +28,7 @@ from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
-from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryTrust
+from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, OdometryFactors, OdometryTrust
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
 
 
@@ -77,6 +77,9 @@ class FrontEnd:
             config.odometry_trust_gate_chi2,
             (0, 1, 2) if config.odometry_trust_translation else (2,),
         )
+        self._odometry_factors = OdometryFactors(self._odometry_trust)
+        # Odometry factors judged at the latest node (``odometry_trust_factors``), for the back end to add with it.
+        self.odometry_factors: list[OdometryFactor] = []
         self.last_odometry: FloatArray | None = None
         self._consecutive_fallbacks = 0
 
@@ -269,9 +272,12 @@ class FrontEnd:
         step, retried from rotated guesses (:meth:`attempt`). With
         ``odometry_trust`` and the node's ``odometry_step`` (the odometry
         increment between the two nodes), a match is fused with that step as
-        far as the odometry has earned it (:mod:`.odometry_trust`).
+        far as the odometry has earned it (:mod:`.odometry_trust`); with
+        ``odometry_trust_factors`` too, the edge stays the match and the
+        odometry steps judged at this node are left in :attr:`odometry_factors`.
         """
         cfg = self.config
+        self.odometry_factors = []
         if cfg.track_scans:
             reg, good = tracked, tracked is not None
         else:
@@ -289,7 +295,13 @@ class FrontEnd:
             self.counters["sequential_matches"] += 1
             self._consecutive_fallbacks = 0
             covariance = np.asarray(np.linalg.inv(reg.information + self._seq_prior) + self._floor, dtype=np.float64)
-            if cfg.odometry_trust and odometry_step is not None:
+            if cfg.odometry_trust and cfg.odometry_trust_factors and odometry_step is not None:
+                # the new node's key is the number of nodes so far
+                self.odometry_factors = self._odometry_factors.add(
+                    len(self._back.odometry), odometry_step, reg.pose, covariance
+                )
+                self.counters["odometry_fused"] += len(self.odometry_factors)
+            elif cfg.odometry_trust and odometry_step is not None:
                 fused = self._odometry_trust.fuse(odometry_step, reg.pose, covariance)
                 self._odometry_trust.add(odometry_step, reg.pose)
                 if fused is not None:

@@ -9,9 +9,9 @@ The method of Grisetti et al. (2010), the thesis's section 2.2.3:
   increment being the initial guess and a weak prior; when the match is poor
   (not converged, low inlier fraction, large residual or an implausible
   correction) the edge is the odometry increment with a larger covariance;
-  with ``odometry_trust`` (off in the default preset) a good match is fused
-  with the odometry's heading where the odometry has shown itself the better
-  of the two (:mod:`.odometry_trust`);
+  with ``odometry_trust`` (on) the odometry's heading joins it as its own
+  factor where the odometry has shown itself the better of the two
+  (:mod:`.odometry_trust`);
 * **loop-closure edges** from ICP against the submaps of earlier nodes near
   the current estimate (:mod:`.loop_closure`), added only after strict tests
   and with a robust kernel;
@@ -129,7 +129,7 @@ class GtsamGraphMapper:
         cfg = self.config
         odometry_step = se2.between(self.back.odometry[-1], odometry)
         relative, covariance = self.front.sequential_edge(step, points, index, tracked, odometry_step)
-        key = self.back.add_node(odometry, step, relative, covariance, points, index)
+        key = self.back.add_node(odometry, step, relative, covariance, points, index, self.front.odometry_factors)
         self.front.new_node()
         self.loops.travelled(math.hypot(relative[0], relative[1]))
         if key % cfg.loop_every_nodes == 0:

@@ -258,3 +258,15 @@ def test_no_velocity_guess_before_a_motion_was_tracked(monkeypatch: pytest.Monke
     assert len(tried) == 1
     assert np.allclose(tried[0], [3.0, 0.0, 0.0])
     assert mapper.counters["tracking_velocity_guess"] == 0
+
+
+def test_odometry_factors_reach_back_to_the_steps_before_the_variance_was_learnt() -> None:
+    """A node per scan, perfect odometry: fused edges start at the 41st matched step, factors cover all 59."""
+    seq = room_sequence(60, odometry_bias_deg=0.0)
+    fused, out_fused = run(seq, node_translation_m=0.1, odometry_trust=True, odometry_trust_factors=False)
+    factors, out_factors = run(seq, node_translation_m=0.1, odometry_trust=True, odometry_trust_factors=True)
+    assert out_fused.counters["sequential_matches"] == out_factors.counters["sequential_matches"] == 59
+    assert out_fused.counters["odometry_fused"] == 59 - 40
+    assert out_factors.counters["odometry_fused"] == 59
+    extra = factors.back.graph._all_factors.size() - fused.back.graph._all_factors.size()
+    assert extra == 59 - out_factors.counters["loop_closures_accepted"] + out_fused.counters["loop_closures_accepted"]
