@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
+from albot1.methods.albot1.mapping.ambiguity import Ambiguity, view_ambiguity
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.perception.endpoints import STABLE
 
@@ -78,6 +79,7 @@ class PlusParams:
     learning_rate: float
     degenerate_sd: float = 0.0  # m (a turn of 1 rad counting m_per_rad m); 0 = off
     gate_probability: float = 0.0  # chi-square quantile of the disagreement with the odometry; 0 = off
+    ambiguity_probability: float = 0.0  # chi-square quantile of the view's own likelihood ratio; 0 = off
 
 
 class OdometryNoise:
@@ -154,6 +156,9 @@ class PlusLocaliser:
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
         self.gate_rejections = 0
+        #: Views whose own terms did not refute the odometry's prediction (:mod:`.ambiguity`), and the last test.
+        self.ambiguous_views = 0
+        self.last_ambiguity: Ambiguity | None = None
 
     def reset(self, view_map: FloatArray, pose: Pose) -> None:
         """A map update placed a view at ``pose``; ``view_map`` are its surfaces in the map (the new reference)."""
@@ -193,6 +198,16 @@ class PlusLocaliser:
         measured, info = self._solve(starts, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
         if p.prior == "off":
             return measured
+        if p.ambiguity_probability > 0.0:
+            sigmas = (p.line_sigma, p.point_sigma, p.scan_sigma, p.huber, p.scan_gate)
+            test = view_ambiguity(
+                self._k.measurement_costs, measured, predicted, lm_view, lm_map, ok, points, self._ref, sigmas,
+                p.ambiguity_probability,
+            )
+            self.last_ambiguity = test
+            if test.ambiguous:
+                self.ambiguous_views += 1
+                return predicted
         return self._fuse(measured, info, predicted, self._motion(since_update))
 
     def _motion(self, since_update: Pose) -> float:
