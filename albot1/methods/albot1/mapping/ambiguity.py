@@ -137,33 +137,48 @@ class Ambiguity:
     ambiguous: bool  # the view does not refute the prediction: keep the odometry
 
 
+#: Degrees of freedom of the likelihood ratio: the pose's x, y and heading.
+DOF = 3
+
+
+def threshold(probability: float, dof: int = DOF) -> float:
+    """The chi-square(``dof``) quantile ``probability`` (0 when the test is off); computed once per mapper.
+
+    scipy is imported here, not per view: the import statement alone costs
+    about 0.1 ms a call (``docs/albot1-mapper.md``, "Kernels").
+    """
+    if probability <= 0.0:
+        return 0.0
+    from scipy.stats import chi2  # noqa: PLC0415  (only when the test is on)
+
+    return float(chi2.ppf(probability, dof))
+
+
 def likelihood_ratio(
     fit_cost: float,
     predicted_cost: float,
     matched_cost: float,
     terms: int,
     independent: int,
-    probability: float,
-    dof: int = 3,
+    limit: float,
+    dof: int = DOF,
 ) -> Ambiguity:
     """Whether the odometry's prediction explains the view about as well as the fit (see the module docstring).
 
     ``fit_cost`` / ``predicted_cost``: the robust costs at the two poses;
     ``matched_cost``: the fit's cost over its ``terms`` associated residual
     terms, of which ``independent`` are independent. The residual variance
-    (in sigmas squared) is ``2 matched_cost / (terms - dof)``;
-    the cost difference is scaled by ``independent / terms`` (correlated
-    terms carry less information than their number says). With no more
-    terms than degrees of freedom the view cannot refute anything: ambiguous.
+    (in sigmas squared) is ``2 matched_cost / (terms - dof)``; the cost
+    difference is scaled by ``independent / terms`` (correlated terms carry
+    less information than their number says) and compared with ``limit``
+    (:func:`threshold`). With no more terms than degrees of freedom the view
+    cannot refute anything: ambiguous.
     """
-    from scipy.stats import chi2  # noqa: PLC0415  (only when the test is on)
-
-    threshold = float(chi2.ppf(probability, dof))
     if terms <= dof or independent <= 0:
-        return Ambiguity(0.0, threshold, True)
+        return Ambiguity(0.0, limit, True)
     variance = max(2.0 * matched_cost / (terms - dof), 1e-12)
     statistic = 2.0 * max(predicted_cost - fit_cost, 0.0) / variance * (independent / terms)
-    return Ambiguity(statistic, threshold, statistic <= threshold)
+    return Ambiguity(statistic, limit, statistic <= limit)
 
 
 def view_ambiguity(
@@ -176,16 +191,16 @@ def view_ambiguity(
     points: FloatArray,
     ref: FloatArray,
     sigmas: tuple[float, float, float, float, float],
-    probability: float,
+    limit: float,
 ) -> Ambiguity:
     """:func:`likelihood_ratio` of one view: costs by ``kernels_costs`` (:func:`measurement_costs`, compiled or not).
 
     ``sigmas``: line, point and scan sigma, Huber threshold (in sigmas) and
-    the scan gate, as the fit used them.
+    the scan gate, as the fit used them; ``limit``: :func:`threshold`.
     """
     poses = np.asarray([fitted, predicted], dtype=float)
     costs, per_surface, matched = kernels_costs(poses, lm_view, lm_map, point_ok, points, ref, *sigmas)  # type: ignore[operator]
     lengths = np.hypot(lm_map[:, 2] - lm_map[:, 0], lm_map[:, 3] - lm_map[:, 1]) if len(lm_map) else np.empty(0)
     landmark_terms = 2 * int(np.count_nonzero(lengths > 0.0)) + int(np.count_nonzero(point_ok))
     terms, independent = effective_terms(landmark_terms, per_surface)
-    return likelihood_ratio(float(costs[0]), float(costs[1]), float(matched), terms, independent, probability)
+    return likelihood_ratio(float(costs[0]), float(costs[1]), float(matched), terms, independent, limit)

@@ -27,8 +27,8 @@ from albot1.data.synthetic.worlds import load_world
 from albot1.geometry import se2, segments
 from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import as_written
-from albot1.methods.albot1.mapping import kernels as mapping_source
 from albot1.methods.albot1.mapping import ambiguity, pose_kernels, update_kernels
+from albot1.methods.albot1.mapping import kernels as mapping_source
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper

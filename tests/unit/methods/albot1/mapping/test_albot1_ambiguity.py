@@ -13,6 +13,7 @@ from albot1.methods.albot1.mapping.ambiguity import (
     effective_terms,
     likelihood_ratio,
     measurement_costs,
+    threshold,
     view_ambiguity,
 )
 from albot1.methods.albot1.mapping.config import Albot1Config
@@ -62,13 +63,14 @@ def test_effective_terms_count_each_surface_for_its_offset_and_turn_at_most() ->
 
 def test_the_likelihood_ratio_in_units_of_the_fits_own_residual_variance() -> None:
     # Residual variance 2 * 10 / (23 - 3) = 1 sigma^2; statistic 2 * 2 / 1 * 10 / 23.
-    test = likelihood_ratio(10.0, 12.0, 10.0, 23, 10, 0.99)
-    assert test.statistic == pytest.approx(40.0 / 23.0, rel=1e-12)
-    assert test.threshold == pytest.approx(11.344867, rel=1e-6) and test.ambiguous
+    limit = threshold(0.99)
+    assert limit == pytest.approx(11.344867, rel=1e-6) and threshold(0.0) == 0.0
+    test = likelihood_ratio(10.0, 12.0, 10.0, 23, 10, limit)
+    assert test.statistic == pytest.approx(40.0 / 23.0, rel=1e-12) and test.ambiguous
     # The same cost difference with ten times less scatter refutes the prediction.
-    assert not likelihood_ratio(1.0, 3.0, 1.0, 23, 10, 0.99).ambiguous
+    assert not likelihood_ratio(1.0, 3.0, 1.0, 23, 10, limit).ambiguous
     # No more terms than degrees of freedom: nothing can be refuted.
-    assert likelihood_ratio(0.0, 100.0, 0.0, 3, 3, 0.99).ambiguous
+    assert likelihood_ratio(0.0, 100.0, 0.0, 3, 3, limit).ambiguous
 
 
 def noisy_room(seed: int = 7) -> tuple[np.ndarray, np.ndarray, tuple[float, float, float]]:
@@ -82,14 +84,18 @@ def noisy_room(seed: int = 7) -> tuple[np.ndarray, np.ndarray, tuple[float, floa
 def test_a_prediction_within_the_views_scatter_is_ambiguous_and_one_20_cm_off_is_not() -> None:
     ref, points, pose = noisy_room()
     fitted = (pose[0] + 0.001, pose[1], pose[2])
-    near = view_ambiguity(KERNELS.measurement_costs, fitted, pose, *NO_LANDMARKS, points, ref, SIGMAS, 0.99)
+    limit = threshold(0.99)
+    near = view_ambiguity(KERNELS.measurement_costs, fitted, pose, *NO_LANDMARKS, points, ref, SIGMAS, limit)
     assert near.ambiguous and near.statistic < 1.0
     far = (pose[0] + 0.2, pose[1], pose[2])
-    refuted = view_ambiguity(KERNELS.measurement_costs, fitted, far, *NO_LANDMARKS, points, ref, SIGMAS, 0.99)
+    refuted = view_ambiguity(KERNELS.measurement_costs, fitted, far, *NO_LANDMARKS, points, ref, SIGMAS, limit)
     assert not refuted.ambiguous and refuted.statistic > 30.0 * refuted.threshold
 
 
-def localise(loc: PlusLocaliser, points: np.ndarray, start: tuple[float, float, float], since: tuple[float, float, float]):
+Pose3 = tuple[float, float, float]
+
+
+def localise(loc: PlusLocaliser, points: np.ndarray, start: Pose3, since: Pose3) -> Pose3:
     empty_kinds = (np.empty((0, 2), dtype=np.int64), np.empty((0, 2), dtype=np.int64))
     return loc.pose(start_poses(start, None, None), np.empty((0, 4)), np.empty((0, 4)), empty_kinds, points, since)
 
