@@ -195,6 +195,16 @@ class Albot1Config(BaseModel):
             " this chi-square quantile of their stated uncertainties is rejected for the odometry (0 = off)"
         ),
     )
+    ambiguity_probability: float = Field(
+        0.0,
+        ge=0,
+        lt=1,
+        description=(
+            "Albot1+ (adaptive prior): keep the odometry's prediction when the view's own robust cost there is"
+            " within this chi-square quantile of its likelihood ratio to the fit (the view does not refute it;"
+            " 0 = off)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -265,4 +275,5 @@ class Albot1Config(BaseModel):
             learning_rate=self.prior_learning_rate,
             degenerate_sd=self.degenerate_sd_m,
             gate_probability=self.gate_probability,
+            ambiguity_probability=self.ambiguity_probability,
         )

@@ -435,6 +435,8 @@ class Albot1Mapper:
             # presets' counters stay as they were.
             counters["plus_degenerate_views"] = self._plus.degenerate_views
             counters["plus_gate_rejections"] = self._plus.gate_rejections
+        if self._plus is not None and self.config.ambiguity_probability > 0.0:
+            counters["plus_ambiguous_views"] = self._plus.ambiguous_views
         counters["updates_per_view"] = c.updates / c.views if c.views else 0.0
         counters["landmarks_recognised_mean"] = float(rec[1:].mean()) if len(rec) > 1 else 0.0
         return MapperOutput(

@@ -29,6 +29,10 @@ pose is computed:
    :func:`screen_measurement` keeps the odometry's component along the
    directions the fit does not fix, and rejects a fit that disagrees with the
    odometry beyond their stated uncertainties.
+6. with ``ambiguity_probability``, :mod:`.ambiguity` evaluates the view's own
+   robust cost at the odometry's prediction: where the view does not refute
+   it (a likelihood ratio below that chi-square quantile), the prediction is
+   the pose and the fusion is skipped.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -45,6 +49,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
+from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.perception.endpoints import STABLE
 
@@ -78,6 +83,7 @@ class PlusParams:
     learning_rate: float
     degenerate_sd: float = 0.0  # m (a turn of 1 rad counting m_per_rad m); 0 = off
     gate_probability: float = 0.0  # chi-square quantile of the disagreement with the odometry; 0 = off
+    ambiguity_probability: float = 0.0  # chi-square quantile of the view's own likelihood ratio; 0 = off
 
 
 class OdometryNoise:
@@ -154,6 +160,10 @@ class PlusLocaliser:
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
         self.gate_rejections = 0
+        #: Views whose own terms did not refute the odometry's prediction (:mod:`.ambiguity`), and the last test.
+        self.ambiguous_views = 0
+        self.last_ambiguity: Ambiguity | None = None
+        self._ambiguity_limit = threshold(params.ambiguity_probability)
 
     def reset(self, view_map: FloatArray, pose: Pose) -> None:
         """A map update placed a view at ``pose``; ``view_map`` are its surfaces in the map (the new reference)."""
@@ -193,6 +203,24 @@ class PlusLocaliser:
         measured, info = self._solve(starts, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
         if p.prior == "off":
             return measured
+        if p.ambiguity_probability > 0.0:
+            sigmas = (p.line_sigma, p.point_sigma, p.scan_sigma, p.huber, p.scan_gate)
+            test = view_ambiguity(
+                self._k.measurement_costs,
+                measured,
+                predicted,
+                lm_view,
+                lm_map,
+                ok,
+                points,
+                self._ref,
+                sigmas,
+                self._ambiguity_limit,
+            )
+            self.last_ambiguity = test
+            if test.ambiguous:
+                self.ambiguous_views += 1
+                return predicted
         return self._fuse(measured, info, predicted, self._motion(since_update))
 
     def _motion(self, since_update: Pose) -> float:

@@ -27,8 +27,8 @@ from albot1.data.synthetic.worlds import load_world
 from albot1.geometry import se2, segments
 from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import as_written
+from albot1.methods.albot1.mapping import ambiguity, pose_kernels, update_kernels
 from albot1.methods.albot1.mapping import kernels as mapping_source
-from albot1.methods.albot1.mapping import pose_kernels, update_kernels
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
@@ -247,6 +247,13 @@ def _refine_args() -> Iterator[tuple[Any, ...]]:
         )
 
 
+def _measurement_costs_args() -> Iterator[tuple[Any, ...]]:
+    """The refine cases' views, costed at their starts (the ambiguity test's fitted and predicted poses)."""
+    for args in _refine_args():
+        starts, lm_view, lm_map, ok, points, ref = args[:6]
+        yield (starts, lm_view, lm_map, ok, points, ref, *args[11:16])
+
+
 CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "build_view": _build_view_args,
     "recognise_landmarks": _recognise_args,
@@ -259,6 +266,7 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "place_segments": _place_args,
     "landmark_rows": _landmark_args,
     "scan_points": _scan_points_args,
+    "measurement_costs": _measurement_costs_args,
 }
 
 
@@ -277,6 +285,7 @@ KERNELS: dict[str, Any] = {
     },
     "update_surfaces": update_kernels.update_surfaces,
     **{name: getattr(pose_kernels, name) for name in ("refine_pose", "scan_points")},
+    "measurement_costs": ambiguity.measurement_costs,
 }
 
 

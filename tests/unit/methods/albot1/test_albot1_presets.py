@@ -60,6 +60,7 @@ OLD_DEFAULT: dict[str, Any] = {
     "prior_learning_rate": 0.02,
     "degenerate_sd_m": 0.0,
     "gate_probability": 0.0,
+    "ambiguity_probability": 0.0,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
@@ -87,6 +88,7 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "odometry_prior": "adaptive",
         "degenerate_sd_m": 0.05,
         "gate_probability": 0.0,
+        "ambiguity_probability": 0.99,
     },
 }
 
