@@ -217,7 +217,9 @@ def resolve_partial(
     k = segs.shape[0]
     action = np.zeros(k, dtype=np.int64)
     new = np.empty((k, 4))
-    match = np.full(k, -1, dtype=np.int64)
+    match = np.empty(k, dtype=np.int64)
+    for r in range(k):  # a loop, not np.full: one numpy routine less to compile
+        match[r] = -1
     used = taken.copy()
     angles = view_angles(view)
     for r in range(k):

@@ -420,7 +420,9 @@ def recognise_landmarks(
                 aa[n] = da
                 n += 1
     # owner[j]: the pair that labels current landmark j (-1: unrecognised).
-    owner = np.full(q, -1, dtype=np.int64)
+    owner = np.empty(q, dtype=np.int64)
+    for j in range(q):  # a loop, not np.full: one numpy routine less to compile
+        owner[j] = -1
     if greedy:
         used = np.zeros(p, dtype=np.bool_)
         order = stable_order(gg[:n])

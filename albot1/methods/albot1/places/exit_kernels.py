@@ -113,7 +113,9 @@ def seen_through(
     -1 where it passes through none; with several, the one met first along the line.
     """
     n = points.shape[0]
-    out = np.full(n, -1, dtype=np.int64)
+    out = np.empty(n, dtype=np.int64)
+    for i in range(n):  # a loop, not np.full: one numpy routine less to compile
+        out[i] = -1
     for p in range(n):
         px = points[p, 0]
         py = points[p, 1]
