@@ -215,7 +215,7 @@ def resolve_partial(
     the view surface it took (-1 if none). ``taken`` is not modified.
     """
     k = segs.shape[0]
-    action = np.zeros(k, dtype=np.int64)
+    action = np.empty(k, dtype=np.int64)  # every row is written below
     new = np.empty((k, 4))
     match = np.empty(k, dtype=np.int64)
     for r in range(k):  # a loop, not np.full: one numpy routine less to compile

@@ -77,9 +77,10 @@ def build_view(
             beam[k] = i
             k += 1
     out_s = np.empty((max(k, 1), 4))
-    out_k = np.zeros((max(k, 1), 2), dtype=np.int64)
-    out_b = np.zeros((max(k, 1), 2), dtype=np.int64)
-    out_c = np.zeros(max(k, 1), dtype=np.int64)
+    # np.empty, not np.zeros (one numpy routine less to compile): every returned row is written below
+    out_k = np.empty((max(k, 1), 2), dtype=np.int64)
+    out_b = np.empty((max(k, 1), 2), dtype=np.int64)
+    out_c = np.empty(max(k, 1), dtype=np.int64)
     if k == 0:
         return out_s[:0], out_k[:0], out_b[:0], out_c[:0]
     # Step 2, clustering of consecutive remaining points by Euclidean gap.
