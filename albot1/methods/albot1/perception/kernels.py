@@ -425,7 +425,9 @@ def recognise_landmarks(
     for j in range(q):  # a loop, not np.full: one numpy routine less to compile
         owner[j] = -1
     if greedy:
-        used = np.zeros(p, dtype=np.bool_)
+        used = np.empty(p, dtype=np.bool_)
+        for z in range(used.shape[0]):  # not np.zeros: one numpy routine less to compile
+            used[z] = False
         order = stable_order(gg[:n])
         for o in order:
             if used[ii[o]] or owner[jj[o]] >= 0:

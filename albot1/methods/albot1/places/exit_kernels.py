@@ -87,8 +87,12 @@ def detect_exits(
                 cw[n] = w
                 n += 1
     order = stable_order(cw[:n])
-    used_left = np.zeros(m, dtype=np.bool_)
-    used_right = np.zeros(m, dtype=np.bool_)
+    used_left = np.empty(m, dtype=np.bool_)
+    for z in range(used_left.shape[0]):  # not np.zeros: one numpy routine less to compile
+        used_left[z] = False
+    used_right = np.empty(m, dtype=np.bool_)
+    for z in range(used_right.shape[0]):  # not np.zeros: one numpy routine less to compile
+        used_right[z] = False
     out_i = np.empty(n, dtype=np.int64)
     out_j = np.empty(n, dtype=np.int64)
     k = 0

@@ -173,8 +173,12 @@ def same_any(a: FloatArray, b: FloatArray, max_angle: float, max_gap: float) -> 
     """
     na = a.shape[0]
     nb = b.shape[0]
-    a_has = np.zeros(na, dtype=np.bool_)
-    b_has = np.zeros(nb, dtype=np.bool_)
+    a_has = np.empty(na, dtype=np.bool_)
+    for z in range(a_has.shape[0]):  # not np.zeros: one numpy routine less to compile
+        a_has[z] = False
+    b_has = np.empty(nb, dtype=np.bool_)
+    for z in range(b_has.shape[0]):  # not np.zeros: one numpy routine less to compile
+        b_has[z] = False
     bx0 = np.empty(nb)
     bx1 = np.empty(nb)
     by0 = np.empty(nb)
