@@ -103,7 +103,9 @@ def classify_endpoints(
     poly: FloatArray, view: FloatArray, pts: FloatArray, margin: float, surfaces_only: bool
 ) -> BoolArray:
     """For each point ``(n, 2)``: inside the view polygon or within ``margin`` of it (:func:`covered`)."""
-    out = np.zeros(pts.shape[0], dtype=np.bool_)
+    out = np.empty(pts.shape[0], dtype=np.bool_)
+    for z in range(out.shape[0]):  # not np.zeros: one numpy routine less to compile
+        out[z] = False
     for k in range(pts.shape[0]):
         out[k] = covered(poly, view, pts[k, 0], pts[k, 1], margin, surfaces_only)
     return out
@@ -215,9 +217,11 @@ def resolve_partial(
     the view surface it took (-1 if none). ``taken`` is not modified.
     """
     k = segs.shape[0]
-    action = np.zeros(k, dtype=np.int64)
+    action = np.empty(k, dtype=np.int64)  # every row is written below
     new = np.empty((k, 4))
-    match = np.full(k, -1, dtype=np.int64)
+    match = np.empty(k, dtype=np.int64)
+    for r in range(k):  # a loop, not np.full: one numpy routine less to compile
+        match[r] = -1
     used = taken.copy()
     angles = view_angles(view)
     for r in range(k):

@@ -77,9 +77,10 @@ def build_view(
             beam[k] = i
             k += 1
     out_s = np.empty((max(k, 1), 4))
-    out_k = np.zeros((max(k, 1), 2), dtype=np.int64)
-    out_b = np.zeros((max(k, 1), 2), dtype=np.int64)
-    out_c = np.zeros(max(k, 1), dtype=np.int64)
+    # np.empty, not np.zeros (one numpy routine less to compile): every returned row is written below
+    out_k = np.empty((max(k, 1), 2), dtype=np.int64)
+    out_b = np.empty((max(k, 1), 2), dtype=np.int64)
+    out_c = np.empty(max(k, 1), dtype=np.int64)
     if k == 0:
         return out_s[:0], out_k[:0], out_b[:0], out_c[:0]
     # Step 2, clustering of consecutive remaining points by Euclidean gap.
@@ -420,9 +421,13 @@ def recognise_landmarks(
                 aa[n] = da
                 n += 1
     # owner[j]: the pair that labels current landmark j (-1: unrecognised).
-    owner = np.full(q, -1, dtype=np.int64)
+    owner = np.empty(q, dtype=np.int64)
+    for j in range(q):  # a loop, not np.full: one numpy routine less to compile
+        owner[j] = -1
     if greedy:
-        used = np.zeros(p, dtype=np.bool_)
+        used = np.empty(p, dtype=np.bool_)
+        for z in range(used.shape[0]):  # not np.zeros: one numpy routine less to compile
+            used[z] = False
         order = stable_order(gg[:n])
         for o in order:
             if used[ii[o]] or owner[jj[o]] >= 0:

@@ -87,8 +87,12 @@ def detect_exits(
                 cw[n] = w
                 n += 1
     order = stable_order(cw[:n])
-    used_left = np.zeros(m, dtype=np.bool_)
-    used_right = np.zeros(m, dtype=np.bool_)
+    used_left = np.empty(m, dtype=np.bool_)
+    for z in range(used_left.shape[0]):  # not np.zeros: one numpy routine less to compile
+        used_left[z] = False
+    used_right = np.empty(m, dtype=np.bool_)
+    for z in range(used_right.shape[0]):  # not np.zeros: one numpy routine less to compile
+        used_right[z] = False
     out_i = np.empty(n, dtype=np.int64)
     out_j = np.empty(n, dtype=np.int64)
     k = 0
@@ -113,7 +117,9 @@ def seen_through(
     -1 where it passes through none; with several, the one met first along the line.
     """
     n = points.shape[0]
-    out = np.full(n, -1, dtype=np.int64)
+    out = np.empty(n, dtype=np.int64)
+    for i in range(n):  # a loop, not np.full: one numpy routine less to compile
+        out[i] = -1
     for p in range(n):
         px = points[p, 0]
         py = points[p, 1]

@@ -58,7 +58,9 @@ def _count_matches(
     c = math.cos(theta)
     s = math.sin(theta)
     seg = np.empty(4)
-    used = np.zeros(nj, dtype=np.bool_)
+    used = np.empty(nj, dtype=np.bool_)
+    for z in range(used.shape[0]):  # not np.zeros: one numpy routine less to compile
+        used[z] = False
     count = 0
     left = False
     right = False

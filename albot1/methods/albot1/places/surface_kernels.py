@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import point_segment_distance
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import kernel
+from albot1.methods.albot1.compiled import jitable, kernel
 from albot1.methods.albot1.mapping.kernels import classify_endpoints
 from albot1.methods.albot1.ordering import stable_order
 
@@ -32,9 +32,11 @@ def merge_collinear(surfaces: FloatArray, max_angle: float, max_offset: float, m
     """
     n = surfaces.shape[0]
     length = np.empty(n)
+    longest_first = np.empty(n)  # -length in the loop: an array expression would be one more routine to compile
     for i in range(n):
         length[i] = np.hypot(surfaces[i, 2] - surfaces[i, 0], surfaces[i, 3] - surfaces[i, 1])
-    order = stable_order(-length)
+        longest_first[i] = -length[i]
+    order = stable_order(longest_first)
     gx = np.empty(n)
     gy = np.empty(n)
     gux = np.empty(n)
@@ -87,6 +89,23 @@ def merge_collinear(surfaces: FloatArray, max_angle: float, max_offset: float, m
     return out
 
 
+@jitable
+def _extent(points: FloatArray, axis: int) -> tuple[float, float]:
+    """``points[:, axis].min()`` and ``.max()`` (``NaN`` if any is ``NaN``), as loops: numba's array reductions
+    cost about 0.6 s of a cold compile (``docs/albot1-mapper.md``, "Compile time")."""
+    if points.shape[0] == 0:
+        raise ValueError("zero-size array to reduction operation minimum which has no identity")
+    lo = points[0, axis]
+    hi = lo
+    for v in range(1, points.shape[0]):
+        x = points[v, axis]
+        if x < lo or x != x:  # a NaN sticks: every comparison with it is False
+            lo = x
+        if x > hi or x != x:
+            hi = x
+    return lo, hi
+
+
 @kernel
 def colocated(
     segments: FloatArray,
@@ -107,10 +126,12 @@ def colocated(
     Rows of an ``excluded`` place, and those whose bounding box ``box``
     cannot meet the polygon's grown box, are skipped.
     """
-    x0 = poly[:, 0].min() - margin
-    x1 = poly[:, 0].max() + margin
-    y0 = poly[:, 1].min() - margin
-    y1 = poly[:, 1].max() + margin
+    x0, x1 = _extent(poly, 0)
+    y0, y1 = _extent(poly, 1)
+    x0 -= margin
+    x1 += margin
+    y0 -= margin
+    y1 += margin
     n = segments.shape[0]
     rows = np.empty(n, dtype=np.int64)
     k = 0
@@ -152,8 +173,12 @@ def same_any(a: FloatArray, b: FloatArray, max_angle: float, max_gap: float) -> 
     """
     na = a.shape[0]
     nb = b.shape[0]
-    a_has = np.zeros(na, dtype=np.bool_)
-    b_has = np.zeros(nb, dtype=np.bool_)
+    a_has = np.empty(na, dtype=np.bool_)
+    for z in range(a_has.shape[0]):  # not np.zeros: one numpy routine less to compile
+        a_has[z] = False
+    b_has = np.empty(nb, dtype=np.bool_)
+    for z in range(b_has.shape[0]):  # not np.zeros: one numpy routine less to compile
+        b_has[z] = False
     bx0 = np.empty(nb)
     bx1 = np.empty(nb)
     by0 = np.empty(nb)

@@ -1,4 +1,4 @@
-"""The kernels' stable order is numpy's ``argsort(kind="stable")``, compiled and as written, on any float array.
+"""The kernels' stable order is numpy's ``argsort(kind="stable")``, compiled and as written, on float and int arrays.
 
 The kernels use :func:`albot1.methods.albot1.ordering.stable_order` instead
 of numba's merge sort only because it compiles faster; any difference in
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -33,3 +33,12 @@ def test_the_order_is_numpy_s_stable_argsort_compiled_and_as_written(values: np.
     assert stable_order(values).tolist() == expected.tolist()
     got = compiled_order(values)
     assert got.dtype == np.int64 and got.tolist() == expected.tolist()
+
+
+@settings(deadline=None)  # the first example compiles the integer version
+@given(arrays(np.int64, st.integers(0, 70), elements=st.integers(-3, 3) | st.integers(-(2**63), 2**63 - 1)))
+def test_integer_arrays_too(values: np.ndarray) -> None:
+    """``update_surfaces`` orders its candidate surface ids with it (an integer array)."""
+    expected = np.argsort(values, kind="stable")
+    assert stable_order(values).tolist() == expected.tolist()
+    assert compiled_order(values).tolist() == expected.tolist()
