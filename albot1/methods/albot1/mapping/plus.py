@@ -133,14 +133,19 @@ def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | No
     alone). Without: the odometry step turned by each of
     :data:`ODOMETRY_TURNS_DEG`.
     """
+    # Filled in place (values as the stacked arrays had them): numpy's stacking calls cost more than the copies.
     if thesis is None or candidates is None:
-        turns = _ODOMETRY_TURNS
-        starts = np.column_stack(
-            [np.full(turns.size, odometry[0]), np.full(turns.size, odometry[1]), odometry[2] + turns]
-        )
-    else:
-        starts = np.vstack([np.asarray([thesis, odometry], dtype=float), np.asarray(candidates, dtype=float)])
-    return np.ascontiguousarray(starts)
+        starts = np.empty((_ODOMETRY_TURNS.size, 3))
+        starts[:, 0] = odometry[0]
+        starts[:, 1] = odometry[1]
+        starts[:, 2] = odometry[2] + _ODOMETRY_TURNS
+        return starts
+    others = np.asarray(candidates, dtype=float).reshape(-1, 3)
+    starts = np.empty((2 + others.shape[0], 3))
+    starts[0] = thesis
+    starts[1] = odometry
+    starts[2:] = others
+    return starts
 
 
 class PlusLocaliser:
