@@ -86,6 +86,7 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
             (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
         ],
         "measurement_costs": [(np.zeros((2, 3)), seg, seg + 0.01, ok, points, seg, 0.05, 0.1, 0.05, 2.0, 0.5)],
+        "screen_directions": [(0.1, 0.2, 0.05, np.diag([1e4, 2.0, 1e3]), 0.0, 0.0, 0.0, 0.4, 400.0)],
         "scan_points": [
             (scan_ranges, _readonly(scan_angles), 30.0, 2),
             (_readonly(scan_ranges), _readonly(scan_angles), 30.0, 2),

@@ -9,7 +9,7 @@ and the parity tests), and so that a warm-up can list what it must compile
 from __future__ import annotations
 
 from albot1.methods.albot1.compiled import select
-from albot1.methods.albot1.mapping import ambiguity, pose_kernels
+from albot1.methods.albot1.mapping import ambiguity, pose_kernels, screen_kernels
 from albot1.methods.albot1.mapping.kernels import place_segments
 from albot1.methods.albot1.mapping.update_kernels import update_surfaces
 
@@ -24,7 +24,11 @@ class MappingKernels:
         A warm-up leaves them out (:func:`albot1.methods.albot1.warm_up.warm_up`),
         which spares a first run of the thesis presets their compile.
         """
-        return () if pose_estimate == "robust" else ("refine_pose", "scan_points", "measurement_costs")
+        return (
+            ()
+            if pose_estimate == "robust"
+            else ("refine_pose", "scan_points", "measurement_costs", "screen_directions")
+        )
 
     def __init__(self, compiled: bool = True) -> None:
         self.compiled = compiled
@@ -33,3 +37,4 @@ class MappingKernels:
         self.refine_pose = select(pose_kernels.refine_pose, compiled)
         self.scan_points = select(pose_kernels.scan_points, compiled)
         self.measurement_costs = select(ambiguity.measurement_costs, compiled)
+        self.screen_directions = select(screen_kernels.screen_directions, compiled)

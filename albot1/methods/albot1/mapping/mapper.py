@@ -317,9 +317,14 @@ class Albot1Mapper:
                 rows.append(r)
                 maps.append(record[0])
                 map_kinds.append(record[1])
-        lm_view = np.ascontiguousarray(rl.surfaces[rows], dtype=float).reshape(-1, 4)
-        lm_map = np.ascontiguousarray(np.asarray(maps, dtype=float).reshape(-1, 4))
-        kinds = (rl.kinds[rows].reshape(-1, 2), np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2))
+        # Every landmark has its map record (the usual case): the arrays as they are, no copy (issue 24's cost).
+        every = len(rows) == len(rl)
+        lm_view = np.ascontiguousarray((rl.surfaces if every else rl.surfaces[rows]), dtype=float).reshape(-1, 4)
+        lm_map = np.asarray(maps, dtype=float).reshape(-1, 4)
+        kinds = (
+            (rl.kinds if every else rl.kinds[rows]).reshape(-1, 2),
+            np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2),
+        )
         since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
         return self._plus.pose(starts, lm_view, lm_map, kinds, self._points, since), loc
 

@@ -42,6 +42,7 @@ the odometry noise and fuses the prior (a few 3x3 products per scan).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,6 +52,7 @@ from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+from albot1.methods.albot1.mapping.screen_kernels import screen_directions
 from albot1.methods.albot1.perception.endpoints import STABLE
 
 #: The odometry learner's fixed choices (``docs/albot1-mapper.md``, "Albot1+"): a view teaches it only when its
@@ -137,14 +139,19 @@ def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | No
     alone). Without: the odometry step turned by each of
     :data:`ODOMETRY_TURNS_DEG`.
     """
+    # Filled in place (values as the stacked arrays had them): numpy's stacking calls cost more than the copies.
     if thesis is None or candidates is None:
-        turns = _ODOMETRY_TURNS
-        starts = np.column_stack(
-            [np.full(turns.size, odometry[0]), np.full(turns.size, odometry[1]), odometry[2] + turns]
-        )
-    else:
-        starts = np.vstack([np.asarray([thesis, odometry], dtype=float), np.asarray(candidates, dtype=float)])
-    return np.ascontiguousarray(starts)
+        starts = np.empty((_ODOMETRY_TURNS.size, 3))
+        starts[:, 0] = odometry[0]
+        starts[:, 1] = odometry[1]
+        starts[:, 2] = odometry[2] + _ODOMETRY_TURNS
+        return starts
+    others = np.asarray(candidates, dtype=float).reshape(-1, 3)
+    starts = np.empty((2 + others.shape[0], 3))
+    starts[0] = thesis
+    starts[1] = odometry
+    starts[2:] = others
+    return starts
 
 
 class PlusLocaliser:
@@ -280,7 +287,9 @@ class PlusLocaliser:
             noise.learn(nu2_xy, d_phi * d_phi, motion)
         v_xy, v_phi = noise.prior_variance(motion)
         if self.params.degenerate_sd > 0.0 or self.params.gate_probability > 0.0:
-            screened = screen_measurement(measured, info, predicted, (v_xy, v_phi), self.params)
+            screened = screen_measurement(
+                measured, info, predicted, (v_xy, v_phi), self.params, self._k.screen_directions
+            )
             if screened.degenerate:
                 self.degenerate_views += 1
             if screened.rejected:
@@ -310,6 +319,13 @@ class PlusLocaliser:
         return (x, y, wrap_angle(phi))
 
 
+#: The signature of :func:`~albot1.methods.albot1.mapping.screen_kernels.screen_directions`.
+ScreenDirections = Callable[
+    [float, float, float, FloatArray, float, float, float, float, float],
+    tuple[FloatArray, FloatArray, FloatArray, float, float, float, FloatArray],
+]
+
+
 @dataclass(frozen=True, slots=True)
 class Screened:
     """A view's measured pose after :func:`screen_measurement`."""
@@ -323,7 +339,12 @@ class Screened:
 
 
 def screen_measurement(
-    measured: Pose, info: FloatArray, predicted: Pose, prior_variance: tuple[float, float], params: PlusParams
+    measured: Pose,
+    info: FloatArray,
+    predicted: Pose,
+    prior_variance: tuple[float, float],
+    params: PlusParams,
+    directions: ScreenDirections = screen_directions,
 ) -> Screened:
     """Degeneracy-aware use of a view's pose fit (after Zhang, Kaess and Singh, ICRA 2016).
 
@@ -341,32 +362,35 @@ def screen_measurement(
     ``gate_probability`` quantile of chi-square with as many degrees of
     freedom as directions kept, the fit is taken for a wrong association and
     rejected (the odometry's prediction is used). With no direction kept the
-    view says nothing and the prediction is the pose.
+    view says nothing and the prediction is the pose. ``directions``: the
+    kernel doing the linear algebra (:func:`~albot1.methods.albot1.mapping.screen_kernels.screen_directions`,
+    compiled or as written).
     """
-    scale = np.asarray([1.0, 1.0, params.m_per_rad])
-    scale2 = np.outer(scale, scale)
-    info_u = np.asarray(info, dtype=float) / scale2
-    eigval, eigvec = np.linalg.eigh(0.5 * (info_u + info_u.T))
     floor = 1.0 / params.degenerate_sd**2 if params.degenerate_sd > 0.0 else 0.0
-    keep = eigval > max(floor, 0.0)
-    basis = eigvec[:, keep]
-    degenerate = bool(not keep.all())
-    if not keep.any():
+    eigval, basis, z, x, y, phi, info_kept = directions(
+        measured[0],
+        measured[1],
+        measured[2],
+        np.ascontiguousarray(info, dtype=float),
+        predicted[0],
+        predicted[1],
+        predicted[2],
+        params.m_per_rad,
+        floor,
+    )
+    kept_n = basis.shape[1]
+    degenerate = kept_n < 3
+    if kept_n == 0:
         return Screened(predicted, np.zeros((3, 3)), degenerate, False)
-    delta = np.asarray([measured[0] - predicted[0], measured[1] - predicted[1], wrap_angle(measured[2] - predicted[2])])
-    z = basis.T @ (scale * delta)  # the disagreement along the kept directions (m)
-    kept_n = int(keep.sum())
     mahalanobis = 0.0
     if params.gate_probability > 0.0:
         # scipy's import (and the test) only when the gate is on: the statement costs ~0.1 ms a call.
         from scipy.stats import chi2  # noqa: PLC0415
 
+        basis = np.ascontiguousarray(basis)  # numpy's own layout of eigvec[:, keep], so its products round as before
         prior_u = np.diag([prior_variance[0], prior_variance[0], prior_variance[1] * params.m_per_rad**2])
-        cov = np.diag(1.0 / eigval[keep]) + basis.T @ prior_u @ basis
+        cov = np.diag(1.0 / eigval[eigval > max(floor, 0.0)]) + basis.T @ prior_u @ basis
         mahalanobis = float(z @ np.linalg.solve(cov, z))
         if mahalanobis > float(chi2.ppf(params.gate_probability, kept_n)):
             return Screened(predicted, np.zeros((3, 3)), degenerate, True, kept_n, mahalanobis)
-    kept = (basis @ z) / scale
-    pose = (predicted[0] + float(kept[0]), predicted[1] + float(kept[1]), wrap_angle(predicted[2] + float(kept[2])))
-    info_kept = (basis * eigval[keep]) @ basis.T * scale2
-    return Screened(pose, np.ascontiguousarray(info_kept), degenerate, False, kept_n, mahalanobis)
+    return Screened((x, y, phi), info_kept, degenerate, False, kept_n, mahalanobis)

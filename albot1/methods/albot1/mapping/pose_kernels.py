@@ -189,6 +189,15 @@ def pose_cost(
     return total
 
 
+@jitable
+def repeats_earlier(starts: FloatArray, q: int) -> bool:
+    """Whether start ``q`` equals an earlier one (the thesis pose is also its landmark's candidate pose)."""
+    for r in range(q):
+        if starts[r, 0] == starts[q, 0] and starts[r, 1] == starts[q, 1] and starts[r, 2] == starts[q, 2]:
+            return True
+    return False
+
+
 @kernel
 def refine_pose(
     starts: FloatArray,
@@ -225,6 +234,8 @@ def refine_pose(
     chosen = 0
     lowest = np.inf
     for q in range(starts.shape[0]):
+        if repeats_earlier(starts, q):
+            continue  # an earlier start is the same pose: same cost, and a tie keeps the earlier one anyway
         cost = pose_cost(
             starts[q, 0],
             starts[q, 1],

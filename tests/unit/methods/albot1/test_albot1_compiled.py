@@ -27,7 +27,7 @@ from albot1.data.synthetic.worlds import load_world
 from albot1.geometry import se2, segments
 from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import as_written
-from albot1.methods.albot1.mapping import ambiguity, pose_kernels, update_kernels
+from albot1.methods.albot1.mapping import ambiguity, pose_kernels, screen_kernels, update_kernels
 from albot1.methods.albot1.mapping import kernels as mapping_source
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
@@ -254,6 +254,16 @@ def _measurement_costs_args() -> Iterator[tuple[Any, ...]]:
         yield (starts, lm_view, lm_map, ok, points, ref, *args[11:16])
 
 
+def _screen_args() -> Iterator[tuple[Any, ...]]:
+    """Information keeping 0 to 3 directions (scaled units, floor 400), headings across the wrap."""
+    rng = np.random.default_rng(24)
+    for _ in range(24):
+        rotation, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        info = np.ascontiguousarray((rotation * 10.0 ** rng.uniform(1.0, 5.0, 3)) @ rotation.T)
+        heading = float(rng.uniform(-math.pi, math.pi))
+        yield (0.1, -0.2, heading, info, 0.05, -0.1, -heading, 0.4, 400.0)
+
+
 CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "build_view": _build_view_args,
     "recognise_landmarks": _recognise_args,
@@ -267,6 +277,7 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "landmark_rows": _landmark_args,
     "scan_points": _scan_points_args,
     "measurement_costs": _measurement_costs_args,
+    "screen_directions": _screen_args,
 }
 
 
@@ -286,6 +297,7 @@ KERNELS: dict[str, Any] = {
     "update_surfaces": update_kernels.update_surfaces,
     **{name: getattr(pose_kernels, name) for name in ("refine_pose", "scan_points")},
     "measurement_costs": ambiguity.measurement_costs,
+    "screen_directions": screen_kernels.screen_directions,
 }
 
 

@@ -86,7 +86,9 @@ def test_a_thesis_preset_s_warm_up_leaves_out_the_kernels_only_albot1_plus_calls
         "recognise_landmarks",
         "update_surfaces",
     ]
-    assert found["plus"] == sorted([*found["thesis"], "measurement_costs", "refine_pose", "scan_points"])
+    assert found["plus"] == sorted(
+        [*found["thesis"], "measurement_costs", "refine_pose", "scan_points", "screen_directions"]
+    )
 
 
 def _python(code: str, cache: str, **env: str) -> str:
