@@ -33,8 +33,27 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import kernel
+from albot1.methods.albot1.compiled import jitable, kernel
 from albot1.methods.albot1.mapping.pose_kernels import huber_cost, nearest_surface, pose_cost, surface_boxes
+
+#: Independent terms a surface's points count for at most: its offset and its direction are what its fit error moves.
+TERMS_PER_SURFACE = 2
+
+
+@jitable
+def effective_terms(landmark_terms: int, per_surface: NDArray[np.int64]) -> tuple[int, int]:
+    """``(terms, independent)``: the residual terms of a view, and how many of them are independent.
+
+    Every landmark term counts; the points on one reference surface count for
+    at most :data:`TERMS_PER_SURFACE` (a straight surface's fit error is an
+    offset and a turn, shared by all its points).
+    """
+    terms = landmark_terms
+    independent = landmark_terms
+    for k in range(per_surface.shape[0]):
+        terms += per_surface[k]
+        independent += min(per_surface[k], TERMS_PER_SURFACE)
+    return terms, independent
 
 
 @kernel
@@ -50,20 +69,22 @@ def measurement_costs(
     scan_sigma: float,
     huber: float,
     gate: float,
-) -> tuple[FloatArray, NDArray[np.int64], float]:
+) -> tuple[FloatArray, NDArray[np.int64], float, int, int]:
     """The robust cost of the view's terms at each of ``poses`` ``(c, 3)``, and the fit's terms at the first.
 
     Costs are :func:`~albot1.methods.albot1.mapping.pose_kernels.pose_cost`'s
     (residuals in sigmas, ``r^2 / 2`` inside the Huber threshold; a point with
     no surface within ``gate`` costs as much as one at the gate). At the first
     pose (the fitted one): per reference surface, how many view points are
-    associated with it (the grouping :func:`effective_terms` needs), and the
-    cost of the associated terms alone (landmarks and matched points: the
-    residuals the fit's variance is estimated from).
+    associated with it, the cost of the associated terms alone (landmarks and
+    matched points: the residuals the fit's variance is estimated from), and
+    :func:`effective_terms` of them. The first pose's cost is summed in one pass
+    with its associations, in :func:`pose_cost`'s order (landmarks, then the
+    points in turn), so it is that function's value to the bit.
     """
     boxes = surface_boxes(ref, gate)
     costs = np.empty(poses.shape[0])
-    for q in range(poses.shape[0]):
+    for q in range(1, poses.shape[0]):
         costs[q] = pose_cost(
             poses[q, 0],
             poses[q, 1],
@@ -82,8 +103,15 @@ def measurement_costs(
         )
     per_surface = np.zeros(ref.shape[0], dtype=np.int64)
     matched = 0.0
+    landmark_terms = 0
+    for i in range(lm_map.shape[0]):
+        if np.hypot(lm_map[i, 2] - lm_map[i, 0], lm_map[i, 3] - lm_map[i, 1]) > 0.0:
+            landmark_terms += 2
+        for e in range(2):
+            if point_ok[i, e]:
+                landmark_terms += 1
     if poses.shape[0] > 0:
-        matched = pose_cost(
+        landmarks = pose_cost(
             poses[0, 0],
             poses[0, 1],
             poses[0, 2],
@@ -99,33 +127,22 @@ def measurement_costs(
             huber,
             gate,
         )
+        total = landmarks
+        matched = landmarks
         c = math.cos(poses[0, 2])
         s = math.sin(poses[0, 2])
         for p in range(points.shape[0]):
             tx = poses[0, 0] + c * points[p, 0] - s * points[p, 1]
             ty = poses[0, 1] + s * points[p, 0] + c * points[p, 1]
             found, distance = nearest_surface(tx, ty, ref, boxes, gate)
+            cost = huber_cost(distance / scan_sigma, huber)
+            total += cost
             if found >= 0:
                 per_surface[found] += 1
-                matched += huber_cost(distance / scan_sigma, huber)
-    return costs, per_surface, matched
-
-
-#: Independent terms a surface's points count for at most: its offset and its direction are what its fit error moves.
-TERMS_PER_SURFACE = 2
-
-
-def effective_terms(landmark_terms: int, per_surface: NDArray[np.int64]) -> tuple[int, int]:
-    """``(terms, independent)``: the residual terms of a view, and how many of them are independent.
-
-    Every landmark term counts; the points on one reference surface count for
-    at most :data:`TERMS_PER_SURFACE` (a straight surface's fit error is an
-    offset and a turn, shared by all its points).
-    """
-    counts = np.asarray(per_surface, dtype=np.int64)
-    terms = int(landmark_terms + counts.sum())
-    independent = int(landmark_terms + np.minimum(counts, TERMS_PER_SURFACE).sum())
-    return terms, independent
+                matched += cost
+        costs[0] = total
+    terms, independent = effective_terms(landmark_terms, per_surface)
+    return costs, per_surface, matched, terms, independent
 
 
 @dataclass(frozen=True, slots=True)
@@ -198,9 +215,6 @@ def view_ambiguity(
     ``sigmas``: line, point and scan sigma, Huber threshold (in sigmas) and
     the scan gate, as the fit used them; ``limit``: :func:`threshold`.
     """
-    poses = np.asarray([fitted, predicted], dtype=float)
-    costs, per_surface, matched = kernels_costs(poses, lm_view, lm_map, point_ok, points, ref, *sigmas)  # type: ignore[operator]
-    lengths = np.hypot(lm_map[:, 2] - lm_map[:, 0], lm_map[:, 3] - lm_map[:, 1]) if len(lm_map) else np.empty(0)
-    landmark_terms = 2 * int(np.count_nonzero(lengths > 0.0)) + int(np.count_nonzero(point_ok))
-    terms, independent = effective_terms(landmark_terms, per_surface)
-    return likelihood_ratio(float(costs[0]), float(costs[1]), float(matched), terms, independent, limit)
+    poses = np.array([fitted, predicted], dtype=float)
+    costs, _, matched, terms, independent = kernels_costs(poses, lm_view, lm_map, point_ok, points, ref, *sigmas)  # type: ignore[operator]
+    return likelihood_ratio(float(costs[0]), float(costs[1]), float(matched), int(terms), int(independent), limit)
