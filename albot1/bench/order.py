@@ -8,12 +8,15 @@ leaves at most the shortest cells for the end.
 
 The expected cost of a cell is the wall time its earlier attempts took
 (``attempt.json``, or ``FAILED.json`` for a failed one) in this results
-folder or a sibling one (``results/*``), matched on what the cell runs
+folder, matched on what the cell runs
 (method entry, preset, overrides, dataset slice, degradation, seed) but not
 on the code version: a code change plans new keys, yet costs move little.
 A cell never seen costs the median of its method entry's known cells, else
 the median of all known cells. With nothing known (a fresh clone) the plan's
-order is kept. The order changes no result: every cell runs in its own
+order is kept. The suites beside it (``results/*``) are not read: they share
+few cells (6 of the thesis suite's 93 with the default suite, none of the
+generalisation suite's), so reading their hundreds of folders would cost
+more than it orders. The order changes no result: every cell runs in its own
 process from its own inputs, and the report reads the store, not the order.
 """
 
@@ -95,16 +98,6 @@ def past_costs(stores: Iterable[Path]) -> dict[Signature, float]:
             if key not in found or mtime > found[key][0]:
                 found[key] = (mtime, elapsed)
     return {key: elapsed for key, (_, elapsed) in found.items()}
-
-
-def sibling_stores(root: Path) -> list[Path]:
-    """``root`` and the other results folders beside it (``results/*`` holding ``runs/``), ``root`` first."""
-    siblings: list[Path] = []
-    try:
-        siblings = sorted(p for p in root.parent.iterdir() if p != root and (p / "runs").is_dir())
-    except OSError:
-        pass
-    return [root, *siblings]
 
 
 def _known_cost(cell: Cell, known: dict[Signature, float]) -> float | None:

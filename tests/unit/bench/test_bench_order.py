@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 
 from albot1.bench.grid import Cell, CellOutcome, GridPlan
-from albot1.bench.order import longest_first, past_costs, sibling_stores, signature
+from albot1.bench.order import longest_first, past_costs, signature
 from albot1.bench.runner import run_grid
 from albot1.bench.store import ResultsStore
 
@@ -86,22 +86,11 @@ def test_signature_tells_apart_what_a_cell_runs_but_not_its_code() -> None:
     assert signature({"method_label": "x"}) is None
 
 
-def test_sibling_stores_are_read_after_the_own_one(tmp_path: Path) -> None:
-    results = tmp_path / "results"
-    for name in ("thesis", "default", "generalisation"):
-        (results / name / "runs").mkdir(parents=True)
-    (results / "not-a-store").mkdir()
-    assert sibling_stores(results / "thesis") == [
-        results / "thesis",
-        results / "default",
-        results / "generalisation",
-    ]
-
-
 def test_run_grid_submits_the_longest_expected_cell_first(tmp_path: Path) -> None:
     root = tmp_path / "results" / "t"
-    stored(tmp_path / "results" / "other", cell("gtsam", "a", "old", code="old"), elapsed=40.0)
-    stored(tmp_path / "results" / "other", cell("odometry", "a", "old2", code="old"), elapsed=0.5)
+    stored(root, cell("gtsam", "a", "old", code="old"), elapsed=40.0)  # this store's runs of an older code
+    stored(root, cell("odometry", "a", "old2", code="old"), elapsed=0.5)
+    stored(tmp_path / "results" / "other", cell("odometry", "a", "o3", code="old"), elapsed=99.0)  # not read
     cells = [cell("odometry", "a", "n1"), cell("gtsam", "a", "n2")]
     plan = GridPlan("t", None, "", cells, [], [], {}, [0], ["none"], {})
     store = ResultsStore(root)
