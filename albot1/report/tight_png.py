@@ -31,7 +31,7 @@ def save_tight_png(fig: Any, path: Path) -> None:
     pad = int(round(float(matplotlib.rcParams["savefig.pad_inches"]) * fig.dpi))
     top, left = max(0, top - pad), max(0, left - pad)
     bottom, right = min(pixels.shape[0], bottom + pad), min(pixels.shape[1], right + pad)
-    image = Image.fromarray(np.ascontiguousarray(pixels[top:bottom, left:right]), mode="RGBA")
+    image = Image.fromarray(np.ascontiguousarray(pixels[top:bottom, left:right]))  # uint8 (h, w, 4): RGBA
     dpi = (round(fig.dpi), round(fig.dpi))
     with path.open("wb") as handle:  # a file object: the caller's temporary name may lack ".png"
         image.save(handle, format="png", dpi=dpi)
