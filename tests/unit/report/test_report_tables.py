@@ -157,7 +157,12 @@ def test_aggregate_of_the_same_cells_is_computed_once_and_each_caller_owns_its_c
 
     calls: list[int] = []
     compute = tables._aggregate
-    monkeypatch.setattr(tables, "_aggregate", lambda cells, columns: calls.append(1) or compute(cells, columns))
+
+    def counted(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
+        calls.append(1)
+        return compute(cells, columns)
+
+    monkeypatch.setattr(tables, "_aggregate", counted)
     monkeypatch.setattr(tables, "_AGGREGATES", {})
     records = [record("w", "odometry", "none", s, ate) for s, ate in ((0, 1.0), (1, 3.0))]
     first = aggregate(cells_frame(records), METRIC_COLUMNS)
