@@ -30,6 +30,7 @@ from albot1.bench.executors import check_jobs, executor_failure, executor_lost, 
 from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.job import results_path, run_cell_job
 from albot1.bench.limits import start_forkserver
+from albot1.bench.order import longest_first, past_costs
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import LOG, UNREADABLE_FAILURE, ResultsStore
 from albot1.bench.suite import find_suite, load_suite
@@ -150,6 +151,8 @@ def run_grid(
     if summary.halted is not None:
         summary.not_started += pending
         pending = []
+    elif len(pending) > 1:  # longest expected first, so that no long cell runs alone at the end (albot1.bench.order)
+        pending = longest_first(pending, past_costs([store.root]))
     if observer is not None:
         observer.started(len(cells), len(cells) - len(pending) - len(summary.failures) - len(summary.not_started))
         for outcome in summary.outcomes:

@@ -82,6 +82,7 @@ def render_plots(
     """
     colors = colors or method_colors(r.cell.method_label for r in records)
     cells = cells_frame(records)
+    cells["held_in"] = [held_in(rec.cell) for rec in records]  # as the tables and the page have it: one aggregate
     metrics = aggregate(cells, METRIC_COLUMNS)
     cost = aggregate(cells, COST_COLUMNS)
     plots_dir = out / "plots"

@@ -15,16 +15,15 @@ from albot1.atomic import atomic_write
 from albot1.contract import RunResult
 from albot1.metrics.alignment import align
 from albot1.report.places_plot import render_places
+from albot1.report.tight_png import save_tight_png
 
 
 def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
 
-    fig, ax = plt.subplots(figsize=(7, 7), dpi=110)
+    fig = Figure(figsize=(7, 7), dpi=110)  # no pyplot: nothing to register or close, Agg is the canvas
+    ax = fig.add_subplot()
     data = result.map
     if data.points is not None and len(data.points):
         pts = np.asarray(data.points)
@@ -46,8 +45,7 @@ def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> 
         f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]", fontsize=9
     )
     ax.legend(loc="upper right", fontsize=7)  # "best" scans every map point: slow
-    fig.savefig(path, format="png", bbox_inches="tight")
-    plt.close(fig)
+    save_tight_png(fig, path)  # one layout pass instead of bbox_inches="tight"'s three
     places = result.files.get("places.json")
     if isinstance(places, dict):  # a method with a network of places (albot1-places): Figure 4.2 beside it
         title = f"{result.method} on {result.dataset} [{result.preset}, {result.degradation}, seed {result.seed}]"

@@ -63,8 +63,48 @@ def cells_frame(records: list[CellRecord]) -> pd.DataFrame:
     return pd.DataFrame(cell_rows(records), columns=cell_columns())  # the columns also when no cell was planned
 
 
+#: The last few :func:`aggregate` results, by the digest of their inputs (see :func:`aggregate`).
+_AGGREGATES: dict[str, pd.DataFrame] = {}
+_AGGREGATES_KEPT = 4
+
+
+def _aggregate_key(cells: pd.DataFrame, columns: dict[str, Column]) -> str | None:
+    """A digest of everything :func:`aggregate` reads (the frame, pickled: values with their types), or None.
+
+    Two equal frames may pickle differently (shared objects become references): that only costs a
+    recomputation; two different frames never share a digest.
+    """
+    import hashlib
+    import pickle
+
+    try:
+        frame = pickle.dumps(cells, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:  # noqa: BLE001 -- a value that does not pickle: computed every time
+        return None
+    return hashlib.sha256(frame + repr(list(columns)).encode()).hexdigest()
+
+
 def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
     """Every planned group (dataset x method x degradation): seed counts, status and mean/std/median/min/max.
+
+    A report asks for the same table up to three times (its tables, its
+    figures, its page), 5-20 s each for a suite of a few hundred cells, so
+    the last few results are kept by the digest of their inputs and each
+    caller gets its own copy: the same computation, done once.
+    """
+    key = _aggregate_key(cells, columns)
+    if key is not None and key in _AGGREGATES:
+        return _AGGREGATES[key].copy()
+    table = _aggregate(cells, columns)
+    if key is not None:
+        while len(_AGGREGATES) >= _AGGREGATES_KEPT:
+            del _AGGREGATES[next(iter(_AGGREGATES))]
+        _AGGREGATES[key] = table.copy()
+    return table
+
+
+def _aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
+    """:func:`aggregate` computed.
 
     ``seeds`` counts the completed seeds the statistics are over;
     ``planned``, ``failed`` and ``not_run`` the cells of the group;

@@ -150,6 +150,34 @@ def test_aggregate_over_seeds_mean_std_median_min_max() -> None:
     assert cell_text(single, "ate_rmse_m") == "0.500"
 
 
+def test_aggregate_of_the_same_cells_is_computed_once_and_each_caller_owns_its_copy(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import albot1.report.tables as tables
+
+    calls: list[int] = []
+    compute = tables._aggregate
+
+    def counted(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
+        calls.append(1)
+        return compute(cells, columns)
+
+    monkeypatch.setattr(tables, "_aggregate", counted)
+    monkeypatch.setattr(tables, "_AGGREGATES", {})
+    records = [record("w", "odometry", "none", s, ate) for s, ate in ((0, 1.0), (1, 3.0))]
+    first = aggregate(cells_frame(records), METRIC_COLUMNS)
+    first.loc[0, "ate_rmse_m_mean"] = -1.0  # a caller's change stays its own
+    again = aggregate(cells_frame(records), METRIC_COLUMNS)  # an equal frame built again
+    assert len(calls) == 1 and again.loc[0, "ate_rmse_m_mean"] == 2.0
+    changed = [record("w", "odometry", "none", 0, 1.0), record("w", "odometry", "none", 1, 5.0)]
+    assert aggregate(cells_frame(changed), METRIC_COLUMNS).loc[0, "ate_rmse_m_mean"] == 3.0 and len(calls) == 2
+    aggregate(cells_frame(records), COST_COLUMNS)  # other columns: another table
+    assert len(calls) == 3
+    for seed in range(2, 8):  # only the last few are kept
+        aggregate(cells_frame([record("w", "odometry", "none", seed, 1.0)]), METRIC_COLUMNS)
+    assert len(tables._AGGREGATES) == tables._AGGREGATES_KEPT
+
+
 @pytest.mark.parametrize(
     ("mean", "std", "low", "high", "n", "text"),
     [

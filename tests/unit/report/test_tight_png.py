@@ -1,0 +1,38 @@
+"""The one-pass tight PNG of run previews: cropped to the ink plus the 0.1 inch margin."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+from PIL import Image
+
+from albot1.report.tight_png import ink_box, save_tight_png
+
+
+def test_ink_box_is_the_rows_and_columns_that_differ_from_the_background() -> None:
+    pixels = np.full((10, 12, 4), 255, dtype=np.uint8)
+    pixels[3, 4] = (0, 0, 0, 255)
+    pixels[6, 9] = (255, 0, 0, 255)
+    assert ink_box(pixels) == (3, 7, 4, 10)
+    assert ink_box(np.full((5, 6, 4), 255, dtype=np.uint8)) == (0, 5, 0, 6)  # background only: whole picture
+
+
+def test_saved_png_is_the_ink_with_a_margin(tmp_path: Path) -> None:
+    fig = Figure(figsize=(4, 4), dpi=50)  # 200 x 200 pixels
+    ax = fig.add_axes((0.25, 0.25, 0.5, 0.5))  # a frame from pixel 50 to 150 each way
+    ax.set_axis_off()
+    ax.add_patch(Rectangle((0, 0), 1, 1, color="k", antialiased=False))
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1)
+    path = tmp_path / "tmp-name-without-suffix"
+    save_tight_png(fig, path)
+    with Image.open(path) as image:
+        assert image.format == "PNG"
+        width, height = image.size
+        pixels = np.asarray(image.convert("RGBA"))
+    assert (width, height) == (110, 110)  # 100 pixels of ink and 5 (0.1 inch at 50 dpi) on each side
+    assert (pixels[5:105, 5:105, :3] == 0).all()
+    assert (pixels[:5, :, :3] == 255).all() and (pixels[-5:, :, :3] == 255).all()
