@@ -15,7 +15,6 @@ from __future__ import annotations
 import importlib
 import json
 import os
-import re
 import shutil
 import tempfile
 from collections.abc import Callable, Iterator
@@ -133,7 +132,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 @dataclass(frozen=True)
 class Unit:
-    """Tests that go to one worker together: one test, or a module whose tests share a module-scoped fixture."""
+    """The tests of one module: xdist's ``loadscope`` gives a module to one worker whole (fixtures built once)."""
 
     name: str
     nodeids: tuple[str, ...]
@@ -141,44 +140,36 @@ class Unit:
 
 
 def schedule_units(
-    tests: list[tuple[str, str, bool, bool]], durations: dict[str, float], slow_default_s: float = SLOW_DEFAULT_S
+    tests: list[tuple[str, str, bool]], durations: dict[str, float], slow_default_s: float = SLOW_DEFAULT_S
 ) -> list[Unit]:
-    """The units of ``tests`` (nodeid, module, marked slow, module shares a fixture), longest first.
+    """The modules of ``tests`` (nodeid, module, marked slow), the longest first, each in collection order.
 
-    A module whose tests share a module-scoped fixture (a report built once
-    for several tests) is one unit, so the fixture is built once; every other
-    test is a unit of its own. The estimate of a unit is the sum of its
-    tests' ``durations`` (``slow_default_s`` for a slow test not listed, 0
-    otherwise); units of equal estimate keep the collection order.
+    The estimate of a module is the sum of its tests' ``durations``
+    (``slow_default_s`` for a slow test not listed, 0 otherwise); modules of
+    equal estimate keep the collection order.
     """
     grouped: dict[str, list[tuple[str, float]]] = {}
-    for nodeid, module, slow, shared in tests:
-        seconds = durations.get(nodeid, slow_default_s if slow else 0.0)
-        grouped.setdefault(module if shared else nodeid, []).append((nodeid, seconds))
+    for nodeid, module, slow in tests:
+        grouped.setdefault(module, []).append((nodeid, durations.get(nodeid, slow_default_s if slow else 0.0)))
     units = [Unit(name, tuple(n for n, _ in group), sum(s for _, s in group)) for name, group in grouped.items()]
     return sorted(units, key=lambda unit: -unit.seconds)
 
 
-@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which turns the groups below into its work units
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Run the longest tests first, each module with a shared module-scoped fixture kept together.
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Run the longest modules first, each kept together.
 
-    ``make test`` hands the tests to its workers one unit at a time in this
-    order (``--dist loadgroup``: a unit is one test, or one ``xdist_group``),
-    so a whole-log test of a minute or two starts at the beginning, beside
-    the other long ones, instead of starting last and keeping the other
-    workers idle until it ends; the short tests fill the gaps at the end.
+    ``make test`` hands its workers one module at a time in this order
+    (``--dist loadscope --no-loadscope-reorder``), so the module of a
+    whole-log test of a minute or two starts at the beginning, beside the
+    other long ones, instead of starting last and keeping the other workers
+    idle until it ends; the short modules fill the gaps at the end. A module
+    goes to one worker whole, so its module-scoped fixtures (a report built
+    once for several tests) are built once.
     """
     durations = _durations()
     tests = [(item.nodeid, _module(item) or item.nodeid, item.get_closest_marker("slow") is not None) for item in items]
-    shared = {module for (_, module, _), item in zip(tests, items) if _uses_module_fixture(item)}
-    units = schedule_units([(n, m, slow, m in shared) for n, m, slow in tests], durations)
     by_id = {item.nodeid: item for item in items}
-    items[:] = [by_id[nodeid] for unit in units for nodeid in unit.nodeids]
-    for unit in units:
-        if len(unit.nodeids) > 1:
-            for nodeid in unit.nodeids:
-                by_id[nodeid].add_marker(pytest.mark.xdist_group(unit.name))
+    items[:] = [by_id[nodeid] for unit in schedule_units(tests, durations) for nodeid in unit.nodeids]
 
 
 def _durations() -> dict[str, float]:
@@ -191,18 +182,11 @@ def _durations() -> dict[str, float]:
     )
 
 
-def _uses_module_fixture(item: pytest.Item) -> bool:
-    info = getattr(item, "_fixtureinfo", None)  # pytest's own record of the fixtures an item uses
-    definitions = getattr(info, "name2fixturedefs", {}) or {}
-    return any(d.scope == "module" for defs in definitions.values() for d in defs)
-
-
 def _module(item: pytest.Item) -> str | None:
     module = getattr(item, "module", None)
     return module.__name__ if module is not None else None
 
 
-_GROUP_SUFFIX = re.compile(r"@[\w.]+$")
 #: Each test's seconds so far under ``--record-durations`` (None: not recording, or an xdist worker).
 _recorded: dict[str, float] | None = None
 
@@ -210,8 +194,7 @@ _recorded: dict[str, float] | None = None
 def pytest_runtest_logreport(report: pytest.TestReport) -> None:
     """Add up each test's phases (the xdist controller receives every worker's reports)."""
     if _recorded is not None:
-        nodeid = _GROUP_SUFFIX.sub("", report.nodeid)  # xdist's loadgroup appends "@<group>" to grouped tests
-        _recorded[nodeid] = _recorded.get(nodeid, 0.0) + report.duration
+        _recorded[report.nodeid] = _recorded.get(report.nodeid, 0.0) + report.duration
 
 
 def pytest_sessionfinish(session: pytest.Session) -> None:

@@ -7,58 +7,36 @@ from pathlib import Path
 
 import pytest
 
-from conftest import DURATIONS_FILE, SLOW_DEFAULT_S, Unit, _durations, _uses_module_fixture, schedule_units
+from conftest import DURATIONS_FILE, SLOW_DEFAULT_S, Unit, _durations, schedule_units
 
 
-def test_units_are_ordered_longest_first_and_ties_keep_the_collection_order() -> None:
-    tests = [(f"t.py::t{i}", "t", False, False) for i in range(5)]
-    units = schedule_units(tests, {"t.py::t3": 40.0, "t.py::t1": 100.0, "t.py::t4": 40.0})
-    assert [u.name for u in units] == ["t.py::t1", "t.py::t3", "t.py::t4", "t.py::t0", "t.py::t2"]
-    assert [u.seconds for u in units] == [100.0, 40.0, 40.0, 0.0, 0.0]
+def test_modules_are_ordered_longest_first_and_ties_keep_the_collection_order() -> None:
+    tests = [("a.py::t0", "a", False), ("b.py::t1", "b", False), ("c.py::t2", "c", False), ("d.py::t3", "d", False)]
+    units = schedule_units(tests, {"b.py::t1": 100.0, "c.py::t2": 40.0, "d.py::t3": 40.0})
+    assert [u.name for u in units] == ["b", "c", "d", "a"]
+    assert [u.seconds for u in units] == [100.0, 40.0, 40.0, 0.0]
 
 
-def test_a_slow_test_the_file_does_not_list_goes_before_the_quick_ones() -> None:
-    tests = [
-        ("a.py::quick", "a", False, False),
-        ("a.py::new_slow", "a", True, False),
-        ("a.py::known", "a", True, False),
-    ]
-    units = schedule_units(tests, {"a.py::known": 0.5})
-    assert units == [
-        Unit("a.py::new_slow", ("a.py::new_slow",), SLOW_DEFAULT_S),
-        Unit("a.py::known", ("a.py::known",), 0.5),
-        Unit("a.py::quick", ("a.py::quick",), 0.0),
-    ]
-
-
-def test_a_module_sharing_a_module_fixture_is_one_unit_estimated_as_the_sum_of_its_tests() -> None:
-    tests = [
-        ("m.py::a", "m", False, True),
-        ("x.py::long", "x", True, False),
-        ("m.py::b", "m", True, True),
-        ("x.py::short", "x", False, False),
-    ]
+def test_a_module_is_one_unit_in_collection_order_estimated_as_the_sum_of_its_tests() -> None:
+    tests = [("m.py::a", "m", False), ("x.py::long", "x", True), ("m.py::b", "m", True), ("x.py::short", "x", False)]
     units = schedule_units(tests, {"m.py::a": 30.0, "m.py::b": 25.0, "x.py::long": 50.0})
-    assert units == [
-        Unit("m", ("m.py::a", "m.py::b"), 55.0),
-        Unit("x.py::long", ("x.py::long",), 50.0),
-        Unit("x.py::short", ("x.py::short",), 0.0),
-    ]
+    assert units == [Unit("m", ("m.py::a", "m.py::b"), 55.0), Unit("x", ("x.py::long", "x.py::short"), 50.0)]
 
 
-@pytest.fixture(scope="module")
-def shared_by_the_module() -> int:
-    return 1
+def test_a_slow_test_the_file_does_not_list_puts_its_module_before_the_quick_ones() -> None:
+    tests = [("q.py::quick", "q", False), ("n.py::new_slow", "n", True), ("k.py::known", "k", True)]
+    units = schedule_units(tests, {"k.py::known": 0.5})
+    assert [(u.name, u.seconds) for u in units] == [("n", SLOW_DEFAULT_S), ("k", 0.5), ("q", 0.0)]
 
 
-def test_a_test_using_a_module_fixture_is_seen_as_sharing_it(
-    request: pytest.FixtureRequest, shared_by_the_module: int
-) -> None:
-    assert _uses_module_fixture(request.node)
-
-
-def test_a_test_using_only_function_fixtures_is_not(request: pytest.FixtureRequest, tmp_path: Path) -> None:
-    assert not _uses_module_fixture(request.node)
+def test_the_collection_runs_in_that_order(request: pytest.FixtureRequest) -> None:
+    """conftest's hook has reordered this session's items: every module's tests together, longest module first."""
+    items = request.session.items
+    modules = [item.module.__name__ for item in items if getattr(item, "module", None) is not None]
+    seen = [m for i, m in enumerate(modules) if i == 0 or modules[i - 1] != m]
+    assert len(seen) == len(set(seen)), "a module's tests are not together"
+    tests = [(item.nodeid, item.module.__name__, item.get_closest_marker("slow") is not None) for item in items]
+    assert [u.name for u in schedule_units(tests, _durations())] == seen
 
 
 def test_the_durations_file_lists_seconds_of_tests_that_exist(request: pytest.FixtureRequest) -> None:
