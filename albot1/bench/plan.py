@@ -161,8 +161,7 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
 
 def _deterministic(degradation: str) -> bool:
     """True when a degradation ignores its seed (every seed would repeat one run)."""
-    spec = parse_spec(degradation)
-    return spec.kind in ("none", "thesis", "bias") or (spec.kind == "gauss" and spec.a == spec.b == 0.0)
+    return not parse_spec(degradation).seeded
 
 
 def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tuple[str, tuple[int, ...]]]:

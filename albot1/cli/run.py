@@ -13,6 +13,8 @@ from albot1.cli.progress import enabled, slice_bound, with_progress
 from albot1.runs.output import writable_folder
 from albot1.settings import get_settings
 
+_DEGRADE_HELP = "none | thesis | gauss:SXY_M:STH_DEG | bias:DX_M:DTH_DEG | offset:DX_M:DY_M:DTH_DEG | dropout:P"
+
 
 def register(app: typer.Typer) -> None:
     app.command("run", cls=RegistryHelpCommand)(run)
@@ -28,7 +30,7 @@ def run(
         ),
     ],
     preset: Annotated[str, typer.Option(help=PRESET_HELP)] = "default",
-    degrade: Annotated[str, typer.Option(help="none | thesis | gauss:SXY_M:STH_DEG | bias:DX_M:DTH_DEG")] = "none",
+    degrade: Annotated[str, typer.Option(help=_DEGRADE_HELP)] = "none",
     seed: Annotated[int, typer.Option(help="seed of the degradation and of any random choice")] = 0,
     out: Annotated[
         Path, typer.Option(help="results root; the run folder is OUT/<hash>, OUT/latest links it (`albot1 runs`)")

@@ -45,6 +45,9 @@ not evidence of how the method generalises, so the reports mark it
 (:func:`tuned_on`, ``albot1.report.tuning``). The table is data, not config:
 it never enters a run's config or its key. A file that
 ``extends`` another adds its held-in datasets to the other's, preset by preset.
+A ``[known_limits.PRESET]`` table records what was found about a log the
+method fails on (:mod:`albot1.config.known_limits`); the standard page prints
+it beside that log's failed row.
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
+from albot1.config.known_limits import KNOWN_LIMITS, KnownLimitsTable, parse_known_limits
 from albot1.config.validation import describe_errors
 from albot1.errors import ConfigError
 from albot1.resources import find_resource
@@ -81,13 +85,14 @@ def _tables(data: dict[str, Any], source: str) -> dict[str, dict[str, Any]]:
     tables = data.get("presets")
     if not isinstance(tables, dict) or not isinstance(tables.get("default"), dict):
         raise ConfigError(f"{source}: expected a [presets.default] table (and optional [presets.NAME] tables)")
-    unknown_top = sorted(set(data) - {"presets", EXTENDS, TUNED_ON})
+    unknown_top = sorted(set(data) - {"presets", EXTENDS, TUNED_ON, KNOWN_LIMITS})
     if unknown_top:
         raise ConfigError(
             f"{source}: unexpected top-level key(s) {', '.join(unknown_top)}; only [presets.NAME] tables, "
-            f'[{TUNED_ON}] and `{EXTENDS} = "METHOD"` are read'
+            f'[{TUNED_ON}], [{KNOWN_LIMITS}.PRESET] and `{EXTENDS} = "METHOD"` are read'
         )
     parse_tuned_on(data, source)
+    parse_known_limits(data, source)
     for name, values in tables.items():
         if not isinstance(values, dict):
             raise ConfigError(f"{source}: presets.{name} must be a table of FIELD = VALUE, got {type(values).__name__}")
@@ -271,6 +276,16 @@ def load_tuned_on(method: str) -> TunedOnTable | None:
         name: tuple(dict.fromkeys([*base.get(name, base["default"]), *own.get(name, own["default"])]))
         for name in [*base, *(n for n in own if n not in base)]
     }
+
+
+def load_known_limits(method: str) -> KnownLimitsTable | None:
+    """``[known_limits]`` of ``method``'s file (:mod:`albot1.config.known_limits`); None when it has none.
+
+    Not inherited through ``extends``: a finding is about the runs of the
+    method that file configures.
+    """
+    path = preset_file(method)
+    return parse_known_limits(_read(path), str(path))
 
 
 def tuned_on_table(owner: type) -> TunedOnTable | None:

@@ -18,10 +18,24 @@ pose, which is how odometry error arises physically. SPEC strings
     zero-mean Gaussian noise on each step's dx, dy (step frame) and dtheta.
 ``bias:DX_M:DTHETA_DEG``
     a constant forward offset and rotation added to every step.
+``offset:DX_M:DY_M:DTHETA_DEG``
+    a wrong laser offset: the odometry is reported for a frame displaced by
+    (dx, dy, dtheta) from where the scans are taken (a mounting the method
+    does not know). Each step becomes ``inv(D) * step * D``, so a turn in
+    place reads as a small arc and a straight step keeps its length but not
+    its direction when dtheta is not 0. Deterministic.
+``dropout:P``
+    scan dropout: every scan after the first is left out with probability
+    ``P`` (0 <= P < 1), independently; the kept frames are renumbered from 0
+    (as a ``[::STEP]`` slice does) and keep their own odometry, reference
+    pose and timestamp. The number of scans dropped says how much the
+    motion between kept scans grows: a Bernoulli thinning, not a stride.
 
-Only the odometry changes; scans, reference poses and relations are kept.
-The noise stream is a ``numpy.random.default_rng(seed)`` re-created for every
-iteration, so a re-read of the sequence gives the same degraded odometry.
+``offset`` and ``dropout`` are the suite's perturbations of the sensor set-up
+rather than of the odometry's noise (issue 21: robustness on held-out logs).
+Otherwise only the odometry changes; scans, reference poses and relations are
+kept. The random stream is a ``numpy.random.default_rng(seed)`` re-created for
+every iteration, so a re-read of the sequence gives the same result.
 """
 
 from __future__ import annotations
@@ -37,7 +51,12 @@ from albot1.data.finite import pose_problem
 from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
-EXPECTED_SPEC = "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG or bias:DX_M:DTHETA_DEG"
+EXPECTED_SPEC = (
+    "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG, bias:DX_M:DTHETA_DEG, "
+    "offset:DX_M:DY_M:DTHETA_DEG or dropout:P"
+)
+#: kind -> how many values its SPEC carries after the kind
+_ARITY = {"gauss": 2, "bias": 2, "offset": 3, "dropout": 1}
 #: Seeds are what ``numpy.random.default_rng`` accepts and a suite's TOML integer can hold: 0 .. 2**63 - 1.
 MAX_SEED = 2**63 - 1
 
@@ -48,17 +67,27 @@ class DegradationSpecError(DataError):
 
 @dataclass(frozen=True)
 class Degradation:
-    """A parsed SPEC; ``kind`` is none | thesis | gauss | bias."""
+    """A parsed SPEC; ``kind`` is none | thesis | gauss | bias | offset | dropout."""
 
     kind: str
-    a: float = 0.0  # translation (m): offset or sigma
+    a: float = 0.0  # translation (m): offset or sigma (offset: dx); dropout: the probability
     b: float = 0.0  # rotation (rad): offset or sigma
+    c: float = 0.0  # offset: dy (m)
 
     @property
     def spec(self) -> str:
         if self.kind in ("none", "thesis"):
             return self.kind
+        if self.kind == "dropout":
+            return f"dropout:{self.a:g}"
+        if self.kind == "offset":
+            return f"offset:{self.a:g}:{self.c:g}:{math.degrees(self.b):g}"
         return f"{self.kind}:{self.a:g}:{math.degrees(self.b):g}"
+
+    @property
+    def seeded(self) -> bool:
+        """Whether the result depends on the seed (otherwise every seed repeats one run)."""
+        return (self.kind == "gauss" and not self.a == self.b == 0.0) or (self.kind == "dropout" and self.a > 0)
 
     def perturb(self, step: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """One degraded increment ``(dx, dy, dtheta)``."""
@@ -75,6 +104,9 @@ class Degradation:
             return np.array([dx + self.a * noise[0], dy + self.a * noise[1], dth + self.b * noise[2]])
         if self.kind == "bias":
             return np.array([dx + self.a, dy, dth + self.b])
+        if self.kind == "offset":
+            mount = np.array([self.a, self.c, self.b])
+            return se2.compose(se2.compose(se2.inverse(mount), np.asarray(step, dtype=float)), mount)
         return np.asarray(step, dtype=float)
 
 
@@ -87,15 +119,24 @@ def parse_spec(spec: str) -> Degradation:
         return Degradation("thesis", 0.1, math.radians(1.0))
     kind, _, rest = text.partition(":")
     parts = rest.split(":") if rest else []
-    if kind not in ("gauss", "bias") or len(parts) != 2:
+    if kind not in _ARITY or len(parts) != _ARITY[kind]:
         raise DegradationSpecError(f"degradation {spec!r} not understood; {EXPECTED_SPEC}")
     try:
-        a, b_deg = float(parts[0]), float(parts[1])
+        values = [float(part) for part in parts]
     except ValueError:
-        raise DegradationSpecError(f"degradation {spec!r}: the two values must be numbers; {EXPECTED_SPEC}") from None
-    if not (math.isfinite(a) and math.isfinite(b_deg)) or (kind == "gauss" and (a < 0 or b_deg < 0)):
+        raise DegradationSpecError(f"degradation {spec!r}: the values must be numbers; {EXPECTED_SPEC}") from None
+    if not all(math.isfinite(v) for v in values) or (kind == "gauss" and min(values) < 0):
         raise DegradationSpecError(f"degradation {spec!r}: values must be finite (and sigmas >= 0); {EXPECTED_SPEC}")
-    return Degradation(kind, a, math.radians(b_deg))
+    if kind == "dropout":
+        if not 0.0 <= values[0] < 1.0:
+            raise DegradationSpecError(
+                f"degradation {spec!r}: the dropout probability must be in [0, 1) (the first scan is always kept); "
+                f"{EXPECTED_SPEC}"
+            )
+        return Degradation(kind, values[0])
+    if kind == "offset":
+        return Degradation(kind, values[0], math.radians(values[2]), values[1])
+    return Degradation(kind, values[0], math.radians(values[1]))
 
 
 def check_seed(seed: object) -> int:
@@ -115,6 +156,8 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
     deg = parse_spec(spec) if isinstance(spec, str) else spec
     if deg.kind == "none":
         return sequence
+    if deg.kind == "dropout":
+        return _dropout(sequence, deg, seed)
 
     def frames(source: Iterator[Frame]) -> Iterator[Frame]:
         rng = np.random.default_rng(seed)
@@ -138,3 +181,20 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
     source = sequence.metadata.odometry_source or "odometry"
     meta = replace(sequence.metadata, odometry_source=f"{source} degraded {deg.spec} seed {seed}")
     return sequence.with_frames(frames, metadata=meta, scan_count=sequence.known_scan_count)
+
+
+def _dropout(sequence: Sequence, deg: Degradation, seed: int) -> Sequence:
+    """Every frame after the first kept with probability 1 - P, renumbered from 0; nothing else changes."""
+
+    def frames(source: Iterator[Frame]) -> Iterator[Frame]:
+        rng = np.random.default_rng(seed)
+        kept = 0
+        for i, frame in enumerate(source):
+            if i > 0 and rng.random() < deg.a:
+                continue
+            yield replace(frame, index=kept)
+            kept += 1
+
+    extra = {**sequence.metadata.extra, "scan_dropout": f"{deg.spec} seed {seed}"}
+    meta = replace(sequence.metadata, extra=extra)
+    return sequence.with_frames(frames, metadata=meta, scan_count=sequence.known_scan_count if deg.a == 0 else None)

@@ -279,11 +279,11 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
 
 
 def severity_order(levels: list[str]) -> list[str]:
-    """none, then Gaussian levels by sigma, then biases, then the thesis's systematic degradation."""
-    rank = {"none": 0, "gauss": 1, "bias": 2, "thesis": 3}
+    """none, Gaussian levels by sigma, biases, the thesis's degradation, then the set-up ones (offset, dropout)."""
+    rank = {"none": 0, "gauss": 1, "bias": 2, "thesis": 3, "offset": 4, "dropout": 5}
 
     def key(level: str) -> tuple[int, float, float]:
         spec = parse_spec(level)
-        return rank.get(spec.kind, 4), spec.a, spec.b
+        return rank.get(spec.kind, 6), spec.a, spec.b
 
     return sorted(levels, key=key)

@@ -32,6 +32,7 @@ from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.metrics.paired import CONFIDENCE, method_text
 from albot1.report.collect import CellRecord
 from albot1.report.comparisons import Cell, Errors, all_pairs, matrix_lines, relation_errors_of
+from albot1.report.limits import known_limit_of
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import bench_argument, data_lines
 from albot1.report.tuning import LEGEND, held_in, marked
@@ -76,6 +77,8 @@ class Row:
     note: str = ""
     #: measured on a dataset the method's values were tuned on (None: published, or the tuning is not recorded)
     held_in: bool | None = None
+    #: a failed or unmeasured row: what the method's preset file records about this log (``[known_limits]``)
+    limit: str = ""
 
     @property
     def speed(self) -> float | None:
@@ -114,6 +117,7 @@ def measured_rows(records: list[CellRecord]) -> list[Row]:
     """
     rows: list[Row] = []
     seen: set[tuple[str, str]] = set()
+    methods: dict[str, tuple[str, str]] = {}
     for rec in records:
         if not _full_log_cell(rec):
             continue
@@ -121,13 +125,15 @@ def measured_rows(records: list[CellRecord]) -> list[Row]:
         if key in seen:
             continue
         seen.add(key)
+        methods.setdefault(rec.cell.method_label, (rec.cell.method, rec.cell.preset))
         rows.append(_measured(rec))
     measured_logs = {log for log, _ in seen}
-    for method in dict.fromkeys(method for _, method in seen):
+    for label, (method, preset) in methods.items():
         for log in STANDARD_LOGS:
-            if log in measured_logs and (log, method) not in seen:
+            if log in measured_logs and (log, label) not in seen:
                 note = "not in this suite's grid for this log (see the suite file)"
-                rows.append(Row(log, "measured", method, status="not measured", note=note))
+                limit = known_limit_of(method, preset, log) or ""
+                rows.append(Row(log, "measured", label, status="not measured", note=note, limit=limit))
     return rows
 
 
@@ -136,7 +142,10 @@ def _measured(rec: CellRecord) -> Row:
     tuned = held_in(rec.cell)
     if rec.status != "done" or rec.metrics is None or rec.result is None:
         reason = rec.failure.reason if rec.failure is not None else "the runner did not reach this cell"
-        return Row(log, "measured", method, status=rec.status, note=reason.replace("\n", " "), held_in=tuned)
+        limit = known_limit_of(rec.cell.method, rec.cell.preset, rec.cell.dataset) or ""
+        return Row(
+            log, "measured", method, status=rec.status, note=reason.replace("\n", " "), held_in=tuned, limit=limit
+        )
     timing = rec.result.timing
     external = rec.cell.trajectory is not None  # another system's file: no timing measured (zeros in result.json)
     wall_s, cpu_s = (None, None) if external else (timing.wall_s, timing.cpu_s)
@@ -397,7 +406,9 @@ def render_page(
         lines += [_HEAD, "|" + "---|" * 11]
         lines += ["| " + " | ".join(_cell(r)) + " |" for r in log_rows]
         sources = [f"- {r.method}: {r.source}" + (f" ({r.note})" if r.note else "") for r in log_rows if r.source]
-        lines += ["", *sources, ""]
+        limits = [f"- {r.method} ({r.status}), known limit from its preset file: {r.limit}" for r in log_rows]
+        limits = [line for line, r in zip(limits, log_rows, strict=True) if r.limit]
+        lines += ["", *sources, *limits, ""]
         lines += _paired_lines((paired or {}).get(log))
     lines += [
         "## Reading the figures",

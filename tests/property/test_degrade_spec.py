@@ -9,7 +9,9 @@ from hypothesis import strategies as st
 
 from albot1.data.degrade import EXPECTED_SPEC, DegradationSpecError, parse_spec
 
-KINDS = st.sampled_from(["none", "thesis", "gauss", "bias", "GAUSS", "Bias", "noise", "", " thesis "])
+KINDS = st.sampled_from(
+    ["none", "thesis", "gauss", "bias", "offset", "dropout", "GAUSS", "Bias", "Dropout", "noise", "", " thesis "]
+)
 NUMBERS = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True).map(repr),
     st.integers(-(10**6), 10**6).map(str),
@@ -24,10 +26,12 @@ def _check(spec: str) -> None:
         assert repr(spec) in str(exc)
         assert EXPECTED_SPEC in str(exc)
         return
-    assert deg.kind in ("none", "thesis", "gauss", "bias")
-    assert math.isfinite(deg.a) and math.isfinite(deg.b)
+    assert deg.kind in ("none", "thesis", "gauss", "bias", "offset", "dropout")
+    assert math.isfinite(deg.a) and math.isfinite(deg.b) and math.isfinite(deg.c)
     if deg.kind == "gauss":
         assert deg.a >= 0 and deg.b >= 0
+    if deg.kind == "dropout":
+        assert 0 <= deg.a < 1
     # What parsed re-parses to the same degradation from its canonical text.
     assert parse_spec(deg.spec).kind == deg.kind
 

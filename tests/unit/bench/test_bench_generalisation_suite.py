@@ -23,6 +23,9 @@ def test_the_suite_runs_the_held_out_logs_whole_and_every_third_scan_on_their_co
         assert f"{log}?odometry=laser-pose" in names and f"{log}?odometry=laser-pose[::3]" in names
     assert all(entry.sweep is True for entry in suite.datasets)
     assert suite.grid.degradations == ("bias:0.02:0.5", "gauss:0.05:2") and len(suite.grid.seeds) >= 3
+    setup = ("bias:0.02:0.5", "gauss:0.05:2", "offset:0.2:0.05:2", "dropout:0.5")  # the set-up perturbations
+    for entry in suite.datasets:
+        assert entry.degradations == (None if entry.name.endswith("[::3]") else setup), entry.name
     assert "odometry" in {m.name for m in suite.methods}  # the page pairs every method with it
 
 
@@ -44,6 +47,13 @@ def test_the_plan_has_one_cell_per_method_dataset_perturbation_and_seed() -> Non
     if plan.skipped_datasets:
         pytest.skip(f"datasets absent: {', '.join(s.name for s in plan.skipped_datasets)}")
     methods = {(c.method_label) for c in plan.cells}
-    # per dataset and method: none (1 seed) + bias (deterministic: 1 seed) + gauss x 3 seeds
-    assert len(plan.cells) == 8 * len(methods) * 5
-    assert {c.degradation for c in plan.cells} == {"none", "bias:0.02:0.5", "gauss:0.05:2"}
+    # per [::3] log and method: none (1 seed) + bias (deterministic: 1 seed) + gauss x 3 seeds; per whole log also
+    # offset (deterministic: 1 seed) + dropout x 3 seeds
+    assert len(plan.cells) == 4 * len(methods) * 5 + 4 * len(methods) * 9
+    assert {c.degradation for c in plan.cells} == {
+        "none",
+        "bias:0.02:0.5",
+        "gauss:0.05:2",
+        "offset:0.2:0.05:2",
+        "dropout:0.5",
+    }

@@ -191,6 +191,14 @@ def test_spec_round_trips(spec: str) -> None:
         "gauss:0.1:-1",
         ":",
         "gauss::",
+        "offset:0.1:0",
+        "offset:0.1:0:2:1",
+        "offset:0.1:nan:2",
+        "dropout",
+        "dropout:0.1:1",
+        "dropout:1",
+        "dropout:-0.1",
+        "dropout:x",
     ],
 )
 def test_bad_specs_raise_with_the_expected_format(spec: str) -> None:
@@ -198,7 +206,10 @@ def test_bad_specs_raise_with_the_expected_format(spec: str) -> None:
         parse_spec(spec)
     message = str(info.value)
     assert repr(spec) in message
-    assert "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG or bias:DX_M:DTHETA_DEG" in message
+    assert (
+        "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG, bias:DX_M:DTHETA_DEG, offset:DX_M:DY_M:DTHETA_DEG "
+        "or dropout:P" in message
+    )
     assert isinstance(info.value, DataError)
 
 
@@ -227,3 +238,40 @@ def test_a_seed_outside_0_to_2_63_is_refused_before_any_scan_is_read(seed: objec
 def test_seeds_at_the_bounds_and_numpy_integers_are_accepted() -> None:
     assert check_seed(0) == 0 and check_seed(2**63 - 1) == 2**63 - 1
     assert check_seed(np.int64(7)) == 7 and type(check_seed(np.uint32(7))) is int
+
+
+def test_a_wrong_laser_offset_turns_a_spin_on_the_spot_into_an_arc_and_keeps_straight_steps() -> None:
+    # The odometry frame sits 0.2 m ahead of the scanner: a 90 deg turn on the spot of the scanner reads, in the
+    # odometry frame, as a move of 0.2 * sqrt(2) m (from (0.2, 0) to (0, 0.2) seen from the start).
+    spin = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, math.pi / 2]])
+    seq = degrade(_sequence(spin), "offset:0.2:0:0")
+    step = se2.relative_steps(seq.odometry)[0]
+    np.testing.assert_allclose(step, [-0.2, 0.2, math.pi / 2], atol=1e-12)
+    straight = degrade(_sequence(_straight(3)), "offset:0.2:0:0").odometry
+    np.testing.assert_allclose(straight, _straight(3), atol=1e-12)  # no turn: a forward mounting changes nothing
+    # A mounting turned by 90 deg: each 1 m forward step of the scanner is a 1 m step to the right of that frame.
+    turned = se2.relative_steps(degrade(_sequence(_straight(2)), "offset:0:0:90").odometry)
+    np.testing.assert_allclose(turned, [[0.0, -1.0, 0.0]] * 2, atol=1e-12)
+    assert parse_spec("offset:0.2:-0.1:3").spec == "offset:0.2:-0.1:3"
+    assert not parse_spec("offset:0.2:0:0").seeded
+
+
+def test_scan_dropout_keeps_the_first_scan_renumbers_and_repeats_with_its_seed() -> None:
+    seq = _sequence(_straight(40))
+    kept = list(degrade(seq, "dropout:0.5", seed=3).frames())
+    again = list(degrade(seq, "dropout:0.5", seed=3).frames())
+    other = list(degrade(seq, "dropout:0.5", seed=4).frames())
+    assert [f.index for f in kept] == list(range(len(kept)))
+    assert kept[0].scan.timestamp == 0.0  # the first scan always stays
+    assert [f.scan.timestamp for f in kept] == [f.scan.timestamp for f in again]
+    assert [f.scan.timestamp for f in kept] != [f.scan.timestamp for f in other]
+    assert 5 < len(kept) < 36  # about half of 40 after the first (binomial(40, 0.5): far inside 5 sigma)
+    by_time = {f.scan.timestamp: f for f in seq.frames()}
+    for frame in kept:  # each kept scan keeps its own odometry, reference pose and ranges
+        source = by_time[frame.scan.timestamp]
+        np.testing.assert_array_equal(frame.odometry, source.odometry)
+        np.testing.assert_array_equal(frame.reference, source.reference)
+        np.testing.assert_array_equal(frame.scan.ranges, source.scan.ranges)
+    assert degrade(seq, "dropout:0.5", seed=3).metadata.extra["scan_dropout"] == "dropout:0.5 seed 3"
+    assert len(list(degrade(seq, "dropout:0", seed=3).frames())) == 41
+    assert parse_spec("dropout:0.25").seeded and not parse_spec("dropout:0").seeded

@@ -9,6 +9,7 @@ import numpy as np
 
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.store import Failure
+from albot1.config.presets import load_known_limits
 from albot1.data.model import Frame, Relations, Scan, Sequence
 from albot1.geometry import se2
 from albot1.methods.baselines.published import published_systems
@@ -154,3 +155,23 @@ def test_a_failed_method_a_method_left_out_of_a_log_and_unrun_systems_are_said_s
     assert "| mrpt-rbpf | failed | not measured | – | – | – |" in text  # the summary table's row
     assert "Methods not run on this machine: mrpt-icp (unavailable: needs icp-slam; `make mrpt`)." in text
     assert "- DP-SLAM: no published figure on these logs." in text
+
+
+def test_a_failed_or_unrun_row_carries_the_known_limit_its_preset_file_records(tmp_path: Path) -> None:
+    limits = load_known_limits("mrpt-rbpf")
+    assert limits is not None and set(limits["default"]) == {"aces", "intel", "fr-clinic"}
+    aces, clinic = _record(tmp_path / "a", "aces"), _record(tmp_path / "c", "fr-clinic")
+    failed = CellRecord(
+        _cell("aces", "mrpt-rbpf", "k1"), "failed", tmp_path, None, None, Failure("diverged", "exception", 1, 9.0, None)
+    )
+    by = {(r.log, r.method): r for r in measured_rows([aces, clinic, failed])}
+    assert by[("aces", "mrpt-rbpf")].limit == limits["default"]["aces"]
+    assert by[("fr-clinic", "mrpt-rbpf")].status == "not measured"
+    assert by[("fr-clinic", "mrpt-rbpf")].limit == limits["default"]["fr-clinic"]
+    assert by[("aces", "odometry")].limit == ""  # a done row, and a file without [known_limits]
+    out = tmp_path / "report"
+    out.mkdir()
+    text = write_standard(_plan([]), [aces, clinic, failed], out)[0].read_text()
+    line = f"- mrpt-rbpf (failed), known limit from its preset file: {limits['default']['aces']}"
+    assert line in text.splitlines()
+    assert f"- mrpt-rbpf (not measured), known limit from its preset file: {limits['default']['fr-clinic']}" in text
