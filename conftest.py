@@ -140,18 +140,33 @@ class Unit:
 
 
 def schedule_units(
-    tests: list[tuple[str, str, bool]], durations: dict[str, float], slow_default_s: float = SLOW_DEFAULT_S
+    tests: list[tuple[str, str, bool, bool]], durations: dict[str, float], slow_default_s: float = SLOW_DEFAULT_S
 ) -> list[Unit]:
-    """The modules of ``tests`` (nodeid, module, marked slow), the longest first, each in collection order.
+    """The modules of ``tests`` (nodeid, module, marked slow, shares state), the longest first.
 
-    The estimate of a module is the sum of its tests' ``durations``
-    (``slow_default_s`` for a slow test not listed, 0 otherwise); modules of
-    equal estimate keep the collection order.
+    The estimate of a test is its ``durations`` entry (``slow_default_s``
+    for a slow test not listed, 0 otherwise), that of a module the sum; ties
+    keep the collection order. Within a module the longest test goes first,
+    because xdist hands a worker its next module when the current one has
+    two tests left: a long test left at the end would hold that next module
+    up behind it while the other worker runs out of work. A module whose
+    tests share state (a module- or class-scoped fixture: part 2 of a worked
+    example continuing part 1's folder) keeps its collection order.
     """
     grouped: dict[str, list[tuple[str, float]]] = {}
-    for nodeid, module, slow in tests:
+    ordered: set[str] = set()
+    for nodeid, module, slow, shares in tests:
         grouped.setdefault(module, []).append((nodeid, durations.get(nodeid, slow_default_s if slow else 0.0)))
-    units = [Unit(name, tuple(n for n, _ in group), sum(s for _, s in group)) for name, group in grouped.items()]
+        if shares:
+            ordered.add(module)
+    units = [
+        Unit(
+            name,
+            tuple(n for n, _ in (group if name in ordered else sorted(group, key=lambda test: -test[1]))),
+            sum(s for _, s in group),
+        )
+        for name, group in grouped.items()
+    ]
     return sorted(units, key=lambda unit: -unit.seconds)
 
 
@@ -167,9 +182,21 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     once for several tests) are built once.
     """
     durations = _durations()
-    tests = [(item.nodeid, _module(item) or item.nodeid, item.get_closest_marker("slow") is not None) for item in items]
+    modules = [_module(item) or item.nodeid for item in items]
+    sharing = {module for module, item in zip(modules, items) if _shares_state(item)}
+    tests = [
+        (item.nodeid, module, item.get_closest_marker("slow") is not None, module in sharing)
+        for module, item in zip(modules, items)
+    ]
     by_id = {item.nodeid: item for item in items}
     items[:] = [by_id[nodeid] for unit in schedule_units(tests, durations) for nodeid in unit.nodeids]
+
+
+def _shares_state(item: pytest.Item) -> bool:
+    """Whether ``item`` uses a module- or class-scoped fixture (pytest's own record of the fixtures it uses)."""
+    info = getattr(item, "_fixtureinfo", None)
+    definitions = getattr(info, "name2fixturedefs", {}) or {}
+    return any(d.scope in ("module", "class") for defs in definitions.values() for d in defs)
 
 
 def _durations() -> dict[str, float]:
