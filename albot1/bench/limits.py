@@ -54,6 +54,8 @@ METHODS_ENV = "ALBOT1_PRELOAD_METHODS"
 #: overshoot its memory limit by what it allocates in this time.
 POLL_S = 0.05
 _FORKSERVER: Any = None
+#: Held while the forkserver is started with its preload list in the environment (:func:`start_forkserver`).
+_START_LOCK = threading.Lock()
 #: Held while a forkserver child is started or its exit status read (:class:`ForkserverChild`).
 _STATUS_LOCK = threading.Lock()
 
@@ -138,7 +140,7 @@ def start_forkserver(methods: Iterable[str] | None = None) -> None:
         from multiprocessing import forkserver
 
         _forkserver()
-        with _preloading(methods):
+        with _START_LOCK, _preloading(methods):  # cell threads call this too: one environment change at a time
             forkserver.ensure_running()
 
 

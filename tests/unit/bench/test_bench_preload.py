@@ -138,3 +138,30 @@ def test_the_runner_starts_the_server_with_the_suite_s_methods(
     with pytest.raises(_Planned):
         runner.run_suite(str(suite), results=tmp_path / "results")
     assert started == [preloaded]
+
+
+def test_cell_threads_starting_the_server_at_once_leave_the_environment_as_it_was(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Every cell thread calls start_forkserver with its method; the changes must not interleave and leak."""
+    import threading
+    import time
+
+    from albot1.bench import limits
+
+    seen: list[str | None] = []
+
+    def ensure_running() -> None:
+        seen.append(os.environ.get(ENV))
+        time.sleep(0.01)  # long enough for another thread to change the variable if it could
+
+    monkeypatch.setattr("multiprocessing.forkserver.ensure_running", ensure_running)
+    monkeypatch.setattr(limits, "launcher", lambda: "forkserver")
+    monkeypatch.delenv(ENV, raising=False)
+    threads = [threading.Thread(target=limits.start_forkserver, args=([f"m{i}"],)) for i in range(8)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert sorted(seen) == [f"m{i}" for i in range(8)]
+    assert ENV not in os.environ
