@@ -32,11 +32,12 @@ $(STAMP): pyproject.toml
 
 # Every test (unit, property, integration on the public logs when ALBOT1_DATA_DIR has them, the slow
 # whole-world runs), spread over TEST_JOBS worker processes (pytest-xdist; auto = one per core).
-# --dist worksteal: a worker that runs out of tests takes half of another's queue, so the long tests
-# (run first, conftest.py) never leave one worker busy alone at the end; docs/benchmarking.md has the times.
+# --dist loadscope: a worker that is nearly done is handed the next module (whole: its module fixtures are
+# built once) in conftest.py's order, longest first by tests/durations.json, so the modules of the whole-log
+# tests start at once and the short ones fill the gaps at the end; docs/benchmarking.md has the times.
 # Bytecode is written (PYTHONDONTWRITEBYTECODE dropped) so that a second run reuses the assertion-rewritten
 # test modules and the compiled package instead of compiling ~300 modules again in every worker.
-XDIST := -n $(TEST_JOBS) --dist worksteal
+XDIST := -n $(TEST_JOBS) --dist loadscope --no-loadscope-reorder
 test: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST)
 

@@ -13,10 +13,12 @@ the derived list against the manifests folder and the datasets README.
 from __future__ import annotations
 
 import importlib
+import json
 import os
 import shutil
 import tempfile
 from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -108,24 +110,125 @@ def fault_plugin(install_method_plugin: PluginInstaller) -> None:
     install_method_plugin({"fault": "bench_fault_mappers:FaultMapper"})
 
 
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Run the modules holding a slow test first, each module kept together (stable order otherwise).
+# -- the order tests run in, so that the long ones start first ------------------------------------------------
 
-    With several xdist workers (``make test``), a whole-log test of a minute
-    or two that starts last keeps the other workers idle until it ends; the
-    workers steal queued tests from each other (``--dist worksteal``), so the
-    short ones started after the slow ones fill the gaps instead. A module is
-    moved whole, not test by test, so that its module-scoped fixtures (a
-    report built once for several tests) are not built a second time when its
-    slow and quick tests would otherwise run far apart.
+#: Measured seconds of the tests that take over a second (``pytest --record-durations=tests/durations.json``);
+#: only the order of the values matters (they come from whatever machine measured them).
+DURATIONS_FILE = Path(__file__).parent / "tests" / "durations.json"
+#: The estimate of a test marked ``slow`` that the file does not list (new or renamed since it was measured).
+SLOW_DEFAULT_S = 2.0
+#: Tests under this many seconds are left out of the file (a unit of them costs about nothing).
+RECORD_MIN_S = 1.0
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption(
+        "--record-durations",
+        metavar="PATH",
+        help=f"write the seconds of every test over {RECORD_MIN_S:g} s (setup + call + teardown) to PATH as JSON "
+        "(tests/durations.json orders `make test`: longest first)",
+    )
+
+
+@dataclass(frozen=True)
+class Unit:
+    """The tests of one module: xdist's ``loadscope`` gives a module to one worker whole (fixtures built once)."""
+
+    name: str
+    nodeids: tuple[str, ...]
+    seconds: float
+
+
+def schedule_units(
+    tests: list[tuple[str, str, bool, bool]], durations: dict[str, float], slow_default_s: float = SLOW_DEFAULT_S
+) -> list[Unit]:
+    """The modules of ``tests`` (nodeid, module, marked slow, shares state), the longest first.
+
+    The estimate of a test is its ``durations`` entry (``slow_default_s``
+    for a slow test not listed, 0 otherwise), that of a module the sum; ties
+    keep the collection order. Within a module the longest test goes first,
+    because xdist hands a worker its next module when the current one has
+    two tests left: a long test left at the end would hold that next module
+    up behind it while the other worker runs out of work. A module whose
+    tests share state (a module- or class-scoped fixture: part 2 of a worked
+    example continuing part 1's folder) keeps its collection order.
     """
-    slow_modules = {_module(item) for item in items if item.get_closest_marker("slow")} - {None}
-    items.sort(key=lambda item: _module(item) not in slow_modules)
+    grouped: dict[str, list[tuple[str, float]]] = {}
+    ordered: set[str] = set()
+    for nodeid, module, slow, shares in tests:
+        grouped.setdefault(module, []).append((nodeid, durations.get(nodeid, slow_default_s if slow else 0.0)))
+        if shares:
+            ordered.add(module)
+    units = [
+        Unit(
+            name,
+            tuple(n for n, _ in (group if name in ordered else sorted(group, key=lambda test: -test[1]))),
+            sum(s for _, s in group),
+        )
+        for name, group in grouped.items()
+    ]
+    return sorted(units, key=lambda unit: -unit.seconds)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Run the longest modules first, each kept together.
+
+    ``make test`` hands its workers one module at a time in this order
+    (``--dist loadscope --no-loadscope-reorder``), so the module of a
+    whole-log test of a minute or two starts at the beginning, beside the
+    other long ones, instead of starting last and keeping the other workers
+    idle until it ends; the short modules fill the gaps at the end. A module
+    goes to one worker whole, so its module-scoped fixtures (a report built
+    once for several tests) are built once.
+    """
+    durations = _durations()
+    modules = [_module(item) or item.nodeid for item in items]
+    sharing = {module for module, item in zip(modules, items) if _shares_state(item)}
+    tests = [
+        (item.nodeid, module, item.get_closest_marker("slow") is not None, module in sharing)
+        for module, item in zip(modules, items)
+    ]
+    by_id = {item.nodeid: item for item in items}
+    items[:] = [by_id[nodeid] for unit in schedule_units(tests, durations) for nodeid in unit.nodeids]
+
+
+def _shares_state(item: pytest.Item) -> bool:
+    """Whether ``item`` uses a module- or class-scoped fixture (pytest's own record of the fixtures it uses)."""
+    info = getattr(item, "_fixtureinfo", None)
+    definitions = getattr(info, "name2fixturedefs", {}) or {}
+    return any(d.scope in ("module", "class") for defs in definitions.values() for d in defs)
+
+
+def _durations() -> dict[str, float]:
+    try:
+        values = json.loads(DURATIONS_FILE.read_text())
+    except (OSError, ValueError):
+        return {}  # no file (or a broken one): slow tests first by the marker alone
+    return (
+        {str(k): float(v) for k, v in values.items() if isinstance(v, int | float)} if isinstance(values, dict) else {}
+    )
 
 
 def _module(item: pytest.Item) -> str | None:
     module = getattr(item, "module", None)
     return module.__name__ if module is not None else None
+
+
+#: Each test's seconds so far under ``--record-durations`` (None: not recording, or an xdist worker).
+_recorded: dict[str, float] | None = None
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    """Add up each test's phases (the xdist controller receives every worker's reports)."""
+    if _recorded is not None:
+        _recorded[report.nodeid] = _recorded.get(report.nodeid, 0.0) + report.duration
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    path = session.config.getoption("record_durations", None)
+    if _recorded is not None and path:
+        kept = {nodeid: round(s, 1) for nodeid, s in sorted(_recorded.items()) if s >= RECORD_MIN_S}
+        Path(path).write_text(json.dumps(kept, indent=1) + "\n")
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -148,11 +251,14 @@ DECODED_CACHE_ENV = "ALBOT1_DECODED_CACHE"
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """On the xdist controller of a run with workers: one decoded-log folder for all of them.
+    """On the xdist controller of a run with workers: one decoded-log folder for all of them (and the recorder).
 
     Each worker would otherwise decode the public logs it opens into a folder of its own
     (:func:`_decoded_cache_of_the_session`); the workers inherit the controller's environment.
     """
+    global _recorded
+    if config.getoption("record_durations", None) and not hasattr(config, "workerinput"):
+        _recorded = {}
     workers = getattr(config.option, "numprocesses", None) or 0
     if hasattr(config, "workerinput") or workers < 1 or config.option.collectonly:
         return

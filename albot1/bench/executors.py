@@ -15,12 +15,16 @@ One code path: the runner only calls ``submit`` and ``concurrent.futures.as_comp
 ``dask://HOST:PORT`` (or ``tcp://``)
     an existing scheduler. Its workers must have albot1 installed and see
     the results folder (and the datasets) at the same paths as this machine.
+    A scheduler that does not answer within :func:`connect_timeout_s` is a
+    one-line error.
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
 import logging
+import math
+import os
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -29,6 +33,24 @@ from typing import Any
 from albot1.bench.errors import BenchError
 
 EXECUTORS_HELP = "local | dask | dask://HOST:PORT"
+#: Seconds to wait for a ``dask://`` scheduler to answer; the variable below changes it (a slow network
+#: may need more, and the test of an unreachable scheduler less: the wait is the whole of that test).
+CONNECT_TIMEOUT_S = 10.0
+CONNECT_TIMEOUT_ENV = "ALBOT1_DASK_CONNECT_TIMEOUT"
+
+
+def connect_timeout_s() -> float:
+    """:data:`CONNECT_TIMEOUT_S`, or ``ALBOT1_DASK_CONNECT_TIMEOUT`` when set (seconds above 0, else a BenchError)."""
+    text = os.environ.get(CONNECT_TIMEOUT_ENV, "").strip()
+    if not text:
+        return CONNECT_TIMEOUT_S
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = math.nan
+    if not (math.isfinite(seconds) and seconds > 0):
+        raise BenchError(f"{CONNECT_TIMEOUT_ENV}={text!r}: expected a number of seconds above 0")
+    return seconds
 
 
 def parse_executor(spec: str) -> tuple[str, str | None]:
@@ -74,12 +96,13 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
         with cf.ThreadPoolExecutor(max_workers=jobs, thread_name_prefix="cell") as pool:
             yield pool
         return
+    timeout_s = connect_timeout_s() if address is not None else None  # a bad setting fails before the imports
     import dask
     from distributed import Client, LocalCluster
 
     if address is not None:
         try:
-            client = Client(address, timeout="10s")
+            client = Client(address, timeout=timeout_s)
         except OSError as exc:
             raise BenchError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
         with _quiet_client_logs():

@@ -32,7 +32,8 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from multiprocessing.connection import wait as wait_ready
 from pathlib import Path
@@ -47,10 +48,14 @@ from albot1.processes import Stop, kill_tree
 from albot1.runs.folder import write_json
 
 PRELOAD = ["__main__", "albot1.bench.preload"]
+#: The methods the forkserver preloads, comma-separated (unset: every one); read by :mod:`albot1.bench.preload`.
+METHODS_ENV = "ALBOT1_PRELOAD_METHODS"
 #: How often the supervisor checks the child's resident memory and the clock (s). A cell may
 #: overshoot its memory limit by what it allocates in this time.
 POLL_S = 0.05
 _FORKSERVER: Any = None
+#: Held while the forkserver is started with its preload list in the environment (:func:`start_forkserver`).
+_START_LOCK = threading.Lock()
 #: Held while a forkserver child is started or its exit status read (:class:`ForkserverChild`).
 _STATUS_LOCK = threading.Lock()
 
@@ -122,18 +127,38 @@ def _forkserver() -> Any:
     return _FORKSERVER
 
 
-def start_forkserver() -> None:
+def start_forkserver(methods: Iterable[str] | None = None) -> None:
     """Start the cell forkserver now (it computes the code version first thing, then imports).
 
     The runner calls this before planning, so that the code version its
     cells are forked with and the one the plan's keys use are taken moments
-    apart rather than a planning pass apart.
+    apart rather than a planning pass apart. ``methods``: the registered
+    methods the server preloads (None: every one; :mod:`albot1.bench.preload`).
+    A server already running is kept as it is.
     """
     if launcher() == "forkserver":
         from multiprocessing import forkserver
 
         _forkserver()
-        forkserver.ensure_running()
+        with _START_LOCK, _preloading(methods):  # cell threads call this too: one environment change at a time
+            forkserver.ensure_running()
+
+
+@contextmanager
+def _preloading(methods: Iterable[str] | None) -> Iterator[None]:
+    """``ALBOT1_PRELOAD_METHODS`` set to ``methods`` while the server starts (it inherits this environment)."""
+    if methods is None:
+        yield
+        return
+    before = os.environ.get(METHODS_ENV)
+    os.environ[METHODS_ENV] = ",".join(sorted(set(methods)))
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(METHODS_ENV, None)
+        else:
+            os.environ[METHODS_ENV] = before
 
 
 def launcher() -> str:
@@ -227,6 +252,7 @@ def run_limited(
     if (how or launcher()) == "forkserver":
         # The forkserver, not this process, is the child's parent; it exits when this process dies.
         args["parent_pid"] = None
+        start_forkserver((cell.method,))  # where no runner started it (a Dask worker), or after it was lost
         forked = ForkserverChild(process_entry, (args,), name=f"cell-{cell.key}")
         process = watch(forked.pid)
         server = _parent_of(process)

@@ -9,7 +9,11 @@ stderr naming the module and the error (:func:`warm` returns them).
 What is imported by name: the modules below (the bench's own layer and the
 layers under it; ``tests/unit/bench/test_bench_imports_by_name.py`` checks
 them against the layer contract), the loader of every registered data
-format and the mapper class of every available registered method.
+format and the mapper class of every available registered method, or of
+only those named by ``ALBOT1_PRELOAD_METHODS`` (comma-separated; the runner
+names its grid's methods there when it starts the server, so a grid of one
+cheap method does not pay for importing and warming up the others; a cell
+of a method left out imports and warms it up itself).
 """
 
 from __future__ import annotations
@@ -17,7 +21,8 @@ from __future__ import annotations
 import functools
 import importlib
 import logging
-from collections.abc import Callable, Iterable
+import os
+from collections.abc import Callable, Collection, Iterable
 from typing import TYPE_CHECKING
 
 from albot1 import versions
@@ -30,6 +35,8 @@ if TYPE_CHECKING:
 versions.code_version()
 
 import matplotlib  # noqa: E402
+
+from albot1.bench.limits import METHODS_ENV  # noqa: E402
 
 _log = logging.getLogger(__name__)
 
@@ -69,8 +76,11 @@ def _attempt(what: str, load: Callable[[], object], failures: list[str]) -> None
         failures.append(f"{what}: {type(exc).__name__}: {exc}")
 
 
-def warm(modules: Iterable[str] = MODULES) -> list[str]:
-    """Import ``modules``, each data format's loader and each available method's class; the failures, one per line."""
+def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = None) -> list[str]:
+    """Import ``modules``, each data format's loader and each available method's class; the failures, one per line.
+
+    ``methods``: only these registered methods (None: all of them).
+    """
     from albot1.config.targets import resolve_target
     from albot1.data.loaders.registry import FORMATS
     from albot1.methods.registry import method_registry
@@ -86,7 +96,7 @@ def warm(modules: Iterable[str] = MODULES) -> list[str]:
     except Exception as exc:  # noqa: BLE001 -- an installed plugin declares a bad entry point
         failures.append(f"method registry: {type(exc).__name__}: {exc}")
     for spec in registry or ():
-        if spec.available():
+        if (methods is None or spec.name in methods) and spec.available():
             _attempt(f"method {spec.name} ({spec.target})", spec.load_class, failures)
             _attempt(f"method {spec.name}: warm-up", functools.partial(_warm_up, spec.name, registry), failures)
     return failures
@@ -110,8 +120,16 @@ def _warm_up(method: str, registry: MethodRegistry | None) -> None:
         cls(resolve_config(method, preset, registry=registry), seed=0).warm_up(None)  # type: ignore[attr-defined]
 
 
+def methods_to_preload() -> frozenset[str] | None:
+    """The method names in ``ALBOT1_PRELOAD_METHODS`` (None when it is unset: every method)."""
+    value = os.environ.get(METHODS_ENV)
+    if value is None:
+        return None
+    return frozenset(name.strip() for name in value.split(",") if name.strip())
+
+
 def _warm() -> None:
-    for failure in warm():
+    for failure in warm(methods=methods_to_preload()):
         _log.warning("albot1 bench: preloading %s (each cell that needs it will fail with this reason)", failure)
     _warm_matplotlib()
 

@@ -316,7 +316,9 @@ def run_suite(
     suite_file = find_suite(suite_ref)
     suite = load_suite(suite_file)
     if kind == "local":
-        start_forkserver()
+        start_forkserver(
+            None if suite.registered_methods else {m.name for m in suite.methods if m.trajectories is None}
+        )
     plan = plan_suite(suite, settings or get_settings())
     writable_folder(results, "--results")  # after the suite and its plan: a bad suite makes no folder
     store = ResultsStore(bench_results_root(results, suite.name))

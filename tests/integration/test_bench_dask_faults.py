@@ -24,6 +24,7 @@ from pathlib import Path
 import pytest
 from dask_cluster import Cluster, cluster_env
 
+from albot1.bench.executors import CONNECT_TIMEOUT_ENV
 from albot1.bench.store import LOG, ResultsStore
 
 WORLD = "synthetic-office-startstop[:20]"
@@ -270,7 +271,8 @@ def test_a_scheduler_that_does_not_answer_is_one_line(suite: Path, tmp_path: Pat
         port = probe.getsockname()[1]
     done = subprocess.run(
         bench_command(suite, tmp_path / "results", "--scheduler", f"127.0.0.1:{port}"),
-        env=cluster_env(),
+        # nothing answers on that port, so the runner waits out its connect timeout: 2 s, not the default 10 s
+        env=dict(cluster_env(), **{CONNECT_TIMEOUT_ENV: "2"}),
         cwd=tmp_path,
         capture_output=True,
         text=True,

@@ -14,7 +14,16 @@ import pytest
 from test_bench_failures import make_cell, plan_of
 
 from albot1.bench.errors import BenchError
-from albot1.bench.executors import _quiet_cancellations, executor_failure, parse_executor, scheduler_executor
+from albot1.bench.executors import (
+    CONNECT_TIMEOUT_ENV,
+    CONNECT_TIMEOUT_S,
+    _quiet_cancellations,
+    connect_timeout_s,
+    executor_failure,
+    open_executor,
+    parse_executor,
+    scheduler_executor,
+)
 from albot1.bench.grid import Cell, CellOutcome
 from albot1.bench.runner import run_grid
 from albot1.bench.store import LOG, ResultsStore
@@ -31,6 +40,27 @@ def test_scheduler_is_the_dask_url_of_its_address(address: str) -> None:
 def test_a_scheduler_address_without_host_and_port_is_refused(address: str) -> None:
     with pytest.raises(BenchError, match="expected HOST:PORT"):
         scheduler_executor(address)
+
+
+def test_the_scheduler_connect_timeout_is_10_s_unless_the_environment_says(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(CONNECT_TIMEOUT_ENV, raising=False)
+    assert connect_timeout_s() == CONNECT_TIMEOUT_S == 10.0
+    monkeypatch.setenv(CONNECT_TIMEOUT_ENV, " 2.5 ")
+    assert connect_timeout_s() == 2.5
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "soon", "nan", "inf", "1e999"])
+def test_a_connect_timeout_that_is_not_a_positive_number_is_one_line(
+    value: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv(CONNECT_TIMEOUT_ENV, value)
+    message = f"{CONNECT_TIMEOUT_ENV}={value!r}: expected a number of seconds above 0"
+    with pytest.raises(BenchError) as refused:
+        connect_timeout_s()
+    assert str(refused.value) == message
+    with pytest.raises(BenchError) as refused, open_executor("dask://127.0.0.1:1", 1):
+        pass  # refused before any connection is tried
+    assert str(refused.value) == message
 
 
 def test_scheduler_and_another_executor_together_are_refused() -> None:

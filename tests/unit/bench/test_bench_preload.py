@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 import logging
+import os
+import subprocess
+import sys
+from pathlib import Path
 from types import ModuleType
 
 import pytest
+
+from albot1.bench.limits import METHODS_ENV as ENV
 
 
 @pytest.fixture
@@ -31,7 +37,7 @@ def test_the_shipped_list_imports_cleanly(preload: ModuleType) -> None:
 def test_failures_are_logged_once_each(
     preload: ModuleType, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
-    monkeypatch.setattr(preload, "warm", lambda: ["module x: ImportError: boom"])
+    monkeypatch.setattr(preload, "warm", lambda methods=None: ["module x: ImportError: boom"])
     monkeypatch.setattr(preload, "_warm_matplotlib", lambda: None)
     with caplog.at_level(logging.WARNING, logger=preload.__name__):
         preload._warm()
@@ -55,9 +61,6 @@ print(json.dumps({name: len(getattr(k, name).signatures) for k in mapper.kernels
 def test_the_forkserver_compiles_every_kernel_before_any_cell_is_forked() -> None:
     """A cell forked after the preload finds every Albot1 kernel compiled: its start-up compiles nothing."""
     import json
-    import os
-    import subprocess
-    import sys
 
     out = subprocess.run(
         [sys.executable, "-c", _FORKED_CELL], env=dict(os.environ), capture_output=True, text=True, timeout=900
@@ -65,3 +68,100 @@ def test_the_forkserver_compiles_every_kernel_before_any_cell_is_forked() -> Non
     assert out.returncode == 0, out.stderr
     counts = json.loads(out.stdout)
     assert counts and all(n >= 1 for n in counts.values()), counts
+
+
+def test_the_methods_to_preload_are_every_method_unless_named(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv(preload.METHODS_ENV, raising=False)
+    assert preload.methods_to_preload() is None
+    monkeypatch.setenv(preload.METHODS_ENV, " odometry, fault ,,")
+    assert preload.methods_to_preload() == {"odometry", "fault"}
+    monkeypatch.setenv(preload.METHODS_ENV, "")
+    assert preload.methods_to_preload() == frozenset()
+
+
+def test_the_server_is_started_with_the_grid_s_methods_named_and_the_environment_restored(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from albot1.bench import limits
+
+    seen: list[str | None] = []
+    monkeypatch.setattr("multiprocessing.forkserver.ensure_running", lambda: seen.append(os.environ.get(ENV)))
+    monkeypatch.setattr(limits, "launcher", lambda: "forkserver")
+    monkeypatch.setenv(ENV, "before")
+    limits.start_forkserver({"odometry", "albot1"})
+    limits.start_forkserver(None)
+    monkeypatch.delenv(ENV)
+    limits.start_forkserver(["kiss-icp"])
+    assert seen == ["albot1,odometry", "before", "kiss-icp"]
+    assert ENV not in os.environ
+
+
+_PRELOADED = """
+import sys
+import albot1.bench.preload
+print(" ".join(sorted(m for m in ("albot1.methods.baselines.odometry", "albot1.methods.albot1.mapping.mapper",
+                                  "albot1.methods.baselines.kiss_icp") if m in sys.modules)))
+"""
+
+
+def test_a_server_told_one_method_imports_that_one_only() -> None:
+    """What ALBOT1_PRELOAD_METHODS saves: the other methods' imports and warm-ups (run in a fresh interpreter)."""
+    env = dict(os.environ, **{ENV: "odometry"})
+    out = subprocess.run([sys.executable, "-c", _PRELOADED], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["albot1.methods.baselines.odometry"]
+
+
+class _Planned(Exception):
+    """Raised in place of planning: the test only looks at how the server was started."""
+
+
+@pytest.mark.parametrize(
+    ("methods", "preloaded"),
+    [
+        ('[[methods]]\nname = "odometry"\n\n[[methods]]\nname = "kiss-icp"\n', {"odometry", "kiss-icp"}),
+        ('registered_methods = true\n\n[[methods]]\nname = "odometry"\n', None),
+    ],
+)
+def test_the_runner_starts_the_server_with_the_suite_s_methods(
+    methods: str, preloaded: set[str] | None, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from albot1.bench import runner
+
+    suite = tmp_path / "small.toml"
+    suite.write_text(methods + '\n[[datasets]]\nname = "synthetic-office-loop"\n')
+    started: list[object] = []
+    monkeypatch.setattr(runner, "start_forkserver", started.append)
+    monkeypatch.setattr(runner, "plan_suite", lambda *_: (_ for _ in ()).throw(_Planned()))
+    with pytest.raises(_Planned):
+        runner.run_suite(str(suite), results=tmp_path / "results")
+    assert started == [preloaded]
+
+
+def test_cell_threads_starting_the_server_at_once_leave_the_environment_as_it_was(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Every cell thread calls start_forkserver with its method; the changes must not interleave and leak."""
+    import threading
+    import time
+
+    from albot1.bench import limits
+
+    seen: list[str | None] = []
+
+    def ensure_running() -> None:
+        seen.append(os.environ.get(ENV))
+        time.sleep(0.01)  # long enough for another thread to change the variable if it could
+
+    monkeypatch.setattr("multiprocessing.forkserver.ensure_running", ensure_running)
+    monkeypatch.setattr(limits, "launcher", lambda: "forkserver")
+    monkeypatch.delenv(ENV, raising=False)
+    threads = [threading.Thread(target=limits.start_forkserver, args=([f"m{i}"],)) for i in range(8)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert sorted(seen) == [f"m{i}" for i in range(8)]
+    assert ENV not in os.environ
