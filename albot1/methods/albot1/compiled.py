@@ -43,8 +43,10 @@ from pathlib import Path
 from typing import Any, TypeVar, cast
 
 import numba
+import numpy as np
 from numba.core import config as numba_config
 from numba.extending import register_jitable
+from numpy.typing import NDArray
 
 from albot1 import versions
 from albot1.errors import ConfigError
@@ -101,6 +103,15 @@ def jitable(fn: F) -> F:
     """``numba.extending.register_jitable``: ``fn`` itself for Python callers, compiled into the kernels calling it."""
     jitted: F = register_jitable(fn)
     return jitted
+
+
+@jitable
+def falses(n: int) -> NDArray[np.bool_]:
+    """``n`` False values: a loop, not ``np.zeros``, is one numpy routine less for numba to compile."""
+    out = np.empty(n, dtype=np.bool_)
+    for z in range(n):
+        out[z] = False
+    return out
 
 
 def as_written(fn: F) -> F:

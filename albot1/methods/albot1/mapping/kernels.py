@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.segments import closest_parameter, line_angle, segment_distance
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import jitable, kernel
+from albot1.methods.albot1.compiled import falses, jitable, kernel
 
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
@@ -103,9 +103,7 @@ def classify_endpoints(
     poly: FloatArray, view: FloatArray, pts: FloatArray, margin: float, surfaces_only: bool
 ) -> BoolArray:
     """For each point ``(n, 2)``: inside the view polygon or within ``margin`` of it (:func:`covered`)."""
-    out = np.empty(pts.shape[0], dtype=np.bool_)
-    for z in range(out.shape[0]):  # not np.zeros: one numpy routine less to compile
-        out[z] = False
+    out = falses(pts.shape[0])
     for k in range(pts.shape[0]):
         out[k] = covered(poly, view, pts[k, 0], pts[k, 1], margin, surfaces_only)
     return out

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import jitable, kernel, select
+from albot1.methods.albot1.compiled import falses, jitable, kernel, select
 from albot1.methods.albot1.ordering import stable_order
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDED, OCCLUDING, UNSTABLE, is_stable
 
@@ -425,9 +425,7 @@ def recognise_landmarks(
     for j in range(q):  # a loop, not np.full: one numpy routine less to compile
         owner[j] = -1
     if greedy:
-        used = np.empty(p, dtype=np.bool_)
-        for z in range(used.shape[0]):  # not np.zeros: one numpy routine less to compile
-            used[z] = False
+        used = falses(p)
         order = stable_order(gg[:n])
         for o in order:
             if used[ii[o]] or owner[jj[o]] >= 0:

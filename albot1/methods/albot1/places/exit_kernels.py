@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.segments import orientation, point_segment_distance
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import kernel
+from albot1.methods.albot1.compiled import falses, kernel
 from albot1.methods.albot1.ordering import stable_order
 from albot1.methods.albot1.perception.endpoints import CORNER, OCCLUDING
 
@@ -87,12 +87,8 @@ def detect_exits(
                 cw[n] = w
                 n += 1
     order = stable_order(cw[:n])
-    used_left = np.empty(m, dtype=np.bool_)
-    for z in range(used_left.shape[0]):  # not np.zeros: one numpy routine less to compile
-        used_left[z] = False
-    used_right = np.empty(m, dtype=np.bool_)
-    for z in range(used_right.shape[0]):  # not np.zeros: one numpy routine less to compile
-        used_right[z] = False
+    used_left = falses(m)
+    used_right = falses(m)
     out_i = np.empty(n, dtype=np.int64)
     out_j = np.empty(n, dtype=np.int64)
     k = 0

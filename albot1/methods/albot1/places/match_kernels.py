@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import closest_parameter, point_segment_distance
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import jitable, kernel
+from albot1.methods.albot1.compiled import falses, jitable, kernel
 
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
@@ -58,9 +58,7 @@ def _count_matches(
     c = math.cos(theta)
     s = math.sin(theta)
     seg = np.empty(4)
-    used = np.empty(nj, dtype=np.bool_)
-    for z in range(used.shape[0]):  # not np.zeros: one numpy routine less to compile
-        used[z] = False
+    used = falses(nj)
     count = 0
     left = False
     right = False

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import point_segment_distance
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.compiled import jitable, kernel
+from albot1.methods.albot1.compiled import falses, jitable, kernel
 from albot1.methods.albot1.mapping.kernels import classify_endpoints
 from albot1.methods.albot1.ordering import stable_order
 
@@ -173,12 +173,8 @@ def same_any(a: FloatArray, b: FloatArray, max_angle: float, max_gap: float) -> 
     """
     na = a.shape[0]
     nb = b.shape[0]
-    a_has = np.empty(na, dtype=np.bool_)
-    for z in range(a_has.shape[0]):  # not np.zeros: one numpy routine less to compile
-        a_has[z] = False
-    b_has = np.empty(nb, dtype=np.bool_)
-    for z in range(b_has.shape[0]):  # not np.zeros: one numpy routine less to compile
-        b_has[z] = False
+    a_has = falses(na)
+    b_has = falses(nb)
     bx0 = np.empty(nb)
     bx1 = np.empty(nb)
     by0 = np.empty(nb)
