@@ -30,13 +30,12 @@ from pathlib import Path
 from typing import Any
 
 from albot1.bench.grid import Cell
+from albot1.bench.store import ATTEMPT, CELL, FAILED
+from albot1.bench.store_records import read_json_file
+from albot1.records import RecordError
 
 #: What a cell's cost is matched on (its run's inputs but for the code version and resolved config).
 Signature = tuple[str, str, str, str, str, str, int]
-
-_CELL = "cell.json"
-_ATTEMPT = "attempt.json"
-_FAILED = "FAILED.json"
 
 
 def signature(description: dict[str, Any]) -> Signature | None:
@@ -56,15 +55,16 @@ def signature(description: dict[str, Any]) -> Signature | None:
 
 
 def _read(path: Path) -> Any:
+    """The store's reader (:func:`read_json_file`); None where it refuses: this only orders cells."""
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        return read_json_file(path, "cell record")
+    except RecordError:
         return None
 
 
 def _elapsed(run_dir: Path) -> float | None:
     """The wall time of the folder's last attempt (s), None when none is recorded."""
-    for name in (_ATTEMPT, _FAILED):
+    for name in (ATTEMPT, FAILED):
         record = _read(run_dir / name)
         if isinstance(record, dict):
             value = record.get("elapsed_s")
@@ -87,10 +87,10 @@ def past_costs(stores: Iterable[Path]) -> dict[Signature, float]:
         for entry in entries:
             run_dir = Path(entry.path)
             try:
-                mtime = (run_dir / _CELL).stat().st_mtime
+                mtime = (run_dir / CELL).stat().st_mtime
             except OSError:
                 continue
-            description = _read(run_dir / _CELL)
+            description = _read(run_dir / CELL)
             key = signature(description) if isinstance(description, dict) else None
             elapsed = _elapsed(run_dir) if key is not None else None
             if key is None or elapsed is None:
