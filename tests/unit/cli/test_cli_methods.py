@@ -44,8 +44,7 @@ def test_presets_table_of_one_method() -> None:
         "    exact    motion_model = exact",
         "    literal  continuation_tolerance_m = 0.0 m, end_spacing_max_m = 0.0 m, delete_margin_from = boundary",
         "    plus     end_spacing_max_m = 0.0 m, surface_fit = tls, motion_model = exact, pose_estimate = robust, "
-        "scan_refinement = true, odometry_prior = adaptive, degenerate_sd_m = 0.05 m, ambiguity_probability = 0.99, "
-        "window_updates = 4",
+        "scan_refinement = true, odometry_prior = adaptive, degenerate_sd_m = 0.05 m, ambiguity_probability = 0.99",
     ]
 
 
@@ -70,7 +69,6 @@ def test_presets_json_of_every_method() -> None:
             "odometry_prior": "adaptive",
             "degenerate_sd_m": 0.05,
             "ambiguity_probability": 0.99,
-            "window_updates": 4,
         },
     }
     field = next(f for f in albot1["fields"] if f["name"] == "delete_margin_m")

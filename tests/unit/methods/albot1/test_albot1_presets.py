@@ -91,7 +91,6 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "degenerate_sd_m": 0.05,
         "gate_probability": 0.0,
         "ambiguity_probability": 0.99,
-        "window_updates": 4,
     },
 }
 
