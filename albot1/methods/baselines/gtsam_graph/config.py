@@ -96,6 +96,9 @@ class GtsamGraphConfig(BaseModel):
     odometry_trust_gate_chi2: float = Field(
         gt=0, description="... nor a step whose odometry and match disagree beyond this Mahalanobis distance squared"
     )
+    odometry_trust_bias_horizon: int = Field(
+        ge=0, description="... its median disagreement counts as a bias accumulated over this many steps (0: off)"
+    )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
         gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"
