@@ -289,7 +289,8 @@ def _noisy_heading_room(scans: int, bias_deg: float, noise_deg: float) -> Sequen
 
 def test_a_steady_heading_bias_the_median_test_misses_gets_no_odometry_factor() -> None:
     """Odometry 0.15 +- 0.3 deg off per step: the median test alone lets its factors in and they turn the map; counted
-    as accumulated over 50 steps (odometry_trust_bias_horizon) the bias keeps them out. Unbiased +-0.3 deg: fused."""
+    as accumulated over 50 steps (odometry_trust_bias_horizon) the bias keeps them out. Unbiased +-0.3 deg: fused.
+    Without the weight floor, whose halving of the odometry's weight would hide what the horizon does."""
     seq = _noisy_heading_room(80, 0.15, 0.3)
     ref = seq.reference
 
@@ -297,9 +298,10 @@ def test_a_steady_heading_bias_the_median_test_misses_gets_no_odometry_factor() 
         est = se2.compose(ref[0], out.poses)
         return float(np.hypot(*(est[:, :2] - ref[:, :2]).T).max())
 
-    _, plain = run(seq, node_translation_m=0.1, odometry_trust=True, odometry_trust_bias_horizon=0)
-    _, horizon = run(seq, node_translation_m=0.1, odometry_trust=True, odometry_trust_bias_horizon=50)
+    trust = {"node_translation_m": 0.1, "odometry_trust": True, "odometry_trust_min_variance_ratio": 0.0}
+    _, plain = run(seq, **trust, odometry_trust_bias_horizon=0)
+    _, horizon = run(seq, **trust, odometry_trust_bias_horizon=50)
     assert plain.counters["odometry_fused"] > 40 and worst(plain) > 0.1
     assert horizon.counters["odometry_fused"] == 0 and worst(horizon) < 0.01
-    _, unbiased = run(_noisy_heading_room(80, 0.0, 0.3), node_translation_m=0.1, odometry_trust=True)
+    _, unbiased = run(_noisy_heading_room(80, 0.0, 0.3), **trust, odometry_trust_bias_horizon=50)
     assert unbiased.counters["odometry_fused"] > 60

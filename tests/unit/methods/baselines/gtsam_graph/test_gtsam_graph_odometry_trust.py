@@ -173,3 +173,27 @@ def test_a_median_within_its_standard_error_counts_as_no_bias() -> None:
     assert squared_bias(0.9 * standard_error, 1.0, 40) == 0.0
     assert squared_bias(2.0 * standard_error, 1.0, 40) == pytest.approx(3.0 * standard_error**2)
     assert squared_bias(-2.0 * standard_error, 1.0, 40) == pytest.approx(3.0 * standard_error**2)
+
+
+def test_the_weight_floor_keeps_a_trusted_odometry_from_outweighing_its_match() -> None:
+    """Perfect-odometry-like innovations (+-0.2 deg): trusted at the sampling floor, or at the match's own variance
+    (ratio 1) or half of it (0.5); what is not trusted stays so; the fused heading is then the plain mean."""
+    spread = MAD_TO_SIGMA * math.radians(0.2)
+    for ratio, expected in (
+        (0.0, spread**2 * math.sqrt(2.0 / 40)),
+        (0.5, 0.5 * MATCH_COV[2, 2]),
+        (1.0, MATCH_COV[2, 2]),
+    ):
+        trust = OdometryTrust(50, bias_z=3.0, gate_chi2=16.27, min_variance_ratio=ratio)
+        for dx, dy, dth in _alternating(40, 0.01, 0.01, 0.2):
+            trust.add(STEP, STEP + np.array([dx, dy, math.radians(dth)]))
+        var = trust.variances(np.diag(MATCH_COV))
+        assert var is not None and var[2] == pytest.approx(expected)
+    match = STEP + np.array([0.0, 0.0, math.radians(0.4)])
+    fused = trust.fuse(STEP, match, MATCH_COV)
+    assert fused is not None and fused[0][2] == pytest.approx(STEP[2] + math.radians(0.2))
+    worse = OdometryTrust(50, bias_z=3.0, gate_chi2=16.27, min_variance_ratio=1.0)
+    for dx, dy, dth in _alternating(40, 0.03, 0.03, 0.8):
+        worse.add(STEP, STEP + np.array([dx, dy, math.radians(dth)]))
+    var = worse.variances(np.diag(MATCH_COV))
+    assert var is not None and np.isinf(var).all()
