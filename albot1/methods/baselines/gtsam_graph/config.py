@@ -96,6 +96,12 @@ class GtsamGraphConfig(BaseModel):
     odometry_trust_gate_chi2: float = Field(
         gt=0, description="... nor a step whose odometry and match disagree beyond this Mahalanobis distance squared"
     )
+    odometry_trust_bias_horizon: int = Field(
+        ge=0, description="... its median disagreement counts as a bias accumulated over this many steps (0: off)"
+    )
+    odometry_trust_min_variance_ratio: float = Field(
+        ge=0, description="... a trusted component's variance never below this times its match's (1: never more weight)"
+    )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
         gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"

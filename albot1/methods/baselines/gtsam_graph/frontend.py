@@ -76,6 +76,8 @@ class FrontEnd:
             config.odometry_trust_bias_z,
             config.odometry_trust_gate_chi2,
             (0, 1, 2) if config.odometry_trust_translation else (2,),
+            config.odometry_trust_bias_horizon,
+            config.odometry_trust_min_variance_ratio,
         )
         self._odometry_factors = OdometryFactors(self._odometry_trust)
         # Odometry factors judged at the latest node (``odometry_trust_factors``), for the back end to add with it.

@@ -9,7 +9,7 @@ The method of Grisetti et al. (2010), the thesis's section 2.2.3:
   increment being the initial guess and a weak prior; when the match is poor
   (not converged, low inlier fraction, large residual or an implausible
   correction) the edge is the odometry increment with a larger covariance;
-  with ``odometry_trust`` (on) the odometry's heading joins it as its own
+  with ``odometry_trust`` (off by default) the odometry's heading joins it as its own
   factor where the odometry has shown itself the better of the two
   (:mod:`.odometry_trust`);
 * **loop-closure edges** from ICP against the submaps of earlier nodes near

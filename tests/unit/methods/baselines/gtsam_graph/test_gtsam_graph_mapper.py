@@ -270,3 +270,38 @@ def test_odometry_factors_reach_back_to_the_steps_before_the_variance_was_learnt
     assert out_factors.counters["odometry_fused"] == 59
     extra = factors.back.graph._all_factors.size() - fused.back.graph._all_factors.size()
     assert extra == 59 - out_factors.counters["loop_closures_accepted"] + out_fused.counters["loop_closures_accepted"]
+
+
+def _noisy_heading_room(scans: int, bias_deg: float, noise_deg: float) -> Sequence:
+    """The room drive whose odometry heading steps are off by ``bias_deg`` +- ``noise_deg`` (alternating)."""
+    t = np.arange(scans)
+    truth = np.column_stack([2.0 + 0.1 * t, 2.0 + 0.02 * t, 0.2 * np.sin(t / 15.0)])
+    steps = se2.relative_steps(truth)
+    # one step per scan after the first
+    steps[:, 2] += np.radians(bias_deg + noise_deg * np.where(t[1:] % 2 == 0, 1.0, -1.0))
+    odometry = se2.integrate_steps(truth[0], steps)
+    frames = [
+        Frame(i, Scan(cast(WALLS, truth[i], ANGLES, 30.0), ANGLES, float(i) * 0.1, 30.0), odometry[i], truth[i])
+        for i in range(scans)
+    ]
+    return Sequence.from_frames("room", frames)
+
+
+def test_a_steady_heading_bias_the_median_test_misses_gets_no_odometry_factor() -> None:
+    """Odometry 0.15 +- 0.3 deg off per step: the median test alone lets its factors in and they turn the map; counted
+    as accumulated over 50 steps (odometry_trust_bias_horizon) the bias keeps them out. Unbiased +-0.3 deg: fused.
+    Without the weight floor, whose halving of the odometry's weight would hide what the horizon does."""
+    seq = _noisy_heading_room(80, 0.15, 0.3)
+    ref = seq.reference
+
+    def worst(out: MapperOutput) -> float:
+        est = se2.compose(ref[0], out.poses)
+        return float(np.hypot(*(est[:, :2] - ref[:, :2]).T).max())
+
+    trust = {"node_translation_m": 0.1, "odometry_trust": True, "odometry_trust_min_variance_ratio": 0.0}
+    _, plain = run(seq, **trust, odometry_trust_bias_horizon=0)
+    _, horizon = run(seq, **trust, odometry_trust_bias_horizon=50)
+    assert plain.counters["odometry_fused"] > 40 and worst(plain) > 0.1
+    assert horizon.counters["odometry_fused"] == 0 and worst(horizon) < 0.01
+    _, unbiased = run(_noisy_heading_room(80, 0.0, 0.3), **trust, odometry_trust_bias_horizon=50)
+    assert unbiased.counters["odometry_fused"] > 60

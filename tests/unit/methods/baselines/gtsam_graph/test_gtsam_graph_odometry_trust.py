@@ -7,7 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from albot1.methods.baselines.gtsam_graph.odometry_trust import MAD_TO_SIGMA, OdometryTrust, innovation, min_history
+from albot1.methods.baselines.gtsam_graph.odometry_trust import (
+    MAD_TO_SIGMA,
+    MEDIAN_EFFICIENCY,
+    OdometryTrust,
+    innovation,
+    min_history,
+    squared_bias,
+)
 
 STEP = np.array([0.5, 0.02, math.radians(3.0)])  # one node step of odometry, previous node's frame
 MATCH_COV = np.diag([0.02**2, 0.02**2, math.radians(0.5) ** 2])  # the match floor of the default preset
@@ -128,3 +135,65 @@ def test_heading_only_leaves_the_translation_to_the_match() -> None:
     pose, cov = fused
     assert pose[0] == match[0] and pose[1] == match[1]
     assert STEP[2] < pose[2] < match[2] and cov[2, 2] < MATCH_COV[2, 2]
+
+
+def _horizon_fed(centre_deg: float, bias_horizon: int) -> OdometryTrust:
+    """40 matches at ``centre_deg`` +- 0.2 deg from the odometry's heading (x, y: +-0.01 m about 0)."""
+    trust = OdometryTrust(50, bias_z=3.0, gate_chi2=16.27, bias_horizon=bias_horizon)
+    for dx, dy, dth in _alternating(40, 0.01, 0.01, 0.2):
+        trust.add(STEP, STEP + np.array([dx, dy, math.radians(centre_deg + dth)]))
+    return trust
+
+
+def test_a_steady_bias_the_median_test_passes_counts_as_accumulated_over_the_horizon() -> None:
+    """Matches 0.1 deg off the odometry's heading, +-0.2 deg: within the median test's 3 standard errors (0.18 deg)
+    and, as white noise, far better than the match (0.5 deg); counted as a bias over 50 steps it is worse."""
+    spread = MAD_TO_SIGMA * math.radians(0.2)
+    standard_error = MEDIAN_EFFICIENCY * spread / math.sqrt(40)
+    assert math.radians(0.1) < 3.0 * standard_error
+    floor = spread**2 * math.sqrt(2.0 / 40)
+    plain = _horizon_fed(0.1, 0).variances(np.diag(MATCH_COV))
+    assert plain is not None and plain[2] == pytest.approx(floor)
+    var = _horizon_fed(0.1, 50).variances(np.diag(MATCH_COV))
+    assert var is not None and math.isinf(var[2])
+    assert floor + 50 * (math.radians(0.1) ** 2 - standard_error**2) > MATCH_COV[2, 2]
+    # 0.07 deg: the accumulated bias is added to the variance, which stays below the match's
+    var = _horizon_fed(0.07, 50).variances(np.diag(MATCH_COV))
+    assert var is not None
+    assert var[2] == pytest.approx(floor + 50 * (math.radians(0.07) ** 2 - standard_error**2))
+    assert var[2] < MATCH_COV[2, 2]
+    # x and y have a median of 0: no bias is counted there
+    assert var[0] == pytest.approx(plain[0]) and var[1] == pytest.approx(plain[1])
+
+
+def test_a_median_within_its_standard_error_counts_as_no_bias() -> None:
+    """The median of white innovations is off 0 by its standard error on average: only the excess counts."""
+    standard_error = MEDIAN_EFFICIENCY * 1.0 / math.sqrt(40)
+    assert squared_bias(0.0, 1.0, 40) == 0.0
+    assert squared_bias(0.9 * standard_error, 1.0, 40) == 0.0
+    assert squared_bias(2.0 * standard_error, 1.0, 40) == pytest.approx(3.0 * standard_error**2)
+    assert squared_bias(-2.0 * standard_error, 1.0, 40) == pytest.approx(3.0 * standard_error**2)
+
+
+def test_the_weight_floor_keeps_a_trusted_odometry_from_outweighing_its_match() -> None:
+    """Perfect-odometry-like innovations (+-0.2 deg): trusted at the sampling floor, or at the match's own variance
+    (ratio 1) or half of it (0.5); what is not trusted stays so; the fused heading is then the plain mean."""
+    spread = MAD_TO_SIGMA * math.radians(0.2)
+    for ratio, expected in (
+        (0.0, spread**2 * math.sqrt(2.0 / 40)),
+        (0.5, 0.5 * MATCH_COV[2, 2]),
+        (1.0, MATCH_COV[2, 2]),
+    ):
+        trust = OdometryTrust(50, bias_z=3.0, gate_chi2=16.27, min_variance_ratio=ratio)
+        for dx, dy, dth in _alternating(40, 0.01, 0.01, 0.2):
+            trust.add(STEP, STEP + np.array([dx, dy, math.radians(dth)]))
+        var = trust.variances(np.diag(MATCH_COV))
+        assert var is not None and var[2] == pytest.approx(expected)
+    match = STEP + np.array([0.0, 0.0, math.radians(0.4)])
+    fused = trust.fuse(STEP, match, MATCH_COV)
+    assert fused is not None and fused[0][2] == pytest.approx(STEP[2] + math.radians(0.2))
+    worse = OdometryTrust(50, bias_z=3.0, gate_chi2=16.27, min_variance_ratio=1.0)
+    for dx, dy, dth in _alternating(40, 0.03, 0.03, 0.8):
+        worse.add(STEP, STEP + np.array([dx, dy, math.radians(dth)]))
+    var = worse.variances(np.diag(MATCH_COV))
+    assert var is not None and np.isinf(var).all()
