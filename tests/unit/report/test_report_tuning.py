@@ -37,7 +37,8 @@ def test_the_dataset_of_a_reference_is_its_catalog_name() -> None:
 def test_cells_on_held_in_datasets_are_marked_and_held_out_ones_are_not() -> None:
     assert held_in(_cell("aces", "gtsam-graph")) is True
     assert held_in(_cell("intel-corrected?odometry=laser-pose[:500]", "gtsam-graph")) is True
-    assert held_in(_cell("orebro-corrected?odometry=laser-pose", "gtsam-graph")) is False
+    assert held_in(_cell("orebro-corrected?odometry=laser-pose", "gtsam-graph")) is True  # the switch-on check
+    assert held_in(_cell("freiburg-campus-corrected?odometry=laser-pose", "gtsam-graph")) is False
     assert held_in(_cell("fhw-corrected?odometry=laser-pose", "kiss-icp")) is False
     assert held_in(_cell("intel", "kiss-icp")) is True and held_in(_cell("aces", "kiss-icp")) is False
     assert held_in(_cell("aces", "odometry")) is False  # tuned on nothing
