@@ -110,3 +110,15 @@ def test_every_float32_exponent_is_written_as_the_dictionary_dumped() -> None:
 def test_segment_map_text_is_the_dictionary_dumped() -> None:
     data = MapData(segments=np.array([[0.1, 0.2, 1e-7, 3.0]]), segment_properties=[{"id": 1}], points=np.ones((2, 2)))
     assert map_text(data) == _reference_text(data)
+
+
+@given(
+    arrays(np.float64, st.tuples(st.integers(0, 6), st.just(4)), elements=st.floats(allow_infinity=True)),
+    st.none() | arrays(np.float64, st.tuples(st.integers(0, 3), st.just(2)), elements=st.floats(allow_nan=True)),
+)
+@settings(max_examples=200, deadline=None)
+def test_segment_map_text_is_the_dictionary_dumped_non_finite_included(
+    segments: np.ndarray, points: np.ndarray | None
+) -> None:
+    data = MapData(segments=segments, segment_properties=[{"n": float(i)} for i in range(len(segments))], points=points)
+    assert map_text(data) == _reference_text(data)
