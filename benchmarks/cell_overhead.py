@@ -113,7 +113,7 @@ def main(argv: list[str] | None = None) -> int:
                 same_maps &= (old / "map.geojson").read_bytes() == (new / "map.geojson").read_bytes()
                 with Image.open(old / "preview.png") as a, Image.open(new / "preview.png") as b:
                     same_pixels &= np.array_equal(np.asarray(a), np.asarray(b))
-        for i, result in enumerate(results):  # the rest of a cell, for its share (same code on both sides)
+        for result in results:  # the rest of a cell, for its share (same code on both sides)
             run_dir = write_run(result, root / "runs")
             start = time.perf_counter()
             evaluate_run(run_dir)
