@@ -70,7 +70,7 @@ _KEYS = st.one_of(st.text(max_size=3), st.integers(-3, 3), st.booleans())
         max_leaves=20,
     )
 )
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 def test_json_value_writes_what_json_dumps_of_the_type_by_type_walk_writes(value: object) -> None:
     """The exact-type fast path changes nothing: same JSON text (and types) as the walk by ``isinstance`` alone."""
 

@@ -82,7 +82,7 @@ def _reference_text(data: MapData) -> str:
         elements=st.floats(width=32, allow_nan=True, allow_infinity=True, allow_subnormal=True),
     )
 )
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=200, deadline=None)
 def test_point_map_text_is_the_dictionary_dumped(points: np.ndarray) -> None:
     data = MapData(points=points)
     assert map_text(data) == _reference_text(data)
