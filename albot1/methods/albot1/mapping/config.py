@@ -205,6 +205,24 @@ class Albot1Config(BaseModel):
             " 0 = off)"
         ),
     )
+    window_updates: int = Field(
+        0,
+        ge=0,
+        description=(
+            "Albot1+ (with the ambiguity test): also test the odometry since the oldest of this many update views"
+            " against that view's surfaces, and keep it when not refuted (0 = off; docs/albot1-mapper.md)"
+        ),
+    )
+    window_probability: float = Field(
+        0.5,
+        gt=0,
+        lt=1,
+        description=(
+            "Albot1+ window test: the odometry over the window is kept when its likelihood ratio is within this"
+            " chi-square quantile (stricter than the per-view test: a false acceptance freezes the odometry's"
+            " error over the whole window, a false refusal only falls back to the per-view test)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -276,4 +294,7 @@ class Albot1Config(BaseModel):
             degenerate_sd=self.degenerate_sd_m,
             gate_probability=self.gate_probability,
             ambiguity_probability=self.ambiguity_probability,
+            window_updates=self.window_updates,
+            window_probability=self.window_probability,
+            motion_model=self.motion_model,
         )

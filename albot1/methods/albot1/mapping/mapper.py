@@ -326,7 +326,7 @@ class Albot1Mapper:
             np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2),
         )
         since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
-        return self._plus.pose(starts, lm_view, lm_map, kinds, self._points, since), loc
+        return self._plus.pose(starts, lm_view, lm_map, kinds, self._points, since, self._odometry), loc
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
         """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md).
@@ -369,7 +369,7 @@ class Albot1Mapper:
         view_map = self._mk.place_segments(view.surfaces, pose[0], pose[1], math.cos(pose[2]), math.sin(pose[2]))
         self._update_odometry = odometry
         if self._plus is not None:
-            self._plus.reset(view_map, pose)
+            self._plus.reset(view_map, pose, odometry)
         out = update_map(self.map, view_map, (pose[0], pose[1]), view_scan, self._update_params, self._mk)
         if self.on_update is not None:
             self.on_update(UpdateEvent(trigger, which, view_scan, pose, out, view_map))
@@ -442,6 +442,8 @@ class Albot1Mapper:
             counters["plus_gate_rejections"] = self._plus.gate_rejections
         if self._plus is not None and self.config.ambiguity_probability > 0.0:
             counters["plus_ambiguous_views"] = self._plus.ambiguous_views
+        if self._plus is not None and self._plus.window is not None:
+            counters["plus_window_views"] = self._plus.window_views
         counters["updates_per_view"] = c.updates / c.views if c.views else 0.0
         counters["landmarks_recognised_mean"] = float(rec[1:].mean()) if len(rec) > 1 else 0.0
         return MapperOutput(

@@ -33,6 +33,11 @@ pose is computed:
    robust cost at the odometry's prediction: where the view does not refute
    it (a likelihood ratio below that chi-square quantile), the prediction is
    the pose and the fusion is skipped.
+7. with ``window_updates`` (and the ambiguity test on), :mod:`.window` first
+   tests the odometry since the oldest of the last ``window_updates`` update
+   views against that view's surfaces: not refuted, the odometry over the
+   window is the pose (false alarms and the fit's bias in the anchors between
+   are dropped).
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -53,6 +58,7 @@ from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.screen_kernels import screen_directions
+from albot1.methods.albot1.mapping.window import OdometryWindow, UpdateRecord, WindowOutcome
 from albot1.methods.albot1.perception.endpoints import STABLE
 
 #: The odometry learner's fixed choices (``docs/albot1-mapper.md``, "Albot1+"): a view teaches it only when its
@@ -86,6 +92,9 @@ class PlusParams:
     degenerate_sd: float = 0.0  # m (a turn of 1 rad counting m_per_rad m); 0 = off
     gate_probability: float = 0.0  # chi-square quantile of the disagreement with the odometry; 0 = off
     ambiguity_probability: float = 0.0  # chi-square quantile of the view's own likelihood ratio; 0 = off
+    window_updates: int = 0  # the window test against the oldest of this many update views (:mod:`.window`); 0 = off
+    window_probability: float = 0.5  # chi-square quantile below which the window's odometry is kept
+    motion_model: str = "exact"  # how an odometry increment becomes a thesis-frame motion (the mapper's)
 
 
 class OdometryNoise:
@@ -171,11 +180,25 @@ class PlusLocaliser:
         self.ambiguous_views = 0
         self.last_ambiguity: Ambiguity | None = None
         self._ambiguity_limit = threshold(params.ambiguity_probability)
+        #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
+        self.window = (
+            OdometryWindow(params.window_updates, params.motion_model)
+            if params.window_updates >= 2 and params.ambiguity_probability > 0.0
+            else None
+        )
+        self.window_views = 0
+        self._window_limit = threshold(params.window_probability) if self.window is not None else 0.0
+        self.last_window: WindowOutcome | None = None
 
-    def reset(self, view_map: FloatArray, pose: Pose) -> None:
-        """A map update placed a view at ``pose``; ``view_map`` are its surfaces in the map (the new reference)."""
+    def reset(self, view_map: FloatArray, pose: Pose, odometry: Pose | None = None) -> None:
+        """A map update placed a view at ``pose``; ``view_map`` are its surfaces in the map (the new reference).
+
+        ``odometry``: the view's own odometry (REP-103), which the window test measures motion from.
+        """
         self._ref = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
         self._anchor = pose
+        if self.window is not None and odometry is not None:
+            self.window.add(UpdateRecord(pose, odometry, self._ref))
 
     def scan_points(self, ranges: FloatArray, angles: FloatArray) -> FloatArray:
         """Every ``scan_stride``-th return within ``max_range``, thesis frame (none without scan refinement)."""
@@ -191,13 +214,15 @@ class PlusLocaliser:
         lm_kinds: tuple[NDArray[np.int64], NDArray[np.int64]],
         points: FloatArray,
         since_update: Pose,
+        odometry: Pose | None = None,
     ) -> Pose:
         """The pose of a view, from the cheapest of ``starts`` ``(c, 3)`` (candidate poses; see the mapper).
 
         ``lm_view`` / ``lm_map`` ``(k, 4)``: recognised landmarks and their
         map copies; ``lm_kinds``: their endpoint labels now and in the map;
         ``points``: :meth:`scan_points`; ``since_update``: the odometry
-        motion since the last update view (thesis frame).
+        motion since the last update view (thesis frame); ``odometry``: the
+        view's own odometry (REP-103; the window test's).
         """
         p = self.params
         ok = np.ascontiguousarray(STABLE[lm_kinds[0]] & STABLE[lm_kinds[1]]).reshape(-1, 2)
@@ -212,6 +237,21 @@ class PlusLocaliser:
             return measured
         if p.ambiguity_probability > 0.0:
             sigmas = (p.line_sigma, p.point_sigma, p.scan_sigma, p.huber, p.scan_gate)
+            if self.window is not None and odometry is not None:
+                window = self.window.test(
+                    odometry,
+                    measured,
+                    points,
+                    self._k.refine_pose,
+                    self._k.measurement_costs,
+                    sigmas,
+                    p.iterations,
+                    self._window_limit,
+                )
+                self.last_window = window
+                if window is not None and window.kept:
+                    self.window_views += 1
+                    return window.prediction
             test = view_ambiguity(
                 self._k.measurement_costs,
                 measured,

@@ -61,6 +61,8 @@ OLD_DEFAULT: dict[str, Any] = {
     "degenerate_sd_m": 0.0,
     "gate_probability": 0.0,
     "ambiguity_probability": 0.0,
+    "window_updates": 0,
+    "window_probability": 0.5,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
