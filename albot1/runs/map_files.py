@@ -74,7 +74,7 @@ def points_text(points: np.ndarray) -> str:
     numpy's float32-to-text (Dragon4, shortest round-trip digits) gives the
     digits; Python's ``repr`` of the float64 nearest to such a decimal (at most
     9 significant digits) has the same digits, so only the notation can
-    differ: numpy switches to an exponent outside about [1e-4, 1e8), Python
+    differ: numpy switches to an exponent outside about [1e-4, 1e6), Python
     outside [1e-4, 1e16), and those few values are written by ``repr``.
     Building the rows with numpy's string functions avoids a Python float
     object and a ``repr`` per coordinate.

@@ -90,7 +90,24 @@ def test_point_map_text_is_the_dictionary_dumped(points: np.ndarray) -> None:
 
 @pytest.mark.parametrize(
     "value",
-    [0.0, -0.0, 1e-4, 9.999999e-5, 1e-5, 1.5e-45, 3.4028235e38, 1e8, 99999990.0, 1e16, 123456789.0, 0.1, -2.3],
+    [
+        0.0,
+        -0.0,
+        1e-4,
+        9.999999e-5,
+        1e-5,
+        1.5e-45,
+        3.4028235e38,
+        1e6,
+        999999.9,
+        1234567.0,
+        1e8,
+        99999990.0,
+        1e16,
+        123456789.0,
+        0.1,
+        -2.3,
+    ],
 )
 def test_point_map_text_at_the_notation_boundaries(value: float) -> None:
     data = MapData(points=np.array([[value, -value], [np.float32(value) / 3, 1.0]], dtype=np.float32))
