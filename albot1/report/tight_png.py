@@ -8,6 +8,11 @@ on the Agg canvas and the picture is cropped to the pixels that differ from
 the figure's background, with the same 0.1 inch margin ``bbox_inches="tight"``
 leaves (``savefig.pad_inches``). The picture is the same drawing; only its
 margins may differ by a pixel or two from Matplotlib's text-box estimate.
+
+The PNG is compressed at zlib level 1 (``PNG_COMPRESS_LEVEL``) rather than
+Pillow's default 6: the same pixels, 2-3x less time encoding and files about
+as large for these mostly white pictures (docs/benchmarking.md, "Cell
+start-up and the rest of a cell").
 """
 
 from __future__ import annotations
@@ -16,6 +21,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+#: zlib level of the saved PNG: 1 (fastest) instead of Pillow's default 6; the decoded pixels are the same.
+PNG_COMPRESS_LEVEL = 1
 
 
 def save_tight_png(fig: Any, path: Path) -> None:
@@ -34,16 +42,22 @@ def save_tight_png(fig: Any, path: Path) -> None:
     image = Image.fromarray(np.ascontiguousarray(pixels[top:bottom, left:right]))  # uint8 (h, w, 4): RGBA
     dpi = (round(fig.dpi), round(fig.dpi))
     with path.open("wb") as handle:  # a file object: the caller's temporary name may lack ".png"
-        image.save(handle, format="png", dpi=dpi)
+        image.save(handle, format="png", dpi=dpi, compress_level=PNG_COMPRESS_LEVEL)
 
 
 def ink_box(pixels: np.ndarray) -> tuple[int, int, int, int]:
     """(top, bottom, left, right), bottom and right exclusive: the rows and columns that differ from the corner.
 
     The top-left pixel is the figure's background; a picture of background
-    only keeps its whole extent.
+    only keeps its whole extent. An RGBA picture is compared as one 32-bit
+    word per pixel (a view, no copy when contiguous): 50x faster than
+    comparing the four channels apart on a 770 x 770 preview.
     """
-    ink = (pixels != pixels[0, 0]).any(axis=2)
+    if pixels.ndim == 3 and pixels.shape[2] == 4 and pixels.dtype == np.uint8:
+        words = np.ascontiguousarray(pixels).view(np.uint32)[..., 0]
+        ink = words != words[0, 0]
+    else:
+        ink = (pixels != pixels[0, 0]).any(axis=2)
     rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
     if not len(rows):
         return 0, pixels.shape[0], 0, pixels.shape[1]

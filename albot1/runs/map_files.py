@@ -10,6 +10,13 @@ file its ``result.json`` names and the metrics read), so existing results
 read the same numbers; the GeoJSON coordinates are those very float32
 values, written in their shortest decimal form. This is the one writer of
 GeoJSON maps in the project.
+
+:func:`map_geojson` defines the file's content. :func:`write_map` writes a
+finite point map's text directly (:func:`points_text`) rather than through
+``json.dumps`` of that dictionary: the same bytes (a property test compares
+the two over all float32 values) in about half the time, and every
+``albot1 bench`` cell of a point-map method pays it (``docs/benchmarking.md``,
+"Cell start-up and the rest of a cell").
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.dtypes import StringDType
 
 from albot1.atomic import atomic_write
 from albot1.contract import MapData
@@ -26,6 +34,7 @@ from albot1.records import json_value
 
 GEOJSON = "map.geojson"
 NPZ = "map.npz"
+_SEPARATORS = (",", ":")
 
 
 def map_geojson(data: MapData) -> dict[str, Any]:
@@ -47,32 +56,62 @@ def map_geojson(data: MapData) -> dict[str, Any]:
         points = _stored_points(data)
         points = points.astype(str).astype(np.float64)  # each float32's shortest decimal form, as a float64
     if points is not None and len(points):
-        features.append(
-            {
-                "type": "Feature",
-                "properties": {"kind": "points"},
-                "geometry": {"type": "MultiPoint", "coordinates": points.tolist()},
-            }
-        )
+        features.append(_points_feature(points.tolist()))
     return {"type": "FeatureCollection", "features": features}
 
 
-def _coordinates(feature: dict[str, Any]) -> np.ndarray:
-    return np.asarray(feature["geometry"]["coordinates"], dtype=float)
+def _points_feature(coordinates: Any) -> dict[str, Any]:
+    return {
+        "type": "Feature",
+        "properties": {"kind": "points"},
+        "geometry": {"type": "MultiPoint", "coordinates": coordinates},
+    }
+
+
+def points_text(points: np.ndarray) -> str:
+    """``[[x,y],...]``: finite float32 ``points`` (n, 2) as ``json.dumps`` writes ``map_geojson``'s coordinates.
+
+    numpy's float32-to-text (Dragon4, shortest round-trip digits) gives the
+    digits; Python's ``repr`` of the float64 nearest to such a decimal (at most
+    9 significant digits) has the same digits, so only the notation can
+    differ: numpy switches to an exponent outside about [1e-4, 1e6), Python
+    outside [1e-4, 1e16), and those few values are written by ``repr``.
+    Building the rows with numpy's string functions avoids a Python float
+    object and a ``repr`` per coordinate.
+    """
+    strings = points.astype(StringDType())
+    exponent = np.strings.find(strings, "e") >= 0
+    if exponent.any():
+        strings[exponent] = [repr(float(s)) for s in strings[exponent].tolist()]
+    rows = np.strings.add(np.strings.add(strings[:, 0], ","), strings[:, 1])
+    return "[[" + "],[".join(rows.tolist()) + "]]"
 
 
 def _stored_points(data: MapData) -> np.ndarray:
     return np.asarray(data.points if data.points is not None else np.empty((0, 2)), dtype=np.float32).reshape(-1, 2)
 
 
-def write_map(run_dir: Path, data: MapData) -> str:
-    """Write the map files of ``data`` into ``run_dir``; the name of the one ``result.json`` points to."""
+def map_text(data: MapData) -> str:
+    """The text of ``map.geojson`` for ``data``: ``map_geojson`` as compact JSON, one line."""
+    if data.segments is None:
+        points = _stored_points(data)
+        if np.isfinite(points).all():
+            if not len(points):
+                return json.dumps({"type": "FeatureCollection", "features": []}, separators=_SEPARATORS) + "\n"
+            frame = json.dumps({"type": "FeatureCollection", "features": [_points_feature([])]}, separators=_SEPARATORS)
+            head, tail = frame.split('"coordinates":[]')
+            return head + '"coordinates":' + points_text(points) + tail + "\n"
     collection = map_geojson(data)
     # Coordinates are Python floats already (``tolist``); only a non-finite one needs json_value's null. Walking
-    # a 145,000-point map value by value cost 0.7 s per run folder (odometry on aces), so it is done only then.
-    finite = all(np.isfinite(_coordinates(f)).all() for f in collection["features"])
-    text = json.dumps(collection if finite else json_value(collection), separators=(",", ":")) + "\n"
+    # a 145,000-point map value by value cost 0.7 s per run folder (odometry on aces), so it is done only then;
+    # whether it is needed is read from the arrays the features were made of.
+    finite = all(np.isfinite(np.asarray(a, dtype=float)).all() for a in (data.segments, data.points) if a is not None)
+    return json.dumps(collection if finite else json_value(collection), separators=_SEPARATORS) + "\n"
 
+
+def write_map(run_dir: Path, data: MapData) -> str:
+    """Write the map files of ``data`` into ``run_dir``; the name of the one ``result.json`` points to."""
+    text = map_text(data)
     atomic_write(run_dir / GEOJSON, lambda p: p.write_text(text, encoding="utf-8"))
     if data.segments is not None:
         return GEOJSON

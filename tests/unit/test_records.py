@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import json
 import math
+from collections.abc import Mapping
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pydantic import ValidationError
 
 from albot1.metrics.blocks import Stats
@@ -40,6 +44,50 @@ def test_json_value_turns_numpy_into_python_and_non_finite_into_null() -> None:
     )
     assert value == {"1": 3, "f": 0.5, "b": True, "a": [1.5, None], "t": [None, 2]}
     assert [type(v) for v in (value["1"], value["f"], value["b"])] == [int, float, bool]
+
+
+_LEAVES = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=3),
+    st.floats(allow_nan=True, width=32).map(np.float32),
+    st.integers(-5, 5).map(np.int64),
+    st.booleans().map(np.bool_),
+)
+_KEYS = st.one_of(st.text(max_size=3), st.integers(-3, 3), st.booleans())
+
+
+@given(
+    st.recursive(
+        _LEAVES,
+        lambda inner: st.one_of(
+            st.lists(inner, max_size=4),
+            st.lists(inner, max_size=4).map(tuple),
+            st.dictionaries(_KEYS, inner, max_size=4),
+        ),
+        max_leaves=20,
+    )
+)
+@settings(max_examples=150, deadline=None)
+def test_json_value_writes_what_json_dumps_of_the_type_by_type_walk_writes(value: object) -> None:
+    """The exact-type fast path changes nothing: same JSON text (and types) as the walk by ``isinstance`` alone."""
+
+    def walk(v: object) -> object:
+        if isinstance(v, Mapping):
+            return {str(k): walk(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [walk(x) for x in v]
+        if isinstance(v, bool) or v is None or isinstance(v, str):
+            return v
+        if isinstance(v, float):
+            return float(v) if math.isfinite(v) else None
+        if isinstance(v, int):
+            return int(v)
+        return walk(v.tolist()) if callable(getattr(v, "tolist", None)) else v  # type: ignore[attr-defined]
+
+    assert json.dumps(json_value(value)) == json.dumps(walk(value))
 
 
 def test_integers_stay_integers_and_floats_stay_floats() -> None:

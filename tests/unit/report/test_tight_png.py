@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 from PIL import Image
@@ -36,3 +38,38 @@ def test_saved_png_is_the_ink_with_a_margin(tmp_path: Path) -> None:
     assert (width, height) == (110, 110)  # 100 pixels of ink and 5 (0.1 inch at 50 dpi) on each side
     assert (pixels[5:105, 5:105, :3] == 0).all()
     assert (pixels[:5, :, :3] == 255).all() and (pixels[-5:, :, :3] == 255).all()
+
+
+@given(
+    st.integers(1, 9),
+    st.integers(1, 9),
+    st.lists(st.tuples(st.integers(0, 8), st.integers(0, 8), st.integers(0, 3), st.integers(0, 254)), max_size=4),
+)
+@settings(max_examples=200, deadline=None)
+def test_ink_box_sees_a_change_in_any_one_channel(
+    height: int, width: int, changes: list[tuple[int, int, int, int]]
+) -> None:
+    """The RGBA fast path (one 32-bit word per pixel) finds what comparing the channels one by one finds."""
+    pixels = np.full((height, width, 4), 255, dtype=np.uint8)
+    for row, col, channel, value in changes:
+        pixels[row % height, col % width, channel] = value
+    ink = (pixels != pixels[0, 0]).any(axis=2)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    expected = (rows[0], rows[-1] + 1, cols[0], cols[-1] + 1) if len(rows) else (0, height, 0, width)
+    assert ink_box(pixels) == expected
+
+
+def test_saved_png_keeps_the_drawn_pixels(tmp_path: Path) -> None:
+    """Compressed at level 1, the PNG decodes to exactly the canvas's pixels (cropped)."""
+    fig = Figure(figsize=(2, 2), dpi=50)
+    ax = fig.add_subplot()
+    ax.plot([0, 1, 0.3], [0, 1, 0.8], color="tab:blue")
+    ax.set_title("t", fontsize=9)
+    path = tmp_path / "p.png"
+    save_tight_png(fig, path)
+    canvas = np.asarray(fig.canvas.buffer_rgba())
+    top, bottom, left, right = ink_box(canvas)
+    pad = 5  # 0.1 inch at 50 dpi
+    crop = canvas[max(0, top - pad) : bottom + pad, max(0, left - pad) : right + pad]
+    with Image.open(path) as image:
+        np.testing.assert_array_equal(np.asarray(image), crop)

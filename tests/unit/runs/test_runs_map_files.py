@@ -8,13 +8,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely.geometry
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 
 from albot1.contract import MapData
 from albot1.data.open import open_sequence
 from albot1.methods.registry import method_registry
+from albot1.records import json_value
 from albot1.runs.execute import run_method
 from albot1.runs.folder import read_run, write_run
-from albot1.runs.map_files import map_geojson, write_map
+from albot1.runs.map_files import map_geojson, map_text, write_map
 
 
 def test_segments_are_linestrings_with_their_properties() -> None:
@@ -64,3 +68,75 @@ def test_every_method_writes_map_geojson(method: str, tmp_path: Path) -> None:
         assert stored.points is not None
         assert len(geometries[0].geoms) == len(stored.points)
         np.testing.assert_allclose(np.array([(p.x, p.y) for p in geometries[0].geoms]), stored.points, atol=1e-6)
+
+
+def _reference_text(data: MapData) -> str:
+    """The writer before the fast path: ``json.dumps`` of :func:`map_geojson` (non-finite values as null)."""
+    return json.dumps(json_value(map_geojson(data)), separators=(",", ":")) + "\n"
+
+
+@given(
+    arrays(
+        np.float32,
+        st.tuples(st.integers(0, 40), st.just(2)),
+        elements=st.floats(width=32, allow_nan=True, allow_infinity=True, allow_subnormal=True),
+    )
+)
+@settings(max_examples=200, deadline=None)
+def test_point_map_text_is_the_dictionary_dumped(points: np.ndarray) -> None:
+    data = MapData(points=points)
+    assert map_text(data) == _reference_text(data)
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        0.0,
+        -0.0,
+        1e-4,
+        9.999999e-5,
+        1e-5,
+        1.5e-45,
+        3.4028235e38,
+        1e6,
+        999999.9,
+        1234567.0,
+        1e8,
+        99999990.0,
+        1e16,
+        123456789.0,
+        0.1,
+        -2.3,
+    ],
+)
+def test_point_map_text_at_the_notation_boundaries(value: float) -> None:
+    data = MapData(points=np.array([[value, -value], [np.float32(value) / 3, 1.0]], dtype=np.float32))
+    assert map_text(data) == _reference_text(data)
+
+
+def test_every_float32_exponent_is_written_as_the_dictionary_dumped() -> None:
+    """64 random mantissas per binary exponent and sign (inf and NaN among them): every float32 magnitude."""
+    rng = np.random.default_rng(7)
+    bits = (np.arange(256, dtype=np.uint32).repeat(64) << 23) | rng.integers(0, 1 << 23, 256 * 64, dtype=np.uint32)
+    values = bits.view(np.float32)
+    values = np.concatenate([values, -values])
+    with np.errstate(invalid="ignore"):  # signalling NaN bit patterns among them
+        data = MapData(points=values.reshape(-1, 2).astype(np.float64))  # exact; stored as float32 again
+    assert map_text(data) == _reference_text(data)
+
+
+def test_segment_map_text_is_the_dictionary_dumped() -> None:
+    data = MapData(segments=np.array([[0.1, 0.2, 1e-7, 3.0]]), segment_properties=[{"id": 1}], points=np.ones((2, 2)))
+    assert map_text(data) == _reference_text(data)
+
+
+@given(
+    arrays(np.float64, st.tuples(st.integers(0, 6), st.just(4)), elements=st.floats(allow_infinity=True)),
+    st.none() | arrays(np.float64, st.tuples(st.integers(0, 3), st.just(2)), elements=st.floats(allow_nan=True)),
+)
+@settings(max_examples=200, deadline=None)
+def test_segment_map_text_is_the_dictionary_dumped_non_finite_included(
+    segments: np.ndarray, points: np.ndarray | None
+) -> None:
+    data = MapData(segments=segments, segment_properties=[{"n": float(i)} for i in range(len(segments))], points=points)
+    assert map_text(data) == _reference_text(data)
