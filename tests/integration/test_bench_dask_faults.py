@@ -200,6 +200,9 @@ def test_the_scheduler_lost_halts_the_runner_naming_it_and_a_restart_serves_agai
     assert len(halted) == 1 and "run the same command again to resume" in halted[0], err
     store = ResultsStore(results / "slow")
     check_recorded(store, err)
+    # The plain local run compared with below (once per test process) runs now, while the workers wait out their
+    # death timeout, instead of after it: the same run and the same comparison, the two waits overlapped.
+    local_tables(suite, tmp_path)
     for worker in cluster.workers:  # workers without their scheduler stop (death timeout) and stop their cells
         worker.wait(timeout=120)
     # The scheduler restarted at the same address, with fresh workers: the same command resumes on it.

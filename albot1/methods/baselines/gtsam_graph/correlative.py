@@ -146,13 +146,35 @@ def _pooled_fields(field: FloatArray, levels: int) -> list[FloatArray]:
 def _sum_at(
     table: FloatArray, base: NDArray[np.int64], rot: NDArray[np.int64], origin: NDArray[np.int64]
 ) -> FloatArray:
-    """For each node ``k``: the sum over source points of ``table[base[rot[k]] + origin[k]]`` (clipped lookups)."""
+    """For each node ``k``: the sum over source points of ``table[base[rot[k]] + origin[k]]`` (clipped lookups).
+
+    Read through the flat table (``take``), 512 nodes at a time (their
+    lookups stay in the processor's cache). A node whose points all land
+    inside the table (most of a place-recognition search's) needs no
+    clipping: its flat lookups are its rotation's flat points plus one shift.
+    The others are clipped in place. Either way the same indices, values and
+    sums as ``np.clip`` and 2-D fancy indexing (a unit test compares the
+    bits), in about a quarter of the time; this is most of a search.
+    """
     out = np.empty(len(rot))
-    hi = np.array(table.shape) - 1
-    for start in range(0, len(rot), 4096):  # bounded memory: nodes x points x 2 indices per chunk
-        sl = slice(start, start + 4096)
-        idx = np.clip(base[rot[sl]] + origin[sl, None, :], 0, hi)
-        out[sl] = table[idx[..., 0], idx[..., 1]].sum(axis=1)
+    n0, n1 = table.shape
+    flat = table.ravel()
+    inside = ((base.min(axis=1)[rot] + origin >= 0) & (base.max(axis=1)[rot] + origin < (n0, n1))).all(axis=1)
+    flat_points = base[..., 0] * n1 + base[..., 1]
+    for nodes, clip in ((np.flatnonzero(inside), False), (np.flatnonzero(~inside), True)):
+        for start in range(0, len(nodes), 512):  # bounded memory: nodes x points indices per chunk
+            chunk = nodes[start : start + 512]
+            if clip:
+                idx = base[rot[chunk]]  # a copy (fancy indexing): the in-place steps leave ``base`` as it is
+                idx += origin[chunk, None, :]
+                np.maximum(idx, 0, out=idx)
+                lookup = np.minimum(idx[..., 0], n0 - 1)
+                lookup *= n1
+                lookup += np.minimum(idx[..., 1], n1 - 1)
+            else:
+                lookup = flat_points[rot[chunk]]
+                lookup += (origin[chunk, 0] * n1 + origin[chunk, 1])[:, None]
+            out[chunk] = flat.take(lookup).sum(axis=1)
     return out
 
 

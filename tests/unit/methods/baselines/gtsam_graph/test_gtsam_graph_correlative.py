@@ -9,6 +9,7 @@ import numpy as np
 from albot1.geometry import se2
 from albot1.methods.baselines.gtsam_graph.correlative import (
     GlobalWindow,
+    _sum_at,
     branch_and_bound_search,
     likelihood_field,
 )
@@ -76,3 +77,26 @@ def test_a_repeating_corridor_is_ambiguous() -> None:
         world, seen_from(world, truth, 10.0), truth + [1.0, 0.0, 0.0], GlobalWindow(half_width_m=10.0)
     )
     assert found.ambiguity > 0.9
+
+
+def test_block_sums_are_the_clipped_lookups_bit_for_bit() -> None:
+    """``_sum_at`` (flat, in-place clipping) gives the bits of the plain ``np.clip`` + 2-D lookup it replaced.
+
+    Lookups fall off every side of the table (clipped to its edge) and the nodes span more than one chunk.
+    """
+    rng = np.random.default_rng(7)
+    table = rng.random((37, 53))
+    # Rotations 0-4 reach past every edge; 5-7 stay well inside, so most of their nodes need no clipping.
+    base = np.concatenate([rng.integers(-12, 66, size=(5, 40, 2)), rng.integers(10, 27, size=(3, 40, 2))])
+    rot = rng.integers(0, 8, size=9000)
+    origin = rng.integers(-9, 9, size=(9000, 2))
+    kept = base.copy()
+    idx = np.clip(base[rot] + origin[:, None, :], 0, np.array(table.shape) - 1)
+    expected = table[idx[..., 0], idx[..., 1]].sum(axis=1)
+    inside = ((base[rot] + origin[:, None, :] >= 0) & (base[rot] + origin[:, None, :] < table.shape)).all(axis=(1, 2))
+    assert 1000 < inside.sum() < 8000  # both kinds of node, in every chunk
+    for n in (9000, 513, 1):  # whole chunks and a short last one; a single node
+        assert _sum_at(table, base, rot[:n], origin[:n]).tobytes() == expected[:n].tobytes()
+    for axis, last in enumerate((36, 52)):  # every edge was reached, so the clipping was exercised
+        assert (idx[..., axis] == 0).any() and (idx[..., axis] == last).any()
+    np.testing.assert_array_equal(base, kept)  # the rotated points are left as they were
