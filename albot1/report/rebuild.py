@@ -9,9 +9,11 @@ the stores and no plotting import.
 What each build reads:
 
 * ``albot1 report results/<suite>``: the store; for the thesis suite also
-  the companion stores it reads beside its own (``results/default``) and the
+  the companion stores it reads beside its own (``results/default``). The
   figures of their reports that its page links (``reports/default/plots/
-  *-maps.png``).
+  *-maps.png``) are not read: which ones are drawn is known from those
+  stores (:meth:`albot1.report.thesis.page._Figures.linked`), so the two
+  reports can be built at once.
 * ``albot1 results-page``: the default store, the thesis store and the
   thesis store's companions; its outputs include the README it rewrites, so
   an edited README is rewritten again.
@@ -62,7 +64,6 @@ def report_sources(results_dir: Path, out: Path, suite: str) -> list[Source]:
     sources = [Source(Path(results_dir))]
     if suite == THESIS_SUITE:
         sources += [Source(Path(results_dir).parent / name) for name in COMPANION_SUITES]
-        sources += [Source(out.parent / name / "plots", "*-maps.png") for name in COMPANION_SUITES]
     return sources
 
 
