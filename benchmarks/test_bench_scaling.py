@@ -4,12 +4,15 @@ A grid of cheap cells (dead reckoning on the first 20 views of a small synthetic
 degradation, N seeds) is run through the real runner (``run_suite``: forkserver cell processes, 2 at a
 time, each with its run folder, preview and metrics.json), then reported from scratch (tables, plots,
 pages). Recorded per size, in ``extra_info``: the grid's wall seconds per cell and its overhead per cell
-(the part of the 2 workers' time outside the cells' own attempts, ``attempt.json``), the cells' own mean
-wall and their method's, the report's wall and CPU seconds per cell, and the load average before and
-after (the timings mix growth with load on a shared machine). All of these should stay flat or fall as N
-grows: a per-cell cost that grows with N is one a suite of thousands of cells pays quadratically. Sizes
-50 and 500 run in ``make bench-timing`` (about 1.5 min on the idle machine); ``ALBOT1_SCALING_CELLS=5000``
-adds a size (about 20 min idle, an hour loaded). Measured curve: ``docs/benchmarking.md``.
+(the part of the 2 workers' time outside the cells' own attempts, ``attempt.json``); the CPU seconds per
+cell of the process that plans, schedules and supervises the cells (the cells run in other processes:
+this part grows with N if the runner does per-cell work over all cells); the cells' own mean wall and
+their method's; the report's wall and CPU seconds per cell; the load average before and after (the wall
+times mix growth with load on a shared machine, the CPU seconds much less). All should stay flat or fall
+as N grows: a per-cell cost that grows with N is one a suite of thousands of cells pays quadratically.
+Sizes 50 and 500 run in ``make bench-timing`` (about 1.5 min on the idle machine);
+``ALBOT1_SCALING_CELLS=5000`` adds a size (about 20 min idle, over an hour loaded). Measured curve:
+``docs/benchmarking.md``.
 """
 
 from __future__ import annotations
@@ -42,10 +45,11 @@ def _suite(path: Path, cells: int) -> Path:
     return path
 
 
-def _cpu_s() -> float:
-    """User + system CPU seconds of this process and of its ended children (the report's drawing workers)."""
-    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+def _cpu_s(*, children: bool = True) -> float:
+    """User + system CPU seconds of this process and (``children``) of its ended children (the report's workers)."""
+    usage = [resource.getrusage(resource.RUSAGE_SELF)]
+    usage += [resource.getrusage(resource.RUSAGE_CHILDREN)] if children else []
+    return sum(u.ru_utime + u.ru_stime for u in usage)
 
 
 def _cells(root: Path) -> dict[str, float]:
@@ -63,9 +67,9 @@ def test_grid_and_report_cost_per_cell(benchmark: Any, tmp_path: Path, cells: in
     timings: dict[str, float] = {"load_before": os.getloadavg()[0]}
 
     def grid_then_report() -> None:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), _cpu_s(children=False)
         _, summary, store = run_suite(str(suite), results=tmp_path / "results", jobs=JOBS)
-        timings["grid_s"] = time.perf_counter() - start
+        timings["grid_s"], timings["runner_cpu_s"] = time.perf_counter() - start, _cpu_s(children=False) - cpu
         assert summary.counts["done"] == cells, summary.counts
         start, cpu = time.perf_counter(), _cpu_s()
         build_report(store.root, tmp_path / "report", jobs=JOBS)
@@ -80,6 +84,7 @@ def test_grid_and_report_cost_per_cell(benchmark: Any, tmp_path: Path, cells: in
         report_cpu_s=timings["report_cpu_s"],
         grid_s_per_cell=timings["grid_s"] / cells,
         overhead_s_per_cell=timings["grid_s"] * JOBS / cells - timings["cell_s"],
+        runner_cpu_s_per_cell=timings["runner_cpu_s"] / cells,
         cell_s=timings["cell_s"],
         method_s=timings["method_s"],
         report_s_per_cell=timings["report_s"] / cells,
