@@ -10,9 +10,9 @@ this part grows with N if the runner does per-cell work over all cells); the cel
 their method's; the report's wall and CPU seconds per cell; the load average before and after (the wall
 times mix growth with load on a shared machine, the CPU seconds much less). All should stay flat or fall
 as N grows: a per-cell cost that grows with N is one a suite of thousands of cells pays quadratically.
-Sizes 50 and 500 run in ``make bench-timing`` (about 1.5 min on the idle machine);
-``ALBOT1_SCALING_CELLS=5000`` adds a size (about 20 min idle, over an hour loaded). Measured curve:
-``docs/benchmarking.md``.
+Sizes 50 and 500 run in ``make bench-timing`` (about 1.5 min at load average 4);
+``ALBOT1_SCALING_CELLS=5000`` adds a size, opt-in because it is long (about 17 min of grid at the 0.2 s
+per cell of a quiet machine, over an hour loaded). Measured curve: ``docs/benchmarking.md``.
 """
 
 from __future__ import annotations
