@@ -56,7 +56,7 @@ def column_selection(columns: str | None) -> ColumnSelection:
     return ALL_COLUMNS if columns is None else parse_columns(columns, {**METRIC_COLUMNS, **COST_COLUMNS})
 
 
-def report_sources(results_dir: Path, out: Path, suite: str) -> list[Source]:
+def report_sources(results_dir: Path, suite: str) -> list[Source]:
     """The folders a report of ``suite`` reads (see the module docstring)."""
     from albot1.report.thesis.evidence import COMPANION_SUITES
     from albot1.report.thesis.experiments.datasets import THESIS_SUITE
@@ -103,7 +103,7 @@ def report(
     from albot1.report.index import build_report
 
     style: MapStyle = "points" if map_style == "points" else "grid"
-    sources = report_sources(results_dir, target, ResultsStore(results_dir).read_plan().suite)
+    sources = report_sources(results_dir, ResultsStore(results_dir).read_plan().suite)
     options = report_options(results_dir, target, plots=plots, map_style=map_style, columns=columns)
     digest = stamp.digest(sources, options)
     selection = column_selection(columns)
