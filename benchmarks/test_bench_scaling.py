@@ -11,8 +11,8 @@ their method's; the report's wall and CPU seconds per cell; the load average bef
 times mix growth with load on a shared machine, the CPU seconds much less). All should stay flat or fall
 as N grows: a per-cell cost that grows with N is one a suite of thousands of cells pays quadratically.
 Sizes 50 and 500 run in ``make bench-timing`` (about 1.5 min at load average 4);
-``ALBOT1_SCALING_CELLS=5000`` adds a size, opt-in because it is long (about 17 min of grid at the 0.2 s
-per cell of a quiet machine, over an hour loaded). Measured curve: ``docs/benchmarking.md``.
+``ALBOT1_SCALING_CELLS=5000`` adds a size, opt-in because it is long (its grid ~5-15 min on a quiet
+machine, 34 min measured under load). Measured curve: ``docs/benchmarking.md``.
 """
 
 from __future__ import annotations
