@@ -50,23 +50,16 @@ test-fast: $(STAMP)
 # a non-zero status (the last one) is passed on. docs/results.md (+ docs/results/) and the README's results
 # block are rewritten from results/default and results/thesis (no date in them: nothing new, no diff);
 # commit them (docs/benchmarking.md). The reports and the results page read the stores and write folders
-# of their own, so they are built at the same time (their serial parts fill the cores the others leave
-# idle), except that reports/thesis links the figures reports/default draws: with both suites, the thesis
-# report starts when the default one has ended. Each one's output is held in a temporary file and shown
-# whole, in order, when all have ended.
+# of their own, so they are all started at once (their serial parts fill the cores the others leave idle):
+# reports/thesis links the maps figures reports/default draws, but which ones those are is known from the
+# default store, so it does not wait for that report. Each one's output is held in a temporary file and
+# shown whole, in order, when all have ended.
 bench: $(STAMP)
 	status=0; \
 	for suite in $(SUITE); do $(BIN)/albot1 bench $$suite -j $(JOBS) || status=$$?; done; \
 	logs=$$(mktemp -d); started=""; \
 	for suite in $(SUITE); do \
-	  case "$$suite:$(filter default,$(SUITE))" in thesis:default) continue;; esac; \
-	  if [ "$$suite:$(filter thesis,$(SUITE))" = default:thesis ]; then \
-	    { $(BIN)/albot1 report results/default -j $(JOBS) >$$logs/default.log 2>&1; code=$$?; \
-	      $(BIN)/albot1 report results/thesis -j $(JOBS) >$$logs/thesis.log 2>&1 || code=$$?; exit $$code; } & \
-	    started="$$started $$!:default:thesis"; \
-	  else \
-	    $(BIN)/albot1 report results/$$suite -j $(JOBS) >$$logs/$$suite.log 2>&1 & started="$$started $$!:$$suite"; \
-	  fi; \
+	  $(BIN)/albot1 report results/$$suite -j $(JOBS) >$$logs/$$suite.log 2>&1 & started="$$started $$!:$$suite"; \
 	done; \
 	if [ -f results/default/grid.json ]; then \
 	  $(BIN)/albot1 results-page results/default --thesis results/thesis --out docs/results.md --readme README.md \
@@ -74,7 +67,7 @@ bench: $(STAMP)
 	fi; \
 	for job in $$started; do \
 	  wait $${job%%:*} || status=$$?; \
-	  for name in $$(echo $${job#*:} | tr : ' '); do cat $$logs/$$name.log; done; \
+	  cat $$logs/$${job#*:}.log; \
 	done; \
 	rm -rf $$logs; \
 	exit $$status

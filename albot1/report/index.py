@@ -41,11 +41,10 @@ from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
 from albot1.report.standard import on_standard_logs, write_standard
-from albot1.report.tables import aggregate, cells_frame, write_tables
+from albot1.report.tables import Aggregates, write_tables
 from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
-from albot1.report.tuning import held_in
 from albot1.versions import commit_label
 
 #: Told ``(datasets whose figures are drawn, datasets to draw)`` while the report draws its figures.
@@ -70,6 +69,7 @@ def render_plots(
     map_style: MapStyle = "grid",
     jobs: int = 1,
     progress: PlotProgress | None = None,
+    aggregates: Aggregates | None = None,
 ) -> dict[str, list[Path]]:
     """Every plot of the report (PNG, each with an SVG twin); dataset label -> its PNGs ("" for cross-dataset).
 
@@ -78,13 +78,11 @@ def render_plots(
     alone, so with ``jobs`` > 1 the datasets are drawn in that many worker
     processes; the figures are the same files either way. ``progress`` is
     told ``(datasets drawn, datasets to draw)`` before the first and after each
-    (the CLI's bar; figures found in the cache are not counted).
+    (the CLI's bar; figures found in the cache are not counted). ``aggregates``: the :class:`Aggregates` of
+    ``records`` (made here otherwise); its tables are read only for figures that are drawn.
     """
     colors = colors or method_colors(r.cell.method_label for r in records)
-    cells = cells_frame(records)
-    cells["held_in"] = [held_in(rec.cell) for rec in records]  # as the tables and the page have it: one aggregate
-    metrics = aggregate(cells, METRIC_COLUMNS)
-    cost = aggregate(cells, COST_COLUMNS)
+    aggregates = Aggregates(records) if aggregates is None else aggregates
     plots_dir = out / "plots"
     plots_dir.mkdir(parents=True, exist_ok=True)
     by_dataset: dict[str, list[CellRecord]] = {}
@@ -100,7 +98,7 @@ def render_plots(
         if cached is not None:
             made[dataset] = [cache.path(name) for name in cached.payload]
         else:
-            tasks.append((dataset, recs, metrics, plots_dir, colors, map_style))
+            tasks.append((dataset, recs, aggregates.metrics, plots_dir, colors, map_style))
     tell = progress or (lambda done, total: None)
     tell(0, len(tasks))
     drawn: list[list[Path]] = []
@@ -124,7 +122,7 @@ def render_plots(
     if cached is not None:
         made[""] = [cache.path(name) for name in cached.payload]
     else:
-        runtime = plot_runtime(cost, plots_dir / "runtime.png", colors)
+        runtime = plot_runtime(aggregates.cost, plots_dir / "runtime.png", colors)
         made[""] = [runtime] if runtime is not None else []
         cache.store("runtime", runtime_digest, made[""], [cache.name(f) for f in made[""]])
     cache.save()
@@ -351,7 +349,8 @@ def build_report(
     records = separate_data(collected)  # runs of one dataset on different data never share a row
     target.mkdir(parents=True, exist_ok=True)
     paired = paired_rows(records)  # the accuracy tables' paired comparisons (metrics.md, paired.csv, index.html)
-    tables = write_tables(records, target, paired, columns)
+    tabled = Aggregates(records)  # computed once, read by the tables, the figures and index.html
+    tables = write_tables(records, target, paired, columns, tabled)
     if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
         tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
     generalisation = write_generalisation(plan, records, target)
@@ -360,17 +359,20 @@ def build_report(
     colors = method_colors(r.cell.method_label for r in records)
     thesis = plan.suite == THESIS_SUITE
     pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default
-    made = render_plots(pictured, target, colors, map_style=map_style, jobs=jobs, progress=progress) if plots else {}
+    drawn_from = tabled if pictured is records else Aggregates(pictured)  # a subset: tables of its own
+    made = (
+        render_plots(pictured, target, colors, map_style=map_style, jobs=jobs, progress=progress, aggregates=drawn_from)
+        if plots
+        else {}
+    )
     views = write_views(pictured, target, colors) if plots else None
     index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
     page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
-    cells = cells_frame(records)
-    cells["held_in"] = [held_in(rec.cell) for rec in records]
     write_html(
         plan,
         records,
-        aggregate(cells, METRIC_COLUMNS),
-        aggregate(cells, COST_COLUMNS),
+        tabled.metrics,
+        tabled.cost,
         (METRIC_COLUMNS, COST_COLUMNS),
         {**tables, index.name: index},
         made,

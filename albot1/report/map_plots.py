@@ -31,6 +31,7 @@ from albot1.report.plots import (
     save,
     transform_points,
 )
+from albot1.report.provenance import separate_data
 
 MapStyle = Literal["grid", "points"]
 MAX_MAP_POINTS = 60_000
@@ -93,6 +94,24 @@ def _extent(runs: dict[str, CellRecord]) -> Extent:
     return Extent.around(parts)
 
 
+def draws_maps(records: list[CellRecord]) -> bool:
+    """Whether :func:`plot_maps` draws a figure for ``records`` (one dataset's): some method completed a run."""
+    return bool(representative(records))
+
+
+def maps_drawn(records: list[CellRecord]) -> set[str]:
+    """The datasets whose maps figure a report of a store of ``records`` (as collected) draws, by report label.
+
+    Known from the store alone, before any drawing: the thesis report links the default report's maps
+    figures while that report is still being drawn (``make bench`` builds them at once). The labels are the
+    report's (:func:`~albot1.report.provenance.separate_data`), as its figure files are named.
+    """
+    by_dataset: dict[str, list[CellRecord]] = {}
+    for rec in separate_data(records):
+        by_dataset.setdefault(rec.cell.dataset_label, []).append(rec)
+    return {dataset for dataset, recs in by_dataset.items() if draws_maps(recs)}
+
+
 def plot_maps(
     records: list[CellRecord], dataset: str, path: Path, colors: dict[str, str], *, style: MapStyle = "grid"
 ) -> Path | None:
@@ -100,9 +119,9 @@ def plot_maps(
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    runs = representative(records)
-    if not runs:
+    if not draws_maps(records):
         return None
+    runs = representative(records)
     plt = pyplot()
     extent = _extent(runs)
     rows, cols, size = panel_layout(extent, len(runs))

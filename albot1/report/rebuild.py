@@ -9,9 +9,11 @@ the stores and no plotting import.
 What each build reads:
 
 * ``albot1 report results/<suite>``: the store; for the thesis suite also
-  the companion stores it reads beside its own (``results/default``) and the
+  the companion stores it reads beside its own (``results/default``). The
   figures of their reports that its page links (``reports/default/plots/
-  *-maps.png``).
+  *-maps.png``) are not read: which ones are drawn is known from those
+  stores (:meth:`albot1.report.thesis.page._Figures.linked`), so the two
+  reports can be built at once.
 * ``albot1 results-page``: the default store, the thesis store and the
   thesis store's companions; its outputs include the README it rewrites, so
   an edited README is rewritten again.
@@ -54,7 +56,7 @@ def column_selection(columns: str | None) -> ColumnSelection:
     return ALL_COLUMNS if columns is None else parse_columns(columns, {**METRIC_COLUMNS, **COST_COLUMNS})
 
 
-def report_sources(results_dir: Path, out: Path, suite: str) -> list[Source]:
+def report_sources(results_dir: Path, suite: str) -> list[Source]:
     """The folders a report of ``suite`` reads (see the module docstring)."""
     from albot1.report.thesis.evidence import COMPANION_SUITES
     from albot1.report.thesis.experiments.datasets import THESIS_SUITE
@@ -62,7 +64,6 @@ def report_sources(results_dir: Path, out: Path, suite: str) -> list[Source]:
     sources = [Source(Path(results_dir))]
     if suite == THESIS_SUITE:
         sources += [Source(Path(results_dir).parent / name) for name in COMPANION_SUITES]
-        sources += [Source(out.parent / name / "plots", "*-maps.png") for name in COMPANION_SUITES]
     return sources
 
 
@@ -102,7 +103,7 @@ def report(
     from albot1.report.index import build_report
 
     style: MapStyle = "points" if map_style == "points" else "grid"
-    sources = report_sources(results_dir, target, ResultsStore(results_dir).read_plan().suite)
+    sources = report_sources(results_dir, ResultsStore(results_dir).read_plan().suite)
     options = report_options(results_dir, target, plots=plots, map_style=map_style, columns=columns)
     digest = stamp.digest(sources, options)
     selection = column_selection(columns)

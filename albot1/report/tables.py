@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -63,48 +64,54 @@ def cells_frame(records: list[CellRecord]) -> pd.DataFrame:
     return pd.DataFrame(cell_rows(records), columns=cell_columns())  # the columns also when no cell was planned
 
 
-#: The last few :func:`aggregate` results, by the digest of their inputs (see :func:`aggregate`).
-_AGGREGATES: dict[str, pd.DataFrame] = {}
-_AGGREGATES_KEPT = 4
+def fields(column: str) -> list[str]:
+    """The columns :func:`aggregate` makes for number ``column``, in table order: count, statistics, n/a reason."""
+    return [f"{column}_n", *(f"{column}_{stat}" for stat in STATS), f"{column}_na"]
 
 
-def _aggregate_key(cells: pd.DataFrame, columns: dict[str, Column]) -> str | None:
-    """A digest of everything :func:`aggregate` reads (the frame, pickled: values with their types), or None.
+def pick(table: pd.DataFrame, every: dict[str, Column], columns: dict[str, Column]) -> pd.DataFrame:
+    """``table`` (the :func:`aggregate` of ``every``) narrowed to ``columns`` (some of ``every``), in their order.
 
-    Two equal frames may pickle differently (shared objects become references): that only costs a
-    recomputation; two different frames never share a digest.
+    Each number column's fields are computed from that column alone and the group columns (first in the
+    table) from the cells alone, so this is :func:`aggregate` of ``columns`` without computing it again.
     """
-    import hashlib
-    import pickle
+    numbers = {name for column in every for name in fields(column)}
+    groups = [name for name in table.columns if name not in numbers]
+    return table[groups + [name for column in columns for name in fields(column) if name in table.columns]]
 
-    try:
-        frame = pickle.dumps(cells, protocol=pickle.HIGHEST_PROTOCOL)
-    except Exception:  # noqa: BLE001 -- a value that does not pickle: computed every time
-        return None
-    return hashlib.sha256(frame + repr(list(columns)).encode()).hexdigest()
+
+class Aggregates:
+    """The cells of one set of records and their two aggregated tables (accuracy, cost), each computed once.
+
+    A report reads the same tables three times (its table files, its figures, index.html), 5-20 s each for
+    a suite of a few hundred cells, so :func:`albot1.report.index.build_report` makes one of these per set
+    of records and hands it to each; a table is computed when first read (a report whose figures are all
+    cached never computes the figures' one). Readers must not change the frames they are given.
+    """
+
+    def __init__(self, records: list[CellRecord]) -> None:
+        self.records = records
+
+    @cached_property
+    def cells(self) -> pd.DataFrame:
+        """:func:`cells_frame` with each cell's held-in mark (:func:`albot1.report.tuning.held_in`)."""
+        cells = cells_frame(self.records)
+        cells["held_in"] = [held_in(rec.cell) for rec in self.records]
+        return cells
+
+    @cached_property
+    def metrics(self) -> pd.DataFrame:
+        """:func:`aggregate` of every accuracy column."""
+        return aggregate(self.cells, METRIC_COLUMNS)
+
+    @cached_property
+    def cost(self) -> pd.DataFrame:
+        """:func:`aggregate` of every cost column."""
+        return aggregate(self.cells, COST_COLUMNS)
 
 
 def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
     """Every planned group (dataset x method x degradation): seed counts, status and mean/std/median/min/max.
-
-    A report asks for the same table up to three times (its tables, its
-    figures, its page), 5-20 s each for a suite of a few hundred cells, so
-    the last few results are kept by the digest of their inputs and each
-    caller gets its own copy: the same computation, done once.
-    """
-    key = _aggregate_key(cells, columns)
-    if key is not None and key in _AGGREGATES:
-        return _AGGREGATES[key].copy()
-    table = _aggregate(cells, columns)
-    if key is not None:
-        while len(_AGGREGATES) >= _AGGREGATES_KEPT:
-            del _AGGREGATES[next(iter(_AGGREGATES))]
-        _AGGREGATES[key] = table.copy()
-    return table
-
-
-def _aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
-    """:func:`aggregate` computed.
 
     ``seeds`` counts the completed seeds the statistics are over;
     ``planned``, ``failed`` and ``not_run`` the cells of the group;
@@ -393,26 +400,28 @@ def write_tables(
     out: Path,
     paired: list[PairedRow] | None = None,
     selection: ColumnSelection = ALL_COLUMNS,
+    aggregates: Aggregates | None = None,
 ) -> dict[str, Path]:
     """Write cells.csv, metrics.{csv,md,tex}, paired.csv and cost.{csv,md,tex} (+ cells-cost.csv) into ``out``.
 
     ``paired``: the metrics tables' paired comparisons when the caller has them (computed here otherwise).
     ``selection``: the number columns the metrics and cost tables show (all formats, CSV included); the
-    one-row-per-cell files keep every column (:mod:`albot1.report.column_selection`).
+    one-row-per-cell files keep every column (:mod:`albot1.report.column_selection`). ``aggregates``: the
+    caller's :class:`Aggregates` of ``records``, shared with its figures and page (made here otherwise).
     """
     out.mkdir(parents=True, exist_ok=True)
     paired = paired_rows(records) if paired is None else paired
-    cells = cells_frame(records)
-    cells["held_in"] = [held_in(rec.cell) for rec in records]
+    aggregates = Aggregates(records) if aggregates is None else aggregates
+    cells = aggregates.cells
     written = {"cells.csv": out / "cells.csv"}
     helper = [c for c in cells.columns if c.endswith("_na")]
     cells.drop(columns=[*COST_COLUMNS, *helper]).to_csv(written["cells.csv"], index=False, float_format="%.9g")
-    for name, every, every_cell, title in (
-        ("metrics", METRIC_COLUMNS, "cells.csv", "Accuracy per dataset, method and degradation"),
-        ("cost", COST_COLUMNS, "cells-cost.csv", "Cost per dataset, method and degradation"),
+    for name, every, whole, every_cell, title in (
+        ("metrics", METRIC_COLUMNS, aggregates.metrics, "cells.csv", "Accuracy per dataset, method and degradation"),
+        ("cost", COST_COLUMNS, aggregates.cost, "cells-cost.csv", "Cost per dataset, method and degradation"),
     ):
         columns, selected = selection.pick(every), selection.note(every, f"{name}.csv", every_cell)
-        table = aggregate(cells, columns)
+        table = pick(whole, every, columns)
         paths = {ext: out / f"{name}.{ext}" for ext in ("csv", "md", "tex")}
         _csv_frame(table).to_csv(paths["csv"], index=False, float_format="%.9g")
         shown = paired if name == "metrics" else None

@@ -6,7 +6,11 @@ page is built from the stores alone (:mod:`albot1.report.thesis.evidence`):
 the verdicts from their numbers, the figures from their run folders. A
 figure that cannot be drawn (a run that failed, a dataset not available for
 a replay) is replaced by the reason; only drawn figures are linked, so every
-link of the page resolves.
+link of the page resolves. The maps figures of the public logs are the
+default report's (``reports/default/plots``): which of them that report
+draws is known from its store, so the page links them whether that report
+is built before, while or after this one (`make bench` builds them at once);
+the links resolve once it is built.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from albot1.report.collect import CellRecord, as_of
 from albot1.report.errors import ReportError
 from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.html import rel
-from albot1.report.map_plots import plot_maps
+from albot1.report.map_plots import maps_drawn, plot_maps
 from albot1.report.markdown import text as md_text
 from albot1.report.places_plot import render_places
 from albot1.report.plots import method_colors, slug, vector_of
@@ -70,6 +74,9 @@ class Drawn:
     caption: str
     path: Path | None
     reason: str | None = None
+    #: Another report's figure (:meth:`_Figures.linked`): drawn there with its SVG twin, maybe not yet on disk;
+    #: without ``path``, that no report draws it (known from the stores: kept like a drawn figure).
+    linked: bool = False
 
 
 class _Figures:
@@ -82,6 +89,20 @@ class _Figures:
         self.dir.mkdir(parents=True, exist_ok=True)
         self.colors = colors
         self._replays: dict[Path, Replay | ReportError] = {}
+        self._drawn_maps: dict[str, set[str]] = {}
+
+    def linked(self, dataset: str) -> Path | None:
+        """The maps figure of ``dataset`` that a companion store's report draws (``reports/<store>/plots``).
+
+        Known from the companion store (:func:`~albot1.report.map_plots.maps_drawn`), never by looking for
+        the file: this page is the same whether that report is built before, while or after it.
+        """
+        for store in self.ev.stores[1:]:
+            if store.name not in self._drawn_maps:
+                self._drawn_maps[store.name] = maps_drawn(store.records)
+            if dataset in self._drawn_maps[store.name]:
+                return self.out.parent / store.name / "plots" / f"{slug(dataset)}-maps.png"
+        return None
 
     def replay(self, record: CellRecord) -> Replay:
         found = self._replays.get(record.run_dir)
@@ -150,13 +171,18 @@ class _Figures:
         return [Drawn(request.caption, path, None if path else "nothing to draw")]
 
     def _linked_maps(self, request: FigureRequest) -> list[Drawn]:
-        """The maps figure of the companion store's report (``reports/<store>/plots``), when it has been built."""
-        for store in self.ev.stores[1:]:
-            figure = self.out.parent / store.name / "plots" / f"{slug(request.dataset)}-maps.png"
-            if figure.is_file():
-                return [Drawn(request.caption.replace("default suite", f"`{store.name}` report"), figure)]
-        where = self.out.parent / "default" / "plots" / f"{slug(request.dataset)}-maps.png"
-        return [Drawn(request.caption, None, f"{where} does not exist (`albot1 report results/default` draws it)")]
+        """The maps figure of the companion store's report, when that report draws one."""
+        figure = self.linked(request.dataset)
+        if figure is not None:
+            name = figure.parent.parent.name
+            return [Drawn(request.caption.replace("default suite", f"`{name}` report"), figure, linked=True)]
+        stores = ", ".join(f"`{store.path}`" for store in self.ev.stores[1:])
+        reason = (
+            f"no completed run of this dataset in {stores}: no report draws its maps"
+            if stores
+            else "no companion store to draw it from (`albot1 bench default` makes one)"
+        )
+        return [Drawn(request.caption, None, reason, linked=True)]
 
     def _gap_maps(self, request: FigureRequest) -> list[Drawn]:
         panels = []
@@ -190,30 +216,31 @@ def _cached_draw(figures: _Figures, cache: FigureCache, request: FigureRequest) 
     """``figures.draw(request)``, or what it drew last time when nothing it is drawn from has changed.
 
     A request reads the runs of its own dataset in every store (and, for a
-    linked figure, the other report's file): their records, the request
-    itself and the colours make its digest (:mod:`albot1.report.figure_cache`).
-    Drawings that failed are not kept: their reason is worked out again.
+    linked figure, which other report's figure it links): their records, the
+    request itself and the colours make its digest
+    (:mod:`albot1.report.figure_cache`). Drawings that failed are not kept:
+    their reason is worked out again. A linked figure is another report's
+    file: it is not one of the group's files (that report may be drawing it).
     """
     records = [r for store in figures.ev.stores for r in store.records if r.cell.dataset_label == request.dataset]
-    linked = [
-        (str(path), path.stat().st_size, path.stat().st_mtime_ns)
-        for store in figures.ev.stores[1:]
-        for path in [figures.out.parent / store.name / "plots" / f"{slug(request.dataset)}-maps.png"]
-        if path.is_file()
-    ]
+    linked = figures.linked(request.dataset)
     colors = sorted((k, v) for k, v in figures.colors.items() if k in {r.cell.method_label for r in records})
-    digest = inputs_digest(records, "thesis", repr(request), colors, linked)
+    where = None if linked is None else linked.relative_to(figures.out.parent).as_posix()
+    digest = inputs_digest(records, "thesis", repr(request), colors, where)
     group = f"thesis:{request.stem}"
     cached = cache.lookup(group, digest)
     if cached is not None:
-        return [Drawn(caption, cache.path(path), reason) for caption, path, reason in cached.payload]
+        return [
+            Drawn(caption, None if path is None else cache.path(path), reason, linked)
+            for caption, path, reason, linked in cached.payload
+        ]
     drawn = figures.draw(request)
-    if all(d.path is not None for d in drawn):
+    if all(d.path is not None or d.linked for d in drawn):
         cache.store(
             group,
             digest,
-            [d.path for d in drawn if d.path],
-            [[d.caption, cache.name(d.path), d.reason] for d in drawn if d.path],
+            [d.path for d in drawn if d.path and not d.linked],
+            [[d.caption, None if d.path is None else cache.name(d.path), d.reason, d.linked] for d in drawn],
         )
     else:
         cache.unsettled(group)  # the report is not skipped as a whole until this figure is drawn
@@ -308,7 +335,8 @@ def _section_lines(section: Section, drawn: dict[str, list[Drawn]], out: Path) -
                 continue
             link = rel(figure.path, out)
             vector = vector_of(figure.path)
-            twin = f" ([SVG]({rel(vector, out)}))" if figure.path.suffix == ".png" and vector.is_file() else ""
+            svg = figure.path.suffix == ".png" and (figure.linked or vector.is_file())
+            twin = f" ([SVG]({rel(vector, out)}))" if svg else ""
             lines.append(f"- [{figure.caption}]({link}){twin}")
         lines.append("")
         for figure in figures:

@@ -18,7 +18,7 @@ from albot1.bench.cells import execute_cell
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
 from albot1.bench.suite import parse_suite
-from albot1.report import index
+from albot1.report import index, tables
 from albot1.report.figure_cache import STAMPS, FigureCache, inputs_digest
 from albot1.report.index import build_report
 from albot1.settings import get_settings
@@ -56,20 +56,35 @@ def _counting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     return drawn
 
 
+def _aggregating(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    calls: list[int] = []
+    original: Callable[..., Any] = tables.aggregate
+
+    def spy(*args: Any) -> Any:
+        calls.append(1)
+        return original(*args)
+
+    monkeypatch.setattr(tables, "aggregate", spy)
+    return calls
+
+
 @pytest.mark.slow
 def test_a_second_report_draws_nothing_and_a_changed_cell_redraws_its_dataset_only(
     results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     out = tmp_path / "report"
     drawn = _counting(monkeypatch)
+    aggregated = _aggregating(monkeypatch)
     build_report(results, out)
     assert sorted(drawn) == sorted(DATASETS)
+    assert len(aggregated) == 2  # accuracy and cost, once each: the tables, figures and index.html share them
     first = {p.name: p.read_bytes() for p in (out / "plots").glob("*.png")}
     readme = (out / "README.md").read_text(encoding="utf-8")
 
     drawn.clear()
     build_report(results, out)
     assert drawn == []
+    assert len(aggregated) == 4  # the tables are written again; the figures, all kept, need no aggregate
     assert {p.name: p.read_bytes() for p in (out / "plots").glob("*.png")} == first
     assert (out / "README.md").read_text(encoding="utf-8") == readme  # the same figures are linked
 

@@ -18,7 +18,16 @@ from albot1.metrics.updates import update_counts
 from albot1.records import ResultRecord, check_number_path, parse_record
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, SOURCE_MODELS, CellRecord, Column
 from albot1.report.markdown import text as md_text
-from albot1.report.tables import aggregate, cell_text, cells_frame, markdown, stats_text, write_tables
+from albot1.report.tables import (
+    Aggregates,
+    aggregate,
+    cell_text,
+    cells_frame,
+    markdown,
+    pick,
+    stats_text,
+    write_tables,
+)
 
 METRIC_NAMES = metric_registry().names
 
@@ -150,32 +159,43 @@ def test_aggregate_over_seeds_mean_std_median_min_max() -> None:
     assert cell_text(single, "ate_rmse_m") == "0.500"
 
 
-def test_aggregate_of_the_same_cells_is_computed_once_and_each_caller_owns_its_copy(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_aggregates_computes_each_table_once_and_only_when_read(monkeypatch: pytest.MonkeyPatch) -> None:
     import albot1.report.tables as tables
 
-    calls: list[int] = []
-    compute = tables._aggregate
+    calls: list[tuple[str, ...]] = []
+    compute = tables.aggregate
 
     def counted(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
-        calls.append(1)
+        calls.append(tuple(columns))
         return compute(cells, columns)
 
-    monkeypatch.setattr(tables, "_aggregate", counted)
-    monkeypatch.setattr(tables, "_AGGREGATES", {})
+    monkeypatch.setattr(tables, "aggregate", counted)
     records = [record("w", "odometry", "none", s, ate) for s, ate in ((0, 1.0), (1, 3.0))]
-    first = aggregate(cells_frame(records), METRIC_COLUMNS)
-    first.loc[0, "ate_rmse_m_mean"] = -1.0  # a caller's change stays its own
-    again = aggregate(cells_frame(records), METRIC_COLUMNS)  # an equal frame built again
-    assert len(calls) == 1 and again.loc[0, "ate_rmse_m_mean"] == 2.0
-    changed = [record("w", "odometry", "none", 0, 1.0), record("w", "odometry", "none", 1, 5.0)]
-    assert aggregate(cells_frame(changed), METRIC_COLUMNS).loc[0, "ate_rmse_m_mean"] == 3.0 and len(calls) == 2
-    aggregate(cells_frame(records), COST_COLUMNS)  # other columns: another table
-    assert len(calls) == 3
-    for seed in range(2, 8):  # only the last few are kept
-        aggregate(cells_frame([record("w", "odometry", "none", seed, 1.0)]), METRIC_COLUMNS)
-    assert len(tables._AGGREGATES) == tables._AGGREGATES_KEPT
+    shared = Aggregates(records)
+    assert calls == []  # nothing computed until read
+    assert shared.metrics is shared.metrics and shared.metrics.loc[0, "ate_rmse_m_mean"] == 2.0
+    assert calls == [tuple(METRIC_COLUMNS)]
+    assert list(shared.cells["held_in"]) == [False, False]
+    assert shared.cost is shared.cost
+    assert calls == [tuple(METRIC_COLUMNS), tuple(COST_COLUMNS)]
+
+
+@pytest.mark.parametrize("keys", [["ate_rmse_m"], ["loop_gap_m", "ate_rmse_m"], []])
+def test_a_picked_aggregate_is_the_aggregate_of_the_picked_columns(keys: list[str]) -> None:
+    records = [
+        record("w", "odometry", "none", 0, 1.0),
+        record("w", "odometry", "gauss:0.1:1", 1, None),
+        record("w", "odometry", "gauss:0.1:1", 2, 2.5),
+        record("v", "odometry", "none", 0, 0.5, status="failed"),
+    ]
+    cells = cells_frame(records)
+    picked = {key: METRIC_COLUMNS[key] for key in keys}
+    whole = aggregate(cells, METRIC_COLUMNS)
+    pd.testing.assert_frame_equal(pick(whole, METRIC_COLUMNS, picked), aggregate(cells, picked))
+    empty = cells_frame([])
+    pd.testing.assert_frame_equal(
+        pick(aggregate(empty, METRIC_COLUMNS), METRIC_COLUMNS, picked), aggregate(empty, picked)
+    )
 
 
 @pytest.mark.parametrize(
