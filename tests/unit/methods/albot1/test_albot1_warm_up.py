@@ -169,8 +169,8 @@ def test_the_number_of_compile_processes_comes_from_the_environment(monkeypatch:
     assert compiled.compile_processes() >= 1
 
 
-def test_every_kernel_has_a_measured_compile_cost_and_the_dearest_is_claimed_first() -> None:
-    """A cold warm-up orders its kernels by measured compile CPU (``COMPILE_CPU_S``): a new kernel needs a measurement."""
+def test_every_kernel_has_a_measured_compile_cost() -> None:
+    """A cold warm-up claims kernels by measured compile CPU (``COMPILE_CPU_S``): a new kernel needs a measurement."""
     from albot1.methods.albot1.mapping.kernel_set import MappingKernels
     from albot1.methods.albot1.perception.kernels import PerceptionKernels
     from albot1.methods.albot1.places.kernels import PlacesKernels
