@@ -199,3 +199,20 @@ def test_a_scan_s_arrays_reach_a_kernel_with_one_type_whatever_their_flags() -> 
     for a, out in zip(inputs, outputs, strict=True):
         np.testing.assert_array_equal(out, np.asarray(a, dtype=np.float64))
     assert np.shares_memory(outputs[0], base) and base.flags.writeable  # a view: the caller's array is untouched
+
+
+def test_a_process_that_claims_refine_pose_claims_measurement_costs_next(tmp_path: Path) -> None:
+    """Kernels sharing dear callees go to one process: ``measurement_costs`` right after ``refine_pose``."""
+    from albot1.methods.albot1 import warm_up
+
+    order: list[str] = []
+    names = ["update_surfaces", "refine_pose", "build_view", "measurement_costs"]
+    calls = [(name, lambda name=name: order.append(name), ()) for name in names]
+    (tmp_path / "update_surfaces").touch()  # another process has it
+    warm_up._compile(tmp_path, calls, names)
+    assert order == ["refine_pose", "measurement_costs", "build_view"]
+    order.clear()
+    fresh = tmp_path / "fresh"
+    fresh.mkdir()
+    warm_up._compile(fresh, calls, ["refine_pose"])
+    assert order == ["refine_pose"]  # the follower only when it is among the names to compile
