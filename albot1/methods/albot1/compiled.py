@@ -114,6 +114,21 @@ def falses(n: int) -> NDArray[np.bool_]:
     return out
 
 
+def readonly_float64(a: NDArray[Any]) -> NDArray[np.float64]:
+    """``a`` as a read-only, C-contiguous float64 array (a view; a copy only when ``a`` is not float64 contiguous).
+
+    Numba compiles a kernel once per set of argument types, and whether an
+    array is writable is part of its type: loaders give read-only scans, a
+    degradation or a caller's own arrays writable ones. A kernel called on
+    ``readonly_float64`` arrays has one signature, so a warm-up compiles it once.
+    """
+    out = np.ascontiguousarray(a, dtype=np.float64)
+    if out.flags.writeable:
+        out = out.view()
+        out.flags.writeable = False
+    return out
+
+
 def as_written(fn: F) -> F:
     """The Python source of kernel ``fn`` (numba's ``py_func``; ``fn`` itself when the JIT is disabled)."""
     return cast(F, getattr(fn, "py_func", fn))

@@ -42,12 +42,6 @@ def kernel_names(kernels: object) -> list[str]:
     return [name for name in vars(kernels) if name != "compiled"]
 
 
-def _readonly(a: NDArray[Any]) -> NDArray[Any]:
-    a = np.array(a)
-    a.flags.writeable = False
-    return a
-
-
 def _update_sample(seg: NDArray[np.float64]) -> tuple[Any, ...]:
     """A two-surface map and a view far from it: only additions, so a second call repeats the first exactly."""
     cap = 8
@@ -87,10 +81,7 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         ],
         "measurement_costs": [(np.zeros((2, 3)), seg, seg + 0.01, ok, points, seg, 0.05, 0.1, 0.05, 2.0, 0.5)],
         "screen_directions": [(0.1, 0.2, 0.05, np.diag([1e4, 2.0, 1e3]), 0.0, 0.0, 0.0, 0.4, 400.0)],
-        "scan_points": [
-            (scan_ranges, _readonly(scan_angles), 30.0, 2),
-            (_readonly(scan_ranges), _readonly(scan_angles), 30.0, 2),
-        ],
+        "scan_points": [(compiled.readonly_float64(scan_ranges), compiled.readonly_float64(scan_angles), 30.0, 2)],
         "detect_exits": [(seg, kinds, 0.6, 1.2, 0.5, 6.0, True)],
         "seen_through": [(seg, ids, np.ones(2, dtype=np.bool_), 0.5, 0.0, poly)],
         "near_exit": [(seg, ids, ids, 1, 10, 1, 0.5, 0.0, 0.5)],
@@ -137,12 +128,20 @@ def compile_claimed(claims: str, kernel_sets: list[str], names: list[str]) -> No
     _compile(Path(claims), list(sample_calls(*sets)), names)
 
 
+#: A kernel that shares dear callees with another: claimed right after it, by the same process, when both are cold.
+#: ``measurement_costs`` calls ``pose_cost``, ``nearest_surface`` and ``huber_cost`` as ``refine_pose`` does: about
+#: 0.7 CPU s compiled once instead of once in each of two processes.
+_FOLLOWS: dict[str, str] = {"refine_pose": "measurement_costs"}
+
+
 def _compile(claims: Path, calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]], names: list[str]) -> None:
-    for name in names:
-        if _claim(claims, name):
-            for called, kernel, args in calls:
-                if called == name:
-                    kernel(*args)
+    for first in names:
+        follower = _FOLLOWS.get(first)
+        for name in (first,) if follower is None or follower not in names else (first, follower):
+            if _claim(claims, name):
+                for called, kernel, args in calls:
+                    if called == name:
+                        kernel(*args)
 
 
 def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) -> list[BaseProcess]:
@@ -161,9 +160,27 @@ def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) ->
     helpers: list[BaseProcess] = [
         context.Process(target=compile_claimed, args=(str(claims), specs, names), daemon=True) for _ in range(count)
     ]
+    before = sum(1 for _ in claims.iterdir())
     for helper in helpers:
         helper.start()
+    if forking:
+        _first_claims(claims, helpers, before + len(helpers))
     return helpers
+
+
+def _first_claims(claims: Path, helpers: list[BaseProcess], claimed: int, wait_s: float = 0.5) -> None:
+    """Wait (at most ``wait_s``) until ``claimed`` kernels are claimed (each helper's first): the dearest go to them.
+
+    This process has already paid numba's set-up and a kernel before the
+    fork; were it also to claim the dearest kernel (a fork starts in about a
+    millisecond, this process goes on at once), it would finish last. With
+    the thesis kernels: ``update_surfaces`` alone takes as long as the rest.
+    """
+    deadline = time.perf_counter() + wait_s
+    while time.perf_counter() < deadline and any(helper.is_alive() for helper in helpers):
+        if sum(1 for _ in claims.iterdir()) >= claimed:
+            return
+        time.sleep(0.001)
 
 
 def warm_up(
@@ -174,8 +191,8 @@ def warm_up(
     With numba's cache filled (any earlier run of this code version on this
     machine) this is a cache load. Kernels missing from the cache are
     compiled by up to :func:`compiled.compile_processes` processes at once:
-    helper processes and this one take the cold kernels one by one, heaviest
-    first (a claim file each), and numba's cache hands this process what the
+    helper processes and this one take the cold kernels one by one, dearest
+    to compile first (:func:`compile_cost`; a claim file each), and numba's cache hands this process what the
     helpers compiled. Whatever a helper did not deliver (it failed, or was
     slower) this process compiles itself, so a helper changes only the time.
     ``announce`` receives a line before and after a real compilation, none
@@ -184,13 +201,15 @@ def warm_up(
     """
     calls = [call for call in sample_calls(*kernel_sets) if call[0] not in skip]
     kernels = {name: kernel for name, kernel, _ in calls}
-    cold = sorted((name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -_size(kernels[n]))
+    cold = sorted(
+        (name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -compile_cost(n, kernels[n])
+    )
     if cold and announce is not None:
         announce(f"albot1: compiling the numba kernels once for this code version (cache: {compiled.CACHE_DIR})")
     start = time.perf_counter()
     if cold:
         with tempfile.TemporaryDirectory(prefix="albot1-compile-") as folder:
-            # The smallest first, here: it pays numba's one-time set-up, which forked helpers then inherit.
+            # The cheapest first, here: it pays numba's one-time set-up, which forked helpers then inherit.
             _compile(Path(folder), calls, cold[-1:])
             helpers = _helpers(Path(folder), kernel_sets, cold[:-1])
             try:
@@ -216,6 +235,36 @@ def _cold(kernel: Callable[..., Any]) -> bool:
     return not signatures and not compiled.is_cached(kernel)
 
 
-def _size(kernel: Callable[..., Any]) -> int:
-    """Lines of the kernel's source: the order of the cold kernels, longest (slowest to compile) first."""
-    return len(inspect.getsourcelines(compiled.as_written(kernel))[0])
+#: CPU seconds of each kernel's cold compile in one process, measured: the order a cold warm-up claims them in.
+#: ``benchmarks/compile_cost.py kernels plus`` and ``... places`` on the idle 2-core machine (a callee two kernels
+#: share is charged to the first). Only the order matters: dearest first, so that the last kernels claimed are
+#: cheap and the processes finish together (longest-processing-time-first scheduling).
+COMPILE_CPU_S: dict[str, float] = {
+    "update_surfaces": 3.44,
+    "refine_pose": 2.28,
+    "screen_directions": 2.08,
+    "build_view": 1.88,
+    "match_structure": 1.87,
+    "recognise_landmarks": 1.24,
+    "measurement_costs": 0.61,
+    "detect_exits": 0.55,
+    "colocated": 0.54,
+    "same_any": 0.46,
+    "merge_collinear": 0.43,
+    "update_sides": 0.38,
+    "landmark_rows": 0.22,
+    "scan_points": 0.18,
+    "seen_through": 0.17,
+    "near_exit": 0.17,
+    "place_segments": 0.15,
+}
+#: CPU seconds per source line for a kernel not (yet) in :data:`COMPILE_CPU_S`: about what the measured ones cost
+_CPU_S_PER_LINE = 0.012
+
+
+def compile_cost(name: str, kernel: Callable[..., Any]) -> float:
+    """Kernel ``name``'s measured cold-compile CPU seconds (:data:`COMPILE_CPU_S`), else an estimate from its length."""
+    measured = COMPILE_CPU_S.get(name)
+    if measured is not None:
+        return measured
+    return _CPU_S_PER_LINE * len(inspect.getsourcelines(compiled.as_written(kernel))[0])

@@ -29,6 +29,7 @@ from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
+from albot1.methods.albot1.compiled import readonly_float64
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
@@ -196,7 +197,9 @@ class Albot1Mapper:
             raise MappingError(f"scan {frame.index}: odometry {odo} is not finite")
         self._odometry = odo
         if self._plus is not None:
-            self._points = self._plus.scan_points(scan.ranges, scan.angles)
+            self._points = self._plus.scan_points(
+                readonly_float64(scan.ranges), readonly_float64(scan.angles)
+            )  # one kernel signature
         c = self._counts
         c.views += 1
         if len(view) == 0:

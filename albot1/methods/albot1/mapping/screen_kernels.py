@@ -76,8 +76,12 @@ def screen_directions(
     keep = eigval > max(floor, 0.0)
     basis = eigvec[:, keep]
     kept_n = basis.shape[1]
-    if kept_n == 0:
-        return eigval, basis, np.zeros(0), px, py, pphi, np.zeros((3, 3))
+    if kept_n == 0:  # (np.empty and a loop, not np.zeros: one numpy routine less to compile)
+        nothing = np.empty((3, 3))
+        for i in range(3):
+            for j in range(3):
+                nothing[i, j] = 0.0
+        return eigval, basis, np.empty(0), px, py, pphi, nothing
     delta = np.empty(3)
     delta[0] = scale[0] * (mx - px)
     delta[1] = scale[1] * (my - py)

@@ -134,7 +134,7 @@ def test_a_helper_s_kernels_are_loaded_from_numba_s_cache_by_the_next_process(tm
     _python(code, str(tmp_path))
     found = json.loads(_python(_LOAD, str(tmp_path)))
     assert {name for name, cached in found["cached"].items() if cached} == {"scan_points"}
-    assert found["stats"] == {"scan_points": [2, 0]}  # both warm-up signatures loaded, none compiled
+    assert found["stats"] == {"scan_points": [1, 0]}  # its one warm-up signature loaded, not compiled
     assert sorted(p.name for p in claims.iterdir()) == ["refine_pose", "scan_points"]
 
 
@@ -167,3 +167,52 @@ def test_the_number_of_compile_processes_comes_from_the_environment(monkeypatch:
             compiled.compile_processes()
     monkeypatch.delenv(compiled.PROCESSES_ENV)
     assert compiled.compile_processes() >= 1
+
+
+def test_every_kernel_has_a_measured_compile_cost() -> None:
+    """A cold warm-up claims kernels by measured compile CPU (``COMPILE_CPU_S``): a new kernel needs a measurement."""
+    from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+    from albot1.methods.albot1.perception.kernels import PerceptionKernels
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+    from albot1.methods.albot1.warm_up import COMPILE_CPU_S, compile_cost, kernel_names
+
+    names = [name for k in (PerceptionKernels(), MappingKernels(), PlacesKernels()) for name in kernel_names(k)]
+    assert sorted(names) == sorted(COMPILE_CPU_S)
+    assert compile_cost("update_surfaces", len) == COMPILE_CPU_S["update_surfaces"]
+    mapping = MappingKernels()
+    assert compile_cost("not measured", mapping.refine_pose) > compile_cost("not measured", mapping.scan_points) > 0
+
+
+def test_a_scan_s_arrays_reach_a_kernel_with_one_type_whatever_their_flags() -> None:
+    """``readonly_float64``: writable, read-only, strided or float32 ranges all become one numba argument type."""
+    import numba
+    import numpy as np
+
+    from albot1.methods.albot1.compiled import readonly_float64
+
+    base = np.arange(10.0)
+    frozen_base = base.copy()
+    frozen_base.flags.writeable = False
+    inputs = [base, frozen_base, np.arange(20.0)[::2], np.arange(10, dtype=np.float32), [0.0, 1.0]]
+    outputs = [readonly_float64(a) for a in inputs]
+    assert {str(numba.typeof(out)) for out in outputs} == {"readonly array(float64, 1d, C)"}
+    for a, out in zip(inputs, outputs, strict=True):
+        np.testing.assert_array_equal(out, np.asarray(a, dtype=np.float64))
+    assert np.shares_memory(outputs[0], base) and base.flags.writeable  # a view: the caller's array is untouched
+
+
+def test_a_process_that_claims_refine_pose_claims_measurement_costs_next(tmp_path: Path) -> None:
+    """Kernels sharing dear callees go to one process: ``measurement_costs`` right after ``refine_pose``."""
+    from albot1.methods.albot1 import warm_up
+
+    order: list[str] = []
+    names = ["update_surfaces", "refine_pose", "build_view", "measurement_costs"]
+    calls = [(name, lambda name=name: order.append(name), ()) for name in names]
+    (tmp_path / "update_surfaces").touch()  # another process has it
+    warm_up._compile(tmp_path, calls, names)
+    assert order == ["refine_pose", "measurement_costs", "build_view"]
+    order.clear()
+    fresh = tmp_path / "fresh"
+    fresh.mkdir()
+    warm_up._compile(fresh, calls, ["refine_pose"])
+    assert order == ["refine_pose"]  # the follower only when it is among the names to compile
