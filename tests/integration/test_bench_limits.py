@@ -76,6 +76,22 @@ name = "{WORLD}[:30]"
 """
 
 
+def _command_line(process: psutil.Process) -> str:
+    """The process's command line, or "" for one that ended or is a zombie (short-lived helpers such as `git`
+    come and go while the runner starts)."""
+    try:
+        return " ".join(process.cmdline())
+    except (psutil.NoSuchProcess, psutil.ZombieProcess, psutil.AccessDenied):
+        return ""
+
+
+def _children(process: psutil.Process) -> list[psutil.Process]:
+    try:
+        return process.children()
+    except (psutil.NoSuchProcess, psutil.ZombieProcess):
+        return []
+
+
 @pytest.mark.slow
 def test_killing_the_cell_pool_is_named_halts_the_grid_and_a_rerun_resumes(tmp_path: Path) -> None:
     suite = tmp_path / "slow.toml"
@@ -88,8 +104,8 @@ def test_killing_the_cell_pool_is_named_halts_the_grid_and_a_rerun_resumes(tmp_p
         deadline = time.monotonic() + 120
         cells: list[psutil.Process] = []
         while time.monotonic() < deadline and len(cells) < 2:  # wait for two running cells under the forkserver
-            servers = [p for p in psutil.Process(runner.pid).children() if "forkserver" in " ".join(p.cmdline())]
-            cells = [c for s in servers for c in s.children()]
+            servers = [p for p in psutil.Process(runner.pid).children() if "forkserver" in _command_line(p)]
+            cells = [c for s in servers for c in _children(s)]
             time.sleep(0.1)
         assert len(servers) == 1 and len(cells) == 2, "the cells did not start"
         time.sleep(1.0)
