@@ -16,6 +16,7 @@ import os
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import numba  # noqa: E402  (after the project: its cache folder is set before numba compiles)
@@ -546,3 +547,23 @@ def test_whole_loop_run_is_identical_with_numba_s_switch(method: str) -> None:
     code = f"{_FINGERPRINT}\nprint(fingerprint({method!r}, 'default', 'synthetic-office-loop', None))\n"
     as_written = _python(code, NUMBA_DISABLE_JIT="1").strip()
     assert as_written == _fingerprint(method, "default", "synthetic-office-loop", None)
+
+
+def _stand_in_kernel() -> None:
+    """A function standing in for a kernel's Python source in the cache-lookup test."""
+
+
+def test_a_kernel_is_cached_only_in_its_own_source_folder_of_the_cache(tmp_path: Path) -> None:
+    # Two checkouts of one code version share the version's folder, each with its own numba subfolder: another
+    # checkout's index must not count, or a warm-up skips the parallel compile of a kernel that is in fact cold.
+    from types import SimpleNamespace
+
+    own, other = tmp_path / "mapping_own", tmp_path / "mapping_other"
+    own.mkdir()
+    other.mkdir()
+    kernel = SimpleNamespace(py_func=_stand_in_kernel, _cache=SimpleNamespace(cache_path=str(own)))
+    index = f"{Path(__file__).stem}._stand_in_kernel-123.py311.nbi"
+    (other / index).write_bytes(b"")
+    assert not compiled.is_cached(kernel)
+    (own / index).write_bytes(b"")
+    assert compiled.is_cached(kernel)
