@@ -18,7 +18,7 @@ import time
 import traceback
 import uuid
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from functools import partial
 from pathlib import Path
@@ -167,9 +167,7 @@ def run_grid(
     cancelled: set[cf.Future[CellOutcome | None]] = set()
     started_at = time.time()
     try:
-        for future in cf.as_completed(futures):
-            if future in cancelled:  # the runner's own cancellation after a halt: listed as not started
-                continue
+        for future in _completed(futures, cancelled):
             halt: str | None = None
             if future.cancelled():  # not by the runner: the executor lost it
                 halt = executor_lost(executor) or "the executor cancelled the cell (its Dask scheduler restarted?)"
@@ -186,7 +184,7 @@ def run_grid(
                     halt = halt or ended.reason
             if halt is not None and summary.halted is None:
                 summary.halted = halt
-                cancelled = {f for f in futures if not f.done() and f.cancel()}
+                cancelled.update([f for f in futures if not f.done() and f.cancel()])
                 summary.not_started += [futures[f] for f in futures if f in cancelled]
     finally:
         for future in futures:
@@ -196,6 +194,32 @@ def run_grid(
     summary.not_started.sort(key=lambda cell: order[cell.key])
     summary.wall_s = time.monotonic() - start
     return summary
+
+
+def _completed(
+    futures: Iterable[cf.Future[CellOutcome | None]], cancelled: set[cf.Future[CellOutcome | None]]
+) -> Iterator[cf.Future[CellOutcome | None]]:
+    """``futures`` as they complete (``cf.as_completed``), leaving out those in ``cancelled`` (the caller adds to it).
+
+    After a halt the runner cancels the cells not yet started and waits only
+    for the others. A Dask client's ``concurrent.futures`` future stays
+    *pending* while its task runs, so the runner's ``cancel`` can succeed on a
+    running cell; when that task then ends, ``distributed`` sets its result on
+    the cancelled future, which raises ``InvalidStateError`` in its callback
+    and leaves the future cancelled but never notified: ``as_completed`` would
+    wait for it forever (seen once in CI: a grid halted by a read-only worker
+    hung until the test's 300 s timeout). So the waiting restarts over the
+    futures not cancelled (at most once per halt).
+    """
+    remaining = set(futures)
+    while remaining:
+        remaining -= cancelled
+        before = len(cancelled)
+        for future in cf.as_completed(remaining):
+            remaining.discard(future)
+            yield future
+            if len(cancelled) != before:  # a halt cancelled cells: wait again, without them
+                break
 
 
 def kept_failure(store: ResultsStore, cell: Cell) -> CellOutcome | None:

@@ -170,3 +170,59 @@ def test_the_runner_s_own_cancellations_never_print_a_traceback_and_other_errors
     assert caplog.records[0].exc_info is not None
     assert isinstance(caplog.records[0].exc_info[1], RuntimeError)
     assert logger.filters == []
+
+
+class PendingWhileRunningExecutor(cf.Executor):
+    """Futures that stay pending while their job runs, as a Dask client's do; a cancelled one is never notified.
+
+    The first job completes at once; every other job "runs" until :meth:`finish`, which sets the results the way
+    ``distributed.cfexecutor`` does: on a future the runner cancelled meanwhile, ``set_result`` raises
+    ``InvalidStateError`` (swallowed here, logged there) and the future stays cancelled without notification.
+    """
+
+    def __init__(self) -> None:
+        self.running: list[tuple[cf.Future[Any], Callable[[], Any]]] = []
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> cf.Future[Any]:
+        future: cf.Future[Any] = cf.Future()
+        if not self.running and not getattr(self, "first_done", False):
+            self.first_done = True
+            future.set_result(fn(*args, **kwargs))
+        else:
+            self.running.append((future, lambda: fn(*args, **kwargs)))
+        return future
+
+    def finish(self) -> None:
+        for future, call in self.running:
+            try:
+                future.set_result(call())
+            except cf.InvalidStateError:
+                pass
+
+
+def test_a_halt_does_not_wait_for_a_running_cell_it_cancelled(tmp_path: Path) -> None:
+    import threading
+
+    cells = [make_cell(f"k{i}") for i in range(3)]
+    store = ResultsStore(tmp_path)
+    executor = PendingWhileRunningExecutor()
+
+    def job(cell: Cell, root: str) -> CellOutcome:
+        if cell.key == "k0":
+            return CellOutcome.of(
+                cell, "failed", 0.0, "cannot write the results: no space left", "storage", halts_grid=True
+            )
+        return CellOutcome.of(cell, "done")
+
+    ended: list[Any] = []
+    grid = threading.Thread(
+        target=lambda: ended.append(run_grid(plan_of(cells), store, executor, job=job)), daemon=True
+    )
+    grid.start()
+    grid.join(timeout=5)
+    executor.finish()  # the "running" cells end after the runner cancelled them
+    grid.join(timeout=5)
+    assert ended, "the runner waited for cells it had cancelled"
+    summary = ended[0]
+    assert summary.halted == "cannot write the results: no space left"
+    assert [c.key for c in summary.not_started] == ["k1", "k2"]
