@@ -79,7 +79,9 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         "refine_pose": [
             (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
         ],
-        "measurement_costs": [(np.zeros((2, 3)), seg, seg + 0.01, ok, points, seg, 0.05, 0.1, 0.05, 2.0, 0.5, math.inf)],
+        "measurement_costs": [
+            (np.zeros((2, 3)), seg, seg + 0.01, ok, points, seg, 0.05, 0.1, 0.05, 2.0, 0.5, math.inf)
+        ],
         "screen_directions": [(0.1, 0.2, 0.05, np.diag([1e4, 2.0, 1e3]), 0.0, 0.0, 0.0, 0.4, 400.0)],
         "scan_points": [(compiled.readonly_float64(scan_ranges), compiled.readonly_float64(scan_angles), 30.0, 2)],
         "detect_exits": [(seg, kinds, 0.6, 1.2, 0.5, 6.0, True)],

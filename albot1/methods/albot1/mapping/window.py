@@ -141,7 +141,17 @@ class OdometryWindow:
         )
         poses = np.array([(x, y, phi), prediction], dtype=float)
         c, per_surface, matched_cost, terms, independent = costs(
-            poses, _NO_LANDMARKS, _NO_LANDMARKS, _NO_POINT_OK, points, oldest.ref, line, point, scan, huber, gate,
+            poses,
+            _NO_LANDMARKS,
+            _NO_LANDMARKS,
+            _NO_POINT_OK,
+            points,
+            oldest.ref,
+            line,
+            point,
+            scan,
+            huber,
+            gate,
             overhang,
         )
         matched = float(np.sum(per_surface)) / points.shape[0]  # type: ignore[call-overload]

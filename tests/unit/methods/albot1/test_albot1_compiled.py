@@ -229,7 +229,26 @@ def _refine_args() -> Iterator[tuple[Any, ...]]:
             yield (starts, lm_view, lm_map, ok, points, ref, *prior, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
         # The overlap rule (mapping/overlap.py) on: points beyond a surface's end are matched elsewhere or not at all.
         for overhang in (0.0, 0.1):
-            yield (starts, lm_view, lm_map, ok, points, ref, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, overhang)
+            yield (
+                starts,
+                lm_view,
+                lm_map,
+                ok,
+                points,
+                ref,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.05,
+                0.1,
+                0.05,
+                2.0,
+                0.5,
+                8,
+                overhang,
+            )
         yield (
             starts[:1],
             lm_view[:0],
