@@ -93,6 +93,8 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "degenerate_sd_m": 0.05,
         "gate_probability": 0.0,
         "ambiguity_probability": 0.99,
+        "scan_overlap": "surface",
+        "scan_overhang_m": 0.05,
     },
 }
 
