@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from albot1.methods.albot1.compiled import as_written
+from albot1.methods.albot1.mapping.ambiguity import measurement_costs
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT, overhangs
 from albot1.methods.albot1.mapping.pose_kernels import nearest_surface, refine_pose, surface_boxes
@@ -80,3 +81,22 @@ def test_the_rule_is_off_unless_asked_for_and_then_carries_its_overhang() -> Non
     assert Albot1Config().plus_params().overhang == NO_LIMIT
     assert Albot1Config(scan_overhang_m=0.2).plus_params().overhang == NO_LIMIT  # "gate": the overhang is unused
     assert Albot1Config(scan_overlap="surface", scan_overhang_m=0.2).plus_params().overhang == 0.2
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "as-written"])
+def test_the_ambiguity_costs_use_the_same_rule(compiled: bool) -> None:
+    """A point 0.3 m past the wall's end, 0.1 m off its line: matched without the rule (the cost counts its
+    distance to the segment, hypot(0.3, 0.1) / 0.05 = 6.3 sigmas, Huber linear beyond 2: 2 * (6.3 - 1)), unmatched
+    with it (the gate's cost: 10 sigmas, 2 * (10 - 1) = 18)."""
+    kernel = measurement_costs if compiled else as_written(measurement_costs)
+    none4 = np.empty((0, 4))
+    none2 = np.empty((0, 2), dtype=np.bool_)
+    points = np.array([[2.3, 5.1]])
+    ref = np.array([WALL])
+    past = 2.0 * (math.hypot(0.3, 0.1) / 0.05 - 1.0)
+    for overhang, cost, matched in ((NO_LIMIT, past, [1]), (0.0, 18.0, [0])):
+        costs, per_surface, matched_cost, *_ = kernel(
+            np.zeros((1, 3)), none4, none4, none2, points, ref, 0.05, 0.1, 0.05, 2.0, 0.5, overhang
+        )
+        assert costs[0] == pytest.approx(cost) and per_surface.tolist() == matched
+        assert matched_cost == pytest.approx(cost if matched == [1] else 0.0)
