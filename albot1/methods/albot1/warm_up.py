@@ -77,9 +77,11 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         "place_segments": [(seg, 0.5, -0.2, math.cos(0.3), math.sin(0.3))],
         "landmark_rows": [(seg, kinds, 0.4)],
         "refine_pose": [
-            (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
+            (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
         ],
-        "measurement_costs": [(np.zeros((2, 3)), seg, seg + 0.01, ok, points, seg, 0.05, 0.1, 0.05, 2.0, 0.5)],
+        "measurement_costs": [
+            (np.zeros((2, 3)), seg, seg + 0.01, ok, points, seg, 0.05, 0.1, 0.05, 2.0, 0.5, math.inf)
+        ],
         "screen_directions": [(0.1, 0.2, 0.05, np.diag([1e4, 2.0, 1e3]), 0.0, 0.0, 0.0, 0.4, 400.0)],
         "scan_points": [(compiled.readonly_float64(scan_ranges), compiled.readonly_float64(scan_angles), 30.0, 2)],
         "detect_exits": [(seg, kinds, 0.6, 1.2, 0.5, 6.0, True)],

@@ -44,7 +44,8 @@ def test_presets_table_of_one_method() -> None:
         "    exact    motion_model = exact",
         "    literal  continuation_tolerance_m = 0.0 m, end_spacing_max_m = 0.0 m, delete_margin_from = boundary",
         "    plus     end_spacing_max_m = 0.0 m, surface_fit = tls, motion_model = exact, pose_estimate = robust, "
-        "scan_refinement = true, odometry_prior = adaptive, degenerate_sd_m = 0.05 m, ambiguity_probability = 0.99",
+        "scan_refinement = true, scan_overlap = surface, scan_overhang_m = 0.05 m, odometry_prior = adaptive, "
+        "degenerate_sd_m = 0.05 m, ambiguity_probability = 0.99",
     ]
 
 
@@ -66,6 +67,8 @@ def test_presets_json_of_every_method() -> None:
             "motion_model": "exact",
             "pose_estimate": "robust",
             "scan_refinement": True,
+            "scan_overlap": "surface",
+            "scan_overhang_m": 0.05,
             "odometry_prior": "adaptive",
             "degenerate_sd_m": 0.05,
             "ambiguity_probability": 0.99,

@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import Pose
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel
+from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.pose_kernels import huber_cost, nearest_surface, pose_cost, surface_boxes
 
 #: Independent terms a surface's points count for at most: its offset and its direction are what its fit error moves.
@@ -69,12 +70,14 @@ def measurement_costs(
     scan_sigma: float,
     huber: float,
     gate: float,
+    overhang: float,
 ) -> tuple[FloatArray, NDArray[np.int64], float, int, int]:
     """The robust cost of the view's terms at each of ``poses`` ``(c, 3)``, and the fit's terms at the first.
 
     Costs are :func:`~albot1.methods.albot1.mapping.pose_kernels.pose_cost`'s
     (residuals in sigmas, ``r^2 / 2`` inside the Huber threshold; a point with
-    no surface within ``gate`` costs as much as one at the gate). At the first
+    no surface within ``gate`` costs as much as one at the gate; ``overhang``:
+    the overlap rule, :mod:`albot1.methods.albot1.mapping.overlap`). At the first
     pose (the fitted one): per reference surface, how many view points are
     associated with it, the cost of the associated terms alone (landmarks and
     matched points: the residuals the fit's variance is estimated from), and
@@ -100,6 +103,7 @@ def measurement_costs(
             scan_sigma,
             huber,
             gate,
+            overhang,
         )
     per_surface = np.empty(ref.shape[0], dtype=np.int64)
     for j in range(ref.shape[0]):  # a loop, not np.zeros: one numpy routine less to compile
@@ -128,6 +132,7 @@ def measurement_costs(
             scan_sigma,
             huber,
             gate,
+            overhang,
         )
         total = landmarks
         matched = landmarks
@@ -136,7 +141,7 @@ def measurement_costs(
         for p in range(points.shape[0]):
             tx = poses[0, 0] + c * points[p, 0] - s * points[p, 1]
             ty = poses[0, 1] + s * points[p, 0] + c * points[p, 1]
-            found, distance = nearest_surface(tx, ty, ref, boxes, gate)
+            found, distance = nearest_surface(tx, ty, ref, boxes, gate, overhang)
             cost = huber_cost(distance / scan_sigma, huber)
             total += cost
             if found >= 0:
@@ -211,12 +216,16 @@ def view_ambiguity(
     ref: FloatArray,
     sigmas: tuple[float, float, float, float, float],
     limit: float,
+    overhang: float = NO_LIMIT,
 ) -> Ambiguity:
     """:func:`likelihood_ratio` of one view: costs by ``kernels_costs`` (:func:`measurement_costs`, compiled or not).
 
     ``sigmas``: line, point and scan sigma, Huber threshold (in sigmas) and
-    the scan gate, as the fit used them; ``limit``: :func:`threshold`.
+    the scan gate, as the fit used them; ``limit``: :func:`threshold`;
+    ``overhang``: the overlap rule the fit used (:mod:`albot1.methods.albot1.mapping.overlap`).
     """
     poses = np.array([fitted, predicted], dtype=float)
-    costs, _, matched, terms, independent = kernels_costs(poses, lm_view, lm_map, point_ok, points, ref, *sigmas)  # type: ignore[operator]
+    costs, _, matched, terms, independent = kernels_costs(  # type: ignore[operator]
+        poses, lm_view, lm_map, point_ok, points, ref, *sigmas, overhang
+    )
     return likelihood_ratio(float(costs[0]), float(costs[1]), float(matched), int(terms), int(independent), limit)

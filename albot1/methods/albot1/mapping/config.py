@@ -17,6 +17,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.plus import PlusParams
 from albot1.methods.albot1.perception.view import ViewParams
 
@@ -151,6 +152,17 @@ class Albot1Config(BaseModel):
         0.5, gt=0, description="Albot1+: a view point farther than this from every update-view surface is unused"
     )
     scan_beam_stride: int = Field(2, ge=1, description="Albot1+: use every n-th return of the scan")
+    scan_overlap: Literal["gate", "surface"] = Field(
+        "gate",
+        description=(
+            "Albot1+: where a view point may be matched to an update-view surface: anywhere within scan_gate_m"
+            " (gate), or only where its projection falls on the surface, up to scan_overhang_m beyond its ends"
+            " (surface: the overlap rule, albot1/methods/albot1/mapping/overlap.py)"
+        ),
+    )
+    scan_overhang_m: float = Field(
+        0.0, ge=0, description="Albot1+ overlap rule (scan_overlap = surface): how far beyond a surface's end"
+    )
     odometry_prior: Literal["off", "fixed", "adaptive"] = Field(
         "off",
         description=(
@@ -297,4 +309,5 @@ class Albot1Config(BaseModel):
             window_updates=self.window_updates,
             window_probability=self.window_probability,
             motion_model=self.motion_model,
+            overhang=self.scan_overhang_m if self.scan_overlap == "surface" else NO_LIMIT,
         )

@@ -33,7 +33,10 @@ pose is computed:
    robust cost at the odometry's prediction: where the view does not refute
    it (a likelihood ratio below that chi-square quantile), the prediction is
    the pose and the fusion is skipped.
-7. with ``window_updates`` (and the ambiguity test on), :mod:`.window` first
+7. with ``scan_overlap = "surface"``, :mod:`.overlap` matches a view point
+   to an update-view surface only where its projection falls on that
+   surface (up to ``scan_overhang_m`` beyond its ends).
+8. with ``window_updates`` (and the ambiguity test on), :mod:`.window` first
    tests the odometry since the oldest of the last ``window_updates`` update
    views against that view's surfaces: not refuted, the odometry over the
    window is the pose (false alarms and the fit's bias in the anchors between
@@ -57,6 +60,7 @@ from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen_kernels import screen_directions
 from albot1.methods.albot1.mapping.window import OdometryWindow, UpdateRecord, WindowOutcome
 from albot1.methods.albot1.perception.endpoints import STABLE
@@ -95,6 +99,7 @@ class PlusParams:
     window_updates: int = 0  # the window test against the oldest of this many update views (:mod:`.window`); 0 = off
     window_probability: float = 0.5  # chi-square quantile below which the window's odometry is kept
     motion_model: str = "exact"  # how an odometry increment becomes a thesis-frame motion (the mapper's)
+    overhang: float = NO_LIMIT  # m a view point may project beyond an update-view surface's end (:mod:`.overlap`)
 
 
 class OdometryNoise:
@@ -247,6 +252,7 @@ class PlusLocaliser:
                     sigmas,
                     p.iterations,
                     self._window_limit,
+                    p.overhang,
                 )
                 self.last_window = window
                 if window is not None and window.kept:
@@ -263,6 +269,7 @@ class PlusLocaliser:
                 self._ref,
                 sigmas,
                 self._ambiguity_limit,
+                p.overhang,
             )
             self.last_ambiguity = test
             if test.ambiguous:
@@ -303,6 +310,7 @@ class PlusLocaliser:
             p.huber,
             p.scan_gate,
             p.iterations,
+            p.overhang,
         )
         return (x, y, phi), info
 

@@ -36,6 +36,7 @@ from albot1.geometry.se2 import wrap_angle
 from albot1.geometry.segments import closest_parameter
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel
+from albot1.methods.albot1.mapping.overlap import overhangs
 
 BoolArray = NDArray[np.bool_]
 
@@ -124,16 +125,22 @@ def surface_boxes(ref: FloatArray, margin: float) -> FloatArray:
 
 
 @jitable
-def nearest_surface(x: float, y: float, ref: FloatArray, boxes: FloatArray, gate: float) -> tuple[int, float]:
+def nearest_surface(
+    x: float, y: float, ref: FloatArray, boxes: FloatArray, gate: float, overhang: float
+) -> tuple[int, float]:
     """The surface of ``ref`` nearest the point and its distance, if nearer than ``gate``; else ``(-1, gate)``.
 
     ``boxes`` (:func:`surface_boxes` grown by ``gate``) skip the surfaces
-    that cannot be within ``gate`` before any distance is computed.
+    that cannot be within ``gate`` before any distance is computed; a surface
+    the point's projection overhangs by more than ``overhang`` m is skipped
+    too (:mod:`albot1.methods.albot1.mapping.overlap`; ``NO_LIMIT``: none is).
     """
     best = gate
     found = -1
     for j in range(ref.shape[0]):
         if x < boxes[j, 0] or x > boxes[j, 2] or y < boxes[j, 1] or y > boxes[j, 3]:
+            continue
+        if overhangs(x, y, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3], overhang):
             continue
         t = closest_parameter(x, y, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3])
         d = np.hypot(ref[j, 0] + t * (ref[j, 2] - ref[j, 0]) - x, ref[j, 1] + t * (ref[j, 3] - ref[j, 1]) - y)
@@ -159,6 +166,7 @@ def pose_cost(
     scan_sigma: float,
     huber: float,
     gate: float,
+    overhang: float,
 ) -> float:
     """The robust cost of the measurement terms at pose ``(x, y, phi)`` (residuals in sigmas).
 
@@ -184,7 +192,7 @@ def pose_cost(
     for p in range(points.shape[0]):
         tx = x + c * points[p, 0] - s * points[p, 1]
         ty = y + s * points[p, 0] + c * points[p, 1]
-        best = nearest_surface(tx, ty, ref, boxes, gate)[1]
+        best = nearest_surface(tx, ty, ref, boxes, gate, overhang)[1]
         total += huber_cost(best / scan_sigma, huber)
     return total
 
@@ -217,6 +225,7 @@ def refine_pose(
     huber: float,
     gate: float,
     iterations: int,
+    overhang: float,
 ) -> tuple[float, float, float, FloatArray]:
     """The pose minimising the weighted robust residuals, from the cheapest of ``starts`` ``(c, 3)``.
 
@@ -226,6 +235,9 @@ def refine_pose(
     update view's surfaces in the map. Returns the pose and the 3x3
     information matrix of the measurement terms alone (no prior) at the
     last linearisation, which says how well the view fixes each direction.
+    ``overhang``: how far beyond a surface's end a view point may still be
+    matched to it (:mod:`albot1.methods.albot1.mapping.overlap`; ``NO_LIMIT``:
+    anywhere within ``gate``, as before the rule existed).
     Stops after ``iterations`` Gauss-Newton steps or when a step moves less
     than 1 micrometre and 0.1 microradian.
     """
@@ -251,6 +263,7 @@ def refine_pose(
             scan_sigma,
             huber,
             gate,
+            overhang,
         )
         if cost < lowest:
             lowest = cost
@@ -346,7 +359,7 @@ def refine_pose(
             dy = s * vx + c * vy
             tx = x + dx
             ty = y + dy
-            found = nearest_surface(tx, ty, ref, boxes, gate)[0]
+            found = nearest_surface(tx, ty, ref, boxes, gate, overhang)[0]
             if found < 0:
                 continue
             # Point-to-line against the nearest reference surface.

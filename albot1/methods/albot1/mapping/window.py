@@ -41,6 +41,7 @@ import numpy as np
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, likelihood_ratio
+from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.perception.recognition import motion_step
 
 #: The share of the scan's points that must find a surface of the window's view (within the gate) at the fit for
@@ -97,6 +98,7 @@ class OdometryWindow:
         sigmas: tuple[float, float, float, float, float],
         iterations: int,
         limit: float,
+        overhang: float = NO_LIMIT,
     ) -> WindowOutcome | None:
         """The window test of a view with odometry ``odometry`` (REP-103) and scan ``points``; None: no window.
 
@@ -107,7 +109,8 @@ class OdometryWindow:
         ``refine`` / ``costs``: the kernels :func:`~albot1.methods.albot1.mapping.pose_kernels.refine_pose`
         and :func:`~albot1.methods.albot1.mapping.ambiguity.measurement_costs` (compiled or not);
         ``sigmas``: line, point and scan sigma, Huber threshold (sigmas), scan gate; ``limit``: the
-        chi-square quantile (:func:`~albot1.methods.albot1.mapping.ambiguity.threshold`).
+        chi-square quantile (:func:`~albot1.methods.albot1.mapping.ambiguity.threshold`); ``overhang``: the
+        overlap rule (:mod:`~albot1.methods.albot1.mapping.overlap`).
         """
         if self.size < 2 or len(self._records) < 2 or points.shape[0] == 0:
             return None
@@ -134,10 +137,22 @@ class OdometryWindow:
             huber,
             gate,
             iterations,
+            overhang,
         )
         poses = np.array([(x, y, phi), prediction], dtype=float)
         c, per_surface, matched_cost, terms, independent = costs(
-            poses, _NO_LANDMARKS, _NO_LANDMARKS, _NO_POINT_OK, points, oldest.ref, line, point, scan, huber, gate
+            poses,
+            _NO_LANDMARKS,
+            _NO_LANDMARKS,
+            _NO_POINT_OK,
+            points,
+            oldest.ref,
+            line,
+            point,
+            scan,
+            huber,
+            gate,
+            overhang,
         )
         matched = float(np.sum(per_surface)) / points.shape[0]  # type: ignore[call-overload]
         test = likelihood_ratio(float(c[0]), float(c[1]), float(matched_cost), int(terms), int(independent), limit)

@@ -226,7 +226,29 @@ def _refine_args() -> Iterator[tuple[Any, ...]]:
         ref = np.ascontiguousarray(ref_view.surfaces)
         starts = np.ascontiguousarray(rng.normal(0.0, [0.1, 0.1, 0.05], (3, 3)))
         for prior in ((0.0, 0.0, 0.0, 0.0, 0.0), (0.05, -0.02, 0.03, 400.0, 3000.0)):
-            yield (starts, lm_view, lm_map, ok, points, ref, *prior, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
+            yield (starts, lm_view, lm_map, ok, points, ref, *prior, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
+        # The overlap rule (mapping/overlap.py) on: points beyond a surface's end are matched elsewhere or not at all.
+        for overhang in (0.0, 0.1):
+            yield (
+                starts,
+                lm_view,
+                lm_map,
+                ok,
+                points,
+                ref,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.05,
+                0.1,
+                0.05,
+                2.0,
+                0.5,
+                8,
+                overhang,
+            )
         yield (
             starts[:1],
             lm_view[:0],
@@ -245,6 +267,7 @@ def _refine_args() -> Iterator[tuple[Any, ...]]:
             2.0,
             0.5,
             8,
+            math.inf,
         )
 
 
@@ -252,7 +275,7 @@ def _measurement_costs_args() -> Iterator[tuple[Any, ...]]:
     """The refine cases' views, costed at their starts (the ambiguity test's fitted and predicted poses)."""
     for args in _refine_args():
         starts, lm_view, lm_map, ok, points, ref = args[:6]
-        yield (starts, lm_view, lm_map, ok, points, ref, *args[11:16])
+        yield (starts, lm_view, lm_map, ok, points, ref, *args[11:16], args[17])
 
 
 def _screen_args() -> Iterator[tuple[Any, ...]]:

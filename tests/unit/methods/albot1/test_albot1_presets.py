@@ -53,6 +53,8 @@ OLD_DEFAULT: dict[str, Any] = {
     "scan_sigma_m": 0.05,
     "scan_gate_m": 0.5,
     "scan_beam_stride": 2,
+    "scan_overlap": "gate",
+    "scan_overhang_m": 0.0,
     "odometry_prior": "off",
     "prior_xy_m_per_sqrt_m": 0.05,
     "prior_deg_per_sqrt_m": 2.0,
@@ -91,6 +93,8 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "degenerate_sd_m": 0.05,
         "gate_probability": 0.0,
         "ambiguity_probability": 0.99,
+        "scan_overlap": "surface",
+        "scan_overhang_m": 0.05,
     },
 }
 

@@ -41,7 +41,9 @@ def plus_params(**changes: float) -> object:
 def test_measurement_costs_counts_every_point_on_its_surface_and_costs_a_sideways_shift_exactly() -> None:
     points = wall_points(ROOM, 11)
     poses = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0]])
-    costs, per_surface, matched, terms, independent = measurement_costs(poses, *NO_LANDMARKS, points, ROOM, *SIGMAS)
+    costs, per_surface, matched, terms, independent = measurement_costs(
+        poses, *NO_LANDMARKS, points, ROOM, *SIGMAS, math.inf
+    )
     assert (terms, independent) == (33, 6)
     assert per_surface.tolist() == [11, 11, 11]
     assert costs[0] == 0.0 and matched == 0.0
@@ -52,7 +54,9 @@ def test_measurement_costs_counts_every_point_on_its_surface_and_costs_a_sideway
 
 def test_a_point_with_no_surface_in_reach_costs_the_gate_and_is_not_matched() -> None:
     points = np.vstack([wall_points(ROOM[:1], 5), [[0.0, 20.0]]])  # the last point: 15 m beyond the back wall
-    costs, per_surface, matched, *_ = measurement_costs(np.zeros((1, 3)), *NO_LANDMARKS, points, ROOM, *SIGMAS)
+    costs, per_surface, matched, *_ = measurement_costs(
+        np.zeros((1, 3)), *NO_LANDMARKS, points, ROOM, *SIGMAS, math.inf
+    )
     assert per_surface.tolist() == [5, 0, 0] and matched == 0.0
     assert costs[0] == pytest.approx(2.0 * (10.0 - 0.5 * 2.0))  # Huber at 10 sigmas (0.5 m / 0.05 m)
 

@@ -38,7 +38,7 @@ VIEW_SURFACES = np.array(
 )
 
 
-def solve(starts, lm_view, lm_map, ok, points, ref, *, prior=(0.0, 0.0, 0.0), info=(0.0, 0.0)):
+def solve(starts, lm_view, lm_map, ok, points, ref, *, prior=(0.0, 0.0, 0.0), info=(0.0, 0.0), overhang=math.inf):
     return KERNELS.refine_pose(
         np.ascontiguousarray(starts, dtype=float),
         np.ascontiguousarray(lm_view, dtype=float).reshape(-1, 4),
@@ -54,6 +54,7 @@ def solve(starts, lm_view, lm_map, ok, points, ref, *, prior=(0.0, 0.0, 0.0), in
         2.0,
         0.5,
         20,
+        overhang,
     )
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -16,7 +18,7 @@ POINTS = np.ascontiguousarray(np.vstack([np.column_stack([np.linspace(-2, 2, 9),
 
 def _solve(kernel, starts: np.ndarray) -> tuple[float, float, float, np.ndarray]:
     ok = np.ones((2, 2), dtype=np.bool_)
-    return kernel(starts, VIEW, MAP, ok, POINTS, MAP, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8)
+    return kernel(starts, VIEW, MAP, ok, POINTS, MAP, 0.0, 0.0, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
 
 
 def test_a_repeated_start_is_found_only_after_its_first_occurrence() -> None:
