@@ -1,9 +1,9 @@
 """How much to trust the odometry of a node step, learnt from its disagreement with the scan matches.
 
-Off in the default preset (``odometry_trust``; docs/baselines.md, gtsam-graph,
+On in the default preset (``odometry_trust``; docs/baselines.md, gtsam-graph,
 "the accumulated bias and a weight floor": no setting measured keeps
-fr-clinic's first return and meets the held-out targets at once); when on,
-as separate odometry factors (:class:`OdometryFactors`,
+fr-clinic's first return and meets the held-out targets at once), as
+separate odometry factors (:class:`OdometryFactors`,
 ``odometry_trust_factors``). The fused edge
 (:meth:`OdometryTrust.fuse`) is the earlier variant, whose result on short
 logs swung with when fusion starts (docs/baselines.md, gtsam-graph,
