@@ -153,9 +153,7 @@ class OdometryTrust:
         own = self._kinds[kind]
         if not math.isfinite(self.turn_rad) or len(own) < self.kind_min_steps:
             return self._estimate(self._pooled, match_variances, self.min_variance_ratio)
-        return np.maximum(
-            self._estimate(self._pooled, match_variances, 0.0), self._estimate(own, match_variances, 0.0)
-        )
+        return np.maximum(self._estimate(self._pooled, match_variances, 0.0), self._estimate(own, match_variances, 0.0))
 
     def _estimate(self, history: deque[FloatArray], match_variances: FloatArray, floor: float) -> FloatArray:
         """:meth:`variances` learnt from ``history`` alone, a trusted one never below ``floor`` times the match's."""
