@@ -59,6 +59,13 @@ first 1500 scans) where the heading alone changed nothing. Finally one node's
 fusion is gated: when the odometry step and the match disagree by more than
 their joint covariance allows (Mahalanobis distance squared above
 ``gate_chi2``), one of them is an outlier and the match stands, as before.
+
+Optionally (``turn_rad``, off in the default preset) turns and straight
+steps are learnt apart (:meth:`OdometryTrust.kind`): a step is then judged
+with the larger of the pooled variance and its own kind's, without the
+floor once its kind has ``kind_min_steps`` steps. It keeps fr-clinic's
+return without the floor, but measured no better everywhere
+(docs/baselines.md, gtsam-graph, "turns learnt apart").
 """
 
 from __future__ import annotations
