@@ -102,6 +102,14 @@ class GtsamGraphConfig(BaseModel):
     odometry_trust_min_variance_ratio: float = Field(
         ge=0, description="... a trusted component's variance never below this times its match's (1: never more weight)"
     )
+    odometry_trust_turn_deg: float = Field(
+        gt=0,
+        description="... steps whose odometry turns more than this learnt and judged apart from the others "
+        "(odometry_trust.OdometryTrust.kind; inf: one population)",
+    )
+    odometry_trust_kind_min_steps: int = Field(
+        ge=2, description="... a kind's own history vetoes (and lifts the floor) once it holds this many steps"
+    )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
         gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"

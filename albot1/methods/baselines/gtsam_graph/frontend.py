@@ -78,6 +78,8 @@ class FrontEnd:
             (0, 1, 2) if config.odometry_trust_translation else (2,),
             config.odometry_trust_bias_horizon,
             config.odometry_trust_min_variance_ratio,
+            math.radians(config.odometry_trust_turn_deg),
+            config.odometry_trust_kind_min_steps,
         )
         self._odometry_factors = OdometryFactors(self._odometry_trust)
         # Odometry factors judged at the latest node (``odometry_trust_factors``), for the back end to add with it.

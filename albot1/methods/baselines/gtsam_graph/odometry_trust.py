@@ -1,9 +1,9 @@
 """How much to trust the odometry of a node step, learnt from its disagreement with the scan matches.
 
-Off in the default preset (``odometry_trust``; docs/baselines.md, gtsam-graph,
+On in the default preset (``odometry_trust``; docs/baselines.md, gtsam-graph,
 "the accumulated bias and a weight floor": no setting measured keeps
-fr-clinic's first return and meets the held-out targets at once); when on,
-as separate odometry factors (:class:`OdometryFactors`,
+fr-clinic's first return and meets the held-out targets at once), as
+separate odometry factors (:class:`OdometryFactors`,
 ``odometry_trust_factors``). The fused edge
 (:meth:`OdometryTrust.fuse`) is the earlier variant, whose result on short
 logs swung with when fusion starts (docs/baselines.md, gtsam-graph,
@@ -59,6 +59,13 @@ first 1500 scans) where the heading alone changed nothing. Finally one node's
 fusion is gated: when the odometry step and the match disagree by more than
 their joint covariance allows (Mahalanobis distance squared above
 ``gate_chi2``), one of them is an outlier and the match stands, as before.
+
+Optionally (``turn_rad``, off in the default preset) turns and straight
+steps are learnt apart (:meth:`OdometryTrust.kind`): a step is then judged
+with the larger of the pooled variance and its own kind's, without the
+floor once its kind has ``kind_min_steps`` steps. It keeps fr-clinic's
+return without the floor, but measured no better everywhere
+(docs/baselines.md, gtsam-graph, "turns learnt apart").
 """
 
 from __future__ import annotations
@@ -101,11 +108,18 @@ class OdometryTrust:
         components: tuple[int, ...] = (0, 1, 2),
         bias_horizon: int = 0,
         min_variance_ratio: float = 0.0,
+        turn_rad: float = math.inf,
+        kind_min_steps: int = 10,
     ) -> None:
         """``components``: which of x (0), y (1), heading (2) may be fused at all; ``bias_horizon``: the number of
         steps over which a median disagreement too small for the bias test is counted as accumulating (0: not);
-        ``min_variance_ratio``: a trusted component's variance is at least this times its match's."""
-        self._history: deque[FloatArray] = deque(maxlen=window)
+        ``min_variance_ratio``: a trusted component's variance is at least this times its match's; ``turn_rad``:
+        steps whose odometry turns more than this are learnt and judged apart from the others (:meth:`kind`;
+        ``inf``: one population)."""
+        self._pooled: deque[FloatArray] = deque(maxlen=window)
+        self._kinds: tuple[deque[FloatArray], deque[FloatArray]] = (deque(maxlen=window), deque(maxlen=window))
+        self.turn_rad = turn_rad
+        self.kind_min_steps = kind_min_steps
         self.bias_horizon = bias_horizon
         self.min_variance_ratio = min_variance_ratio
         self._min_history = min(window, min_history(bias_z))
@@ -113,21 +127,45 @@ class OdometryTrust:
         self.gate_chi2 = gate_chi2
         self.components = components
 
-    def add(self, odometry_step: FloatArray, match_step: FloatArray) -> None:
-        """Record one matched node step's innovation (the match seen from the odometry step)."""
-        self._history.append(innovation(odometry_step, match_step))
+    def kind(self, odometry_step: FloatArray) -> int:
+        """1 for a turn (the odometry's heading step beyond ``turn_rad``), else 0: the population a step belongs to.
 
-    def variances(self, match_variances: FloatArray) -> FloatArray | None:
+        A wheel odometry's heading error is a different population in turns
+        than on straight steps (slip grows with the turn), and a turn is rare
+        on most routes: learnt together, the straight steps' spread sets the
+        turns' weight (fr-clinic: innovation spread 0.26 deg on steps under
+        2 deg, 0.6-1.0 deg beyond half a node's rotation step, against the
+        matches' 0.51 deg). Each step is therefore learnt and judged with
+        the history of its own kind (docs/baselines.md, gtsam-graph, "turns
+        learnt apart").
+        """
+        return 1 if abs(float(odometry_step[2])) > self.turn_rad else 0
+
+    def add(self, odometry_step: FloatArray, match_step: FloatArray) -> None:
+        """Record one matched node step's innovation (the match seen from the odometry step), with its kind."""
+        d = innovation(odometry_step, match_step)
+        self._pooled.append(d)
+        self._kinds[self.kind(odometry_step)].append(d)
+
+    def variances(self, match_variances: FloatArray, kind: int = 0) -> FloatArray | None:
         """Per component (x, y, theta) the odometry step's variance, ``inf`` where not trusted; None: too few steps.
 
         ``match_variances`` are the diagonal of the match edge's covariance
-        (what the match claims of itself). Not trusted: no spread, a biased
-        median, or a variance not below the match's (module docstring).
+        (what the match claims of itself), ``kind`` the step's population
+        (:meth:`kind`). Not trusted: no spread, a biased median, or a
+        variance not below the match's (module docstring).
         """
-        n = len(self._history)
-        if n < self._min_history:
+        if len(self._pooled) < self._min_history:
             return None
-        h = np.asarray(self._history, dtype=float)
+        own = self._kinds[kind]
+        if not math.isfinite(self.turn_rad) or len(own) < self.kind_min_steps:
+            return self._estimate(self._pooled, match_variances, self.min_variance_ratio)
+        return np.maximum(self._estimate(self._pooled, match_variances, 0.0), self._estimate(own, match_variances, 0.0))
+
+    def _estimate(self, history: deque[FloatArray], match_variances: FloatArray, floor: float) -> FloatArray:
+        """:meth:`variances` learnt from ``history`` alone, a trusted one never below ``floor`` times the match's."""
+        n = len(history)
+        h = np.asarray(history, dtype=float)
         centre = np.median(h, axis=0)
         spread = MAD_TO_SIGMA * np.median(np.abs(h - centre), axis=0)
         out = np.full(3, np.inf)
@@ -141,7 +179,7 @@ class OdometryTrust:
             variance += self.bias_horizon * squared_bias(float(centre[k]), float(spread[k]), n)
             if variance < float(match_variances[k]):
                 # the odometry is the better of the two here (else: the match alone, as tuned)
-                out[k] = max(variance, self.min_variance_ratio * float(match_variances[k]))
+                out[k] = max(variance, floor * float(match_variances[k]))
         return out
 
     def fuse(
@@ -175,7 +213,7 @@ class OdometryTrust:
         odometry step and the match disagree beyond ``gate_chi2`` on the
         trusted components (their joint covariance).
         """
-        variances = self.variances(np.diag(match_covariance))
+        variances = self.variances(np.diag(match_covariance), self.kind(odometry_step))
         if variances is None or not np.isfinite(variances).any():
             return None
         trusted = np.isfinite(variances)
