@@ -14,10 +14,14 @@ tests name the kernel whose sample no longer fits.
 A cold warm-up (this code version's first on the machine) spreads the
 compile over processes, as numba compiles under one lock per process; see
 :func:`warm_up` and ``docs/albot1-mapper.md`` ("Kernels", "Compile time").
+Several warm-ups in a row (the bench's forkserver warms every preset of
+every method) balance better as one: inside :func:`together` they only note
+their kernels, and one warm-up compiles them all on leaving it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import inspect
 import math
@@ -198,8 +202,71 @@ def warm_up(
     ``announce`` receives a line before and after a real compilation, none
     for a cache load. ``skip``: kernels the caller's configuration never
     calls (``MappingKernels.not_called``), neither compiled nor loaded.
+    Inside :func:`together` the kernels are only noted, and compiled on leaving it.
     """
     calls = [call for call in sample_calls(*kernel_sets) if call[0] not in skip]
+    if _batch is not None:
+        _batch.add(kernel_sets, calls, announce)
+        return
+    _warm(kernel_sets, calls, announce)
+
+
+class _Batch:
+    """The kernels of the warm-ups made inside :func:`together`: each (kernel, sample) once, in first-seen order."""
+
+    def __init__(self) -> None:
+        self.kernel_sets: dict[type, object] = {}
+        self.calls: dict[tuple[str, int, int], tuple[str, Callable[..., Any], tuple[Any, ...]]] = {}
+        self.announce: Callable[[str], None] | None = None
+
+    def add(
+        self,
+        kernel_sets: tuple[object, ...],
+        calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]],
+        announce: Callable[[str], None] | None,
+    ) -> None:
+        for kernels in kernel_sets:
+            self.kernel_sets.setdefault(type(kernels), kernels)
+        seen: dict[tuple[str, int], int] = {}
+        for name, kernel, args in calls:  # the same kernel's n-th sample: the same argument types in every warm-up
+            n = seen[name, id(kernel)] = seen.get((name, id(kernel)), -1) + 1
+            self.calls.setdefault((name, id(kernel), n), (name, kernel, args))
+        self.announce = self.announce or announce
+
+
+_batch: _Batch | None = None
+
+
+@contextlib.contextmanager
+def together() -> Iterator[None]:
+    """Make the warm-ups called inside one: they note their kernels, which are all compiled when the block ends.
+
+    Why: each cold warm-up ends when its slowest process does, so warm-ups in
+    a row (the thesis kernels, then Albot1+'s, then the places layer's, as
+    the bench's forkserver warms every preset of both methods) each wait for
+    their own dearest kernel while the other process idles; one warm-up over
+    the union keeps both busy to the end. Nested blocks join the outermost.
+    Nothing is compiled when the block raises.
+    """
+    global _batch
+    if _batch is not None:
+        yield
+        return
+    batch = _batch = _Batch()
+    try:
+        yield
+    finally:
+        _batch = None
+    if batch.calls:
+        _warm(tuple(batch.kernel_sets.values()), list(batch.calls.values()), batch.announce)
+
+
+def _warm(
+    kernel_sets: tuple[object, ...],
+    calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]],
+    announce: Callable[[str], None] | None,
+) -> None:
+    """:func:`warm_up` of ``calls`` (the samples of ``kernel_sets`` that are to be called)."""
     kernels = {name: kernel for name, kernel, _ in calls}
     cold = sorted(
         (name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -compile_cost(n, kernels[n])
