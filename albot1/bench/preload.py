@@ -127,9 +127,15 @@ def _warm_ups(methods: list[str], registry: MethodRegistry | None, failures: lis
                     stack.enter_context(together())
             for method in methods:
                 _warm_up(method, registry)
-    except Exception:  # noqa: BLE001 -- not swallowed: the same failure is reported below under its method
+    except Exception as exc:  # noqa: BLE001 -- reported: under its method below, or as itself if it does not recur
+        reported = len(failures)
         for method in methods:
             _attempt(f"method {method}: warm-up", functools.partial(_warm_up, method, registry), failures)
+        if len(failures) == reported:
+            failures.append(
+                f"methods {', '.join(methods)}: warm-up together: {type(exc).__name__}: {exc} "
+                "(each method's warm-up alone then succeeded)"
+            )
 
 
 def _warm_up(method: str, registry: MethodRegistry | None) -> None:

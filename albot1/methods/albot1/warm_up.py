@@ -205,8 +205,8 @@ def warm_up(
     Inside :func:`together` the kernels are only noted, and compiled on leaving it.
     """
     calls = [call for call in sample_calls(*kernel_sets) if call[0] not in skip]
-    if _batch is not None:
-        _batch.add(kernel_sets, calls, announce)
+    if _open.batch is not None:
+        _open.batch.add(kernel_sets, calls, announce)
         return
     _warm(kernel_sets, calls, announce)
 
@@ -234,7 +234,13 @@ class _Batch:
         self.announce = self.announce or announce
 
 
-_batch: _Batch | None = None
+class _Open(threading.local):
+    """This thread's open :func:`together` block (a warm-up in another thread is not taken into it)."""
+
+    batch: _Batch | None = None
+
+
+_open = _Open()
 
 
 @contextlib.contextmanager
@@ -245,18 +251,18 @@ def together() -> Iterator[None]:
     a row (the thesis kernels, then Albot1+'s, then the places layer's, as
     the bench's forkserver warms every preset of both methods) each wait for
     their own dearest kernel while the other process idles; one warm-up over
-    the union keeps both busy to the end. Nested blocks join the outermost.
+    the union keeps both busy to the end. Nested blocks join the outermost; a
+    block covers the warm-ups of its own thread.
     Nothing is compiled when the block raises.
     """
-    global _batch
-    if _batch is not None:
+    if _open.batch is not None:
         yield
         return
-    batch = _batch = _Batch()
+    batch = _open.batch = _Batch()
     try:
         yield
     finally:
-        _batch = None
+        _open.batch = None
     if batch.calls:
         _warm(tuple(batch.kernel_sets.values()), list(batch.calls.values()), batch.announce)
 

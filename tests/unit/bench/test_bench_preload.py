@@ -223,3 +223,26 @@ def test_a_failed_warm_up_together_is_reported_under_its_own_method(
     preload._warm_ups(["a", "b", "c"], None, failures)
     assert events == ["open a", "open c", "warm a", "warm b", "close c", "close a", "warm a", "warm b", "warm c"]
     assert failures == ["method b: warm-up: RuntimeError: b does not compile"]
+
+
+def test_a_failure_of_the_joint_warm_up_alone_is_still_reported(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Nothing swallowed: when the one-by-one warm-ups all succeed, the joint pass's error is reported as itself."""
+    events: list[str] = []
+    _fake_methods(preload, monkeypatch, events, failing=set())
+    failed_once: list[str] = []
+
+    def close_failing_once(self: _Together, *exc: object) -> None:
+        self.events.append(f"close {self.name}")
+        if not failed_once:
+            failed_once.append(self.name)
+            raise RuntimeError("helper lost")
+
+    monkeypatch.setattr(_Together, "__exit__", close_failing_once)
+    failures: list[str] = []
+    preload._warm_ups(["a", "c"], None, failures)
+    assert events == ["open a", "open c", "warm a", "warm c", "close c", "close a", "warm a", "warm c"]
+    assert failures == [
+        "methods a, c: warm-up together: RuntimeError: helper lost (each method's warm-up alone then succeeded)"
+    ]

@@ -273,3 +273,21 @@ def test_a_together_block_that_raises_compiles_nothing_and_ends(monkeypatch: pyt
     assert warms == []
     warm_up.warm_up((PlacesKernels(),))
     assert len(warms) == 1
+
+
+def test_a_together_block_takes_only_its_own_thread_s_warm_ups(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A warm-up in another thread (a run's own) compiles at once, never left to a block it does not know of."""
+    import threading
+
+    from albot1.methods.albot1 import warm_up
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+
+    warms = _recorded_warms(monkeypatch)
+    with warm_up.together():
+        other = threading.Thread(target=warm_up.warm_up, args=((PlacesKernels(),),))
+        other.start()
+        other.join()
+        assert len(warms) == 1
+        warm_up.warm_up((PlacesKernels(),))
+        assert len(warms) == 1
+    assert len(warms) == 2
