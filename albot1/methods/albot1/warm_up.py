@@ -33,8 +33,9 @@ import time
 from collections.abc import Callable, Collection, Iterator
 from multiprocessing.process import BaseProcess
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -175,10 +176,10 @@ def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) ->
 def _first_claims(claims: Path, helpers: list[BaseProcess], claimed: int, wait_s: float = 0.5) -> None:
     """Wait (at most ``wait_s``) until ``claimed`` kernels are claimed (each helper's first): the dearest go to them.
 
-    This process has already paid numba's set-up and a kernel before the
-    fork; were it also to claim the dearest kernel (a fork starts in about a
-    millisecond, this process goes on at once), it would finish last. With
-    the thesis kernels: ``update_surfaces`` alone takes as long as the rest.
+    This process has already paid numba's set-up before the fork; were it
+    also to claim the dearest kernel (a fork starts in about a millisecond,
+    this process goes on at once), it would finish last. With the thesis
+    kernels: ``update_surfaces`` alone takes as long as the rest.
     """
     deadline = time.perf_counter() + wait_s
     while time.perf_counter() < deadline and any(helper.is_alive() for helper in helpers):
@@ -282,9 +283,8 @@ def _warm(
     start = time.perf_counter()
     if cold:
         with tempfile.TemporaryDirectory(prefix="albot1-compile-") as folder:
-            # The cheapest first, here: it pays numba's one-time set-up, which forked helpers then inherit.
-            _compile(Path(folder), calls, cold[-1:])
-            helpers = _helpers(Path(folder), kernel_sets, cold[:-1])
+            _set_up_numba()  # before the fork: forked helpers inherit it
+            helpers = _helpers(Path(folder), kernel_sets, cold)
             try:
                 _compile(Path(folder), calls, cold)
             except BaseException:  # a failed compile or an interrupt: the helpers' work is no longer wanted
@@ -298,6 +298,28 @@ def _warm(
         kernel(*args)
     if cold and announce is not None:
         announce(f"albot1: kernels compiled in {time.perf_counter() - start:.1f} s")
+
+
+def _copy(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    out = np.empty(a.shape[0])
+    for i in range(a.shape[0]):
+        out[i] = a[i]
+    return out
+
+
+def _set_up_numba() -> None:
+    """Pay numba's one-time set-up (its typing and target registries, LLVM, arrays) with a throw-away function.
+
+    Why not with the cheapest kernel, as before: a forked helper starts when
+    this returns, and the dearest kernel goes to it, so whatever is compiled
+    here lies on the longest path of a cold warm-up; this function (not
+    cached, nothing written) costs less than any kernel and leaves about as
+    little for each process to set up. Measured with
+    ``benchmarks/compile_cost.py warm-up thesis``: the longest path 4.8 ->
+    4.5-4.6 CPU-s (``docs/albot1-mapper.md``, "Compile time").
+    """
+    copy = cast(Callable[[NDArray[np.float64]], NDArray[np.float64]], numba.njit(_copy))
+    copy(np.zeros(1))
 
 
 def _cold(kernel: Callable[..., Any]) -> bool:

@@ -291,3 +291,17 @@ def test_a_together_block_takes_only_its_own_thread_s_warm_ups(monkeypatch: pyte
         warm_up.warm_up((PlacesKernels(),))
         assert len(warms) == 1
     assert len(warms) == 2
+
+
+_SET_UP = """
+import json
+from albot1.methods.albot1 import compiled, warm_up
+before = sorted(str(p) for p in compiled.CACHE_DIR.rglob("*"))
+warm_up._set_up_numba()
+print(json.dumps({"cache": sorted(str(p) for p in compiled.CACHE_DIR.rglob("*")) == before}))
+"""
+
+
+def test_numba_s_set_up_before_the_fork_writes_nothing_to_the_kernel_cache(tmp_path: Path) -> None:
+    """The throw-away function that pays numba's set-up is not a kernel: no cache entry, nothing to invalidate."""
+    assert json.loads(_python(_SET_UP, str(tmp_path))) == {"cache": True}
