@@ -18,6 +18,7 @@ of a method left out imports and warms it up itself).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib
 import logging
@@ -95,11 +96,46 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
         registry = method_registry()
     except Exception as exc:  # noqa: BLE001 -- an installed plugin declares a bad entry point
         failures.append(f"method registry: {type(exc).__name__}: {exc}")
+    warmed: list[str] = []
     for spec in registry or ():
         if (methods is None or spec.name in methods) and spec.available():
             _attempt(f"method {spec.name} ({spec.target})", spec.load_class, failures)
-            _attempt(f"method {spec.name}: warm-up", functools.partial(_warm_up, spec.name, registry), failures)
+            warmed.append(spec.name)
+    _warm_ups(warmed, registry, failures)
     return failures
+
+
+def _warm_ups(methods: list[str], registry: MethodRegistry | None, failures: list[str]) -> None:
+    """Every method's warm-up (:func:`_warm_up`), compiled together where the classes offer it, else one by one.
+
+    A class may offer ``warm_up_together()``, a context manager inside which
+    its warm-ups only note their kernels and which compiles them all when
+    it ends (:func:`albot1.methods.albot1.warm_up.together`): one cold compile
+    of every preset of ``albot1`` and ``albot1-places`` keeps the cores busy
+    to the end, where a warm-up per preset waits for its own dearest kernel
+    each time. Should anything in it fail, the warm-ups run again one by one,
+    so that each failure is reported under its own method (what was compiled
+    before the failure is loaded from numba's cache, not compiled again).
+    """
+    from albot1.methods.registry import get_method
+
+    try:
+        with contextlib.ExitStack() as stack:
+            for method in methods:
+                together = getattr(get_method(method, registry).load_class(), "warm_up_together", None)
+                if together is not None:
+                    stack.enter_context(together())
+            for method in methods:
+                _warm_up(method, registry)
+    except Exception as exc:  # noqa: BLE001 -- reported: under its method below, or as itself if it does not recur
+        reported = len(failures)
+        for method in methods:
+            _attempt(f"method {method}: warm-up", functools.partial(_warm_up, method, registry), failures)
+        if len(failures) == reported:
+            failures.append(
+                f"methods {', '.join(methods)}: warm-up together: {type(exc).__name__}: {exc} "
+                "(each method's warm-up alone then succeeded)"
+            )
 
 
 def _warm_up(method: str, registry: MethodRegistry | None) -> None:

@@ -14,10 +14,14 @@ tests name the kernel whose sample no longer fits.
 A cold warm-up (this code version's first on the machine) spreads the
 compile over processes, as numba compiles under one lock per process; see
 :func:`warm_up` and ``docs/albot1-mapper.md`` ("Kernels", "Compile time").
+Several warm-ups in a row (the bench's forkserver warms every preset of
+every method) balance better as one: inside :func:`together` they only note
+their kernels, and one warm-up compiles them all on leaving it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import inspect
 import math
@@ -29,8 +33,9 @@ import time
 from collections.abc import Callable, Collection, Iterator
 from multiprocessing.process import BaseProcess
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -173,10 +178,10 @@ def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) ->
 def _first_claims(claims: Path, helpers: list[BaseProcess], claimed: int, wait_s: float = 0.5) -> None:
     """Wait (at most ``wait_s``) until ``claimed`` kernels are claimed (each helper's first): the dearest go to them.
 
-    This process has already paid numba's set-up and a kernel before the
-    fork; were it also to claim the dearest kernel (a fork starts in about a
-    millisecond, this process goes on at once), it would finish last. With
-    the thesis kernels: ``update_surfaces`` alone takes as long as the rest.
+    This process has already paid numba's set-up before the fork; were it
+    also to claim the dearest kernel (a fork starts in about a millisecond,
+    this process goes on at once), it would finish last. With the thesis
+    kernels: ``update_surfaces`` alone takes as long as the rest.
     """
     deadline = time.perf_counter() + wait_s
     while time.perf_counter() < deadline and any(helper.is_alive() for helper in helpers):
@@ -200,8 +205,77 @@ def warm_up(
     ``announce`` receives a line before and after a real compilation, none
     for a cache load. ``skip``: kernels the caller's configuration never
     calls (``MappingKernels.not_called``), neither compiled nor loaded.
+    Inside :func:`together` the kernels are only noted, and compiled on leaving it.
     """
     calls = [call for call in sample_calls(*kernel_sets) if call[0] not in skip]
+    if _open.batch is not None:
+        _open.batch.add(kernel_sets, calls, announce)
+        return
+    _warm(kernel_sets, calls, announce)
+
+
+class _Batch:
+    """The kernels of the warm-ups made inside :func:`together`: each (kernel, sample) once, in first-seen order."""
+
+    def __init__(self) -> None:
+        self.kernel_sets: dict[type, object] = {}
+        self.calls: dict[tuple[str, int, int], tuple[str, Callable[..., Any], tuple[Any, ...]]] = {}
+        self.announce: Callable[[str], None] | None = None
+
+    def add(
+        self,
+        kernel_sets: tuple[object, ...],
+        calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]],
+        announce: Callable[[str], None] | None,
+    ) -> None:
+        for kernels in kernel_sets:
+            self.kernel_sets.setdefault(type(kernels), kernels)
+        seen: dict[tuple[str, int], int] = {}
+        for name, kernel, args in calls:  # the same kernel's n-th sample: the same argument types in every warm-up
+            n = seen[name, id(kernel)] = seen.get((name, id(kernel)), -1) + 1
+            self.calls.setdefault((name, id(kernel), n), (name, kernel, args))
+        self.announce = self.announce or announce
+
+
+class _Open(threading.local):
+    """This thread's open :func:`together` block (a warm-up in another thread is not taken into it)."""
+
+    batch: _Batch | None = None
+
+
+_open = _Open()
+
+
+@contextlib.contextmanager
+def together() -> Iterator[None]:
+    """Make the warm-ups called inside one: they note their kernels, which are all compiled when the block ends.
+
+    Why: each cold warm-up ends when its slowest process does, so warm-ups in
+    a row (the thesis kernels, then Albot1+'s, then the places layer's, as
+    the bench's forkserver warms every preset of both methods) each wait for
+    their own dearest kernel while the other process idles; one warm-up over
+    the union keeps both busy to the end. Nested blocks join the outermost; a
+    block covers the warm-ups of its own thread.
+    Nothing is compiled when the block raises.
+    """
+    if _open.batch is not None:
+        yield
+        return
+    batch = _open.batch = _Batch()
+    try:
+        yield
+    finally:
+        _open.batch = None
+    if batch.calls:
+        _warm(tuple(batch.kernel_sets.values()), list(batch.calls.values()), batch.announce)
+
+
+def _warm(
+    kernel_sets: tuple[object, ...],
+    calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]],
+    announce: Callable[[str], None] | None,
+) -> None:
+    """:func:`warm_up` of ``calls`` (the samples of ``kernel_sets`` that are to be called)."""
     kernels = {name: kernel for name, kernel, _ in calls}
     cold = sorted(
         (name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -compile_cost(n, kernels[n])
@@ -211,9 +285,8 @@ def warm_up(
     start = time.perf_counter()
     if cold:
         with tempfile.TemporaryDirectory(prefix="albot1-compile-") as folder:
-            # The cheapest first, here: it pays numba's one-time set-up, which forked helpers then inherit.
-            _compile(Path(folder), calls, cold[-1:])
-            helpers = _helpers(Path(folder), kernel_sets, cold[:-1])
+            _set_up_numba()  # before the fork: forked helpers inherit it
+            helpers = _helpers(Path(folder), kernel_sets, cold)
             try:
                 _compile(Path(folder), calls, cold)
             except BaseException:  # a failed compile or an interrupt: the helpers' work is no longer wanted
@@ -227,6 +300,28 @@ def warm_up(
         kernel(*args)
     if cold and announce is not None:
         announce(f"albot1: kernels compiled in {time.perf_counter() - start:.1f} s")
+
+
+def _copy(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    out = np.empty(a.shape[0])
+    for i in range(a.shape[0]):
+        out[i] = a[i]
+    return out
+
+
+def _set_up_numba() -> None:
+    """Pay numba's one-time set-up (its typing and target registries, LLVM, arrays) with a throw-away function.
+
+    Why not with the cheapest kernel, as before: a forked helper starts when
+    this returns, and the dearest kernel goes to it, so whatever is compiled
+    here lies on the longest path of a cold warm-up; this function (not
+    cached, nothing written) costs less than any kernel and leaves about as
+    little for each process to set up. Measured with
+    ``benchmarks/compile_cost.py warm-up thesis``: the longest path 4.8 ->
+    4.5-4.6 CPU-s (``docs/albot1-mapper.md``, "Compile time").
+    """
+    copy = cast(Callable[[NDArray[np.float64]], NDArray[np.float64]], numba.njit(_copy))
+    copy(np.zeros(1))
 
 
 def _cold(kernel: Callable[..., Any]) -> bool:

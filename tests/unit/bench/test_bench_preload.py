@@ -165,3 +165,84 @@ def test_cell_threads_starting_the_server_at_once_leave_the_environment_as_it_wa
         thread.join()
     assert sorted(seen) == [f"m{i}" for i in range(8)]
     assert ENV not in os.environ
+
+
+class _Together:
+    """A class's ``warm_up_together`` that records when its block opens and closes."""
+
+    def __init__(self, name: str, events: list[str]) -> None:
+        self.name, self.events = name, events
+
+    def __enter__(self) -> None:
+        self.events.append(f"open {self.name}")
+
+    def __exit__(self, *exc: object) -> None:
+        self.events.append(f"close {self.name}")
+
+
+def _fake_methods(preload: ModuleType, monkeypatch: pytest.MonkeyPatch, events: list[str], failing: set[str]) -> None:
+    """Methods ``a`` (with ``warm_up_together``), ``b`` (without) and ``c`` (with); a warm-up of ``failing`` raises."""
+    from types import SimpleNamespace
+
+    def load(name: str) -> object:
+        if name == "b":
+            return SimpleNamespace()
+        return SimpleNamespace(warm_up_together=lambda: _Together(name, events))
+
+    def warm_up(name: str, registry: object) -> None:
+        events.append(f"warm {name}")
+        if name in failing:
+            raise RuntimeError(f"{name} does not compile")
+
+    monkeypatch.setattr(
+        "albot1.methods.registry.get_method",
+        lambda name, registry=None: SimpleNamespace(load_class=lambda: load(name)),
+    )
+    monkeypatch.setattr(preload, "_warm_up", warm_up)
+
+
+def test_the_methods_warm_ups_run_inside_every_class_s_together_block(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """One cold compile for every preset of every method: the blocks close after the last warm-up."""
+    events: list[str] = []
+    _fake_methods(preload, monkeypatch, events, failing=set())
+    failures: list[str] = []
+    preload._warm_ups(["a", "b", "c"], None, failures)
+    assert events == ["open a", "open c", "warm a", "warm b", "warm c", "close c", "close a"]
+    assert failures == []
+
+
+def test_a_failed_warm_up_together_is_reported_under_its_own_method(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The warm-ups then run again one by one, so each failure names its method and the others still warm up."""
+    events: list[str] = []
+    _fake_methods(preload, monkeypatch, events, failing={"b"})
+    failures: list[str] = []
+    preload._warm_ups(["a", "b", "c"], None, failures)
+    assert events == ["open a", "open c", "warm a", "warm b", "close c", "close a", "warm a", "warm b", "warm c"]
+    assert failures == ["method b: warm-up: RuntimeError: b does not compile"]
+
+
+def test_a_failure_of_the_joint_warm_up_alone_is_still_reported(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Nothing swallowed: when the one-by-one warm-ups all succeed, the joint pass's error is reported as itself."""
+    events: list[str] = []
+    _fake_methods(preload, monkeypatch, events, failing=set())
+    failed_once: list[str] = []
+
+    def close_failing_once(self: _Together, *exc: object) -> None:
+        self.events.append(f"close {self.name}")
+        if not failed_once:
+            failed_once.append(self.name)
+            raise RuntimeError("helper lost")
+
+    monkeypatch.setattr(_Together, "__exit__", close_failing_once)
+    failures: list[str] = []
+    preload._warm_ups(["a", "c"], None, failures)
+    assert events == ["open a", "open c", "warm a", "warm c", "close c", "close a", "warm a", "warm c"]
+    assert failures == [
+        "methods a, c: warm-up together: RuntimeError: helper lost (each method's warm-up alone then succeeded)"
+    ]

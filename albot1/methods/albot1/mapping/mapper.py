@@ -42,7 +42,7 @@ from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
 from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise
 from albot1.methods.albot1.perception.view import View, construct_view
-from albot1.methods.albot1.warm_up import warm_up
+from albot1.methods.albot1.warm_up import together, warm_up
 
 
 @dataclass(slots=True)
@@ -178,6 +178,9 @@ class Albot1Mapper:
     def kernels(self) -> tuple[PerceptionKernels, MappingKernels]:
         """The kernel sets this mapper calls (compiled unless ``accelerate`` is false)."""
         return self._pk, self._mk
+
+    #: warm-ups made inside it are compiled as one (the bench's forkserver warms every preset so)
+    warm_up_together = staticmethod(together)
 
     def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
         """Compile every kernel now (or load numba's cache), before the runner's timed loop (``Mapper.warm_up``)."""

@@ -52,7 +52,7 @@ from albot1.methods.albot1.places.matcher import confirm, structural, trigger_th
 from albot1.methods.albot1.places.memory import Place, PlaceNetwork, Visit, invert, same_surfaces
 from albot1.methods.albot1.places.navigation import Prediction, align_at_exit, nearest_prediction, predict
 from albot1.methods.albot1.places.network import network_files
-from albot1.methods.albot1.warm_up import warm_up
+from albot1.methods.albot1.warm_up import together, warm_up
 
 IntArray = NDArray[np.int64]
 
@@ -100,6 +100,9 @@ class Albot1PlacesMapper:
         self._crossings: list[dict[str, Any]] = []
         self._counts = PlacesCounts()
         self._n = 0
+
+    #: warm-ups made inside it are compiled as one (the bench's forkserver warms every preset so)
+    warm_up_together = staticmethod(together)
 
     def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
         """Compile every kernel, the places layer's too, before the timed loop (:meth:`Albot1Mapper.warm_up`)."""

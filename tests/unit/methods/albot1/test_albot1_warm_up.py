@@ -216,3 +216,92 @@ def test_a_process_that_claims_refine_pose_claims_measurement_costs_next(tmp_pat
     fresh.mkdir()
     warm_up._compile(fresh, calls, ["refine_pose"])
     assert order == ["refine_pose"]  # the follower only when it is among the names to compile
+
+
+def _recorded_warms(monkeypatch: pytest.MonkeyPatch) -> list[tuple[list[str], list[str], object]]:
+    """Replace the compiling part of ``warm_up`` by a record of (kernel set types, kernel names, announce) per call."""
+    from albot1.methods.albot1 import warm_up
+
+    warms: list[tuple[list[str], list[str], object]] = []
+
+    def record(kernel_sets: tuple[object, ...], calls: list[tuple[str, object, object]], announce: object) -> None:
+        warms.append(([type(k).__name__ for k in kernel_sets], [name for name, _, _ in calls], announce))
+
+    monkeypatch.setattr(warm_up, "_warm", record)
+    return warms
+
+
+def test_warm_ups_inside_together_are_compiled_once_as_their_union(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The forkserver's case: every preset of both methods, one cold compile over every kernel each needs, once each."""
+    from albot1.methods.albot1 import warm_up
+    from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+    from albot1.methods.albot1.perception.kernels import PerceptionKernels
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+
+    warms = _recorded_warms(monkeypatch)
+    thesis_skip = MappingKernels.not_called("")
+    with warm_up.together():
+        warm_up.warm_up((PerceptionKernels(), MappingKernels()), skip=thesis_skip)
+        with warm_up.together():  # nested: joins the outer block
+            warm_up.warm_up((PerceptionKernels(), MappingKernels()), print)
+        warm_up.warm_up((PerceptionKernels(), MappingKernels(), PlacesKernels()), skip=thesis_skip)
+        assert warms == []  # noted, not compiled
+    every = [name for k in (PerceptionKernels(), MappingKernels(), PlacesKernels()) for name in warm_up.kernel_names(k)]
+    thesis_first = [
+        name for name in every if name not in thesis_skip and name not in warm_up.kernel_names(PlacesKernels())
+    ]
+    assert warms == [
+        (
+            ["PerceptionKernels", "MappingKernels", "PlacesKernels"],
+            [*thesis_first, *thesis_skip, *warm_up.kernel_names(PlacesKernels())],
+            print,
+        )
+    ]
+    assert sorted(warms[0][1]) == sorted(every)
+    warm_up.warm_up((PlacesKernels(),))  # after the block: compiled at once again
+    assert warms[1] == (["PlacesKernels"], warm_up.kernel_names(PlacesKernels()), None)
+
+
+def test_a_together_block_that_raises_compiles_nothing_and_ends(monkeypatch: pytest.MonkeyPatch) -> None:
+    from albot1.methods.albot1 import warm_up
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+
+    warms = _recorded_warms(monkeypatch)
+    with pytest.raises(RuntimeError, match="boom"), warm_up.together():
+        warm_up.warm_up((PlacesKernels(),))
+        raise RuntimeError("boom")
+    assert warms == []
+    warm_up.warm_up((PlacesKernels(),))
+    assert len(warms) == 1
+
+
+def test_a_together_block_takes_only_its_own_thread_s_warm_ups(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A warm-up in another thread (a run's own) compiles at once, never left to a block it does not know of."""
+    import threading
+
+    from albot1.methods.albot1 import warm_up
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+
+    warms = _recorded_warms(monkeypatch)
+    with warm_up.together():
+        other = threading.Thread(target=warm_up.warm_up, args=((PlacesKernels(),),))
+        other.start()
+        other.join()
+        assert len(warms) == 1
+        warm_up.warm_up((PlacesKernels(),))
+        assert len(warms) == 1
+    assert len(warms) == 2
+
+
+_SET_UP = """
+import json
+from albot1.methods.albot1 import compiled, warm_up
+before = sorted(str(p) for p in compiled.CACHE_DIR.rglob("*"))
+warm_up._set_up_numba()
+print(json.dumps({"cache": sorted(str(p) for p in compiled.CACHE_DIR.rglob("*")) == before}))
+"""
+
+
+def test_numba_s_set_up_before_the_fork_writes_nothing_to_the_kernel_cache(tmp_path: Path) -> None:
+    """The throw-away function that pays numba's set-up is not a kernel: no cache entry, nothing to invalidate."""
+    assert json.loads(_python(_SET_UP, str(tmp_path))) == {"cache": True}
