@@ -90,14 +90,22 @@ def correlative_search(
     grid = np.stack(np.meshgrid(offsets, offsets, indexing="ij"), axis=-1).reshape(-1, 2)
     n_r = int(round(window.half_angle_rad / window.step_rad))
     thetas = guess[2] + np.arange(-n_r, n_r + 1) * window.step_rad
+    # The field read through its flat table, with one zero appended for every lookup that falls outside it.
+    n0, n1 = shape
+    flat = np.append(field.ravel(), 0.0)
     scores = np.empty((len(thetas), len(grid)))
     for r, theta in enumerate(thetas):
         c, s = math.cos(theta), math.sin(theta)
         moved = src @ np.array([[c, s], [-s, c]]) + guess[:2]
-        idx = np.floor((moved[None, :, :] + grid[:, None, :] - lo) / window.cell_m).astype(int)
-        inside = (idx[..., 0] >= 0) & (idx[..., 0] < shape[0]) & (idx[..., 1] >= 0) & (idx[..., 1] < shape[1])
-        vals = field[np.clip(idx[..., 0], 0, shape[0] - 1), np.clip(idx[..., 1], 0, shape[1] - 1)]
-        scores[r] = np.where(inside, vals, 0.0).sum(axis=1)
+        # Per axis, the same elementwise operations as on (x, y) pairs: the same cells.
+        i = np.floor((moved[None, :, 0] + grid[:, None, 0] - lo[0]) / window.cell_m).astype(np.int64)
+        j = np.floor((moved[None, :, 1] + grid[:, None, 1] - lo[1]) / window.cell_m).astype(np.int64)
+        # Unsigned, a negative index is huge: one comparison tests both ends.
+        inside = i.view(np.uint64) < n0
+        inside &= j.view(np.uint64) < n1
+        i *= n1
+        i += j
+        scores[r] = flat.take(np.where(inside, i, n0 * n1)).sum(axis=1)
     # Ties go to the pose nearest the guess: order by distance, argmax takes the first maximum.
     order = np.argsort(np.add.outer(np.abs(thetas - guess[2]), np.hypot(grid[:, 0], grid[:, 1])).ravel(), kind="stable")
     flat = scores.ravel()
