@@ -103,9 +103,15 @@ def correlative_search(
 
 
 def _pose_scores(
-    field: FloatArray, lo: FloatArray, src: FloatArray, guess: FloatArray, grid: FloatArray, thetas: FloatArray, cell_m: float
+    field: FloatArray,
+    lo: FloatArray,
+    src: FloatArray,
+    guess: FloatArray,
+    grid: FloatArray,
+    thetas: FloatArray,
+    cell_m: float,
 ) -> FloatArray:
-    """``scores[r, g]``: the sum of ``field`` at ``src`` moved by rotation ``thetas[r]`` and translation ``guess + grid[g]``.
+    """``scores[r, g]``: the sum of ``field`` at ``src`` turned by ``thetas[r]`` and moved to ``guess + grid[g]``.
 
     A point outside the field scores 0. The field is read through its flat
     table with one zero appended, where every outside lookup goes; unsigned,

@@ -107,7 +107,6 @@ def test_block_sums_are_the_clipped_lookups_bit_for_bit() -> None:
     np.testing.assert_array_equal(base, kept)  # the rotated points are left as they were
 
 
-
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_correlative_scores_are_the_bounds_tested_lookups_bit_for_bit(seed: int) -> None:
     """The flat lookups with one appended zero give the bits of a bounds test and a clipped 2-D lookup.
