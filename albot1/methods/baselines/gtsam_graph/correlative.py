@@ -236,8 +236,8 @@ def _zero_border(
     edge cells are zeros (:func:`branch_and_bound_search` pads the field by
     more than its widest block), so a clipped lookup reads 0.0 and so does the
     same lookup in the border: every sum of :func:`_sum_at` keeps its bits,
-    but no node needs clipping any more (the clipped path costs about three
-    times the plain one, and half a place-recognition search's nodes took it).
+    but no node needs clipping any more (the clipped path costs several
+    times the plain one, and about half of fr-clinic's search nodes took it).
     Past a size bound the tables are left as they are and the clipping stays.
     """
     shape = np.array(tables[0].shape)

@@ -233,12 +233,13 @@ def _linearise(
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Jacobian rows, point-to-line residuals and Cauchy weights of the matches within ``gate``.
 
-    Run once per ICP iteration, so it is written for few numpy calls (each
-    costs about as much as a hundred points' arithmetic): one gather of
-    points and normals together, the moved points computed once, and no
-    selection when every point found a neighbour within the gate. The
-    arithmetic is the same elementwise operations in the same order, so the
+    Run once per ICP iteration, with few numpy calls: one gather of points
+    and normals together, the moved points computed once, and no selection
+    when every point found a neighbour within the gate. The arithmetic is
+    the same elementwise operations in the same order as before, so the
     bits are too (the sha256 fingerprints of the method's poses and maps).
+    The saving is small (replaying intel's registrations: within the noise);
+    the k-d tree query is most of an iteration (docs/baselines.md, "Cost").
     """
     rot = rotate(src, pose[2])
     moved = rot + pose[:2]
