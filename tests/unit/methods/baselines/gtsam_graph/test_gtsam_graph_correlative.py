@@ -5,11 +5,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from albot1.geometry import se2
+from albot1.methods.baselines.gtsam_graph import correlative
 from albot1.methods.baselines.gtsam_graph.correlative import (
     GlobalWindow,
+    _pooled_fields,
+    _pose_scores,
     _sum_at,
+    _zero_border,
     branch_and_bound_search,
     likelihood_field,
 )
@@ -100,3 +105,76 @@ def test_block_sums_are_the_clipped_lookups_bit_for_bit() -> None:
     for axis, last in enumerate((36, 52)):  # every edge was reached, so the clipping was exercised
         assert (idx[..., axis] == 0).any() and (idx[..., axis] == last).any()
     np.testing.assert_array_equal(base, kept)  # the rotated points are left as they were
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_correlative_scores_are_the_bounds_tested_lookups_bit_for_bit(seed: int) -> None:
+    """The flat lookups with one appended zero give the bits of a bounds test and a clipped 2-D lookup.
+
+    The field covers a small patch of a larger scan, so moved points fall outside it on every side: those
+    score 0, not the edge value.
+    """
+    rng = np.random.default_rng(seed)
+    world = random_walls(seed=seed)
+    src = seen_from(world, np.array([1.0, -2.0, 0.4]))[::9]
+    field, lo = likelihood_field(world[np.hypot(world[:, 0] - 1.0, world[:, 1] + 2.0) < 10.0], 0.1, 0.15)
+    offsets = np.arange(-10, 11) * 0.2
+    grid = np.stack(np.meshgrid(offsets, offsets, indexing="ij"), axis=-1).reshape(-1, 2)
+    guess = np.array([1.0, -2.0, 0.4]) + rng.normal(0.0, 0.3, 3)
+    thetas = guess[2] + np.arange(-5, 6) * math.radians(3.0)
+    expected = []
+    cells = []
+    for theta in thetas:
+        c, s = math.cos(theta), math.sin(theta)
+        moved = src @ np.array([[c, s], [-s, c]]) + guess[:2]
+        idx = np.floor((moved[None, :, :] + grid[:, None, :] - lo) / 0.1).astype(int)
+        inside = (idx >= 0).all(axis=-1) & (idx < field.shape).all(axis=-1)
+        vals = field[np.clip(idx[..., 0], 0, field.shape[0] - 1), np.clip(idx[..., 1], 0, field.shape[1] - 1)]
+        expected.append(np.where(inside, vals, 0.0).sum(axis=1))
+        cells.append(idx)
+    every = np.concatenate(cells).reshape(-1, 2)
+    for axis in (0, 1):  # lookups fell off both ends of both axes
+        assert (every[:, axis] < 0).any() and (every[:, axis] >= field.shape[axis]).any()
+    assert _pose_scores(field, lo, src, guess, grid, thetas, 0.1).tobytes() == np.array(expected).tobytes()
+
+
+def test_the_zero_border_leaves_the_global_search_bit_for_bit(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Widening the pooled tables (no clipped lookups) finds the same pose, score and ambiguity, to the bit.
+
+    The search's half-width reaches far beyond the field, so without the border most blocks need clipping.
+    """
+    world = random_walls(seed=5, extent_m=12.0)
+    truth = np.array([2.0, 1.0, -0.3])
+    source = seen_from(world, truth, 25.0)
+    guess = truth + np.array([6.5, -4.0, math.radians(12.0)])
+    window = GlobalWindow(half_width_m=20.0, half_angle_rad=math.radians(15.0))
+    widened = branch_and_bound_search(world, source, guess, window)
+    monkeypatch.setattr(correlative, "_zero_border", lambda tables, base, low, high: (tables, base))
+    clipped = branch_and_bound_search(world, source, guess, window)
+    assert widened.pose.tobytes() == clipped.pose.tobytes()
+    assert (widened.score, widened.ambiguity) == (clipped.score, clipped.ambiguity)
+    assert np.hypot(*(widened.pose[:2] - truth[:2])) < 0.3  # a real match, not two equal failures
+
+
+def test_block_sums_on_the_zero_border_are_the_clipped_ones_bit_for_bit() -> None:
+    """Every level's block sums read through the widened tables equal the clipped lookups of the padded field.
+
+    As in the search, the field is padded by one more than the widest block, so each pooled level's edge cells
+    are zero; points and origins reach far past every side, so most nodes would need clipping.
+    """
+    rng = np.random.default_rng(11)
+    levels = 3
+    field = rng.random((30, 41))
+    pooled = _pooled_fields(np.pad(field, 2**levels + 1), levels)
+    base = rng.integers(-20, 70, size=(4, 50, 2))
+    low, high = -24, 23
+    rot = rng.integers(0, 4, size=3000)
+    origin = rng.integers(low, high + 1, size=(3000, 2))
+    widened, shifted = _zero_border(pooled, base, low, high)
+    assert widened[0].shape[0] > pooled[0].shape[0] and widened[0].shape[1] > pooled[0].shape[1]
+    n0, n1 = pooled[0].shape
+    reach = base[rot] + origin[:, None, :]
+    clipped = ~((reach >= 0) & (reach < (n0, n1))).all(axis=(1, 2))
+    assert clipped.mean() > 0.5
+    for h in range(levels + 1):
+        assert _sum_at(widened[h], shifted, rot, origin).tobytes() == _sum_at(pooled[h], base, rot, origin).tobytes()

@@ -14,6 +14,7 @@ from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
 from albot1.methods.baselines.gtsam_graph.registration import (
     IcpParams,
     Target,
+    _linearise,
     line_normals,
     register,
     rotate,
@@ -142,3 +143,33 @@ def test_try_register_is_none_below_the_minimum_points_and_register_otherwise() 
     found = try_register(target, source, np.zeros(3), params)
     expected = register(target, source, np.zeros(3), params)
     assert found is not None and np.array_equal(found.pose, expected.pose) and found.converged
+
+
+@pytest.mark.parametrize("gate", [5.0, 0.05])
+def test_linearisation_has_the_bits_of_the_per_array_formulation(gate: float) -> None:
+    """One gather of points and normals, moved points once: the same Jacobian, residuals and weights, bit for bit.
+
+    A wide gate keeps every point (no selection), a narrow one drops some (the selection path).
+    """
+    target = Target.from_points(scan_points(np.array([2.0, 1.5, 0.3])))
+    src = scan_points(np.array([2.6, 1.9, 0.5]))
+    pose = se2.between(np.array([2.0, 1.5, 0.3]), np.array([2.6, 1.9, 0.5])) + np.array([0.03, -0.02, 0.01])
+    jac, res, w = _linearise(target, src, pose, gate, 0.1)
+    # The formulation every recorded result was computed with: separate gathers, the sum formed twice.
+    rot = rotate(src, pose[2])
+    assert target.tree is not None
+    dist, idx = target.tree.query(rot + pose[:2], k=1, distance_upper_bound=gate)
+    ok = dist < gate
+    assert ok.all() == (gate > 1.0)
+    rot, idx = rot[ok], idx[ok]
+    n = target.normals[idx]
+    diff = rot + pose[:2] - target.points[idx]
+    expected_res = n[:, 0] * diff[:, 0] + n[:, 1] * diff[:, 1]
+    expected_jac = np.empty((len(expected_res), 3))
+    expected_jac[:, :2] = n
+    expected_jac[:, 2] = n[:, 1] * rot[:, 0] - n[:, 0] * rot[:, 1]
+    expected_w = 1.0 / (1.0 + (expected_res / 0.1) ** 2)
+    assert len(res) > 10
+    assert jac.tobytes() == expected_jac.tobytes()
+    assert res.tobytes() == expected_res.tobytes()
+    assert w.tobytes() == expected_w.tobytes()
