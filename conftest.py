@@ -194,6 +194,7 @@ def schedule_units(
     return sorted(units, key=lambda unit: -unit.seconds)
 
 
+@pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Run the longest modules first, each kept together.
 
@@ -203,7 +204,10 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     other long ones, instead of starting last and keeping the other workers
     idle until it ends; the short modules fill the gaps at the end. A module
     goes to one worker whole, so its module-scoped fixtures (a report built
-    once for several tests) are built once.
+    once for several tests) are built once. It runs after the other plugins'
+    hooks (``trylast``), so it orders what a ``-m``/``-k`` selection kept
+    (``make test-fast``): ordered before the selection, the kept tests were in
+    an order of the whole suite's module sums, not of their own.
     """
     durations = _durations()
     modules = [_module(item) or item.nodeid for item in items]
