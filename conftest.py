@@ -118,11 +118,11 @@ def fault_plugin(install_method_plugin: PluginInstaller) -> None:
 def pytest_collection(session: pytest.Session) -> Iterator[None]:
     """Collect with the cyclic garbage collector paused; it is back in its former state before the first test.
 
-    Collecting imports about 2,300 modules and rewrites the assertions of every test file. Almost all the
+    Collecting imports about 1,600 modules and rewrites the assertions of every test file. Almost all the
     objects this makes (modules, classes, functions, parametrisations) live until the session ends, yet
     each full pass of the collector walks them all again, and as the heap grows the passes come more often
-    and cost more: 18 full passes took 1.8 of a cold collection's 6.4 CPU-s and freed next to nothing
-    (peak memory 287 MB with them, 292 MB without; docs/benchmarking.md). Reference counting still frees
+    and cost more: 19 full passes, 1.3-1.4 of a cold collection's 5.8 CPU-s, for next to nothing freed
+    (peak memory 168 MB with them, 172 MB without; docs/benchmarking.md). Reference counting still frees
     everything that is not in a cycle; the cycles left are collected by the first pass after collection.
     """
     enabled = gc.isenabled()
