@@ -15,8 +15,7 @@ import multiprocessing
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, as_of, collect
@@ -46,6 +45,9 @@ from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 from albot1.versions import commit_label
+
+if TYPE_CHECKING:
+    import pandas as pd  # an annotation only: importing the report does not import pandas
 
 #: Told ``(datasets whose figures are drawn, datasets to draw)`` while the report draws its figures.
 PlotProgress = Callable[[int, int], None]

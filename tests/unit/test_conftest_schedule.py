@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import json
 from pathlib import Path
 
@@ -84,3 +85,8 @@ def test_the_durations_file_lists_seconds_of_tests_that_exist(request: pytest.Fi
 
 def _files(root: Path) -> set[str]:
     return {str(path.relative_to(root)) for path in (root / "tests").rglob("test_*.py")}
+
+
+def test_the_garbage_collector_paused_for_collection_is_on_again_for_the_tests() -> None:
+    """``conftest.pytest_collection`` pauses the cyclic collector while collecting and must resume it."""
+    assert gc.isenabled()

@@ -18,7 +18,6 @@ import subprocess
 from pathlib import Path
 
 import headless_chromium
-import pandas as pd
 import pytest
 from loop_sequence import loop
 
@@ -138,6 +137,8 @@ def test_markdown_and_latex_show_the_identity_columns_then_the_selection_in_its_
 def test_the_tables_csv_follow_the_selection_and_the_per_cell_csv_keep_every_column(
     selected: Path, whole: Path
 ) -> None:
+    import pandas as pd  # here, not at collection: pandas costs every test run's collection
+
     identity = ["dataset", "method", "degradation", "seeds", "planned", "failed", "not_run", "status", "held_in"]
     stats = ("mean", "std", "median", "min", "max", "na")
     metrics = pd.read_csv(selected / "metrics.csv")

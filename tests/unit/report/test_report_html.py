@@ -15,7 +15,6 @@ from pathlib import Path
 import headless_chromium
 import numpy as np
 import pytest
-from matplotlib.image import imread
 
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ResultsStore
@@ -123,6 +122,8 @@ def test_a_headless_browser_renders_the_page_with_its_tables(report: Path, tmp_p
         timeout=120,
     )
     assert shot.is_file(), done.stderr[-2000:]
+    from matplotlib.image import imread  # here, not at collection: matplotlib costs every test run's collection
+
     pixels = imread(shot)[..., :3]
     assert float(pixels.std()) > 0.05  # something was drawn: not a blank page
     assert float((pixels < 0.5).mean()) > 0.002  # dark text and lines on the white page
@@ -176,6 +177,8 @@ def test_plots_drawn_by_worker_processes_are_the_same_files(tmp_path: Path) -> N
         and any(n.startswith("loop-a-") for n in serial)
         and any(n.startswith("loop-b-") for n in serial)
     )
+    from matplotlib.image import imread
+
     for name in serial:
         a = imread(tmp_path / "serial" / "plots" / name)
         b = imread(tmp_path / "parallel" / "plots" / name)

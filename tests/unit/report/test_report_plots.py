@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from matplotlib.image import imread
 
 from albot1.bench.grid import Cell
 from albot1.data.model import Frame, Scan, Sequence
@@ -162,6 +161,8 @@ def corridor(tmp_path_factory: pytest.TempPathFactory) -> list[CellRecord]:
 def _check_png(path: Path | None) -> tuple[int, int]:
     assert path is not None and path.read_bytes()[:8] == PNG_SIGNATURE
     assert path.with_suffix(".svg").read_text().startswith("<?xml")  # the vector twin
+    from matplotlib.image import imread  # here, not at collection: matplotlib costs every test run's collection
+
     pixels = imread(path)
     assert float(pixels[..., :3].std()) > 0.05  # not a blank canvas
     return pixels.shape[1], pixels.shape[0]

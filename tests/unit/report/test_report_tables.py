@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from albot1.bench.grid import Cell
@@ -28,6 +27,9 @@ from albot1.report.tables import (
     stats_text,
     write_tables,
 )
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 METRIC_NAMES = metric_registry().names
 
@@ -182,6 +184,8 @@ def test_aggregates_computes_each_table_once_and_only_when_read(monkeypatch: pyt
 
 @pytest.mark.parametrize("keys", [["ate_rmse_m"], ["loop_gap_m", "ate_rmse_m"], []])
 def test_a_picked_aggregate_is_the_aggregate_of_the_picked_columns(keys: list[str]) -> None:
+    import pandas as pd  # here, not at collection: pandas costs every test run's collection
+
     records = [
         record("w", "odometry", "none", 0, 1.0),
         record("w", "odometry", "gauss:0.1:1", 1, None),
@@ -256,6 +260,8 @@ def test_latex_tables_are_booktabs_with_escaped_labels(tmp_path: Path) -> None:
 
 
 def test_write_tables_keeps_cost_out_of_the_accuracy_files(tmp_path: Path) -> None:
+    import pandas as pd
+
     records = [record("w", "odometry", "none", 0, 0.5, ms=3.0), record("w", "x", "none", 0, None, status="failed")]
     written = write_tables(records, tmp_path)
     metrics = pd.read_csv(written["metrics.csv"])

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import pandas as pd
-
 from albot1.bench.grid import Cell
 from albot1.report.collect import METRIC_COLUMNS
 from albot1.report.tables import LEGEND, markdown
@@ -51,6 +49,8 @@ def test_cells_on_held_in_datasets_are_marked_and_held_out_ones_are_not() -> Non
 
 
 def test_the_metrics_table_marks_held_in_rows_and_prints_the_legend() -> None:
+    import pandas as pd  # here, not at collection: pandas costs every test run's collection
+
     row = {"dataset": "aces", "method": "gtsam-graph", "degradation": "none", "seeds": 1, "status": "ok"}
     row |= {"ate_rmse_m_n": 1, "ate_rmse_m_na": None}
     row |= {f"ate_rmse_m_{stat}": 0.5 for stat in ("mean", "std", "median", "min", "max")}

@@ -7,8 +7,6 @@ from pathlib import Path
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
 from PIL import Image
 
 from albot1.report.tight_png import ink_box, save_tight_png
@@ -23,6 +21,9 @@ def test_ink_box_is_the_rows_and_columns_that_differ_from_the_background() -> No
 
 
 def test_saved_png_is_the_ink_with_a_margin(tmp_path: Path) -> None:
+    from matplotlib.figure import Figure  # here, not at collection: matplotlib costs every test run's collection
+    from matplotlib.patches import Rectangle
+
     fig = Figure(figsize=(4, 4), dpi=50)  # 200 x 200 pixels
     ax = fig.add_axes((0.25, 0.25, 0.5, 0.5))  # a frame from pixel 50 to 150 each way
     ax.set_axis_off()
@@ -61,6 +62,8 @@ def test_ink_box_sees_a_change_in_any_one_channel(
 
 def test_saved_png_keeps_the_drawn_pixels(tmp_path: Path) -> None:
     """Compressed at level 1, the PNG decodes to exactly the canvas's pixels (cropped)."""
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(2, 2), dpi=50)
     ax = fig.add_subplot()
     ax.plot([0, 1, 0.3], [0, 1, 0.8], color="tab:blue")

@@ -29,7 +29,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from albot1.data.errors import DataError, ParseError
 from albot1.data.loaders.rosbag.msg import quaternion_problem
@@ -40,6 +39,7 @@ if TYPE_CHECKING:
     from collections.abc import Mapping
 
     from rosbags.highlevel import AnyReader
+    from scipy.spatial.transform import Rotation
 
 log = logging.getLogger(__name__)
 
@@ -81,6 +81,8 @@ def odometry_child_frame(reader: AnyReader, topic: str, shown: Path) -> str | No
 
 def _links(reader: AnyReader, topic: str, shown: Path) -> dict[str, _Link]:
     """``child -> first transform from its parent`` of a TFMessage topic."""
+    from scipy.spatial.transform import Rotation  # imported here: ~0.2 s that importing the loader (tests, CLI) skips
+
     links: dict[str, _Link] = {}
     for i, msg in topic_messages(reader, topic, shown):
         for tf in msg.transforms:
@@ -121,6 +123,8 @@ def _chain(links: Mapping[str, _Link], laser: str, base: str | None, odom_frame:
 
 
 def _planar(path: list[_Link], laser: str, base: str, shown: Path) -> tuple[float, float, float]:
+    from scipy.spatial.transform import Rotation
+
     translation, rotation = np.zeros(3), Rotation.identity()
     for link in path:
         translation = translation + rotation.apply(link.translation)
