@@ -250,7 +250,11 @@ def build_report(
             tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
         views = write_views(pictured, target, colors) if plots else None
         name = "benchmark.md" if thesis else "README.md"
-        page = write_thesis_page(results, target, benchmark_index=name, plots=plots) if thesis else None
+        page = (
+            write_thesis_page(results, target, benchmark_index=name, plots=plots, index_follows=True)
+            if thesis
+            else None
+        )
         made = pending.result() if pending is not None else {}
     index = write_index(plan, records, tables, made, target, results, name)
     write_html(
