@@ -22,9 +22,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
+
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.store import ATTEMPT, METRICS, Failure, ResultsStore
+from albot1.contract import MapData
 from albot1.data.degrade import parse_spec
+from albot1.geometry.types import FloatArray
 from albot1.metrics.record import MetricsRecord
 from albot1.metrics.registry import MetricRegistry, metric_registry
 from albot1.metrics.unit import ColumnSpec, Metric
@@ -193,12 +197,32 @@ class CellRecord:
     failure: Failure | None
     attempt: AttemptRecord | None = None
     _stored: StoredRun | None = field(default=None, repr=False, compare=False)
+    _map: MapData | None = field(default=None, repr=False, compare=False)
+    _geometry: FloatArray | None = field(default=None, repr=False, compare=False)
 
     def stored_run(self) -> StoredRun:
         """The run folder read back, once per record (several plots draw the same run)."""
         if self._stored is None:
             self._stored = read_run(self.run_dir)
         return self._stored
+
+    def stored_map(self) -> MapData:
+        """The run's map read back, once per record.
+
+        The maps figure and the interactive view each read it twice (its extent, then its drawing); a whole-log
+        line map is megabytes of GeoJSON, and decoding it was a tenth of the default report's figure time.
+        """
+        if self._map is None:
+            self._map = self.stored_run().load_map()
+        return self._map
+
+    def map_geometry(self) -> FloatArray:
+        """:meth:`MapData.geometry_points` of :meth:`stored_map` (the points that frame a map), once per record."""
+        if self._geometry is None:
+            geometry = np.asarray(self.stored_map().geometry_points(), dtype=float).reshape(-1, 2)
+            geometry.setflags(write=False)  # shared by every figure of the record
+            self._geometry = geometry
+        return self._geometry
 
 
 def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:

@@ -11,157 +11,36 @@ with the tables and every plot, for a browser.
 
 from __future__ import annotations
 
-import multiprocessing
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from contextlib import nullcontext
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, as_of, collect
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
-from albot1.report.cost_plots import plot_runtime, plot_scan_time
 from albot1.report.external_notes import external_markdown
-from albot1.report.figure_cache import FigureCache, inputs_digest
+from albot1.report.figure_pool import PlotProgress, start_plots
 from albot1.report.folders import default_out
 from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
 from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
 from albot1.report.generalisation import write_generalisation
 from albot1.report.html import INDEX_HTML, rel, write_html
 from albot1.report.interactive_page import write_views
-from albot1.report.map_plots import MapStyle, plot_maps
+from albot1.report.map_plots import MapStyle
 from albot1.report.markdown import code, text
 from albot1.report.paired_tables import paired_rows
-from albot1.report.plots import method_colors, slug, vector_of
+from albot1.report.plots import method_colors, vector_of
 from albot1.report.provenance import data_by_dataset, describe_data, separate_data
-from albot1.report.relation_plots import plot_relation_boxes
-from albot1.report.robustness_plots import plot_robustness
-from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
 from albot1.report.standard import on_standard_logs, write_standard
 from albot1.report.tables import Aggregates, write_tables
 from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
-from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 from albot1.versions import commit_label
-
-if TYPE_CHECKING:
-    import pandas as pd  # an annotation only: importing the report does not import pandas
-
-#: Told ``(datasets whose figures are drawn, datasets to draw)`` while the report draws its figures.
-PlotProgress = Callable[[int, int], None]
-#: The metrics whose robustness (value per degradation) is plotted: column, axis label, file suffix.
-ROBUSTNESS = (
-    ("ate_rmse_m", "ATE RMSE (m)", "robustness-ate"),
-    ("drift_10m_m", "RPE per 10 m, translation (m)", "robustness-drift"),
-    ("loop_gap_m", "loop gap (m)", "robustness-loop-gap"),
-)
 
 
 def _rel(path: Path, start: Path) -> str:
     return rel(path, start)
-
-
-def render_plots(
-    records: list[CellRecord],
-    out: Path,
-    colors: dict[str, str] | None = None,
-    *,
-    map_style: MapStyle = "grid",
-    jobs: int = 1,
-    progress: PlotProgress | None = None,
-    aggregates: Aggregates | None = None,
-) -> dict[str, list[Path]]:
-    """Every plot of the report (PNG, each with an SVG twin); dataset label -> its PNGs ("" for cross-dataset).
-
-    Drawing is most of a report's time (matplotlib's layout and two file
-    formats per figure) and each dataset's figures depend on its records
-    alone, so with ``jobs`` > 1 the datasets are drawn in that many worker
-    processes; the figures are the same files either way. ``progress`` is
-    told ``(datasets drawn, datasets to draw)`` before the first and after each
-    (the CLI's bar; figures found in the cache are not counted). ``aggregates``: the :class:`Aggregates` of
-    ``records`` (made here otherwise); its tables are read only for figures that are drawn.
-    """
-    colors = colors or method_colors(r.cell.method_label for r in records)
-    aggregates = Aggregates(records) if aggregates is None else aggregates
-    plots_dir = out / "plots"
-    plots_dir.mkdir(parents=True, exist_ok=True)
-    by_dataset: dict[str, list[CellRecord]] = {}
-    for rec in records:
-        by_dataset.setdefault(rec.cell.dataset_label, []).append(rec)
-    cache = FigureCache(plots_dir)
-    made: dict[str, list[Path]] = {}
-    digests: dict[str, str] = {}
-    tasks = []
-    for dataset, recs in by_dataset.items():
-        digests[dataset] = inputs_digest(recs, "dataset", dataset, map_style, sorted(_colors_of(recs, colors).items()))
-        cached = cache.lookup(f"dataset:{dataset}", digests[dataset])
-        if cached is not None:
-            made[dataset] = [cache.path(name) for name in cached.payload]
-        else:
-            tasks.append((dataset, recs, aggregates.metrics, plots_dir, colors, map_style))
-    tell = progress or (lambda done, total: None)
-    tell(0, len(tasks))
-    drawn: list[list[Path]] = []
-    if jobs > 1 and len(tasks) > 1:
-        # spawn: a fresh interpreter per worker, whatever threads or matplotlib state this process holds.
-        with ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=multiprocessing.get_context("spawn")) as pool:
-            for files in pool.map(_dataset_plots, *zip(*tasks, strict=True)):
-                drawn.append(files)
-                tell(len(drawn), len(tasks))
-    else:
-        for task in tasks:
-            drawn.append(_dataset_plots(*task))
-            tell(len(drawn), len(tasks))
-    for task, files in zip(tasks, drawn, strict=True):
-        dataset = task[0]
-        made[dataset] = files
-        cache.store(f"dataset:{dataset}", digests[dataset], files, [cache.name(f) for f in files])
-    made = {dataset: made[dataset] for dataset in by_dataset}  # suite order, whichever were drawn now
-    runtime_digest = inputs_digest(records, "runtime", sorted(colors.items()))
-    cached = cache.lookup("runtime", runtime_digest)
-    if cached is not None:
-        made[""] = [cache.path(name) for name in cached.payload]
-    else:
-        runtime = plot_runtime(aggregates.cost, plots_dir / "runtime.png", colors)
-        made[""] = [runtime] if runtime is not None else []
-        cache.store("runtime", runtime_digest, made[""], [cache.name(f) for f in made[""]])
-    cache.save()
-    return made
-
-
-def _colors_of(records: list[CellRecord], colors: dict[str, str]) -> dict[str, str]:
-    """The colours of the methods in ``records`` (what a dataset's figures draw them in)."""
-    labels = {r.cell.method_label for r in records}
-    return {label: color for label, color in colors.items() if label in labels}
-
-
-def _dataset_plots(
-    dataset: str,
-    recs: list[CellRecord],
-    metrics: pd.DataFrame,
-    plots_dir: Path,
-    colors: dict[str, str],
-    map_style: MapStyle,
-) -> list[Path]:
-    """The figures of one dataset (a module-level function: worker processes run it)."""
-    stem = slug(dataset)
-
-    def at(kind: str) -> Path:
-        return plots_dir / f"{stem}-{kind}.png"
-
-    files = [
-        plot_trajectories(recs, dataset, at("trajectories"), colors),
-        plot_ape_map(recs, dataset, at("ape"), colors),
-        plot_error_vs_distance(recs, dataset, at("error-distance"), colors),
-        plot_rpe_boxes(recs, dataset, at("rpe-boxes"), colors),
-        plot_relation_boxes(recs, dataset, at("relation-boxes"), colors),
-        plot_maps(recs, dataset, at("maps"), colors, style=map_style),
-        *[plot_robustness(metrics, dataset, column, label, at(kind), colors) for column, label, kind in ROBUSTNESS],
-        plot_scan_time(recs, dataset, at("scan-time"), colors),
-    ]
-    return [f for f in files if f is not None]
 
 
 def _machine_lines(plan: GridPlan) -> list[str]:
@@ -339,7 +218,7 @@ def build_report(
 ) -> Path:
     """Tables, plots, README.md and index.html for ``results_dir``; returns the README path.
 
-    ``jobs``: worker processes drawing the plots (:func:`render_plots`, which tells ``progress``).
+    ``jobs``: worker processes drawing the plots (:mod:`albot1.report.figure_pool`, which tells ``progress``).
     ``columns``: the number columns of the metrics and cost tables (:mod:`albot1.report.column_selection`).
 
     For the ``thesis`` suite README.md is the thesis reproduction page
@@ -350,26 +229,34 @@ def build_report(
     plan, collected = collect(results)
     records = separate_data(collected)  # runs of one dataset on different data never share a row
     target.mkdir(parents=True, exist_ok=True)
-    paired = paired_rows(records)  # the accuracy tables' paired comparisons (metrics.md, paired.csv, index.html)
-    tabled = Aggregates(records)  # computed once, read by the tables, the figures and index.html
-    tables = write_tables(records, target, paired, columns, tabled)
-    if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
-        tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
-    generalisation = write_generalisation(plan, records, target)
-    if generalisation is not None:
-        tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
     colors = method_colors(r.cell.method_label for r in records)
     thesis = plan.suite == THESIS_SUITE
     pictured = own_records(records) if thesis else records  # the thesis suite's public-log runs: see reports/default
+    tabled = Aggregates(records)  # computed once, read by the tables, the figures and index.html
     drawn_from = tabled if pictured is records else Aggregates(pictured)  # a subset: tables of its own
-    made = (
-        render_plots(pictured, target, colors, map_style=map_style, jobs=jobs, progress=progress, aggregates=drawn_from)
+    # the figures first: worker processes draw them while this one writes the tables and pages (figure_pool)
+    plotting = (
+        start_plots(pictured, target, colors, map_style=map_style, jobs=jobs, progress=progress, aggregates=drawn_from)
         if plots
-        else {}
+        else nullcontext(None)
     )
-    views = write_views(pictured, target, colors) if plots else None
-    index = write_index(plan, records, tables, made, target, results, "benchmark.md" if thesis else "README.md")
-    page = write_thesis_page(results, target, benchmark_index=index.name, plots=plots) if thesis else None
+    with plotting as pending:
+        paired = paired_rows(records)  # the accuracy tables' paired comparisons (metrics.md, paired.csv, index.html)
+        tables = write_tables(records, target, paired, columns, tabled)
+        if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
+            tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
+        generalisation = write_generalisation(plan, records, target)
+        if generalisation is not None:
+            tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
+        views = write_views(pictured, target, colors) if plots else None
+        name = "benchmark.md" if thesis else "README.md"
+        page = (
+            write_thesis_page(results, target, benchmark_index=name, plots=plots, index_follows=True)
+            if thesis
+            else None
+        )
+        made = pending.result() if pending is not None else {}
+    index = write_index(plan, records, tables, made, target, results, name)
     write_html(
         plan,
         records,

@@ -131,7 +131,7 @@ def _map_traces(
     """The traces of one method's map (lines, occupied cells) in the figure's frame, or a note why none."""
     if rec.cell.trajectory is not None:
         return [], "no map: an external trajectory file"
-    data = rec.stored_run().load_map()
+    data = rec.stored_map()
 
     def frame(points: NDArray[np.float64]) -> NDArray[np.float64]:
         return points if view.transform is None else np.asarray(se2.transform_points(view.transform, points))
@@ -190,7 +190,7 @@ def _extent(views: list[RunView], records: dict[str, CellRecord], reference: NDA
         rec = records[view.label]
         if rec.cell.trajectory is not None:
             continue
-        geometry = np.asarray(rec.stored_run().load_map().geometry_points(), dtype=float).reshape(-1, 2)
+        geometry = rec.map_geometry()
         if len(geometry) and view.transform is not None:
             geometry = np.asarray(se2.transform_points(view.transform, geometry))
         if len(geometry):

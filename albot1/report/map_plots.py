@@ -58,7 +58,7 @@ def _draw_map(ax: Any, rec: CellRecord, extent: Extent, style: MapStyle) -> None
     from matplotlib.colors import ListedColormap
 
     run = rec.stored_run()
-    data = run.load_map()
+    data = rec.stored_map()
     if data.points is not None and len(data.points):
         pts = transform_points(np.asarray(data.points, dtype=float), run.poses, run.reference)
         if style == "grid":
@@ -88,7 +88,7 @@ def _extent(runs: dict[str, CellRecord]) -> Extent:
         parts.append(aligned_poses(run.poses, run.reference))
         if run.reference is not None:
             parts.append(run.reference)
-        geometry = run.load_map().geometry_points()
+        geometry = rec.map_geometry()
         if len(geometry):
             parts.append(robust_points(transform_points(np.asarray(geometry, dtype=float), run.poses, run.reference)))
     return Extent.around(parts)

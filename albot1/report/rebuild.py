@@ -30,7 +30,7 @@ from albot1.report.folders import default_out
 
 if TYPE_CHECKING:
     from albot1.report.column_selection import ColumnSelection
-    from albot1.report.index import PlotProgress
+    from albot1.report.figure_pool import PlotProgress
     from albot1.report.map_plots import MapStyle
 
 

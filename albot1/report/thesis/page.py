@@ -412,8 +412,13 @@ def write_thesis_page(
     benchmark_index: str = "benchmark.md",
     companions: tuple[str, ...] = COMPANION_SUITES,
     plots: bool = True,
+    index_follows: bool = False,
 ) -> Path:
-    """Write ``out/README.md`` for the thesis suite's ``results_dir`` (figures under ``out/figures``)."""
+    """Write ``out/README.md`` for the thesis suite's ``results_dir`` (figures under ``out/figures``).
+
+    ``benchmark_index`` is linked when it exists, or when ``index_follows``: the caller writes it next
+    (:func:`albot1.report.index.build_report` writes this page while its figures are drawn, before the index).
+    """
     ev = open_stores(results_dir, companions)
     sections = all_sections(ev)
     labels = [r.cell.method_label for s in ev.stores for r in s.records]
@@ -446,7 +451,7 @@ def write_thesis_page(
     ]
     if ev.notes:
         lines += ["Notes on the stores:", "", *[f"- {note}" for note in ev.notes], ""]
-    if (out / benchmark_index).is_file():
+    if index_follows or (out / benchmark_index).is_file():
         lines += [
             f"This suite's full benchmark report (every table and plot): [{benchmark_index}]({benchmark_index}), "
             "[index.html](index.html).",

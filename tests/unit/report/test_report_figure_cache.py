@@ -18,7 +18,7 @@ from albot1.bench.cells import execute_cell
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
 from albot1.bench.suite import parse_suite
-from albot1.report import index, tables
+from albot1.report import figure_pool, tables
 from albot1.report.figure_cache import STAMPS, FigureCache, inputs_digest
 from albot1.report.index import build_report
 from albot1.settings import get_settings
@@ -46,13 +46,13 @@ def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def _counting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     drawn: list[str] = []
-    original: Callable[..., list[Path]] = index._dataset_plots
+    original: Callable[..., list[Path]] = figure_pool._dataset_plots
 
     def spy(dataset: str, *args: Any) -> list[Path]:
         drawn.append(dataset)
         return original(dataset, *args)
 
-    monkeypatch.setattr(index, "_dataset_plots", spy)
+    monkeypatch.setattr(figure_pool, "_dataset_plots", spy)
     return drawn
 
 

@@ -145,6 +145,8 @@ def test_report_of_a_thesis_store_makes_the_page_its_readme(results: Path, tmp_p
     index = build_report(results, tmp_path / "report", plots=False)
     assert index == tmp_path / "report" / "README.md"
     assert index.read_text(encoding="utf-8").startswith("# The thesis's experiments, reproduced")
+    # written (while the figures are drawn) before the benchmark index, into an empty folder, it still links it
+    assert "full benchmark report (every table and plot): [benchmark.md](benchmark.md)" in index.read_text("utf-8")
     assert (tmp_path / "report" / "benchmark.md").read_text(encoding="utf-8").startswith("# Benchmark report")
     html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
     assert 'href="README.md"' in html and 'href="benchmark.md"' in html
