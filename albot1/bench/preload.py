@@ -171,23 +171,21 @@ def _warm() -> None:
     _warm_matplotlib()
 
 
-def freeze_heap() -> None:
-    """Collect the garbage the imports and warm-ups left, then move every object left out of the cycle collector's reach.
+def collect_garbage() -> None:
+    """Free the garbage the imports and warm-ups left, once, here, before any cell is forked.
 
-    Why: a cell is a fork of this server and inherits its heap (about 300,000
-    objects after the joint warm-up) together with its collector's state. The
-    warm-ups leave tens of thousands of unreachable cycles and a full
-    collection pending, so the first full collection in a cell (set off by
-    whatever allocates next, such as the places layer's network files at the
-    end of a run) walked the whole inherited heap, touching, and so copying,
-    every page of it: 0.2 s on an idle machine, more on a loaded one, inside
-    the cell's timed wall. Collected here once, and frozen (``gc.freeze``, as
-    the ``gc`` documentation advises before forking), the inherited objects
-    are never walked again by a cell's collector, which sees only what the
-    cell itself allocates.
+    Why: a cell is a fork of this server and inherits its heap and its cycle
+    collector's state. The joint warm-up leaves about 49,000 unreachable
+    objects and a full collection due (generation 2's count at its
+    threshold), so each cell's first full collection, set off by whatever
+    allocated next (the places layer's network files at the end of a run,
+    issue 24), walked the whole inherited heap of some 330,000 objects,
+    touching, and so copying, every page of it: 0.2 s of the cell's timed
+    wall on an idle machine, over a second on a loaded one. Collected here,
+    a cell starts with nothing due; :func:`albot1.bench.cell_main.process_entry`
+    then freezes the inherited heap, so no later collection walks it either.
     """
     gc.collect()
-    gc.freeze()
 
 
 def _warm_matplotlib() -> None:
@@ -204,4 +202,4 @@ def _warm_matplotlib() -> None:
 
 
 _warm()
-freeze_heap()  # last: after this nothing the server imported is walked by a cell's collector
+collect_garbage()  # last: every cell forked from here starts with no garbage and no collection due
