@@ -248,7 +248,6 @@ def test_a_failure_of_the_joint_warm_up_alone_is_still_reported(
     ]
 
 
-
 _COLLECTED = """
 import gc
 import json

@@ -34,7 +34,8 @@ print(sorted(name for name in set(sys.modules) - loaded if name.split(".")[0] ==
 
 
 def _run(code: str) -> list[str]:
-    out = subprocess.run([sys.executable, "-c", code], env=dict(os.environ), capture_output=True, text=True, timeout=300)
+    command = [sys.executable, "-c", code]
+    out = subprocess.run(command, env=dict(os.environ), capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     return out.stdout.split("\n")
 
