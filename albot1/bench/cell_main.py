@@ -181,18 +181,25 @@ def _chain(exc: BaseException) -> list[BaseException]:
     return out
 
 
-def process_entry(args: dict[str, Any]) -> None:
-    """``multiprocessing.Process`` target (a forkserver child): freeze the inherited heap, then run the cell.
+def freeze_inherited_heap() -> None:
+    """Move every object this forked cell inherited out of the cycle collector's generations (``gc.freeze``).
 
-    ``gc.freeze`` moves every object the forkserver imported or compiled
-    (about 330,000 after the joint warm-up) out of the cycle collector's
-    generations, as the ``gc`` documentation advises for a fork that does
-    not exec: the cell's collections then walk only what the cell allocates,
-    and never touch (copy) the pages it shares with the server. Done here,
-    in the child, rather than in the server, so that a test process that
-    imports :mod:`albot1.bench.preload` keeps its collector as it was.
+    A forkserver child inherits the server's heap: about 330,000 objects
+    after the joint warm-up of the kernels. Frozen, as the ``gc``
+    documentation advises for a fork that does not exec, they are never
+    walked by the cell's collections, which see only what the cell
+    allocates, and never touched (so never copied) by them (issue 24:
+    before, a full collection in the cell walked them all, 0.2 s of a
+    places cell's ``finish_s`` on an idle machine). Done here, in the
+    child, rather than in the server, so that a test process that imports
+    :mod:`albot1.bench.preload` keeps its collector as it was.
     """
     gc.freeze()
+
+
+def process_entry(args: dict[str, Any]) -> None:
+    """``multiprocessing.Process`` target (a forkserver child): freeze the inherited heap, then run the cell."""
+    freeze_inherited_heap()
     raise SystemExit(child_main(args))
 
 
