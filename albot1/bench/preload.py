@@ -182,8 +182,9 @@ def collect_garbage() -> None:
     issue 24), walked the whole inherited heap of some 330,000 objects,
     touching, and so copying, every page of it: 0.2 s of the cell's timed
     wall on an idle machine, over a second on a loaded one. Collected here,
-    a cell starts with nothing due; :func:`albot1.bench.cell_main.process_entry`
-    then freezes the inherited heap, so no later collection walks it either.
+    a cell starts with nothing due; the cell then freezes the inherited heap
+    (:func:`albot1.bench.cell_main.freeze_inherited_heap`), so no later
+    collection walks it either.
     """
     gc.collect()
 
