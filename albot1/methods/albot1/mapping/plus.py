@@ -251,27 +251,28 @@ class PlusLocaliser:
         if p.prior == "off":
             return measured
         sigmas = (p.line_sigma, p.point_sigma, p.scan_sigma, p.huber, p.scan_gate)
-        limit = allowance(p.turn_floor, p.turn_scale, since_update[2])
-        if not placed and beyond(measured[2] - predicted[2], limit):
-            support = view_ambiguity(
-                self._k.measurement_costs,
-                measured,
-                predicted,
-                lm_view,
-                lm_map,
-                ok,
-                points,
-                self._ref,
-                sigmas,
-                0.0,
-                p.overhang,
-            )
-            if support.statistic <= p.turn_statistic:
-                self.turn_bounded_views += 1
-                near = bounded_starts(starts, limit)
-                measured, info = self._solve(near, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
-                if beyond(measured[2] - predicted[2], limit):
-                    return predicted
+        if not placed and p.turn_floor > 0.0:  # the turn bound (:mod:`.turn_bound`); views a landmark placed skip it
+            limit = allowance(p.turn_floor, p.turn_scale, since_update[2])
+            if beyond(measured[2] - predicted[2], limit):
+                support = view_ambiguity(
+                    self._k.measurement_costs,
+                    measured,
+                    predicted,
+                    lm_view,
+                    lm_map,
+                    ok,
+                    points,
+                    self._ref,
+                    sigmas,
+                    0.0,
+                    p.overhang,
+                )
+                if support.statistic <= p.turn_statistic:
+                    self.turn_bounded_views += 1
+                    near = bounded_starts(starts, limit)
+                    measured, info = self._solve(near, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
+                    if beyond(measured[2] - predicted[2], limit):
+                        return predicted
         if p.ambiguity_probability > 0.0:
             if self.window is not None and odometry is not None:
                 window = self.window.test(
