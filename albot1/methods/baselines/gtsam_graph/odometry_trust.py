@@ -65,7 +65,10 @@ steps are learnt apart (:meth:`OdometryTrust.kind`): a step is then judged
 with the larger of the pooled variance and its own kind's, without the
 floor once its kind has ``kind_min_steps`` steps. It keeps fr-clinic's
 return without the floor, but measured no better everywhere
-(docs/baselines.md, gtsam-graph, "turns learnt apart").
+(docs/baselines.md, gtsam-graph, "turns learnt apart"). Also optional
+(``floor_turn_rad``, off: 0) is a floor held only on turning steps
+(:meth:`OdometryTrust.floor_ratio`), measured and left off for the same reason
+(docs/baselines.md, gtsam-graph, "why one run of edmonton swings").
 """
 
 from __future__ import annotations

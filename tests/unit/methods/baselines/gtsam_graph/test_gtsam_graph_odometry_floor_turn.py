@@ -1,4 +1,4 @@
-"""The weight floor held only on turning steps (odometry_trust.OdometryTrust.floor_ratio, odometry_trust_floor_turn_deg)."""
+"""The weight floor held only on turning steps (OdometryTrust.floor_ratio, odometry_trust_floor_turn_deg)."""
 
 from __future__ import annotations
 
