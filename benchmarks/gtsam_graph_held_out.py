@@ -16,7 +16,10 @@ weight floor") were measured; ``albot1 run`` / ``albot1 evaluate`` give the
 same numbers one cell at a time. ``--innovations`` adds the heading
 innovations (odometry step minus match) of every matched node step, by how
 far the step's odometry turns (docs/baselines.md, gtsam-graph, "turns learnt
-apart").
+apart"). ``--edges`` (cells with a reference) adds every sequential edge's and
+loop closure's error against the reference: the heading RMS of the matched
+edges, their lag-1 autocorrelation, the worst ones and every accepted closure
+(docs/baselines.md, gtsam-graph, "why one run of edmonton swings").
 """
 
 from __future__ import annotations
@@ -32,13 +35,16 @@ from typing import Any
 import numpy as np
 
 from albot1.data.open import open_sequence
-from albot1.methods.baselines.gtsam_graph import odometry_trust
+from albot1.geometry import se2
+from albot1.methods.baselines.gtsam_graph import backend, odometry_trust
 from albot1.metrics.ate import ate
 from albot1.metrics.relations import relation_metric
 from albot1.runs.execute import run_method
 
 #: Bins of the odometry's heading step per node (deg) for ``--innovations`` (14.3 = half a node's rotation step).
 TURN_BINS_DEG = (0.0, 2.0, 5.0, 10.0, 14.3239, 20.0, 30.0, math.inf)
+#: A sequential edge stating a heading sigma of this or more is an odometry fallback, not a match (fallback: 10 deg).
+FALLBACK_SIGMA_DEG = 5.0
 
 
 def _value(text: str) -> Any:
@@ -70,6 +76,69 @@ def recorded_innovations() -> Iterator[list[tuple[float, float]]]:
         odometry_trust.OdometryTrust.add = add  # type: ignore[method-assign]
 
 
+@contextmanager
+def recorded_edges() -> Iterator[dict[str, list[tuple[Any, ...]]]]:
+    """Every sequential edge (relative pose, stated sigmas) and accepted loop closure, while the block runs."""
+    seen: dict[str, list[tuple[Any, ...]]] = {"sequential": [], "loops": []}
+    add_node, add_loops = backend.BackEnd.add_node, backend.BackEnd.add_loops
+
+    def node(self: backend.BackEnd, odometry: Any, step: Any, relative: Any, covariance: Any, *rest: Any) -> int:
+        seen["sequential"].append((np.array(relative, dtype=float), np.sqrt(np.diag(covariance))))
+        return add_node(self, odometry, step, relative, covariance, *rest)
+
+    def loops(self: backend.BackEnd, accepted: Any) -> None:
+        seen["loops"].extend(
+            (m.current, m.candidate, np.array(m.relative), np.sqrt(np.diag(m.covariance))) for m in accepted
+        )
+        add_loops(self, accepted)
+
+    backend.BackEnd.add_node = node  # type: ignore[method-assign,assignment]
+    backend.BackEnd.add_loops = loops  # type: ignore[method-assign]
+    try:
+        yield seen
+    finally:
+        backend.BackEnd.add_node = add_node  # type: ignore[method-assign]
+        backend.BackEnd.add_loops = add_loops  # type: ignore[method-assign]
+
+
+def edge_table(seen: dict[str, list[tuple[Any, ...]]], truth: np.ndarray, worst: int = 8) -> dict[str, Any]:
+    """Sequential edges' and loop closures' errors against ``truth`` (the reference at the node scans), deg and m.
+
+    A sequential edge whose stated heading sigma is at the fallback's
+    (odometry, not a match) is left out of the RMS and the autocorrelation.
+    """
+    rows = []
+    for key, (relative, sigma) in enumerate(seen["sequential"], start=1):
+        true = se2.between(truth[key - 1], truth[key])
+        error = se2.between(true, relative)
+        rows.append((key, math.degrees(true[2]), math.degrees(error[2]), math.degrees(sigma[2])))
+    table = np.array(rows, dtype=float).reshape(-1, 4)
+    matched = table[table[:, 3] < FALLBACK_SIGMA_DEG]
+    heading = matched[:, 2] - matched[:, 2].mean() if len(matched) else matched[:, 2]
+    lag1 = float(np.corrcoef(heading[:-1], heading[1:])[0, 1]) if len(heading) > 2 else None
+    order = np.argsort(-np.abs(matched[:, 2]))[:worst]
+    loops = []
+    for current, candidate, relative, sigma in seen["loops"]:
+        error = se2.between(se2.between(truth[candidate], truth[current]), relative)
+        loops.append(
+            {
+                "nodes": [int(current), int(candidate)],
+                "error_m": round(math.hypot(error[0], error[1]), 3),
+                "error_deg": round(math.degrees(error[2]), 2),
+                "stated_m": round(float(max(sigma[0], sigma[1])), 3),
+            }
+        )
+    return {
+        "matched_heading_rms_deg": round(float(np.sqrt(np.mean(matched[:, 2] ** 2))), 3) if len(matched) else None,
+        "lag1_autocorrelation": None if lag1 is None else round(lag1, 3),
+        "worst": [
+            {"node": int(k), "turn_deg": round(t, 1), "error_deg": round(e, 2), "stated_deg": round(sd, 2)}
+            for k, t, e, sd in matched[order]
+        ],
+        "loops": loops,
+    }
+
+
 def innovation_table(seen: list[tuple[float, float]]) -> list[dict[str, Any]]:
     """Per bin of |odometry heading step| (deg; None: no bound): steps, robust spread (1.4826 MAD), median, deg."""
     turn = np.degrees(np.abs([t for t, _ in seen]))
@@ -91,13 +160,14 @@ def innovation_table(seen: list[tuple[float, float]]) -> list[dict[str, Any]]:
     return rows
 
 
-def measure(cell: str, overrides: dict[str, Any], innovations: bool = False) -> dict[str, Any]:
-    """Run gtsam-graph on one cell and score it (with ``innovations``: the odometry trust's heading innovations too)."""
+def measure(cell: str, overrides: dict[str, Any], innovations: bool = False, edges: bool = False) -> dict[str, Any]:
+    """Run gtsam-graph on one cell and score it (with ``innovations``: the odometry trust's heading innovations too;
+    with ``edges``: the edges' errors against the reference, :func:`edge_table`)."""
     dataset, _, rest = cell.partition("|")
     degradation, _, seed = rest.partition("|")
     seq = open_sequence(dataset).materialize()
     wall = time.perf_counter()
-    with recorded_innovations() as seen:
+    with recorded_innovations() as seen, recorded_edges() as graph_edges:
         result = run_method(
             "gtsam-graph",
             seq,
@@ -124,6 +194,9 @@ def measure(cell: str, overrides: dict[str, Any], innovations: bool = False) -> 
         row["relations_deg"] = round(block["rotation_deg"]["mean"], 3)
     if innovations:
         row["innovations"] = innovation_table(seen)
+    if edges and result.reference is not None:
+        truth = np.asarray(result.reference, dtype=float)[np.asarray(result.extras["node_scans"], dtype=np.int64)]
+        row["edges"] = edge_table(graph_edges, truth)
     return row
 
 
@@ -133,11 +206,14 @@ def main() -> None:
     parser.add_argument(
         "--innovations", action="store_true", help="also the heading innovations by turn (docs/baselines.md)"
     )
+    parser.add_argument(
+        "--edges", action="store_true", help="also the edges' errors against the reference (docs/baselines.md)"
+    )
     parser.add_argument("cells", nargs="+")
     args = parser.parse_args()
     overrides = {key: _value(value) for key, _, value in (s.partition("=") for s in args.settings)}
     for cell in args.cells:
-        print(json.dumps(measure(cell, overrides, args.innovations)), flush=True)
+        print(json.dumps(measure(cell, overrides, args.innovations, args.edges)), flush=True)
 
 
 if __name__ == "__main__":

@@ -45,7 +45,8 @@ def test_presets_table_of_one_method() -> None:
         "    literal  continuation_tolerance_m = 0.0 m, end_spacing_max_m = 0.0 m, delete_margin_from = boundary",
         "    plus     end_spacing_max_m = 0.0 m, surface_fit = tls, motion_model = exact, pose_estimate = robust, "
         "scan_refinement = true, scan_overlap = surface, scan_overhang_m = 0.05 m, odometry_prior = adaptive, "
-        "degenerate_sd_m = 0.05 m, ambiguity_probability = 0.99",
+        "degenerate_sd_m = 0.05 m, ambiguity_probability = 0.99, turn_bound_floor_deg = 3.0 deg, "
+        "turn_bound_statistic = 40.0",
     ]
 
 
@@ -72,6 +73,8 @@ def test_presets_json_of_every_method() -> None:
             "odometry_prior": "adaptive",
             "degenerate_sd_m": 0.05,
             "ambiguity_probability": 0.99,
+            "turn_bound_floor_deg": 3.0,
+            "turn_bound_statistic": 40.0,
         },
     }
     field = next(f for f in albot1["fields"] if f["name"] == "delete_margin_m")

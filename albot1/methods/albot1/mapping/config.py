@@ -235,6 +235,27 @@ class Albot1Config(BaseModel):
             " error over the whole window, a false refusal only falls back to the per-view test)"
         ),
     )
+    turn_bound_floor_deg: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ turn bound: a view no landmark places may depart from the odometry's predicted heading by"
+            " at most this plus turn_bound_scale times the odometry's turn since the last update view unless it"
+            " refutes the odometry beyond turn_bound_statistic: else it is fitted from the starts within that"
+            " allowance, and a fit still beyond keeps the prediction (0 = off; docs/albot1-mapper.md)"
+        ),
+    )
+    turn_bound_scale: float = Field(
+        1.0, ge=0, description="Albot1+ turn bound: allowance per degree the odometry turned since the update"
+    )
+    turn_bound_statistic: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ turn bound: a view whose likelihood ratio of the odometry's prediction against its fit"
+            " (the ambiguity test's statistic) exceeds this refutes the odometry strongly enough to turn freely"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -310,4 +331,7 @@ class Albot1Config(BaseModel):
             window_probability=self.window_probability,
             motion_model=self.motion_model,
             overhang=self.scan_overhang_m if self.scan_overlap == "surface" else NO_LIMIT,
+            turn_floor=math.radians(self.turn_bound_floor_deg),
+            turn_scale=self.turn_bound_scale,
+            turn_statistic=self.turn_bound_statistic,
         )

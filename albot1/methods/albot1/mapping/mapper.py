@@ -332,7 +332,9 @@ class Albot1Mapper:
             np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2),
         )
         since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
-        return self._plus.pose(starts, lm_view, lm_map, kinds, self._points, since, self._odometry), loc
+        return self._plus.pose(
+            starts, lm_view, lm_map, kinds, self._points, since, self._odometry, loc is not None
+        ), loc
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
         """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md).
@@ -448,6 +450,8 @@ class Albot1Mapper:
             counters["plus_gate_rejections"] = self._plus.gate_rejections
         if self._plus is not None and self.config.ambiguity_probability > 0.0:
             counters["plus_ambiguous_views"] = self._plus.ambiguous_views
+        if self._plus is not None and self.config.turn_bound_floor_deg > 0.0:
+            counters["plus_turn_bounded_views"] = self._plus.turn_bounded_views
         if self._plus is not None and self._plus.window is not None:
             counters["plus_window_views"] = self._plus.window_views
         counters["updates_per_view"] = c.updates / c.views if c.views else 0.0

@@ -41,6 +41,8 @@ pose is computed:
    views against that view's surfaces: not refuted, the odometry over the
    window is the pose (false alarms and the fit's bias in the anchors between
    are dropped).
+9. with ``turn_bound_floor_deg``, :mod:`.turn_bound` refits a view no landmark places from its near starts
+   when it turns the robot further than its odometry did on weak evidence.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -62,6 +64,7 @@ from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_a
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen_kernels import screen_directions
+from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
 from albot1.methods.albot1.mapping.window import OdometryWindow, UpdateRecord, WindowOutcome
 from albot1.methods.albot1.perception.endpoints import STABLE
 
@@ -100,6 +103,9 @@ class PlusParams:
     window_probability: float = 0.5  # chi-square quantile below which the window's odometry is kept
     motion_model: str = "exact"  # how an odometry increment becomes a thesis-frame motion (the mapper's)
     overhang: float = NO_LIMIT  # m a view point may project beyond an update-view surface's end (:mod:`.overlap`)
+    turn_floor: float = 0.0  # rad: the turn bound's allowance on a straight stretch (:mod:`.turn_bound`); 0 = off
+    turn_scale: float = 1.0  # the turn bound's allowance per rad the odometry turned since the update
+    turn_statistic: float = 0.0  # a view's likelihood ratio above which the turn bound does not apply
 
 
 class OdometryNoise:
@@ -194,6 +200,8 @@ class PlusLocaliser:
         self.window_views = 0
         self._window_limit = threshold(params.window_probability) if self.window is not None else 0.0
         self.last_window: WindowOutcome | None = None
+        #: Views no landmark placed refitted from their near starts by the turn bound (:mod:`.turn_bound`).
+        self.turn_bounded_views = 0
 
     def reset(self, view_map: FloatArray, pose: Pose, odometry: Pose | None = None) -> None:
         """A map update placed a view at ``pose``; ``view_map`` are its surfaces in the map (the new reference).
@@ -220,6 +228,7 @@ class PlusLocaliser:
         points: FloatArray,
         since_update: Pose,
         odometry: Pose | None = None,
+        placed: bool = True,
     ) -> Pose:
         """The pose of a view, from the cheapest of ``starts`` ``(c, 3)`` (candidate poses; see the mapper).
 
@@ -227,7 +236,8 @@ class PlusLocaliser:
         map copies; ``lm_kinds``: their endpoint labels now and in the map;
         ``points``: :meth:`scan_points`; ``since_update``: the odometry
         motion since the last update view (thesis frame); ``odometry``: the
-        view's own odometry (REP-103; the window test's).
+        view's own odometry (REP-103; the window test's); ``placed``: a
+        landmark placed the robot (False: the turn bound applies).
         """
         p = self.params
         ok = np.ascontiguousarray(STABLE[lm_kinds[0]] & STABLE[lm_kinds[1]]).reshape(-1, 2)
@@ -240,8 +250,30 @@ class PlusLocaliser:
         measured, info = self._solve(starts, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
         if p.prior == "off":
             return measured
+        sigmas = (p.line_sigma, p.point_sigma, p.scan_sigma, p.huber, p.scan_gate)
+        if not placed and p.turn_floor > 0.0:  # the turn bound (:mod:`.turn_bound`); views a landmark placed skip it
+            limit = allowance(p.turn_floor, p.turn_scale, since_update[2])
+            if beyond(measured[2] - predicted[2], limit):
+                support = view_ambiguity(
+                    self._k.measurement_costs,
+                    measured,
+                    predicted,
+                    lm_view,
+                    lm_map,
+                    ok,
+                    points,
+                    self._ref,
+                    sigmas,
+                    0.0,
+                    p.overhang,
+                )
+                if support.statistic <= p.turn_statistic:
+                    self.turn_bounded_views += 1
+                    near = bounded_starts(starts, limit)
+                    measured, info = self._solve(near, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
+                    if beyond(measured[2] - predicted[2], limit):
+                        return predicted
         if p.ambiguity_probability > 0.0:
-            sigmas = (p.line_sigma, p.point_sigma, p.scan_sigma, p.huber, p.scan_gate)
             if self.window is not None and odometry is not None:
                 window = self.window.test(
                     odometry,

@@ -102,6 +102,9 @@ class GtsamGraphConfig(BaseModel):
     odometry_trust_min_variance_ratio: float = Field(
         ge=0, description="... a trusted component's variance never below this times its match's (1: never more weight)"
     )
+    odometry_trust_floor_turn_deg: float = Field(
+        ge=0, description="... that floor only on steps whose odometry turns at least this much (0: every step)"
+    )
     odometry_trust_turn_deg: float = Field(
         gt=0,
         description="... steps whose odometry turns more than this learnt and judged apart from the others "

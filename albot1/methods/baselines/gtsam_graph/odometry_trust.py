@@ -65,7 +65,10 @@ steps are learnt apart (:meth:`OdometryTrust.kind`): a step is then judged
 with the larger of the pooled variance and its own kind's, without the
 floor once its kind has ``kind_min_steps`` steps. It keeps fr-clinic's
 return without the floor, but measured no better everywhere
-(docs/baselines.md, gtsam-graph, "turns learnt apart").
+(docs/baselines.md, gtsam-graph, "turns learnt apart"). Also optional
+(``floor_turn_rad``, off: 0) is a floor held only on turning steps
+(:meth:`OdometryTrust.floor_ratio`), measured and left off for the same reason
+(docs/baselines.md, gtsam-graph, "why one run of edmonton swings").
 """
 
 from __future__ import annotations
@@ -110,12 +113,15 @@ class OdometryTrust:
         min_variance_ratio: float = 0.0,
         turn_rad: float = math.inf,
         kind_min_steps: int = 10,
+        floor_turn_rad: float = 0.0,
     ) -> None:
         """``components``: which of x (0), y (1), heading (2) may be fused at all; ``bias_horizon``: the number of
         steps over which a median disagreement too small for the bias test is counted as accumulating (0: not);
         ``min_variance_ratio``: a trusted component's variance is at least this times its match's; ``turn_rad``:
         steps whose odometry turns more than this are learnt and judged apart from the others (:meth:`kind`;
-        ``inf``: one population)."""
+        ``inf``: one population); ``floor_turn_rad``: the floor holds only for steps whose odometry turns at least
+        this much (0: every step; :meth:`floor_ratio`)."""
+        self.floor_turn_rad = floor_turn_rad
         self._pooled: deque[FloatArray] = deque(maxlen=window)
         self._kinds: tuple[deque[FloatArray], deque[FloatArray]] = (deque(maxlen=window), deque(maxlen=window))
         self.turn_rad = turn_rad
@@ -147,7 +153,20 @@ class OdometryTrust:
         self._pooled.append(d)
         self._kinds[self.kind(odometry_step)].append(d)
 
-    def variances(self, match_variances: FloatArray, kind: int = 0) -> FloatArray | None:
+    def floor_ratio(self, turn_rad: float) -> float:
+        """The weight floor of a step whose odometry turns ``turn_rad``: ``min_variance_ratio``, or 0 below the turn.
+
+        The floor keeps a wheel odometry from outweighing the matches where it
+        is locally worse than its window shows, which is in turns (wheels slip;
+        fr-clinic's heading innovations spread 2-4x wider in turns than on its
+        straight steps, docs/baselines.md). On a straight step it also halves
+        the weight of an odometry that has earned more: with perfect odometry
+        on edmonton the steps whose match is 1-3 deg off are mostly straight,
+        and the floor leaves half of each error in the map.
+        """
+        return self.min_variance_ratio if abs(turn_rad) >= self.floor_turn_rad else 0.0
+
+    def variances(self, match_variances: FloatArray, kind: int = 0, turn_rad: float = math.inf) -> FloatArray | None:
         """Per component (x, y, theta) the odometry step's variance, ``inf`` where not trusted; None: too few steps.
 
         ``match_variances`` are the diagonal of the match edge's covariance
@@ -159,7 +178,7 @@ class OdometryTrust:
             return None
         own = self._kinds[kind]
         if not math.isfinite(self.turn_rad) or len(own) < self.kind_min_steps:
-            return self._estimate(self._pooled, match_variances, self.min_variance_ratio)
+            return self._estimate(self._pooled, match_variances, self.floor_ratio(turn_rad))
         return np.maximum(self._estimate(self._pooled, match_variances, 0.0), self._estimate(own, match_variances, 0.0))
 
     def _estimate(self, history: deque[FloatArray], match_variances: FloatArray, floor: float) -> FloatArray:
@@ -213,7 +232,7 @@ class OdometryTrust:
         odometry step and the match disagree beyond ``gate_chi2`` on the
         trusted components (their joint covariance).
         """
-        variances = self.variances(np.diag(match_covariance), self.kind(odometry_step))
+        variances = self.variances(np.diag(match_covariance), self.kind(odometry_step), float(odometry_step[2]))
         if variances is None or not np.isfinite(variances).any():
             return None
         trusted = np.isfinite(variances)

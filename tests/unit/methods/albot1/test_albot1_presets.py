@@ -65,6 +65,9 @@ OLD_DEFAULT: dict[str, Any] = {
     "ambiguity_probability": 0.0,
     "window_updates": 0,
     "window_probability": 0.5,
+    "turn_bound_floor_deg": 0.0,
+    "turn_bound_scale": 1.0,
+    "turn_bound_statistic": 0.0,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
@@ -95,6 +98,8 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "ambiguity_probability": 0.99,
         "scan_overlap": "surface",
         "scan_overhang_m": 0.05,
+        "turn_bound_floor_deg": 3.0,
+        "turn_bound_statistic": 40.0,
     },
 }
 
