@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import gc
 import importlib
 import logging
 import os
@@ -170,6 +171,24 @@ def _warm() -> None:
     _warm_matplotlib()
 
 
+def collect_garbage() -> None:
+    """Free the garbage the imports and warm-ups left, once, here, before any cell is forked.
+
+    Why: a cell is a fork of this server and inherits its heap and its cycle
+    collector's state. The joint warm-up leaves about 49,000 unreachable
+    objects and a full collection due (generation 2's count at its
+    threshold), so each cell's first full collection, set off by whatever
+    allocated next (the places layer's network files at the end of a run,
+    issue 24), walked the whole inherited heap of some 330,000 objects,
+    touching, and so copying, every page of it: 0.2 s of the cell's timed
+    wall on an idle machine, over a second on a loaded one. Collected here,
+    a cell starts with nothing due; the cell then freezes the inherited heap
+    (:func:`albot1.bench.cell_main.freeze_inherited_heap`), so no later
+    collection walks it either.
+    """
+    gc.collect()
+
+
 def _warm_matplotlib() -> None:
     """Render one tiny figure so the font cache and the Agg renderer are set up before forking."""
     import io
@@ -184,3 +203,4 @@ def _warm_matplotlib() -> None:
 
 
 _warm()
+collect_garbage()  # last: every cell forked from here starts with no garbage and no collection due

@@ -246,3 +246,39 @@ def test_a_failure_of_the_joint_warm_up_alone_is_still_reported(
     assert failures == [
         "methods a, c: warm-up together: RuntimeError: helper lost (each method's warm-up alone then succeeded)"
     ]
+
+
+_COLLECTED = """
+import gc
+import json
+
+import albot1.bench.preload  # what the forkserver imports before it forks any cell
+print(json.dumps({"count": gc.get_count(), "garbage": gc.collect()}))
+"""
+
+
+def test_the_server_leaves_no_garbage_and_no_collection_due_for_its_cells() -> None:
+    """A forked cell inherits the server's collector: nothing to free and generation 2 not due (issue 24)."""
+    import json
+
+    env = dict(os.environ, **{ENV: "odometry"})
+    out = subprocess.run([sys.executable, "-c", _COLLECTED], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    state = json.loads(out.stdout)
+    assert state["garbage"] == 0
+    assert state["count"][1:] == [0, 0]
+
+
+def test_a_forkserver_child_freezes_what_it_inherited_before_it_runs_the_cell(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Its collections then walk only what the cell allocates, never the server's heap (issue 24)."""
+    import gc
+
+    from albot1.bench import cell_main
+
+    order: list[str] = []
+    monkeypatch.setattr(gc, "freeze", lambda: order.append("freeze"))  # this test process is left as it is
+    monkeypatch.setattr(cell_main, "child_main", lambda args: order.append(f"cell {args['cell']}") or 0)
+    with pytest.raises(SystemExit) as ended:
+        cell_main.process_entry({"cell": "k"})
+    assert ended.value.code == 0
+    assert order == ["freeze", "cell k"]

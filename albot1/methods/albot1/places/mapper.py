@@ -51,7 +51,7 @@ from albot1.methods.albot1.places.kernels import PlacesKernels
 from albot1.methods.albot1.places.matcher import confirm, structural, trigger_threshold
 from albot1.methods.albot1.places.memory import Place, PlaceNetwork, Visit, invert, same_surfaces
 from albot1.methods.albot1.places.navigation import Prediction, align_at_exit, nearest_prediction, predict
-from albot1.methods.albot1.places.network import network_files
+from albot1.methods.albot1.places.network import load_graph_library, network_files
 from albot1.methods.albot1.warm_up import together, warm_up
 
 IntArray = NDArray[np.int64]
@@ -105,7 +105,11 @@ class Albot1PlacesMapper:
     warm_up_together = staticmethod(together)
 
     def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
-        """Compile every kernel, the places layer's too, before the timed loop (:meth:`Albot1Mapper.warm_up`)."""
+        """Compile every kernel, the places layer's too, and import the graph library, before the timed loop.
+
+        (:meth:`Albot1Mapper.warm_up`; :func:`load_graph_library`: ``finish`` then only writes the network.)
+        """
+        load_graph_library()
         if self.config.accelerate:
             warm_up((*self.inner.kernels, self._k), announce, skip=MappingKernels.not_called(self.config.pose_estimate))
 
