@@ -48,6 +48,7 @@ from albot1.settings import Settings
 if TYPE_CHECKING:
     from albot1.data.model import Sequence
 
+
 def evaluate_run(run_dir: Path, *, settings: Settings | None = None) -> MetricsRecord:
     """Compute every metric of the run in ``run_dir``, write ``metrics.json`` there, return it."""
     run = read_run(run_dir)

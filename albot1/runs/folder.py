@@ -53,7 +53,15 @@ METRICS_FILE = "metrics.json"
 LATEST = "latest"
 #: Files of a run that a new write of the same folder may not produce again (the metrics above all:
 #: they belong to the older run); :func:`write_run` removes them first.
-REWRITTEN_FILES = (METRICS_FILE, "reference.tum", "relations.txt", "map.geojson", "map.npz", "preview.png")
+REWRITTEN_FILES = (
+    METRICS_FILE,
+    "reference.tum",
+    "relations.txt",
+    "map.geojson",
+    "map.npz",
+    "preview.png",
+    "places.png",  # the preview's picture of a network of places (report/preview.py)
+)
 #: The files a run folder may hold (the bench's cell files included); a mapper's extra file must not take one.
 STANDARD_FILES = frozenset(
     {

@@ -36,9 +36,7 @@ def _sequence() -> Sequence:
 def test_a_run_folders_relations_read_back_as_they_were_scored(tmp_path: Path, counted: bool, note: bool) -> None:
     """A repeated relation line counts in a run folder as it did when scored; copies from before the reading
     note (``note=False``) counted every line."""
-    twice = Relations(
-        np.array([100.0, 100.0]), np.array([101.0, 101.0]), np.array([[0.6, 0.2, 0.1]] * 2), 1, counted
-    )
+    twice = Relations(np.array([100.0, 100.0]), np.array([101.0, 101.0]), np.array([[0.6, 0.2, 0.1]] * 2), 1, counted)
     once = Relations(np.array([100.0]), np.array([101.0]), np.array([[0.6, 0.2, 0.1]]), 1, counted)
     sequence = _sequence()
     sequence.relations = twice if counted else once
@@ -128,9 +126,11 @@ def test_rewriting_a_run_never_keeps_the_older_runs_metrics_or_files(tmp_path: P
     run_dir = write_run(result, tmp_path)
     evaluate_run(run_dir)
     (run_dir / "preview.png").write_bytes(b"old")
+    (run_dir / "places.png").write_bytes(b"old")
     assert (run_dir / "metrics.json").is_file()
     write_run(result, tmp_path)  # the same inputs again: same folder
     assert not (run_dir / "metrics.json").exists() and not (run_dir / "preview.png").exists()
+    assert not (run_dir / "places.png").exists()
     assert is_complete(run_dir)
 
 
@@ -185,7 +185,10 @@ def test_per_scan_times_are_written_atomically_and_no_temporary_file_stays(
     ("damage", "words"),
     [
         (lambda d: (d / "per_scan_ns.npy").unlink(), r"per_scan_ns\.npy: missing from a run folder marked complete"),
-        (lambda d: (d / "per_scan_ns.npy").write_text("garbage"), r"per_scan_ns\.npy: not a numpy array file this project wrote"),
+        (
+            lambda d: (d / "per_scan_ns.npy").write_text("garbage"),
+            r"per_scan_ns\.npy: not a numpy array file this project wrote",
+        ),
         (
             lambda d: np.save(d / "per_scan_ns.npy", np.zeros(3)),
             r"per_scan_ns\.npy: holds float64 of shape \(3,\); expected a \.npy array of 8 per-scan times",

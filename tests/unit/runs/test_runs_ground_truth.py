@@ -125,7 +125,9 @@ class _Cheat:
 def test_a_mapper_that_reads_ground_truth_fails_loudly(trap: list[Frame], monkeypatch: pytest.MonkeyPatch) -> None:
     spec = method_registry().get("odometry")
     monkeypatch.setattr(execute, "get_method", lambda name, registry=None: _Spec(spec, _trapped(_Cheat, trap)))
-    with pytest.raises(Exception, match=r"odometry on synthetic-office-startstop.* failed at scan 0: GroundTruthAccess"):
+    with pytest.raises(
+        Exception, match=r"odometry on synthetic-office-startstop.* failed at scan 0: GroundTruthAccess"
+    ):
         execute.run_method("odometry", open_sequence(WORLD), seed=0)
 
 

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from albot1.data.trajectory import write_tum
 from albot1.errors import Albot1Error
 from albot1.runs.evaluate import evaluate_pair
-from albot1.data.trajectory import write_tum
 from albot1.runs.pair import parse_alignment
 
 # Found, not imported, at collection: evo (with scipy, ~0.2 s) is imported by the test that compares with it.
