@@ -2,7 +2,7 @@
 
 A *kernel* is a loop over numpy arrays and scalars in the subset numba
 compiles, called from the mappers' Python code: it is decorated with
-:func:`kernel`, i.e. ``numba.njit(cache=True, nogil=True)``. A function a
+:func:`kernel`, i.e. ``numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)``. A function a
 kernel calls is decorated with :func:`jitable` (``numba.extending.register_jitable``):
 it stays the plain Python function when Python calls it and is compiled into
 every kernel that calls it. The geometry helpers the kernels call live in a
@@ -103,16 +103,21 @@ def _use_cache_dir() -> Path:
 CACHE_DIR: Path = _use_cache_dir()
 
 
-def kernel(fn: F) -> F:
-    """``numba.njit(cache=True, nogil=True)``: compiled on first call (or loaded from the cache), typed as written.
+#: numba's options of a kernel (``numba.njit``) and of a function kernels call (``register_jitable``)
+KERNEL_OPTIONS: dict[str, Any] = {"cache": True, "nogil": True, "no_cfunc_wrapper": True}
+JITABLE_OPTIONS: dict[str, Any] = {"no_cfunc_wrapper": True}
 
-    ``no_cfunc_wrapper``: numba otherwise also builds, optimises and
+
+def kernel(fn: F) -> F:
+    """``numba.njit(**KERNEL_OPTIONS)``: compiled on first call (or loaded from the cache), typed as written.
+
+    Cached, ``nogil``, and ``no_cfunc_wrapper``: numba otherwise also builds, optimises and
     generates machine code for a C-callable twin of every compiled function
     (for ``cfunc`` callbacks and first-class function values, which nothing
     here uses); without it a cold compile costs 5-10 % less CPU and the
     kernels' code is the same (``docs/albot1-mapper.md``, "Compile time").
     """
-    return cast(F, numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)(fn))
+    return cast(F, numba.njit(**KERNEL_OPTIONS)(fn))
 
 
 def jitable(fn: F) -> F:
@@ -120,7 +125,7 @@ def jitable(fn: F) -> F:
 
     Compiled without a C-callable twin, as :func:`kernel` is.
     """
-    jitted: F = register_jitable(no_cfunc_wrapper=True)(fn)
+    jitted: F = register_jitable(**JITABLE_OPTIONS)(fn)
     return jitted
 
 
