@@ -44,11 +44,17 @@ def command(preset: str, out: Path) -> list[str]:
     return [sys.executable, "-c", ENTRY, "run", *run, "--out", str(out)]
 
 
-def timed(argv: list[str], env: dict[str, str]) -> tuple[float, float]:
-    """Wall and CPU seconds (user + system of the child and its children) of one command, which must succeed."""
+def timed(argv: list[str], env: dict[str, str], cwd: Path) -> tuple[float, float]:
+    """Wall and CPU seconds (user + system of the child and its children) of one command, which must succeed.
+
+    Run in ``cwd``, a folder without code: ``python -c`` puts its working
+    folder first on ``sys.path``, before ``PYTHONPATH``'s tree.
+    """
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    done = subprocess.run(argv, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False)
+    done = subprocess.run(
+        argv, env=env, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False
+    )
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
@@ -62,8 +68,8 @@ def pair(tree: Path, preset: str, mpl: Path) -> str:
     with tempfile.TemporaryDirectory(prefix="albot1-first-run-") as folder:
         env = {**os.environ, "PYTHONPATH": str(tree), "XDG_CACHE_HOME": str(Path(folder) / "cache")}
         env["MPLCONFIGDIR"] = str(mpl)
-        cold = timed(command(preset, Path(folder) / "cold"), env)
-        warm = timed(command(preset, Path(folder) / "warm"), env)
+        cold = timed(command(preset, Path(folder) / "cold"), env, Path(folder))
+        warm = timed(command(preset, Path(folder) / "warm"), env, Path(folder))
     return (
         f"{tree.name or tree}  {preset:8s} cold {cold[0]:6.2f} s ({cold[1]:5.2f} CPU-s)  "
         f"warm {warm[0]:5.2f} s ({warm[1]:4.2f} CPU-s)  "
@@ -81,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     trees = [tree.resolve() for tree in args.trees]
     with tempfile.TemporaryDirectory(prefix="albot1-first-run-mpl-") as mpl:
         env = {**os.environ, "MPLCONFIGDIR": mpl, "PYTHONPATH": str(trees[0])}
-        subprocess.run([sys.executable, "-c", "import matplotlib.pyplot"], env=env, check=True)  # its font cache
+        subprocess.run([sys.executable, "-c", "import matplotlib.pyplot"], env=env, cwd=mpl, check=True)  # font cache
         for _ in range(args.rounds):
             for preset in args.presets:
                 for tree in trees:
