@@ -2,7 +2,7 @@
 
 A *kernel* is a loop over numpy arrays and scalars in the subset numba
 compiles, called from the mappers' Python code: it is decorated with
-:func:`kernel`, i.e. ``numba.njit(cache=True, nogil=True)``. A function a
+:func:`kernel`, i.e. ``numba.njit(cache=True, nogil=True, no_cfunc_wrapper=True)``. A function a
 kernel calls is decorated with :func:`jitable` (``numba.extending.register_jitable``):
 it stays the plain Python function when Python calls it and is compiled into
 every kernel that calls it. The geometry helpers the kernels call live in a
@@ -42,15 +42,24 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-import numba
-import numpy as np
-from numba.core import config as numba_config
-from numba.extending import register_jitable
-from numpy.typing import NDArray
+#: numba's documented switch for plain error messages; why it is on: :data:`PLAIN_ERRORS_ENV`'s comment
+PLAIN_ERRORS_ENV = "NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING"
+# Typing a kernel, numba tries each overload of every operation and formats an error message for each one that
+# does not fit (thousands per kernel, all discarded); with highlighting on, each message also sets colorama up
+# and tears it down. Off, a cold compile costs about 3 % less CPU (docs/albot1-mapper.md, "Compile time, fifth
+# round"). Numba reads the switch when it is first imported, hence here, before the import; a value set by the
+# user is kept, and numba's default colour scheme ("no_color") adds no colour either way.
+os.environ.setdefault(PLAIN_ERRORS_ENV, "1")
 
-from albot1 import versions
-from albot1.errors import ConfigError
-from albot1.geometry import se2, segments
+import numba  # noqa: E402  (after the switch above)
+import numpy as np  # noqa: E402
+from numba.core import config as numba_config  # noqa: E402
+from numba.extending import register_jitable  # noqa: E402
+from numpy.typing import NDArray  # noqa: E402
+
+from albot1 import versions  # noqa: E402
+from albot1.errors import ConfigError  # noqa: E402
+from albot1.geometry import se2, segments  # noqa: E402
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -94,14 +103,29 @@ def _use_cache_dir() -> Path:
 CACHE_DIR: Path = _use_cache_dir()
 
 
+#: numba's options of a kernel (``numba.njit``) and of a function kernels call (``register_jitable``)
+KERNEL_OPTIONS: dict[str, Any] = {"cache": True, "nogil": True, "no_cfunc_wrapper": True}
+JITABLE_OPTIONS: dict[str, Any] = {"no_cfunc_wrapper": True}
+
+
 def kernel(fn: F) -> F:
-    """``numba.njit(cache=True, nogil=True)``: compiled on first call (or loaded from the cache), typed as written."""
-    return cast(F, numba.njit(cache=True, nogil=True)(fn))
+    """``numba.njit(**KERNEL_OPTIONS)``: compiled on first call (or loaded from the cache), typed as written.
+
+    Cached, ``nogil``, and ``no_cfunc_wrapper``: numba otherwise also builds, optimises and
+    generates machine code for a C-callable twin of every compiled function
+    (for ``cfunc`` callbacks and first-class function values, which nothing
+    here uses); without it a cold compile costs 5-10 % less CPU and the
+    kernels' code is the same (``docs/albot1-mapper.md``, "Compile time").
+    """
+    return cast(F, numba.njit(**KERNEL_OPTIONS)(fn))
 
 
 def jitable(fn: F) -> F:
-    """``numba.extending.register_jitable``: ``fn`` itself for Python callers, compiled into the kernels calling it."""
-    jitted: F = register_jitable(fn)
+    """``numba.extending.register_jitable``: ``fn`` itself for Python callers, compiled into the kernels calling it.
+
+    Compiled without a C-callable twin, as :func:`kernel` is.
+    """
+    jitted: F = register_jitable(**JITABLE_OPTIONS)(fn)
     return jitted
 
 
