@@ -329,7 +329,7 @@ def save(fig: Figure, png: Path) -> Path:
     lay it out twice per format (a dry draw, then the real one, each running the constrained layout):
     four passes where two do (docs/benchmarking.md, "The report half, laid out once"). The PNG's pixels
     are those ``savefig(dpi=DPI)`` gives; the SVG's boxes are placed from text measured at the PNG's
-    resolution instead of at 72 dpi (a fraction of a point apart). Its dense layers (:func:`dense`) are
+    resolution instead of at 72 dpi (boxes up to about 1 pt apart). Its dense layers (:func:`dense`) are
     embedded as images at :data:`DPI`, as the point maps already were.
     """
     import matplotlib
@@ -338,10 +338,13 @@ def save(fig: Figure, png: Path) -> Path:
 
     plt = pyplot()
     fig.set_dpi(DPI)
-    FigureCanvasAgg(fig).print_png(png)  # one draw: the layout engine runs inside it, then the picture
+    # one draw: the layout engine runs inside it, then the picture is drawn
+    FigureCanvasAgg(fig).print_png(png)  # type: ignore[no-untyped-call]
     fig.set_layout_engine("none")  # keep the positions just computed (the engine would measure again)
     with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "albot1"}):  # text stays editable text
-        FigureCanvasSVG(fig).print_svg(png.with_suffix(f".{VECTOR_FORMAT}"), metadata={"Date": None})
+        FigureCanvasSVG(fig).print_svg(  # type: ignore[no-untyped-call]
+            png.with_suffix(f".{VECTOR_FORMAT}"), metadata={"Date": None}
+        )
     plt.close(fig)
     return png
 

@@ -132,15 +132,15 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
     out_rows: list[dict[str, Any]] = []
     # each column as floats once (None -> NaN, as ``dropna().astype(float)`` of a group saw it), and the
     # statistics from numpy: the same numbers as pandas' (same sums, same order), without a Series per call
-    numbers = {column: cells[column].astype(float).to_numpy() for column in columns}
+    numbers = {column: cells[column].to_numpy(dtype=np.float64, na_value=np.nan) for column in columns}
     reasons_of = {column: cells[f"{column}_na"].to_numpy(dtype=object) for column in columns if f"{column}_na" in cells}
     is_done = (cells["status"] == "done").to_numpy()
     groups = cells.groupby(list(KEY_COLUMNS), sort=False)
     for (dataset, method, degradation), group in groups:
         done = group[group["status"] == "done"]
         failed = group[group["status"] == "failed"]
-        rows = groups.indices[(dataset, method, degradation)]
-        rows = rows[is_done[rows]]
+        members = np.asarray(groups.indices[(dataset, method, degradation)], dtype=np.intp)
+        rows = members[is_done[members]]
         row: dict[str, Any] = {
             "dataset": dataset,
             "method": method,
@@ -153,7 +153,7 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
             "held_in": bool(group["held_in"].eq(True).any()) if "held_in" in group else False,
         }
         for column in columns:
-            values = numbers[column][rows]
+            values: NDArray[np.float64] = numbers[column][rows]
             values = values[~np.isnan(values)]
             row[f"{column}_n"] = int(len(values))
             for stat in STATS:
