@@ -333,13 +333,10 @@ def save(fig: Figure, png: Path) -> Path:
     embedded as images at :data:`DPI`, as the point maps already were.
     """
     import matplotlib
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.backends.backend_svg import FigureCanvasSVG
 
     plt = pyplot()
-    fig.set_dpi(DPI)
-    # one draw: the layout engine runs inside it, then the picture is drawn
-    FigureCanvasAgg(fig).print_png(png)  # type: ignore[no-untyped-call]
+    write_png(fig, png)
     fig.set_layout_engine("none")  # keep the positions just computed (the engine would measure again)
     with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "albot1"}):  # text stays editable text
         FigureCanvasSVG(fig).print_svg(  # type: ignore[no-untyped-call]
@@ -347,6 +344,17 @@ def save(fig: Figure, png: Path) -> Path:
         )
     plt.close(fig)
     return png
+
+
+def write_png(fig: Figure, png: Path) -> None:
+    """Write ``fig`` as ``png`` at :data:`DPI` in one draw (the pixels of ``savefig(png, dpi=DPI)``).
+
+    The layout engine runs inside that draw; ``savefig`` draws the figure once more before it, to lay it out.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig.set_dpi(DPI)
+    FigureCanvasAgg(fig).print_png(png)  # type: ignore[no-untyped-call]
 
 
 def dense(artist: Any) -> Any:
