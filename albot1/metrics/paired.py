@@ -33,6 +33,7 @@ from functools import lru_cache
 from typing import Final
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import ArrayLike, NDArray
 
 CONFIDENCE: Final = 0.95
@@ -126,6 +127,14 @@ def _pooled(num: float, den: float, power: int) -> float:
     return math.sqrt(num / den) if power == 2 else (num / den) ** (1.0 / power)
 
 
+def _pooled_all(num: NDArray[np.float64], den: NDArray[np.float64], power: int) -> NDArray[np.float64]:
+    """:func:`_pooled` of every resample at once (IEEE division, square root and power: the same numbers)."""
+    positive = den > 0
+    ratio = np.divide(num, den, out=np.full(len(num), np.inf), where=positive)
+    pooled = np.sqrt(ratio) if power == 2 else np.power(ratio, 1.0 / power)
+    return np.where(positive, pooled, np.inf)
+
+
 def _shape(n: int) -> tuple[int, int, int]:
     """``(n, block length, blocks)`` of a group of ``n`` errors."""
     length = max(1, math.ceil(n / BLOCKS))
@@ -169,12 +178,15 @@ def bootstrap_ratio(
     num = np.zeros(resamples)
     den = np.zeros(resamples)
     for (a, b), (n, length, _), first in zip(powered, shapes, starts, strict=True):
-        offsets = np.arange(length)
+        # a resample's blocks are copied whole from the windows of ``length`` errors, then summed as one
+        # contiguous row: the same values in the same order as gathering them one index at a time (so the
+        # same pairwise sums, bit for bit), at about half the cost
+        windows_a, windows_b = sliding_window_view(a, length), sliding_window_view(b, length)
         for lo in range(0, resamples, CHUNK):
-            idx = (first[lo : lo + CHUNK, :, None] + offsets).reshape(len(first[lo : lo + CHUNK]), -1)[:, :n]
-            num[lo : lo + CHUNK] += a[idx].sum(axis=1)
-            den[lo : lo + CHUNK] += b[idx].sum(axis=1)
-    draws = np.array([_pooled(float(x), float(y), power) for x, y in zip(num, den, strict=True)])
+            chunk = first[lo : lo + CHUNK]
+            num[lo : lo + CHUNK] += np.ascontiguousarray(windows_a[chunk].reshape(len(chunk), -1)[:, :n]).sum(axis=1)
+            den[lo : lo + CHUNK] += np.ascontiguousarray(windows_b[chunk].reshape(len(chunk), -1)[:, :n]).sum(axis=1)
+    draws = _pooled_all(num, den, power)
     tail = (1.0 - confidence) / 2
     low, high = np.quantile(draws, [tail, 1.0 - tail])
     return ratio, float(low), float(high)

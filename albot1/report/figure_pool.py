@@ -41,6 +41,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING
 
+from albot1.errors import Albot1Error
 from albot1.report.collect import CellRecord
 from albot1.report.cost_plots import plot_runtime, plot_scan_time
 from albot1.report.figure_cache import FigureCache, inputs_digest
@@ -155,6 +156,23 @@ def drawing_cost(records: list[CellRecord]) -> int:
     return size
 
 
+def read_pictured(records: list[CellRecord]) -> None:
+    """Read the run folder and the map of each pictured run of one dataset, into its record.
+
+    The report's own process reads them anyway (the paired comparisons read every run, the interactive view
+    the pictured maps), so reading them before a dataset is handed to a worker costs nothing more, and the
+    records sent to the worker carry them (numpy arrays pickle at memory speed; re-reading a run's text files
+    and decoding a line map's GeoJSON was ~10 CPU-s of the default report's workers). A run that cannot be
+    read is left to the figure that needs it, which fails as it did (the same error, from the worker).
+    """
+    for rec in representative(r for r in records if r.status == "done").values():
+        try:
+            rec.stored_run()
+            rec.map_geometry()  # reads the map too (stored_map), as the maps figure does
+        except Albot1Error:
+            continue
+
+
 def _size(path: Path) -> int:
     try:
         return path.stat().st_size
@@ -221,6 +239,7 @@ class PendingPlots:
         pool = self._pool
         costs = {dataset: drawing_cost(self._by_dataset[dataset]) for dataset in self._to_draw}
         for dataset in sorted(self._to_draw, key=lambda d: -costs[d]):  # stable: equal costs keep suite order
+            read_pictured(self._by_dataset[dataset])  # sent with the records: the worker reads nothing again
             args = (dataset, self._by_dataset[dataset], self._plots_dir, self._colors, self._map_style)
             self._runs[dataset] = pool.submit(_run_figures, *args)
             self._runs[dataset].add_done_callback(self._ended(dataset))

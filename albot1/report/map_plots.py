@@ -22,6 +22,7 @@ from albot1.report.plots import (
     REFERENCE_COLOR,
     Extent,
     aligned_poses,
+    dense,
     has_reference,
     label_grid,
     panel_layout,
@@ -78,7 +79,7 @@ def _draw_map(ax: Any, rec: CellRecord, extent: Extent, style: MapStyle) -> None
     if data.segments is not None and len(data.segments):
         ends = np.asarray(data.segments, dtype=float).reshape(-1, 2)
         seg = transform_points(ends, run.poses, run.reference).reshape(-1, 2, 2)
-        ax.add_collection(LineCollection(list(seg), colors="0.15", linewidths=0.8, zorder=2))
+        ax.add_collection(dense(LineCollection(list(seg), colors="0.15", linewidths=0.8, zorder=2)))
 
 
 def _extent(runs: dict[str, CellRecord]) -> Extent:

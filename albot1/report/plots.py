@@ -15,8 +15,9 @@
 * **Figures follow the data's shape** (:func:`panel_layout`): a long narrow
   corridor gets wide, flat panels stacked in rows instead of a 20-pixel
   strip; legends sit outside the axes.
-* **PNG and SVG** of every figure (:func:`save`): PNG for the pages, SVG for
-  papers (dense map layers are embedded as images inside the SVG).
+* **PNG and SVG** of every figure (:func:`save`, laid out once for both): PNG
+  for the pages, SVG for papers (dense layers, the point maps, the line maps
+  and the per-pose error tracks, are embedded as images inside the SVG).
 """
 
 from __future__ import annotations
@@ -322,15 +323,48 @@ def value_axis(ax: Any, floor: float | None, clipped: list[str], unit: str) -> N
 
 
 def save(fig: Figure, png: Path) -> Path:
-    """Write ``png`` and its vector twin (same stem, ``.svg``); close the figure; return the PNG's path."""
+    """Write ``png`` and its vector twin (same stem, ``.svg``); close the figure; return the PNG's path.
+
+    The figure is laid out once, by the PNG's own draw, and the SVG reuses that layout. ``savefig`` would
+    lay it out twice per format (a dry draw, then the real one, each running the constrained layout):
+    four passes where two do (docs/benchmarking.md, "The report half, laid out once"). The PNG's pixels
+    are those ``savefig(dpi=DPI)`` gives; the SVG's boxes are placed from text measured at the PNG's
+    resolution instead of at 72 dpi (boxes up to about 1 pt apart). Its dense layers (:func:`dense`) are
+    embedded as images at :data:`DPI`, as the point maps already were.
+    """
     import matplotlib
+    from matplotlib.backends.backend_svg import FigureCanvasSVG
 
     plt = pyplot()
-    fig.savefig(png, format="png", dpi=DPI)
+    write_png(fig, png)
+    fig.set_layout_engine("none")  # keep the positions just computed (the engine would measure again)
     with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "albot1"}):  # text stays editable text
-        fig.savefig(png.with_suffix(f".{VECTOR_FORMAT}"), format=VECTOR_FORMAT, metadata={"Date": None})
+        FigureCanvasSVG(fig).print_svg(  # type: ignore[no-untyped-call]
+            png.with_suffix(f".{VECTOR_FORMAT}"), metadata={"Date": None}
+        )
     plt.close(fig)
     return png
+
+
+def write_png(fig: Figure, png: Path) -> None:
+    """Write ``fig`` as ``png`` at :data:`DPI` in one draw (the pixels of ``savefig(png, dpi=DPI)``).
+
+    The layout engine runs inside that draw; ``savefig`` draws the figure once more before it, to lay it out.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig.set_dpi(DPI)
+    FigureCanvasAgg(fig).print_png(png)  # type: ignore[no-untyped-call]
+
+
+def dense(artist: Any) -> Any:
+    """Mark ``artist`` (a collection of thousands of segments) to be drawn as an image in the SVG twin.
+
+    Written as vectors, each segment is an SVG element of its own: most of the file and of its writing
+    time. The PNG is unchanged (it is an image anyway). Returns ``artist``.
+    """
+    artist.set_rasterized(True)
+    return artist
 
 
 def vector_of(png: Path) -> Path:

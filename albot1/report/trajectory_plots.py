@@ -26,6 +26,7 @@ from albot1.report.plots import (
     REFERENCE_COLOR,
     Extent,
     aligned_poses,
+    dense,
     has_reference,
     label_grid,
     log_floor,
@@ -125,7 +126,7 @@ def plot_ape_map(records: list[CellRecord], dataset: str, path: Path, colors: di
         errors = errors_of[label]
         ax.plot(ref[:, 0], ref[:, 1], color="0.55", lw=0.9, ls="--", zorder=1)
         segments = np.stack([xy[:-1, :2], xy[1:, :2]], axis=1)
-        lc = LineCollection(list(segments), cmap=APE_COLORMAP, linewidths=1.6, zorder=2)
+        lc = dense(LineCollection(list(segments), cmap=APE_COLORMAP, linewidths=1.6, zorder=2))
         lc.set_array((errors[:-1] + errors[1:]) / 2)
         lc.set_clim(0.0, top)
         ax.add_collection(lc)

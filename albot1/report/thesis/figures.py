@@ -23,7 +23,6 @@ from albot1.geometry.types import FloatArray
 from albot1.metrics.alignment import alignment_transform
 from albot1.metrics.errors import MetricsError
 from albot1.report.plots import (
-    DPI,
     REFERENCE_COLOR,
     Extent,
     has_reference,
@@ -32,6 +31,7 @@ from albot1.report.plots import (
     pyplot,
     robust_points,
     save,
+    write_png,
 )
 from albot1.report.thesis.replay import Replay
 from albot1.runs.folder import StoredRun
@@ -108,7 +108,7 @@ def _draw_state(ax: Any, replay: Replay, k: int, transform: FloatArray, *, highl
 
 def save_png(fig: Any, png: Path) -> Path:
     """Write ``png`` only: the trace's many panels would make a vector twin of several MB and seconds to write."""
-    fig.savefig(png, format="png", dpi=DPI)
+    write_png(fig, png)  # laid out in its one draw
     pyplot().close(fig)
     return png
 

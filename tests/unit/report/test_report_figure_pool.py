@@ -41,3 +41,32 @@ def test_a_datasets_figures_keep_their_order_whichever_task_drew_them(tmp_path: 
     robustness = [f"d-{kind}.png" for _, _, kind in ROBUSTNESS]
     expected = ["d-trajectories.png", "d-ape.png", "d-error-distance.png", "d-rpe-boxes.png", "d-maps.png"]
     assert names == [*expected, *robustness, "d-scan-time.png"]
+
+
+class _Run:
+    """A record's reading, counted (what read_pictured asks of a CellRecord)."""
+
+    def __init__(self, method: str, seed: int, status: str = "done", broken: bool = False) -> None:
+        self.cell = SimpleNamespace(method_label=method, degradation="none", seed=seed)
+        self.status = status
+        self.broken = broken
+        self.read: list[str] = []
+
+    def stored_run(self) -> None:
+        if self.broken:
+            from albot1.runs.errors import RunError
+
+            raise RunError("trajectory.tum: damaged")
+        self.read.append("run")
+
+    def map_geometry(self) -> None:
+        self.read.append("map")
+
+
+def test_the_pictured_runs_are_read_before_the_workers_get_them_and_a_damaged_one_is_left() -> None:
+    from albot1.report.figure_pool import read_pictured
+
+    pictured, other, failed, broken = _Run("a", 0), _Run("a", 1), _Run("b", 0, "failed"), _Run("c", 0, broken=True)
+    read_pictured(cast(list[CellRecord], [other, pictured, failed, broken]))  # the lowest seed is pictured
+    assert pictured.read == ["run", "map"]
+    assert other.read == [] and failed.read == [] and broken.read == []  # the damaged one fails in its figure
