@@ -24,14 +24,16 @@ export MPLBACKEND := Agg
 venv: $(STAMP)
 
 # The project is installed by uv (itself installed from PyPI into the venv): the same versions as pip picks
-# for pyproject.toml, in ~2-8 s instead of pip's ~32 s (docs/benchmarking.md, "Installing"). uv reads neither
+# for pyproject.toml, in ~12 s instead of pip's ~32 s (docs/benchmarking.md, "Installing"). Like pip, it
+# compiles the bytecode at install (--compile-bytecode): with PYTHONDONTWRITEBYTECODE set, as on this machine,
+# no process would ever write it, and each would compile every module it imports again. uv reads neither
 # pip.conf nor pip's find-links, so where it cannot be installed or cannot reach its index the install falls
 # back to pip, saying so; INSTALLER=pip chooses pip from the start (e.g. behind a private index).
 INSTALLER ?= uv
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	if [ "$(INSTALLER)" = uv ] && $(BIN)/python -m pip install --quiet uv \
-	    && $(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[dev]'; then :; else \
+	    && $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[dev]'; then :; else \
 	  [ "$(INSTALLER)" = uv ] && echo "make venv: uv could not install the project; installing with pip" >&2; \
 	  $(BIN)/python -m pip install --quiet --upgrade pip && $(BIN)/python -m pip install --quiet -e '.[dev]'; \
 	fi
