@@ -31,6 +31,7 @@ venv: $(STAMP)
 # back to pip, saying so; INSTALLER=pip chooses pip from the start (e.g. behind a private index).
 INSTALLER ?= uv
 $(STAMP): pyproject.toml
+	@case "$(INSTALLER)" in uv|pip) ;; *) echo "make venv: INSTALLER=$(INSTALLER): expected uv or pip" >&2; exit 2;; esac
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	if [ "$(INSTALLER)" = uv ] && $(BIN)/python -m pip install --quiet uv \
 	    && $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[dev]'; then :; else \

@@ -129,7 +129,7 @@ def _pooled(num: float, den: float, power: int) -> float:
 
 def _pooled_all(num: NDArray[np.float64], den: NDArray[np.float64], power: int) -> NDArray[np.float64]:
     """:func:`_pooled` of every resample at once (IEEE division, square root and power: the same numbers)."""
-    positive = den > 0
+    positive = ~(den <= 0)  # as _pooled's test: a NaN sum is divided (NaN), not taken for zero (inf)
     ratio = np.divide(num, den, out=np.full(len(num), np.inf), where=positive)
     pooled = np.sqrt(ratio) if power == 2 else np.power(ratio, 1.0 / power)
     return np.where(positive, pooled, np.inf)
@@ -178,6 +178,8 @@ def bootstrap_ratio(
     num = np.zeros(resamples)
     den = np.zeros(resamples)
     for (a, b), (n, length, _), first in zip(powered, shapes, starts, strict=True):
+        if n == 0:  # an empty group adds nothing to any resample (and has no window to copy)
+            continue
         # a resample's blocks are copied whole from the windows of ``length`` errors, then summed as one
         # contiguous row: the same values in the same order as gathering them one index at a time (so the
         # same pairwise sums, bit for bit), at about half the cost

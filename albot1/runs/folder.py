@@ -74,6 +74,7 @@ STANDARD_FILES = frozenset(
         "map.npz",
         "extras.json",
         "preview.png",
+        "places.png",
         PER_SCAN_FILE,
         METRICS_FILE,
         DONE,

@@ -35,7 +35,6 @@ from multiprocessing.process import BaseProcess
 from pathlib import Path
 from typing import Any, cast
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -320,6 +319,8 @@ def _set_up_numba() -> None:
     ``benchmarks/compile_cost.py warm-up thesis``: the longest path 4.8 ->
     4.5-4.6 CPU-s (``docs/albot1-mapper.md``, "Compile time").
     """
+    import numba  # here, not at the top: :mod:`.compiled` (imported above) sets numba's switches before its import
+
     copy = cast(Callable[[NDArray[np.float64]], NDArray[np.float64]], numba.njit(_copy))
     copy(np.zeros(1))
 

@@ -128,3 +128,15 @@ def test_the_block_copies_give_the_bits_of_the_index_by_index_gather(power: int,
     pairs[0][1][: len(pairs[0][1]) // 2] = 0.0  # resamples whose B error is zero: an infinite draw, as before
     _, low, high = bootstrap_ratio(pairs, power=power, resamples=700, seed=11)
     assert (low, high) == _gathered_one_index_at_a_time(pairs, power, 700, 11)
+
+
+@pytest.mark.parametrize("power", [1, 2])
+def test_a_nan_error_and_an_empty_group_give_the_gathers_numbers(power: int) -> None:
+    """A NaN error makes NaN draws (not infinite ones) and an empty group adds nothing, as in the gather."""
+    rng = np.random.default_rng(5 + power)
+    a, b = rng.gamma(2.0, 0.3, 30), rng.gamma(2.0, 0.35, 30)
+    b[7] = np.nan
+    pairs = [(a, b), (np.array([]), np.array([])), (rng.gamma(2.0, 0.3, 12), rng.gamma(2.0, 0.3, 12))]
+    _, low, high = bootstrap_ratio(pairs, power=power, resamples=300, seed=2)
+    expected = _gathered_one_index_at_a_time(pairs, power, 300, 2)
+    assert np.array_equal([low, high], expected, equal_nan=True), ((low, high), expected)

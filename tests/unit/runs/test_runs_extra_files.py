@@ -16,7 +16,7 @@ from albot1.report.preview import render_preview
 from albot1.runs.errors import RunError
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
-from albot1.runs.folder import STANDARD_FILES, is_complete, write_run
+from albot1.runs.folder import REWRITTEN_FILES, STANDARD_FILES, is_complete, write_run
 
 
 def test_extra_files_are_written_as_text_bytes_or_json(tmp_path: Path) -> None:
@@ -36,6 +36,7 @@ def test_an_extra_file_may_not_take_a_run_folder_name_or_leave_it(tmp_path: Path
     with pytest.raises(RunError, match="extra file name"):
         write_run(result, tmp_path)
     assert "result.json" in STANDARD_FILES
+    assert set(REWRITTEN_FILES) <= STANDARD_FILES  # what a rewrite removes is never a mapper's own file
 
 
 def test_albot1_places_run_folder_has_its_network_judged_against_the_reference(tmp_path: Path) -> None:
