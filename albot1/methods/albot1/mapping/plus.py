@@ -269,7 +269,9 @@ class PlusLocaliser:
                 )
                 if support.statistic <= p.turn_statistic:
                     self.turn_bounded_views += 1
-                    near = bounded_starts(starts, limit)
+                    # around the prediction the allowance is measured from, not the first start (the previous
+                    # view's pose composed with the step: between updates the two differ)
+                    near = bounded_starts(start_poses(predicted, None, None), limit)
                     measured, info = self._solve(near, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
                     if beyond(measured[2] - predicted[2], limit):
                         return predicted

@@ -104,3 +104,24 @@ def test_the_thesis_presets_leave_the_bound_off() -> None:
     for name in ("default", "thesis", "exact", "literal"):
         config = Albot1Config.model_validate({**Albot1Mapper.presets["default"], **Albot1Mapper.presets[name]})
         assert config.turn_bound_floor_deg == 0.0
+
+
+def test_the_refit_starts_centre_on_the_prediction_not_on_the_first_start(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Between updates the first start (the previous view's pose and the step) is not the prediction the
+    allowance is measured from (the update view's pose and the odometry since): the refit starts around the latter."""
+    loc = localiser(turn_bound_floor_deg=3.0, turn_bound_scale=1.0, turn_bound_statistic=1e300)
+    seen: list[np.ndarray] = []
+    solve = loc._solve
+
+    def spy(starts: np.ndarray, *rest: object) -> object:
+        seen.append(np.array(starts))
+        return solve(starts, *rest)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(loc, "_solve", spy)
+    first = (0.0, 0.5, math.radians(8.0))  # a previous view refined 8 deg away from the prediction
+    empty = np.empty((0, 4))
+    pose = loc.pose(start_poses(first, None, None), empty, empty, NO_KINDS, scan_from(TURNED), SINCE, None, False)
+    assert pose == SINCE and loc.turn_bounded_views == 1  # the true 10 deg is beyond 3 deg from the prediction
+    assert len(seen) == 2
+    np.testing.assert_allclose(np.degrees(seen[1][:, 2]), [0.0, -3.0, 3.0], atol=1e-9)
+    assert (seen[1][:, :2] == SINCE[:2]).all()
