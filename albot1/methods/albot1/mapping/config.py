@@ -239,7 +239,8 @@ class Albot1Config(BaseModel):
         0.0,
         ge=0,
         description=(
-            "Albot1+ turn bound: a view no landmark places may depart from the odometry's predicted heading by"
+            "Albot1+ (adaptive prior) turn bound: a view no landmark places may depart from the odometry's"
+            " predicted heading by"
             " at most this plus turn_bound_scale times the odometry's turn since the last update view unless it"
             " refutes the odometry beyond turn_bound_statistic: else it is fitted from the starts within that"
             " allowance, and a fit still beyond keeps the prediction (0 = off; docs/albot1-mapper.md)"

@@ -103,7 +103,9 @@ class GtsamGraphConfig(BaseModel):
         ge=0, description="... a trusted component's variance never below this times its match's (1: never more weight)"
     )
     odometry_trust_floor_turn_deg: float = Field(
-        ge=0, description="... that floor only on steps whose odometry turns at least this much (0: every step)"
+        ge=0,
+        description="... that floor only on steps whose odometry turns at least this much (0: every step; not "
+        "consulted for a kind learnt apart, odometry_trust_turn_deg, once it holds odometry_trust_kind_min_steps)",
     )
     odometry_trust_turn_deg: float = Field(
         gt=0,
