@@ -225,50 +225,14 @@ def _refine_args() -> Iterator[tuple[Any, ...]]:
         points = np.ascontiguousarray(view.surfaces.reshape(-1, 2) + rng.normal(0.0, 0.02, (2 * len(view), 2)))
         ref = np.ascontiguousarray(ref_view.surfaces)
         starts = np.ascontiguousarray(rng.normal(0.0, [0.1, 0.1, 0.05], (3, 3)))
-        for prior in ((0.0, 0.0, 0.0, 0.0, 0.0), (0.05, -0.02, 0.03, 400.0, 3000.0)):
-            yield (starts, lm_view, lm_map, ok, points, ref, *prior, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
+        no_prior = (0.0, 0.0, 0.0, 0.0, 0.0)
+        solver = (0.05, 0.1, 0.05, 2.0, 0.5, 8)  # line, point and scan sigmas, Huber, scan gate, iterations
+        for prior in (no_prior, (0.05, -0.02, 0.03, 400.0, 3000.0)):
+            yield (starts, lm_view, lm_map, ok, points, ref, *prior, *solver, math.inf)
         # The overlap rule (mapping/overlap.py) on: points beyond a surface's end are matched elsewhere or not at all.
         for overhang in (0.0, 0.1):
-            yield (
-                starts,
-                lm_view,
-                lm_map,
-                ok,
-                points,
-                ref,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                0.05,
-                0.1,
-                0.05,
-                2.0,
-                0.5,
-                8,
-                overhang,
-            )
-        yield (
-            starts[:1],
-            lm_view[:0],
-            lm_map[:0],
-            ok[:0],
-            points,
-            ref,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.05,
-            0.1,
-            0.05,
-            2.0,
-            0.5,
-            8,
-            math.inf,
-        )
+            yield (starts, lm_view, lm_map, ok, points, ref, *no_prior, *solver, overhang)
+        yield (starts[:1], lm_view[:0], lm_map[:0], ok[:0], points, ref, *no_prior, *solver, math.inf)
 
 
 def _measurement_costs_args() -> Iterator[tuple[Any, ...]]:
