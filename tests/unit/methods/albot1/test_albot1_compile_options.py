@@ -12,7 +12,9 @@ import os
 import subprocess
 import sys
 
-from albot1.methods.albot1.compiled import jitable, kernel
+import numba
+
+from albot1.methods.albot1.compiled import KERNEL_OPTIONS, jitable
 
 
 @jitable
@@ -20,9 +22,13 @@ def _double(x: float) -> float:
     return 2.0 * x
 
 
-@kernel
-def _twice(x: float) -> float:
+def _twice_source(x: float) -> float:
     return _double(x)
+
+
+# A kernel with :func:`~albot1.methods.albot1.compiled.kernel`'s options but numba's disk cache: compiled in every
+# run of the tests, never loaded from an earlier one's cache, which keeps no callee's code to inspect.
+_twice = numba.njit(**{**KERNEL_OPTIONS, "cache": False})(_twice_source)
 
 
 def _defines_a_cfunc_wrapper(llvm_ir: str) -> bool:
