@@ -30,8 +30,14 @@ venv: $(STAMP)
 # pip.conf nor pip's find-links, so where it cannot be installed or cannot reach its index the install falls
 # back to pip, saying so; INSTALLER=pip chooses pip from the start (e.g. behind a private index).
 INSTALLER ?= uv
+# After installing, `albot1 warm-up` compiles Albot1's numba kernels for this machine and code version (~15 s
+# on 2 cores), as pip compiles bytecode at install: the first run after an install then loads them from numba's
+# cache instead of compiling them (docs/albot1-mapper.md, "Kernels"). WARM_UP=0 leaves that to the first run.
+# A failed warm-up does not fail the install: it says so, and the tests then show which kernel fails and why.
+WARM_UP ?= 1
 $(STAMP): pyproject.toml
 	@case "$(INSTALLER)" in uv|pip) ;; *) echo "make venv: INSTALLER=$(INSTALLER): expected uv or pip" >&2; exit 2;; esac
+	@case "$(WARM_UP)" in 0|1) ;; *) echo "make venv: WARM_UP=$(WARM_UP): expected 1 (compile the kernels) or 0" >&2; exit 2;; esac
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	if [ "$(INSTALLER)" = uv ] && $(BIN)/python -m pip install --quiet uv \
 	    && $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[dev]'; then :; else \
@@ -40,6 +46,8 @@ $(STAMP): pyproject.toml
 	fi
 	rm -f $(VENV)/.installed-*
 	touch $@
+	@if [ "$(WARM_UP)" = 1 ]; then $(BIN)/albot1 warm-up \
+	  || echo "make venv: NOTICE: albot1 warm-up failed (above); the first run will compile its kernels itself" >&2; fi
 
 # Every test (unit, property, integration on the public logs when ALBOT1_DATA_DIR has them, the slow
 # whole-world runs), spread over TEST_JOBS worker processes (pytest-xdist; auto = one per core).

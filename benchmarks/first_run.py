@@ -12,6 +12,11 @@ to alternate, pair by pair, so that old and new code meet the same load::
 
     python benchmarks/first_run.py --presets thesis plus places --rounds 2
     python benchmarks/first_run.py --trees /tmp/old . --presets thesis --rounds 3
+    python benchmarks/first_run.py --install-warm-up --presets thesis plus places --rounds 2
+
+``--install-warm-up`` first runs ``albot1 warm-up`` on the empty cache, as
+``make venv`` does after installing, and reports its time apart (it is the
+install's cost); the first run then follows it.
 
 Presets: ``albot1`` presets on ``synthetic-office-loop``, and ``places``
 (``albot1-places`` default on ``synthetic-places-loop``), the commands of
@@ -62,16 +67,22 @@ def timed(argv: list[str], env: dict[str, str], cwd: Path) -> tuple[float, float
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def pair(tree: Path, preset: str, mpl: Path) -> str:
-    """One cold and one warm run of ``preset`` from source tree ``tree`` on a fresh cache: a line of numbers."""
+def pair(tree: Path, preset: str, mpl: Path, install_warm_up: bool = False) -> str:
+    """One cold and one warm run of ``preset`` from source tree ``tree`` on a fresh cache: a line of numbers.
+
+    ``install_warm_up``: ``albot1 warm-up`` first, as ``make venv`` runs it after installing (timed apart).
+    """
     load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="albot1-first-run-") as folder:
         env = {**os.environ, "PYTHONPATH": str(tree), "XDG_CACHE_HOME": str(Path(folder) / "cache")}
         env["MPLCONFIGDIR"] = str(mpl)
+        install = timed([sys.executable, "-c", ENTRY, "warm-up"], env, Path(folder)) if install_warm_up else None
         cold = timed(command(preset, Path(folder) / "cold"), env, Path(folder))
         warm = timed(command(preset, Path(folder) / "warm"), env, Path(folder))
+    installed = f"install warm-up {install[0]:6.2f} s ({install[1]:5.2f} CPU-s)  " if install else ""
     return (
-        f"{tree.name or tree}  {preset:8s} cold {cold[0]:6.2f} s ({cold[1]:5.2f} CPU-s)  "
+        f"{tree.name or tree}  {preset:8s} {installed}{'first' if install else 'cold'} "
+        f"{cold[0]:6.2f} s ({cold[1]:5.2f} CPU-s)  "
         f"warm {warm[0]:5.2f} s ({warm[1]:4.2f} CPU-s)  "
         f"adds {cold[0] - warm[0]:5.2f} s ({cold[1] - warm[1]:5.2f} CPU-s)  "
         f"load {load:.1f} -> {os.getloadavg()[0]:.1f}"
@@ -83,6 +94,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--presets", nargs="+", default=["thesis", "plus"], help="albot1 presets, or places")
     parser.add_argument("--trees", nargs="+", type=Path, default=[Path.cwd()], help="source trees to alternate")
     parser.add_argument("--rounds", type=int, default=1)
+    parser.add_argument(
+        "--install-warm-up", action="store_true", help="run `albot1 warm-up` first, as `make venv` does (timed apart)"
+    )
     args = parser.parse_args(argv)
     trees = [tree.resolve() for tree in args.trees]
     with tempfile.TemporaryDirectory(prefix="albot1-first-run-mpl-") as mpl:
@@ -91,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         for _ in range(args.rounds):
             for preset in args.presets:
                 for tree in trees:
-                    print(pair(tree, preset, Path(mpl)), flush=True)
+                    print(pair(tree, preset, Path(mpl), args.install_warm_up), flush=True)
     return 0
 
 

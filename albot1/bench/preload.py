@@ -18,7 +18,6 @@ of a method left out imports and warms it up itself).
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import gc
 import importlib
@@ -86,6 +85,7 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
     from albot1.config.targets import resolve_target
     from albot1.data.loaders.registry import FORMATS
     from albot1.methods.registry import method_registry
+    from albot1.methods.warm_ups import warm_up_methods
 
     failures: list[str] = []
     for name in modules:
@@ -102,59 +102,11 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
         if (methods is None or spec.name in methods) and spec.available():
             _attempt(f"method {spec.name} ({spec.target})", spec.load_class, failures)
             warmed.append(spec.name)
-    _warm_ups(warmed, registry, failures)
+    # Every preset's warm-up, once, here, before any fork: every cell forked from this server then starts with the
+    # kernels in memory, so a cell's start-up is not paid once per cell (1.3-1.9 s for Albot1 with numba's cache
+    # filled).
+    failures.extend(warm_up_methods(warmed, registry))
     return failures
-
-
-def _warm_ups(methods: list[str], registry: MethodRegistry | None, failures: list[str]) -> None:
-    """Every method's warm-up (:func:`_warm_up`), compiled together where the classes offer it, else one by one.
-
-    A class may offer ``warm_up_together()``, a context manager inside which
-    its warm-ups only note their kernels and which compiles them all when
-    it ends (:func:`albot1.methods.albot1.warm_up.together`): one cold compile
-    of every preset of ``albot1`` and ``albot1-places`` keeps the cores busy
-    to the end, where a warm-up per preset waits for its own dearest kernel
-    each time. Should anything in it fail, the warm-ups run again one by one,
-    so that each failure is reported under its own method (what was compiled
-    before the failure is loaded from numba's cache, not compiled again).
-    """
-    from albot1.methods.registry import get_method
-
-    try:
-        with contextlib.ExitStack() as stack:
-            for method in methods:
-                together = getattr(get_method(method, registry).load_class(), "warm_up_together", None)
-                if together is not None:
-                    stack.enter_context(together())
-            for method in methods:
-                _warm_up(method, registry)
-    except Exception as exc:  # noqa: BLE001 -- reported: under its method below, or as itself if it does not recur
-        reported = len(failures)
-        for method in methods:
-            _attempt(f"method {method}: warm-up", functools.partial(_warm_up, method, registry), failures)
-        if len(failures) == reported:
-            failures.append(
-                f"methods {', '.join(methods)}: warm-up together: {type(exc).__name__}: {exc} "
-                "(each method's warm-up alone then succeeded)"
-            )
-
-
-def _warm_up(method: str, registry: MethodRegistry | None) -> None:
-    """Run a method's optional ``warm_up`` (compiling or loading its kernels) once, here, before any fork.
-
-    Every cell forked from this server then starts with the kernels in
-    memory: its own warm-up finds nothing left to compile or load, so a
-    cell's start-up is not paid once per cell (1.3-1.9 s for Albot1 with
-    numba's cache filled). Methods without ``warm_up`` are not built.
-    """
-    from albot1.methods.registry import get_method, resolve_config
-
-    cls = get_method(method, registry).load_class()
-    warm = getattr(cls, "warm_up", None)
-    if warm is None:
-        return
-    for preset in cls.presets:  # every preset: a preset's warm-up may leave out kernels only others call
-        cls(resolve_config(method, preset, registry=registry), seed=0).warm_up(None)  # type: ignore[attr-defined]
 
 
 def methods_to_preload() -> frozenset[str] | None:

@@ -76,6 +76,7 @@ _COMMANDS: tuple[tuple[str, str, str | None], ...] = (
     ("albot1.cli.runs", "register", None),
     ("albot1.cli.bench", "register", None),
     ("albot1.cli.results", "register", None),
+    ("albot1.cli.warm_up", "register", None),
 )
 
 for _module_name, _attr, _group in _COMMANDS:

@@ -1,0 +1,79 @@
+"""Every preset's start-up work of some methods, done now: the bench's forkserver and ``albot1 warm-up`` share it.
+
+A method's optional ``warm_up`` (``Mapper.warm_up``; Albot1's compiles its
+numba kernels, or loads them from numba's on-disk cache) runs before a run's
+first scan. Doing it for every preset ahead of the runs serves two callers:
+the bench's forkserver, so that each forked cell starts with the kernels in
+memory, and ``albot1 warm-up`` (run by ``make venv``), so that the first run
+after an install loads the kernels from the cache instead of compiling them
+(``docs/albot1-mapper.md``, "Kernels").
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from albot1.methods.registry import MethodRegistry
+
+
+def warm_up_methods(
+    methods: list[str], registry: MethodRegistry | None = None, announce: Callable[[str], None] | None = None
+) -> list[str]:
+    """Every preset's warm-up of ``methods``, compiled together where the classes offer it; the failures, one per line.
+
+    A class may offer ``warm_up_together()``, a context manager inside which
+    its warm-ups only note their kernels and which compiles them all when
+    it ends (:func:`albot1.methods.albot1.warm_up.together`): one cold compile
+    of every preset of ``albot1`` and ``albot1-places`` keeps the cores busy
+    to the end, where a warm-up per preset waits for its own dearest kernel
+    each time. Should anything in it fail, the warm-ups run again one by one,
+    so that each failure is reported under its own method (what was compiled
+    before the failure is loaded from numba's cache, not compiled again).
+    ``announce`` receives the warm-ups' own lines (a real compilation says so
+    and how long it took; a cache load is silent).
+    """
+    from albot1.methods.registry import get_method
+
+    failures: list[str] = []
+    try:
+        with contextlib.ExitStack() as stack:
+            for method in methods:
+                together = getattr(get_method(method, registry).load_class(), "warm_up_together", None)
+                if together is not None:
+                    stack.enter_context(together())
+            for method in methods:
+                warm_up_method(method, registry, announce)
+    except Exception as exc:  # noqa: BLE001 -- reported: under its method below, or as itself if it does not recur
+        for method in methods:
+            try:
+                warm_up_method(method, registry, announce)
+            except Exception as again:  # noqa: BLE001 -- each method's own failure, reported under its name
+                failures.append(f"method {method}: warm-up: {type(again).__name__}: {again}")
+        if not failures:
+            failures.append(
+                f"methods {', '.join(methods)}: warm-up together: {type(exc).__name__}: {exc} "
+                "(each method's warm-up alone then succeeded)"
+            )
+    return failures
+
+
+def warm_up_method(
+    method: str, registry: MethodRegistry | None = None, announce: Callable[[str], None] | None = None
+) -> bool:
+    """Run ``method``'s optional ``warm_up`` once for each of its presets; whether it has one.
+
+    Every preset: a preset's warm-up may leave out kernels that only the
+    others call. Methods without ``warm_up`` are not built.
+    """
+    from albot1.methods.registry import get_method, resolve_config
+
+    cls = get_method(method, registry).load_class()
+    warm = getattr(cls, "warm_up", None)
+    if warm is None:
+        return False
+    for preset in cls.presets:
+        cls(resolve_config(method, preset, registry=registry), seed=0).warm_up(announce)  # type: ignore[attr-defined]
+    return True
