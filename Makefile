@@ -30,6 +30,9 @@ venv: $(STAMP)
 # pip.conf nor pip's find-links, so where it cannot be installed or cannot reach its index the install falls
 # back to pip, saying so; INSTALLER=pip chooses pip from the start (e.g. behind a private index).
 INSTALLER ?= uv
+# uv's own version is pinned (the one measured in docs/benchmarking.md, "Installing"), so that how the venv was
+# made does not change under a fresh clone; the project's dependencies are resolved from pyproject.toml as before.
+UV_VERSION ?= 0.13.9
 # After installing, `albot1 warm-up` compiles Albot1's numba kernels for this machine and code version (~15 s
 # on 2 cores), as pip compiles bytecode at install: the first run after an install then loads them from numba's
 # cache instead of compiling them (docs/albot1-mapper.md, "Kernels"). WARM_UP=0 leaves that to the first run.
@@ -39,7 +42,7 @@ $(STAMP): pyproject.toml
 	@case "$(INSTALLER)" in uv|pip) ;; *) echo "make venv: INSTALLER=$(INSTALLER): expected uv or pip" >&2; exit 2;; esac
 	@case "$(WARM_UP)" in 0|1) ;; *) echo "make venv: WARM_UP=$(WARM_UP): expected 1 (compile the kernels) or 0" >&2; exit 2;; esac
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	if [ "$(INSTALLER)" = uv ] && $(BIN)/python -m pip install --quiet uv \
+	if [ "$(INSTALLER)" = uv ] && $(BIN)/python -m pip install --quiet 'uv==$(UV_VERSION)' \
 	    && $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[dev]'; then :; else \
 	  [ "$(INSTALLER)" = uv ] && echo "make venv: uv could not install the project; installing with pip" >&2; \
 	  $(BIN)/python -m pip install --quiet --upgrade pip && $(BIN)/python -m pip install --quiet -e '.[dev]'; \
