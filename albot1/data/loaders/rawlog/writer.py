@@ -23,6 +23,15 @@ not centred (the 180-beam logs span -90..+89 deg) is described by rotating
 the sensor pose by the centre angle. Beams must be evenly spaced. The laser's
 mounting pose on the robot is ``SequenceMetadata.sensor_offset``. A beam with
 no return (NaN) or beyond the scan's max range is written as invalid.
+
+Stamps: each scan's own. With ``fill_stamps`` (what the mrpt-icp and
+mrpt-rbpf methods use) a scan whose stamp MRPT cannot use (not finite, or not
+strictly later than the previous scan's) gets a filled-in one instead and is
+counted in :class:`RawlogStats`; ``stamps`` says why icp-slam needs strictly
+increasing stamps. A log whose stamps are all usable is written byte for byte
+as without it. ``albot1 convert`` does not fill (it changes no data unless
+asked: its ``--retime`` makes repeated or backward stamps strictly increasing,
+which is what icp-slam needs).
 """
 
 from __future__ import annotations
@@ -40,6 +49,7 @@ from numpy.typing import NDArray
 from albot1.atomic import atomic_write
 from albot1.data.errors import DataError
 from albot1.data.loaders.rawlog import serialize
+from albot1.data.loaders.rawlog.stamps import StampClock
 from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
@@ -80,6 +90,9 @@ class RawlogStats:
     scans: int = 0
     invalid_beams: int = 0
     bytes_written: int = 0
+    #: Scans written with a filled-in stamp instead of their own (see ``stamps``), and the first such scan and why.
+    replaced_stamps: int = 0
+    first_replaced_stamp: str | None = None
 
 
 def encode_frame(
@@ -90,8 +103,12 @@ def encode_frame(
     sensor_offset: tuple[float, float, float],
     motion_model: serialize.GaussianMotionModel,
     label: str = "LASER",
+    stamp: int | None = None,
 ) -> tuple[bytes, int]:
-    """The serialized objects of one frame, and how many of its beams are invalid."""
+    """The serialized objects of one frame, and how many of its beams are invalid.
+
+    ``stamp`` (``mrpt::Clock`` ticks) is the one :func:`write_frames` chose; None: the scan's own.
+    """
     scan = frame.scan
     where = f"frame {frame.index}"
     geometry = beam_geometry(scan.angles, where)
@@ -101,10 +118,11 @@ def encode_frame(
     odometry = np.asarray(frame.odometry, dtype=float)
     if odometry.shape != (3,) or not np.isfinite(odometry).all():
         raise DataError(f"{where}: odometry {odometry.tolist()} is not a finite (x, y, theta)")
-    try:
-        stamp = serialize.mrpt_timestamp(float(scan.timestamp))
-    except ValueError as exc:
-        raise DataError(f"{where}: {exc}") from None
+    if stamp is None:
+        try:
+            stamp = serialize.mrpt_timestamp(float(scan.timestamp))
+        except ValueError as exc:
+            raise DataError(f"{where}: {exc}") from None
     ranges = np.asarray(scan.ranges, dtype=float)
     with np.errstate(invalid="ignore"):
         valid = np.isfinite(ranges) & (ranges > 0) & (ranges <= max_range)
@@ -134,20 +152,32 @@ def write_frames(
     layout: RawlogLayout = "actions",
     sensor_offset: tuple[float, float, float] = (0.0, 0.0, 0.0),
     motion_model: serialize.GaussianMotionModel | None = None,
+    fill_stamps: bool = False,
 ) -> RawlogStats:
-    """Serialize ``frames`` to the open binary stream ``out`` (see the module doc for the layouts)."""
+    """Serialize ``frames`` to the open binary stream ``out`` (see the module doc for the layouts and stamps)."""
     if layout not in LAYOUTS:
         raise DataError(f"rawlog layout {layout!r}; expected one of: {', '.join(LAYOUTS)}")
     model = motion_model or serialize.GaussianMotionModel()
     stats = RawlogStats()
+    clock = StampClock()
     previous: NDArray[np.float64] | None = None
     for frame in frames:
-        data, invalid = encode_frame(frame, previous, layout=layout, sensor_offset=sensor_offset, motion_model=model)
+        stamp: int | None = None
+        if fill_stamps:
+            try:
+                stamp = clock.stamp(frame.index, float(frame.scan.timestamp))
+            except DataError as exc:
+                raise DataError(f"frame {frame.index}: {exc}") from None
+        data, invalid = encode_frame(
+            frame, previous, layout=layout, sensor_offset=sensor_offset, motion_model=model, stamp=stamp
+        )
         out.write(data)
         previous = np.asarray(frame.odometry, dtype=float)
         stats.scans += 1
         stats.invalid_beams += invalid
         stats.bytes_written += len(data)
+    stats.replaced_stamps = clock.replaced
+    stats.first_replaced_stamp = clock.first_replacement
     return stats
 
 

@@ -23,6 +23,12 @@ max_path_ratio]`` of the odometry's. A failure is a :class:`BaselineError`
 with the reason (timeout, memory limit, MRPT's exception message, a short or
 frozen path).
 
+Stamps: a scan whose stamp icp-slam cannot use (not finite, not strictly
+after the previous scan's: several corrected logs have one stamp for every
+scan) is written with a filled-in one (``albot1.data.loaders.rawlog.stamps``);
+how many, and the first, are ``extras.mrpt.rawlog_replaced_stamps`` and
+``rawlog_first_replaced_stamp``.
+
 Frames: the runner gives the laser's trajectory (the mounting offset applied
 once for every method, :func:`albot1.data.transforms.sensor_frame`), so the
 rawlog's sensor pose is the origin. rbpf-slam's poses are relative to the
@@ -159,6 +165,9 @@ class _MrptMapper:
                         # scans are centred on it, so the rawlog's sensor pose is the origin.
                         sensor_offset=(0.0, 0.0, 0.0),
                         motion_model=self._motion_model(),
+                        # icp-slam ignores the odometry of a scan not stamped strictly after the previous one
+                        # (albot1.data.loaders.rawlog.stamps); rbpf-slam reads no stamps. Usable stamps are kept.
+                        fill_stamps=True,
                     )
             except DataError as exc:
                 raise BaselineError(f"{self.name}: cannot write the rawlog: {exc}") from None
@@ -192,6 +201,9 @@ class _MrptMapper:
             "rawlog_layout": self.layout,
             "rawlog_bytes": rawlog.bytes_written,
             "rawlog_invalid_beams": rawlog.invalid_beams,
+            # Scans whose own stamp MRPT could not use (albot1.data.loaders.rawlog.stamps), and the first one.
+            "rawlog_replaced_stamps": rawlog.replaced_stamps,
+            "rawlog_first_replaced_stamp": rawlog.first_replaced_stamp,
             "seed": self.seed,
             "threads": 1,
             **extras,
