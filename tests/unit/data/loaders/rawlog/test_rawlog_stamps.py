@@ -1,0 +1,137 @@
+"""Rawlog stamps: usable ones kept, the rest filled in strictly increasing (exact ticks), and what the writer does."""
+
+from __future__ import annotations
+
+import io
+import math
+import struct
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from albot1.data.errors import DataError
+from albot1.data.loaders.rawlog import serialize as ser
+from albot1.data.loaders.rawlog.stamps import NOMINAL_STEP_S, StampClock
+from albot1.data.loaders.rawlog.writer import write_frames
+from albot1.data.model import Frame, Scan
+
+ANGLES = np.radians(np.linspace(-90.0, 90.0, 5))
+T = ser.TICKS_PER_S
+NOMINAL = round(NOMINAL_STEP_S * T)
+
+
+def _stamps(seconds: list[float]) -> tuple[list[int], StampClock]:
+    clock = StampClock()
+    return [clock.stamp(i, s) for i, s in enumerate(seconds)], clock
+
+
+def test_strictly_increasing_stamps_are_kept_exactly() -> None:
+    seconds = [100.0, 100.5, 101.25, 1e9]
+    got, clock = _stamps(seconds)
+    assert got == [ser.mrpt_timestamp(s) for s in seconds]
+    assert (clock.replaced, clock.first_replacement) == (0, None)
+
+
+def test_constant_stamps_advance_by_the_nominal_step() -> None:
+    got, clock = _stamps([0.0] * 4)
+    base = ser.mrpt_timestamp(0.0)
+    assert got == [base, base + NOMINAL, base + 2 * NOMINAL, base + 3 * NOMINAL]
+    assert clock.replaced == 3
+    assert clock.first_replacement == "scan 1: timestamp 0.0 s is not after the previous scan's"
+
+
+def test_a_backward_stamp_is_filled_at_the_logs_own_interval_until_the_stamps_pass_it() -> None:
+    got, clock = _stamps([10.0, 10.5, 9.0, 10.8, 12.0])
+    # 10.0 -> 10.5 kept (interval 0.5 s); 9.0 goes back: 11.0; 10.8 is before 11.0: 11.5; 12.0 kept.
+    assert got == [ser.mrpt_timestamp(s) for s in (10.0, 10.5, 11.0, 11.5, 12.0)]
+    assert clock.replaced == 2 and clock.first_replacement is not None
+    assert clock.first_replacement.startswith("scan 2: timestamp 9.0 s")
+
+
+def test_unusable_stamps_are_filled_and_a_first_one_starts_at_the_unix_epoch() -> None:
+    got, clock = _stamps([math.nan, math.inf, -2e10, 5.0])
+    base = ser.mrpt_timestamp(0.0)
+    assert got == [base, base + NOMINAL, base + 2 * NOMINAL, ser.mrpt_timestamp(5.0)]
+    assert clock.replaced == 3 and clock.first_replacement == "scan 0: timestamp nan is not finite"
+
+
+def test_mrpts_invalid_stamp_and_a_jump_of_hours_are_not_periods() -> None:
+    # Tick 0 is MRPT's INVALID_TIMESTAMP; a kept jump of 2^32 s is kept but not used as the fill step.
+    invalid = -ser.FILETIME_EPOCH_OFFSET_S
+    got, _ = _stamps([1.0, float(invalid), 2.0**32, 3.0])
+    assert got[1] == ser.mrpt_timestamp(1.0) + NOMINAL
+    assert got[2:] == [ser.mrpt_timestamp(2.0**32), ser.mrpt_timestamp(2.0**32) + NOMINAL]
+
+
+def test_a_clock_at_the_end_of_mrpts_range_is_an_error() -> None:
+    last = 2**64 / T - ser.FILETIME_EPOCH_OFFSET_S - 0.5 * NOMINAL_STEP_S
+    clock = StampClock()
+    clock.stamp(0, last)
+    with pytest.raises(DataError, match="no later MRPT timestamp"):
+        clock.stamp(1, last)
+
+
+finite_or_not = st.one_of(
+    st.floats(min_value=-1e3, max_value=1e10, allow_nan=False), st.sampled_from([math.nan, math.inf, -1e11, 0.0])
+)
+
+
+@given(st.lists(finite_or_not, min_size=1, max_size=40))
+def test_written_stamps_always_increase_and_usable_increasing_ones_are_kept(seconds: list[float]) -> None:
+    got, clock = _stamps(seconds)
+    assert all(b > a for a, b in zip(got, got[1:], strict=False))
+    own: list[int | None] = []
+    for s in seconds:
+        try:
+            own.append(ser.mrpt_timestamp(s))
+        except ValueError:
+            own.append(None)
+    kept = sum(1 for g, o in zip(got, own, strict=True) if g == o)
+    assert clock.replaced == len(seconds) - kept
+    if all(o is not None and o > 0 for o in own) and all(
+        b > a for a, b in zip(own, own[1:], strict=False)  # type: ignore[operator]
+    ):
+        assert clock.replaced == 0 and got == own
+
+
+def _frames(seconds: list[float]) -> list[Frame]:
+    return [
+        Frame(i, Scan(np.full(5, 2.0), ANGLES, s, 30.0), np.array([0.5 * i, 0.0, 0.0])) for i, s in enumerate(seconds)
+    ]
+
+
+def _scan_stamps(blob: bytes) -> list[int]:
+    """The stamp of every range scan in an observations-layout rawlog (stamp, beamAperture, then the label)."""
+    name = b"mrpt::obs::CObservation2DRangeScan"
+    out, k = [], blob.find(name)
+    while k >= 0:
+        label = blob.find(b"\x05\x00\x00\x00LASER", k)
+        out.append(struct.unpack_from("<Q", blob, label - 12)[0])  # then beamAperture (f4), then the label
+        k = blob.find(name, label)
+    return out
+
+
+def test_the_writer_fills_only_when_asked_and_is_unchanged_for_usable_stamps() -> None:
+    good = _frames([10.0, 10.5, 11.0])
+    plain, filled = io.BytesIO(), io.BytesIO()
+    write_frames(good, plain, layout="observations")
+    stats = write_frames(good, filled, layout="observations", fill_stamps=True)
+    assert plain.getvalue() == filled.getvalue() and stats.replaced_stamps == 0
+    base = ser.mrpt_timestamp(7.0)
+    as_given = io.BytesIO()
+    write_frames(_frames([7.0] * 3), as_given, layout="observations")
+    assert _scan_stamps(as_given.getvalue()) == [base] * 3
+    for layout in ("observations", "actions"):
+        out = io.BytesIO()
+        stats = write_frames(_frames([7.0] * 3), out, layout=layout, fill_stamps=True)
+        assert stats.replaced_stamps == 2
+        assert stats.first_replaced_stamp == "scan 1: timestamp 7.0 s is not after the previous scan's"
+        assert _scan_stamps(out.getvalue()) == [base, base + NOMINAL, base + 2 * NOMINAL]
+
+
+def test_without_filling_a_non_finite_stamp_is_still_an_error() -> None:
+    with pytest.raises(DataError, match="frame 1: timestamp nan is not finite"):
+        write_frames(_frames([1.0, math.nan]), io.BytesIO())
+    assert write_frames(_frames([1.0, math.nan]), io.BytesIO(), fill_stamps=True).replaced_stamps == 1
