@@ -42,10 +42,11 @@ def test_constant_stamps_advance_by_the_nominal_step() -> None:
     assert clock.first_replacement == "scan 1: timestamp 0.0 s is not after the previous scan's"
 
 
-def test_a_backward_stamp_is_filled_at_the_logs_own_interval_until_the_stamps_pass_it() -> None:
-    got, clock = _stamps([10.0, 10.5, 9.0, 10.8, 12.0])
-    # 10.0 -> 10.5 kept (interval 0.5 s); 9.0 goes back: 11.0; 10.8 is before 11.0: 11.5; 12.0 kept.
-    assert got == [ser.mrpt_timestamp(s) for s in (10.0, 10.5, 11.0, 11.5, 12.0)]
+def test_a_backward_stamp_is_filled_at_a_tenth_of_the_logs_interval_until_the_stamps_pass_it() -> None:
+    got, clock = _stamps([10.0, 10.5, 9.0, 10.52, 11.0, 11.2])
+    # 10.0 -> 10.5 kept (interval 0.5 s, fill step 0.05 s); 9.0 goes back: 10.55; 10.52 is before it: 10.6;
+    # 11.0 kept; 11.2 kept (the step becomes 0.02 s).
+    assert got == [ser.mrpt_timestamp(s) for s in (10.0, 10.5, 10.55, 10.6, 11.0, 11.2)]
     assert clock.replaced == 2 and clock.first_replacement is not None
     assert clock.first_replacement.startswith("scan 2: timestamp 9.0 s")
 
