@@ -92,7 +92,8 @@ def test_written_stamps_always_increase_and_usable_increasing_ones_are_kept(seco
     kept = sum(1 for g, o in zip(got, own, strict=True) if g == o)
     assert clock.replaced == len(seconds) - kept
     if all(o is not None and o > 0 for o in own) and all(
-        b > a for a, b in zip(own, own[1:], strict=False)  # type: ignore[operator]
+        b > a
+        for a, b in zip(own, own[1:], strict=False)  # type: ignore[operator]
     ):
         assert clock.replaced == 0 and got == own
 
