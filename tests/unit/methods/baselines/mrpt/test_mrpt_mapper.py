@@ -7,6 +7,7 @@ import math
 import os
 import stat
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -174,3 +175,14 @@ def test_runs_are_repeatable(fake_apps: Path) -> None:
     a, b = _run(_rbpf(seed=3)), _run(_rbpf(seed=3))
     np.testing.assert_array_equal(a.poses, b.poses)
     assert os.environ["FAKE_MRPT_SCANS"] == str(SCANS)
+
+
+def test_unusable_scan_stamps_are_filled_and_counted(fake_apps: Path) -> None:
+    usable = _run(_icp()).extras["mrpt"]
+    assert (usable["rawlog_replaced_stamps"], usable["rawlog_first_replaced_stamp"]) == (0, None)
+    for mapper in (_icp(), _rbpf()):
+        for frame in _frames():
+            mapper.process(Frame(frame.index, replace(frame.scan, timestamp=5.0), frame.odometry))
+        mrpt = mapper.finish().extras["mrpt"]
+        assert mrpt["rawlog_replaced_stamps"] == SCANS - 1
+        assert mrpt["rawlog_first_replaced_stamp"] == "scan 1: timestamp 5.0 s is not after the previous scan's"
