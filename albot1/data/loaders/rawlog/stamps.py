@@ -1,4 +1,4 @@
-"""The stamps a rawlog gives its scans: each scan's own, unless MRPT cannot use it.
+"""The stamps a rawlog gives its scans: each scan's own unless MRPT cannot use it.
 
 Why stamps matter to MRPT: ``icp-slam`` keeps the robot pose in a
 ``CRobot2DPoseEstimator`` (``libs/poses/src/CRobot2DPoseEstimator.cpp`` in
@@ -11,11 +11,12 @@ travelled since the last ICP with that pose and skips ICP until it exceeds
 ``localizationLinDistance`` / ``localizationAngDistance``. With every scan at
 one stamp (or stamps going back) the odometry is never newer, the distance
 never grows, ICP never runs again and the estimate stays where it was: the
-path freezes, or, with stamps only sometimes equal, odometry increments are
-dropped and ICP starts from a wrong guess. The size of the interval does not
-matter to it (no velocities are written, so nothing is extrapolated), only its
-sign: each scan's stamp must be strictly later than the previous scan's, in
-MRPT's 100 ns ticks, and must not be MRPT's invalid stamp (tick 0).
+path freezes. With a stamp going back now and then, the pose logged (and used
+to insert the scan into the map) at that scan leaves out the odometry since
+the last correction, and the next ICP comes later. The size of the interval
+does not matter to it (no velocities are written, so nothing is extrapolated),
+only its sign: each scan's stamp must be strictly later than the previous
+scan's, in MRPT's 100 ns ticks, and must not be MRPT's invalid stamp (tick 0).
 ``rbpf-slam`` copies the stamps of the actions but never compares them.
 
 So a scan keeps its own stamp when it is finite, representable and strictly
@@ -25,10 +26,10 @@ interval between the last two scans that kept their own stamps, when there is
 one of at most :data:`MAX_LEARNED_STEP_S`, else :data:`NOMINAL_STEP_S`. The
 fraction lets the log's own stamps pass the filled ones again a few scans
 after a stamp went back (at the log's full interval they never would: the raw
-intel log, with 631 stamps going back by up to 0.6 s, would keep its own
-stamp on 27 of its first 2,000 scans). A log whose stamps all qualify is
-written exactly as before. Each replacement is counted and the first one is
-described, so a run can say so.
+intel log, with 631 stamps going back by up to 0.6 s, would keep its own stamp
+on 27 of its first 2,000 scans; with the fraction, on 1,649). A log whose
+stamps all qualify is written exactly as before. Each replacement is counted
+and the first one is described, so a run can say so.
 """
 
 from __future__ import annotations
