@@ -12,7 +12,7 @@ of the process.
 
 An entry's name is a sha256 of everything the cloud depends on (:func:`entry_key`):
 the dataset's name (its slice and loader options), the sha256 of its files,
-the code version (the loaders, the projection and the thinning), the number
+the code version (the loaders, the projection and the thinning) and numpy's, the number
 of scans scored, the reference poses and scan times of the run (bytes), the
 sensor offset and the thinning's parameters. A changed parameter, dataset or
 run is a new entry, never an old cloud. An entry is only written after the
@@ -65,6 +65,7 @@ def entry_key(
     described = {
         "layout": LAYOUT,
         "code": code_version(),
+        "numpy": np.__version__,
         "dataset": dataset,
         "checksums": dict(sorted(checksums.items())),
         "count": int(count),
