@@ -59,6 +59,17 @@ def decoded_cache_dir() -> Path | None:
     return Path(value).expanduser() if value else _user_cache_dir() / "decoded"
 
 
+def reference_map_cache_dir() -> Path | None:
+    """The folder of the map-shape metric's reference maps: ``reference-maps`` in the decoded logs' folder; None = off.
+
+    Derived from the logs as the decoded logs are, it follows the same switch
+    (``ALBOT1_DECODED_CACHE``: another folder, or ``off`` for neither); see
+    :mod:`albot1.metrics.reference_map`.
+    """
+    decoded = decoded_cache_dir()
+    return None if decoded is None else decoded / "reference-maps"
+
+
 @dataclass(frozen=True)
 class Settings:
     """Resolved dataset locations; build with :func:`get_settings`."""

@@ -58,14 +58,20 @@ def map_agreement(
     tol: float = TOLERANCE_M,
     voxel_m: float = VOXEL_M,
     max_points: int = MAX_POINTS,
+    reference_thinned: bool = False,
 ) -> dict[str, Any]:
-    """Precision, coverage and distances between two point sets in the same frame (m)."""
+    """Precision, coverage and distances between two point sets in the same frame (m).
+
+    ``reference_thinned``: ``reference_points`` is already ``thin(..., voxel_m,
+    max_points)`` (a cached reference map); thinning is idempotent, so this only
+    saves doing it again.
+    """
     from scipy.spatial import cKDTree
 
     if tol <= 0:
         raise MetricsError(f"map shape: expected a positive tolerance, got {tol} m")
     mp = thin(map_points, voxel_m, max_points)
-    rp = thin(reference_points, voxel_m, max_points)
+    rp = np.asarray(reference_points, dtype=float) if reference_thinned else thin(reference_points, voxel_m, max_points)
     if len(mp) == 0:
         raise MetricsError("map shape: the method's map has no geometry to compare")
     if len(rp) == 0:

@@ -7,6 +7,8 @@ pose (and the sensor offset), so the dataset is reopened here (through
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from albot1.data.transforms import head
@@ -16,9 +18,13 @@ from albot1.geometry.types import FloatArray
 from albot1.metrics.alignment import describe, rigid_transform
 from albot1.metrics.blocks import AlignmentTransform, block_of, fmt
 from albot1.metrics.errors import MetricsError
-from albot1.metrics.map_shape import map_agreement
+from albot1.metrics.map_shape import MAX_POINTS, VOXEL_M, map_agreement, thin
+from albot1.metrics.reference_map import entry_key, reference_cloud
 from albot1.metrics.unit import MAP, REFERENCE, ColumnSpec, Metric, MetricInputs
 from albot1.records import Record
+
+if TYPE_CHECKING:
+    from albot1.data.model import Sequence
 
 
 class MapShapeBlock(Record):
@@ -41,13 +47,33 @@ class MapShapeBlock(Record):
 
 
 def reference_points(inputs: MetricInputs, reference: FloatArray) -> FloatArray:
-    """Every scan of the run's dataset projected with its reference pose; MetricsError when they do not fit."""
+    """The reference map of the run, thinned as :func:`map_agreement` thins it; MetricsError when the scans do not fit.
+
+    Every scan of the run's dataset projected with its reference pose, built
+    once per machine for the same inputs (:mod:`albot1.metrics.reference_map`).
+    """
     dataset, n = inputs.dataset, int(len(inputs.poses))
     try:
         sequence = head(inputs.open_dataset(), n)
     except Albot1Error as exc:
         raise MetricsError(f"cannot reopen dataset {dataset!r} for the reference map: {exc}") from exc
     offset = np.asarray(sequence.metadata.sensor_offset, dtype=float)
+    key = entry_key(
+        dataset=dataset,
+        checksums=sequence.metadata.checksums,
+        count=n,
+        reference=reference,
+        timestamps=np.asarray(inputs.timestamps, dtype=float),
+        sensor_offset=offset,
+        voxel_m=VOXEL_M,
+        max_points=MAX_POINTS,
+    )
+    return reference_cloud(key, lambda: thin(projected_scans(inputs, sequence, reference, offset)))
+
+
+def projected_scans(inputs: MetricInputs, sequence: Sequence, reference: FloatArray, offset: FloatArray) -> FloatArray:
+    """Every scan of ``sequence`` (the run's first scans) projected with its reference pose and the sensor offset."""
+    dataset, n = inputs.dataset, int(len(inputs.poses))
     parts: list[FloatArray] = []
     count = 0
     for frame in sequence.frames():
@@ -73,7 +99,7 @@ def compute(inputs: MetricInputs) -> MapShapeBlock:
     points = reference_points(inputs, reference)
     transform = rigid_transform(inputs.poses, reference)
     map_points = se2.transform_points(transform, load_map().geometry_points())
-    block = map_agreement(map_points, points)
+    block = map_agreement(map_points, points, reference_thinned=True)
     return block_of(
         MapShapeBlock,
         {
