@@ -38,10 +38,11 @@ import numpy as np
 
 #: MAD of a normal sample times this is its standard deviation (as in odometry_trust).
 MAD_TO_SIGMA = 1.4826
-#: Innovations beyond this many robust standard deviations from their median are clipped there (a bad match in a
-#: turn would otherwise pull the slope by its full size; Huber's usual constant is 1.345, 3 keeps the fit nearly
-#: least squares for the normal bulk).
+#: Residuals beyond this many robust standard deviations are clipped there (Huber's usual constant is 1.345; 3 keeps
+#: the fit nearly least squares for the normal bulk). Not tuned.
 CLIP_SIGMAS = 3.0
+#: Refits on the clipped residuals (the slope settles in two or three).
+ITERATIONS = 3
 
 
 class TurnScale:
@@ -63,22 +64,32 @@ class TurnScale:
     def estimate(self) -> tuple[float, float]:
         """The scale error (rad of innovation per rad turned) and its standard error; (0, inf) without evidence.
 
-        Least squares through the origin on the innovations clipped at
-        ``CLIP_SIGMAS`` robust standard deviations from their median; the
-        standard error uses that robust spread (of the innovations, not the
-        residuals: the larger, so a scale is not claimed on less evidence).
+        Least squares through the origin, made robust by winsorising: the
+        residuals are clipped at ``CLIP_SIGMAS`` robust standard deviations
+        (1.4826 MAD) and the slope refitted, ``ITERATIONS`` times (a bad
+        match in a turn would otherwise pull the slope by its full size; the
+        innovations themselves are not clipped, since a mis-scaled odometry's
+        large turns are off by large amounts on purpose). The standard error
+        is the heteroscedasticity-consistent one of the clipped residuals
+        (White's): the innovations spread wider in turns than on straight
+        steps, even with perfect odometry (the matches' own errors grow), so
+        the straight steps' spread would understate it.
         """
         t = np.asarray(self._turns, dtype=float)
         d = np.asarray(self._innovations, dtype=float)
         turned = float(t @ t)
         if len(t) < 2 or turned <= 0.0:
             return 0.0, math.inf
-        centre = float(np.median(d))
-        spread = MAD_TO_SIGMA * float(np.median(np.abs(d - centre)))
-        if spread <= 0.0:
-            return 0.0, math.inf
-        clipped = np.clip(d, centre - CLIP_SIGMAS * spread, centre + CLIP_SIGMAS * spread)
-        return float(t @ clipped) / turned, spread / math.sqrt(turned)
+        scale = float(t @ d) / turned
+        clipped = d - scale * t
+        for _ in range(ITERATIONS + 1):
+            residual = d - scale * t
+            spread = MAD_TO_SIGMA * float(np.median(np.abs(residual - np.median(residual))))
+            if spread <= 0.0:
+                return 0.0, math.inf
+            clipped = np.clip(residual, -CLIP_SIGMAS * spread, CLIP_SIGMAS * spread)
+            scale += float(t @ clipped) / turned
+        return scale, math.sqrt(float((t * t) @ (clipped * clipped))) / turned
 
     def squared_scale(self) -> float:
         """The squared scale error if the estimate stands ``bias_z`` standard errors from 0, less its sampling

@@ -68,7 +68,12 @@ return without the floor, but measured no better everywhere
 (docs/baselines.md, gtsam-graph, "turns learnt apart"). Also optional
 (``floor_turn_rad``, off: 0) is a floor held only on turning steps
 (:meth:`OdometryTrust.floor_ratio`), measured and left off for the same reason
-(docs/baselines.md, gtsam-graph, "why one run of edmonton swings").
+(docs/baselines.md, gtsam-graph, "why one run of edmonton swings"). And
+optional (``turn_scale``, off in the default preset) is a heading scale error
+learnt from every step of the run (:class:`.odometry_scale.TurnScale`): the
+error a mis-scaled odometry makes in proportion to each turn, which the median
+test cannot see, is added to that step's variance (docs/baselines.md,
+gtsam-graph, "the turn scale").
 """
 
 from __future__ import annotations
