@@ -107,6 +107,10 @@ class GtsamGraphConfig(BaseModel):
         description="... that floor only on steps whose odometry turns at least this much (0: every step; not "
         "consulted for a kind learnt apart, odometry_trust_turn_deg, once it holds odometry_trust_kind_min_steps)",
     )
+    odometry_trust_turn_scale: bool = Field(
+        description="... a heading scale error learnt from every matched step (odometry_scale.TurnScale) adds to a "
+        "step's heading variance in proportion to its turn, counted like the bias over odometry_trust_bias_horizon"
+    )
     odometry_trust_turn_deg: float = Field(
         gt=0,
         description="... steps whose odometry turns more than this learnt and judged apart from the others "

@@ -81,6 +81,7 @@ class FrontEnd:
             math.radians(config.odometry_trust_turn_deg),
             config.odometry_trust_kind_min_steps,
             math.radians(config.odometry_trust_floor_turn_deg),
+            config.odometry_trust_turn_scale,
         )
         self._odometry_factors = OdometryFactors(self._odometry_trust)
         # Odometry factors judged at the latest node (``odometry_trust_factors``), for the back end to add with it.

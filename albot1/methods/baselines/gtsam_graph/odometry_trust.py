@@ -68,7 +68,12 @@ return without the floor, but measured no better everywhere
 (docs/baselines.md, gtsam-graph, "turns learnt apart"). Also optional
 (``floor_turn_rad``, off: 0) is a floor held only on turning steps
 (:meth:`OdometryTrust.floor_ratio`), measured and left off for the same reason
-(docs/baselines.md, gtsam-graph, "why one run of edmonton swings").
+(docs/baselines.md, gtsam-graph, "why one run of edmonton swings"). And
+optional (``turn_scale``, off in the default preset) is a heading scale error
+learnt from every step of the run (:class:`.odometry_scale.TurnScale`): the
+error a mis-scaled odometry makes in proportion to each turn, which the median
+test cannot see, is added to that step's variance (docs/baselines.md,
+gtsam-graph, "the turn scale").
 """
 
 from __future__ import annotations
@@ -81,6 +86,7 @@ import numpy as np
 
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
+from albot1.methods.baselines.gtsam_graph.odometry_scale import TurnScale
 
 #: MAD of a normal sample times this is its standard deviation.
 MAD_TO_SIGMA = 1.4826
@@ -114,13 +120,16 @@ class OdometryTrust:
         turn_rad: float = math.inf,
         kind_min_steps: int = 10,
         floor_turn_rad: float = 0.0,
+        turn_scale: bool = False,
     ) -> None:
         """``components``: which of x (0), y (1), heading (2) may be fused at all; ``bias_horizon``: the number of
         steps over which a median disagreement too small for the bias test is counted as accumulating (0: not);
         ``min_variance_ratio``: a trusted component's variance is at least this times its match's; ``turn_rad``:
         steps whose odometry turns more than this are learnt and judged apart from the others (:meth:`kind`;
         ``inf``: one population); ``floor_turn_rad``: the floor holds only for steps whose odometry turns at least
-        this much (0: every step; :meth:`floor_ratio`)."""
+        this much (0: every step; :meth:`floor_ratio`); ``turn_scale``: a heading scale error learnt from every
+        step (:class:`.odometry_scale.TurnScale`) adds to each step's heading variance in proportion to its turn."""
+        self.scale = TurnScale(bias_z, bias_horizon) if turn_scale else None
         self.floor_turn_rad = floor_turn_rad
         self._pooled: deque[FloatArray] = deque(maxlen=window)
         self._kinds: tuple[deque[FloatArray], deque[FloatArray]] = (deque(maxlen=window), deque(maxlen=window))
@@ -152,6 +161,8 @@ class OdometryTrust:
         d = innovation(odometry_step, match_step)
         self._pooled.append(d)
         self._kinds[self.kind(odometry_step)].append(d)
+        if self.scale is not None:
+            self.scale.add(float(odometry_step[2]), float(d[2]))
 
     def floor_ratio(self, turn_rad: float) -> float:
         """The weight floor of a step whose odometry turns ``turn_rad``: ``min_variance_ratio``, or 0 below the turn.
@@ -176,13 +187,19 @@ class OdometryTrust:
         """
         if len(self._pooled) < self._min_history:
             return None
+        scale = self.scale.variance(turn_rad) if self.scale is not None and math.isfinite(turn_rad) else 0.0
         own = self._kinds[kind]
         if not math.isfinite(self.turn_rad) or len(own) < self.kind_min_steps:
-            return self._estimate(self._pooled, match_variances, self.floor_ratio(turn_rad))
-        return np.maximum(self._estimate(self._pooled, match_variances, 0.0), self._estimate(own, match_variances, 0.0))
+            return self._estimate(self._pooled, match_variances, self.floor_ratio(turn_rad), scale)
+        return np.maximum(
+            self._estimate(self._pooled, match_variances, 0.0, scale), self._estimate(own, match_variances, 0.0, scale)
+        )
 
-    def _estimate(self, history: deque[FloatArray], match_variances: FloatArray, floor: float) -> FloatArray:
-        """:meth:`variances` learnt from ``history`` alone, a trusted one never below ``floor`` times the match's."""
+    def _estimate(
+        self, history: deque[FloatArray], match_variances: FloatArray, floor: float, scale: float = 0.0
+    ) -> FloatArray:
+        """:meth:`variances` learnt from ``history`` alone, a trusted one never below ``floor`` times the match's;
+        ``scale``: the heading variance the turn scale error adds to this step (:class:`.odometry_scale.TurnScale`)."""
         n = len(history)
         h = np.asarray(history, dtype=float)
         centre = np.median(h, axis=0)
@@ -196,6 +213,8 @@ class OdometryTrust:
             total = spread[k] ** 2
             variance = max(total - float(match_variances[k]), total * math.sqrt(2.0 / n))
             variance += self.bias_horizon * squared_bias(float(centre[k]), float(spread[k]), n)
+            if k == 2:
+                variance += scale
             if variance < float(match_variances[k]):
                 # the odometry is the better of the two here (else: the match alone, as tuned)
                 out[k] = max(variance, floor * float(match_variances[k]))
