@@ -33,10 +33,11 @@ INSTALLER ?= uv
 # uv's own version is pinned (the one measured in docs/benchmarking.md, "Installing"), so that how the venv was
 # made does not change under a fresh clone; the project's dependencies are resolved from pyproject.toml as before.
 UV_VERSION ?= 0.13.9
-# After installing, `albot1 warm-up` compiles Albot1's numba kernels for this machine and code version (~15 s
-# on 2 cores), as pip compiles bytecode at install: the first run after an install then loads them from numba's
-# cache instead of compiling them (docs/albot1-mapper.md, "Kernels"). WARM_UP=0 leaves that to the first run.
-# A failed warm-up does not fail the install: it says so, and the tests then show which kernel fails and why.
+# After installing, `albot1 warm-up` compiles Albot1's numba kernels for this machine and code version (~20 CPU-s,
+# 20-30 s on 2 loaded cores), as pip compiles bytecode at install: the first run after an install then loads them
+# from numba's cache instead of compiling them (docs/albot1-mapper.md, "Kernels"). WARM_UP=0 leaves that to the
+# first run (make also reads WARM_UP from the environment; only 0 and 1 are accepted). A failed warm-up does not
+# fail the install: it says so, and the tests then show which kernel fails and why.
 WARM_UP ?= 1
 $(STAMP): pyproject.toml
 	@case "$(INSTALLER)" in uv|pip) ;; *) echo "make venv: INSTALLER=$(INSTALLER): expected uv or pip" >&2; exit 2;; esac

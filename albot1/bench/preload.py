@@ -105,7 +105,7 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
     # Every preset's warm-up, once, here, before any fork: every cell forked from this server then starts with the
     # kernels in memory, so a cell's start-up is not paid once per cell (1.3-1.9 s for Albot1 with numba's cache
     # filled).
-    failures.extend(warm_up_methods(warmed, registry))
+    failures.extend(warm_up_methods(warmed, registry).lines())
     return failures
 
 

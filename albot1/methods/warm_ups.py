@@ -13,16 +13,38 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from albot1.methods.registry import MethodRegistry
 
 
+@dataclass(frozen=True)
+class WarmUpOutcome:
+    """What :func:`warm_up_methods` found: one line per method whose warm-up failed, and a joint-only failure.
+
+    ``joint_failure``: the joint pass failed but each method's warm-up alone then
+    succeeded (every kernel is ready; the error is still reported, not swallowed).
+    """
+
+    failures: list[str] = field(default_factory=list)
+    joint_failure: str | None = None
+
+    def lines(self) -> list[str]:
+        """Every failure line, the joint one last (what the forkserver's preload reports)."""
+        return self.failures + ([self.joint_failure] if self.joint_failure else [])
+
+
+def has_warm_up(cls: type) -> bool:
+    """Whether mapper class ``cls`` has the optional start-up step (``Mapper.warm_up``)."""
+    return callable(getattr(cls, "warm_up", None))
+
+
 def warm_up_methods(
     methods: list[str], registry: MethodRegistry | None = None, announce: Callable[[str], None] | None = None
-) -> list[str]:
-    """Every preset's warm-up of ``methods``, compiled together where the classes offer it; the failures, one per line.
+) -> WarmUpOutcome:
+    """Every preset's warm-up of ``methods``, compiled together where the classes offer it.
 
     A class may offer ``warm_up_together()``, a context manager inside which
     its warm-ups only note their kernels and which compiles them all when
@@ -37,7 +59,6 @@ def warm_up_methods(
     """
     from albot1.methods.registry import get_method
 
-    failures: list[str] = []
     try:
         with contextlib.ExitStack() as stack:
             for method in methods:
@@ -47,23 +68,25 @@ def warm_up_methods(
             for method in methods:
                 warm_up_method(method, registry, announce)
     except Exception as exc:  # noqa: BLE001 -- reported: under its method below, or as itself if it does not recur
+        failures: list[str] = []
         for method in methods:
             try:
                 warm_up_method(method, registry, announce)
             except Exception as again:  # noqa: BLE001 -- each method's own failure, reported under its name
                 failures.append(f"method {method}: warm-up: {type(again).__name__}: {again}")
-        if not failures:
-            failures.append(
-                f"methods {', '.join(methods)}: warm-up together: {type(exc).__name__}: {exc} "
-                "(each method's warm-up alone then succeeded)"
-            )
-    return failures
+        if failures:
+            return WarmUpOutcome(failures=failures)
+        return WarmUpOutcome(
+            joint_failure=f"methods {', '.join(methods)}: warm-up together: {type(exc).__name__}: {exc} "
+            "(each method's warm-up alone then succeeded)"
+        )
+    return WarmUpOutcome()
 
 
 def warm_up_method(
     method: str, registry: MethodRegistry | None = None, announce: Callable[[str], None] | None = None
-) -> bool:
-    """Run ``method``'s optional ``warm_up`` once for each of its presets; whether it has one.
+) -> None:
+    """Run ``method``'s optional ``warm_up`` once for each of its presets (nothing for a method without one).
 
     Every preset: a preset's warm-up may leave out kernels that only the
     others call. Methods without ``warm_up`` are not built.
@@ -71,9 +94,7 @@ def warm_up_method(
     from albot1.methods.registry import get_method, resolve_config
 
     cls = get_method(method, registry).load_class()
-    warm = getattr(cls, "warm_up", None)
-    if warm is None:
-        return False
+    if not has_warm_up(cls):
+        return
     for preset in cls.presets:
         cls(resolve_config(method, preset, registry=registry), seed=0).warm_up(announce)  # type: ignore[attr-defined]
-    return True

@@ -34,6 +34,24 @@ def test_the_shipped_list_imports_cleanly(preload: ModuleType) -> None:
     assert [f for f in preload.warm() if f.startswith("module ")] == []
 
 
+def test_the_methods_warm_up_failures_are_returned_with_the_import_failures(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each method's failed warm-up and a joint-only failure reach the runner's warning lines, in that order."""
+    from albot1.methods import warm_ups
+
+    seen: list[list[str]] = []
+
+    def warm_up_methods(methods: list[str], registry: object = None, announce: object = None) -> object:
+        seen.append(list(methods))
+        return warm_ups.WarmUpOutcome(failures=["method odometry: warm-up: E: x"], joint_failure="methods odometry: j")
+
+    monkeypatch.setattr(warm_ups, "warm_up_methods", warm_up_methods)
+    failures = preload.warm([], methods=frozenset({"odometry"}))
+    assert seen == [["odometry"]]
+    assert failures[-2:] == ["method odometry: warm-up: E: x", "methods odometry: j"]
+
+
 def test_failures_are_logged_once_each(
     preload: ModuleType, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:

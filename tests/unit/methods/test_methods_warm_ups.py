@@ -29,11 +29,10 @@ def _fake_methods(monkeypatch: pytest.MonkeyPatch, events: list[str], failing: s
             return SimpleNamespace()
         return SimpleNamespace(warm_up_together=lambda: _Together(name, events))
 
-    def warm_up(name: str, registry: object, announce: object = None) -> bool:
+    def warm_up(name: str, registry: object, announce: object = None) -> None:
         events.append(f"warm {name}")
         if name in failing:
             raise RuntimeError(f"{name} does not compile")
-        return True
 
     monkeypatch.setattr(
         "albot1.methods.registry.get_method",
@@ -48,9 +47,9 @@ def test_the_methods_warm_ups_run_inside_every_class_s_together_block(
     """One cold compile for every preset of every method: the blocks close after the last warm-up."""
     events: list[str] = []
     _fake_methods(monkeypatch, events, failing=set())
-    failures = warm_ups.warm_up_methods(["a", "b", "c"])
+    outcome = warm_ups.warm_up_methods(["a", "b", "c"])
     assert events == ["open a", "open c", "warm a", "warm b", "warm c", "close c", "close a"]
-    assert failures == []
+    assert outcome == warm_ups.WarmUpOutcome() and outcome.lines() == []
 
 
 def test_a_failed_warm_up_together_is_reported_under_its_own_method(
@@ -59,9 +58,10 @@ def test_a_failed_warm_up_together_is_reported_under_its_own_method(
     """The warm-ups then run again one by one, so each failure names its method and the others still warm up."""
     events: list[str] = []
     _fake_methods(monkeypatch, events, failing={"b"})
-    failures = warm_ups.warm_up_methods(["a", "b", "c"])
+    outcome = warm_ups.warm_up_methods(["a", "b", "c"])
     assert events == ["open a", "open c", "warm a", "warm b", "close c", "close a", "warm a", "warm b", "warm c"]
-    assert failures == ["method b: warm-up: RuntimeError: b does not compile"]
+    assert outcome.failures == ["method b: warm-up: RuntimeError: b does not compile"]
+    assert outcome.joint_failure is None
 
 
 def test_a_failure_of_the_joint_warm_up_alone_is_still_reported(
@@ -79,8 +79,25 @@ def test_a_failure_of_the_joint_warm_up_alone_is_still_reported(
             raise RuntimeError("helper lost")
 
     monkeypatch.setattr(_Together, "__exit__", close_failing_once)
-    failures = warm_ups.warm_up_methods(["a", "c"])
+    outcome = warm_ups.warm_up_methods(["a", "c"])
     assert events == ["open a", "open c", "warm a", "warm c", "close c", "close a", "warm a", "warm c"]
-    assert failures == [
-        "methods a, c: warm-up together: RuntimeError: helper lost (each method's warm-up alone then succeeded)"
-    ]
+    joint = "methods a, c: warm-up together: RuntimeError: helper lost (each method's warm-up alone then succeeded)"
+    assert outcome.failures == [] and outcome.joint_failure == joint and outcome.lines() == [joint]
+
+
+def test_a_method_without_a_start_up_step_is_not_built(monkeypatch: pytest.MonkeyPatch) -> None:
+    from types import SimpleNamespace
+
+    built: list[str] = []
+
+    class NoWarmUp:
+        presets = {"default": {}}
+
+        def __init__(self, *args: object, **kwargs: object) -> None:
+            built.append("built")
+
+    monkeypatch.setattr(
+        "albot1.methods.registry.get_method", lambda name, registry=None: SimpleNamespace(load_class=lambda: NoWarmUp)
+    )
+    warm_ups.warm_up_method("x")
+    assert built == [] and not warm_ups.has_warm_up(NoWarmUp)
