@@ -266,6 +266,16 @@ class Albot1Config(BaseModel):
             " the fusion (0 = off; albot1/methods/albot1/mapping/consistency.py)"
         ),
     )
+    view_noise_learning_rate: float = Field(
+        0.0,
+        ge=0,
+        le=1,
+        description=(
+            "Albot1+ (adaptive prior with the ambiguity test): learn the fit's own scatter from the views that"
+            " do not refute the odometry, at this rate, and take it out of the odometry learner's samples"
+            " (0 = off; albot1/methods/albot1/mapping/view_noise.py)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -345,4 +355,5 @@ class Albot1Config(BaseModel):
             turn_scale=self.turn_bound_scale,
             turn_statistic=self.turn_bound_statistic,
             consistency=self.consistent_information,
+            view_noise_rate=self.view_noise_learning_rate,
         )

@@ -43,7 +43,8 @@ pose is computed:
    are dropped).
 9. with ``turn_bound_floor_deg``, :mod:`.turn_bound` refits a view no landmark places from its near starts
    when it turns the robot further than its odometry did on weak evidence.
-10. with ``consistent_information`` (off in ``plus``), :mod:`.consistency` scales the fit's information down
+10. with ``view_noise_learning_rate``, :mod:`.view_noise` takes the views' own scatter out of the odometry learner's
+    samples. With ``consistent_information`` (off in ``plus``), :mod:`.consistency` scales the fit's information down
     to what the ambiguity test's likelihood ratio says the view knows, before the fusion.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
@@ -68,6 +69,7 @@ from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen_kernels import screen_directions
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
+from albot1.methods.albot1.mapping.view_noise import ViewNoise
 from albot1.methods.albot1.mapping.window import OdometryWindow, UpdateRecord, WindowOutcome
 from albot1.methods.albot1.perception.endpoints import STABLE
 
@@ -110,6 +112,7 @@ class PlusParams:
     turn_scale: float = 1.0  # the turn bound's allowance per rad the odometry turned since the update
     turn_statistic: float = 0.0  # a view's likelihood ratio above which the turn bound does not apply
     consistency: float = 0.0  # the fit's information scaled to its likelihood ratio (:mod:`.consistency`); 0 = off
+    view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
 
 
 class OdometryNoise:
@@ -188,6 +191,7 @@ class PlusLocaliser:
         self._ref = np.empty((0, 4))
         self._anchor: Pose = (0.0, 0.0, 0.0)
         self.noise = OdometryNoise(params)
+        self.view_noise = ViewNoise(params.view_noise_rate) if params.view_noise_rate > 0.0 else None  # :mod:`.view_noise`
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
         self.gate_rejections = 0
@@ -312,6 +316,8 @@ class PlusLocaliser:
             self.last_ambiguity = test
             if test.ambiguous:
                 self.ambiguous_views += 1
+                if self.view_noise is not None:
+                    self.view_noise.learn(measured, predicted)
                 return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
                 scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
@@ -375,7 +381,10 @@ class PlusLocaliser:
         min_xy = half_trace - math.sqrt(max(0.0, half_trace * half_trace - (h00 * h11 - h01 * h01)))
         if min_xy > LEARN_MIN_INFO and h22 > LEARN_MIN_INFO and motion > LEARN_MIN_MOTION_M:
             nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
-            noise.learn(nu2_xy, d_phi * d_phi, motion)
+            nu2_phi = d_phi * d_phi
+            if self.view_noise is not None:  # the odometry's share of the disagreement (:mod:`.view_noise`)
+                nu2_xy, nu2_phi = self.view_noise.remove(nu2_xy, nu2_phi)
+            noise.learn(nu2_xy, nu2_phi, motion)
         v_xy, v_phi = noise.prior_variance(motion)
         if self.params.degenerate_sd > 0.0 or self.params.gate_probability > 0.0:
             screened = screen_measurement(
