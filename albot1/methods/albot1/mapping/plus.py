@@ -191,7 +191,7 @@ class PlusLocaliser:
         self._ref = np.empty((0, 4))
         self._anchor: Pose = (0.0, 0.0, 0.0)
         self.noise = OdometryNoise(params)
-        self.view_noise = ViewNoise(params.view_noise_rate) if params.view_noise_rate > 0.0 else None  # :mod:`.view_noise`
+        self.view_noise = ViewNoise(params.view_noise_rate) if params.view_noise_rate > 0.0 else None  # .view_noise
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
         self.gate_rejections = 0
