@@ -257,6 +257,25 @@ class Albot1Config(BaseModel):
             " (the ambiguity test's statistic) exceeds this refutes the odometry strongly enough to turn freely"
         ),
     )
+    consistent_information: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ (with the ambiguity test): scale a view's fit information so that its stated distance from"
+            " the odometry's prediction is at most this times the view's likelihood ratio against it, before"
+            " the fusion (0 = off; albot1/methods/albot1/mapping/consistency.py)"
+        ),
+    )
+    view_noise_learning_rate: float = Field(
+        0.0,
+        ge=0,
+        le=1,
+        description=(
+            "Albot1+ (adaptive prior with the ambiguity test): learn the fit's own scatter from the views that"
+            " do not refute the odometry, at this rate, and take it out of the odometry learner's samples"
+            " (0 = off; albot1/methods/albot1/mapping/view_noise.py)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -335,4 +354,6 @@ class Albot1Config(BaseModel):
             turn_floor=math.radians(self.turn_bound_floor_deg),
             turn_scale=self.turn_bound_scale,
             turn_statistic=self.turn_bound_statistic,
+            consistency=self.consistent_information,
+            view_noise_rate=self.view_noise_learning_rate,
         )

@@ -43,6 +43,9 @@ pose is computed:
    are dropped).
 9. with ``turn_bound_floor_deg``, :mod:`.turn_bound` refits a view no landmark places from its near starts
    when it turns the robot further than its odometry did on weak evidence.
+10. with ``view_noise_learning_rate``, :mod:`.view_noise` takes the views' own scatter out of the odometry learner's
+    samples. With ``consistent_information`` (off in ``plus``), :mod:`.consistency` scales the fit's information down
+    to what the ambiguity test's likelihood ratio says the view knows, before the fusion.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -61,10 +64,12 @@ from numpy.typing import NDArray
 from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
+from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen_kernels import screen_directions
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
+from albot1.methods.albot1.mapping.view_noise import ViewNoise
 from albot1.methods.albot1.mapping.window import OdometryWindow, UpdateRecord, WindowOutcome
 from albot1.methods.albot1.perception.endpoints import STABLE
 
@@ -106,6 +111,8 @@ class PlusParams:
     turn_floor: float = 0.0  # rad: the turn bound's allowance on a straight stretch (:mod:`.turn_bound`); 0 = off
     turn_scale: float = 1.0  # the turn bound's allowance per rad the odometry turned since the update
     turn_statistic: float = 0.0  # a view's likelihood ratio above which the turn bound does not apply
+    consistency: float = 0.0  # the fit's information scaled to its likelihood ratio (:mod:`.consistency`); 0 = off
+    view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
 
 
 class OdometryNoise:
@@ -184,6 +191,7 @@ class PlusLocaliser:
         self._ref = np.empty((0, 4))
         self._anchor: Pose = (0.0, 0.0, 0.0)
         self.noise = OdometryNoise(params)
+        self.view_noise = ViewNoise(params.view_noise_rate) if params.view_noise_rate > 0.0 else None  # .view_noise
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
         self.gate_rejections = 0
@@ -308,7 +316,12 @@ class PlusLocaliser:
             self.last_ambiguity = test
             if test.ambiguous:
                 self.ambiguous_views += 1
+                if self.view_noise is not None:
+                    self.view_noise.learn(measured, predicted)
                 return predicted
+            if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
+                scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
+                return self._fuse(measured, info, predicted, self._motion(since_update), scale)
         return self._fuse(measured, info, predicted, self._motion(since_update))
 
     def _motion(self, since_update: Pose) -> float:
@@ -348,8 +361,10 @@ class PlusLocaliser:
         )
         return (x, y, phi), info
 
-    def _fuse(self, measured: Pose, info: FloatArray, predicted: Pose, motion: float) -> Pose:
+    def _fuse(self, measured: Pose, info: FloatArray, predicted: Pose, motion: float, scale: float = 1.0) -> Pose:
         """Learn from this view, then combine the measured and predicted poses by their information.
+
+        ``scale`` (:mod:`.consistency`) multiplies the measurement's information in the combination only.
 
         The measurement's information is the solver's (``info``, 3x3), the
         prediction's the inverse of :meth:`OdometryNoise.prior_variance`
@@ -366,7 +381,10 @@ class PlusLocaliser:
         min_xy = half_trace - math.sqrt(max(0.0, half_trace * half_trace - (h00 * h11 - h01 * h01)))
         if min_xy > LEARN_MIN_INFO and h22 > LEARN_MIN_INFO and motion > LEARN_MIN_MOTION_M:
             nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
-            noise.learn(nu2_xy, d_phi * d_phi, motion)
+            nu2_phi = d_phi * d_phi
+            if self.view_noise is not None:  # the odometry's share of the disagreement (:mod:`.view_noise`)
+                nu2_xy, nu2_phi = self.view_noise.remove(nu2_xy, nu2_phi)
+            noise.learn(nu2_xy, nu2_phi, motion)
         v_xy, v_phi = noise.prior_variance(motion)
         if self.params.degenerate_sd > 0.0 or self.params.gate_probability > 0.0:
             screened = screen_measurement(
@@ -381,6 +399,8 @@ class PlusLocaliser:
             h00, h01, h02 = float(info[0, 0]), float(info[0, 1]), float(info[0, 2])
             h11, h12, h22 = float(info[1, 1]), float(info[1, 2]), float(info[2, 2])
             d_phi = wrap_angle(measured[2] - predicted[2])
+        if scale != 1.0:  # after learning and the screen, which judge the fit by its stated information
+            h00, h01, h02, h11, h12, h22 = h00 * scale, h01 * scale, h02 * scale, h11 * scale, h12 * scale, h22 * scale
         p_xy, p_phi = 1.0 / v_xy, 1.0 / v_phi
         # The prediction's heading unwrapped next to the measured one, so the average does not jump by 2 pi.
         t0, t1, t2 = predicted[0], predicted[1], measured[2] - d_phi

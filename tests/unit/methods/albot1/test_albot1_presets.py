@@ -68,6 +68,8 @@ OLD_DEFAULT: dict[str, Any] = {
     "turn_bound_floor_deg": 0.0,
     "turn_bound_scale": 1.0,
     "turn_bound_statistic": 0.0,
+    "consistent_information": 0.0,
+    "view_noise_learning_rate": 0.0,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
@@ -100,6 +102,7 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "scan_overhang_m": 0.05,
         "turn_bound_floor_deg": 3.0,
         "turn_bound_statistic": 40.0,
+        "view_noise_learning_rate": 0.05,
     },
 }
 
