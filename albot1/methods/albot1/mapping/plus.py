@@ -69,7 +69,7 @@ from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen_kernels import screen_directions
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
-from albot1.methods.albot1.mapping.view_noise import ViewNoise
+from albot1.methods.albot1.mapping.view_noise import ViewNoise, median_step
 from albot1.methods.albot1.mapping.window import OdometryWindow, UpdateRecord, WindowOutcome
 from albot1.methods.albot1.perception.endpoints import STABLE
 
@@ -78,8 +78,6 @@ from albot1.methods.albot1.perception.endpoints import STABLE
 #: above 400 per m^2 and per rad^2) after at least 5 cm of motion since the update.
 LEARN_MIN_INFO = 400.0
 LEARN_MIN_MOTION_M = 0.05
-#: The median of a chi-square variable with one degree of freedom, in units of its mean.
-CHI2_1_MEDIAN = 0.45493642
 #: Variance floors of the prior (m^2, rad^2): odometry is never trusted below 1 cm and 1 mrad.
 PRIOR_FLOOR = (1e-4, 1e-6)
 
@@ -143,8 +141,7 @@ class OdometryNoise:
         self.samples += 1
         step = 2.0 * self.params.learning_rate
         for g, nu2 in ((0, nu2_xy), (1, nu2_phi)):
-            up = nu2 / motion > CHI2_1_MEDIAN * self.q[g]
-            self.q[g] = max(self.q[g] * math.exp(step if up else -step), 1e-12)
+            self.q[g] = max(median_step(self.q[g], nu2 / motion, step), 1e-12)
 
     def prior_variance(self, motion: float) -> tuple[float, float]:
         """Variance (m^2 per axis, rad^2) of the odometry's prediction after ``motion`` since the update."""

@@ -9,10 +9,11 @@ weakly supported 2-5 deg departure and the map updates froze them in.
 
 The views the ambiguity test keeps as the prediction measure the other term: there the view does not refute
 the odometry, so their disagreement is mostly the fit's own scatter. :class:`ViewNoise` tracks its running
-median per position axis and in heading (the learner's own rule: multiplicative steps towards the samples,
-divided by the chi-square(1) median), and :meth:`ViewNoise.remove` takes it out of a teaching view's squared
-disagreement before the odometry learner sees it: ``E[nu^2] = odometry variance + view variance``. Where the
-odometry is bad the disagreements are far larger than the view's scatter and little changes.
+median per position axis and in heading (the learner's own rule, :func:`median_step`: multiplicative steps
+towards the samples, divided by the chi-square(1) median), and :meth:`ViewNoise.remove` takes it out of a
+teaching view's squared disagreement before the odometry learner sees it:
+``E[nu^2] = odometry variance + view variance``. Where the odometry is bad the disagreements are far larger
+than the view's scatter and little changes.
 """
 
 from __future__ import annotations
@@ -29,6 +30,16 @@ START = (1e-6, 1e-4)
 FLOOR = (1e-12, 1e-14)
 
 
+def median_step(value: float, sample: float, step: float) -> float:
+    """``value`` moved one multiplicative step (``exp(+-step)``) towards making it the running median of ``sample``.
+
+    The rule both of Albot1+'s noise learners use (:class:`ViewNoise`, ``plus.OdometryNoise``): up when the
+    sample exceeds the chi-square(1) median of a variable of variance ``value``, down otherwise; a median, unlike
+    a mean, is not moved by the occasional mismatched view.
+    """
+    return value * math.exp(step if sample > CHI2_1_MEDIAN * value else -step)
+
+
 class ViewNoise:
     """The running median of the squared disagreement in views that do not refute the odometry's prediction."""
 
@@ -41,8 +52,7 @@ class ViewNoise:
         nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
         d_phi = wrap_angle(measured[2] - predicted[2])
         for g, nu2 in ((0, nu2_xy), (1, d_phi * d_phi)):
-            up = nu2 > CHI2_1_MEDIAN * self.variance[g]
-            self.variance[g] *= math.exp(self.step if up else -self.step)
+            self.variance[g] = median_step(self.variance[g], nu2, self.step)
 
     def remove(self, nu2_xy: float, nu2_phi: float) -> tuple[float, float]:
         """A teaching view's squared disagreement (per position axis, m^2; heading, rad^2) less the view's own."""

@@ -14,13 +14,13 @@ from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.plus import (
-    CHI2_1_MEDIAN,
     ODOMETRY_TURNS_DEG,
     OdometryNoise,
     PlusLocaliser,
     screen_measurement,
     start_poses,
 )
+from albot1.methods.albot1.mapping.view_noise import CHI2_1_MEDIAN
 from albot1.methods.albot1.perception.endpoints import CORNER, UNSTABLE
 from albot1.metrics.ate import ate
 
