@@ -208,7 +208,7 @@ class GtsamGraphConfig(BaseModel):
     loop_distinct_max_ambiguity: float = Field(
         gt=0,
         le=1,
-        description="... or when a pose more than 1 m away scores more than this fraction of the best (1 = only the first test)",
+        description="... or when a pose more than 1 m away scores more than this fraction of the best (1: only that)",
     )
     loop_kernel: Literal["cauchy", "huber", "none"] = Field(description="robust kernel on loop-closure edges")
     loop_kernel_scale: float = Field(

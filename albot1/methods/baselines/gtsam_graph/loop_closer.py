@@ -146,7 +146,7 @@ class LoopCloser:
             self.add(accepted)
 
     def distinct(self, target: FloatArray, key: int, pose: FloatArray) -> str:
-        """``""`` unless the distinct-alignment check is on and refuses node ``key``'s match at ``pose`` (the reason)."""
+        """``""`` unless the distinct-alignment check is on and refuses node ``key``'s match at ``pose``: the reason."""
         cfg = self.config
         if cfg.loop_distinct_half_width_m <= 0:
             return ""
