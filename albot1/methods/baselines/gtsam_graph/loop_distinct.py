@@ -18,6 +18,9 @@ search's ambiguity radius from the ICP pose (a distinct alignment scores
 better: ICP sits in a local minimum), or when the best pose is ICP's but a
 pose beyond that radius scores more than ``max_ambiguity`` of it (the ratio
 test of the correlative seed, applied to every match).
+
+Measured and left off: it also refuses right closures (orebro, edmonton,
+intel and the synthetic office loop got worse; docs/baselines.md).
 """
 
 from __future__ import annotations
