@@ -198,6 +198,18 @@ class GtsamGraphConfig(BaseModel):
         gt=0, description="two loop matches agree when their corrections differ by less than this (m)"
     )
     loop_agreement_deg: float = Field(gt=0, description="... and this (deg)")
+    loop_distinct_half_width_m: float = Field(
+        ge=0,
+        description=(
+            "a loop match is refused when a correlative search this wide around its pose finds a better pose more "
+            "than 1 m away (0 = off; loop_distinct.py)"
+        ),
+    )
+    loop_distinct_max_ambiguity: float = Field(
+        gt=0,
+        le=1,
+        description="... or when a pose more than 1 m away scores more than this fraction of the best (1: only that)",
+    )
     loop_kernel: Literal["cauchy", "huber", "none"] = Field(description="robust kernel on loop-closure edges")
     loop_kernel_scale: float = Field(
         gt=0, description="kernel parameter on the whitened error (in standard deviations)"

@@ -30,6 +30,7 @@ from albot1.methods.baselines.gtsam_graph.loop_closure import (
     search_radius,
     verify,
 )
+from albot1.methods.baselines.gtsam_graph.loop_distinct import distinct_alignment
 from albot1.methods.baselines.gtsam_graph.registration import Registration, try_register
 
 
@@ -131,6 +132,9 @@ class LoopCloser:
                     cov, why = verify(retry, guess, self.tests, self.prior)
                     if cov is not None:
                         covariance, reason, reg = cov, "", retry
+            if covariance is not None:
+                reason = self.distinct(target.points, key, reg.pose)
+                covariance = None if reason else covariance
             if covariance is None:
                 self.reject(reason)
                 continue
@@ -140,6 +144,19 @@ class LoopCloser:
             self.reject("not confirmed", expired)
         if accepted:
             self.add(accepted)
+
+    def distinct(self, target: FloatArray, key: int, pose: FloatArray) -> str:
+        """``""`` unless the distinct-alignment check is on and refuses node ``key``'s match at ``pose``: the reason."""
+        cfg = self.config
+        if cfg.loop_distinct_half_width_m <= 0:
+            return ""
+        window = SearchWindow(
+            half_width_m=cfg.loop_distinct_half_width_m,
+            step_m=cfg.loop_coarse_step_m,
+            half_angle_rad=math.radians(cfg.loop_coarse_half_angle_deg),
+            step_rad=math.radians(cfg.loop_coarse_step_deg),
+        )
+        return distinct_alignment(target, self._back.scans[key], pose, window, cfg.loop_distinct_max_ambiguity)
 
     def add(self, accepted: list[LoopMatch]) -> None:
         """Confirmed loop matches become robust edges of the graph; the path since the last closure starts over."""

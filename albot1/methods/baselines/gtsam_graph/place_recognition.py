@@ -95,11 +95,15 @@ class PlaceRecognition:
         j = int(chosen[np.argmin(np.hypot(*(back.estimates[chosen, :2] - world[:2]).T))])
         nodes = range(max(0, j - cfg.loop_submap_nodes), min(last, j + cfg.loop_submap_nodes) + 1)
         guess = se2.between(back.estimates[j], world)
-        reg = try_register(back.target(nodes, j), back.scans[key], guess, self._icp)
+        submap = back.target(nodes, j)
+        reg = try_register(submap, back.scans[key], guess, self._icp)
         if reg is None:
             reject("place-too-few-points")
             return
         covariance, reason = verify(reg, guess, self._confirmer.tests, self._closer.prior)
+        if covariance is not None:
+            reason = self._closer.distinct(submap.points, key, reg.pose)
+            covariance = None if reason else covariance
         if covariance is None:
             reject(f"place-{reason}")
             return
