@@ -19,6 +19,7 @@ from albot1.data.loaders.output import check_output
 from albot1.data.loaders.registry import writer_for
 from albot1.data.model import Frame, Sequence
 from albot1.data.open import open_sequence
+from albot1.data.retime import RETIME_STEP_S, next_stamp
 
 if TYPE_CHECKING:
     from albot1.settings import Settings
@@ -63,23 +64,17 @@ class Conversion:
     retimed: int = 0
 
 
-#: The smallest step ``retime`` leaves between consecutive scans: 1 us is
-#: representable at Unix-epoch magnitudes (float64 spacing there ~ 0.2 us)
-#: and far above a bag's 1 ns clock.
-RETIME_STEP_S = 1e-6
-
-
 def retimed(frames: Iterator[Frame], shifted: list[int]) -> Iterator[Frame]:
     """Frames whose timestamp is at least ``RETIME_STEP_S`` after the previous one's.
 
-    Only stamps that repeat or go backwards move, and only as far as needed;
-    ``shifted[0]`` counts them so the caller can report it.
+    Only stamps that repeat or go backwards move, and only as far as needed
+    (:func:`albot1.data.retime.next_stamp`, the rule the MRPT rawlog's stamp
+    fill shares); ``shifted[0]`` counts them so the caller can report it.
     """
-    previous = -math.inf
+    previous: float | None = None
     for frame in frames:
-        t = frame.scan.timestamp
-        if t < previous + RETIME_STEP_S:
-            t = previous + RETIME_STEP_S
+        t = next_stamp(frame.scan.timestamp, previous, step=RETIME_STEP_S, resolution=RETIME_STEP_S)
+        if t != frame.scan.timestamp and not math.isnan(t):  # a NaN stamp is never moved (as before)
             shifted[0] += 1
             frame = replace(frame, scan=replace(frame.scan, timestamp=t))
         previous = t

@@ -19,57 +19,50 @@ only its sign: each scan's stamp must be strictly later than the previous
 scan's, in MRPT's 100 ns ticks, and must not be MRPT's invalid stamp (tick 0).
 ``rbpf-slam`` copies the stamps of the actions but never compares them.
 
-So a scan keeps its own stamp when it is finite, representable and strictly
-later than the stamp written for the previous scan; otherwise it is given the
-previous written stamp plus a step: a tenth (:data:`FILL_FRACTION`) of the
-interval between the last two scans that kept their own stamps, when there is
-one of at most :data:`MAX_LEARNED_STEP_S`, else :data:`NOMINAL_STEP_S`. The
-fraction lets the log's own stamps pass the filled ones again a few scans
-after a stamp went back (at the log's full interval they never would: the raw
-intel log, with 631 stamps going back by up to 0.6 s, would keep its own stamp
-on 27 of its first 2,000 scans; with the fraction, on 1,649). A log whose
+So a scan keeps its own stamp when it is finite, representable in MRPT's
+ticks, not tick 0 and strictly later than the stamp *written* for the
+previous scan (kept or filled); otherwise it is given that written stamp plus
+:data:`~albot1.data.retime.RETIME_STEP_S` (1 us, 10 ticks): the rule
+``albot1 convert --retime`` uses (:func:`albot1.data.retime.next_stamp`), so
+each stamp moves only as far as needed and the log's own stamps take over
+again as soon as they pass the filled ones. When the first scan's stamp is
+unusable the clock starts at the Unix epoch (:data:`START_S`). A log whose
 stamps all qualify is written exactly as before. Each replacement is counted
 and the first one is described, so a run can say so.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from albot1.data.errors import DataError
 from albot1.data.loaders.rawlog import serialize
+from albot1.data.retime import RETIME_STEP_S, next_stamp
 
-#: Step between filled-in stamps when the log gives no usable interval of its own (s). Any positive value
-#: works for MRPT (see the module doc); 1 s is the order of the corrected logs' scan intervals (1.5-5 s).
-NOMINAL_STEP_S = 1.0
-#: The interval between two kept stamps is used as the step only up to this (s): a jump of hours is not a period.
-MAX_LEARNED_STEP_S = 60.0
+#: Where the clock starts when the first scan's own stamp is unusable (Unix seconds): the Unix epoch.
+START_S = 0.0
 
-#: Filled stamps advance by this fraction of the log's own interval (see the module doc).
-FILL_FRACTION = 0.1
-
-_NOMINAL_STEP_TICKS = round(NOMINAL_STEP_S * serialize.TICKS_PER_S)
-_MAX_LEARNED_STEP_TICKS = round(MAX_LEARNED_STEP_S * serialize.TICKS_PER_S)
+#: :data:`~albot1.data.retime.RETIME_STEP_S` in ``mrpt::Clock`` ticks.
+STEP_TICKS = round(RETIME_STEP_S * serialize.TICKS_PER_S)
 #: MRPT's ``INVALID_TIMESTAMP`` (a default ``mrpt::Clock::time_point``).
 _INVALID_TICKS = 0
-#: Where a clock starts when the first scan's own stamp is unusable: the Unix epoch.
-_START_TICKS = serialize.mrpt_timestamp(0.0)
+_START_TICKS = serialize.mrpt_timestamp(START_S)
 
 
 @dataclass
 class StampClock:
     """Gives scans their MRPT stamps in order (see the module doc); counts and describes replacements."""
 
-    replaced: int = 0
+    replaced: int = field(default=0, init=False)
     #: The first replacement: the scan index, its stamp and why it could not be kept (None: none replaced).
-    first_replacement: str | None = None
-    _last_ticks: int | None = None
-    _last_kept: bool = False
-    _step_ticks: int = _NOMINAL_STEP_TICKS
+    first_replacement: str | None = field(default=None, init=False)
+    #: The stamp written for the previous scan (None before the first).
+    _last_ticks: int | None = field(default=None, init=False)
 
     def stamp(self, index: int, unix_s: float) -> int:
         """The stamp (``mrpt::Clock`` ticks) to write for scan ``index`` whose own stamp is ``unix_s``."""
         problem: str | None = None
+        written = _START_TICKS if self._last_ticks is None else self._last_ticks + STEP_TICKS
         try:
             ticks = serialize.mrpt_timestamp(unix_s)
         except ValueError as exc:
@@ -77,18 +70,15 @@ class StampClock:
         else:
             if ticks == _INVALID_TICKS:
                 problem = f"timestamp {unix_s!r} is MRPT's invalid timestamp"
-            elif self._last_ticks is not None and ticks <= self._last_ticks:
-                problem = f"timestamp {unix_s!r} s is not after the previous scan's"
-        if problem is None:
-            if self._last_kept and self._last_ticks is not None and ticks - self._last_ticks <= _MAX_LEARNED_STEP_TICKS:
-                self._step_ticks = max(1, round(FILL_FRACTION * (ticks - self._last_ticks)))
-            self._last_ticks, self._last_kept = ticks, True
-            return ticks
-        filled = _START_TICKS if self._last_ticks is None else self._last_ticks + self._step_ticks
-        if filled >= 2**64:
-            raise DataError(f"no later MRPT timestamp can follow the previous scan's ({problem})")
-        self.replaced += 1
-        if self.first_replacement is None:
-            self.first_replacement = f"scan {index}: {problem}"
-        self._last_ticks, self._last_kept = filled, False
-        return filled
+            else:
+                written = next_stamp(ticks, self._last_ticks, step=STEP_TICKS, resolution=1)
+                if written != ticks:
+                    problem = f"timestamp {unix_s!r} s is not after the previous scan's"
+        if problem is not None:
+            if written >= 2**64:
+                raise DataError(f"no later MRPT timestamp can follow the previous scan's ({problem})")
+            self.replaced += 1
+            if self.first_replacement is None:
+                self.first_replacement = f"scan {index}: {problem}"
+        self._last_ticks = written
+        return written

@@ -25,13 +25,15 @@ mounting pose on the robot is ``SequenceMetadata.sensor_offset``. A beam with
 no return (NaN) or beyond the scan's max range is written as invalid.
 
 Stamps: each scan's own. With ``fill_stamps`` (what the mrpt-icp and
-mrpt-rbpf methods use) a scan whose stamp MRPT cannot use (not finite, or not
-strictly later than the previous scan's) gets a filled-in one instead and is
-counted in :class:`RawlogStats`; ``stamps`` says why icp-slam needs strictly
-increasing stamps. A log whose stamps are all usable is written byte for byte
-as without it. ``albot1 convert`` does not fill (it changes no data unless
-asked: its ``--retime`` makes repeated or backward stamps strictly increasing,
-which is what icp-slam needs).
+mrpt-rbpf methods use) a scan whose stamp MRPT cannot use (not finite, not
+representable, tick 0, or not strictly later than the stamp written for the
+previous scan) gets the previous written stamp plus 1 us instead (the step of
+``albot1 convert --retime``, :mod:`albot1.data.retime`) and is counted in
+:class:`RawlogStats`; ``stamps`` says why icp-slam needs strictly increasing
+stamps and gives the rule exactly. A log whose stamps are all usable is
+written byte for byte as without it. ``albot1 convert`` does not fill (it
+changes no data unless asked: its ``--retime`` makes repeated or backward
+stamps strictly increasing by the same rule, which is what icp-slam needs).
 """
 
 from __future__ import annotations

@@ -23,10 +23,11 @@ max_path_ratio]`` of the odometry's. A failure is a :class:`BaselineError`
 with the reason (timeout, memory limit, MRPT's exception message, a short or
 frozen path).
 
-Stamps: a scan whose stamp icp-slam cannot use (not finite, not strictly
-after the previous scan's: several corrected logs have one stamp for every
-scan) is written with a filled-in one (``albot1.data.loaders.rawlog.stamps``);
-how many, and the first, are ``extras.mrpt.rawlog_replaced_stamps`` and
+Stamps: a scan whose stamp icp-slam cannot use (not finite, tick 0, not
+strictly after the stamp written for the previous scan: several corrected logs
+have one stamp for every scan) is written 1 us after that stamp instead
+(``albot1.data.loaders.rawlog.stamps``); how many, and the first, are
+``extras.mrpt.rawlog_replaced_stamps`` and
 ``rawlog_first_replaced_stamp``.
 
 Frames: the runner gives the laser's trajectory (the mounting offset applied

@@ -13,18 +13,23 @@ from hypothesis import strategies as st
 
 from albot1.data.errors import DataError
 from albot1.data.loaders.rawlog import serialize as ser
-from albot1.data.loaders.rawlog.stamps import NOMINAL_STEP_S, StampClock
+from albot1.data.loaders.rawlog.stamps import START_S, STEP_TICKS, StampClock
 from albot1.data.loaders.rawlog.writer import write_frames
 from albot1.data.model import Frame, Scan
+from albot1.data.retime import RETIME_STEP_S
 
 ANGLES = np.radians(np.linspace(-90.0, 90.0, 5))
 T = ser.TICKS_PER_S
-NOMINAL = round(NOMINAL_STEP_S * T)
+S = STEP_TICKS  # 1 us: the step `albot1 convert --retime` uses
 
 
 def _stamps(seconds: list[float]) -> tuple[list[int], StampClock]:
     clock = StampClock()
     return [clock.stamp(i, s) for i, s in enumerate(seconds)], clock
+
+
+def test_the_fill_step_is_the_retime_step_in_mrpt_ticks() -> None:
+    assert (S, RETIME_STEP_S) == (10, 1e-6)
 
 
 def test_strictly_increasing_stamps_are_kept_exactly() -> None:
@@ -34,44 +39,71 @@ def test_strictly_increasing_stamps_are_kept_exactly() -> None:
     assert (clock.replaced, clock.first_replacement) == (0, None)
 
 
-def test_constant_stamps_advance_by_the_nominal_step() -> None:
+def test_constant_stamps_advance_by_one_step_each() -> None:
     got, clock = _stamps([0.0] * 4)
     base = ser.mrpt_timestamp(0.0)
-    assert got == [base, base + NOMINAL, base + 2 * NOMINAL, base + 3 * NOMINAL]
+    assert got == [base, base + S, base + 2 * S, base + 3 * S]
     assert clock.replaced == 3
     assert clock.first_replacement == "scan 1: timestamp 0.0 s is not after the previous scan's"
 
 
-def test_a_backward_stamp_is_filled_at_a_tenth_of_the_logs_interval_until_the_stamps_pass_it() -> None:
-    got, clock = _stamps([10.0, 10.5, 9.0, 10.52, 11.0, 11.2])
-    # 10.0 -> 10.5 kept (interval 0.5 s, fill step 0.05 s); 9.0 goes back: 10.55; 10.52 is before it: 10.6;
-    # 11.0 kept; 11.2 kept (the step becomes 0.02 s).
-    assert got == [ser.mrpt_timestamp(s) for s in (10.0, 10.5, 10.55, 10.6, 11.0, 11.2)]
-    assert clock.replaced == 2 and clock.first_replacement is not None
-    assert clock.first_replacement.startswith("scan 2: timestamp 9.0 s")
+def test_a_repeated_first_stamp_moves_only_that_scan() -> None:
+    seconds = [0.0, 0.0] + [round(0.1 * k, 1) for k in range(1, 50)]  # 0, 0, 0.1 .. 4.9
+    got, clock = _stamps(seconds)
+    assert got == [ser.mrpt_timestamp(0.0), ser.mrpt_timestamp(0.0) + S] + [ser.mrpt_timestamp(s) for s in seconds[2:]]
+    assert (len(seconds), clock.replaced) == (51, 1)
+
+
+def test_a_backward_stamp_moves_one_step_past_the_previous_written_one() -> None:
+    got, clock = _stamps([10.0, 10.5, 9.0, 10.5000005, 10.5000021, 11.0])
+    # 9.0 goes back: 10.5 s + 1 us; 10.5 s + 0.5 us is not after that: 10.5 s + 2 us; 10.5 s + 2.1 us (one tick
+    # after the written stamp) and 11.0 are kept.
+    t = ser.mrpt_timestamp(10.5)
+    assert got == [ser.mrpt_timestamp(10.0), t, t + S, t + 2 * S, t + 21, ser.mrpt_timestamp(11.0)]
+    assert clock.replaced == 2
+    assert clock.first_replacement == "scan 2: timestamp 9.0 s is not after the previous scan's"
 
 
 def test_unusable_stamps_are_filled_and_a_first_one_starts_at_the_unix_epoch() -> None:
     got, clock = _stamps([math.nan, math.inf, -2e10, 5.0])
-    base = ser.mrpt_timestamp(0.0)
-    assert got == [base, base + NOMINAL, base + 2 * NOMINAL, ser.mrpt_timestamp(5.0)]
+    base = ser.mrpt_timestamp(START_S)
+    assert (START_S, base) == (0.0, ser.FILETIME_EPOCH_OFFSET_S * T)
+    assert got == [base, base + S, base + 2 * S, ser.mrpt_timestamp(5.0)]
     assert clock.replaced == 3 and clock.first_replacement == "scan 0: timestamp nan is not finite"
 
 
-def test_mrpts_invalid_stamp_and_a_jump_of_hours_are_not_periods() -> None:
-    # Tick 0 is MRPT's INVALID_TIMESTAMP; a kept jump of 2^32 s is kept but not used as the fill step.
-    invalid = -ser.FILETIME_EPOCH_OFFSET_S
-    got, _ = _stamps([1.0, float(invalid), 2.0**32, 3.0])
-    assert got[1] == ser.mrpt_timestamp(1.0) + NOMINAL
-    assert got[2:] == [ser.mrpt_timestamp(2.0**32), ser.mrpt_timestamp(2.0**32) + NOMINAL]
+def test_mrpts_invalid_stamp_at_the_first_scan_is_replaced() -> None:
+    # Tick 0 is MRPT's INVALID_TIMESTAMP: there is no previous stamp for it to fail to follow.
+    invalid = float(-ser.FILETIME_EPOCH_OFFSET_S)
+    assert ser.mrpt_timestamp(invalid) == 0
+    got, clock = _stamps([invalid, 1.0])
+    assert got == [ser.mrpt_timestamp(START_S), ser.mrpt_timestamp(1.0)]
+    assert clock.replaced == 1
+    assert clock.first_replacement == f"scan 0: timestamp {invalid!r} is MRPT's invalid timestamp"
+
+
+def test_private_state_is_not_a_constructor_argument() -> None:
+    with pytest.raises(TypeError):
+        StampClock(_last_ticks=5)  # type: ignore[call-arg]
+    with pytest.raises(TypeError):
+        StampClock(replaced=3)  # type: ignore[call-arg]
 
 
 def test_a_clock_at_the_end_of_mrpts_range_is_an_error() -> None:
-    last = 2**64 / T - ser.FILETIME_EPOCH_OFFSET_S - 0.5 * NOMINAL_STEP_S
+    last = 2**64 / T - ser.FILETIME_EPOCH_OFFSET_S
+    while True:  # the largest float second MRPT's clock can hold
+        try:
+            ticks = ser.mrpt_timestamp(last)
+            break
+        except ValueError:
+            last = math.nextafter(last, -math.inf)
+    fills = -(-(2**64 - ticks) // S)  # the fill that would reach 2^64
     clock = StampClock()
-    clock.stamp(0, last)
+    assert clock.stamp(0, last) == ticks
+    for k in range(1, fills):
+        assert clock.stamp(k, last) == ticks + k * S
     with pytest.raises(DataError, match="no later MRPT timestamp"):
-        clock.stamp(1, last)
+        clock.stamp(fills, last)
 
 
 finite_or_not = st.one_of(
@@ -130,7 +162,7 @@ def test_the_writer_fills_only_when_asked_and_is_unchanged_for_usable_stamps() -
         stats = write_frames(_frames([7.0] * 3), out, layout=layout, fill_stamps=True)
         assert stats.replaced_stamps == 2
         assert stats.first_replaced_stamp == "scan 1: timestamp 7.0 s is not after the previous scan's"
-        assert _scan_stamps(out.getvalue()) == [base, base + NOMINAL, base + 2 * NOMINAL]
+        assert _scan_stamps(out.getvalue()) == [base, base + S, base + 2 * S]
 
 
 def test_without_filling_a_non_finite_stamp_is_still_an_error() -> None:
