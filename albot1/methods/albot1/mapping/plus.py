@@ -155,13 +155,14 @@ ODOMETRY_TURNS_DEG = (0.0, -3.0, 3.0, -6.0, 6.0, -10.0, 10.0, -15.0, 15.0, -20.0
 _ODOMETRY_TURNS = np.radians(np.asarray(ODOMETRY_TURNS_DEG))
 
 
-def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | None) -> FloatArray:
+def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | list[Pose] | None) -> FloatArray:
     """The poses the solver starts from (it keeps the cheapest): ``(c, 3)``, contiguous.
 
     With a thesis localisation: its pose, the odometry step and every
     landmark's candidate pose (one mismatched landmark cannot then decide
     alone). Without: the odometry step turned by each of
-    :data:`ODOMETRY_TURNS_DEG`.
+    :data:`ODOMETRY_TURNS_DEG`. ``candidates``: ``(c, 3)``, or the poses as localisation listed them
+    (:attr:`~albot1.methods.albot1.mapping.localisation.Localisation.poses`; one array built, not two).
     """
     # Filled in place (values as the stacked arrays had them): numpy's stacking calls cost more than the copies.
     if thesis is None or candidates is None:
@@ -170,6 +171,8 @@ def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | No
         starts[:, 1] = odometry[1]
         starts[:, 2] = odometry[2] + _ODOMETRY_TURNS
         return starts
+    if isinstance(candidates, list):  # the same float64 values, from Python floats in one call
+        return np.array([thesis, odometry, *candidates], dtype=float).reshape(-1, 3)
     others = np.asarray(candidates, dtype=float).reshape(-1, 3)
     starts = np.empty((2 + others.shape[0], 3))
     starts[0] = thesis
