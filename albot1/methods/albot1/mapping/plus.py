@@ -199,9 +199,8 @@ class PlusLocaliser:
         self.ambiguous_views = 0
         self.last_ambiguity: Ambiguity | None = None
         self._ambiguity_limit = threshold(params.ambiguity_probability)
-        #: The fit's sigmas as the ambiguity tests take them, and the solver's trailing settings (built once, not per view).
+        #: The fit's sigmas as the ambiguity tests take them (built once, not per view).
         self._sigmas = (params.line_sigma, params.point_sigma, params.scan_sigma, params.huber, params.scan_gate)
-        self._solver_settings = (*self._sigmas, params.iterations, params.overhang)
         #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
         self.window = (
             OdometryWindow(params.window_updates, params.motion_model)
@@ -348,8 +347,26 @@ class PlusLocaliser:
         info_xy: float,
         info_phi: float,
     ) -> tuple[Pose, FloatArray]:
+        p = self.params
         x, y, phi, info = self._k.refine_pose(
-            starts, lm_view, lm_map, ok, points, self._ref, *prior, info_xy, info_phi, *self._solver_settings
+            starts,
+            lm_view,
+            lm_map,
+            ok,
+            points,
+            self._ref,
+            prior[0],
+            prior[1],
+            prior[2],
+            info_xy,
+            info_phi,
+            p.line_sigma,
+            p.point_sigma,
+            p.scan_sigma,
+            p.huber,
+            p.scan_gate,
+            p.iterations,
+            p.overhang,
         )
         return (x, y, phi), info
 
