@@ -21,11 +21,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from itertools import compress
 
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.geometry.se2 import Pose, rotate, wrap_angle
+from albot1.geometry.se2 import Pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.perception.endpoints import STABLE
 from albot1.methods.albot1.perception.recognition import Tracked
@@ -84,12 +85,19 @@ def algorithm2_pose(map_seg: FloatArray, view_seg: FloatArray, side: int) -> Pos
 
 
 def landmark_pose(map_seg: FloatArray | Sequence[float], view_seg: FloatArray | Sequence[float], side: int) -> Pose:
-    """The view's pose in the map that lays ``view_seg`` onto ``map_seg`` at the reference point ``side``."""
-    phi = wrap_angle(_direction(map_seg) - _direction(view_seg))
-    mx, my = _reference(map_seg, side)
-    vx, vy = _reference(view_seg, side)
-    rx, ry = rotate(phi, vx, vy)
-    return (mx - rx, my - ry, phi)
+    """The view's pose in the map that lays ``view_seg`` onto ``map_seg`` at the reference point ``side``.
+
+    :func:`_direction`, :func:`_reference` and ``rotate`` written out (the same operations in the same order):
+    localisation calls this for every recognised landmark of every scan, where the calls cost more than the sums.
+    """
+    phi = wrap_angle(
+        math.atan2(float(map_seg[3] - map_seg[1]), float(map_seg[2] - map_seg[0]))
+        - math.atan2(float(view_seg[3] - view_seg[1]), float(view_seg[2] - view_seg[0]))
+    )
+    i = 2 * side
+    vx, vy = float(view_seg[i]), float(view_seg[i + 1])
+    c, s = math.cos(phi), math.sin(phi)
+    return (float(map_seg[i]) - (c * vx - s * vy), float(map_seg[i + 1]) - (s * vx + c * vy), phi)
 
 
 def outlier_keep(positions: Sequence[tuple[float, float]], min_candidates: int) -> list[bool]:
@@ -102,10 +110,11 @@ def outlier_keep(positions: Sequence[tuple[float, float]], min_candidates: int) 
     n = len(positions)
     if n < min_candidates:
         return [True] * n
-    mx = sum(p[0] for p in positions) / n
-    my = sum(p[1] for p in positions) / n
+    # sums of lists, not of generators: the same additions in the same order, without a generator's cost
+    mx = sum([p[0] for p in positions]) / n
+    my = sum([p[1] for p in positions]) / n
     dist = [math.hypot(p[0] - mx, p[1] - my) for p in positions]
-    sigma = math.sqrt(sum(d * d for d in dist) / n)
+    sigma = math.sqrt(sum([d * d for d in dist]) / n)
     return [d <= sigma * (1.0 + 1e-12) for d in dist]
 
 
@@ -205,5 +214,5 @@ def localise(
         return None
     n = len(poses)
     kept = outlier_keep([(p[0], p[1]) for p in poses], min_candidates)
-    best = max((k for k in range(n) if kept[k]), key=lambda k: scores[k])
+    best = max(compress(range(n), kept), key=scores.__getitem__)  # the first best-scored kept candidate
     return Localisation(poses[best], ids[best], ids, poses, kept, scores)

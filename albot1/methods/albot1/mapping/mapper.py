@@ -312,7 +312,7 @@ class Albot1Mapper:
         assert self._plus is not None
         loc = self._localise(rl)
         starts = start_poses(
-            compose_pose(prev_pose, step), None if loc is None else loc.pose, None if loc is None else loc.candidates
+            compose_pose(prev_pose, step), None if loc is None else loc.pose, None if loc is None else loc.poses
         )
         rows: list[int] = []
         maps: list[list[float]] = []

@@ -155,13 +155,14 @@ ODOMETRY_TURNS_DEG = (0.0, -3.0, 3.0, -6.0, 6.0, -10.0, 10.0, -15.0, 15.0, -20.0
 _ODOMETRY_TURNS = np.radians(np.asarray(ODOMETRY_TURNS_DEG))
 
 
-def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | None) -> FloatArray:
+def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | list[Pose] | None) -> FloatArray:
     """The poses the solver starts from (it keeps the cheapest): ``(c, 3)``, contiguous.
 
     With a thesis localisation: its pose, the odometry step and every
     landmark's candidate pose (one mismatched landmark cannot then decide
     alone). Without: the odometry step turned by each of
-    :data:`ODOMETRY_TURNS_DEG`.
+    :data:`ODOMETRY_TURNS_DEG`. ``candidates``: ``(c, 3)``, or the poses as localisation listed them
+    (:attr:`~albot1.methods.albot1.mapping.localisation.Localisation.poses`; one array built, not two).
     """
     # Filled in place (values as the stacked arrays had them): numpy's stacking calls cost more than the copies.
     if thesis is None or candidates is None:
@@ -170,6 +171,8 @@ def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | No
         starts[:, 1] = odometry[1]
         starts[:, 2] = odometry[2] + _ODOMETRY_TURNS
         return starts
+    if isinstance(candidates, list):  # the same float64 values, from Python floats in one call
+        return np.array([thesis, odometry, *candidates], dtype=float).reshape(-1, 3)
     others = np.asarray(candidates, dtype=float).reshape(-1, 3)
     starts = np.empty((2 + others.shape[0], 3))
     starts[0] = thesis
@@ -196,6 +199,8 @@ class PlusLocaliser:
         self.ambiguous_views = 0
         self.last_ambiguity: Ambiguity | None = None
         self._ambiguity_limit = threshold(params.ambiguity_probability)
+        #: The fit's sigmas as the ambiguity tests take them (built once, not per view).
+        self._sigmas = (params.line_sigma, params.point_sigma, params.scan_sigma, params.huber, params.scan_gate)
         #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
         self.window = (
             OdometryWindow(params.window_updates, params.motion_model)
@@ -255,7 +260,9 @@ class PlusLocaliser:
         measured, info = self._solve(starts, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
         if p.prior == "off":
             return measured
-        sigmas = (p.line_sigma, p.point_sigma, p.scan_sigma, p.huber, p.scan_gate)
+        sigmas = self._sigmas
+        #: The turn bound's test of ``measured`` (limit 0), reused by the ambiguity test while ``measured`` stands.
+        support: Ambiguity | None = None
         if not placed and p.turn_floor > 0.0:  # the turn bound (:mod:`.turn_bound`); views a landmark placed skip it
             limit = allowance(p.turn_floor, p.turn_scale, since_update[2])
             if beyond(measured[2] - predicted[2], limit):
@@ -278,6 +285,7 @@ class PlusLocaliser:
                     # view's pose composed with the step: between updates the two differ)
                     near = bounded_starts(start_poses(predicted, None, None), limit)
                     measured, info = self._solve(near, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
+                    support = None  # a new fit: the ambiguity test measures it afresh
                     if beyond(measured[2] - predicted[2], limit):
                         return predicted
         if p.ambiguity_probability > 0.0:
@@ -297,19 +305,23 @@ class PlusLocaliser:
                 if window is not None and window.kept:
                     self.window_views += 1
                     return window.prediction
-            test = view_ambiguity(
-                self._k.measurement_costs,
-                measured,
-                predicted,
-                lm_view,
-                lm_map,
-                ok,
-                points,
-                self._ref,
-                sigmas,
-                self._ambiguity_limit,
-                p.overhang,
-            )
+            if support is not None:  # same poses, terms and sigmas: the statistic does not depend on the limit
+                bound = self._ambiguity_limit
+                test = Ambiguity(support.statistic, bound, support.statistic <= bound)
+            else:
+                test = view_ambiguity(
+                    self._k.measurement_costs,
+                    measured,
+                    predicted,
+                    lm_view,
+                    lm_map,
+                    ok,
+                    points,
+                    self._ref,
+                    sigmas,
+                    self._ambiguity_limit,
+                    p.overhang,
+                )
             self.last_ambiguity = test
             if test.ambiguous:
                 self.ambiguous_views += 1
@@ -370,8 +382,8 @@ class PlusLocaliser:
         would cost more than the arithmetic).
         """
         noise = self.noise
-        h00, h01, h02 = float(info[0, 0]), float(info[0, 1]), float(info[0, 2])
-        h11, h12, h22 = float(info[1, 1]), float(info[1, 2]), float(info[2, 2])
+        # One conversion to Python floats (the same values as six ``float(info[i, j])``).
+        (h00, h01, h02), (_, h11, h12), (_, _, h22) = info.tolist()
         d_phi = wrap_angle(measured[2] - predicted[2])
         # The smaller eigenvalue of the position block: how well the worst-fixed direction is known.
         half_trace = 0.5 * (h00 + h11)
@@ -393,8 +405,7 @@ class PlusLocaliser:
                 self.gate_rejections += 1
                 return predicted
             measured, info = screened.pose, screened.info
-            h00, h01, h02 = float(info[0, 0]), float(info[0, 1]), float(info[0, 2])
-            h11, h12, h22 = float(info[1, 1]), float(info[1, 2]), float(info[2, 2])
+            (h00, h01, h02), (_, h11, h12), (_, _, h22) = info.tolist()
             d_phi = wrap_angle(measured[2] - predicted[2])
         if scale != 1.0:  # after learning and the screen, which judge the fit by its stated information
             h00, h01, h02, h11, h12, h22 = h00 * scale, h01 * scale, h02 * scale, h11 * scale, h12 * scale, h22 * scale

@@ -136,6 +136,11 @@ def test_start_poses() -> None:
     np.testing.assert_allclose(alone[:, 2], 0.5 + np.radians(ODOMETRY_TURNS_DEG))
     both = start_poses(odometry, (1.1, 2.1, 0.4), np.array([[0.0, 0.0, 0.0], [5.0, 5.0, 1.0]]))
     np.testing.assert_allclose(both, [[1.1, 2.1, 0.4], [1.0, 2.0, 0.5], [0.0, 0.0, 0.0], [5.0, 5.0, 1.0]])
+    # localisation's list of candidate poses gives the same starts, bit for bit, as their array
+    listed = start_poses(odometry, (1.1, 2.1, 0.4), [(0.0, 0.0, 0.0), (5.0, 5.0, 1.0)])
+    assert listed.flags["C_CONTIGUOUS"] and listed.dtype == np.float64
+    np.testing.assert_array_equal(listed, both)
+    assert start_poses(odometry, (1.1, 2.1, 0.4), []).shape == (2, 3)
 
 
 def plus_params(**changes):
