@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from albot1.atomic import atomic_write
+from albot1.data import decoded
 from albot1.geometry.types import FloatArray
 from albot1.settings import reference_map_cache_dir
 from albot1.versions import code_version
@@ -146,13 +147,4 @@ def clear(folder: Path | None = None) -> int:
     """Delete every stored reference map (``folder`` or the configured one) and those in memory; the number deleted."""
     forget()
     target = folder if folder is not None else reference_map_cache_dir()
-    if target is None or not target.is_dir():
-        return 0
-    removed = 0
-    for entry in target.glob("*.npz"):
-        try:
-            entry.unlink()
-            removed += 1
-        except OSError:
-            continue
-    return removed
+    return 0 if target is None else decoded.clear(target)  # the decoded-log cache's own: every .npz entry of a folder
