@@ -1,6 +1,6 @@
 """The degeneracy screen's linear algebra (Albot1+), as one compiled call instead of a dozen numpy calls per view.
 
-:func:`albot1.methods.albot1.mapping.plus.screen_measurement` decides what
+:func:`albot1.methods.albot1.mapping.screen.screen_measurement` decides what
 to do with a view's pose fit; this kernel does its arithmetic: the
 eigendecomposition of the fit's information in scaled units, the
 disagreement with the odometry along the kept directions, the pose that

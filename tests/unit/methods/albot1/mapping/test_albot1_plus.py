@@ -17,9 +17,9 @@ from albot1.methods.albot1.mapping.plus import (
     ODOMETRY_TURNS_DEG,
     OdometryNoise,
     PlusLocaliser,
-    screen_measurement,
     start_poses,
 )
+from albot1.methods.albot1.mapping.screen import screen_measurement
 from albot1.methods.albot1.mapping.view_noise import CHI2_1_MEDIAN
 from albot1.methods.albot1.perception.endpoints import CORNER, UNSTABLE
 from albot1.metrics.ate import ate
