@@ -27,7 +27,6 @@ for bit, so the metric's numbers are the same with or without the cache.
 from __future__ import annotations
 
 import hashlib
-import io
 import json
 import zipfile
 from collections import OrderedDict
@@ -36,7 +35,6 @@ from pathlib import Path
 
 import numpy as np
 
-from albot1.atomic import atomic_write
 from albot1.data import decoded
 from albot1.geometry.types import FloatArray
 from albot1.settings import reference_map_cache_dir
@@ -123,19 +121,12 @@ def read_entry(entry: Path, key: str) -> FloatArray | None:
 
 
 def write_entry(entry: Path, key: str, cloud: FloatArray) -> bool:
-    """Store ``cloud`` atomically at ``entry``; False (and nothing stored) when the folder cannot be written."""
+    """Store ``cloud`` atomically at ``entry``; False (and nothing stored) when the folder cannot be written.
 
-    def write(tmp: Path) -> None:
-        buffer = io.BytesIO()
-        np.savez(buffer, key=np.array(key), points=cloud)
-        tmp.write_bytes(buffer.getvalue())
-
-    try:
-        entry.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write(entry, write)
-    except OSError:
-        return False
-    return True
+    The decoded-log cache's own writer (:func:`albot1.data.decoded.write_entry`): the entry is its ``key`` and
+    ``points`` arrays.
+    """
+    return decoded.write_entry(entry, {"key": np.array(key), "points": cloud})
 
 
 def forget() -> None:

@@ -6,20 +6,13 @@ import math
 
 import numpy as np
 import pytest
+from plus_room import NO_KINDS, SINCE, localiser, scan_from
 
-from albot1.geometry import se2
-from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
-from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
 
-KERNELS = MappingKernels(False)  # the plain functions: exactness, not speed, is tested here
-NO_KINDS = (np.empty((0, 2), dtype=np.int64), np.empty((0, 2), dtype=np.int64))
-# The last update view's surfaces (thesis frame, the update view at the origin facing +y): a room and a box.
-ROOM = np.array([[-3.0, 5.0, 3.0, 5.0], [3.0, 5.0, 3.0, 0.5], [-3.0, 0.5, -3.0, 5.0], [-0.5, 2.0, 0.5, 2.0]])
-SINCE = (0.0, 0.5, 0.0)  # the odometry since the update: 0.5 m straight ahead
 TRUE = (0.02, 0.5, math.radians(2.0))  # the view's true pose: 2 cm aside and turned 2 deg
 
 
@@ -41,26 +34,6 @@ def test_the_scale_makes_the_stated_distance_at_most_factor_times_the_likelihood
     assert information_scale(3.0, 12.0, 0.0) == 1.0  # off
     assert information_scale(3.0, 0.0) == 1.0 and information_scale(3.0, math.inf) == 1.0  # nothing measured
     assert information_scale(0.0, 12.0) == 0.0  # the ambiguity test keeps such a view before the fusion anyway
-
-
-def scan_from(pose: tuple[float, float, float], jitter: float) -> np.ndarray:
-    """The room's surfaces sampled every 10 cm as a view at ``pose`` sees them, every other point ``jitter`` off."""
-    seen = transform_segments(se2.inverse(pose), ROOM)
-    out = []
-    for x1, y1, x2, y2 in seen:
-        t = np.linspace(0.0, 1.0, max(2, int(math.hypot(x2 - x1, y2 - y1) / 0.1)))
-        out.append(np.column_stack([x1 + t * (x2 - x1), y1 + t * (y2 - y1)]))
-    points = np.vstack(out)
-    points[::2, 1] += jitter
-    points[1::2, 1] -= jitter
-    return np.ascontiguousarray(points)
-
-
-def localiser(**changes: float) -> PlusLocaliser:
-    config = Albot1Config.model_validate({**Albot1Mapper.presets["plus"], **changes})
-    loc = PlusLocaliser(config.plus_params(), KERNELS, 30.0)
-    loc.reset(ROOM, (0.0, 0.0, 0.0))
-    return loc
 
 
 def view_pose(loc: PlusLocaliser, jitter: float) -> tuple[float, float, float]:

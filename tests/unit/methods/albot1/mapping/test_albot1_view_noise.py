@@ -6,20 +6,13 @@ import math
 
 import numpy as np
 import pytest
+from plus_room import NO_KINDS, SINCE, localiser, scan_from
 
 from albot1.geometry import se2
-from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.config import Albot1Config
-from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
 from albot1.methods.albot1.mapping.view_noise import FLOOR, START, ViewNoise
-
-KERNELS = MappingKernels(False)  # the plain functions: exactness, not speed, is tested here
-NO_KINDS = (np.empty((0, 2), dtype=np.int64), np.empty((0, 2), dtype=np.int64))
-# The last update view's surfaces (thesis frame, the update view at the origin facing +y): a room and a box.
-ROOM = np.array([[-3.0, 5.0, 3.0, 5.0], [3.0, 5.0, 3.0, 0.5], [-3.0, 0.5, -3.0, 5.0], [-0.5, 2.0, 0.5, 2.0]])
-SINCE = (0.0, 0.5, 0.0)  # the odometry since the update: 0.5 m straight ahead
 
 
 def test_the_median_tracker_steps_towards_each_sample_by_the_learning_rate() -> None:
@@ -37,23 +30,6 @@ def test_the_views_own_variance_is_taken_out_of_a_teaching_sample_down_to_a_floo
     noise = ViewNoise(0.05)
     assert noise.remove(5e-6, 3e-4) == pytest.approx((4e-6, 2e-4), rel=1e-12)
     assert noise.remove(5e-7, 5e-5) == FLOOR
-
-
-def scan_from(pose: tuple[float, float, float]) -> np.ndarray:
-    """The room's surfaces sampled every 10 cm, as a view at ``pose`` sees them (its own frame)."""
-    seen = transform_segments(se2.inverse(pose), ROOM)
-    out = []
-    for x1, y1, x2, y2 in seen:
-        t = np.linspace(0.0, 1.0, max(2, int(math.hypot(x2 - x1, y2 - y1) / 0.1)))
-        out.append(np.column_stack([x1 + t * (x2 - x1), y1 + t * (y2 - y1)]))
-    return np.ascontiguousarray(np.vstack(out))
-
-
-def localiser(**changes: float) -> PlusLocaliser:
-    config = Albot1Config.model_validate({**Albot1Mapper.presets["plus"], **changes})
-    loc = PlusLocaliser(config.plus_params(), KERNELS, 30.0)
-    loc.reset(ROOM, (0.0, 0.0, 0.0))
-    return loc
 
 
 def view_pose(loc: PlusLocaliser, true: tuple[float, float, float]) -> tuple[float, float, float]:
