@@ -276,6 +276,23 @@ class Albot1Config(BaseModel):
             " (0 = off; albot1/methods/albot1/mapping/view_noise.py)"
         ),
     )
+    fit_noise_factor: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ (with the view noise): add this times the views' learnt scatter to the fit's stated"
+            " covariance before the fusion with the odometry's prediction"
+            " (0 = off; albot1/methods/albot1/mapping/fit_noise.py)"
+        ),
+    )
+    fit_noise_statistic: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ fit noise: a view whose likelihood ratio against the prediction exceeds this gets the added"
+            " scatter scaled by the square of this over its ratio (0 = every view gets all of it)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -356,4 +373,6 @@ class Albot1Config(BaseModel):
             turn_statistic=self.turn_bound_statistic,
             consistency=self.consistent_information,
             view_noise_rate=self.view_noise_learning_rate,
+            fit_noise=self.fit_noise_factor,
+            fit_noise_statistic=self.fit_noise_statistic,
         )

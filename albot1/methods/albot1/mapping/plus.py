@@ -64,6 +64,7 @@ from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
+from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_noise
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen import screen_measurement
@@ -110,6 +111,10 @@ class PlusParams:
     turn_statistic: float = 0.0  # a view's likelihood ratio above which the turn bound does not apply
     consistency: float = 0.0  # the fit's information scaled to its likelihood ratio (:mod:`.consistency`); 0 = off
     view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
+    fit_noise: float = (
+        0.0  # that scatter, times this, added to the fit's stated covariance in the fusion (:mod:`.fit_noise`)
+    )
+    fit_noise_statistic: float = 0.0  # ... falling with the square of the view's likelihood ratio beyond this
 
 
 class OdometryNoise:
@@ -329,7 +334,8 @@ class PlusLocaliser:
                 return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
                 scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
-                return self._fuse(measured, info, predicted, self._motion(since_update), scale)
+                return self._fuse(measured, info, predicted, self._motion(since_update), scale, test.statistic)
+            return self._fuse(measured, info, predicted, self._motion(since_update), 1.0, test.statistic)
         return self._fuse(measured, info, predicted, self._motion(since_update))
 
     def _motion(self, since_update: Pose) -> float:
@@ -369,10 +375,19 @@ class PlusLocaliser:
         )
         return (x, y, phi), info
 
-    def _fuse(self, measured: Pose, info: FloatArray, predicted: Pose, motion: float, scale: float = 1.0) -> Pose:
+    def _fuse(
+        self,
+        measured: Pose,
+        info: FloatArray,
+        predicted: Pose,
+        motion: float,
+        scale: float = 1.0,
+        statistic: float = 0.0,
+    ) -> Pose:
         """Learn from this view, then combine the measured and predicted poses by their information.
 
-        ``scale`` (:mod:`.consistency`) multiplies the measurement's information in the combination only.
+        ``scale`` (:mod:`.consistency`) multiplies the measurement's information in the combination only;
+        ``statistic`` (the ambiguity test's) sets how much of the fit's scatter :mod:`.fit_noise` adds to it.
 
         The measurement's information is the solver's (``info``, 3x3), the
         prediction's the inverse of :meth:`OdometryNoise.prior_variance`
@@ -408,6 +423,11 @@ class PlusLocaliser:
             d_phi = wrap_angle(measured[2] - predicted[2])
         if scale != 1.0:  # after learning and the screen, which judge the fit by its stated information
             h00, h01, h02, h11, h12, h22 = h00 * scale, h01 * scale, h02 * scale, h11 * scale, h12 * scale, h22 * scale
+        if (
+            self.params.fit_noise > 0.0 and self.view_noise is not None
+        ):  # the fit's measured scatter (:mod:`.fit_noise`)
+            f = fit_noise_factor(self.params.fit_noise, statistic, self.params.fit_noise_statistic)
+            h00, h01, h02, h11, h12, h22 = with_fit_noise((h00, h01, h02, h11, h12, h22), self.view_noise.variance, f)
         p_xy, p_phi = 1.0 / v_xy, 1.0 / v_phi
         # The prediction's heading unwrapped next to the measured one, so the average does not jump by 2 pi.
         t0, t1, t2 = predicted[0], predicted[1], measured[2] - d_phi

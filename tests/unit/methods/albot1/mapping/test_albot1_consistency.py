@@ -62,7 +62,7 @@ def test_an_overstated_fit_is_weighed_by_its_likelihood_ratio(monkeypatch: pytes
     monkeypatch.setattr(loc, "_fuse", spy)
     on = view_pose(loc, 0.03)
     off = view_pose(localiser(), 0.03)
-    measured, info, predicted, motion, scale = seen[0]
+    measured, info, predicted, motion, scale, _ = seen[0]
     assert loc.last_ambiguity is not None and not loc.last_ambiguity.ambiguous
     stated = stated_distance(info, measured, predicted)  # type: ignore[arg-type]
     assert 0.0 < float(scale) < 1.0  # type: ignore[arg-type]
