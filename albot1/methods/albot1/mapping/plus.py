@@ -45,7 +45,8 @@ pose is computed:
    when it turns the robot further than its odometry did on weak evidence.
 10. with ``view_noise_learning_rate``, :mod:`.view_noise` takes the views' own scatter out of the odometry learner's
     samples. With ``consistent_information`` (off in ``plus``), :mod:`.consistency` scales the fit's information down
-    to what the ambiguity test's likelihood ratio says the view knows, before the fusion.
+    to what the ambiguity test's likelihood ratio says the view knows, before the fusion. With ``fit_noise`` (off in
+    ``plus``), :mod:`.fit_noise` adds the view noise to a fused fit's covariance.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
