@@ -112,9 +112,7 @@ class PlusParams:
     turn_statistic: float = 0.0  # a view's likelihood ratio above which the turn bound does not apply
     consistency: float = 0.0  # the fit's information scaled to its likelihood ratio (:mod:`.consistency`); 0 = off
     view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
-    fit_noise: float = (
-        0.0  # that scatter, times this, added to the fit's stated covariance in the fusion (:mod:`.fit_noise`)
-    )
+    fit_noise: float = 0.0  # the view noise, times this, added to a fused fit's covariance (:mod:`.fit_noise`)
     fit_noise_statistic: float = 0.0  # ... falling with the square of the view's likelihood ratio beyond this
 
 
@@ -376,15 +374,8 @@ class PlusLocaliser:
         )
         return (x, y, phi), info
 
-    def _fuse(
-        self,
-        measured: Pose,
-        info: FloatArray,
-        predicted: Pose,
-        motion: float,
-        scale: float = 1.0,
-        statistic: float = 0.0,
-    ) -> Pose:
+    def _fuse(self, measured: Pose, info: FloatArray, predicted: Pose, motion: float, scale: float = 1.0,
+              statistic: float = 0.0) -> Pose:  # fmt: skip
         """Learn from this view, then combine the measured and predicted poses by their information.
 
         ``scale`` (:mod:`.consistency`) multiplies the measurement's information in the combination only;
@@ -424,9 +415,7 @@ class PlusLocaliser:
             d_phi = wrap_angle(measured[2] - predicted[2])
         if scale != 1.0:  # after learning and the screen, which judge the fit by its stated information
             h00, h01, h02, h11, h12, h22 = h00 * scale, h01 * scale, h02 * scale, h11 * scale, h12 * scale, h22 * scale
-        if (
-            self.params.fit_noise > 0.0 and self.view_noise is not None
-        ):  # the fit's measured scatter (:mod:`.fit_noise`)
+        if self.params.fit_noise > 0.0 and self.view_noise is not None:  # its measured scatter (:mod:`.fit_noise`)
             f = fit_noise_factor(self.params.fit_noise, statistic, self.params.fit_noise_statistic)
             h00, h01, h02, h11, h12, h22 = with_fit_noise((h00, h01, h02, h11, h12, h22), self.view_noise.variance, f)
         p_xy, p_phi = 1.0 / v_xy, 1.0 / v_phi
