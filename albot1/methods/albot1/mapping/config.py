@@ -276,6 +276,15 @@ class Albot1Config(BaseModel):
             " (0 = off; albot1/methods/albot1/mapping/view_noise.py)"
         ),
     )
+    mount_prior_m: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ (adaptive prior): learn where the odometry's frame sits on the scanner from the views that"
+            " fix their pose, with this prior standard deviation (m) of the mount's position, and turn each"
+            " odometry increment into the scanner's (0 = off; albot1/methods/albot1/mapping/mount.py)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -356,4 +365,5 @@ class Albot1Config(BaseModel):
             turn_statistic=self.turn_bound_statistic,
             consistency=self.consistent_information,
             view_noise_rate=self.view_noise_learning_rate,
+            mount_prior=self.mount_prior_m,
         )

@@ -60,11 +60,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
+from albot1.geometry.se2 import Pose, between_pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+from albot1.methods.albot1.mapping.mount import MountCalibration
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen import screen_measurement
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
@@ -110,6 +111,7 @@ class PlusParams:
     turn_statistic: float = 0.0  # a view's likelihood ratio above which the turn bound does not apply
     consistency: float = 0.0  # the fit's information scaled to its likelihood ratio (:mod:`.consistency`); 0 = off
     view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
+    mount_prior: float = 0.0  # m: prior sd of the odometry-to-scanner mount learnt online (:mod:`.mount`); 0 = off
 
 
 class OdometryNoise:
@@ -191,6 +193,8 @@ class PlusLocaliser:
         self._anchor: Pose = (0.0, 0.0, 0.0)
         self.noise = OdometryNoise(params)
         self.view_noise = ViewNoise(params.view_noise_rate) if params.view_noise_rate > 0.0 else None  # .view_noise
+        self.mount = MountCalibration(params.mount_prior) if params.mount_prior > 0.0 else None  # .mount
+        self._odometry_since: Pose = (0.0, 0.0, 0.0)  # the odometry's own increment, which the mount learns from
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
         self.gate_rejections = 0
@@ -250,6 +254,8 @@ class PlusLocaliser:
         """
         p = self.params
         ok = np.ascontiguousarray(STABLE[lm_kinds[0]] & STABLE[lm_kinds[1]]).reshape(-1, 2)
+        if self.mount is not None:  # the scanner's increment, not the odometry frame's (:mod:`.mount`)
+            self._odometry_since, since_update = since_update, self.mount.correct(since_update)
         predicted = compose_pose(self._anchor, since_update)
         if p.prior == "fixed":
             motion = self._motion(since_update)
@@ -392,6 +398,9 @@ class PlusLocaliser:
             nu2_phi = d_phi * d_phi
             if self.view_noise is not None:  # the odometry's share of the disagreement (:mod:`.view_noise`)
                 nu2_xy, nu2_phi = self.view_noise.remove(nu2_xy, nu2_phi)
+            if self.mount is not None:
+                weight = 1.0 / noise.prior_variance(motion)[0]
+                self.mount.learn(self._odometry_since, between_pose(self._anchor, measured), weight)
             noise.learn(nu2_xy, nu2_phi, motion)
         v_xy, v_phi = noise.prior_variance(motion)
         if self.params.degenerate_sd > 0.0 or self.params.gate_probability > 0.0:
