@@ -285,6 +285,14 @@ class Albot1Config(BaseModel):
             " odometry increment into the scanner's (0 = off; albot1/methods/albot1/mapping/mount.py)"
         ),
     )
+    kept_views_teach: bool = Field(
+        False,
+        description=(
+            "Albot1+ (adaptive prior with the ambiguity test): the views the test keeps as the odometry's"
+            " prediction also teach the odometry learner, so its samples are not selected by their size"
+            " (docs/albot1-mapper.md, \"The wrong laser offset\")"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -366,4 +374,5 @@ class Albot1Config(BaseModel):
             consistency=self.consistent_information,
             view_noise_rate=self.view_noise_learning_rate,
             mount_prior=self.mount_prior_m,
+            kept_views_teach=self.kept_views_teach,
         )

@@ -13,8 +13,7 @@ Writing ``R(delta) = [[c, -s], [s, c]]``, the translation of ``M D = D O`` is li
 
 (a planar hand-eye calibration). :class:`MountCalibration` keeps the normal equations of that least squares over
 the views that fix their pose on their own (the odometry learner's teaching views), each weighted by the inverse
-of the prediction's variance at that view, with a Gaussian prior at the identity mount (``prior_m`` per position
-axis, :data:`PRIOR_RAD` in the mount's turn): the degeneracy-aware part -- ``d`` is learnt only from turns, the
+of the prediction's variance at that view, XX -- ``d`` is learnt only from turns, the
 direction only from translations, and where neither has been seen the mount stays at the identity.
 :meth:`MountCalibration.correct` turns an odometry increment into the scanner's, ``D O D^-1``.
 """
@@ -29,6 +28,9 @@ from albot1.geometry.se2 import Pose
 
 #: Prior standard deviation of the mount's turn (rad): a laser mounted within about 6 deg of the odometry's axis.
 PRIOR_RAD = 0.1
+#: The mount is applied only while it explains at least this share of the weighted squared disagreement between the
+#: odometry's and the views' translations (a mount that explains little is the odometry's own error fitted).
+EXPLAINED = 0.5
 #: Teaching views between two solves of the 4x4 normal equations (the sums are kept at every view).
 SOLVE_EVERY = 8
 
@@ -41,6 +43,10 @@ class MountCalibration:
         # Normal equations A^T W A (upper triangle, row-major) and A^T W b, prior included; u0 = (0, 0, 1, 0).
         self._ata = [self._prior[0], 0.0, 0.0, 0.0, self._prior[0], 0.0, 0.0, self._prior[1], 0.0, self._prior[1]]
         self._atb = [0.0, 0.0, self._prior[1], 0.0]
+        self._btb = self._prior[1]  # sum of w |t_M|^2 (and the prior's target), for the residual at the estimate
+        self._identity_residual = 0.0  # sum of w |t_M - t_O|^2: the residual of the identity mount
+        #: The estimate explains at least :data:`EXPLAINED` of the disagreement: :meth:`correct` applies it.
+        self.active = False
         self.samples = 0
         #: The current estimate: mount position (m, the increment's frame) and the rotation's cosine and sine.
         self.dx = 0.0
@@ -69,6 +75,8 @@ class MountCalibration:
         v[1] += weight * (b * mx + a * my)
         v[2] += weight * (ox * mx + oy * my)
         v[3] += weight * (-oy * mx + ox * my)
+        self._btb += weight * (mx * mx + my * my)
+        self._identity_residual += weight * ((mx - ox) ** 2 + (my - oy) ** 2)
         self.samples += 1
         if self.samples % SOLVE_EVERY == 0:
             self._solve()
@@ -83,14 +91,20 @@ class MountCalibration:
                 [m[3], m[6], m[8], m[9]],
             ]
         )
-        dx, dy, c, s = np.linalg.solve(full, np.asarray(self._atb)).tolist()
+        atb = np.asarray(self._atb)
+        u = np.linalg.solve(full, atb)
+        dx, dy, c, s = u.tolist()
         norm = math.hypot(c, s)
         if not norm > 0.0:  # no rotation can be read off: keep the last estimate
             return
+        residual = self._btb - 2.0 * float(u @ atb) + float(u @ full @ u)
+        self.active = residual <= (1.0 - EXPLAINED) * self._identity_residual
         self.dx, self.dy, self.cos, self.sin = dx, dy, c / norm, s / norm
 
     def correct(self, odometry: Pose) -> Pose:
         """The scanner's increment ``D O D^-1`` for the odometry's increment ``O`` (the heading is unchanged)."""
+        if not self.active:
+            return odometry
         th = odometry[2]
         a = 1.0 - math.cos(th)
         b = math.sin(th)

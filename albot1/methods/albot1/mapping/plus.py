@@ -112,6 +112,7 @@ class PlusParams:
     consistency: float = 0.0  # the fit's information scaled to its likelihood ratio (:mod:`.consistency`); 0 = off
     view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
     mount_prior: float = 0.0  # m: prior sd of the odometry-to-scanner mount learnt online (:mod:`.mount`); 0 = off
+    kept_views_teach: bool = False  # the views the ambiguity test keeps also teach the odometry learner
 
 
 class OdometryNoise:
@@ -332,6 +333,8 @@ class PlusLocaliser:
                 self.ambiguous_views += 1
                 if self.view_noise is not None:
                     self.view_noise.learn(measured, predicted)
+                if p.kept_views_teach:  # the learner's samples not selected by their size (:mod:`.mount` docs)
+                    self._fuse(measured, info, predicted, self._motion(since_update))
                 return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
                 scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
