@@ -47,6 +47,8 @@ class MountCalibration:
         self._identity_residual = 0.0  # sum of w |t_M - t_O|^2: the residual of the identity mount
         #: The estimate explains at least :data:`EXPLAINED` of the disagreement: :meth:`correct` applies it.
         self.active = False
+        #: The share of the weighted squared disagreement the estimate explains (at the last solve).
+        self.explained = 0.0
         self.samples = 0
         #: The current estimate: mount position (m, the increment's frame) and the rotation's cosine and sine.
         self.dx = 0.0
@@ -98,7 +100,8 @@ class MountCalibration:
         if not norm > 0.0:  # no rotation can be read off: keep the last estimate
             return
         residual = self._btb - 2.0 * float(u @ atb) + float(u @ full @ u)
-        self.active = residual <= (1.0 - EXPLAINED) * self._identity_residual
+        self.explained = 1.0 - residual / self._identity_residual if self._identity_residual > 0.0 else 0.0
+        self.active = self.explained >= EXPLAINED
         self.dx, self.dy, self.cos, self.sin = dx, dy, c / norm, s / norm
 
     def correct(self, odometry: Pose) -> Pose:
