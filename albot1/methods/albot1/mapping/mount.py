@@ -13,9 +13,12 @@ Writing ``R(delta) = [[c, -s], [s, c]]``, the translation of ``M D = D O`` is li
 
 (a planar hand-eye calibration). :class:`MountCalibration` keeps the normal equations of that least squares over
 the views that fix their pose on their own (the odometry learner's teaching views), each weighted by the inverse
-of the prediction's variance at that view, XX -- ``d`` is learnt only from turns, the
+of the prediction's variance at that view, with a Gaussian prior at the identity mount (``prior_m`` per position
+axis, :data:`PRIOR_RAD` in the mount's turn): the degeneracy-aware part -- ``d`` is learnt only from turns, the
 direction only from translations, and where neither has been seen the mount stays at the identity.
-:meth:`MountCalibration.correct` turns an odometry increment into the scanner's, ``D O D^-1``.
+:meth:`MountCalibration.correct` turns an odometry increment into the scanner's, ``D O D^-1``, while the estimate
+explains at least :data:`EXPLAINED` of the weighted squared disagreement (else the increment is left as it came:
+a mount that explains little is the odometry's own error fitted).
 """
 
 from __future__ import annotations

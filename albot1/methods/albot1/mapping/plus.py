@@ -333,7 +333,7 @@ class PlusLocaliser:
                 self.ambiguous_views += 1
                 if self.view_noise is not None:
                     self.view_noise.learn(measured, predicted)
-                if p.kept_views_teach:  # the learner's samples not selected by their size (:mod:`.mount` docs)
+                if p.kept_views_teach:  # samples not selected by their size (docs: "The wrong laser offset")
                     self._fuse(measured, info, predicted, self._motion(since_update))
                 return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows

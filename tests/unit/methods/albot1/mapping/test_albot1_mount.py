@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
+from plus_room import NO_KINDS, SINCE, localiser, scan_from
 
 from albot1.geometry.se2 import between_pose, compose_pose
 from albot1.methods.albot1.mapping.config import Albot1Config
+from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.mount import SOLVE_EVERY, MountCalibration
+from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
 
 #: A mount 0.2 m ahead, 0.05 m aside and turned 2 deg (the generalisation suite's wrong offset, thesis frame).
 MOUNT = (-0.05, 0.2, math.radians(2.0))
@@ -69,7 +73,35 @@ def test_disagreements_a_mount_does_not_explain_leave_the_odometry_alone() -> No
     assert cal.correct(STEPS[3]) == STEPS[3]
 
 
-def test_the_field_is_off_by_default_and_off_in_every_preset() -> None:
-    assert Albot1Config().mount_prior_m == 0.0
-    assert Albot1Config().plus_params().mount_prior == 0.0
-    assert not Albot1Config().plus_params().kept_views_teach
+def test_both_settings_are_off_in_every_preset() -> None:
+    for name in ("default", "thesis", "exact", "literal", "plus"):
+        config = Albot1Config.model_validate({**Albot1Mapper.presets["default"], **Albot1Mapper.presets[name]})
+        assert config.plus_params().mount_prior == 0.0 and not config.plus_params().kept_views_teach
+
+
+def view_pose(loc: PlusLocaliser, true: tuple[float, float, float]) -> tuple[float, float, float]:
+    empty = np.empty((0, 4))
+    return loc.pose(start_poses(SINCE, None, None), empty, empty, NO_KINDS, scan_from(true), SINCE, None, True)
+
+
+def test_a_kept_view_teaches_the_odometry_learner_only_when_asked() -> None:
+    for teach in (False, True):
+        loc = localiser(kept_views_teach=teach)
+        # the odometry is right: the view does not refute it and the prediction is the pose
+        assert view_pose(loc, SINCE) == SINCE and loc.ambiguous_views == 1
+        assert loc.noise.samples == int(teach)
+
+
+def test_a_teaching_view_teaches_the_mount_with_the_odometrys_own_increment() -> None:
+    loc = localiser(mount_prior_m=0.5)
+    assert loc.mount is not None and not loc.mount.active
+    taught: list[tuple[object, ...]] = []
+    learn = loc.mount.learn
+    loc.mount.learn = lambda *args: (taught.append(args), learn(*args))[1]  # type: ignore[method-assign]
+    true = (0.03, 0.5, math.radians(5.0))  # refutes the odometry (0.5 m straight ahead): fused, and teaches
+    view_pose(loc, true)
+    assert len(taught) == 1 and loc.mount.samples == 1
+    odometry, measured, weight = taught[0]
+    assert odometry == SINCE  # not active: the odometry's increment as it came
+    assert measured == pytest.approx(true, abs=0.01) and weight > 0.0  # type: ignore[operator]
+    assert localiser().mount is None
