@@ -46,6 +46,8 @@ pose is computed:
 10. with ``view_noise_learning_rate``, :mod:`.view_noise` takes the views' own scatter out of the odometry learner's
     samples. With ``consistent_information`` (off in ``plus``), :mod:`.consistency` scales the fit's information down
     to what the ambiguity test's likelihood ratio says the view knows, before the fusion.
+11. with ``mount_prior_m`` (off in ``plus``), :mod:`.mount` learns the odometry-to-scanner mount and corrects the
+    odometry's increments; with ``kept_views_teach`` (off), the ambiguity test's kept views also teach the learner.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
