@@ -293,6 +293,23 @@ class Albot1Config(BaseModel):
             " scatter scaled by the square of this over its ratio (0 = every view gets all of it)"
         ),
     )
+    mount_prior_m: float = Field(
+        0.0,
+        ge=0,
+        description=(
+            "Albot1+ (adaptive prior): learn where the odometry's frame sits on the scanner from the views that"
+            " fix their pose, with this prior standard deviation (m) of the mount's position, and turn each"
+            " odometry increment into the scanner's (0 = off; albot1/methods/albot1/mapping/mount.py)"
+        ),
+    )
+    kept_views_teach: bool = Field(
+        False,
+        description=(
+            "Albot1+ (adaptive prior with the ambiguity test): the views the test keeps as the odometry's"
+            " prediction also teach the odometry learner, so its samples are not selected by their size"
+            ' (docs/albot1-mapper.md, "The wrong laser offset")'
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -375,4 +392,6 @@ class Albot1Config(BaseModel):
             view_noise_rate=self.view_noise_learning_rate,
             fit_noise=self.fit_noise_factor,
             fit_noise_statistic=self.fit_noise_statistic,
+            mount_prior=self.mount_prior_m,
+            kept_views_teach=self.kept_views_teach,
         )

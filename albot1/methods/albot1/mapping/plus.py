@@ -47,6 +47,8 @@ pose is computed:
     samples. With ``consistent_information`` (off in ``plus``), :mod:`.consistency` scales the fit's information down
     to what the ambiguity test's likelihood ratio says the view knows, before the fusion. With ``fit_noise`` (off in
     ``plus``), :mod:`.fit_noise` adds the view noise to a fused fit's covariance.
+11. with ``mount_prior_m`` (off in ``plus``), :mod:`.mount` learns the odometry-to-scanner mount and corrects the
+    odometry's increments; with ``kept_views_teach`` (off), the ambiguity test's kept views also teach the learner.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -61,12 +63,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.geometry.se2 import Pose, compose_pose, wrap_angle
+from albot1.geometry.se2 import Pose, between_pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
 from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_noise
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+from albot1.methods.albot1.mapping.mount import MountCalibration
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.screen import screen_measurement
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
@@ -114,6 +117,8 @@ class PlusParams:
     view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
     fit_noise: float = 0.0  # the view noise, times this, added to a fused fit's covariance (:mod:`.fit_noise`)
     fit_noise_statistic: float = 0.0  # ... falling with the square of the view's likelihood ratio beyond this
+    mount_prior: float = 0.0  # m: prior sd of the odometry-to-scanner mount learnt online (:mod:`.mount`); 0 = off
+    kept_views_teach: bool = False  # the views the ambiguity test keeps also teach the odometry learner
 
 
 class OdometryNoise:
@@ -195,6 +200,8 @@ class PlusLocaliser:
         self._anchor: Pose = (0.0, 0.0, 0.0)
         self.noise = OdometryNoise(params)
         self.view_noise = ViewNoise(params.view_noise_rate) if params.view_noise_rate > 0.0 else None  # .view_noise
+        self.mount = MountCalibration(params.mount_prior) if params.mount_prior > 0.0 else None  # .mount
+        self._odometry_since: Pose = (0.0, 0.0, 0.0)  # the odometry's own increment, which the mount learns from
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
         self.gate_rejections = 0
@@ -254,6 +261,8 @@ class PlusLocaliser:
         """
         p = self.params
         ok = np.ascontiguousarray(STABLE[lm_kinds[0]] & STABLE[lm_kinds[1]]).reshape(-1, 2)
+        if self.mount is not None:  # the scanner's increment, not the odometry frame's (:mod:`.mount`)
+            self._odometry_since, since_update = since_update, self.mount.correct(since_update)
         predicted = compose_pose(self._anchor, since_update)
         if p.prior == "fixed":
             motion = self._motion(since_update)
@@ -330,6 +339,8 @@ class PlusLocaliser:
                 self.ambiguous_views += 1
                 if self.view_noise is not None:
                     self.view_noise.learn(measured, predicted)
+                if p.kept_views_teach:  # samples not selected by their size (docs: "The wrong laser offset")
+                    self._fuse(measured, info, predicted, self._motion(since_update))
                 return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
                 scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
@@ -399,6 +410,9 @@ class PlusLocaliser:
             nu2_phi = d_phi * d_phi
             if self.view_noise is not None:  # the odometry's share of the disagreement (:mod:`.view_noise`)
                 nu2_xy, nu2_phi = self.view_noise.remove(nu2_xy, nu2_phi)
+            if self.mount is not None:
+                weight = 1.0 / noise.prior_variance(motion)[0]
+                self.mount.learn(self._odometry_since, between_pose(self._anchor, measured), weight)
             noise.learn(nu2_xy, nu2_phi, motion)
         v_xy, v_phi = noise.prior_variance(motion)
         if self.params.degenerate_sd > 0.0 or self.params.gate_probability > 0.0:

@@ -72,6 +72,8 @@ OLD_DEFAULT: dict[str, Any] = {
     "view_noise_learning_rate": 0.0,
     "fit_noise_factor": 0.0,
     "fit_noise_statistic": 0.0,
+    "mount_prior_m": 0.0,
+    "kept_views_teach": False,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
