@@ -46,7 +46,7 @@ def test_presets_table_of_one_method() -> None:
         "    plus     end_spacing_max_m = 0.0 m, surface_fit = tls, motion_model = exact, pose_estimate = robust, "
         "scan_refinement = true, scan_overlap = surface, scan_overhang_m = 0.05 m, odometry_prior = adaptive, "
         "degenerate_sd_m = 0.05 m, ambiguity_probability = 0.99, turn_bound_floor_deg = 3.0 deg, "
-        "turn_bound_statistic = 40.0, view_noise_learning_rate = 0.05",
+        "turn_bound_statistic = 40.0, view_noise_learning_rate = 0.05, kept_views_teach = true",
     ]
 
 
@@ -76,6 +76,7 @@ def test_presets_json_of_every_method() -> None:
             "turn_bound_floor_deg": 3.0,
             "turn_bound_statistic": 40.0,
             "view_noise_learning_rate": 0.05,
+            "kept_views_teach": True,
         },
     }
     field = next(f for f in albot1["fields"] if f["name"] == "delete_margin_m")

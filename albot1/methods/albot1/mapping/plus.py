@@ -340,7 +340,7 @@ class PlusLocaliser:
                 if self.view_noise is not None:
                     self.view_noise.learn(measured, predicted)
                 if p.kept_views_teach:  # samples not selected by their size (docs: "The wrong laser offset")
-                    self._fuse(measured, info, predicted, self._motion(since_update))
+                    self._learn(measured, info.tolist(), predicted, self._motion(since_update))
                 return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
                 scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
@@ -385,6 +385,29 @@ class PlusLocaliser:
         )
         return (x, y, phi), info
 
+    def _learn(self, measured: Pose, rows: list[list[float]], predicted: Pose, motion: float) -> float:
+        """Teach the odometry learner this view's disagreement with the prediction; return the heading difference.
+
+        Only a view whose fit fixes every direction (``rows``: its 3x3 information as nested lists) after enough
+        motion teaches: elsewhere the disagreement is the fit's slack, not the odometry's error. Kept views (the
+        ambiguity test's, with ``kept_views_teach``) come here without the fusion that follows for fused views.
+        """
+        (h00, h01, _), (_, h11, _), (_, _, h22) = rows
+        d_phi = wrap_angle(measured[2] - predicted[2])
+        # The smaller eigenvalue of the position block: how well the worst-fixed direction is known.
+        half_trace = 0.5 * (h00 + h11)
+        min_xy = half_trace - math.sqrt(max(0.0, half_trace * half_trace - (h00 * h11 - h01 * h01)))
+        if min_xy > LEARN_MIN_INFO and h22 > LEARN_MIN_INFO and motion > LEARN_MIN_MOTION_M:
+            nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
+            nu2_phi = d_phi * d_phi
+            if self.view_noise is not None:  # the odometry's share of the disagreement (:mod:`.view_noise`)
+                nu2_xy, nu2_phi = self.view_noise.remove(nu2_xy, nu2_phi)
+            if self.mount is not None:
+                weight = 1.0 / self.noise.prior_variance(motion)[0]
+                self.mount.learn(self._odometry_since, between_pose(self._anchor, measured), weight)
+            self.noise.learn(nu2_xy, nu2_phi, motion)
+        return d_phi
+
     def _fuse(self, measured: Pose, info: FloatArray, predicted: Pose, motion: float, scale: float = 1.0,
               statistic: float = 0.0) -> Pose:  # fmt: skip
         """Learn from this view, then combine the measured and predicted poses by their information.
@@ -398,23 +421,11 @@ class PlusLocaliser:
         written out for 3x3 symmetric matrices (numpy's per-call overhead
         would cost more than the arithmetic).
         """
-        noise = self.noise
         # One conversion to Python floats (the same values as six ``float(info[i, j])``).
-        (h00, h01, h02), (_, h11, h12), (_, _, h22) = info.tolist()
-        d_phi = wrap_angle(measured[2] - predicted[2])
-        # The smaller eigenvalue of the position block: how well the worst-fixed direction is known.
-        half_trace = 0.5 * (h00 + h11)
-        min_xy = half_trace - math.sqrt(max(0.0, half_trace * half_trace - (h00 * h11 - h01 * h01)))
-        if min_xy > LEARN_MIN_INFO and h22 > LEARN_MIN_INFO and motion > LEARN_MIN_MOTION_M:
-            nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
-            nu2_phi = d_phi * d_phi
-            if self.view_noise is not None:  # the odometry's share of the disagreement (:mod:`.view_noise`)
-                nu2_xy, nu2_phi = self.view_noise.remove(nu2_xy, nu2_phi)
-            if self.mount is not None:
-                weight = 1.0 / noise.prior_variance(motion)[0]
-                self.mount.learn(self._odometry_since, between_pose(self._anchor, measured), weight)
-            noise.learn(nu2_xy, nu2_phi, motion)
-        v_xy, v_phi = noise.prior_variance(motion)
+        rows = info.tolist()
+        (h00, h01, h02), (_, h11, h12), (_, _, h22) = rows
+        d_phi = self._learn(measured, rows, predicted, motion)
+        v_xy, v_phi = self.noise.prior_variance(motion)
         if self.params.degenerate_sd > 0.0 or self.params.gate_probability > 0.0:
             screened = screen_measurement(
                 measured, info, predicted, (v_xy, v_phi), self.params, self._k.screen_directions

@@ -107,6 +107,7 @@ OLD_PRESETS: dict[str, dict[str, Any]] = {
         "turn_bound_floor_deg": 3.0,
         "turn_bound_statistic": 40.0,
         "view_noise_learning_rate": 0.05,
+        "kept_views_teach": True,
     },
 }
 

@@ -73,10 +73,11 @@ def test_disagreements_a_mount_does_not_explain_leave_the_odometry_alone() -> No
     assert cal.correct(STEPS[3]) == STEPS[3]
 
 
-def test_both_settings_are_off_in_every_preset() -> None:
+def test_the_mount_is_off_everywhere_and_kept_views_teach_in_plus_only() -> None:
     for name in ("default", "thesis", "exact", "literal", "plus"):
         config = Albot1Config.model_validate({**Albot1Mapper.presets["default"], **Albot1Mapper.presets[name]})
-        assert config.plus_params().mount_prior == 0.0 and not config.plus_params().kept_views_teach
+        assert config.plus_params().mount_prior == 0.0
+        assert config.plus_params().kept_views_teach == (name == "plus")
 
 
 def view_pose(loc: PlusLocaliser, true: tuple[float, float, float]) -> tuple[float, float, float]:
