@@ -166,7 +166,7 @@ def measure(cell: str, overrides: dict[str, Any], innovations: bool = False, edg
     dataset, _, rest = cell.partition("|")
     degradation, _, seed = rest.partition("|")
     seq = open_sequence(dataset).materialize()
-    wall = time.perf_counter()
+    wall, cpu = time.perf_counter(), time.process_time()
     with recorded_innovations() as seen, recorded_edges() as graph_edges:
         result = run_method(
             "gtsam-graph",
@@ -179,9 +179,12 @@ def measure(cell: str, overrides: dict[str, Any], innovations: bool = False, edg
     row: dict[str, Any] = {
         "cell": cell,
         "wall_s": round(time.perf_counter() - wall, 1),
+        "cpu_s": round(time.process_time() - cpu, 1),
         "odometry_factors": result.counters.get("odometry_fused"),
         "loop_closures": result.counters.get("loop_closures_accepted"),
         "place_closures": result.counters.get("place_closures_accepted"),
+        "velocity_matches": result.counters.get("tracking_velocity_guess"),
+        "slides_refused": result.counters.get("tracking_velocity_slides_refused"),
     }
     if result.reference is not None:
         graph = ate(result.poses, result.reference)["rmse_m"]
