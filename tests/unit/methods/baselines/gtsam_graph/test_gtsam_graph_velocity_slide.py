@@ -87,8 +87,8 @@ def test_a_velocity_match_the_room_tells_apart_replaces_the_odometry_match() -> 
     assert slide_refused(target, scan, wrong, truth, truth, None, 0.9, SIGMA_M).startswith("indistinct (1.000 vs 0.")
 
 
-def test_the_shipped_preset_leaves_both_rules_off() -> None:
+def test_the_shipped_preset_has_the_translation_gate_on_and_the_scene_test_off() -> None:
     cfg = resolve_config("gtsam-graph", "default", {})
     assert isinstance(cfg, GtsamGraphConfig)
-    assert cfg.track_velocity_max_shift is False
+    assert cfg.track_velocity_max_shift is True
     assert cfg.track_velocity_distinct_ratio == 0.0
