@@ -192,7 +192,7 @@ class FrontEnd:
             cfg.track_velocity_distinct_ratio,
             cfg.point_sigma_m,
         )
-        if why:  # counted only when a rule is on: the counters of the default preset stay as they were
+        if why:  # the key appears only in runs that refused a slide: the others keep the counters they had
             self.counters["tracking_velocity_slides_refused"] = (
                 self.counters.get("tracking_velocity_slides_refused", 0) + 1
             )
