@@ -19,7 +19,9 @@ far the step's odometry turns (docs/baselines.md, gtsam-graph, "turns learnt
 apart"). ``--edges`` (cells with a reference) adds every sequential edge's and
 loop closure's error against the reference: the heading RMS of the matched
 edges, their lag-1 autocorrelation, the worst ones and every accepted closure
-(docs/baselines.md, gtsam-graph, "why one run of edmonton swings").
+(docs/baselines.md, gtsam-graph, "why one run of edmonton swings"). ``--moves`` adds every tracked scan whose
+match moved the odometry guess by more than 0.25 m, and which guess's match won (docs/baselines.md, gtsam-graph,
+"sequential slides").
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ import numpy as np
 
 from albot1.data.open import open_sequence
 from albot1.geometry import se2
-from albot1.methods.baselines.gtsam_graph import backend, odometry_trust
+from albot1.methods.baselines.gtsam_graph import backend, frontend, odometry_trust
 from albot1.metrics.ate import ate
 from albot1.metrics.relations import relation_metric
 from albot1.runs.execute import run_method
@@ -101,6 +103,48 @@ def recorded_edges() -> Iterator[dict[str, list[tuple[Any, ...]]]]:
         backend.BackEnd.add_loops = add_loops  # type: ignore[method-assign]
 
 
+@contextmanager
+def recorded_moves(min_m: float = 0.25) -> Iterator[list[dict[str, Any]]]:
+    """Every tracked scan whose passing match moved the odometry guess by more than ``min_m``, while the block runs:
+    its scan count, the odometry step, the move, and which guess's match won against which fits (``--moves``)."""
+    seen: list[dict[str, Any]] = []
+    follow, attempt = frontend.FrontEnd.follow, frontend.FrontEnd.attempt
+    tried: list[tuple[Any, ...]] = []
+    scans = [0]
+
+    def attempting(self: frontend.FrontEnd, target: Any, points: Any, guess: Any, *rest: Any, **named: Any) -> Any:
+        out = attempt(self, target, points, guess, *rest, **named)
+        tried.append(out)
+        return out
+
+    def following(self: frontend.FrontEnd, guess: Any, increment: Any, points: Any) -> Any:
+        tried.clear()
+        scans[0] += 1
+        reg = follow(self, guess, increment, points)
+        if reg is not None:
+            move = se2.between(guess, reg.pose)
+            if math.hypot(move[0], move[1]) > min_m:
+                seen.append(
+                    {
+                        "scan": scans[0],
+                        "odometry_step_m": round(math.hypot(increment[0], increment[1]), 3),
+                        "move_m": round(math.hypot(move[0], move[1]), 3),
+                        "won": "odometry guess" if tried and tried[0][0] is reg else "velocity guess",
+                        "fitness": [None if t[0] is None else round(t[0].fitness, 3) for t in tried],
+                        "passed": [bool(t[1]) for t in tried],
+                    }
+                )
+        return reg
+
+    frontend.FrontEnd.follow = following  # type: ignore[method-assign]
+    frontend.FrontEnd.attempt = attempting  # type: ignore[method-assign]
+    try:
+        yield seen
+    finally:
+        frontend.FrontEnd.follow = follow  # type: ignore[method-assign]
+        frontend.FrontEnd.attempt = attempt  # type: ignore[method-assign]
+
+
 def edge_table(seen: dict[str, list[tuple[Any, ...]]], truth: np.ndarray, worst: int = 8) -> dict[str, Any]:
     """Sequential edges' and loop closures' errors against ``truth`` (the reference at the node scans), deg and m.
 
@@ -160,14 +204,17 @@ def innovation_table(seen: list[tuple[float, float]]) -> list[dict[str, Any]]:
     return rows
 
 
-def measure(cell: str, overrides: dict[str, Any], innovations: bool = False, edges: bool = False) -> dict[str, Any]:
+def measure(
+    cell: str, overrides: dict[str, Any], innovations: bool = False, edges: bool = False, moves: bool = False
+) -> dict[str, Any]:
     """Run gtsam-graph on one cell and score it (with ``innovations``: the odometry trust's heading innovations too;
-    with ``edges``: the edges' errors against the reference, :func:`edge_table`)."""
+    with ``edges``: the edges' errors against the reference, :func:`edge_table`; with ``moves``: the tracked scans
+    whose match moved the odometry guess far, :func:`recorded_moves`)."""
     dataset, _, rest = cell.partition("|")
     degradation, _, seed = rest.partition("|")
     seq = open_sequence(dataset).materialize()
-    wall = time.perf_counter()
-    with recorded_innovations() as seen, recorded_edges() as graph_edges:
+    wall, cpu = time.perf_counter(), time.process_time()
+    with recorded_innovations() as seen, recorded_edges() as graph_edges, recorded_moves() as moved:
         result = run_method(
             "gtsam-graph",
             seq,
@@ -179,9 +226,12 @@ def measure(cell: str, overrides: dict[str, Any], innovations: bool = False, edg
     row: dict[str, Any] = {
         "cell": cell,
         "wall_s": round(time.perf_counter() - wall, 1),
+        "cpu_s": round(time.process_time() - cpu, 1),
         "odometry_factors": result.counters.get("odometry_fused"),
         "loop_closures": result.counters.get("loop_closures_accepted"),
         "place_closures": result.counters.get("place_closures_accepted"),
+        "velocity_matches": result.counters.get("tracking_velocity_guess"),
+        "slides_refused": result.counters.get("tracking_velocity_slides_refused"),
     }
     if result.reference is not None:
         graph = ate(result.poses, result.reference)["rmse_m"]
@@ -192,6 +242,8 @@ def measure(cell: str, overrides: dict[str, Any], innovations: bool = False, edg
         block = relation_metric(result.timestamps, result.poses, seq.relations)
         row["relations_m"] = round(block["translation_m"]["mean"], 4)
         row["relations_deg"] = round(block["rotation_deg"]["mean"], 3)
+    if moves:
+        row["moves"] = moved
     if innovations:
         row["innovations"] = innovation_table(seen)
     if edges and result.reference is not None:
@@ -209,11 +261,14 @@ def main() -> None:
     parser.add_argument(
         "--edges", action="store_true", help="also the edges' errors against the reference (docs/baselines.md)"
     )
+    parser.add_argument(
+        "--moves", action="store_true", help="also the tracked scans whose match moved the odometry guess > 0.25 m"
+    )
     parser.add_argument("cells", nargs="+")
     args = parser.parse_args()
     overrides = {key: _value(value) for key, _, value in (s.partition("=") for s in args.settings)}
     for cell in args.cells:
-        print(json.dumps(measure(cell, overrides, args.innovations, args.edges)), flush=True)
+        print(json.dumps(measure(cell, overrides, args.innovations, args.edges, args.moves)), flush=True)
 
 
 if __name__ == "__main__":

@@ -54,6 +54,16 @@ class GtsamGraphConfig(BaseModel):
     track_velocity_guess: bool = Field(
         description="also try the last tracked motion as the guess when it disagrees with the odometry increment"
     )
+    track_velocity_max_shift: bool = Field(
+        description="a velocity match may replace a passing odometry match only within the tracker's translation "
+        "gate of the odometry guess (velocity_slide.py)"
+    )
+    track_velocity_distinct_ratio: float = Field(
+        ge=0,
+        le=1,
+        description="... only if the odometry match scores at most this fraction of the velocity match's "
+        "likelihood-field score on the local map (0 = off; velocity_slide.py)",
+    )
     track_prior_sigma_xy_m: float = Field(
         gt=0, description="prior std dev of the odometry guess over one scan period (x, y), used inside tracking ICP"
     )

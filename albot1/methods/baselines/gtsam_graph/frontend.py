@@ -30,6 +30,7 @@ from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, OdometryFactors, OdometryTrust
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
+from albot1.methods.baselines.gtsam_graph.velocity_slide import slide_refused
 
 
 def preprocess(config: GtsamGraphConfig, scan: Scan, index: int) -> FloatArray:
@@ -149,6 +150,13 @@ class FrontEnd:
             if alt_good and not velocity_match_allowed(alt.pose, guess, good, limits[3]):  # type: ignore[union-attr]
                 alt_good = False
                 self.counters["tracking_velocity_rejected"] += 1
+            if (
+                alt_good
+                and good
+                and alt.fitness > reg.fitness  # type: ignore[union-attr]
+                and self._slide_refused(target, points, alt, reg, guess, limits[1])  # type: ignore[arg-type]
+            ):
+                alt_good = False
             if alt_good and (not good or alt.fitness > reg.fitness):  # type: ignore[union-attr]
                 reg, good = alt, True
                 self.counters["tracking_velocity_guess"] += 1
@@ -166,6 +174,29 @@ class FrontEnd:
             return reg
         self.counters["tracking_failures"] += 1
         return None
+
+    def _slide_refused(
+        self, target: Target, points: FloatArray, alt: Registration, reg: Registration, guess: FloatArray, max_m: float
+    ) -> bool:
+        """Whether velocity match ``alt`` may not replace passing odometry match ``reg`` (:mod:`.velocity_slide`)."""
+        cfg = self.config
+        if not cfg.track_velocity_max_shift and cfg.track_velocity_distinct_ratio <= 0:
+            return False
+        why = slide_refused(
+            target,
+            points,
+            alt.pose,
+            reg.pose,
+            guess,
+            max_m if cfg.track_velocity_max_shift else None,
+            cfg.track_velocity_distinct_ratio,
+            cfg.point_sigma_m,
+        )
+        if why:  # the key appears only in runs that refused a slide: the others keep the counters they had
+            self.counters["tracking_velocity_slides_refused"] = (
+                self.counters.get("tracking_velocity_slides_refused", 0) + 1
+            )
+        return bool(why)
 
     def track_limits(self, increment: FloatArray) -> tuple[IcpParams, float, float, float]:
         """ICP parameters, correction gates (m, deg) and wide rotation gate (deg) for a guess holding ``increment``.
