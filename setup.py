@@ -46,7 +46,9 @@ def bundle_kernels(build_lib: Path) -> None:
     if os.environ.get(KERNELS_ENV, "1").strip() == "0":
         return
     with tempfile.TemporaryDirectory(prefix="albot1-build-kernels-") as cache:
-        env = {**os.environ, "PYTHONPATH": str(build_lib), "XDG_CACHE_HOME": cache, "PYTHONDONTWRITEBYTECODE": "1"}
+        # The build tree first; pip's isolated build environment is found through PYTHONPATH too.
+        path = os.pathsep.join(p for p in (str(build_lib), os.environ.get("PYTHONPATH", "")) if p)
+        env = {**os.environ, "PYTHONPATH": path, "XDG_CACHE_HOME": cache, "PYTHONDONTWRITEBYTECODE": "1"}
         done = subprocess.run(
             [sys.executable, "-m", "albot1.methods.albot1.kernel_bundle_build", str(build_lib / KERNELS)],
             cwd=cache,
