@@ -16,14 +16,22 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from albot1.methods.albot1 import compiled, kernel_bundle, kernel_bundle_build, warm_up
-from albot1.methods.albot1.mapping.kernel_set import MappingKernels
-from albot1.methods.albot1.perception.kernels import PerceptionKernels
-from albot1.methods.albot1.places.kernels import PlacesKernels
+# numba and the kernels are imported by the tests, not at collection (collection stays cheap)
+if TYPE_CHECKING:
+    from types import ModuleType
+
+#: ``compiled.CPU_NAME_ENV``, numba's switch
+CPU_NAME_ENV = "NUMBA_CPU_NAME"
+
+
+def _bundle_module() -> ModuleType:
+    from albot1.methods.albot1 import kernel_bundle
+
+    return kernel_bundle
 
 _SEED_AND_LOAD = """
 import json, sys
@@ -44,18 +52,25 @@ print(json.dumps({"seeded": sorted(seeded), "compiled": compiled}))
 
 @pytest.fixture(scope="module")
 def bundle(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from albot1.methods.albot1 import kernel_bundle_build
+
     dest = tmp_path_factory.mktemp("bundle") / "kernels"
     assert kernel_bundle_build.build(dest) > 0
     return dest
 
 
 def _calls() -> list[tuple[str, Any, tuple[Any, ...]]]:
+    from albot1.methods.albot1 import warm_up
+    from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+    from albot1.methods.albot1.perception.kernels import PerceptionKernels
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+
     return list(warm_up.sample_calls(PerceptionKernels(), MappingKernels(), PlacesKernels()))
 
 
 def _fresh_process(bundle: Path, cache: Path) -> dict[str, list[str]]:
     env = {**os.environ, "XDG_CACHE_HOME": str(cache)}
-    env.pop("NUMBA_CPU_NAME", None)
+    env.pop(CPU_NAME_ENV, None)
     out = subprocess.run(
         [sys.executable, "-c", _SEED_AND_LOAD, str(bundle)], env=env, capture_output=True, text=True, timeout=600
     )
@@ -100,7 +115,7 @@ def test_a_fresh_cache_loads_every_bundled_kernel_without_compiling(bundle: Path
 
 def test_every_kernel_of_the_bundle_is_seeded_where_nothing_is_cached(bundle: Path, tmp_path: Path) -> None:
     calls = _elsewhere(tmp_path)
-    assert sorted(kernel_bundle.seed(calls, _always_cold, bundle)) == sorted({name for name, _, _ in calls})
+    assert sorted(_bundle_module().seed(calls, _always_cold, bundle)) == sorted({name for name, _, _ in calls})
     for name, kernel, _ in calls:
         index = f"{kernel._cache._impl.filename_base}.nbi"
         assert (tmp_path / name / index).read_bytes() == next(bundle.rglob(index)).read_bytes()
@@ -112,7 +127,7 @@ def test_a_damaged_file_leaves_its_kernel_to_be_compiled(bundle: Path, tmp_path:
     data = sorted(copy.rglob("update_kernels.update_surfaces-*.nbc"))
     assert data
     data[0].write_bytes(data[0].read_bytes()[:-1])
-    seeded = kernel_bundle.seed(_elsewhere(tmp_path / "cache"), _always_cold, copy)
+    seeded = _bundle_module().seed(_elsewhere(tmp_path / "cache"), _always_cold, copy)
     assert "update_surfaces" not in seeded
     assert "build_view" in seeded
     assert not (tmp_path / "cache" / "update_surfaces").exists()
@@ -124,11 +139,11 @@ def test_a_damaged_file_leaves_its_kernel_to_be_compiled(bundle: Path, tmp_path:
 def test_a_bundle_built_for_something_else_is_not_read(bundle: Path, tmp_path: Path, key: str, value: str) -> None:
     copy = tmp_path / "bundle"
     shutil.copytree(bundle, copy)
-    manifest = json.loads((copy / kernel_bundle.MANIFEST).read_text())
-    (copy / kernel_bundle.MANIFEST).write_text(json.dumps({**manifest, key: value}))
-    assert kernel_bundle.read_manifest(copy) is None
-    assert kernel_bundle.seed(_elsewhere(tmp_path / "cache"), _always_cold, copy) == []
-    assert kernel_bundle.seed(_calls(), _always_cold, tmp_path / "none") == []  # no bundle at all
+    manifest = json.loads((copy / _bundle_module().MANIFEST).read_text())
+    (copy / _bundle_module().MANIFEST).write_text(json.dumps({**manifest, key: value}))
+    assert _bundle_module().read_manifest(copy) is None
+    assert _bundle_module().seed(_elsewhere(tmp_path / "cache"), _always_cold, copy) == []
+    assert _bundle_module().seed(_calls(), _always_cold, tmp_path / "none") == []  # no bundle at all
 
 
 def test_an_index_built_for_another_cpu_leaves_its_kernel_cold(bundle: Path, tmp_path: Path) -> None:
@@ -139,10 +154,10 @@ def test_an_index_built_for_another_cpu_leaves_its_kernel_cold(bundle: Path, tmp
     numba_version, stamp, overloads = _read_index(index)
     moved = {(k[0], (k[1][0], "skylake", k[1][2]), k[2]): v for k, v in overloads.items()}
     _write_index(index, numba_version, stamp, moved)
-    manifest = json.loads((copy / kernel_bundle.MANIFEST).read_text())
-    manifest["files"][index.relative_to(copy).as_posix()] = kernel_bundle.sha256(index)
-    (copy / kernel_bundle.MANIFEST).write_text(json.dumps(manifest))
-    seeded = kernel_bundle.seed(_elsewhere(tmp_path / "cache"), _always_cold, copy)
+    manifest = json.loads((copy / _bundle_module().MANIFEST).read_text())
+    manifest["files"][index.relative_to(copy).as_posix()] = _bundle_module().sha256(index)
+    (copy / _bundle_module().MANIFEST).write_text(json.dumps(manifest))
+    seeded = _bundle_module().seed(_elsewhere(tmp_path / "cache"), _always_cold, copy)
     assert "build_view" not in seeded and "recognise_landmarks" in seeded
 
 
@@ -155,23 +170,23 @@ def test_numba_s_own_index_is_never_replaced_and_an_unwritable_folder_is_skipped
     own.parent.mkdir()
     own.write_bytes(b"numba's own")
     (tmp_path / "update_surfaces").write_text("a file where the folder would be")
-    seeded = kernel_bundle.seed(calls, _always_cold, bundle)
+    seeded = _bundle_module().seed(calls, _always_cold, bundle)
     assert "build_view" not in seeded and "update_surfaces" not in seeded and "landmark_rows" in seeded
     assert own.read_bytes() == b"numba's own"
 
 
 def test_a_kernel_already_cached_is_not_seeded(bundle: Path, tmp_path: Path) -> None:
-    assert kernel_bundle.seed(_elsewhere(tmp_path), lambda kernel: False, bundle) == []
+    assert _bundle_module().seed(_elsewhere(tmp_path), lambda kernel: False, bundle) == []
     assert not any(tmp_path.iterdir())
 
 
 def test_kernels_are_compiled_for_numba_s_generic_cpu_unless_the_user_says_otherwise() -> None:
     """``generic`` code loads on any machine of the architecture, which a shipped kernel needs."""
     code = "import albot1.methods.albot1.compiled\nfrom numba.core import config\nprint(config.CPU_NAME)\n"
-    env = {k: v for k, v in os.environ.items() if k != compiled.CPU_NAME_ENV}
+    env = {k: v for k, v in os.environ.items() if k != CPU_NAME_ENV}
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "generic"
-    env[compiled.CPU_NAME_ENV] = "host"
+    env[CPU_NAME_ENV] = "host"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "host"
 
