@@ -79,6 +79,7 @@ def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
     from albot1.methods.albot1.mapping.kernel_set import MappingKernels
     from albot1.methods.albot1.perception.kernels import PerceptionKernels
     from albot1.methods.albot1.places.kernels import PlacesKernels
+
     build = tmp_path / "build"
     subprocess.run(
         [sys.executable, "setup.py", "-q", "build_py", "--build-lib", str(build)],

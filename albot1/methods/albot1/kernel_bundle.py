@@ -69,14 +69,15 @@ def fingerprint() -> dict[str, str]:
         "llvmlite": llvmlite.__version__,
         "python": f"{platform.python_implementation()} {platform.python_version()} {sys.abiflags}",
         "target": llvm.get_process_triple(),
-        "cpu_name": str(numba_config.CPU_NAME),
-        "cpu_features": str(numba_config.CPU_FEATURES),
+        "cpu_name": str(getattr(numba_config, "CPU_NAME", None)),
+        "cpu_features": str(getattr(numba_config, "CPU_FEATURES", None)),
     }
 
 
 def cache_subfolder(source_folder: Path) -> str:
     """Numba's subfolder of its cache folder for the kernels of ``source_folder`` (numba's own naming)."""
-    return str(_CacheLocator.get_suitable_cache_subpath(str(source_folder / "__init__.py")))
+    subpath: Callable[[str], str] = _CacheLocator.get_suitable_cache_subpath
+    return subpath(str(source_folder / "__init__.py"))
 
 
 def sha256(path: Path) -> str:

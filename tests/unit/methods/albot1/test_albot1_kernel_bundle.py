@@ -33,6 +33,7 @@ def _bundle_module() -> ModuleType:
 
     return kernel_bundle
 
+
 _SEED_AND_LOAD = """
 import json, sys
 from pathlib import Path
@@ -161,9 +162,7 @@ def test_an_index_built_for_another_cpu_leaves_its_kernel_cold(bundle: Path, tmp
     assert "build_view" not in seeded and "recognise_landmarks" in seeded
 
 
-def test_numba_s_own_index_is_never_replaced_and_an_unwritable_folder_is_skipped(
-    bundle: Path, tmp_path: Path
-) -> None:
+def test_numba_s_own_index_is_never_replaced_and_an_unwritable_folder_is_skipped(bundle: Path, tmp_path: Path) -> None:
     calls = _elsewhere(tmp_path)
     own = tmp_path / "build_view" / f"{calls[0][1]._cache._impl.filename_base}.nbi"
     assert calls[0][0] == "build_view"
