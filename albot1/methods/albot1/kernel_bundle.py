@@ -19,7 +19,8 @@ architecture. A kernel is seeded only when every check numba will make
 passes here first: the manifest names this code version, this numba,
 llvmlite and Python, and this process's CPU target; the bundled index
 holds this source file's stamp and a key for each of the kernel's
-samples; and every file has the sha256 the manifest records. Anything
+samples; and every file has the sha256 the manifest records. The kernel
+is then loaded at once, and its files taken back should numba fail. Anything
 else (another numba, a user's ``NUMBA_CPU_NAME``, a damaged or foreign
 file, a cache folder that cannot be written, a change in numba's
 internals) leaves the kernel cold, and the warm-up compiles it as before.
@@ -165,32 +166,53 @@ def seed(
     seeded: list[str] = []
     for name, kernel in kernels.items():
         try:
-            if is_cold(kernel) and _seed_one(kernel, samples[name], manifest["files"], bundle):
-                seeded.append(name)
+            copied = _seed_one(kernel, samples[name], manifest["files"], bundle) if is_cold(kernel) else []
         except Exception:  # noqa: BLE001 -- any mismatch (numba's internals, a damaged file): compiled as before
             continue
+        if copied and _loads(kernel, samples[name], copied):
+            seeded.append(name)
     return seeded
 
 
-def _seed_one(kernel: Any, samples: list[tuple[Any, ...]], files: dict[str, str], bundle: Path) -> bool:
+def _loads(kernel: Callable[..., Any], samples: list[tuple[Any, ...]], copied: list[Path]) -> bool:
+    """Load ``kernel`` now (numba reads what was just seeded); should numba fail, take the seeded files back.
+
+    The checks before the copy are numba's own, so numba loads the kernel;
+    this covers what they cannot see (a data file numba cannot rebuild),
+    so that such a kernel is compiled by the warm-up instead of failing the run.
+    """
+    try:
+        for args in samples:
+            kernel(*args)
+    except Exception:  # noqa: BLE001 -- numba could not use the seeded files: they go, and the kernel is compiled
+        for path in reversed(copied):  # the index first: numba reads the data files only through it
+            path.unlink(missing_ok=True)
+        return False
+    return True
+
+
+def _seed_one(kernel: Any, samples: list[tuple[Any, ...]], files: dict[str, str], bundle: Path) -> list[Path]:
+    """Copy ``kernel``'s bundled files into numba's cache if numba will accept them: the files copied (index last)."""
     source = Path(kernel.py_func.__code__.co_filename).resolve()
     folder = source.parent.relative_to(PACKAGE_DIR).as_posix()
     base = kernel._cache._impl.filename_base
     index = bundle / folder / f"{base}.nbi"
     relative = f"{folder}/{index.name}"
     if files.get(relative) is None or sha256(index) != files[relative]:
-        return False
+        return []
     data = _index_entries(kernel, index)
     if data is None or not _has_keys(kernel, index, samples):
-        return False
+        return []
     for name in data:
         if files.get(f"{folder}/{name}") != sha256(bundle / folder / name):
-            return False
+            return []
     target = Path(kernel._cache.cache_path)
     if (target / index.name).exists():  # numba's own index: never replaced
-        return False
+        return []
     target.mkdir(parents=True, exist_ok=True)
+    copied: list[Path] = []
     for name in sorted(data):
         _copy(bundle / folder / name, target / name)
+        copied.append(target / name)
     _copy(index, target / index.name)  # last: numba reads the data files only through the index
-    return True
+    return [*copied, target / index.name]

@@ -90,15 +90,20 @@ class _Elsewhere:
         def __getattr__(self, name: str) -> Any:
             return getattr(self._real, name)
 
-    def __init__(self, kernel: Any, folder: Path) -> None:
-        self._kernel, self._cache = kernel, _Elsewhere._Cache(kernel._cache, folder)
+    def __init__(self, kernel: Any, folder: Path, fails: bool = False) -> None:
+        self._kernel, self._cache, self._fails = kernel, _Elsewhere._Cache(kernel._cache, folder), fails
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._kernel, name)
 
+    def __call__(self, *args: Any) -> Any:  # the real kernel, from this session's cache; or numba failing
+        if self._fails:
+            raise RuntimeError("numba could not rebuild the cached kernel")
+        return self._kernel(*args)
 
-def _elsewhere(folder: Path) -> list[tuple[str, Any, tuple[Any, ...]]]:
-    return [(name, _Elsewhere(kernel, folder / name), args) for name, kernel, args in _calls()]
+
+def _elsewhere(folder: Path, failing: str = "") -> list[tuple[str, Any, tuple[Any, ...]]]:
+    return [(name, _Elsewhere(kernel, folder / name, name == failing), args) for name, kernel, args in _calls()]
 
 
 def _always_cold(kernel: object) -> bool:
@@ -172,6 +177,12 @@ def test_numba_s_own_index_is_never_replaced_and_an_unwritable_folder_is_skipped
     seeded = _bundle_module().seed(calls, _always_cold, bundle)
     assert "build_view" not in seeded and "update_surfaces" not in seeded and "landmark_rows" in seeded
     assert own.read_bytes() == b"numba's own"
+
+
+def test_seeded_files_numba_cannot_load_are_taken_back(bundle: Path, tmp_path: Path) -> None:
+    seeded = _bundle_module().seed(_elsewhere(tmp_path, failing="match_structure"), _always_cold, bundle)
+    assert "match_structure" not in seeded and "same_any" in seeded
+    assert list((tmp_path / "match_structure").iterdir()) == []  # compiled by the warm-up, as without a bundle
 
 
 def test_a_kernel_already_cached_is_not_seeded(bundle: Path, tmp_path: Path) -> None:
