@@ -49,6 +49,12 @@ def bundle_kernels(build_lib: Path) -> None:
         # The build tree first; pip's isolated build environment is found through PYTHONPATH too.
         path = os.pathsep.join(p for p in (str(build_lib), os.environ.get("PYTHONPATH", "")) if p)
         env = {**os.environ, "PYTHONPATH": path, "XDG_CACHE_HOME": cache, "PYTHONDONTWRITEBYTECODE": "1"}
+        for own in (
+            "NUMBA_CPU_NAME",
+            "NUMBA_CPU_FEATURES",
+            "NUMBA_DISABLE_JIT",
+        ):  # the kernels are numba's generic ones
+            env.pop(own, None)
         done = subprocess.run(
             [sys.executable, "-m", "albot1.methods.albot1.kernel_bundle_build", str(build_lib / KERNELS)],
             cwd=cache,
