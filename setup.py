@@ -17,6 +17,8 @@ import json
 import os
 import shutil
 import subprocess
+import sys
+import tempfile
 from pathlib import Path
 
 from setuptools import setup
@@ -27,6 +29,44 @@ FOLDERS = ("datasets", "baselines", "benchmarks")  # albot1.resources.FOLDERS
 BUNDLE = Path("albot1") / "_bundled"  # albot1.resources.BUNDLE_DIR_NAME
 BUILD_FILE = "build.json"  # albot1.versions.BUILD_FILE
 COMMIT_ENV = "ALBOT1_BUILD_COMMIT"
+KERNELS = BUNDLE / "kernels"  # albot1.methods.albot1.kernel_bundle.BUNDLE_DIR
+KERNELS_ENV = "ALBOT1_BUILD_KERNELS"  # 0: build the wheel without its compiled kernels
+
+
+def bundle_kernels(build_lib: Path) -> None:
+    """Compile Albot1's numba kernels into the wheel (``albot1.methods.albot1.kernel_bundle_build``), or say why not.
+
+    Numba compiles them from the build tree's sources into an empty cache;
+    its files go into ``albot1/_bundled/kernels/``, and the first run after
+    a bare ``pip install`` loads them instead of compiling them, where numba
+    accepts them (same numba, Python and architecture; otherwise it
+    compiles, as without them). A build environment without the runtime
+    dependencies builds a wheel without them, with a notice.
+    """
+    if os.environ.get(KERNELS_ENV, "1").strip() == "0":
+        return
+    with tempfile.TemporaryDirectory(prefix="albot1-build-kernels-") as cache:
+        # The build tree first; pip's isolated build environment is found through PYTHONPATH too.
+        path = os.pathsep.join(p for p in (str(build_lib), os.environ.get("PYTHONPATH", "")) if p)
+        env = {**os.environ, "PYTHONPATH": path, "XDG_CACHE_HOME": cache, "PYTHONDONTWRITEBYTECODE": "1"}
+        for own in (
+            "NUMBA_CPU_NAME",
+            "NUMBA_CPU_FEATURES",
+            "NUMBA_DISABLE_JIT",
+        ):  # the kernels are numba's generic ones
+            env.pop(own, None)
+        done = subprocess.run(
+            [sys.executable, "-m", "albot1.methods.albot1.kernel_bundle_build", str(build_lib / KERNELS)],
+            cwd=cache,
+            env=env,
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+    if done.returncode != 0:
+        shutil.rmtree(build_lib / KERNELS, ignore_errors=True)
+        why = (done.stderr.strip().splitlines() or ["no message"])[-1]
+        print(f"albot1-bench build: the wheel carries no compiled kernels ({why})", file=sys.stderr)
 
 
 def build_commit() -> str | None:
@@ -69,6 +109,7 @@ class BuildPyWithProjectFiles(build_py):
         # The commit the wheel is built from (albot1.versions.git_commit reads it back): an installed
         # package has no git beside it. Unknown is recorded as null, never guessed.
         (target / BUILD_FILE).write_text(json.dumps({"commit": build_commit()}) + "\n", encoding="utf-8")
+        bundle_kernels(Path(self.build_lib).resolve())
 
     def get_outputs(self, include_bytecode: bool = True) -> list[str]:
         outputs = list(super().get_outputs(include_bytecode))
@@ -79,6 +120,7 @@ class BuildPyWithProjectFiles(build_py):
                 for file in sorted((ROOT / folder).glob("*.toml"))
             ]
             outputs.append(str(Path(self.build_lib) / BUNDLE / BUILD_FILE))
+            outputs += sorted(str(p) for p in (Path(self.build_lib) / KERNELS).rglob("*") if p.is_file())
         return outputs
 
 

@@ -169,7 +169,8 @@ def launcher() -> str:
 
 
 def child_args(cell: Cell, runs_root: Path, log_path: Path, preview: str | None = None) -> dict[str, Any]:
-    env = {k: v for k, v in os.environ.items() if k.startswith("ALBOT1_")}
+    with _START_LOCK:  # another cell's thread may be setting and removing ALBOT1_PRELOAD_METHODS (_preloading)
+        env = {k: v for k, v in os.environ.items() if k.startswith("ALBOT1_")}
     return {
         "cell": cell.to_json(),
         "runs_root": str(runs_root),

@@ -68,7 +68,18 @@ def test_installed_package_uses_the_bundle(tmp_path: Path, monkeypatch: pytest.M
 
 @pytest.mark.slow
 def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
-    """setup.py's build_py copies the top-level folders into the package tree of the build."""
+    """setup.py's build_py copies the top-level folders into the package tree of the build, and the kernels.
+
+    The kernels (Albot1's numba kernels compiled for the wheel,
+    ``albot1/methods/albot1/kernel_bundle.py``): a bundle this process would
+    read (same code version, numba, Python and CPU target) with an index for
+    every kernel a warm-up calls.
+    """
+    from albot1.methods.albot1 import kernel_bundle, warm_up
+    from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+    from albot1.methods.albot1.perception.kernels import PerceptionKernels
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+
     build = tmp_path / "build"
     subprocess.run(
         [sys.executable, "setup.py", "-q", "build_py", "--build-lib", str(build)],
@@ -84,6 +95,12 @@ def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
                 CHECKOUT / folder / name
             ).read_bytes()
     assert not (CHECKOUT / "albot1" / "_bundled").exists()  # never into the source tree
+    kernels = build / "albot1" / "_bundled" / "kernels"
+    manifest = kernel_bundle.read_manifest(kernels)
+    assert manifest is not None, (kernels / kernel_bundle.MANIFEST).read_text() if kernels.is_dir() else "no bundle"
+    indexes = {Path(name).name for name in manifest["files"] if name.endswith(".nbi")}
+    for name, kernel, _ in warm_up.sample_calls(PerceptionKernels(), MappingKernels(), PlacesKernels()):
+        assert f"{kernel._cache._impl.filename_base}.nbi" in indexes, name
 
 
 def test_the_code_version_ignores_the_bundle(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -50,6 +50,15 @@ PLAIN_ERRORS_ENV = "NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING"
 # round"). Numba reads the switch when it is first imported, hence here, before the import; a value set by the
 # user is kept, and numba's default colour scheme ("no_color") adds no colour either way.
 os.environ.setdefault(PLAIN_ERRORS_ENV, "1")
+#: numba's documented switch for the CPU its code is compiled for; why ``generic``: :data:`CPU_NAME_ENV`'s comment
+CPU_NAME_ENV = "NUMBA_CPU_NAME"
+# Numba compiles for the host's CPU model unless told otherwise, and keys its cache by that model and its feature
+# list, so kernels compiled on one machine are never loaded on another. With ``generic`` (the architecture's
+# baseline, e.g. x86-64 without AVX) they load anywhere, which is what lets a wheel ship its kernels
+# (:mod:`.kernel_bundle`). Measured: the same bits (benchmarks/fingerprints.py) and no slower per scan
+# (docs/albot1-mapper.md, "Compile time, seventh round"). A value set by the user is kept (the bundle then does
+# not match, and the kernels are compiled for that CPU as before).
+os.environ.setdefault(CPU_NAME_ENV, "generic")
 
 import numba  # noqa: E402  (after the switch above)
 import numpy as np  # noqa: E402

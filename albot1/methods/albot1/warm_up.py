@@ -38,7 +38,7 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from albot1.methods.albot1 import compiled
+from albot1.methods.albot1 import compiled, kernel_bundle
 
 
 def kernel_names(kernels: object) -> list[str]:
@@ -276,6 +276,8 @@ def _warm(
 ) -> None:
     """:func:`warm_up` of ``calls`` (the samples of ``kernel_sets`` that are to be called)."""
     kernels = {name: kernel for name, kernel, _ in calls}
+    if any(_cold(kernel) for kernel in kernels.values()):
+        kernel_bundle.seed(calls, _cold)  # the wheel's own compiled kernels, where numba will accept them
     cold = sorted(
         (name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -compile_cost(n, kernels[n])
     )

@@ -1,0 +1,220 @@
+"""The kernels a wheel ships (``kernel_bundle``): loaded without a compile where numba accepts them, else left cold.
+
+The bundle is built here from this session's cache (``kernel_bundle_build.build``,
+a cache load when the kernels are warm), then handed to an empty cache: in a
+fresh process every kernel must be seeded and loaded with no compile (numba's
+own cache statistics), and each thing numba would reject (a damaged file,
+another numba, another CPU target, an index numba already has, a folder that
+cannot be written) must leave the kernel to an ordinary compile.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+# numba and the kernels are imported by the tests, not at collection (collection stays cheap)
+if TYPE_CHECKING:
+    from types import ModuleType
+
+#: ``compiled.CPU_NAME_ENV``, numba's switch
+CPU_NAME_ENV = "NUMBA_CPU_NAME"
+
+
+def _bundle_module() -> ModuleType:
+    from albot1.methods.albot1 import kernel_bundle
+
+    return kernel_bundle
+
+
+_SEED_AND_LOAD = """
+import json, sys
+from pathlib import Path
+from albot1.methods.albot1 import kernel_bundle, warm_up
+from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
+from albot1.methods.albot1.places.kernels import PlacesKernels
+
+calls = list(warm_up.sample_calls(PerceptionKernels(), MappingKernels(), PlacesKernels()))
+seeded = kernel_bundle.seed(calls, warm_up._cold, bundle=Path(sys.argv[1]))
+for _, kernel, args in calls:
+    kernel(*args)
+compiled = sorted({name for name, kernel, _ in calls if kernel.stats.cache_misses})
+print(json.dumps({"seeded": sorted(seeded), "compiled": compiled}))
+"""
+
+
+@pytest.fixture(scope="module")
+def bundle(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from albot1.methods.albot1 import kernel_bundle_build
+
+    dest = tmp_path_factory.mktemp("bundle") / "kernels"
+    assert kernel_bundle_build.build(dest) > 0
+    return dest
+
+
+def _calls() -> list[tuple[str, Any, tuple[Any, ...]]]:
+    from albot1.methods.albot1 import warm_up
+    from albot1.methods.albot1.mapping.kernel_set import MappingKernels
+    from albot1.methods.albot1.perception.kernels import PerceptionKernels
+    from albot1.methods.albot1.places.kernels import PlacesKernels
+
+    return list(warm_up.sample_calls(PerceptionKernels(), MappingKernels(), PlacesKernels()))
+
+
+def _fresh_process(bundle: Path, cache: Path) -> dict[str, list[str]]:
+    env = {**os.environ, "XDG_CACHE_HOME": str(cache)}
+    env.pop(CPU_NAME_ENV, None)
+    out = subprocess.run(
+        [sys.executable, "-c", _SEED_AND_LOAD, str(bundle)], env=env, capture_output=True, text=True, timeout=600
+    )
+    assert out.returncode == 0, out.stderr
+    result: dict[str, list[str]] = json.loads(out.stdout)
+    return result
+
+
+class _Elsewhere:
+    """A kernel whose numba cache folder is ``folder`` (a fresh one), everything else the kernel's own."""
+
+    class _Cache:
+        def __init__(self, cache: Any, folder: Path) -> None:
+            self._real, self.cache_path = cache, str(folder)
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self._real, name)
+
+    def __init__(self, kernel: Any, folder: Path, fails: bool = False) -> None:
+        self._kernel, self._cache, self._fails = kernel, _Elsewhere._Cache(kernel._cache, folder), fails
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._kernel, name)
+
+    def __call__(self, *args: Any) -> Any:  # the real kernel, from this session's cache; or numba failing
+        if self._fails:
+            raise RuntimeError("numba could not rebuild the cached kernel")
+        return self._kernel(*args)
+
+
+def _elsewhere(folder: Path, failing: str = "") -> list[tuple[str, Any, tuple[Any, ...]]]:
+    return [(name, _Elsewhere(kernel, folder / name, name == failing), args) for name, kernel, args in _calls()]
+
+
+def _always_cold(kernel: object) -> bool:
+    return True
+
+
+@pytest.mark.slow
+def test_a_fresh_cache_loads_every_bundled_kernel_without_compiling(bundle: Path, tmp_path: Path) -> None:
+    names = sorted({name for name, _, _ in _calls()})
+    first = _fresh_process(bundle, tmp_path / "cache")
+    assert first == {"seeded": names, "compiled": []}
+    again = _fresh_process(bundle, tmp_path / "cache")  # numba's own files now: nothing seeded, nothing compiled
+    assert again == {"seeded": [], "compiled": []}
+
+
+def test_every_kernel_of_the_bundle_is_seeded_where_nothing_is_cached(bundle: Path, tmp_path: Path) -> None:
+    calls = _elsewhere(tmp_path)
+    assert sorted(_bundle_module().seed(calls, _always_cold, bundle)) == sorted({name for name, _, _ in calls})
+    for name, kernel, _ in calls:
+        index = f"{kernel._cache._impl.filename_base}.nbi"
+        assert (tmp_path / name / index).read_bytes() == next(bundle.rglob(index)).read_bytes()
+
+
+def test_a_damaged_file_leaves_its_kernel_to_be_compiled(bundle: Path, tmp_path: Path) -> None:
+    copy = tmp_path / "bundle"
+    shutil.copytree(bundle, copy)
+    data = sorted(copy.rglob("update_kernels.update_surfaces-*.nbc"))
+    assert data
+    data[0].write_bytes(data[0].read_bytes()[:-1])
+    seeded = _bundle_module().seed(_elsewhere(tmp_path / "cache"), _always_cold, copy)
+    assert "update_surfaces" not in seeded
+    assert "build_view" in seeded
+    assert not (tmp_path / "cache" / "update_surfaces").exists()
+
+
+@pytest.mark.parametrize(
+    "key, value", [("numba", "0.1.0"), ("cpu_name", "skylake"), ("code_version", "0+other"), ("format", "0")]
+)
+def test_a_bundle_built_for_something_else_is_not_read(bundle: Path, tmp_path: Path, key: str, value: str) -> None:
+    copy = tmp_path / "bundle"
+    shutil.copytree(bundle, copy)
+    manifest = json.loads((copy / _bundle_module().MANIFEST).read_text())
+    (copy / _bundle_module().MANIFEST).write_text(json.dumps({**manifest, key: value}))
+    assert _bundle_module().read_manifest(copy) is None
+    assert _bundle_module().seed(_elsewhere(tmp_path / "cache"), _always_cold, copy) == []
+    assert _bundle_module().seed(_calls(), _always_cold, tmp_path / "none") == []  # no bundle at all
+
+
+def test_an_index_built_for_another_cpu_leaves_its_kernel_cold(bundle: Path, tmp_path: Path) -> None:
+    """The manifest can say ``generic`` while an index holds another target's keys: the keys are checked too."""
+    copy = tmp_path / "bundle"
+    shutil.copytree(bundle, copy)
+    index = next(copy.rglob("kernels.build_view-*.nbi"))
+    numba_version, stamp, overloads = _read_index(index)
+    moved = {(k[0], (k[1][0], "skylake", k[1][2]), k[2]): v for k, v in overloads.items()}
+    _write_index(index, numba_version, stamp, moved)
+    manifest = json.loads((copy / _bundle_module().MANIFEST).read_text())
+    manifest["files"][index.relative_to(copy).as_posix()] = _bundle_module().sha256(index)
+    (copy / _bundle_module().MANIFEST).write_text(json.dumps(manifest))
+    seeded = _bundle_module().seed(_elsewhere(tmp_path / "cache"), _always_cold, copy)
+    assert "build_view" not in seeded and "recognise_landmarks" in seeded
+
+
+def test_numba_s_own_index_is_never_replaced_and_an_unwritable_folder_is_skipped(bundle: Path, tmp_path: Path) -> None:
+    calls = _elsewhere(tmp_path)
+    own = tmp_path / "build_view" / f"{calls[0][1]._cache._impl.filename_base}.nbi"
+    assert calls[0][0] == "build_view"
+    own.parent.mkdir()
+    own.write_bytes(b"numba's own")
+    (tmp_path / "update_surfaces").write_text("a file where the folder would be")
+    seeded = _bundle_module().seed(calls, _always_cold, bundle)
+    assert "build_view" not in seeded and "update_surfaces" not in seeded and "landmark_rows" in seeded
+    assert own.read_bytes() == b"numba's own"
+
+
+def test_seeded_files_numba_cannot_load_are_taken_back(bundle: Path, tmp_path: Path) -> None:
+    seeded = _bundle_module().seed(_elsewhere(tmp_path, failing="match_structure"), _always_cold, bundle)
+    assert "match_structure" not in seeded and "same_any" in seeded
+    assert list((tmp_path / "match_structure").iterdir()) == []  # compiled by the warm-up, as without a bundle
+
+
+def test_a_kernel_already_cached_is_not_seeded(bundle: Path, tmp_path: Path) -> None:
+    assert _bundle_module().seed(_elsewhere(tmp_path), lambda kernel: False, bundle) == []
+    assert not any(tmp_path.iterdir())
+
+
+def test_kernels_are_compiled_for_numba_s_generic_cpu_unless_the_user_says_otherwise() -> None:
+    """``generic`` code loads on any machine of the architecture, which a shipped kernel needs."""
+    code = "import albot1.methods.albot1.compiled\nfrom numba.core import config\nprint(config.CPU_NAME)\n"
+    env = {k: v for k, v in os.environ.items() if k != CPU_NAME_ENV}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "generic"
+    env[CPU_NAME_ENV] = "host"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "host"
+
+
+def _read_index(index: Path) -> tuple[Any, Any, dict[Any, str]]:
+    import pickle
+
+    with index.open("rb") as f:
+        version = pickle.load(f)
+        stamp, overloads = pickle.loads(f.read())
+    return version, stamp, overloads
+
+
+def _write_index(index: Path, version: Any, stamp: Any, overloads: dict[Any, str]) -> None:
+    import pickle
+
+    from numba.core.serialize import dumps
+
+    with index.open("wb") as f:
+        pickle.dump(version, f, protocol=-1)
+        f.write(dumps((stamp, overloads)))
