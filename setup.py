@@ -31,6 +31,13 @@ BUILD_FILE = "build.json"  # albot1.versions.BUILD_FILE
 COMMIT_ENV = "ALBOT1_BUILD_COMMIT"
 KERNELS = BUNDLE / "kernels"  # albot1.methods.albot1.kernel_bundle.BUNDLE_DIR
 KERNELS_ENV = "ALBOT1_BUILD_KERNELS"  # 0: build the wheel without its compiled kernels
+#: the build step's child process: compile, bundle, say how many files (or fail with the reason as its last line)
+BUILD_KERNELS = """
+import sys
+from pathlib import Path
+from albot1.methods.albot1.kernel_bundle_build import build
+print(f"kernel bundle: {build(Path(sys.argv[1]))} numba cache files in {sys.argv[1]}")
+"""
 
 
 def bundle_kernels(build_lib: Path) -> None:
@@ -48,15 +55,13 @@ def bundle_kernels(build_lib: Path) -> None:
     with tempfile.TemporaryDirectory(prefix="albot1-build-kernels-") as cache:
         # The build tree first; pip's isolated build environment is found through PYTHONPATH too.
         path = os.pathsep.join(p for p in (str(build_lib), os.environ.get("PYTHONPATH", "")) if p)
-        env = {**os.environ, "PYTHONPATH": path, "XDG_CACHE_HOME": cache, "PYTHONDONTWRITEBYTECODE": "1"}
-        for own in (
-            "NUMBA_CPU_NAME",
-            "NUMBA_CPU_FEATURES",
-            "NUMBA_DISABLE_JIT",
-        ):  # the kernels are numba's generic ones
-            env.pop(own, None)
+        # No NUMBA_* setting of the builder's reaches the compile: numba's cache key holds neither its
+        # optimisation level nor bounds checking nor debug info, so such a setting would ship other code
+        # to every install under the same key; the kernels are numba's defaults for its generic CPU.
+        env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+        env.update(PYTHONPATH=path, XDG_CACHE_HOME=cache, PYTHONDONTWRITEBYTECODE="1")
         done = subprocess.run(
-            [sys.executable, "-m", "albot1.methods.albot1.kernel_bundle_build", str(build_lib / KERNELS)],
+            [sys.executable, "-c", BUILD_KERNELS, str(build_lib / KERNELS)],
             cwd=cache,
             env=env,
             capture_output=True,

@@ -55,9 +55,10 @@ CPU_NAME_ENV = "NUMBA_CPU_NAME"
 # Numba compiles for the host's CPU model unless told otherwise, and keys its cache by that model and its feature
 # list, so kernels compiled on one machine are never loaded on another. With ``generic`` (the architecture's
 # baseline, e.g. x86-64 without AVX) they load anywhere, which is what lets a wheel ship its kernels
-# (:mod:`.kernel_bundle`). Measured: the same bits (benchmarks/fingerprints.py) and no slower per scan
-# (docs/albot1-mapper.md, "Compile time, seventh round"). A value set by the user is kept (the bundle then does
-# not match, and the kernels are compiled for that CPU as before).
+# (:mod:`.kernel_bundle`). Measured on this project's machine (one CPU model, an Intel "rocketlake"): the same
+# bits (benchmarks/fingerprints.py) and no slower per scan (docs/albot1-mapper.md, "Compile time, seventh round");
+# without fast-math numba contracts no multiply-add, so the bits should not depend on the CPU model either. A
+# value set by the user is kept (the bundle then does not match, and the kernels are compiled for that CPU).
 os.environ.setdefault(CPU_NAME_ENV, "generic")
 
 import numba  # noqa: E402  (after the switch above)

@@ -12,8 +12,10 @@ this code version's numba cache (:data:`compiled.CACHE_DIR`), where numba
 then loads them as if it had compiled them itself.
 
 Why this is safe: the code is numba's own (compiled by numba, loaded by
-numba, checked by numba: its version, the source file's sha256, the CPU
-target and the kernel's bytecode), compiled for numba's ``generic`` CPU
+numba, checked by numba: its version, the source file's stamp (its sha256
+from numba 0.68 on; its mtime and size before, which an install does not
+keep, so with an older numba the bundle is never used), the CPU target
+and the kernel's bytecode), compiled for numba's ``generic`` CPU
 (:data:`compiled.CPU_NAME_ENV`), so it runs on any machine of the
 architecture. A kernel is seeded only when every check numba will make
 passes here first: the manifest names this code version, this numba,
@@ -46,7 +48,6 @@ import llvmlite
 import numba
 from llvmlite import binding as llvm
 from numba.core import config as numba_config
-from numba.core.caching import _CacheLocator
 
 from albot1.methods.albot1 import compiled
 
@@ -68,17 +69,17 @@ def fingerprint() -> dict[str, str]:
         "code_version": compiled.CACHE_DIR.name,
         "numba": numba.__version__,
         "llvmlite": llvmlite.__version__,
-        "python": f"{platform.python_implementation()} {platform.python_version()} {sys.abiflags}",
+        # sys.abiflags is POSIX-only before Python 3.14
+        "python": f"{platform.python_implementation()} {platform.python_version()} {getattr(sys, 'abiflags', '')}",
         "target": llvm.get_process_triple(),
         "cpu_name": str(getattr(numba_config, "CPU_NAME", None)),
         "cpu_features": str(getattr(numba_config, "CPU_FEATURES", None)),
     }
 
 
-def cache_subfolder(source_folder: Path) -> str:
-    """Numba's subfolder of its cache folder for the kernels of ``source_folder`` (numba's own naming)."""
-    subpath: Callable[[str], str] = _CacheLocator.get_suitable_cache_subpath
-    return subpath(str(source_folder / "__init__.py"))
+def bundle_folder(kernel: Any) -> str:
+    """The bundle's folder of ``kernel``'s cache files: its source folder relative to the package, POSIX-style."""
+    return Path(kernel.py_func.__code__.co_filename).resolve().parent.relative_to(PACKAGE_DIR).as_posix()
 
 
 def sha256(path: Path) -> str:
@@ -155,7 +156,10 @@ def seed(
     kernel is left alone (and so compiled by the warm-up) when anything
     does not match; see the module docstring.
     """
-    manifest = read_manifest(bundle)
+    try:
+        manifest = read_manifest(bundle)
+    except Exception:  # noqa: BLE001 -- whatever this platform or numba lacks: the kernels are compiled as before
+        return []
     if manifest is None:
         return []
     samples: dict[str, list[tuple[Any, ...]]] = {}
@@ -186,15 +190,17 @@ def _loads(kernel: Callable[..., Any], samples: list[tuple[Any, ...]], copied: l
             kernel(*args)
     except Exception:  # noqa: BLE001 -- numba could not use the seeded files: they go, and the kernel is compiled
         for path in reversed(copied):  # the index first: numba reads the data files only through it
-            path.unlink(missing_ok=True)
+            try:
+                path.unlink(missing_ok=True)
+            except OSError:  # e.g. a file another process holds open on Windows: numba recompiles over it
+                pass
         return False
     return True
 
 
 def _seed_one(kernel: Any, samples: list[tuple[Any, ...]], files: dict[str, str], bundle: Path) -> list[Path]:
     """Copy ``kernel``'s bundled files into numba's cache if numba will accept them: the files copied (index last)."""
-    source = Path(kernel.py_func.__code__.co_filename).resolve()
-    folder = source.parent.relative_to(PACKAGE_DIR).as_posix()
+    folder = bundle_folder(kernel)
     base = kernel._cache._impl.filename_base
     index = bundle / folder / f"{base}.nbi"
     relative = f"{folder}/{index.name}"

@@ -1,57 +1,65 @@
-"""Build the kernel bundle of a wheel: ``python -m albot1.methods.albot1.kernel_bundle_build DEST`` (``setup.py``).
+"""Build the kernel bundle of a wheel: :func:`build`, called by ``setup.py``'s build step.
 
 Compiles every kernel of Albot1 and of its places layer on its warm-up
 samples (the argument types the mappers call them with) and copies numba's
-cache files into ``DEST`` (:mod:`.kernel_bundle` explains what is checked
-where they are used). Run by the build step with ``XDG_CACHE_HOME`` set to
-an empty folder, so that what is copied is what this build compiled; a
-module of its own, imported by no other, because it needs every kernel
-set, and the warm-up (which reads the bundle) is imported by the mappers.
+cache files of each kernel into ``DEST`` (:mod:`.kernel_bundle` explains
+what is checked where they are used). The build step runs it in a process
+whose user cache folder is empty, so that what is copied is what this build
+compiled. A module of its own, imported by no other, because it needs every
+kernel set, and the warm-up (which reads the bundle) is imported by the
+mappers.
 """
 
 from __future__ import annotations
 
 import json
 import shutil
-import sys
 from pathlib import Path
+from typing import Any
 
-from albot1.methods.albot1 import compiled, kernel_bundle, warm_up
+from albot1.errors import Albot1Error
+from albot1.methods.albot1 import kernel_bundle, warm_up
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.places.kernels import PlacesKernels
 
 
+class KernelBundleError(Albot1Error):
+    """A kernel the warm-up compiled left no cache files to bundle: a wheel without it would say it has it."""
+
+
+def _kernel_files(name: str, kernel: Any) -> list[Path]:
+    """Numba's cache files of ``kernel`` (its index, then its data files), read from where numba wrote them."""
+    cached = Path(kernel._cache.cache_path)
+    base = kernel._cache._impl.filename_base
+    index = cached / f"{base}.nbi"
+    if not index.is_file():
+        raise KernelBundleError(f"kernel bundle: {name} was compiled but numba wrote no index {index}")
+    data = sorted(p for p in cached.glob(f"{base}.*.nbc") if p.is_file())
+    if not data:
+        raise KernelBundleError(f"kernel bundle: {name} has an index but no data file in {cached}")
+    return [index, *data]
+
+
 def build(dest: Path) -> int:
-    """Compile every kernel (or load this code version's cache) and copy numba's files to ``dest``: file count."""
-    warm_up.warm_up((PerceptionKernels(), MappingKernels(), PlacesKernels()))
+    """Compile every kernel (or load this code version's cache) and copy numba's files to ``dest``: file count.
+
+    Raises :class:`KernelBundleError` naming the first kernel whose files are
+    missing, so that a build never ships a bundle that lacks a kernel.
+    """
+    kernel_sets = (PerceptionKernels(), MappingKernels(), PlacesKernels())
+    warm_up.warm_up(kernel_sets)
+    kernels = {name: kernel for name, kernel, _ in warm_up.sample_calls(*kernel_sets)}
     if dest.exists():
         shutil.rmtree(dest)
     files: dict[str, str] = {}
-    for folder in sorted({p.parent for p in kernel_bundle.PACKAGE_DIR.rglob("*.py")}):
-        cached = compiled.CACHE_DIR / kernel_bundle.cache_subfolder(folder)
-        if not cached.is_dir():
-            continue
-        relative = folder.relative_to(kernel_bundle.PACKAGE_DIR).as_posix()
-        for path in sorted(cached.iterdir()):
-            if path.suffix in kernel_bundle.SUFFIXES:
-                (dest / relative).mkdir(parents=True, exist_ok=True)
-                shutil.copyfile(path, dest / relative / path.name)
-                files[f"{relative}/{path.name}"] = kernel_bundle.sha256(path)
+    for name, kernel in sorted(kernels.items()):
+        folder = kernel_bundle.bundle_folder(kernel)
+        for path in _kernel_files(name, kernel):
+            (dest / folder).mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(path, dest / folder / path.name)
+            files[f"{folder}/{path.name}"] = kernel_bundle.sha256(path)
     manifest = {**kernel_bundle.fingerprint(), "files": files}
     dest.mkdir(parents=True, exist_ok=True)
     (dest / kernel_bundle.MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n", encoding="utf-8")
     return len(files)
-
-
-def main(argv: list[str]) -> int:
-    if len(argv) != 1:
-        sys.stderr.write("usage: python -m albot1.methods.albot1.kernel_bundle_build DEST\n")
-        return 2
-    count = build(Path(argv[0]))
-    sys.stdout.write(f"kernel bundle: {count} numba cache files in {argv[0]}\n")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main(sys.argv[1:]))

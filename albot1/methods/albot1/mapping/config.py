@@ -307,7 +307,7 @@ class Albot1Config(BaseModel):
         description=(
             "Albot1+ (adaptive prior with the ambiguity test): the views the test keeps as the odometry's"
             " prediction also teach the odometry learner, so its samples are not selected by their size"
-            ' (docs/albot1-mapper.md, "The wrong laser offset")'
+            ' (docs/albot1-mapper.md, "Kept views teach, adopted in `plus`")'
         ),
     )
     # 3.1.7 update

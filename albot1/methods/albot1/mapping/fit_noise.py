@@ -2,7 +2,7 @@
 
 The pose fit's information matrix (``J^T W J`` of its landmark and scan terms) counts every scan point as an
 independent measurement of the stated ``scan_sigma``. On fr-clinic it states a heading sigma of 0.08-0.12 deg in
-views whose fit swings by 1-4 deg from one view to the next (``docs/albot1-mapper.md``, "Fit noise in the fusion",
+views whose fit swings by 1-4 deg from one view to the next (``docs/albot1-mapper.md``, "Support and fit noise",
 the seventh pass). The fusion with the odometry's prediction then keeps most of each departure, and the next map
 update freezes it: on a log with good odometry the heading walks away from it by +-10 deg over the route.
 

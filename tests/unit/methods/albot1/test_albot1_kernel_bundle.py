@@ -218,3 +218,41 @@ def _write_index(index: Path, version: Any, stamp: Any, overloads: dict[Any, str
     with index.open("wb") as f:
         pickle.dump(version, f, protocol=-1)
         f.write(dumps((stamp, overloads)))
+
+
+def _fake_kernel(cache_path: Path) -> Any:
+    from types import SimpleNamespace
+
+    impl = SimpleNamespace(filename_base="stage.kernel-12.py311")
+    return SimpleNamespace(_cache=SimpleNamespace(cache_path=str(cache_path), _impl=impl))
+
+
+def test_the_build_refuses_a_kernel_whose_cache_files_are_missing(tmp_path: Path) -> None:
+    """A wheel whose bundle silently lacked a kernel would compile it at the first run while claiming it ships it."""
+    from albot1.methods.albot1.kernel_bundle_build import KernelBundleError, _kernel_files
+
+    kernel = _fake_kernel(tmp_path)
+    with pytest.raises(KernelBundleError, match=r"^kernel bundle: stage_kernel was compiled but numba wrote no index"):
+        _kernel_files("stage_kernel", kernel)
+    (tmp_path / "stage.kernel-12.py311.nbi").write_bytes(b"i")
+    (tmp_path / "stage.kernel-120.py311.1.nbc").write_bytes(b"another kernel's")
+    with pytest.raises(KernelBundleError, match=r"^kernel bundle: stage_kernel has an index but no data file"):
+        _kernel_files("stage_kernel", kernel)
+    (tmp_path / "stage.kernel-12.py311.2.nbc").write_bytes(b"d")
+    (tmp_path / "stage.kernel-12.py311.1.nbc").write_bytes(b"d")
+    assert [p.name for p in _kernel_files("stage_kernel", kernel)] == [
+        "stage.kernel-12.py311.nbi",
+        "stage.kernel-12.py311.1.nbc",
+        "stage.kernel-12.py311.2.nbc",
+    ]
+
+
+def test_the_fingerprint_and_the_seed_hold_where_python_has_no_abiflags(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """``sys.abiflags`` is POSIX-only before Python 3.14: a cold warm-up on Windows must compile, not crash."""
+    bundle_module = _bundle_module()
+    monkeypatch.delattr(sys, "abiflags", raising=False)
+    assert bundle_module.fingerprint()["python"].endswith(" ")
+    (tmp_path / bundle_module.MANIFEST).write_text(json.dumps({"files": {}}))  # read, so compared with the fingerprint
+    assert bundle_module.seed([], lambda kernel: True, bundle=tmp_path) == []

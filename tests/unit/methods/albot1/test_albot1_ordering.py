@@ -27,6 +27,7 @@ def test_examples() -> None:
     assert compiled_order(np.array([0.0, -0.0, np.nan, 0.0])).tolist() == [0, 1, 3, 2]
 
 
+@settings(deadline=None)  # the first example compiles the float version when test_examples did not run first
 @given(arrays(np.float64, st.integers(0, 70), elements=VALUES))
 def test_the_order_is_numpy_s_stable_argsort_compiled_and_as_written(values: np.ndarray) -> None:
     expected = np.argsort(values, kind="stable")
