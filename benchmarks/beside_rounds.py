@@ -9,7 +9,9 @@ in fresh processes (``PYTHONPATH`` names the checkout measured)::
         PYTHONPATH=$tree python benchmarks/beside_rounds.py
     done; done
 
-Only ratios within one round mean anything on a shared machine.
+Only ratios within one round mean anything on a shared machine. The runs take
+the environment's config overrides (``ALBOT1_ALBOT1_KEPT_VIEWS_TEACH=false``
+measures ``plus`` without that field), and each line lists the ones set.
 """
 
 from __future__ import annotations
@@ -31,6 +33,9 @@ from albot1.data.loaders.registry import load  # noqa: E402
 from albot1.data.synthetic.worlds import load_world  # noqa: E402
 from albot1.data.transforms import head  # noqa: E402
 
+#: Environment variables that override a measured run's config (``albot1.config.env``).
+OVERRIDE_PREFIXES = ("ALBOT1_ALBOT1_", "ALBOT1_KISS_ICP_")
+
 RUNS = (("kiss", "kiss-icp", "default"), ("thesis", "albot1", "thesis"), ("plus", "albot1", "plus"))
 
 
@@ -44,6 +49,8 @@ def main() -> int:
     for _, method, preset in RUNS:  # compile / load every kernel before timing
         _per_scan_ns(frames[:50], preset, time.thread_time_ns, method)
     out: dict[str, object] = {"code": str(Path(albot1.__file__).resolve().parent.parent)}
+    # The environment overrides the runs took (``ALBOT1_ALBOT1_*``, ``ALBOT1_KISS_ICP_*``): a round says what it ran.
+    out["overrides"] = {k: v for k, v in sorted(os.environ.items()) if k.startswith(OVERRIDE_PREFIXES)}
     means: dict[str, float] = {}
     for name, method, preset in RUNS:
         ms = _per_scan_ns(frames, preset, time.thread_time_ns, method) / 1e6

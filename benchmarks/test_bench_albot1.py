@@ -44,8 +44,10 @@ from albot1.methods.registry import resolve_config
 def _per_scan_ns(
     frames: list[Frame], preset: str = "thesis", clock: Callable[[], int] = time.perf_counter_ns, method: str = "albot1"
 ) -> np.ndarray:
+    # Both through resolve_config: the preset's values, with the ``ALBOT1_<METHOD>_*`` environment overrides
+    # (``ALBOT1_ALBOT1_KEPT_VIEWS_TEACH=false`` measures ``plus`` without the kept views' learning).
     mapper: Any = (
-        Albot1Mapper(Albot1Config(**Albot1Mapper.presets[preset]))
+        Albot1Mapper(resolve_config("albot1", preset))  # type: ignore[arg-type]
         if method == "albot1"
         else KissIcpMapper(resolve_config("kiss-icp", preset))  # type: ignore[arg-type]
     )

@@ -48,7 +48,8 @@ pose is computed:
     to what the ambiguity test's likelihood ratio says the view knows, before the fusion. With ``fit_noise`` (off in
     ``plus``), :mod:`.fit_noise` adds the view noise to a fused fit's covariance.
 11. with ``mount_prior_m`` (off in ``plus``), :mod:`.mount` learns the odometry-to-scanner mount and corrects the
-    odometry's increments; with ``kept_views_teach`` (off), the ambiguity test's kept views also teach the learner.
+    odometry's increments; with ``kept_views_teach`` (on in ``plus``), the ambiguity test's kept views also teach
+    the learner, so its samples are not only the views that refute the odometry.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -339,7 +340,7 @@ class PlusLocaliser:
                 self.ambiguous_views += 1
                 if self.view_noise is not None:
                     self.view_noise.learn(measured, predicted)
-                if p.kept_views_teach:  # samples not selected by their size (docs: "The wrong laser offset")
+                if p.kept_views_teach:  # samples not selected by their size (docs: "Kept views teach, adopted")
                     self._learn(measured, info.tolist(), predicted, self._motion(since_update))
                 return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
