@@ -65,6 +65,17 @@ def test_with_perfect_odometry_the_method_ate_is_shown_without_a_ratio() -> None
     assert "Nowhere" in text  # perfect odometry is not counted as "worse"
 
 
+def test_scan_dropout_with_exact_odometry_is_a_column_of_its_own_beside_the_undisturbed_run() -> None:
+    """Both rows have perfect odometry; the dropout row must not stand in for the undisturbed one."""
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    none = replace(_row("gtsam-graph", 0.0, 0.0, 0.0, PERFECT, False), ate_m=0.304, odometry_ate_m=0.0)
+    dropout = replace(none, degradation="dropout:0.5", seeds=3, ate_m=0.411)
+    text = render_page(plan, [none, dropout])
+    log = "fhw-corrected?odometry=laser-pose"
+    assert f"| method | {log} | {log} (dropout:0.5) |" in text
+    assert "| gtsam-graph | 0.304 | 0.411 |" in text
+
+
 def _drive(name: str) -> Sequence:
     """A straight 40-scan drive with reference poses; the odometry is 10 % long and turns 0.5 deg per step."""
     t = np.arange(40, dtype=float)
