@@ -2,6 +2,8 @@
 
 Measured (``docs/albot1-mapper.md``, "The turn bound"): relation metric 2.29 m without the bound, 0.95 m with it,
 19 views bounded; the odometry's own 0.615 m. The bounds below leave room for library versions, not for the bursts.
+The test holds kept views teaching off, as `plus` was when the bound was measured: with it on (`plus` now) the
+bursts are smaller to begin with (1.09 m without the bound, 0.23 m with it; "Kept views teach, adopted in `plus`").
 """
 
 from __future__ import annotations
@@ -23,7 +25,8 @@ def test_the_turn_bound_removes_fr_clinics_bursts(data_file: Callable[[str], Pat
     sequence = open_sequence("fr-clinic")
     errors = {}
     for floor in (0.0, 3.0):
-        result = run_method("albot1", sequence, preset="plus", overrides={"turn_bound_floor_deg": floor})
+        overrides = {"turn_bound_floor_deg": floor, "kept_views_teach": False}
+        result = run_method("albot1", sequence, preset="plus", overrides=overrides)
         metric = relation_metric(result.timestamps, result.poses, result.relations, outside="exclude")
         errors[floor] = metric["translation_m"]["mean"]
         if floor > 0.0:
