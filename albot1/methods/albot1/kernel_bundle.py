@@ -99,37 +99,34 @@ def read_manifest(bundle: Path = BUNDLE_DIR) -> dict[str, Any] | None:
     return manifest
 
 
-def _index_entries(kernel: Any, index: Path) -> set[str] | None:
-    """The data files of ``index`` (a bundled numba index of ``kernel``) if numba will accept it here, else None.
-
-    Numba's index file is its version (pickled) followed by the pickled
-    ``(source stamp, {key: data file})``; numba reads it only when the
-    version and the stamp of the kernel's source file match
-    (``numba.core.caching.IndexDataCacheFile``).
-    """
-    cache = kernel._cache
+def _read_index(index: Path) -> tuple[Any, Any, Any]:
+    """Numba's index file: its numba version (pickled), then the pickled ``(source stamp, {key: data file})``."""
     with index.open("rb") as f:
         version = pickle.load(f)
         stamp, overloads = pickle.loads(f.read())
+    return version, stamp, overloads
+
+
+def _index_entries(kernel: Any, index: Path, samples: list[tuple[Any, ...]]) -> set[str] | None:
+    """The data files of ``index`` (a bundled numba index of ``kernel``) if numba will accept it here, else None.
+
+    Numba reads an index only when its version and the stamp of the kernel's
+    source file match (``numba.core.caching.IndexDataCacheFile``), and uses
+    it only if it holds numba's key of every sample's signature for this
+    process's CPU target.
+    """
+    cache = kernel._cache
+    version, stamp, overloads = _read_index(index)
     if version != numba.__version__ or stamp != cache._impl.locator.get_source_stamp():
         return None
     if not isinstance(overloads, dict):
         return None
-    return {str(name) for name in overloads.values()}
-
-
-def _has_keys(kernel: Any, index: Path, samples: list[tuple[Any, ...]]) -> bool:
-    """Whether ``index`` holds numba's key of every sample's signature for this process's CPU target."""
-    cache = kernel._cache
-    with index.open("rb") as f:
-        pickle.load(f)
-        _, overloads = pickle.loads(f.read())
     codegen = kernel.targetctx.codegen()
     for args in samples:
         signature = tuple(kernel.typeof_pyval(a) for a in args)
         if cache._index_key(signature, codegen) not in overloads:
-            return False
-    return True
+            return None
+    return {str(name) for name in overloads.values()}
 
 
 def _copy(source: Path, target: Path) -> None:
@@ -206,8 +203,8 @@ def _seed_one(kernel: Any, samples: list[tuple[Any, ...]], files: dict[str, str]
     relative = f"{folder}/{index.name}"
     if files.get(relative) is None or sha256(index) != files[relative]:
         return []
-    data = _index_entries(kernel, index)
-    if data is None or not _has_keys(kernel, index, samples):
+    data = _index_entries(kernel, index, samples)
+    if data is None:
         return []
     for name in data:
         if files.get(f"{folder}/{name}") != sha256(bundle / folder / name):

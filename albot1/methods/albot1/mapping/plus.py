@@ -279,19 +279,7 @@ class PlusLocaliser:
         if not placed and p.turn_floor > 0.0:  # the turn bound (:mod:`.turn_bound`); views a landmark placed skip it
             limit = allowance(p.turn_floor, p.turn_scale, since_update[2])
             if beyond(measured[2] - predicted[2], limit):
-                support = view_ambiguity(
-                    self._k.measurement_costs,
-                    measured,
-                    predicted,
-                    lm_view,
-                    lm_map,
-                    ok,
-                    points,
-                    self._ref,
-                    sigmas,
-                    0.0,
-                    p.overhang,
-                )
+                support = self._ambiguity(measured, predicted, lm_view, lm_map, ok, points, 0.0)
                 if support.statistic <= p.turn_statistic:
                     self.turn_bounded_views += 1
                     # around the prediction the allowance is measured from, not the first start (the previous
@@ -322,19 +310,7 @@ class PlusLocaliser:
                 bound = self._ambiguity_limit
                 test = Ambiguity(support.statistic, bound, support.statistic <= bound)
             else:
-                test = view_ambiguity(
-                    self._k.measurement_costs,
-                    measured,
-                    predicted,
-                    lm_view,
-                    lm_map,
-                    ok,
-                    points,
-                    self._ref,
-                    sigmas,
-                    self._ambiguity_limit,
-                    p.overhang,
-                )
+                test = self._ambiguity(measured, predicted, lm_view, lm_map, ok, points, self._ambiguity_limit)
             self.last_ambiguity = test
             if test.ambiguous:
                 self.ambiguous_views += 1
@@ -385,6 +361,35 @@ class PlusLocaliser:
             p.overhang,
         )
         return (x, y, phi), info
+
+    def _ambiguity(
+        self,
+        measured: Pose,
+        predicted: Pose,
+        lm_view: FloatArray,
+        lm_map: FloatArray,
+        ok: NDArray[np.bool_],
+        points: FloatArray,
+        limit: float,
+    ) -> Ambiguity:
+        """The ambiguity test of ``measured`` against ``predicted`` (:mod:`.ambiguity`) at ``limit``.
+
+        One place for the turn bound's test (limit 0) and the ambiguity test's, which must score the same terms
+        with the same sigmas so that the turn bound's statistic can stand in for the second.
+        """
+        return view_ambiguity(
+            self._k.measurement_costs,
+            measured,
+            predicted,
+            lm_view,
+            lm_map,
+            ok,
+            points,
+            self._ref,
+            self._sigmas,
+            limit,
+            self.params.overhang,
+        )
 
     def _learn(self, measured: Pose, rows: list[list[float]], predicted: Pose, motion: float) -> float:
         """Teach the odometry learner this view's disagreement with the prediction; return the heading difference.

@@ -157,7 +157,7 @@ def test_an_index_built_for_another_cpu_leaves_its_kernel_cold(bundle: Path, tmp
     copy = tmp_path / "bundle"
     shutil.copytree(bundle, copy)
     index = next(copy.rglob("kernels.build_view-*.nbi"))
-    numba_version, stamp, overloads = _read_index(index)
+    numba_version, stamp, overloads = _bundle_module()._read_index(index)
     moved = {(k[0], (k[1][0], "skylake", k[1][2]), k[2]): v for k, v in overloads.items()}
     _write_index(index, numba_version, stamp, moved)
     manifest = json.loads((copy / _bundle_module().MANIFEST).read_text())
@@ -199,15 +199,6 @@ def test_kernels_are_compiled_for_numba_s_generic_cpu_unless_the_user_says_other
     env[CPU_NAME_ENV] = "host"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "host"
-
-
-def _read_index(index: Path) -> tuple[Any, Any, dict[Any, str]]:
-    import pickle
-
-    with index.open("rb") as f:
-        version = pickle.load(f)
-        stamp, overloads = pickle.loads(f.read())
-    return version, stamp, overloads
 
 
 def _write_index(index: Path, version: Any, stamp: Any, overloads: dict[Any, str]) -> None:
