@@ -232,6 +232,7 @@ def measure(
         "place_closures": result.counters.get("place_closures_accepted"),
         "velocity_matches": result.counters.get("tracking_velocity_guess"),
         "slides_refused": result.counters.get("tracking_velocity_slides_refused"),
+        "earned_odometry_match": [result.counters.get(f"odometry_earned_{k}", 0) for k in ("odometry", "match")],
     }
     if result.reference is not None:
         graph = ate(result.poses, result.reference)["rmse_m"]

@@ -129,6 +129,12 @@ class GtsamGraphConfig(BaseModel):
     odometry_trust_kind_min_steps: int = Field(
         ge=2, description="... a kind's own history vetoes (and lifts the floor) once it holds this many steps"
     )
+    odometry_trust_earned_level: float = Field(
+        ge=0,
+        lt=1,
+        description="... a step whose odometry and match disagree beyond this chi-square level keeps the side with the "
+        "smaller earned variance along the disagreement (earned_choice.py; 0: off)",
+    )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
         gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"

@@ -27,6 +27,7 @@ from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
+from albot1.methods.baselines.gtsam_graph.earned_choice import EarnedFactors
 from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, OdometryFactors, OdometryTrust
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
@@ -84,7 +85,11 @@ class FrontEnd:
             math.radians(config.odometry_trust_floor_turn_deg),
             config.odometry_trust_turn_scale,
         )
-        self._odometry_factors = OdometryFactors(self._odometry_trust)
+        self._odometry_factors = (
+            EarnedFactors(self._odometry_trust, config.odometry_trust_earned_level, counters)
+            if config.odometry_trust_earned_level > 0
+            else OdometryFactors(self._odometry_trust)
+        )
         # Odometry factors judged at the latest node (``odometry_trust_factors``), for the back end to add with it.
         self.odometry_factors: list[OdometryFactor] = []
         self.last_odometry: FloatArray | None = None
@@ -338,6 +343,7 @@ class FrontEnd:
                     len(self._back.odometry), odometry_step, reg.pose, covariance
                 )
                 self.counters["odometry_fused"] += len(self.odometry_factors)
+                covariance = self._odometry_factors.match_covariance(len(self._back.odometry), covariance)
             elif cfg.odometry_trust and odometry_step is not None:
                 fused = self._odometry_trust.fuse(odometry_step, reg.pose, covariance)
                 self._odometry_trust.add(odometry_step, reg.pose)

@@ -177,20 +177,23 @@ class OdometryTrust:
         """
         return self.min_variance_ratio if abs(turn_rad) >= self.floor_turn_rad else 0.0
 
-    def variances(self, match_variances: FloatArray, kind: int = 0, turn_rad: float = math.inf) -> FloatArray | None:
+    def variances(
+        self, match_variances: FloatArray, kind: int = 0, turn_rad: float = math.inf, floor: bool = True
+    ) -> FloatArray | None:
         """Per component (x, y, theta) the odometry step's variance, ``inf`` where not trusted; None: too few steps.
 
         ``match_variances`` are the diagonal of the match edge's covariance
         (what the match claims of itself), ``kind`` the step's population
         (:meth:`kind`). Not trusted: no spread, a biased median, or a
-        variance not below the match's (module docstring).
+        variance not below the match's (module docstring). ``floor=False``:
+        what the record alone earns, without the weight floor (:mod:`.earned_choice`).
         """
         if len(self._pooled) < self._min_history:
             return None
         scale = self.scale.variance(turn_rad) if self.scale is not None and math.isfinite(turn_rad) else 0.0
         own = self._kinds[kind]
         if not math.isfinite(self.turn_rad) or len(own) < self.kind_min_steps:
-            return self._estimate(self._pooled, match_variances, self.floor_ratio(turn_rad), scale)
+            return self._estimate(self._pooled, match_variances, self.floor_ratio(turn_rad) if floor else 0.0, scale)
         return np.maximum(
             self._estimate(self._pooled, match_variances, 0.0, scale), self._estimate(own, match_variances, 0.0, scale)
         )
@@ -302,12 +305,22 @@ class OdometryFactors:
             return []  # too few steps to judge any of them yet
         factors = []
         for k, odo, match, cov in self._pending:
-            variances = self.trust.gated_variances(odo, match, cov)
-            if variances is not None:
-                covariance = np.diag(np.where(np.isfinite(variances), variances, UNTRUSTED_VARIANCE))
+            covariance = self.judge(k, odo, match, cov)
+            if covariance is not None:
                 factors.append(OdometryFactor(k, odo, covariance))
         self._pending = []
         return factors
+
+    def judge(self, key: int, odometry_step: FloatArray, match_step: FloatArray, match_covariance: FloatArray) -> (
+        FloatArray | None
+    ):
+        """Node ``key``'s odometry factor covariance (untrusted components at :data:`UNTRUSTED_VARIANCE`); None: none."""
+        variances = self.trust.gated_variances(odometry_step, match_step, match_covariance)
+        return None if variances is None else np.diag(np.where(np.isfinite(variances), variances, UNTRUSTED_VARIANCE))
+
+    def match_covariance(self, key: int, covariance: FloatArray) -> FloatArray:
+        """Node ``key``'s match edge covariance as judged (here unchanged; :class:`.earned_choice.EarnedFactors`)."""
+        return covariance
 
 
 def min_history(bias_z: float) -> int:
