@@ -21,7 +21,8 @@ loop closure's error against the reference: the heading RMS of the matched
 edges, their lag-1 autocorrelation, the worst ones and every accepted closure
 (docs/baselines.md, gtsam-graph, "why one run of edmonton swings"). ``--moves`` adds every tracked scan whose
 match moved the odometry guess by more than 0.25 m, and which guess's match won (docs/baselines.md, gtsam-graph,
-"sequential slides").
+"sequential slides"). ``earned_odometry_match`` counts the earned choice's decisions (``odometry_trust_earned_level``;
+docs/baselines.md, gtsam-graph, "the earned choice").
 """
 
 from __future__ import annotations

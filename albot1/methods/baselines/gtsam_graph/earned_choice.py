@@ -109,7 +109,10 @@ def quantile(level: float, dof: int) -> float:
 
 
 class EarnedFactors(OdometryFactors):
-    """:class:`.odometry_trust.OdometryFactors` whose disagreeing steps keep the side that earned it (:func:`choose`)."""
+    """:class:`.odometry_trust.OdometryFactors` whose disagreeing steps keep the side that earned it (:func:`choose`).
+
+    Only the newest node's grown match covariance is handed back (:meth:`match_covariance`).
+    """
 
     def __init__(self, trust: OdometryTrust, level: float, counters: dict[str, int]) -> None:
         """``counters``: the mapper's; ``odometry_earned_odometry`` / ``odometry_earned_match`` count the choices

@@ -311,10 +311,10 @@ class OdometryFactors:
         self._pending = []
         return factors
 
-    def judge(self, key: int, odometry_step: FloatArray, match_step: FloatArray, match_covariance: FloatArray) -> (
-        FloatArray | None
-    ):
-        """Node ``key``'s odometry factor covariance (untrusted components at :data:`UNTRUSTED_VARIANCE`); None: none."""
+    def judge(
+        self, key: int, odometry_step: FloatArray, match_step: FloatArray, match_covariance: FloatArray
+    ) -> FloatArray | None:
+        """Node ``key``'s odometry factor covariance (untrusted components: :data:`UNTRUSTED_VARIANCE`); None: none."""
         variances = self.trust.gated_variances(odometry_step, match_step, match_covariance)
         return None if variances is None else np.diag(np.where(np.isfinite(variances), variances, UNTRUSTED_VARIANCE))
 
