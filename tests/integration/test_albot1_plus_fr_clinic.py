@@ -23,6 +23,7 @@ NEITHER = {"view_noise_learning_rate": 0.0, "kept_views_teach": False}
 
 
 @pytest.mark.slow
+@pytest.mark.whole_log
 def test_plus_takes_fr_clinic_below_its_odometry_and_a_perturbed_repeat_too(
     data_file: Callable[[str], Path],
 ) -> None:

@@ -19,6 +19,7 @@ from albot1.runs.execute import run_method
 
 
 @pytest.mark.slow
+@pytest.mark.whole_log
 def test_the_turn_bound_removes_fr_clinics_bursts(data_file: Callable[[str], Path]) -> None:
     data_file("radish/fr-clinic_robotlaser.clf.bz2")
     data_file("radish/fr-clinic.relations")

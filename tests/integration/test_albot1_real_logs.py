@@ -32,6 +32,7 @@ def test_prefix_of_a_real_log_runs_with_sane_counters(data_file: Callable[[str],
 
 
 @pytest.mark.slow
+@pytest.mark.whole_log
 def test_full_intel_log_runs(data_file: Callable[[str], Path]) -> None:
     result = run_method("albot1", load(data_file("radish/intel.clf.bz2")), preset="exact")
     c = result.counters

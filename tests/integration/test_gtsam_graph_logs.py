@@ -67,6 +67,7 @@ def test_aces_prefix_relation_error_is_at_graph_mapping_level(data_file: Callabl
         ("mit-csail", "radish/mit-csail.clf.bz2", 0.0319, 0.369),
     ],
 )
+@pytest.mark.whole_log
 def test_whole_standard_log_beats_the_published_figures(
     data_file: Callable[[str], Path], log: str, path: str, translation_m: float, rotation_deg: float
 ) -> None:
@@ -99,6 +100,7 @@ def test_intel_relations_are_all_scored_although_its_stamps_go_back(data_file: C
 
 
 @pytest.mark.slow
+@pytest.mark.whole_log
 def test_fr_clinic_big_loop_is_closed_by_place_recognition(data_file: Callable[[str], Path]) -> None:
     """The hospital's ~1 km loop returns with ~30 m of drift: only the place-recognition search reaches it.
 

@@ -31,6 +31,7 @@ def _gap(poses: np.ndarray) -> float:
     return float(np.hypot(*(poses[-1, :2] - poses[0, :2])))
 
 
+@pytest.mark.whole_log
 def test_icp_slam_closes_mit_csail_within_3_m(data_file: Callable[[str], Path]) -> None:
     sequence = load(data_file("radish/mit-csail.clf.bz2"))
     result = run_method("mrpt-icp", sequence, dataset_name="mit-csail")

@@ -50,6 +50,7 @@ def _relation_error(timestamps: np.ndarray, poses: np.ndarray, relations_file: P
 
 
 @pytest.mark.slow
+@pytest.mark.whole_log
 def test_gmapping_style_filter_on_mit_csail(data_file: Callable[[str], Path]) -> None:
     sequence = load(data_file("radish/mit-csail.clf.bz2"))
     result = run_method("mrpt-rbpf", sequence, dataset_name="mit-csail")

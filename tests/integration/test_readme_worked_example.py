@@ -28,7 +28,7 @@ EXTRACT = ROOT / ".ci" / "readme-example"
 OWN_BAG = "robot.mcap?reference=gt.tum"
 EXTERNAL = "mine (external)"
 
-pytestmark = pytest.mark.integration
+pytestmark = [pytest.mark.integration, pytest.mark.whole_log]
 
 
 def _needs(*names: str) -> None:

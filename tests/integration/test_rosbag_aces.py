@@ -51,6 +51,7 @@ def test_aces_prefix_round_trips(aces_prefix: Sequence, tmp_path: Path, fmt: str
 
 
 @pytest.mark.slow
+@pytest.mark.whole_log
 def test_full_aces_round_trips_through_every_format(data_file: Callable[[str], Path], tmp_path: Path) -> None:
     aces = load(data_file("radish/aces.clf.bz2")).materialize()
     assert len(aces) == 7374

@@ -4,6 +4,7 @@ does return keeps the data model's promises (finite poses, ascending angles, ran
 
 from __future__ import annotations
 
+import functools
 import math
 import shutil
 import tempfile
@@ -51,13 +52,21 @@ QUATERNION = st.one_of(
 )
 
 
+@functools.cache
+def humble_typestore() -> Any:
+    """One type store for every example: a fresh one compiles each message's serializer again (a tenth of the
+    test's time), and a store holds nothing of the bags written with it."""
+    from rosbags.typesys import Stores, get_typestore
+
+    return get_typestore(Stores.ROS2_HUMBLE)
+
+
 def write_bag(
     path: Path, scans: list[dict[str, Any]], poses: list[tuple[Any, ...]], stamps: list[int], tf: bool
 ) -> None:
     from rosbags.rosbag2 import Writer
-    from rosbags.typesys import Stores, get_typestore
 
-    ts = get_typestore(Stores.ROS2_HUMBLE)
+    ts = humble_typestore()
     t = ts.types
 
     def header(sec: int, frame: str = "odom") -> Any:

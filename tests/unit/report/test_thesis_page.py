@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import re
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -79,12 +80,46 @@ def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return _store(root, "thesis", _suite("thesis", [{"name": SQUARE, "sweep": True}]), fail=FAILED_METHOD)
 
 
+@dataclass(frozen=True)
+class Written:
+    """The page written once for the module, and the figure requests it drew (by stem, in order)."""
+
+    page: Path
+    drawn: list[str]
+
+
+def _fewer_panels(patch: pytest.MonkeyPatch) -> None:
+    """Fewer panels and frames: the same code, drawn faster."""
+    patch.setattr(figures, "MAX_TRACE_PANELS", 4)
+    patch.setattr(figures, "MAX_FRAMES", 6)
+
+
+def _spy_on_drawing(patch: pytest.MonkeyPatch, drawn: list[str]) -> None:
+    """Record the stem of every figure request the page draws (not those its figure cache serves)."""
+    from albot1.report.thesis import page as page_module
+
+    original = page_module._Figures.draw
+
+    def spy(self: Any, request: Any) -> Any:
+        drawn.append(request.stem)
+        return original(self, request)
+
+    patch.setattr(page_module._Figures, "draw", spy)
+
+
 @pytest.fixture(scope="module")
-def page(results: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    with pytest.MonkeyPatch.context() as patch:  # fewer panels and frames: the same code, drawn faster
-        patch.setattr(figures, "MAX_TRACE_PANELS", 4)
-        patch.setattr(figures, "MAX_FRAMES", 6)
-        return write_thesis_page(results, tmp_path_factory.mktemp("report"))
+def written(results: Path, tmp_path_factory: pytest.TempPathFactory) -> Written:
+    """The page of ``results``, written once: rendered, linked and written again by the tests below."""
+    drawn: list[str] = []
+    with pytest.MonkeyPatch.context() as patch:
+        _fewer_panels(patch)
+        _spy_on_drawing(patch, drawn)
+        return Written(write_thesis_page(results, tmp_path_factory.mktemp("report")), drawn)
+
+
+@pytest.fixture(scope="module")
+def page(written: Written) -> Path:
+    return written.page
 
 
 def test_experiment_3_verdicts_are_computed_from_the_stored_loop_gaps(results: Path) -> None:
@@ -188,25 +223,23 @@ def test_experiment_6_says_why_a_relation_cell_is_missing(results: Path) -> None
 
 @pytest.mark.slow
 def test_a_page_written_again_draws_no_figure_whose_runs_did_not_change(
-    results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    results: Path, written: Written, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from albot1.report.thesis import page as page_module
-
-    monkeypatch.setattr(figures, "MAX_TRACE_PANELS", 4)
-    monkeypatch.setattr(figures, "MAX_FRAMES", 6)
+    # The first writing is the module's page (the same settings, its drawing recorded); it is written again in a
+    # copy of its folder, so the page the other tests read stays as it was written. The figure stamps name the
+    # files relative to the folder and the digests hold no output path, so the copy is what a second run finds.
+    # The copy is tmp_path itself: like the page's folder, a child of pytest's base temporary folder, so the
+    # page's relative links to the results are the same.
+    assert tmp_path.parent == written.page.parent.parent
+    out = tmp_path
+    shutil.copytree(written.page.parent, out, dirs_exist_ok=True)
+    first = written.page.read_text(encoding="utf-8")
+    assert written.drawn
+    made = sorted(written.drawn)
+    _fewer_panels(monkeypatch)
     drawn: list[str] = []
-    original = page_module._Figures.draw
-
-    def spy(self: Any, request: Any) -> Any:
-        drawn.append(request.stem)
-        return original(self, request)
-
-    monkeypatch.setattr(page_module._Figures, "draw", spy)
-    first = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
-    assert drawn
-    made = sorted(drawn)
-    drawn.clear()
-    second = write_thesis_page(results, tmp_path).read_text(encoding="utf-8")
+    _spy_on_drawing(monkeypatch, drawn)
+    second = write_thesis_page(results, out).read_text(encoding="utf-8")
     # only the requests that could not be drawn (a failed run, no run) are worked out again, for their reason
     assert set(drawn) < set(made)
     strip = re.compile(r"^Generated .*$", re.MULTILINE)

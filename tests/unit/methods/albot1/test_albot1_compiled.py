@@ -517,18 +517,21 @@ def test_identical_presets_are_run_once() -> None:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("preset", _distinct_presets())
+@pytest.mark.whole_log
 def test_whole_startstop_run_is_identical_compiled_and_as_written(preset: str) -> None:
     _assert_same_run("synthetic-office-startstop", preset)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("preset", _distinct_presets())
+@pytest.mark.whole_log
 def test_whole_loop_run_is_identical_compiled_and_as_written(preset: str) -> None:
     _assert_same_run("synthetic-office-loop", preset)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("method", ["albot1", "albot1-places"])
+@pytest.mark.whole_log
 def test_whole_loop_run_is_identical_with_numba_s_switch(method: str) -> None:
     """Every kernel and callee as Python, process-wide (``NUMBA_DISABLE_JIT=1``), against the compiled run."""
     code = f"{_FINGERPRINT}\nprint(fingerprint({method!r}, 'default', 'synthetic-office-loop', None))\n"
