@@ -72,6 +72,7 @@ from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_n
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mount import MountCalibration
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
+from albot1.methods.albot1.mapping.refutation import refutes
 from albot1.methods.albot1.mapping.screen import screen_measurement
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
 from albot1.methods.albot1.mapping.view_noise import ViewNoise, median_step
@@ -85,6 +86,8 @@ LEARN_MIN_INFO = 400.0
 LEARN_MIN_MOTION_M = 0.05
 #: Variance floors of the prior (m^2, rad^2): odometry is never trusted below 1 cm and 1 mrad.
 PRIOR_FLOOR = (1e-4, 1e-6)
+import os as _os  # SCRATCH
+_SCRATCH_NOTEACH = bool(_os.environ.get("SCRATCH_NOTEACH"))
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,6 +123,7 @@ class PlusParams:
     fit_noise_statistic: float = 0.0  # ... falling with the square of the view's likelihood ratio beyond this
     mount_prior: float = 0.0  # m: prior sd of the odometry-to-scanner mount learnt online (:mod:`.mount`); 0 = off
     kept_views_teach: bool = False  # the views the ambiguity test keeps also teach the odometry learner
+    refutation_probability: float = 0.0  # keep the prediction unless the fit departs beyond the view noise; 0 = off
 
 
 class OdometryNoise:
@@ -210,6 +214,9 @@ class PlusLocaliser:
         self.ambiguous_views = 0
         self.last_ambiguity: Ambiguity | None = None
         self._ambiguity_limit = threshold(params.ambiguity_probability)
+        #: Views the ambiguity test let through whose departure the view noise explains (:mod:`.refutation`).
+        self.unrefuted_views = 0
+        self._refutation_limit = threshold(params.refutation_probability) if self.view_noise is not None else 0.0
         #: The fit's sigmas as the ambiguity tests take them (built once, not per view).
         self._sigmas = (params.line_sigma, params.point_sigma, params.scan_sigma, params.huber, params.scan_gate)
         #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
@@ -319,6 +326,13 @@ class PlusLocaliser:
                 if p.kept_views_teach:  # samples not selected by their size (docs: "Kept views teach, adopted")
                     self._learn(measured, info.tolist(), predicted, self._motion(since_update))
                 return predicted
+            if self._refutation_limit > 0.0 and self.view_noise is not None:  # :mod:`.refutation`
+                rows = info.tolist()
+                if not refutes(measured, rows, predicted, self.view_noise.variance, self._refutation_limit):
+                    self.unrefuted_views += 1
+                    if not _SCRATCH_NOTEACH:
+                        self._learn(measured, rows, predicted, self._motion(since_update))
+                    return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
                 scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
                 return self._fuse(measured, info, predicted, self._motion(since_update), scale, test.statistic)
