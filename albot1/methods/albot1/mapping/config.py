@@ -320,6 +320,16 @@ class Albot1Config(BaseModel):
             " learnt scatter (0 = off; albot1/methods/albot1/mapping/refutation.py)"
         ),
     )
+    noise_split_samples: int = Field(
+        0,
+        ge=0,
+        description=(
+            "Albot1+ (adaptive prior): learn the odometry's spread and the views' own as the slope and intercept of"
+            " the squared view-odometry disagreement against the motion since the update, over this many views"
+            " of memory; the fusion adds the views' to the fit's covariance (0 = off;"
+            " albot1/methods/albot1/mapping/noise_split.py)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -405,4 +415,5 @@ class Albot1Config(BaseModel):
             mount_prior=self.mount_prior_m,
             kept_views_teach=self.kept_views_teach,
             refutation_probability=self.refutation_probability,
+            noise_split=self.noise_split_samples,
         )

@@ -1,4 +1,4 @@
-"""Albot1+'s refutation test (``refutation_probability``): a departure the view's own noise explains keeps the odometry."""
+"""Albot1+'s refutation test (``refutation_probability``): a departure the view noise explains keeps the odometry."""
 
 from __future__ import annotations
 
