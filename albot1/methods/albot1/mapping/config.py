@@ -310,6 +310,26 @@ class Albot1Config(BaseModel):
             ' (docs/albot1-mapper.md, "Kept views teach, adopted in `plus`")'
         ),
     )
+    refutation_probability: float = Field(
+        0.0,
+        ge=0,
+        lt=1,
+        description=(
+            "Albot1+ (with the ambiguity test and the view noise): keep the odometry's prediction when the fit's"
+            " departure from it is within this chi-square(3) quantile of the fit's stated covariance plus the views'"
+            " learnt scatter (0 = off; albot1/methods/albot1/mapping/refutation.py)"
+        ),
+    )
+    noise_split_samples: int = Field(
+        0,
+        ge=0,
+        description=(
+            "Albot1+ (adaptive prior): learn the odometry's spread and the views' own as the slope and intercept of"
+            " the squared view-odometry disagreement against the motion since the update, over this many views"
+            " of memory; the fusion adds the views' to the fit's covariance (0 = off;"
+            " albot1/methods/albot1/mapping/noise_split.py)"
+        ),
+    )
     # 3.1.7 update
     update_polygon: Literal["robot_and_endpoints", "endpoints"] = Field(
         "robot_and_endpoints", description="Algorithm 3 line 7: polygon vertices (note 15)"
@@ -394,4 +414,6 @@ class Albot1Config(BaseModel):
             fit_noise_statistic=self.fit_noise_statistic,
             mount_prior=self.mount_prior_m,
             kept_views_teach=self.kept_views_teach,
+            refutation_probability=self.refutation_probability,
+            noise_split=self.noise_split_samples,
         )

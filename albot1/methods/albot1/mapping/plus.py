@@ -50,6 +50,9 @@ pose is computed:
 11. with ``mount_prior_m`` (off in ``plus``), :mod:`.mount` learns the odometry-to-scanner mount and corrects the
     odometry's increments; with ``kept_views_teach`` (on in ``plus``), the ambiguity test's kept views also teach
     the learner, so its samples are not only the views that refute the odometry.
+12. with ``refutation_probability`` (off), :mod:`.refutation` keeps the prediction where the view noise explains the
+    fit's departure; with ``noise_split_samples`` (off), :mod:`.noise_split` learns the odometry's spread and the views'
+    own as the slope and intercept of the disagreement against the motion since the update.
 
 The per-scan loop is :func:`albot1.methods.albot1.mapping.pose_kernels.refine_pose`
 (numba or plain Python, same bits); this module prepares its inputs, learns
@@ -71,10 +74,12 @@ from albot1.methods.albot1.mapping.consistency import information_scale, stated_
 from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_noise
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mount import MountCalibration
+from albot1.methods.albot1.mapping.noise_split import NoiseSplit
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
+from albot1.methods.albot1.mapping.refutation import refutes
 from albot1.methods.albot1.mapping.screen import screen_measurement
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
-from albot1.methods.albot1.mapping.view_noise import ViewNoise, median_step
+from albot1.methods.albot1.mapping.view_noise import START, ViewNoise, median_step
 from albot1.methods.albot1.mapping.window import OdometryWindow, UpdateRecord, WindowOutcome
 from albot1.methods.albot1.perception.endpoints import STABLE
 
@@ -120,6 +125,8 @@ class PlusParams:
     fit_noise_statistic: float = 0.0  # ... falling with the square of the view's likelihood ratio beyond this
     mount_prior: float = 0.0  # m: prior sd of the odometry-to-scanner mount learnt online (:mod:`.mount`); 0 = off
     kept_views_teach: bool = False  # the views the ambiguity test keeps also teach the odometry learner
+    refutation_probability: float = 0.0  # keep the prediction unless the fit departs beyond the view noise; 0 = off
+    noise_split: int = 0  # views of memory of the line nu^2 = V + q s splitting the two noises (:mod:`.noise_split`)
 
 
 class OdometryNoise:
@@ -199,8 +206,16 @@ class PlusLocaliser:
         self._max_range = max_range
         self._ref = np.empty((0, 4))
         self._anchor: Pose = (0.0, 0.0, 0.0)
-        self.noise = OdometryNoise(params)
+        self.noise: OdometryNoise | NoiseSplit = OdometryNoise(params)
         self.view_noise = ViewNoise(params.view_noise_rate) if params.view_noise_rate > 0.0 else None  # .view_noise
+        #: The views' own variance and the odometry's from one line (:mod:`.noise_split`): it replaces both learners.
+        self.split = (
+            NoiseSplit(params.noise_split, (self.noise.q[0], self.noise.q[1]), START, PRIOR_FLOOR)
+            if params.noise_split > 0
+            else None
+        )
+        if self.split is not None:
+            self.noise, self.view_noise = self.split, None
         self.mount = MountCalibration(params.mount_prior) if params.mount_prior > 0.0 else None  # .mount
         self._odometry_since: Pose = (0.0, 0.0, 0.0)  # the odometry's own increment, which the mount learns from
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
@@ -210,6 +225,9 @@ class PlusLocaliser:
         self.ambiguous_views = 0
         self.last_ambiguity: Ambiguity | None = None
         self._ambiguity_limit = threshold(params.ambiguity_probability)
+        #: Views the ambiguity test let through whose departure the view noise explains (:mod:`.refutation`).
+        self.unrefuted_views = 0
+        self._refutation_limit = threshold(params.refutation_probability) if self.view_noise is not None else 0.0
         #: The fit's sigmas as the ambiguity tests take them (built once, not per view).
         self._sigmas = (params.line_sigma, params.point_sigma, params.scan_sigma, params.huber, params.scan_gate)
         #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
@@ -319,6 +337,12 @@ class PlusLocaliser:
                 if p.kept_views_teach:  # samples not selected by their size (docs: "Kept views teach, adopted")
                     self._learn(measured, info.tolist(), predicted, self._motion(since_update))
                 return predicted
+            if self._refutation_limit > 0.0 and self.view_noise is not None:  # :mod:`.refutation`
+                rows = info.tolist()
+                if not refutes(measured, rows, predicted, self.view_noise.variance, self._refutation_limit):
+                    self.unrefuted_views += 1
+                    self._learn(measured, rows, predicted, self._motion(since_update))
+                    return predicted
             if p.consistency > 0.0:  # :mod:`.consistency`: weigh the fit by what its own cost says it knows
                 scale = information_scale(test.statistic, stated_distance(info, measured, predicted), p.consistency)
                 return self._fuse(measured, info, predicted, self._motion(since_update), scale, test.statistic)
@@ -446,7 +470,9 @@ class PlusLocaliser:
             d_phi = wrap_angle(measured[2] - predicted[2])
         if scale != 1.0:  # after learning and the screen, which judge the fit by its stated information
             h00, h01, h02, h11, h12, h22 = h00 * scale, h01 * scale, h02 * scale, h11 * scale, h12 * scale, h22 * scale
-        if self.params.fit_noise > 0.0 and self.view_noise is not None:  # its measured scatter (:mod:`.fit_noise`)
+        if self.split is not None:  # the views' own variance from the noise split (:mod:`.noise_split`)
+            h00, h01, h02, h11, h12, h22 = with_fit_noise((h00, h01, h02, h11, h12, h22), self.split.variance, 1.0)
+        elif self.params.fit_noise > 0.0 and self.view_noise is not None:  # its measured scatter (:mod:`.fit_noise`)
             f = fit_noise_factor(self.params.fit_noise, statistic, self.params.fit_noise_statistic)
             h00, h01, h02, h11, h12, h22 = with_fit_noise((h00, h01, h02, h11, h12, h22), self.view_noise.variance, f)
         p_xy, p_phi = 1.0 / v_xy, 1.0 / v_phi

@@ -74,6 +74,8 @@ OLD_DEFAULT: dict[str, Any] = {
     "fit_noise_statistic": 0.0,
     "mount_prior_m": 0.0,
     "kept_views_teach": False,
+    "refutation_probability": 0.0,
+    "noise_split_samples": 0,
     "update_polygon": "robot_and_endpoints",
     "delete_margin_m": 0.4,
     "delete_margin_from": "surfaces",
