@@ -18,13 +18,19 @@ the returned information matrix says how much the match actually knows.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
+from albot1.methods.baselines.gtsam_graph.nearest import Grid, correspondences
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 
 @dataclass(frozen=True)
@@ -106,11 +112,14 @@ def line_normals(
 
 
 class Target:
-    """Points with line normals (from :func:`line_normals`), indexed by a k-d tree for matching."""
+    """Points with line normals (from :func:`line_normals`), indexed for matching.
+
+    Two indexes, each built on first use: the compiled grid ICP's
+    correspondences search (:mod:`.nearest`), and scipy's k-d tree, which
+    answers the grid's ambiguous queries and every other caller.
+    """
 
     def __init__(self, points: FloatArray, normals: FloatArray) -> None:
-        from scipy.spatial import cKDTree
-
         self.points: FloatArray = np.asarray(points, dtype=float).reshape(-1, 2)
         self.normals: FloatArray = np.asarray(normals, dtype=float).reshape(-1, 2)
         if self.points.shape != self.normals.shape:
@@ -119,9 +128,20 @@ class Target:
             )
         if not (np.isfinite(self.points).all() and np.isfinite(self.normals).all()):
             raise RegistrationError("target points and normals must be finite")
-        self.tree = cKDTree(self.points) if len(self.points) else None
         # Each point beside its normal: one gather per ICP iteration fetches both (:func:`_linearise`).
         self.lines: FloatArray = np.hstack([self.points, self.normals])
+
+    @functools.cached_property
+    def tree(self) -> cKDTree | None:
+        """scipy's k-d tree of the points (None when there are none)."""
+        from scipy.spatial import cKDTree
+
+        return cKDTree(self.points) if len(self.points) else None
+
+    @functools.cached_property
+    def grid(self) -> Grid:
+        """The points in grid cells, for ICP's correspondences (:mod:`.nearest`); needs at least one point."""
+        return Grid(self.points)
 
     @classmethod
     def from_points(
@@ -167,7 +187,7 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         raise RegistrationError(f"initial guess must be finite, got {init.tolist()}")
     if not np.isfinite(src).all():
         raise RegistrationError(f"source points must be finite; {int((~np.isfinite(src)).any(axis=1).sum())} are not")
-    if len(src) < params.min_points or len(target) < params.min_points or target.tree is None:
+    if len(src) < params.min_points or len(target) < params.min_points or len(target) == 0:
         raise RegistrationError(
             f"need at least {params.min_points} source points and line-like target points, "
             f"got {len(src)} source and {len(target)} target"
@@ -233,29 +253,13 @@ def _linearise(
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Jacobian rows, point-to-line residuals and Cauchy weights of the matches within ``gate``.
 
-    Run once per ICP iteration, with few numpy calls: one gather of points
-    and normals together, the moved points computed once, and no selection
-    when every point found a neighbour within the gate. The arithmetic is
-    the same elementwise operations in the same order as before, so the
-    bits are too (the sha256 fingerprints of the method's poses and maps).
-    The saving is small (replaying intel's registrations: within the noise);
-    the k-d tree query is most of an iteration (docs/baselines.md, "Cost").
+    Run once per ICP iteration. The correspondences are those of
+    ``target.tree.query(moved, k=1, distance_upper_bound=gate)`` kept where
+    ``dist < gate``, found by a compiled grid search that leaves to the k-d
+    tree each query where the two could differ, and the terms are computed
+    with the same operations in the same order as the numpy formulation every
+    recorded result came from (:mod:`.nearest`; docs/baselines.md, "Cost,
+    continued"): the same bits.
     """
     rot = rotate(src, pose[2])
-    moved = rot + pose[:2]
-    assert target.tree is not None  # register() raises before linearising against an empty target
-    dist, idx = target.tree.query(moved, k=1, distance_upper_bound=gate)
-    ok = dist < gate
-    if not ok.all():
-        keep = ok.nonzero()[0]
-        rot, moved, idx = rot[keep], moved[keep], idx[keep]
-    lines = target.lines[idx]
-    n = lines[:, 2:]
-    diff = moved - lines[:, :2]
-    res = n[:, 0] * diff[:, 0] + n[:, 1] * diff[:, 1]
-    # d(R p + t)/d theta = (-(R p)_y, (R p)_x).
-    jac = np.empty((len(res), 3))
-    jac[:, :2] = n
-    jac[:, 2] = n[:, 1] * rot[:, 0] - n[:, 0] * rot[:, 1]
-    w = 1.0 / (1.0 + (res / cauchy_scale) ** 2)
-    return jac, res, w
+    return correspondences(target.grid, lambda: target.tree, target.lines, rot, pose, gate, cauchy_scale)
