@@ -193,10 +193,12 @@ def linearise_terms(
     py: float,
     gate: float,
     cauchy: float,
+    inv_var: float,
     idx: IntArray,
     jac: FloatArray,
     res: FloatArray,
     w: FloatArray,
+    wj: FloatArray,
 ) -> int:
     """Every rotated point's correspondence in ``idx``; the terms of the matched ones, or -1 when one is ambiguous.
 
@@ -215,7 +217,7 @@ def linearise_terms(
             idx[i] = order[at] if at >= 0 else -1
     if ambiguous:
         return -1
-    return _terms(lines, rot, px, py, cauchy, idx, jac, res, w)
+    return _terms(lines, rot, px, py, cauchy, inv_var, idx, jac, res, w, wj)
 
 
 @jitable
@@ -225,16 +227,19 @@ def _terms(
     px: float,
     py: float,
     cauchy: float,
+    inv_var: float,
     idx: IntArray,
     jac: FloatArray,
     res: FloatArray,
     w: FloatArray,
+    wj: FloatArray,
 ) -> int:
-    """Residual, Jacobian row and Cauchy weight of each matched point, in order; their count.
+    """Residual, Jacobian row, Cauchy weight and weighted row of each matched point, in order; their count.
 
     The operations of the numpy formulation they replace, in its order:
     ``moved = rot + t``, ``diff = moved - p``, ``res = n0 * d0 + n1 * d1``,
-    ``jac = (n0, n1, n1 * r0 - n0 * r1)``, ``w = 1 / (1 + (res / c) ** 2)``.
+    ``jac = (n0, n1, n1 * r0 - n0 * r1)``, ``w = 1 / (1 + (res / c) ** 2)``,
+    ``wj = jac * (w * inv_var)``.
     """
     m = 0
     for i in range(idx.shape[0]):
@@ -252,6 +257,10 @@ def _terms(
         jac[m, 2] = n1 * r0 - n0 * r1
         s = e / cauchy
         w[m] = 1.0 / (1.0 + s * s)
+        scale = w[m] * inv_var
+        wj[m, 0] = jac[m, 0] * scale
+        wj[m, 1] = jac[m, 1] * scale
+        wj[m, 2] = jac[m, 2] * scale
         m += 1
     return m
 
@@ -263,41 +272,58 @@ def terms(
     px: float,
     py: float,
     cauchy: float,
+    inv_var: float,
     idx: IntArray,
     jac: FloatArray,
     res: FloatArray,
     w: FloatArray,
+    wj: FloatArray,
 ) -> int:
     """:func:`_terms` called from Python (after the ambiguous queries were answered by the k-d tree)."""
-    return _terms(lines, rot, px, py, cauchy, idx, jac, res, w)
+    return _terms(lines, rot, px, py, cauchy, inv_var, idx, jac, res, w, wj)
 
 
-def correspondences(
-    grid: Grid,
-    tree: Callable[[], Any],
-    lines: FloatArray,
-    rot: FloatArray,
-    pose: FloatArray,
-    gate: float,
-    cauchy: float,
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Jacobian rows, residuals and Cauchy weights of the points of ``rot`` moved by ``pose`` that match within ``gate``.
+class Matches:
+    """One registration's correspondences and terms: buffers for ``n`` source points, filled once per ICP iteration.
 
-    The same correspondences as ``tree.query(rot + pose[:2], k=1,
-    distance_upper_bound=gate)`` kept where ``dist < gate`` (``tree()`` gives
-    the target's ``cKDTree``, asked only about ambiguous queries), and the same
-    terms bit for bit.
+    :meth:`find` returns views of the first rows (the matched points, in
+    source order); they hold until the next call.
     """
-    n = rot.shape[0]
-    px, py = float(pose[0]), float(pose[1])
-    idx = np.empty(n, dtype=np.int64)
-    jac, res, w = np.empty((n, 3)), np.empty(n), np.empty(n)
-    m = linearise_terms(
-        grid.origin, grid.dims, grid.cell, grid.starts, grid.xy, grid.order, lines, rot, px, py, gate, cauchy, idx, jac, res, w
-    )
-    if m < 0:
-        unsure = (idx == AMBIGUOUS).nonzero()[0]
-        dist, found = tree().query(rot[unsure] + pose[:2], k=1, distance_upper_bound=gate)
-        idx[unsure] = np.where(dist < gate, found, NONE)
-        m = terms(lines, rot, px, py, cauchy, idx, jac, res, w)
-    return jac[:m], res[:m], w[:m]
+
+    def __init__(self, n: int) -> None:
+        self.idx: IntArray = np.empty(n, dtype=np.int64)
+        self.jac: FloatArray = np.empty((n, 3))
+        self.res: FloatArray = np.empty(n)
+        self.w: FloatArray = np.empty(n)
+        self.wj: FloatArray = np.empty((n, 3))
+
+    def find(
+        self,
+        grid: Grid,
+        tree: Callable[[], Any],
+        lines: FloatArray,
+        rot: FloatArray,
+        pose: FloatArray,
+        gate: float,
+        cauchy: float,
+        inv_var: float,
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Jacobian rows, residuals, Cauchy weights and weighted rows of the points of ``rot`` moved by ``pose``.
+
+        The points kept are those ``tree().query(rot + pose[:2], k=1,
+        distance_upper_bound=gate)`` finds with ``dist < gate`` (``tree()``
+        gives the target's ``cKDTree``, asked only about ambiguous queries),
+        their correspondences the same, and the terms the same bit for bit.
+        """
+        px, py = float(pose[0]), float(pose[1])
+        idx, jac, res, w, wj = self.idx, self.jac, self.res, self.w, self.wj
+        m = linearise_terms(
+            grid.origin, grid.dims, grid.cell, grid.starts, grid.xy, grid.order, lines, rot, px, py, gate, cauchy,
+            inv_var, idx, jac, res, w, wj,
+        )  # fmt: skip
+        if m < 0:
+            unsure = (idx == AMBIGUOUS).nonzero()[0]
+            dist, found = tree().query(rot[unsure] + pose[:2], k=1, distance_upper_bound=gate)
+            idx[unsure] = np.where(dist < gate, found, NONE)
+            m = terms(lines, rot, px, py, cauchy, inv_var, idx, jac, res, w, wj)
+        return jac[:m], res[:m], w[:m], wj[:m]

@@ -27,7 +27,7 @@ import numpy as np
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
-from albot1.methods.baselines.gtsam_graph.nearest import Grid, correspondences
+from albot1.methods.baselines.gtsam_graph.nearest import Grid, Matches
 
 if TYPE_CHECKING:
     from scipy.spatial import cKDTree
@@ -201,11 +201,11 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
     converged = False
     settled = False
     iterations = 0
+    matches = Matches(len(src))
     for iterations in range(1, params.max_iterations + 1):  # noqa: B007 -- read after the loop (the count run)
-        jac, res, w = _linearise(target, src, pose, gate, params.cauchy_scale_m)
+        jac, res, _, wj = _linearise(target, src, pose, gate, params.cauchy_scale_m, inv_var, matches)
         if len(res) < params.min_points:
             break
-        wj = jac * (w * inv_var)[:, None]
         offset = pose - init
         offset[2] = math.remainder(offset[2], tau)
         try:
@@ -233,9 +233,9 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         gate = max(params.min_correspondence_m, gate * params.gate_decay)
 
     converged = converged or (settled and iterations == params.max_iterations)
-    jac, res, w = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m)
+    jac, res, _, wj = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches)
     inliers = int(len(res))
-    information = (jac * (w * inv_var)[:, None]).T @ jac if inliers else np.zeros((3, 3))
+    information = wj.T @ jac if inliers else np.zeros((3, 3))
     rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")
     return Registration(
         pose=pose,
@@ -249,11 +249,18 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
 
 
 def _linearise(
-    target: Target, src: FloatArray, pose: FloatArray, gate: float, cauchy_scale: float
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Jacobian rows, point-to-line residuals and Cauchy weights of the matches within ``gate``.
+    target: Target,
+    src: FloatArray,
+    pose: FloatArray,
+    gate: float,
+    cauchy_scale: float,
+    inv_var: float,
+    matches: Matches | None = None,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Jacobian rows, point-to-line residuals, Cauchy weights and weighted rows (``jac * w * inv_var``) within ``gate``.
 
-    Run once per ICP iteration. The correspondences are those of
+    Run once per ICP iteration (``matches``: the registration's buffers, see
+    :class:`.nearest.Matches`). The correspondences are those of
     ``target.tree.query(moved, k=1, distance_upper_bound=gate)`` kept where
     ``dist < gate``, found by a compiled grid search that leaves to the k-d
     tree each query where the two could differ, and the terms are computed
@@ -262,4 +269,5 @@ def _linearise(
     continued"): the same bits.
     """
     rot = rotate(src, pose[2])
-    return correspondences(target.grid, lambda: target.tree, target.lines, rot, pose, gate, cauchy_scale)
+    found = Matches(len(src)) if matches is None else matches
+    return found.find(target.grid, lambda: target.tree, target.lines, rot, pose, gate, cauchy_scale, inv_var)
