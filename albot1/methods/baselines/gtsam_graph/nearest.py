@@ -33,6 +33,7 @@ the same operations in the same order as the numpy formulation they replace
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -40,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
+from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import jitable, kernel
 
 #: ambiguous when two squared distances (or one and the gate squared) are this close, relative to the gate squared
@@ -327,3 +329,34 @@ class Matches:
             idx[unsure] = np.where(dist < gate, found, NONE)
             m = terms(lines, rot, px, py, cauchy, inv_var, idx, jac, res, w, wj)
         return jac[:m], res[:m], w[:m], wj[:m]
+
+
+def _sample() -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Target points and normals and source points whose match meets every case: matched, unmatched, ambiguous.
+
+    The first source point is equidistant from the first two target points
+    (an exact tie, left to the k-d tree), so :func:`terms` is called too.
+    """
+    points = np.array([[0.0, 0.0], [0.2, 0.0], [0.4, 0.0], [5.0, 5.0]])
+    normals = np.tile([0.0, 1.0], (len(points), 1))
+    source = np.array([[0.1, 0.05], [0.4, 0.01], [3.0, -3.0]])
+    return points, normals, source
+
+
+def warm_up(announce: Callable[[str], None] | None = None) -> None:
+    """Compile the kernels (or load them from numba's cache) before a run's first scan, with the run's argument types.
+
+    ``announce`` receives a line before and after a real compilation (none for
+    a cache load), as Albot1's warm-up does.
+    """
+    from scipy.spatial import cKDTree
+
+    cold = not all(compiled.is_cached(k) for k in (build_grid, linearise_terms, terms))
+    if cold and announce is not None:
+        announce(f"gtsam-graph: compiling its grid search once for this code version (cache: {compiled.CACHE_DIR})")
+    start = time.perf_counter()
+    points, normals, source = _sample()
+    lines = np.hstack([points, normals])
+    Matches(len(source)).find(Grid(points), lambda: cKDTree(points), lines, source @ np.eye(2), np.zeros(3), 1.0, 0.1, 1.0)
+    if cold and announce is not None:
+        announce(f"gtsam-graph: grid search compiled in {time.perf_counter() - start:.1f} s")
