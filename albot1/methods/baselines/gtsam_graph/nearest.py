@@ -143,7 +143,14 @@ def _scan_cells(
 
 @jitable
 def _nearest_one(
-    origin: FloatArray, dims: IntArray, cell: float, starts: IntArray, xy: FloatArray, qx: float, qy: float, gate2: float
+    origin: FloatArray,
+    dims: IntArray,
+    cell: float,
+    starts: IntArray,
+    xy: FloatArray,
+    qx: float,
+    qy: float,
+    gate2: float,
 ) -> tuple[int, bool]:
     """The cell-order index of the point nearest ``(qx, qy)`` within the gate (-1: none) and whether it is ambiguous."""
     nx, ny = dims[0], dims[1]
@@ -357,6 +364,8 @@ def warm_up(announce: Callable[[str], None] | None = None) -> None:
     start = time.perf_counter()
     points, normals, source = _sample()
     lines = np.hstack([points, normals])
-    Matches(len(source)).find(Grid(points), lambda: cKDTree(points), lines, source @ np.eye(2), np.zeros(3), 1.0, 0.1, 1.0)
+    Matches(len(source)).find(
+        Grid(points), lambda: cKDTree(points), lines, source @ np.eye(2), np.zeros(3), 1.0, 0.1, 1.0
+    )
     if cold and announce is not None:
         announce(f"gtsam-graph: grid search compiled in {time.perf_counter() - start:.1f} s")

@@ -233,7 +233,9 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         gate = max(params.min_correspondence_m, gate * params.gate_decay)
 
     converged = converged or (settled and iterations == params.max_iterations)
-    jac, res, _, wj = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches)
+    jac, res, _, wj = _linearise(
+        target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches
+    )
     inliers = int(len(res))
     information = wj.T @ jac if inliers else np.zeros((3, 3))
     rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")

@@ -1,4 +1,4 @@
-"""ICP's compiled grid search gives scipy's k-d tree answers, bit for bit: on ties, at the gate, far away, compiled or not."""
+"""ICP's compiled grid search gives the k-d tree's answers, bit for bit: ties, the gate, far away, compiled or not."""
 
 from __future__ import annotations
 
@@ -30,7 +30,13 @@ class CountingTree:
 
 
 def expected_terms(
-    points: np.ndarray, normals: np.ndarray, rot: np.ndarray, pose: np.ndarray, gate: float, cauchy: float, inv_var: float
+    points: np.ndarray,
+    normals: np.ndarray,
+    rot: np.ndarray,
+    pose: np.ndarray,
+    gate: float,
+    cauchy: float,
+    inv_var: float,
 ) -> tuple[np.ndarray, ...]:
     """The numpy formulation every recorded gtsam-graph result was computed with."""
     dist, idx = cKDTree(points).query(rot + pose[:2], k=1, distance_upper_bound=gate)
@@ -128,7 +134,13 @@ def test_compiled_and_as_written_kernels_give_the_same_bits() -> None:
     grid = Grid(points)
     outs = []
     for fn, fill in ((linearise_terms, terms), (as_written(linearise_terms), as_written(terms))):
-        idx, jac, res, w, wj = (np.zeros(40, dtype=np.int64), np.zeros((40, 3)), np.zeros(40), np.zeros(40), np.zeros((40, 3)))
+        idx, jac, res, w, wj = (
+            np.zeros(40, dtype=np.int64),
+            np.zeros((40, 3)),
+            np.zeros(40),
+            np.zeros(40),
+            np.zeros((40, 3)),
+        )
         args = (grid.origin, grid.dims, grid.cell, grid.starts, grid.xy, grid.order, lines, rot, 0.01, -0.02, 0.3, 0.1)
         m = fn(*args, 400.0, idx, jac, res, w, wj)
         assert m == -1  # the lattice has ties: the ambiguous ones are marked, no terms yet
