@@ -350,6 +350,11 @@ def _sample() -> tuple[FloatArray, FloatArray, FloatArray]:
     return points, normals, source
 
 
+def _cold(fn: Any) -> bool:
+    """Whether calling kernel ``fn`` compiles it: not compiled here nor in numba's cache (never when run as Python)."""
+    return hasattr(fn, "py_func") and not fn.signatures and not compiled.is_cached(fn)
+
+
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
     """Compile the kernels (or load them from numba's cache) before a run's first scan, with the run's argument types.
 
@@ -358,7 +363,7 @@ def warm_up(announce: Callable[[str], None] | None = None) -> None:
     """
     from scipy.spatial import cKDTree
 
-    cold = not all(compiled.is_cached(k) for k in (build_grid, linearise_terms, terms))
+    cold = any(_cold(k) for k in (build_grid, linearise_terms, terms))
     if cold and announce is not None:
         announce(f"gtsam-graph: compiling its grid search once for this code version (cache: {compiled.CACHE_DIR})")
     start = time.perf_counter()
