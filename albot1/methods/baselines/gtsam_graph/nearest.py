@@ -6,7 +6,7 @@ Why: half of gtsam-graph's CPU on the sparse corrected logs was
 search here must give the same correspondence as ``cKDTree.query(moved, k=1,
 distance_upper_bound=gate)`` followed by ``dist < gate``, bit for bit, and it
 does so by deferring: a point whose answer the k-d tree could give differently
-is marked and handed to the k-d tree itself (:func:`correspondences`).
+is marked and handed to the k-d tree itself (:meth:`Matches.find`).
 
 Where could they differ? The k-d tree returns the first point it meets among
 points at exactly the same squared distance (its traversal order), and its
@@ -25,7 +25,7 @@ margin, clearly inside or outside the gate, so both searches name it.
 The grid: the target's points sorted into square cells (counting sort), the
 query searched ring by ring of cells around its own until the next ring
 cannot hold a point within the bound. The terms of the linearisation
-(residual, Jacobian row, Cauchy weight) are computed in the same kernel with
+(residual, Jacobian row, Cauchy weight, weighted row) are computed in the same kernel with
 the same operations in the same order as the numpy formulation they replace
 (no fast-math, so no fused multiply-add), written into arrays numpy allocated.
 """

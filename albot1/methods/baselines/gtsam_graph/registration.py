@@ -1,6 +1,7 @@
 """2D scan registration: point-to-line ICP with an odometry prior.
 
-Pure maths (numpy + scipy's cKDTree), no I/O. A :class:`Target` is a point
+Pure maths (numpy, scipy's cKDTree and a compiled grid search that gives
+the tree's answers, :mod:`.nearest`), no I/O. A :class:`Target` is a point
 set with one line normal per point (:func:`line_normals`: the principal axes
 of its nearest neighbours); :func:`register` finds the SE(2) pose that maps source points
 onto the target's local lines, Gauss-Newton with Cauchy weights, starting
@@ -114,9 +115,9 @@ def line_normals(
 class Target:
     """Points with line normals (from :func:`line_normals`), indexed for matching.
 
-    Two indexes, each built on first use: the compiled grid ICP's
-    correspondences search (:mod:`.nearest`), and scipy's k-d tree, which
-    answers the grid's ambiguous queries and every other caller.
+    Two indexes, each built on first use: the grid of ICP's compiled
+    correspondence search (:mod:`.nearest`), and scipy's k-d tree, which
+    answers that search's ambiguous queries and every other caller.
     """
 
     def __init__(self, points: FloatArray, normals: FloatArray) -> None:
