@@ -36,6 +36,7 @@ map projection). They share one set of counters.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
@@ -47,6 +48,7 @@ from albot1.data.model import Frame
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
+from albot1.methods.baselines.gtsam_graph import nearest
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.errors import GraphError, RegistrationError
@@ -91,6 +93,10 @@ class GtsamGraphMapper:
         self.front = FrontEnd(config, self.back, self.counters)
         self.loops = LoopCloser(config, self.back, self.counters)
         self.places = PlaceRecognition(config, self.back, self.loops, self.counters)
+
+    def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
+        """Compile ICP's grid search (or load numba's cache) before the runner's timed loop (``Mapper.warm_up``)."""
+        nearest.warm_up(announce)
 
     # ------------------------------------------------------------------ input
     def process(self, frame: Frame) -> None:

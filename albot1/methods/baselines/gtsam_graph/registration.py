@@ -1,6 +1,7 @@
 """2D scan registration: point-to-line ICP with an odometry prior.
 
-Pure maths (numpy + scipy's cKDTree), no I/O. A :class:`Target` is a point
+Pure maths (numpy, scipy's cKDTree and a compiled grid search that gives
+the tree's answers, :mod:`.nearest`), no I/O. A :class:`Target` is a point
 set with one line normal per point (:func:`line_normals`: the principal axes
 of its nearest neighbours); :func:`register` finds the SE(2) pose that maps source points
 onto the target's local lines, Gauss-Newton with Cauchy weights, starting
@@ -18,13 +19,19 @@ the returned information matrix says how much the match actually knows.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
+from albot1.methods.baselines.gtsam_graph.nearest import Grid, Matches
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 
 @dataclass(frozen=True)
@@ -106,11 +113,14 @@ def line_normals(
 
 
 class Target:
-    """Points with line normals (from :func:`line_normals`), indexed by a k-d tree for matching."""
+    """Points with line normals (from :func:`line_normals`), indexed for matching.
+
+    Two indexes, each built on first use: the grid of ICP's compiled
+    correspondence search (:mod:`.nearest`), and scipy's k-d tree, which
+    answers that search's ambiguous queries and every other caller.
+    """
 
     def __init__(self, points: FloatArray, normals: FloatArray) -> None:
-        from scipy.spatial import cKDTree
-
         self.points: FloatArray = np.asarray(points, dtype=float).reshape(-1, 2)
         self.normals: FloatArray = np.asarray(normals, dtype=float).reshape(-1, 2)
         if self.points.shape != self.normals.shape:
@@ -119,9 +129,20 @@ class Target:
             )
         if not (np.isfinite(self.points).all() and np.isfinite(self.normals).all()):
             raise RegistrationError("target points and normals must be finite")
-        self.tree = cKDTree(self.points) if len(self.points) else None
         # Each point beside its normal: one gather per ICP iteration fetches both (:func:`_linearise`).
         self.lines: FloatArray = np.hstack([self.points, self.normals])
+
+    @functools.cached_property
+    def tree(self) -> cKDTree | None:
+        """scipy's k-d tree of the points (None when there are none)."""
+        from scipy.spatial import cKDTree
+
+        return cKDTree(self.points) if len(self.points) else None
+
+    @functools.cached_property
+    def grid(self) -> Grid:
+        """The points in grid cells, for ICP's correspondences (:mod:`.nearest`); needs at least one point."""
+        return Grid(self.points)
 
     @classmethod
     def from_points(
@@ -167,7 +188,7 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         raise RegistrationError(f"initial guess must be finite, got {init.tolist()}")
     if not np.isfinite(src).all():
         raise RegistrationError(f"source points must be finite; {int((~np.isfinite(src)).any(axis=1).sum())} are not")
-    if len(src) < params.min_points or len(target) < params.min_points or target.tree is None:
+    if len(src) < params.min_points or len(target) < params.min_points or len(target) == 0:
         raise RegistrationError(
             f"need at least {params.min_points} source points and line-like target points, "
             f"got {len(src)} source and {len(target)} target"
@@ -181,11 +202,11 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
     converged = False
     settled = False
     iterations = 0
+    matches = Matches(len(src))
     for iterations in range(1, params.max_iterations + 1):  # noqa: B007 -- read after the loop (the count run)
-        jac, res, w = _linearise(target, src, pose, gate, params.cauchy_scale_m)
+        jac, res, _, wj = _linearise(target, src, pose, gate, params.cauchy_scale_m, inv_var, matches)
         if len(res) < params.min_points:
             break
-        wj = jac * (w * inv_var)[:, None]
         offset = pose - init
         offset[2] = math.remainder(offset[2], tau)
         try:
@@ -213,9 +234,11 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         gate = max(params.min_correspondence_m, gate * params.gate_decay)
 
     converged = converged or (settled and iterations == params.max_iterations)
-    jac, res, w = _linearise(target, src, pose, params.min_correspondence_m, params.cauchy_scale_m)
+    jac, res, _, wj = _linearise(
+        target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches
+    )
     inliers = int(len(res))
-    information = (jac * (w * inv_var)[:, None]).T @ jac if inliers else np.zeros((3, 3))
+    information = wj.T @ jac if inliers else np.zeros((3, 3))
     rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")
     return Registration(
         pose=pose,
@@ -229,33 +252,25 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
 
 
 def _linearise(
-    target: Target, src: FloatArray, pose: FloatArray, gate: float, cauchy_scale: float
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Jacobian rows, point-to-line residuals and Cauchy weights of the matches within ``gate``.
+    target: Target,
+    src: FloatArray,
+    pose: FloatArray,
+    gate: float,
+    cauchy_scale: float,
+    inv_var: float,
+    matches: Matches | None = None,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Jacobian rows, point-to-line residuals, Cauchy weights and weighted rows (``jac * w * inv_var``) within ``gate``.
 
-    Run once per ICP iteration, with few numpy calls: one gather of points
-    and normals together, the moved points computed once, and no selection
-    when every point found a neighbour within the gate. The arithmetic is
-    the same elementwise operations in the same order as before, so the
-    bits are too (the sha256 fingerprints of the method's poses and maps).
-    The saving is small (replaying intel's registrations: within the noise);
-    the k-d tree query is most of an iteration (docs/baselines.md, "Cost").
+    Run once per ICP iteration (``matches``: the registration's buffers, see
+    :class:`.nearest.Matches`). The correspondences are those of
+    ``target.tree.query(moved, k=1, distance_upper_bound=gate)`` kept where
+    ``dist < gate``, found by a compiled grid search that leaves to the k-d
+    tree each query where the two could differ, and the terms are computed
+    with the same operations in the same order as the numpy formulation every
+    recorded result came from (:mod:`.nearest`; docs/baselines.md, "Cost,
+    continued"): the same bits.
     """
     rot = rotate(src, pose[2])
-    moved = rot + pose[:2]
-    assert target.tree is not None  # register() raises before linearising against an empty target
-    dist, idx = target.tree.query(moved, k=1, distance_upper_bound=gate)
-    ok = dist < gate
-    if not ok.all():
-        keep = ok.nonzero()[0]
-        rot, moved, idx = rot[keep], moved[keep], idx[keep]
-    lines = target.lines[idx]
-    n = lines[:, 2:]
-    diff = moved - lines[:, :2]
-    res = n[:, 0] * diff[:, 0] + n[:, 1] * diff[:, 1]
-    # d(R p + t)/d theta = (-(R p)_y, (R p)_x).
-    jac = np.empty((len(res), 3))
-    jac[:, :2] = n
-    jac[:, 2] = n[:, 1] * rot[:, 0] - n[:, 0] * rot[:, 1]
-    w = 1.0 / (1.0 + (res / cauchy_scale) ** 2)
-    return jac, res, w
+    found = Matches(len(src)) if matches is None else matches
+    return found.find(target.grid, lambda: target.tree, target.lines, rot, pose, gate, cauchy_scale, inv_var)

@@ -147,14 +147,14 @@ def test_try_register_is_none_below_the_minimum_points_and_register_otherwise() 
 
 @pytest.mark.parametrize("gate", [5.0, 0.05])
 def test_linearisation_has_the_bits_of_the_per_array_formulation(gate: float) -> None:
-    """One gather of points and normals, moved points once: the same Jacobian, residuals and weights, bit for bit.
+    """The compiled correspondences and terms: the Jacobian, residuals, weights and weighted rows of numpy, bit for bit.
 
     A wide gate keeps every point (no selection), a narrow one drops some (the selection path).
     """
     target = Target.from_points(scan_points(np.array([2.0, 1.5, 0.3])))
     src = scan_points(np.array([2.6, 1.9, 0.5]))
     pose = se2.between(np.array([2.0, 1.5, 0.3]), np.array([2.6, 1.9, 0.5])) + np.array([0.03, -0.02, 0.01])
-    jac, res, w = _linearise(target, src, pose, gate, 0.1)
+    jac, res, w, wj = _linearise(target, src, pose, gate, 0.1, 400.0)
     # The formulation every recorded result was computed with: separate gathers, the sum formed twice.
     rot = rotate(src, pose[2])
     assert target.tree is not None
@@ -173,3 +173,4 @@ def test_linearisation_has_the_bits_of_the_per_array_formulation(gate: float) ->
     assert jac.tobytes() == expected_jac.tobytes()
     assert res.tobytes() == expected_res.tobytes()
     assert w.tobytes() == expected_w.tobytes()
+    assert wj.tobytes() == (expected_jac * (expected_w * 400.0)[:, None]).tobytes()
