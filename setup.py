@@ -35,13 +35,13 @@ KERNELS_ENV = "ALBOT1_BUILD_KERNELS"  # 0: build the wheel without its compiled 
 BUILD_KERNELS = """
 import sys
 from pathlib import Path
-from albot1.methods.albot1.kernel_bundle_build import build
+from albot1.methods.kernel_sources import build
 print(f"kernel bundle: {build(Path(sys.argv[1]))} numba cache files in {sys.argv[1]}")
 """
 
 
 def bundle_kernels(build_lib: Path) -> None:
-    """Compile Albot1's numba kernels into the wheel (``albot1.methods.albot1.kernel_bundle_build``), or say why not.
+    """Compile the numba kernels into the wheel (``albot1.methods.kernel_sources``: Albot1's, gtsam-graph's), or say why not.
 
     Numba compiles them from the build tree's sources into an empty cache;
     its files go into ``albot1/_bundled/kernels/``, and the first run after

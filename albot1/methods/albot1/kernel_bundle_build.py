@@ -1,7 +1,9 @@
 """Build the kernel bundle of a wheel: :func:`build`, called by ``setup.py``'s build step.
 
 Compiles every kernel of Albot1 and of its places layer on its warm-up
-samples (the argument types the mappers call them with) and copies numba's
+samples (the argument types the mappers call them with), and those of the
+other kernel sources it is given (another method's warm-up and samples,
+listed by :mod:`albot1.methods.kernel_sources`, which names them all), and copies numba's
 cache files of each kernel into ``DEST`` (:mod:`.kernel_bundle` explains
 what is checked where they are used). The build step runs it in a process
 whose user cache folder is empty, so that what is copied is what this build
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -41,15 +44,39 @@ def _kernel_files(name: str, kernel: Any) -> list[Path]:
     return [index, *data]
 
 
-def build(dest: Path) -> int:
+#: ``(kernel name, kernel, sample arguments)``, as :func:`warm_up.sample_calls` gives them
+Call = tuple[str, Callable[..., Any], tuple[Any, ...]]
+#: another method's kernels: its warm-up (compiles them, or loads them) and its sample calls (names them)
+KernelSource = tuple[Callable[[], None], Callable[[], Iterable[Call]]]
+
+
+def albot1_kernel_sets() -> tuple[object, ...]:
+    """Every kernel set of Albot1 and its places layer: the kernels of the bundle besides ``others``."""
+    return (PerceptionKernels(), MappingKernels(), PlacesKernels())
+
+
+def albot1_calls() -> list[Call]:
+    """The sample calls of :func:`albot1_kernel_sets`."""
+    return list(warm_up.sample_calls(*albot1_kernel_sets()))
+
+
+def build(dest: Path, others: Iterable[KernelSource]) -> int:
     """Compile every kernel (or load this code version's cache) and copy numba's files to ``dest``: file count.
 
+    ``others``: the kernels of other methods, besides Albot1's kernel sets.
     Raises :class:`KernelBundleError` naming the first kernel whose files are
     missing, so that a build never ships a bundle that lacks a kernel.
     """
-    kernel_sets = (PerceptionKernels(), MappingKernels(), PlacesKernels())
+    kernel_sets = albot1_kernel_sets()
     warm_up.warm_up(kernel_sets)
-    kernels = {name: kernel for name, kernel, _ in warm_up.sample_calls(*kernel_sets)}
+    calls = list(warm_up.sample_calls(*kernel_sets))
+    for warm, sample_calls in others:
+        warm()
+        calls += sample_calls()
+    kernels: dict[str, Any] = {}
+    for name, kernel, _ in calls:
+        if kernels.setdefault(name, kernel) is not kernel:
+            raise KernelBundleError(f"kernel bundle: two kernels are named {name}")
     if dest.exists():
         shutil.rmtree(dest)
     files: dict[str, str] = {}

@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1 import compiled
+from albot1.methods.albot1 import compiled, kernel_bundle
 from albot1.methods.albot1.compiled import jitable, kernel
 
 #: ambiguous when two squared distances (or one and the gate squared) are this close, relative to the gate squared
@@ -355,15 +355,50 @@ def _cold(fn: Any) -> bool:
     return hasattr(fn, "py_func") and not fn.signatures and not compiled.is_cached(fn)
 
 
+def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
+    """``(kernel name, kernel, arguments)`` of each kernel, typed as :meth:`Matches.find` calls them on :func:`_sample`.
+
+    What the wheel's kernel bundle is built from and checked against
+    (``albot1.methods.kernel_sources``, :mod:`albot1.methods.albot1.kernel_bundle`):
+    numba keys a cached kernel by its argument types, so these must be the
+    types of a run's calls (a test checks that the warm-up then compiles
+    nothing). The grid is built by :func:`build_grid` as written, so making
+    the samples compiles nothing.
+    """
+    points, normals, source = _sample()
+    pts = np.ascontiguousarray(points, dtype=np.float64)
+    origin, dims, cell, starts, order = compiled.as_written(build_grid)(pts, CELL_M, MAX_CELLS_PER_POINT)
+    xy = np.ascontiguousarray(pts[order])
+    lines, rot = np.hstack([points, normals]), source @ np.eye(2)
+    n = len(source)
+    idx = np.zeros(n, dtype=np.int64)  # every point matched to the first target point: terms has rows to write
+    buffers = (np.empty((n, 3)), np.empty(n), np.empty(n), np.empty((n, 3)))
+    return [
+        ("gtsam_graph.build_grid", build_grid, (pts, CELL_M, MAX_CELLS_PER_POINT)),
+        (
+            "gtsam_graph.linearise_terms",
+            linearise_terms,
+            (origin, dims, float(cell), starts, xy, order, lines, rot, 0.0, 0.0, 1.0, 0.1, 1.0, idx.copy(), *buffers),
+        ),
+        ("gtsam_graph.terms", terms, (lines, rot, 0.0, 0.0, 0.1, 1.0, idx, *buffers)),
+    ]
+
+
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
     """Compile the kernels (or load them from numba's cache) before a run's first scan, with the run's argument types.
 
-    ``announce`` receives a line before and after a real compilation (none for
-    a cache load), as Albot1's warm-up does.
+    Cold kernels are first sought in the wheel's kernel bundle, by Albot1's
+    own loader with its checks (:func:`kernel_bundle.seed`; nothing happens
+    outside a wheel or where the bundle does not fit). ``announce`` receives a
+    line before and after a real compilation (none for a cache load), as
+    Albot1's warm-up does.
     """
     from scipy.spatial import cKDTree
 
-    cold = any(_cold(k) for k in (build_grid, linearise_terms, terms))
+    kernels = (build_grid, linearise_terms, terms)
+    if any(_cold(k) for k in kernels):
+        kernel_bundle.seed(sample_calls(), _cold)
+    cold = any(_cold(k) for k in kernels)
     if cold and announce is not None:
         announce(f"gtsam-graph: compiling its grid search once for this code version (cache: {compiled.CACHE_DIR})")
     start = time.perf_counter()
