@@ -41,7 +41,7 @@ print(f"kernel bundle: {build(Path(sys.argv[1]))} numba cache files in {sys.argv
 
 
 def bundle_kernels(build_lib: Path) -> None:
-    """Compile the numba kernels into the wheel (``albot1.methods.kernel_sources``: Albot1's, gtsam-graph's), or say why not.
+    """Compile the numba kernels into the wheel (``albot1.methods.kernel_sources``: Albot1's, gtsam-graph's), or not.
 
     Numba compiles them from the build tree's sources into an empty cache;
     its files go into ``albot1/_bundled/kernels/``, and the first run after

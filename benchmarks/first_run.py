@@ -37,7 +37,8 @@ were bundled) and alternates the two, pair by pair::
 
 Presets: ``albot1`` presets on ``synthetic-office-loop``, and ``places``
 (``albot1-places`` default on ``synthetic-places-loop``), the commands of
-``docs/albot1-mapper.md``, "Compile time". Wall seconds are only meaningful
+``docs/albot1-mapper.md``, "Compile time", and ``gtsam-graph`` (its default
+on ``synthetic-office-loop``; its grid search's kernels). Wall seconds are only meaningful
 on an idle machine (the load average is printed with every pair); the CPU
 seconds are inflated less by a loaded one.
 """
@@ -85,9 +86,11 @@ class Install:
 
 
 def command(install: Install, preset: str, out: Path) -> list[str]:
-    """The `albot1 run` arguments of ``preset`` (``places``: the places layer's default)."""
+    """The `albot1 run` arguments of ``preset`` (``places``: the places layer's default; ``gtsam-graph``: its default)."""
     if preset == "places":
         run = ["albot1-places", "synthetic-places-loop"]
+    elif preset == "gtsam-graph":
+        run = ["gtsam-graph", "synthetic-office-loop"]
     else:
         run = ["albot1", "synthetic-office-loop", "--preset", preset]
     return [install.python, "-c", ENTRY, "run", *run, "--out", str(out)]
@@ -184,7 +187,7 @@ def pair(source: Install, preset: str, mpl: Path, install_warm_up: bool = False)
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--presets", nargs="+", default=["thesis", "plus"], help="albot1 presets, or places")
+    parser.add_argument("--presets", nargs="+", default=["thesis", "plus"], help="albot1 presets, places, gtsam-graph")
     parser.add_argument("--trees", nargs="+", type=Path, default=[Path.cwd()], help="source trees to alternate")
     parser.add_argument("--rounds", type=int, default=1)
     parser.add_argument(
