@@ -70,15 +70,14 @@ def test_installed_package_uses_the_bundle(tmp_path: Path, monkeypatch: pytest.M
 def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
     """setup.py's build_py copies the top-level folders into the package tree of the build, and the kernels.
 
-    The kernels (Albot1's numba kernels compiled for the wheel,
+    The kernels (the numba kernels compiled for the wheel,
     ``albot1/methods/albot1/kernel_bundle.py``): a bundle this process would
     read (same code version, numba, Python and CPU target) with an index for
-    every kernel a warm-up calls.
+    every kernel a warm-up calls, Albot1's and gtsam-graph's
+    (``albot1/methods/kernel_sources.py``).
     """
-    from albot1.methods.albot1 import kernel_bundle, warm_up
-    from albot1.methods.albot1.mapping.kernel_set import MappingKernels
-    from albot1.methods.albot1.perception.kernels import PerceptionKernels
-    from albot1.methods.albot1.places.kernels import PlacesKernels
+    from albot1.methods import kernel_sources
+    from albot1.methods.albot1 import kernel_bundle
 
     build = tmp_path / "build"
     subprocess.run(
@@ -99,8 +98,12 @@ def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
     manifest = kernel_bundle.read_manifest(kernels)
     assert manifest is not None, (kernels / kernel_bundle.MANIFEST).read_text() if kernels.is_dir() else "no bundle"
     indexes = {Path(name).name for name in manifest["files"] if name.endswith(".nbi")}
-    for name, kernel, _ in warm_up.sample_calls(PerceptionKernels(), MappingKernels(), PlacesKernels()):
-        assert f"{kernel._cache._impl.filename_base}.nbi" in indexes, name
+    calls = kernel_sources.calls()
+    assert {name for name, _, _ in calls} >= {"gtsam_graph.build_grid", "gtsam_graph.linearise_terms", "update_surfaces"}
+    for name, kernel, _ in calls:
+        folder = kernel_bundle.bundle_folder(kernel)
+        assert f"{folder}/{kernel._cache._impl.filename_base}.nbi" in manifest["files"], name
+    assert len(indexes) == len({kernel for _, kernel, _ in calls})  # nothing else
 
 
 def test_the_code_version_ignores_the_bundle(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -144,15 +144,17 @@ def _copy(source: Path, target: Path) -> None:
 def seed(
     calls: Iterable[tuple[str, Callable[..., Any], tuple[Any, ...]]],
     is_cold: Callable[[Callable[..., Any]], bool],
-    bundle: Path = BUNDLE_DIR,
+    bundle: Path | None = None,
 ) -> list[str]:
     """Hand numba's cache the bundled files of every cold kernel of ``calls`` that numba will accept: their names.
 
     ``calls``: ``(kernel name, kernel, sample arguments)`` as a warm-up
-    makes them; ``is_cold``: whether a kernel still has to be compiled. A
+    makes them; ``is_cold``: whether a kernel still has to be compiled;
+    ``bundle``: :data:`BUNDLE_DIR` unless given (read when called). A
     kernel is left alone (and so compiled by the warm-up) when anything
     does not match; see the module docstring.
     """
+    bundle = BUNDLE_DIR if bundle is None else bundle
     try:
         manifest = read_manifest(bundle)
     except Exception:  # noqa: BLE001 -- whatever this platform or numba lacks: the kernels are compiled as before

@@ -1,6 +1,7 @@
 """The kernels a wheel ships (``kernel_bundle``): loaded without a compile where numba accepts them, else left cold.
 
-The bundle is built here from this session's cache (``kernel_bundle_build.build``,
+Every bundled kernel: Albot1's kernel sets and gtsam-graph's grid search
+(``albot1.methods.kernel_sources``). The bundle is built here from this session's cache (``kernel_sources.build``,
 a cache load when the kernels are warm), then handed to an empty cache: in a
 fresh process every kernel must be seeded and loaded with no compile (numba's
 own cache statistics), and each thing numba would reject (a damaged file,
@@ -37,43 +38,54 @@ def _bundle_module() -> ModuleType:
 _SEED_AND_LOAD = """
 import json, sys
 from pathlib import Path
+from albot1.methods import kernel_sources
 from albot1.methods.albot1 import kernel_bundle, warm_up
-from albot1.methods.albot1.mapping.kernel_set import MappingKernels
-from albot1.methods.albot1.perception.kernels import PerceptionKernels
-from albot1.methods.albot1.places.kernels import PlacesKernels
+from albot1.methods.baselines.gtsam_graph import nearest
 
-calls = list(warm_up.sample_calls(PerceptionKernels(), MappingKernels(), PlacesKernels()))
+calls = kernel_sources.calls()
 seeded = kernel_bundle.seed(calls, warm_up._cold, bundle=Path(sys.argv[1]))
 for _, kernel, args in calls:
     kernel(*args)
+nearest.warm_up(print)  # a run's own calls: nothing more to compile (nothing printed)
 compiled = sorted({name for name, kernel, _ in calls if kernel.stats.cache_misses})
 print(json.dumps({"seeded": sorted(seeded), "compiled": compiled}))
+"""
+
+#: gtsam-graph's warm-up alone, as its first run after a wheel install makes it (the bundle where the wheel's is)
+_GTSAM_WARM_UP = """
+import json, sys
+from pathlib import Path
+from albot1.methods.albot1 import kernel_bundle
+from albot1.methods.baselines.gtsam_graph import nearest
+
+kernel_bundle.BUNDLE_DIR = Path(sys.argv[1])
+lines = []
+nearest.warm_up(lines.append)
+compiled = sorted(name for name, kernel, _ in nearest.sample_calls() if kernel.stats.cache_misses)
+print(json.dumps({"announced": lines, "compiled": compiled}))
 """
 
 
 @pytest.fixture(scope="module")
 def bundle(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from albot1.methods.albot1 import kernel_bundle_build
+    from albot1.methods import kernel_sources
 
     dest = tmp_path_factory.mktemp("bundle") / "kernels"
-    assert kernel_bundle_build.build(dest) > 0
+    assert kernel_sources.build(dest) > 0
     return dest
 
 
 def _calls() -> list[tuple[str, Any, tuple[Any, ...]]]:
-    from albot1.methods.albot1 import warm_up
-    from albot1.methods.albot1.mapping.kernel_set import MappingKernels
-    from albot1.methods.albot1.perception.kernels import PerceptionKernels
-    from albot1.methods.albot1.places.kernels import PlacesKernels
+    from albot1.methods import kernel_sources
 
-    return list(warm_up.sample_calls(PerceptionKernels(), MappingKernels(), PlacesKernels()))
+    return kernel_sources.calls()
 
 
-def _fresh_process(bundle: Path, cache: Path) -> dict[str, list[str]]:
+def _fresh_process(bundle: Path, cache: Path, script: str = _SEED_AND_LOAD) -> dict[str, list[str]]:
     env = {**os.environ, "XDG_CACHE_HOME": str(cache)}
     env.pop(CPU_NAME_ENV, None)
     out = subprocess.run(
-        [sys.executable, "-c", _SEED_AND_LOAD, str(bundle)], env=env, capture_output=True, text=True, timeout=600
+        [sys.executable, "-c", script, str(bundle)], env=env, capture_output=True, text=True, timeout=600
     )
     assert out.returncode == 0, out.stderr
     result: dict[str, list[str]] = json.loads(out.stdout)
@@ -113,10 +125,21 @@ def _always_cold(kernel: object) -> bool:
 @pytest.mark.slow
 def test_a_fresh_cache_loads_every_bundled_kernel_without_compiling(bundle: Path, tmp_path: Path) -> None:
     names = sorted({name for name, _, _ in _calls()})
+    assert {"gtsam_graph.build_grid", "gtsam_graph.linearise_terms", "gtsam_graph.terms"} <= set(names)
     first = _fresh_process(bundle, tmp_path / "cache")
     assert first == {"seeded": names, "compiled": []}
     again = _fresh_process(bundle, tmp_path / "cache")  # numba's own files now: nothing seeded, nothing compiled
     assert again == {"seeded": [], "compiled": []}
+
+
+@pytest.mark.slow
+def test_gtsam_graph_s_warm_up_loads_its_kernels_from_the_bundle(bundle: Path, tmp_path: Path) -> None:
+    """Its first run after a wheel install: no compile, nothing announced; without a bundle it compiles, as before."""
+    loaded = _fresh_process(bundle, tmp_path / "cache", _GTSAM_WARM_UP)
+    assert loaded == {"announced": [], "compiled": []}
+    compiled = _fresh_process(tmp_path / "no-bundle", tmp_path / "cache-2", _GTSAM_WARM_UP)
+    assert compiled["compiled"] == ["gtsam_graph.build_grid", "gtsam_graph.linearise_terms", "gtsam_graph.terms"]
+    assert compiled["announced"][0].startswith("gtsam-graph: compiling its grid search")
 
 
 def test_every_kernel_of_the_bundle_is_seeded_where_nothing_is_cached(bundle: Path, tmp_path: Path) -> None:
@@ -183,6 +206,53 @@ def test_seeded_files_numba_cannot_load_are_taken_back(bundle: Path, tmp_path: P
     seeded = _bundle_module().seed(_elsewhere(tmp_path, failing="match_structure"), _always_cold, bundle)
     assert "match_structure" not in seeded and "same_any" in seeded
     assert list((tmp_path / "match_structure").iterdir()) == []  # compiled by the warm-up, as without a bundle
+
+
+def test_a_damaged_gtsam_graph_kernel_is_left_to_be_compiled(bundle: Path, tmp_path: Path) -> None:
+    """The same checks for gtsam-graph's kernels: a file that is not what the manifest says is not seeded."""
+    copy = tmp_path / "bundle"
+    shutil.copytree(bundle, copy)
+    data = sorted(copy.rglob("nearest.linearise_terms-*.nbc"))
+    assert data
+    data[0].write_bytes(data[0].read_bytes()[:-1])
+    seeded = _bundle_module().seed(_elsewhere(tmp_path / "cache"), _always_cold, copy)
+    assert "gtsam_graph.linearise_terms" not in seeded
+    assert {"gtsam_graph.build_grid", "gtsam_graph.terms", "build_view"} <= set(seeded)
+    assert not (tmp_path / "cache" / "gtsam_graph.linearise_terms").exists()
+
+
+def test_the_build_refuses_a_missing_gtsam_graph_kernel(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Its kernels go through the build's one check: a kernel numba left no files for fails the build, named."""
+    from albot1.methods import kernel_sources
+    from albot1.methods.albot1 import kernel_bundle_build
+
+    missing = _fake_kernel(tmp_path / "nowhere")
+    missing.py_func = kernel_sources.nearest.build_grid.py_func
+    others = [(lambda: None, lambda: [("gtsam_graph.build_grid", missing, ())])]
+    monkeypatch.setattr(kernel_bundle_build, "albot1_kernel_sets", lambda: ())
+    with pytest.raises(kernel_bundle_build.KernelBundleError, match=r"^kernel bundle: gtsam_graph.build_grid was"):
+        kernel_bundle_build.build(tmp_path / "dest", others)
+    assert not (tmp_path / "dest").exists()
+
+
+def test_the_build_refuses_two_kernels_of_one_name(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from albot1.methods.albot1 import kernel_bundle_build
+
+    others = [(lambda: None, lambda: [("k", _fake_kernel(tmp_path), ()), ("k", _fake_kernel(tmp_path), ())])]
+    monkeypatch.setattr(kernel_bundle_build, "albot1_kernel_sets", lambda: ())
+    with pytest.raises(kernel_bundle_build.KernelBundleError, match=r"^kernel bundle: two kernels are named k$"):
+        kernel_bundle_build.build(tmp_path / "dest", others)
+
+
+def test_the_gtsam_graph_kernels_are_bundled_without_gtsam(tmp_path: Path) -> None:
+    """The build imports gtsam-graph's grid search, which needs no GTSAM: a build environment without it works."""
+    code = (
+        "import sys\nsys.modules['gtsam'] = None\n"  # import gtsam now raises ImportError
+        "from albot1.methods import kernel_sources\n"
+        "print(sorted(name for name, _, _ in kernel_sources.calls() if name.startswith('gtsam_graph.')))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=True)
+    assert out.stdout.strip() == "['gtsam_graph.build_grid', 'gtsam_graph.linearise_terms', 'gtsam_graph.terms']"
 
 
 def test_a_kernel_already_cached_is_not_seeded(bundle: Path, tmp_path: Path) -> None:
