@@ -86,7 +86,7 @@ class Install:
 
 
 def command(install: Install, preset: str, out: Path) -> list[str]:
-    """The `albot1 run` arguments of ``preset`` (``places``: the places layer's default; ``gtsam-graph``: its default)."""
+    """The `albot1 run` arguments of ``preset`` (``places``, ``gtsam-graph``: that method's default)."""
     if preset == "places":
         run = ["albot1-places", "synthetic-places-loop"]
     elif preset == "gtsam-graph":

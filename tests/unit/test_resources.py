@@ -99,7 +99,7 @@ def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
     assert manifest is not None, (kernels / kernel_bundle.MANIFEST).read_text() if kernels.is_dir() else "no bundle"
     indexes = {Path(name).name for name in manifest["files"] if name.endswith(".nbi")}
     calls = kernel_sources.calls()
-    assert {name for name, _, _ in calls} >= {"gtsam_graph.build_grid", "gtsam_graph.linearise_terms", "update_surfaces"}
+    assert {name for name, _, _ in calls} >= {"gtsam_graph.build_grid", "gtsam_graph.terms", "update_surfaces"}
     for name, kernel, _ in calls:
         folder = kernel_bundle.bundle_folder(kernel)
         assert f"{folder}/{kernel._cache._impl.filename_base}.nbi" in manifest["files"], name
