@@ -88,6 +88,13 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         ],
         "screen_directions": [(0.1, 0.2, 0.05, np.diag([1e4, 2.0, 1e3]), 0.0, 0.0, 0.0, 0.4, 400.0)],
         "scan_points": [(compiled.readonly_float64(scan_ranges), compiled.readonly_float64(scan_angles), 30.0, 2)],
+        "perceive": [
+            (compiled.readonly_float64(scan_ranges), compiled.readonly_float64(scan_angles), 30.0, 0.6, 0.2, 0.1, 0.1)
+            + (math.radians(30.0), 0.0, 0.1, 0.0, 0.0, False, 0.4, 30.0, 2)
+        ],
+        "refine_and_score": [
+            (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
+        ],
         "detect_exits": [(seg, kinds, 0.6, 1.2, 0.5, 6.0, True)],
         "seen_through": [(seg, ids, np.ones(2, dtype=np.bool_), 0.5, 0.0, poly)],
         "near_exit": [(seg, ids, ids, 1, 10, 1, 0.5, 0.0, 0.5)],

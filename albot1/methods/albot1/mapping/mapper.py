@@ -29,19 +29,19 @@ from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
-from albot1.methods.albot1.compiled import readonly_float64
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.step_kernels import perceive_scan
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
 from albot1.methods.albot1.perception.kernels import PerceptionKernels
-from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
+from albot1.methods.albot1.perception.landmarks import Landmarks
 from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise
-from albot1.methods.albot1.perception.view import View, construct_view
+from albot1.methods.albot1.perception.view import View
 from albot1.methods.albot1.warm_up import together, warm_up
 
 
@@ -135,6 +135,12 @@ class Albot1Mapper:
             else None
         )
         self._points = np.empty((0, 2))
+        #: :func:`perceive_scan`'s landmark length and Albot1+'s point range and stride (stride 0: no points)
+        self._perceive_args = (
+            config.landmark_min_length_m,
+            config.max_range_m,
+            config.scan_beam_stride if self._plus is not None and config.scan_refinement else 0,
+        )
         self._odometry: Pose = (0.0, 0.0, 0.0)
         self._update_odometry: Pose = (0.0, 0.0, 0.0)
         #: Called after every map update (chapter 4's places observe the map through it); None: nobody listens.
@@ -190,19 +196,16 @@ class Albot1Mapper:
     def process(self, frame: Frame) -> None:
         n = self._n
         scan = frame.scan
-        try:
-            view = construct_view(scan.ranges, scan.angles, self._view_params, self._pk)
+        try:  # the view, its landmarks and Albot1+'s points in one kernel call (issue 24: .step_kernels)
+            view, lms, self._points = perceive_scan(
+                scan.ranges, scan.angles, self._view_params, *self._perceive_args, self._mk.perceive
+            )
         except (ValueError, TypeError) as exc:
             raise MappingError(f"scan {frame.index}: cannot build a view: {exc}") from exc
-        lms = find_landmarks(view, self.config.landmark_min_length_m, self._pk)
         odo = (float(frame.odometry[0]), float(frame.odometry[1]), float(frame.odometry[2]))
         if not all(map(math.isfinite, odo)):
             raise MappingError(f"scan {frame.index}: odometry {odo} is not finite")
         self._odometry = odo
-        if self._plus is not None:
-            self._points = self._plus.scan_points(
-                readonly_float64(scan.ranges), readonly_float64(scan.angles)
-            )  # one kernel signature
         c = self._counts
         c.views += 1
         if len(view) == 0:

@@ -66,7 +66,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, between_pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
+from albot1.methods.albot1.mapping.ambiguity import Ambiguity, likelihood_ratio, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
 from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_noise
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
@@ -212,6 +212,10 @@ class PlusLocaliser:
         self._ambiguity_limit = threshold(params.ambiguity_probability)
         #: The fit's sigmas as the ambiguity tests take them (built once, not per view).
         self._sigmas = (params.line_sigma, params.point_sigma, params.scan_sigma, params.huber, params.scan_gate)
+        #: Fits without a prior are scored in the same kernel call for the ambiguity test (:meth:`_solve`).
+        self._score_fits = params.prior == "adaptive" and params.ambiguity_probability > 0.0
+        self._score_args = (*self._sigmas, params.iterations, params.overhang)
+        self._scored: tuple[Pose, Pose, float, float, float, int, int] | None = None
         #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
         self.window = (
             OdometryWindow(params.window_updates, params.motion_model)
@@ -340,6 +344,12 @@ class PlusLocaliser:
         info_phi: float,
     ) -> tuple[Pose, FloatArray]:
         p = self.params
+        if self._score_fits and info_xy == 0.0 and info_phi == 0.0:  # the ambiguity test scores this fit next
+            x, y, phi, info, *costs = self._k.refine_and_score(  # one kernel call, not two (.step_kernels)
+                starts, lm_view, lm_map, ok, points, self._ref, *prior, *self._score_args
+            )
+            self._scored = ((x, y, phi), prior, *costs)
+            return self._scored[0], info
         x, y, phi, info = self._k.refine_pose(
             starts,
             lm_view,
@@ -377,6 +387,9 @@ class PlusLocaliser:
         One place for the turn bound's test (limit 0) and the ambiguity test's, which must score the same terms
         with the same sigmas so that the turn bound's statistic can stand in for the second.
         """
+        scored = self._scored  # the fit's own costs, computed with it (:meth:`_solve`), when it is this fit
+        if scored is not None and scored[0] is measured and scored[1] is predicted:
+            return likelihood_ratio(*scored[2:], limit)
         return view_ambiguity(
             self._k.measurement_costs,
             measured,
