@@ -141,16 +141,19 @@ def compile_claimed(claims: str, kernel_sets: list[str], names: list[str]) -> No
     _compile(Path(claims), list(sample_calls(*sets)), names)
 
 
-#: A kernel that shares dear callees with another: claimed right after it, by the same process, when both are cold.
+#: Kernels that share dear callees with another: claimed right after it, by the same process, when they are cold.
 #: ``measurement_costs`` calls ``pose_cost``, ``nearest_surface`` and ``huber_cost`` as ``refine_pose`` does: about
-#: 0.7 CPU s compiled once instead of once in each of two processes.
-_FOLLOWS: dict[str, str] = {"refine_pose": "measurement_costs"}
+#: 0.7 CPU s compiled once instead of once in each of two processes. A fused kernel (:mod:`.mapping.step_kernels`)
+#: calls the kernels it fuses, which its compile reuses when this process has compiled them.
+_FOLLOWS: dict[str, tuple[str, ...]] = {
+    "refine_pose": ("measurement_costs", "refine_and_score"),
+    "build_view": ("landmark_rows", "scan_points", "perceive"),
+}
 
 
 def _compile(claims: Path, calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]], names: list[str]) -> None:
     for first in names:
-        follower = _FOLLOWS.get(first)
-        for name in (first,) if follower is None or follower not in names else (first, follower):
+        for name in (first, *(follower for follower in _FOLLOWS.get(first, ()) if follower in names)):
             if _claim(claims, name):
                 for called, kernel, args in calls:
                     if called == name:

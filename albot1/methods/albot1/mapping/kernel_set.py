@@ -22,7 +22,7 @@ class MappingKernels:
 
     @staticmethod
     def not_called(pose_estimate: str) -> tuple[str, ...]:
-        """The kernels a mapper with this ``pose_estimate`` never calls: :data:`FUSED`, and Albot1+'s pose unless ``robust``.
+        """The kernels a mapper with this ``pose_estimate`` never calls: :data:`FUSED`, and the pose unless robust.
 
         A warm-up leaves them out (:func:`albot1.methods.albot1.warm_up.warm_up`),
         which spares a first run of the thesis presets their compile, and every

@@ -214,7 +214,6 @@ class PlusLocaliser:
         self._sigmas = (params.line_sigma, params.point_sigma, params.scan_sigma, params.huber, params.scan_gate)
         #: Fits without a prior are scored in the same kernel call for the ambiguity test (:meth:`_solve`).
         self._score_fits = params.prior == "adaptive" and params.ambiguity_probability > 0.0
-        self._score_args = (*self._sigmas, params.iterations, params.overhang)
         self._scored: tuple[Pose, Pose, float, float, float, int, int] | None = None
         #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
         self.window = (
@@ -238,12 +237,6 @@ class PlusLocaliser:
         if self.window is not None and odometry is not None:
             self.window.add(UpdateRecord(pose, odometry, self._ref))
 
-    def scan_points(self, ranges: FloatArray, angles: FloatArray) -> FloatArray:
-        """Every ``scan_stride``-th return within ``max_range``, thesis frame (none without scan refinement)."""
-        if not self.params.scan_refinement:
-            return np.empty((0, 2))
-        return self._k.scan_points(ranges, angles, self._max_range, self.params.scan_stride)
-
     def pose(
         self,
         starts: FloatArray,
@@ -259,7 +252,7 @@ class PlusLocaliser:
 
         ``lm_view`` / ``lm_map`` ``(k, 4)``: recognised landmarks and their
         map copies; ``lm_kinds``: their endpoint labels now and in the map;
-        ``points``: :meth:`scan_points`; ``since_update``: the odometry
+        ``points``: the scan's (:func:`~.step_kernels.perceive`); ``since_update``: the odometry
         motion since the last update view (thesis frame); ``odometry``: the
         view's own odometry (REP-103; the window test's); ``placed``: a
         landmark placed the robot (False: the turn bound applies).
@@ -345,11 +338,26 @@ class PlusLocaliser:
     ) -> tuple[Pose, FloatArray]:
         p = self.params
         if self._score_fits and info_xy == 0.0 and info_phi == 0.0:  # the ambiguity test scores this fit next
-            x, y, phi, info, *costs = self._k.refine_and_score(  # one kernel call, not two (.step_kernels)
-                starts, lm_view, lm_map, ok, points, self._ref, *prior, *self._score_args
-            )
-            self._scored = ((x, y, phi), prior, *costs)
-            return self._scored[0], info
+            line, point, scan, huber, gate = self._sigmas
+            x, y, phi, info, fit_cost, predicted_cost, matched, terms, independent = self._k.refine_and_score(
+                starts,
+                lm_view,
+                lm_map,
+                ok,
+                points,
+                self._ref,
+                *prior,
+                line,
+                point,
+                scan,
+                huber,
+                gate,
+                p.iterations,
+                p.overhang,
+            )  # one kernel call, not two (.step_kernels)
+            pose = (x, y, phi)
+            self._scored = (pose, prior, fit_cost, predicted_cost, matched, terms, independent)
+            return pose, info
         x, y, phi, info = self._k.refine_pose(
             starts,
             lm_view,
