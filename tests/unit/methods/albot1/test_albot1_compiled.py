@@ -391,7 +391,7 @@ def test_refine_and_score_is_refine_pose_then_measurement_costs_as_written() -> 
         arrays, prior, solver = args[:6], args[6:9], args[9:]
         x, y, phi, info = refine(*arrays, *prior, 0.0, 0.0, *solver)
         poses = np.array([(x, y, phi), prior], dtype=float)  # as view_ambiguity builds them
-        costs, _, matched, terms, independent = costs_of(poses, *arrays, *solver[:5], solver[6])
+        costs, _, matched, terms, independent = costs_of(poses, *arrays[1:], *solver[:5], solver[6])
         expected = (x, y, phi, info, float(costs[0]), float(costs[1]), float(matched), int(terms), int(independent))
         assert_same_bits(step_kernels.refine_and_score(*args), expected)
 

@@ -248,7 +248,7 @@ def test_warm_ups_inside_together_are_compiled_once_as_their_union(monkeypatch: 
     assert warms == [
         (
             ["PerceptionKernels", "MappingKernels", "PlacesKernels"],
-            [*thesis_first, *thesis_skip, *warm_up.kernel_names(PlacesKernels())],
+            [*thesis_first, *(name for name in every if name in thesis_skip), *warm_up.kernel_names(PlacesKernels())],
             print,
         )
     ]
