@@ -371,7 +371,7 @@ COMPILE_CPU_S: dict[str, float] = {
     "near_exit": 0.17,
     "place_segments": 0.15,
     # the fused kernels (plusfast10, under load 9-11: scaled by build_view's idle/loaded ratio, 1.88 / 2.58 s);
-    # perceive cold with the three kernels it calls (a mapper's warm-up leaves those out), refine_and_score after
+    # perceive cold with the three kernels it calls (plus's warm-up leaves those out), refine_and_score after
     # refine_pose and measurement_costs (its follower: their code reused)
     "perceive": 3.1,
     "refine_and_score": 0.31,

@@ -73,7 +73,7 @@ from albot1.methods.albot1.warm_up import kernel_names
 
 mapper = get_method("albot1").load_class()(resolve_config("albot1", "plus", None))
 counts = {name: len(getattr(k, name).signatures) for k in mapper.kernels for name in kernel_names(k)}
-# the kernels perceive compiles into itself are never called on their own (MappingKernels.FUSED)
+# plus never calls MappingKernels.FUSED on their own: perceive compiles them into itself
 print(json.dumps({name: n for name, n in counts.items() if name not in MappingKernels.FUSED}))
 """
 

@@ -17,19 +17,21 @@ from albot1.methods.albot1.mapping.update_kernels import update_surfaces
 class MappingKernels:
     """The map-update and Albot1+ pose kernels a mapper calls: each compiled, or its Python source."""
 
-    #: The kernels no mapper calls on their own: :func:`~.step_kernels.perceive` calls them (compiled into it).
+    #: The kernels Albot1+ does not call on their own: :func:`~.step_kernels.perceive` calls them (compiled into it).
     FUSED: tuple[str, ...] = ("build_view", "landmark_rows", "scan_points")
 
     @staticmethod
     def not_called(pose_estimate: str) -> tuple[str, ...]:
-        """The kernels a mapper with this ``pose_estimate`` never calls: :data:`FUSED`, and the pose unless robust.
+        """The kernels a mapper with this ``pose_estimate`` never calls on their own (a warm-up leaves them out).
 
-        A warm-up leaves them out (:func:`albot1.methods.albot1.warm_up.warm_up`),
-        which spares a first run of the thesis presets their compile, and every
-        preset a second compile of the kernels :func:`~.step_kernels.perceive` compiles into itself.
+        Albot1+ (``robust``) calls the fused kernels of :mod:`.step_kernels` instead of :data:`FUSED`, which
+        ``perceive`` compiles into itself; the other presets call neither Albot1+'s pose kernels nor
+        ``perceive`` (which saves them no time: docs/albot1-mapper.md, "Fewer kernel calls"), so their first run
+        does not pay for compiling them (:func:`albot1.methods.albot1.warm_up.warm_up`).
         """
-        plus = ("refine_pose", "measurement_costs", "screen_directions", "refine_and_score")
-        return MappingKernels.FUSED + (() if pose_estimate == "robust" else plus)
+        if pose_estimate == "robust":
+            return MappingKernels.FUSED
+        return ("refine_pose", "scan_points", "measurement_costs", "screen_directions", "perceive", "refine_and_score")
 
     def __init__(self, compiled: bool = True) -> None:
         self.compiled = compiled

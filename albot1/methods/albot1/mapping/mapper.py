@@ -39,9 +39,9 @@ from albot1.methods.albot1.mapping.step_kernels import perceive_scan
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
 from albot1.methods.albot1.perception.kernels import PerceptionKernels
-from albot1.methods.albot1.perception.landmarks import Landmarks
+from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
 from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise
-from albot1.methods.albot1.perception.view import View
+from albot1.methods.albot1.perception.view import View, construct_view
 from albot1.methods.albot1.warm_up import together, warm_up
 
 
@@ -135,11 +135,11 @@ class Albot1Mapper:
             else None
         )
         self._points = np.empty((0, 2))
-        #: :func:`perceive_scan`'s landmark length and Albot1+'s point range and stride (stride 0: no points)
+        #: Albot1+'s :func:`perceive_scan` arguments: landmark length, the points' range and stride (0: no points)
         self._perceive_args = (
             config.landmark_min_length_m,
             config.max_range_m,
-            config.scan_beam_stride if self._plus is not None and config.scan_refinement else 0,
+            config.scan_beam_stride if config.scan_refinement else 0,
         )
         self._odometry: Pose = (0.0, 0.0, 0.0)
         self._update_odometry: Pose = (0.0, 0.0, 0.0)
@@ -196,10 +196,14 @@ class Albot1Mapper:
     def process(self, frame: Frame) -> None:
         n = self._n
         scan = frame.scan
-        try:  # the view, its landmarks and Albot1+'s points in one kernel call (issue 24: .step_kernels)
-            view, lms, self._points = perceive_scan(
-                scan.ranges, scan.angles, self._view_params, *self._perceive_args, self._mk.perceive
-            )
+        try:
+            if self._plus is None:
+                view = construct_view(scan.ranges, scan.angles, self._view_params, self._pk)
+                lms = find_landmarks(view, self.config.landmark_min_length_m, self._pk)
+            else:  # the view, its landmarks and the scan's points in one kernel call (issue 24: .step_kernels)
+                view, lms, self._points = perceive_scan(
+                    scan.ranges, scan.angles, self._view_params, *self._perceive_args, self._mk.perceive
+                )
         except (ValueError, TypeError) as exc:
             raise MappingError(f"scan {frame.index}: cannot build a view: {exc}") from exc
         odo = (float(frame.odometry[0]), float(frame.odometry[1]), float(frame.odometry[2]))

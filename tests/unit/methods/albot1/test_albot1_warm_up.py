@@ -79,10 +79,17 @@ def test_a_thesis_preset_s_warm_up_leaves_out_the_kernels_only_albot1_plus_calls
     )
     assert out.returncode == 0, out.stderr
     found = json.loads(out.stdout)
-    # build_view, landmark_rows and scan_points are compiled into perceive (step_kernels), not warmed on their own
-    assert found["thesis"] == ["perceive", "place_segments", "recognise_landmarks", "update_surfaces"]
-    assert found["plus"] == sorted(
-        [*found["thesis"], "measurement_costs", "refine_and_score", "refine_pose", "screen_directions"]
+    assert found["thesis"] == [
+        "build_view",
+        "landmark_rows",
+        "place_segments",
+        "recognise_landmarks",
+        "update_surfaces",
+    ]
+    # plus calls perceive, which compiles scan_points into itself (a compile in this process gives scan_points a
+    # signature too, a load from the cache does not): scan_points is not warmed on its own
+    assert sorted(set(found["plus"]) - {"scan_points"}) == sorted(
+        [*found["thesis"], "measurement_costs", "perceive", "refine_and_score", "refine_pose", "screen_directions"]
     )
 
 

@@ -15,7 +15,7 @@ from albot1.methods.albot1.mapping import mapper as mapper_module
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.perception.landmarks import CORNER, find_landmarks
+from albot1.methods.albot1.perception.landmarks import CORNER
 from albot1.methods.albot1.perception.view import View
 from albot1.runs.execute import run_method
 
@@ -50,12 +50,7 @@ def blank_frame(i: int, odometry=(0.0, 0.0, 0.0)) -> Frame:
 
 def run_views(monkeypatch: pytest.MonkeyPatch, sequence: list[str], **config) -> Albot1Mapper:
     views: Iterator[View] = iter(hand_view(names) for names in sequence)
-
-    def perceived(ranges, angles, params, min_length, *rest) -> tuple[View, object, np.ndarray]:
-        view = next(views)  # the hand-made view, its landmarks found as the mapper's kernel finds them
-        return view, find_landmarks(view, min_length), np.empty((0, 2))
-
-    monkeypatch.setattr(mapper_module, "perceive_scan", perceived)
+    monkeypatch.setattr(mapper_module, "construct_view", lambda *args, **kwargs: next(views))
     mapper = Albot1Mapper(Albot1Config(**config))
     for i in range(len(sequence)):
         mapper.process(blank_frame(i))
