@@ -56,7 +56,8 @@ def test_whole_runs_after_the_warm_up_compile_nothing_new() -> None:
     assert out.returncode == 0, out.stderr
     found = json.loads(out.stdout)
     assert found["added"] == {}
-    assert all(len(sigs) >= 1 for sigs in found["warmed"].values()), found["warmed"]  # every kernel warmed by one
+    # every kernel warmed by one run, but scan_points: only perceive calls it (plus's warm-up leaves out FUSED)
+    assert {name for name, sigs in found["warmed"].items() if not sigs} <= {"scan_points"}, found["warmed"]
 
 
 _SKIPPED = """
