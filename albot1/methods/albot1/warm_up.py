@@ -88,6 +88,13 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         ],
         "screen_directions": [(0.1, 0.2, 0.05, np.diag([1e4, 2.0, 1e3]), 0.0, 0.0, 0.0, 0.4, 400.0)],
         "scan_points": [(compiled.readonly_float64(scan_ranges), compiled.readonly_float64(scan_angles), 30.0, 2)],
+        "perceive": [
+            (compiled.readonly_float64(scan_ranges), compiled.readonly_float64(scan_angles), 30.0, 0.6, 0.2, 0.1, 0.1)
+            + (math.radians(30.0), 0.0, 0.1, 0.0, 0.0, False, 0.4, 30.0, 2)
+        ],
+        "refine_and_score": [
+            (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
+        ],
         "detect_exits": [(seg, kinds, 0.6, 1.2, 0.5, 6.0, True)],
         "seen_through": [(seg, ids, np.ones(2, dtype=np.bool_), 0.5, 0.0, poly)],
         "near_exit": [(seg, ids, ids, 1, 10, 1, 0.5, 0.0, 0.5)],
@@ -134,20 +141,26 @@ def compile_claimed(claims: str, kernel_sets: list[str], names: list[str]) -> No
     _compile(Path(claims), list(sample_calls(*sets)), names)
 
 
-#: A kernel that shares dear callees with another: claimed right after it, by the same process, when both are cold.
+#: Kernels that share dear callees with another: claimed right after it, by the same process, when they are cold.
 #: ``measurement_costs`` calls ``pose_cost``, ``nearest_surface`` and ``huber_cost`` as ``refine_pose`` does: about
-#: 0.7 CPU s compiled once instead of once in each of two processes.
-_FOLLOWS: dict[str, str] = {"refine_pose": "measurement_costs"}
+#: 0.7 CPU s compiled once instead of once in each of two processes. A fused kernel (:mod:`.mapping.step_kernels`)
+#: calls the kernels it fuses, which its compile reuses when this process has compiled them.
+_FOLLOWS: dict[str, tuple[str, ...]] = {
+    "refine_pose": ("measurement_costs", "refine_and_score"),
+    "build_view": ("landmark_rows", "scan_points", "perceive"),
+}
 
 
 def _compile(claims: Path, calls: list[tuple[str, Callable[..., Any], tuple[Any, ...]]], names: list[str]) -> None:
     for first in names:
-        follower = _FOLLOWS.get(first)
-        for name in (first,) if follower is None or follower not in names else (first, follower):
-            if _claim(claims, name):
-                for called, kernel, args in calls:
-                    if called == name:
-                        kernel(*args)
+        if not _claim(claims, first):
+            continue
+        # its followers claimed with it: another process reaching one first would compile the shared callees again
+        followers = [name for name in _FOLLOWS.get(first, ()) if name in names and _claim(claims, name)]
+        for name in (first, *followers):
+            for called, kernel, args in calls:
+                if called == name:
+                    kernel(*args)
 
 
 def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) -> list[BaseProcess]:
@@ -357,6 +370,11 @@ COMPILE_CPU_S: dict[str, float] = {
     "seen_through": 0.17,
     "near_exit": 0.17,
     "place_segments": 0.15,
+    # the fused kernels (plusfast10, under load 9-11: scaled by build_view's idle/loaded ratio, 1.88 / 2.58 s);
+    # perceive cold with the three kernels it calls (plus's warm-up leaves those out), refine_and_score after
+    # refine_pose and measurement_costs (its follower: their code reused)
+    "perceive": 3.1,
+    "refine_and_score": 0.31,
 }
 #: CPU seconds per source line for a kernel not (yet) in :data:`COMPILE_CPU_S`: about what the measured ones cost
 _CPU_S_PER_LINE = 0.012

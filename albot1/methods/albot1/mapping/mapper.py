@@ -29,13 +29,13 @@ from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.geometry.se2 import Pose, between_pose, compose_pose
-from albot1.methods.albot1.compiled import readonly_float64
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.step_kernels import perceive_scan
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
 from albot1.methods.albot1.perception.kernels import PerceptionKernels
@@ -135,6 +135,12 @@ class Albot1Mapper:
             else None
         )
         self._points = np.empty((0, 2))
+        #: Albot1+'s :func:`perceive_scan` arguments: landmark length, the points' range and stride (0: no points)
+        self._perceive_args = (
+            config.landmark_min_length_m,
+            config.max_range_m,
+            config.scan_beam_stride if config.scan_refinement else 0,
+        )
         self._odometry: Pose = (0.0, 0.0, 0.0)
         self._update_odometry: Pose = (0.0, 0.0, 0.0)
         #: Called after every map update (chapter 4's places observe the map through it); None: nobody listens.
@@ -191,18 +197,19 @@ class Albot1Mapper:
         n = self._n
         scan = frame.scan
         try:
-            view = construct_view(scan.ranges, scan.angles, self._view_params, self._pk)
+            if self._plus is None:
+                view = construct_view(scan.ranges, scan.angles, self._view_params, self._pk)
+                lms = find_landmarks(view, self.config.landmark_min_length_m, self._pk)
+            else:  # the view, its landmarks and the scan's points in one kernel call (issue 24: .step_kernels)
+                view, lms, self._points = perceive_scan(
+                    scan.ranges, scan.angles, self._view_params, *self._perceive_args, self._mk.perceive
+                )
         except (ValueError, TypeError) as exc:
             raise MappingError(f"scan {frame.index}: cannot build a view: {exc}") from exc
-        lms = find_landmarks(view, self.config.landmark_min_length_m, self._pk)
         odo = (float(frame.odometry[0]), float(frame.odometry[1]), float(frame.odometry[2]))
         if not all(map(math.isfinite, odo)):
             raise MappingError(f"scan {frame.index}: odometry {odo} is not finite")
         self._odometry = odo
-        if self._plus is not None:
-            self._points = self._plus.scan_points(
-                readonly_float64(scan.ranges), readonly_float64(scan.angles)
-            )  # one kernel signature
         c = self._counts
         c.views += 1
         if len(view) == 0:

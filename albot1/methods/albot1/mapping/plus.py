@@ -69,7 +69,7 @@ from numpy.typing import NDArray
 
 from albot1.geometry.se2 import Pose, between_pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1.mapping.ambiguity import Ambiguity, threshold, view_ambiguity
+from albot1.methods.albot1.mapping.ambiguity import Ambiguity, likelihood_ratio, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
 from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_noise
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
@@ -230,6 +230,9 @@ class PlusLocaliser:
         self._refutation_limit = threshold(params.refutation_probability) if self.view_noise is not None else 0.0
         #: The fit's sigmas as the ambiguity tests take them (built once, not per view).
         self._sigmas = (params.line_sigma, params.point_sigma, params.scan_sigma, params.huber, params.scan_gate)
+        #: Fits without a prior are scored in the same kernel call for the ambiguity test (:meth:`_solve`).
+        self._score_fits = params.prior == "adaptive" and params.ambiguity_probability > 0.0
+        self._scored: tuple[Pose, Pose, float, float, float, int, int] | None = None
         #: The window test (:mod:`.window`; only with the ambiguity test), its kept views and its last outcome.
         self.window = (
             OdometryWindow(params.window_updates, params.motion_model)
@@ -252,12 +255,6 @@ class PlusLocaliser:
         if self.window is not None and odometry is not None:
             self.window.add(UpdateRecord(pose, odometry, self._ref))
 
-    def scan_points(self, ranges: FloatArray, angles: FloatArray) -> FloatArray:
-        """Every ``scan_stride``-th return within ``max_range``, thesis frame (none without scan refinement)."""
-        if not self.params.scan_refinement:
-            return np.empty((0, 2))
-        return self._k.scan_points(ranges, angles, self._max_range, self.params.scan_stride)
-
     def pose(
         self,
         starts: FloatArray,
@@ -273,7 +270,7 @@ class PlusLocaliser:
 
         ``lm_view`` / ``lm_map`` ``(k, 4)``: recognised landmarks and their
         map copies; ``lm_kinds``: their endpoint labels now and in the map;
-        ``points``: :meth:`scan_points`; ``since_update``: the odometry
+        ``points``: the scan's (:func:`~.step_kernels.perceive`); ``since_update``: the odometry
         motion since the last update view (thesis frame); ``odometry``: the
         view's own odometry (REP-103; the window test's); ``placed``: a
         landmark placed the robot (False: the turn bound applies).
@@ -364,6 +361,27 @@ class PlusLocaliser:
         info_phi: float,
     ) -> tuple[Pose, FloatArray]:
         p = self.params
+        if self._score_fits and info_xy == 0.0 and info_phi == 0.0:  # the ambiguity test scores this fit next
+            line, point, scan, huber, gate = self._sigmas
+            x, y, phi, info, fit_cost, predicted_cost, matched, terms, independent = self._k.refine_and_score(
+                starts,
+                lm_view,
+                lm_map,
+                ok,
+                points,
+                self._ref,
+                *prior,
+                line,
+                point,
+                scan,
+                huber,
+                gate,
+                p.iterations,
+                p.overhang,
+            )  # one kernel call, not two (.step_kernels)
+            pose = (x, y, phi)
+            self._scored = (pose, prior, fit_cost, predicted_cost, matched, terms, independent)
+            return pose, info
         x, y, phi, info = self._k.refine_pose(
             starts,
             lm_view,
@@ -401,6 +419,9 @@ class PlusLocaliser:
         One place for the turn bound's test (limit 0) and the ambiguity test's, which must score the same terms
         with the same sigmas so that the turn bound's statistic can stand in for the second.
         """
+        scored = self._scored  # the fit's own costs, computed with it (:meth:`_solve`), when it is this fit
+        if scored is not None and scored[0] is measured and scored[1] is predicted:
+            return likelihood_ratio(*scored[2:], limit)
         return view_ambiguity(
             self._k.measurement_costs,
             measured,

@@ -28,7 +28,7 @@ from albot1.data.synthetic.worlds import load_world
 from albot1.geometry import se2, segments
 from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import as_written
-from albot1.methods.albot1.mapping import ambiguity, pose_kernels, screen_kernels, update_kernels
+from albot1.methods.albot1.mapping import ambiguity, pose_kernels, screen_kernels, step_kernels, update_kernels
 from albot1.methods.albot1.mapping import kernels as mapping_source
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
@@ -242,6 +242,21 @@ def _measurement_costs_args() -> Iterator[tuple[Any, ...]]:
         yield (starts, lm_view, lm_map, ok, points, ref, *args[11:16], args[17])
 
 
+def _perceive_args() -> Iterator[tuple[Any, ...]]:
+    """REP-103 beams (read-only, as the mapper passes them), view settings, landmark length, point range and stride."""
+    for args in _build_view_args():
+        ranges = compiled.readonly_float64(np.ascontiguousarray(args[0][::-1]))
+        angles = compiled.readonly_float64(np.ascontiguousarray(args[1][::-1]))
+        for tail in ((0.4, 30.0, 2), (1.5, 5.0, 1), (0.0, 8.0, 0)):
+            yield (ranges, angles, *args[2:], *tail)
+
+
+def _refine_and_score_args() -> Iterator[tuple[Any, ...]]:
+    """``refine_pose``'s cases without their prior's information (the fused kernel fits without one)."""
+    for args in _refine_args():
+        yield (*args[:9], *args[11:])
+
+
 def _screen_args() -> Iterator[tuple[Any, ...]]:
     """Information keeping 0 to 3 directions (scaled units, floor 400), headings across the wrap."""
     rng = np.random.default_rng(24)
@@ -266,6 +281,8 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "scan_points": _scan_points_args,
     "measurement_costs": _measurement_costs_args,
     "screen_directions": _screen_args,
+    "perceive": _perceive_args,
+    "refine_and_score": _refine_and_score_args,
 }
 
 
@@ -286,6 +303,7 @@ KERNELS: dict[str, Any] = {
     **{name: getattr(pose_kernels, name) for name in ("refine_pose", "scan_points")},
     "measurement_costs": ambiguity.measurement_costs,
     "screen_directions": screen_kernels.screen_directions,
+    **{name: getattr(step_kernels, name) for name in ("perceive", "refine_and_score")},
 }
 
 
@@ -325,6 +343,57 @@ def test_kernel_sample_gives_the_same_bits_compiled_and_as_written(name: str) ->
     for (fast, args), plain in zip(calls, slow):
         assert isinstance(fast, numba.core.registry.CPUDispatcher) and plain is fast.py_func
         assert_same_bits(fast(*args), plain(*args))
+
+
+# -- the fused kernels (step_kernels) against the pieces they call, as written ------------------------------------
+# Their own Python source calls the compiled pieces, so the parity above does not reach the pieces' source: here the
+# compiled fused kernel meets the pieces' Python source, called as the mapper called them before the fusion.
+
+
+def _perceive_by_pieces(*args: Any) -> tuple[Any, ...]:
+    ranges, angles, stride = args[0], args[1], args[15]
+    view = as_written(perception_source.build_view)(*_thesis_order(ranges, angles), *args[2:13])
+    rows = as_written(perception_source.landmark_rows)(view[0], view[1], args[13])
+    points = as_written(pose_kernels.scan_points)(ranges, angles, args[14], stride) if stride > 0 else np.empty((0, 2))
+    return (*view, *rows, points)
+
+
+def test_perceive_is_build_view_landmark_rows_and_scan_points_as_written() -> None:
+    cases = list(_perceive_args())
+    assert len(cases) >= 20 and any(args[15] == 0 for args in cases)
+    for args in cases:
+        assert_same_bits(step_kernels.perceive(*args), _perceive_by_pieces(*args))
+
+
+def _landmark_arrays(landmarks: Any) -> tuple[Any, ...]:
+    return (landmarks.index, landmarks.surfaces, landmarks.kinds)
+
+
+def test_perceive_scan_holds_construct_view_s_view_and_find_landmarks_landmarks() -> None:
+    plain = PerceptionKernels(False)
+    for ranges, angles in _scans():
+        for params in (PARAMS, ViewParams(fit_lines=True, end_spacing_max=0.15)):
+            view, lms, points = step_kernels.perceive_scan(ranges, angles, params, 0.4, 30.0, 0)
+            expected = construct_view(ranges, angles, params, plain)
+            landmarks = find_landmarks(expected, 0.4, plain)
+            assert_same_bits(
+                (view.surfaces, view.kinds, view.beams, view.cluster, lms.index, lms.surfaces, lms.kinds),
+                (expected.surfaces, expected.kinds, expected.beams, expected.cluster, *_landmark_arrays(landmarks)),
+            )
+            assert points.shape == (0, 2)
+
+
+def test_refine_and_score_is_refine_pose_then_measurement_costs_as_written() -> None:
+    refine, costs_of = as_written(pose_kernels.refine_pose), as_written(ambiguity.measurement_costs)
+    cases = list(_refine_and_score_args())
+    assert len(cases) >= 20
+    for args in cases:
+        arrays, prior, solver = args[:6], args[6:9], args[9:]
+        x, y, phi, info = refine(*arrays, *prior, 0.0, 0.0, *solver)
+        poses = np.array([(x, y, phi), prior], dtype=float)  # as view_ambiguity builds them
+        costs, _, matched, terms, independent = costs_of(poses, *arrays[1:], *solver[:5], solver[6])
+        expected = (x, y, phi, info, float(costs[0]), float(costs[1]), float(matched), int(terms), int(independent))
+        assert_same_bits(step_kernels.refine_and_score(*args), expected)
 
 
 # -- the callees, compiled on their own ------------------------------------------------------------------------

@@ -56,7 +56,8 @@ def test_whole_runs_after_the_warm_up_compile_nothing_new() -> None:
     assert out.returncode == 0, out.stderr
     found = json.loads(out.stdout)
     assert found["added"] == {}
-    assert all(len(sigs) >= 1 for sigs in found["warmed"].values()), found["warmed"]  # every kernel warmed by one
+    # every kernel warmed by one run, but scan_points: only perceive calls it (plus's warm-up leaves out FUSED)
+    assert {name for name, sigs in found["warmed"].items() if not sigs} <= {"scan_points"}, found["warmed"]
 
 
 _SKIPPED = """
@@ -86,8 +87,10 @@ def test_a_thesis_preset_s_warm_up_leaves_out_the_kernels_only_albot1_plus_calls
         "recognise_landmarks",
         "update_surfaces",
     ]
-    assert found["plus"] == sorted(
-        [*found["thesis"], "measurement_costs", "refine_pose", "scan_points", "screen_directions"]
+    # plus calls perceive, which compiles scan_points into itself (a compile in this process gives scan_points a
+    # signature too, a load from the cache does not): scan_points is not warmed on its own
+    assert sorted(set(found["plus"]) - {"scan_points"}) == sorted(
+        [*found["thesis"], "measurement_costs", "perceive", "refine_and_score", "refine_pose", "screen_directions"]
     )
 
 
@@ -253,7 +256,7 @@ def test_warm_ups_inside_together_are_compiled_once_as_their_union(monkeypatch: 
     assert warms == [
         (
             ["PerceptionKernels", "MappingKernels", "PlacesKernels"],
-            [*thesis_first, *thesis_skip, *warm_up.kernel_names(PlacesKernels())],
+            [*thesis_first, *(name for name in every if name in thesis_skip), *warm_up.kernel_names(PlacesKernels())],
             print,
         )
     ]
