@@ -74,7 +74,7 @@ test-all: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST)
 
 # The edit-test loop (under a minute on 2 cores): unit and property tests without the slow ones
-# (marked `slow`: over about 1.5 s each) and without the public logs. `make test` runs them all.
+# (marked `slow`: over about 1.5 s each) and without the public logs. `make test-all` runs them all.
 test-fast: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not slow and not integration" tests/unit tests/property
 

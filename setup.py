@@ -32,10 +32,16 @@ COMMIT_ENV = "ALBOT1_BUILD_COMMIT"
 KERNELS = BUNDLE / "kernels"  # albot1.methods.albot1.kernel_bundle.BUNDLE_DIR
 KERNELS_ENV = "ALBOT1_BUILD_KERNELS"  # 0: build the wheel without its compiled kernels
 #: the build step's child process: compile, bundle, say how many files (or fail with the reason as its last line)
+#: (exit 3: a runtime dependency is missing from the build environment, e.g. --no-build-isolation without numba)
+MISSING_DEPENDENCY = 3
 BUILD_KERNELS = """
 import sys
 from pathlib import Path
-from albot1.methods.kernel_sources import build
+try:
+    from albot1.methods.kernel_sources import build
+except ImportError as error:
+    print(f"a runtime dependency is missing from the build environment: {error}", file=sys.stderr)
+    sys.exit(3)
 print(f"kernel bundle: {build(Path(sys.argv[1]))} numba cache files in {sys.argv[1]}")
 """
 
@@ -48,7 +54,10 @@ def bundle_kernels(build_lib: Path) -> None:
     a bare ``pip install`` loads them instead of compiling them, where numba
     accepts them (same numba, Python and architecture; otherwise it
     compiles, as without them). A build environment without the runtime
-    dependencies builds a wheel without them, with a notice.
+    dependencies builds a wheel without them, with a notice; any other
+    failure (a kernel that does not compile, a sample call that raises, a
+    kernel that left no cache files) fails the build with its reason: a
+    wheel silently without its kernels would cost every install a compile.
     """
     if os.environ.get(KERNELS_ENV, "1").strip() == "0":
         return
@@ -71,6 +80,8 @@ def bundle_kernels(build_lib: Path) -> None:
     if done.returncode != 0:
         shutil.rmtree(build_lib / KERNELS, ignore_errors=True)
         why = (done.stderr.strip().splitlines() or ["no message"])[-1]
+        if done.returncode != MISSING_DEPENDENCY:
+            raise RuntimeError(f"albot1-bench build: compiling the kernel bundle failed: {why}")
         print(f"albot1-bench build: the wheel carries no compiled kernels ({why})", file=sys.stderr)
 
 

@@ -192,6 +192,18 @@ def is_cached(fn: Callable[..., Any] | None = None) -> bool:
     return any(Path(own).glob(pattern)) if own else any(CACHE_DIR.rglob(pattern))
 
 
+def needs_compile(kernel: Callable[..., Any]) -> bool:
+    """Whether calling ``kernel`` compiles it: numba's dispatcher has no signature here and no cache index.
+
+    False for a function run as written (``NUMBA_DISABLE_JIT``): nothing to compile. The one test of "cold"
+    the warm-ups of Albot1 and of gtsam-graph and the wheel's kernel bundle share.
+    """
+    signatures = getattr(kernel, "signatures", None)
+    if signatures is None:
+        return False
+    return not signatures and not is_cached(kernel)
+
+
 def compile_processes() -> int:
     """How many processes may compile kernels at once: ``ALBOT1_COMPILE_PROCESSES``, else the CPUs this process may use.
 

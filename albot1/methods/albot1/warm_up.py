@@ -289,10 +289,13 @@ def _warm(
 ) -> None:
     """:func:`warm_up` of ``calls`` (the samples of ``kernel_sets`` that are to be called)."""
     kernels = {name: kernel for name, kernel, _ in calls}
-    if any(_cold(kernel) for kernel in kernels.values()):
-        kernel_bundle.seed(calls, _cold)  # the wheel's own compiled kernels, where numba will accept them
+    if any(compiled.needs_compile(kernel) for kernel in kernels.values()):
+        kernel_bundle.seed(
+            calls, compiled.needs_compile
+        )  # the wheel's own compiled kernels, where numba will accept them
     cold = sorted(
-        (name for name, kernel in kernels.items() if _cold(kernel)), key=lambda n: -compile_cost(n, kernels[n])
+        (name for name, kernel in kernels.items() if compiled.needs_compile(kernel)),
+        key=lambda n: -compile_cost(n, kernels[n]),
     )
     if cold and announce is not None:
         announce(f"albot1: compiling the numba kernels once for this code version (cache: {compiled.CACHE_DIR})")
@@ -338,14 +341,6 @@ def _set_up_numba() -> None:
 
     copy = cast(Callable[[NDArray[np.float64]], NDArray[np.float64]], numba.njit(_copy))
     copy(np.zeros(1))
-
-
-def _cold(kernel: Callable[..., Any]) -> bool:
-    """Whether ``kernel`` still has to be compiled (numba's dispatcher has no signature and no cache index)."""
-    signatures = getattr(kernel, "signatures", None)
-    if signatures is None:  # NUMBA_DISABLE_JIT: the function as written, nothing to compile
-        return False
-    return not signatures and not compiled.is_cached(kernel)
 
 
 #: CPU seconds of each kernel's cold compile in one process, measured: the order a cold warm-up claims them in.

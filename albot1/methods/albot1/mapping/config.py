@@ -15,10 +15,11 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from albot1.methods.albot1.mapping.noise_split import MIN_WEIGHT
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
-from albot1.methods.albot1.mapping.plus import PlusParams
+from albot1.methods.albot1.mapping.plus_params import PlusParams
 from albot1.methods.albot1.perception.view import ViewParams
 
 
@@ -382,6 +383,21 @@ class Albot1Config(BaseModel):
             end_spacing_grazing=self.end_spacing_grazing,
             fit_lines=self.surface_fit == "tls",
         )
+
+    @model_validator(mode="after")
+    def _settings_that_would_do_nothing(self) -> Albot1Config:
+        """Refuse an Albot1+ setting that the others would leave without effect, rather than ignore it."""
+        if self.refutation_probability > 0 and (self.view_noise_learning_rate == 0 or self.noise_split_samples > 0):
+            raise ValueError(
+                "refutation_probability needs the view noise (view_noise_learning_rate > 0) and no noise split"
+                " (noise_split_samples = 0): without them it would do nothing"
+            )
+        if 0 < self.noise_split_samples < MIN_WEIGHT:
+            raise ValueError(
+                f"noise_split_samples: expected 0 (off) or at least {MIN_WEIGHT:g} views (below that the split"
+                f" never leaves its start values), got {self.noise_split_samples}"
+            )
+        return self
 
     def plus_params(self) -> PlusParams:
         return PlusParams(

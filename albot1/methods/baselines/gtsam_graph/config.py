@@ -13,7 +13,7 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams
 
@@ -36,9 +36,11 @@ class GtsamGraphConfig(BaseModel):
 
     # Registration (point-to-line ICP, albot1.methods.baselines.gtsam_graph.registration).
     icp_max_iterations: int = Field(ge=1, description="Gauss-Newton iterations per registration")
-    icp_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate (annealed down)")
+    icp_max_correspondence_m: float = Field(
+        gt=0, allow_inf_nan=False, description="initial correspondence gate (annealed down)"
+    )
     icp_min_correspondence_m: float = Field(
-        gt=0, description="final correspondence gate; inliers are counted within it"
+        gt=0, allow_inf_nan=False, description="final correspondence gate; inliers are counted within it"
     )
     point_sigma_m: float = Field(gt=0, description="std dev of one point-to-line residual (sets the match information)")
     normal_neighbours: int = Field(ge=3, description="neighbours used to fit each target point's line")
@@ -68,7 +70,9 @@ class GtsamGraphConfig(BaseModel):
         gt=0, description="prior std dev of the odometry guess over one scan period (x, y), used inside tracking ICP"
     )
     track_prior_sigma_theta_deg: float = Field(gt=0, description="... (theta)")
-    track_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of tracking matches")
+    track_max_correspondence_m: float = Field(
+        gt=0, allow_inf_nan=False, description="initial correspondence gate of tracking matches"
+    )
     track_max_correction_m: float = Field(gt=0, description="a tracking match may move its guess this far at most")
     track_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most")
     track_wide_correction_deg: float = Field(
@@ -177,7 +181,9 @@ class GtsamGraphConfig(BaseModel):
     loop_submap_nodes: int = Field(
         ge=0, description="a candidate's submap is its scan plus this many node scans either side"
     )
-    loop_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of loop matches")
+    loop_max_correspondence_m: float = Field(
+        gt=0, allow_inf_nan=False, description="initial correspondence gate of loop matches"
+    )
     loop_coarse_max_half_width_m: float = Field(
         ge=0, description="failed loop matches are retried from a correlative search this wide at most (0 = off)"
     )
@@ -276,7 +282,9 @@ class GtsamGraphConfig(BaseModel):
     refine_nodes_either_side: int = Field(
         ge=0, description="the refinement's local map: the scan's node and this many node scans either side"
     )
-    refine_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of the refinement")
+    refine_max_correspondence_m: float = Field(
+        gt=0, allow_inf_nan=False, description="initial correspondence gate of the refinement"
+    )
     refine_min_fitness: float = Field(ge=0, le=1, description="a refined pose needs this inlier fraction")
     refine_max_rmse_m: float = Field(gt=0, description="... and this inlier RMS point-to-line distance or less")
     refine_max_correction_m: float = Field(gt=0, description="... and may move its seed this far at most (m)")
@@ -285,6 +293,15 @@ class GtsamGraphConfig(BaseModel):
     # Map.
     map_voxel_m: float = Field(gt=0, description="grid cell for thinning the projected map points")
     map_every: int = Field(ge=1, description="project every n-th scan into the map")
+
+    @model_validator(mode="after")
+    def _settings_that_would_do_nothing(self) -> GtsamGraphConfig:
+        """Refuse the earned choice without the odometry factors it judges, rather than ignore it."""
+        if self.odometry_trust_earned_level > 0 and not self.odometry_trust_factors:
+            raise ValueError(
+                "odometry_trust_earned_level needs odometry_trust_factors = true: without it it does nothing"
+            )
+        return self
 
     def track_icp(self) -> IcpParams:
         """Registration parameters of per-scan tracking (a guess one scan period of odometry away)."""

@@ -47,7 +47,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.stats import chi2
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph.odometry_trust import (
@@ -104,7 +103,13 @@ def choose(
 
 @lru_cache(maxsize=16)
 def quantile(level: float, dof: int) -> float:
-    """The chi-square quantile of ``level`` with ``dof`` degrees of freedom (cached: scipy's costs ~0.1 ms a call)."""
+    """The chi-square quantile of ``level`` with ``dof`` degrees of freedom (cached: scipy's costs ~0.1 ms a call).
+
+    ``scipy.stats`` is imported here, not with the module: every gtsam-graph run imports this module, and only
+    a run with the setting on asks for a quantile.
+    """
+    from scipy.stats import chi2
+
     return float(chi2.ppf(level, dof))
 
 

@@ -43,8 +43,10 @@ from numpy.typing import NDArray
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1 import compiled, kernel_bundle
 from albot1.methods.albot1.compiled import jitable, kernel
+from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
 
 #: ambiguous when two squared distances (or one and the gate squared) are this close, relative to the gate squared
+#: plus the gate times the coordinates' size (the k-d tree's rounding grows with both: see :func:`_nearest_one`)
 TIE_TOLERANCE = 1e-9
 #: the cell size of a target's grid (m); only the speed depends on it (measured in docs/baselines.md, "Cost, continued")
 CELL_M = 0.2
@@ -63,6 +65,8 @@ class Grid:
 
     def __init__(self, points: FloatArray) -> None:
         pts = np.ascontiguousarray(points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[0] == 0 or pts.shape[1] != 2 or not np.isfinite(pts).all():
+            raise RegistrationError(f"grid search: expected a non-empty (n, 2) array of finite points, got {pts.shape}")
         origin, dims, cell, starts, order = build_grid(pts, CELL_M, MAX_CELLS_PER_POINT)
         self.origin: FloatArray = origin
         self.dims: IntArray = dims
@@ -152,9 +156,22 @@ def _nearest_one(
     qy: float,
     gate2: float,
 ) -> tuple[int, bool]:
-    """The cell-order index of the point nearest ``(qx, qy)`` within the gate (-1: none) and whether it is ambiguous."""
+    """The cell-order index of the point nearest ``(qx, qy)`` within the gate (-1: none) and whether it is ambiguous.
+
+    The k-d tree rounds its squared distances and bounds with an error that grows with the gate and with the
+    coordinates' size (``q - p`` and ``q - bound`` of numbers ``scale`` large, squared and summed: a few units
+    of ``eps * gate * scale``), so the tolerance is ``TIE_TOLERANCE`` times ``gate2 + gate * scale``: about a
+    million times that rounding at any scale (at 1e6 m, UTM-sized, as at 10 m). A query that is not finite is
+    left to the tree (which refuses it, as it always did); the rings stop at the grid's far side whatever the
+    bounds say.
+    """
+    if not (math.isfinite(qx) and math.isfinite(qy)):
+        return -1, True
     nx, ny = dims[0], dims[1]
-    tol = TIE_TOLERANCE * gate2
+    far_x = max(abs(origin[0]), abs(origin[0] + nx * cell))
+    far_y = max(abs(origin[1]), abs(origin[1] + ny * cell))
+    scale = max(far_x, far_y, abs(qx), abs(qy))
+    tol = TIE_TOLERANCE * (gate2 + math.sqrt(gate2) * scale)
     margin = 1e-6 * cell  # cells are assigned by rounded divisions: a ring's bound is kept this much looser
     reach = math.sqrt(gate2 + tol) + margin
     rings = int(reach / cell) + 2
@@ -181,6 +198,8 @@ def _nearest_one(
                     best, second, at = _scan_cells(xy, starts, ny, cx, iy + r, iy + r, qx, qy, best, second, at)
         below = r * cell + inside - margin  # every point of the next ring is farther than this
         if below > 0.0 and below * below > min(best, gate2) + tol:
+            break
+        if r > nx + ny + 2 * rings + 2:  # every cell of the grid has been searched
             break
         r += 1
     if at < 0 or best >= gate2 + tol:
@@ -324,6 +343,8 @@ class Matches:
         gives the target's ``cKDTree``, asked only about ambiguous queries),
         their correspondences the same, and the terms the same bit for bit.
         """
+        if not (math.isfinite(gate) and gate > 0):
+            raise RegistrationError(f"grid search: expected a finite positive correspondence gate, got {gate}")
         px, py = float(pose[0]), float(pose[1])
         idx, jac, res, w, wj = self.idx, self.jac, self.res, self.w, self.wj
         m = linearise_terms(
@@ -348,11 +369,6 @@ def _sample() -> tuple[FloatArray, FloatArray, FloatArray]:
     normals = np.tile([0.0, 1.0], (len(points), 1))
     source = np.array([[0.1, 0.05], [0.4, 0.01], [3.0, -3.0]])
     return points, normals, source
-
-
-def _cold(fn: Any) -> bool:
-    """Whether calling kernel ``fn`` compiles it: not compiled here nor in numba's cache (never when run as Python)."""
-    return hasattr(fn, "py_func") and not fn.signatures and not compiled.is_cached(fn)
 
 
 def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
@@ -396,9 +412,9 @@ def warm_up(announce: Callable[[str], None] | None = None) -> None:
     from scipy.spatial import cKDTree
 
     kernels = (build_grid, linearise_terms, terms)
-    if any(_cold(k) for k in kernels):
-        kernel_bundle.seed(sample_calls(), _cold)
-    cold = any(_cold(k) for k in kernels)
+    if any(compiled.needs_compile(k) for k in kernels):
+        kernel_bundle.seed(sample_calls(), compiled.needs_compile)
+    cold = any(compiled.needs_compile(k) for k in kernels)
     if cold and announce is not None:
         announce(f"gtsam-graph: compiling its grid search once for this code version (cache: {compiled.CACHE_DIR})")
     start = time.perf_counter()

@@ -39,11 +39,11 @@ _SEED_AND_LOAD = """
 import json, sys
 from pathlib import Path
 from albot1.methods import kernel_sources
-from albot1.methods.albot1 import kernel_bundle, warm_up
+from albot1.methods.albot1 import compiled as kernels, kernel_bundle
 from albot1.methods.baselines.gtsam_graph import nearest
 
 calls = kernel_sources.calls()
-seeded = kernel_bundle.seed(calls, warm_up._cold, bundle=Path(sys.argv[1]))
+seeded = kernel_bundle.seed(calls, kernels.needs_compile, bundle=Path(sys.argv[1]))
 for _, kernel, args in calls:
     kernel(*args)
 nearest.warm_up(print)  # a run's own calls: nothing more to compile (nothing printed)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 from plus_room import localiser
+from pydantic import ValidationError
 
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
@@ -51,3 +52,8 @@ def test_it_replaces_both_learners_when_on_and_is_off_in_every_preset() -> None:
     for name in ("default", "thesis", "exact", "literal", "plus"):
         config = Albot1Config.model_validate({**Albot1Mapper.presets["default"], **Albot1Mapper.presets[name]})
         assert config.noise_split_samples == 0
+    plus = {**Albot1Mapper.presets["default"], **Albot1Mapper.presets["plus"]}
+    for few in (1, 9):  # fewer views of memory than the split needs to leave its start values: refused
+        with pytest.raises(ValidationError, match="noise_split_samples: expected 0 \\(off\\) or at least 10 views"):
+            Albot1Config.model_validate({**plus, "noise_split_samples": few})
+    assert Albot1Config.model_validate({**plus, "noise_split_samples": 10}).noise_split_samples == 10

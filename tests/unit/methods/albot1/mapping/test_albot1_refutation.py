@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 from plus_room import NO_KINDS, SINCE, localiser, scan_from
+from pydantic import ValidationError
 
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
@@ -66,4 +67,8 @@ def test_it_is_off_in_every_preset_and_without_the_view_noise() -> None:
     for name in ("default", "thesis", "exact", "literal", "plus"):
         config = Albot1Config.model_validate({**Albot1Mapper.presets["default"], **Albot1Mapper.presets[name]})
         assert config.refutation_probability == 0.0
-    assert localiser(view_noise_learning_rate=0.0, refutation_probability=0.99)._refutation_limit == 0.0
+    plus = {**Albot1Mapper.presets["default"], **Albot1Mapper.presets["plus"]}
+    # without the view noise, or with the noise split replacing it, the setting would do nothing: refused
+    for without in ({"view_noise_learning_rate": 0.0}, {"noise_split_samples": 200}):
+        with pytest.raises(ValidationError, match="refutation_probability needs the view noise"):
+            Albot1Config.model_validate({**plus, "refutation_probability": 0.99, **without})

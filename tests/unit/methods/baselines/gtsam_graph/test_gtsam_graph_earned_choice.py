@@ -139,3 +139,7 @@ def test_the_level_is_off_in_the_preset_and_bounded() -> None:
     assert cfg.odometry_trust_earned_level == 0.0
     with pytest.raises(ValidationError):
         GtsamGraphConfig.model_validate({**cfg.model_dump(), "odometry_trust_earned_level": 1.0})
+    with pytest.raises(ValidationError, match="odometry_trust_earned_level needs odometry_trust_factors"):
+        GtsamGraphConfig.model_validate(
+            {**cfg.model_dump(), "odometry_trust_earned_level": 0.99, "odometry_trust_factors": False}
+        )

@@ -6,13 +6,17 @@ from typing import Any
 
 import numpy as np
 import pytest
+from pydantic import ValidationError
 from scipy.spatial import cKDTree
 
 from albot1.data import open_sequence
 from albot1.methods.albot1.compiled import as_written
 from albot1.methods.baselines.gtsam_graph import nearest
+from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
+from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
 from albot1.methods.baselines.gtsam_graph.nearest import Grid, Matches, build_grid, linearise_terms, terms
 from albot1.methods.baselines.gtsam_graph.registration import rotate
+from albot1.methods.registry import resolve_config
 from albot1.runs.execute import run_method
 
 
@@ -111,6 +115,44 @@ def test_a_query_exactly_at_the_gate_and_far_outside_the_grid() -> None:
     got, _ = found(points, normals, rot, np.zeros(3), 0.25)
     assert_same_bits(got, expected_terms(points, normals, rot, np.zeros(3), 0.25, 0.1, 400.0))
     assert len(got[1]) == 1  # only (0, 0.2499) is within the gate
+
+
+@pytest.mark.parametrize("offset", [5e5, 4e6])
+def test_far_from_the_origin_the_ties_still_reach_the_k_d_tree(offset: float) -> None:
+    """UTM-sized coordinates: the k-d tree's rounding grows with them, and so does the tolerance."""
+    rng = np.random.default_rng(3)
+    points = rng.integers(0, 60, size=(400, 2)) * 0.1 + offset
+    normals = unit_normals(rng, len(points))
+    rot = rng.integers(-10, 130, size=(300, 2)) * 0.05
+    pose = np.array([offset, offset, 0.0])
+    got, tree = found(points, normals, rot, pose, 0.5)
+    assert_same_bits(got, expected_terms(points, normals, rot, pose, 0.5, 0.1, 400.0))
+    assert tree.asked > 0
+
+
+def test_a_query_that_is_not_finite_is_refused_by_the_k_d_tree_as_before() -> None:
+    """The grid leaves it to the tree (no endless ring search), which raises as the numpy formulation did."""
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    normals = np.tile([0.0, 1.0], (3, 1))
+    for bad in (np.nan, np.inf):
+        rot = np.array([[bad, 0.0], [0.05, 0.0]])
+        with pytest.raises(ValueError) as want:
+            expected_terms(points, normals, rot, np.zeros(3), 0.5, 0.1, 400.0)
+        with pytest.raises(ValueError) as got:
+            found(points, normals, rot, np.zeros(3), 0.5)
+        assert str(got.value) == str(want.value)
+
+
+def test_an_infinite_gate_or_an_empty_target_is_refused_in_one_line() -> None:
+    points = np.array([[0.0, 0.0], [1.0, 0.0]])
+    lines = np.hstack([points, np.tile([0.0, 1.0], (2, 1))])
+    with pytest.raises(RegistrationError, match="finite positive correspondence gate, got inf"):
+        Matches(1).find(Grid(points), lambda: cKDTree(points), lines, np.zeros((1, 2)), np.zeros(3), np.inf, 0.1, 1.0)
+    with pytest.raises(RegistrationError, match=r"non-empty \(n, 2\) array of finite points"):
+        Grid(np.empty((0, 2)))
+    with pytest.raises(ValidationError, match="finite number"):
+        cfg = resolve_config("gtsam-graph", "default", {})
+        GtsamGraphConfig.model_validate({**cfg.model_dump(), "icp_max_correspondence_m": np.inf})
 
 
 def test_a_wide_sparse_target_gets_coarser_cells_and_every_point_is_in_its_own_cell() -> None:
