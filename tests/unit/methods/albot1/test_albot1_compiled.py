@@ -13,6 +13,7 @@ from __future__ import annotations
 import copy
 import math
 import os
+import re
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
@@ -381,6 +382,30 @@ def test_perceive_scan_holds_construct_view_s_view_and_find_landmarks_landmarks(
                 (expected.surfaces, expected.kinds, expected.beams, expected.cluster, *_landmark_arrays(landmarks)),
             )
             assert points.shape == (0, 2)
+
+
+def test_perceive_scan_on_degenerate_scans_does_what_the_pieces_do() -> None:
+    """No beam, no finite beam, every beam out of range: the same (empty) view and landmarks, or the same error."""
+    plain = PerceptionKernels(False)
+    angles = np.radians(np.arange(-90.0, 90.5, 1.0))
+    for ranges, beams in (
+        (np.empty(0), np.empty(0)),
+        (np.full(angles.size, np.nan), angles),
+        (np.full(angles.size, 50.0), angles),
+    ):
+        try:
+            expected = construct_view(ranges, beams, PARAMS, plain)
+            landmarks = find_landmarks(expected, 0.4, plain)
+        except Exception as error:  # noqa: BLE001 (whatever the pieces raise, the fused call must raise too)
+            with pytest.raises(type(error), match=re.escape(str(error))):
+                step_kernels.perceive_scan(ranges, beams, PARAMS, 0.4, 30.0, 1)
+            continue
+        view, lms, points = step_kernels.perceive_scan(ranges, beams, PARAMS, 0.4, 30.0, 1)
+        assert_same_bits(
+            (view.surfaces, view.kinds, view.beams, view.cluster, lms.index, lms.surfaces, lms.kinds),
+            (expected.surfaces, expected.kinds, expected.beams, expected.cluster, *_landmark_arrays(landmarks)),
+        )
+        assert len(view.surfaces) == 0 and points.shape[1] == 2
 
 
 def test_refine_and_score_is_refine_pose_then_measurement_costs_as_written() -> None:
