@@ -119,3 +119,66 @@ def test_the_code_version_ignores_the_bundle(tmp_path: Path, monkeypatch: pytest
     assert versions.code_version.__wrapped__() == checkout
     (package / "methods" / "presets.toml").write_text("[presets.default]\nx = 1\n")
     assert versions.code_version.__wrapped__() != checkout  # package data does count
+
+
+def _build_step(monkeypatch: pytest.MonkeyPatch) -> dict[str, object]:
+    """setup.py's functions, without running its ``setup()`` (which would parse this process's argv)."""
+    import runpy
+
+    import setuptools
+
+    monkeypatch.setattr(setuptools, "setup", lambda **_: None)
+    return runpy.run_path(str(CHECKOUT / "setup.py"))
+
+
+def _fake_kernel_sources(build_lib: Path, body: str) -> None:
+    """A build tree whose ``albot1.methods.kernel_sources`` is ``body``: the build step's child imports it first."""
+    methods = build_lib / "albot1" / "methods"
+    methods.mkdir(parents=True)
+    (build_lib / "albot1" / "__init__.py").write_text("")
+    (methods / "__init__.py").write_text("")
+    (methods / "kernel_sources.py").write_text(body)
+
+
+def test_the_build_step_fails_when_a_kernel_does_not_bundle(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A kernel that does not compile fails the wheel's build with its reason, and leaves no partial bundle.
+
+    A wheel silently without its kernels would cost every install a compile
+    (setup.py, ``bundle_kernels``); only a missing runtime dependency (exit
+    3) builds a wheel without them, with a notice.
+    """
+    step = _build_step(monkeypatch)
+    bundle_kernels = step["bundle_kernels"]
+    assert callable(bundle_kernels)
+    monkeypatch.delenv("ALBOT1_BUILD_KERNELS", raising=False)
+    build_lib = tmp_path / "build"
+    _fake_kernel_sources(
+        build_lib,
+        "from pathlib import Path\n"
+        "def build(dest: Path) -> int:\n"
+        "    (dest / 'part').mkdir(parents=True)\n"
+        "    (dest / 'part' / 'x.nbi').write_text('')\n"
+        "    raise ValueError('kernel update_surfaces: its sample call raised')\n",
+    )
+    with pytest.raises(RuntimeError) as failed:
+        bundle_kernels(build_lib)
+    assert str(failed.value) == (
+        "albot1-bench build: compiling the kernel bundle failed: "
+        "ValueError: kernel update_surfaces: its sample call raised"
+    )
+    assert not (build_lib / "albot1" / "_bundled" / "kernels").exists()  # no partial bundle in the wheel
+
+    missing = tmp_path / "missing"
+    _fake_kernel_sources(missing, "import albot1_no_such_dependency\n")
+    bundle_kernels(missing)  # a wheel without kernels, said once
+    assert capsys.readouterr().err == (
+        "albot1-bench build: the wheel carries no compiled kernels (a runtime dependency is missing from the build "
+        "environment: No module named 'albot1_no_such_dependency')\n"
+    )
+    assert not (missing / "albot1" / "_bundled" / "kernels").exists()
+
+    monkeypatch.setenv("ALBOT1_BUILD_KERNELS", "0")  # asked for a wheel without kernels: the step is not run
+    bundle_kernels(build_lib)
+    assert capsys.readouterr().err == ""
