@@ -18,7 +18,12 @@ the same bits:
   the disagreement (``basis.T @ v`` in numpy), a column-major one for a single
   kept direction and for ``basis @ z``; the information kept, a matrix product
   (``dgemm`` in numpy), is computed column by column with that column-major
-  ``dgemv``, which gives the same bits and spares compiling a third variant.
+  ``dgemv``, which gave the same bits on the Intel Xeon this was written on
+  and spares compiling a third variant. (On an AMD EPYC, OpenBLAS's ``dgemm``
+  and ``dgemv`` round the last bit of this product differently, so there the
+  information kept differs from the old numpy code's by at most one unit in
+  the last place of its largest entry; the poses stay deterministic on each
+  machine.)
   These layouts were found by comparing
   bits (numba calls SciPy's BLAS, numpy its own), and the parity tests
   (``tests/unit/methods/albot1/mapping/test_albot1_screen_kernels.py``)

@@ -42,6 +42,18 @@ def numpy_screen(
     return basis, z, pose, (basis * eigval[keep]) @ basis.T * scale2
 
 
+def columns_kept(info: np.ndarray, basis: np.ndarray) -> np.ndarray:
+    """The information kept as the kernel computes it: numpy's ``dgemv`` one column at a time, then the units."""
+    scale2 = np.outer([1.0, 1.0, M_PER_RAD], [1.0, 1.0, M_PER_RAD])
+    info_u = np.asarray(info, dtype=float) / scale2
+    eigval = np.linalg.eigh(0.5 * (info_u + info_u.T))[0]
+    weighted = np.asfortranarray(basis * eigval[eigval > FLOOR])
+    out = np.empty((3, 3))
+    for j in range(3):
+        out[:, j] = np.dot(weighted, np.ascontiguousarray(basis[j, :]))
+    return out * scale2
+
+
 def _cases() -> Iterator[tuple[tuple[float, float, float], np.ndarray, tuple[float, float, float]]]:
     rng = np.random.default_rng(24)
     for _ in range(400):
@@ -72,5 +84,10 @@ def test_the_kernel_gives_the_bits_of_the_numpy_screen(compiled: bool) -> None:
         assert np.array_equal(k_basis, basis)
         assert np.array_equal(k_z, z)
         assert (x, y, phi) == pose
-        assert np.array_equal(k_info, info_kept)
+        # The information kept: the kernel's column-by-column dgemv, bit for bit; numpy's dgemm of the code before
+        # the kernel (``@``) gives the same bits on the Intel Xeon the kernel was written on, but on an AMD EPYC
+        # its OpenBLAS rounds the last bit differently in about 70 % of these cases, so there it is compared to
+        # one unit in the last place of the matrix's largest entry (docs/albot1-mapper.md, the screen kernel).
+        assert np.array_equal(k_info, columns_kept(info, basis) if basis.shape[1] else np.zeros((3, 3)))
+        assert np.max(np.abs(k_info - info_kept)) <= np.spacing(np.max(np.abs(info_kept)))
     assert kept_counts == {0, 1, 2, 3}
