@@ -19,9 +19,9 @@ A kept view's disagreement is the odometry's error too wherever the fit is preci
 gauss:0.1:1`` the estimate came out at the odometry's own 1 deg per step), and with perfect odometry the fit
 states a quarter to a half of the scatter the kept views show (``docs/albot1-mapper.md``, "Why `plus` leaves
 perfect odometry"). :meth:`ViewNoise.learn_cross` learns it from a disagreement that holds no odometry: the same
-view fitted against the last update view and against the one before it (``view_noise_source = "cross"``). Both
-fits are the view's pose in the map; they differ by the two fits' errors and by the placement of the last update
-view relative to the one before, which is the error a map update freezes.
+view fitted against the last update view and against the one before it (:mod:`.cross_noise`, for the fit noise
+with ``fit_noise_source = "cross"``). Both fits are the view's pose in the map; they differ by the two fits' errors
+and by the placement of the last update view relative to the one before, which is the error a map update freezes.
 """
 
 from __future__ import annotations
