@@ -294,6 +294,15 @@ class Albot1Config(BaseModel):
             " scatter scaled by the square of this over its ratio (0 = every view gets all of it)"
         ),
     )
+    fit_noise_source: Literal["kept", "cross"] = Field(
+        "kept",
+        description=(
+            "Albot1+ fit noise: where the scatter it adds is learnt. kept: the view noise (the kept views'"
+            " disagreement with the odometry's prediction); cross: a view's fit against the last update view"
+            " against its fit against the update view before, which holds no odometry"
+            " (albot1/methods/albot1/mapping/view_noise.py)"
+        ),
+    )
     mount_prior_m: float = Field(
         0.0,
         ge=0,
@@ -392,6 +401,14 @@ class Albot1Config(BaseModel):
                 "refutation_probability needs the view noise (view_noise_learning_rate > 0) and no noise split"
                 " (noise_split_samples = 0): without them it would do nothing"
             )
+        if self.fit_noise_source != "kept" and (
+            self.fit_noise_factor == 0 or self.view_noise_learning_rate == 0 or self.noise_split_samples > 0
+        ):
+            raise ValueError(
+                f"fit_noise_source = {self.fit_noise_source!r} needs the fit noise (fit_noise_factor > 0), the view"
+                " noise (view_noise_learning_rate > 0) and no noise split (noise_split_samples = 0): without them it"
+                " would do nothing"
+            )
         if 0 < self.noise_split_samples < MIN_WEIGHT:
             raise ValueError(
                 f"noise_split_samples: expected 0 (off) or at least {MIN_WEIGHT:g} views (below that the split"
@@ -426,6 +443,7 @@ class Albot1Config(BaseModel):
             turn_statistic=self.turn_bound_statistic,
             consistency=self.consistent_information,
             view_noise_rate=self.view_noise_learning_rate,
+            cross_fit_noise=self.fit_noise_source == "cross",
             fit_noise=self.fit_noise_factor,
             fit_noise_statistic=self.fit_noise_statistic,
             mount_prior=self.mount_prior_m,

@@ -18,7 +18,11 @@ axis, :data:`PRIOR_RAD` in the mount's turn): the degeneracy-aware part -- ``d``
 direction only from translations, and where neither has been seen the mount stays at the identity.
 :meth:`MountCalibration.correct` turns an odometry increment into the scanner's, ``D O D^-1``, while the estimate
 explains at least :data:`EXPLAINED` of the weighted squared disagreement (else the increment is left as it came:
-a mount that explains little is the odometry's own error fitted).
+a mount that explains little is the odometry's own error fitted). The disagreement counts the heading too (at
+``m_per_rad`` metres per radian, the prior's own exchange rate): a mount leaves the headings equal, so a heading
+disagreement is error no mount explains. Without it the mount came on on intel's raw log, whose odometry has a
+systematic heading error that a turned mount half explains in translation (``docs/albot1-mapper.md``, "The wrong
+laser offset, again").
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ import math
 
 import numpy as np
 
-from albot1.geometry.se2 import Pose
+from albot1.geometry.se2 import Pose, wrap_angle
 
 #: Prior standard deviation of the mount's turn (rad): a laser mounted within about 6 deg of the odometry's axis.
 PRIOR_RAD = 0.1
@@ -41,7 +45,10 @@ SOLVE_EVERY = 8
 class MountCalibration:
     """The odometry-to-scanner mount ``D``, estimated online (see the module docstring)."""
 
-    def __init__(self, prior_m: float) -> None:
+    def __init__(self, prior_m: float, m_per_rad: float = 0.0) -> None:
+        """``prior_m``: the prior sd of the mount's position; ``m_per_rad``: a heading disagreement's weight."""
+        self._m_per_rad = m_per_rad
+        self._heading_residual = 0.0  # sum of w (m_per_rad * heading disagreement)^2: no mount explains it
         self._prior = (1.0 / prior_m**2, 1.0 / PRIOR_RAD**2)
         # Normal equations A^T W A (upper triangle, row-major) and A^T W b, prior included; u0 = (0, 0, 1, 0).
         self._ata = [self._prior[0], 0.0, 0.0, 0.0, self._prior[0], 0.0, 0.0, self._prior[1], 0.0, self._prior[1]]
@@ -82,6 +89,7 @@ class MountCalibration:
         v[3] += weight * (-oy * mx + ox * my)
         self._btb += weight * (mx * mx + my * my)
         self._identity_residual += weight * ((mx - ox) ** 2 + (my - oy) ** 2)
+        self._heading_residual += weight * (self._m_per_rad * wrap_angle(measured[2] - th)) ** 2
         self.samples += 1
         if self.samples % SOLVE_EVERY == 0:
             self._solve()
@@ -103,7 +111,9 @@ class MountCalibration:
         if not norm > 0.0:  # no rotation can be read off: keep the last estimate
             return
         residual = self._btb - 2.0 * float(u @ atb) + float(u @ full @ u)
-        self.explained = 1.0 - residual / self._identity_residual if self._identity_residual > 0.0 else 0.0
+        heading = self._heading_residual
+        total = self._identity_residual + heading
+        self.explained = 1.0 - (residual + heading) / total if total > 0.0 else 0.0
         self.active = self.explained >= EXPLAINED
         self.dx, self.dy, self.cos, self.sin = dx, dy, c / norm, s / norm
 

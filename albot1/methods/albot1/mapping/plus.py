@@ -46,9 +46,12 @@ pose is computed:
 10. with ``view_noise_learning_rate``, :mod:`.view_noise` takes the views' own scatter out of the odometry learner's
     samples. With ``consistent_information`` (off in ``plus``), :mod:`.consistency` scales the fit's information down
     to what the ambiguity test's likelihood ratio says the view knows, before the fusion. With ``fit_noise`` (off in
-    ``plus``), :mod:`.fit_noise` adds the view noise to a fused fit's covariance.
+    ``plus``), :mod:`.fit_noise` adds the view noise to a fused fit's covariance; with ``fit_noise_source = "cross"``
+    (off) the scatter it adds is learnt instead from the view's fit against the update view before the last
+    (:meth:`.ViewNoise.learn_cross`), a disagreement that holds no odometry.
 11. with ``mount_prior_m`` (off in ``plus``), :mod:`.mount` learns the odometry-to-scanner mount and corrects the
-    odometry's increments; with ``kept_views_teach`` (on in ``plus``), the ambiguity test's kept views also teach
+    odometry's increments (only while it explains half the disagreement, headings counted); with
+    ``kept_views_teach`` (on in ``plus``), the ambiguity test's kept views also teach
     the learner, so its samples are not only the views that refute the odometry.
 12. with ``refutation_probability`` (off), :mod:`.refutation` keeps the prediction where the view noise explains the
     fit's departure; with ``noise_split_samples`` (off), :mod:`.noise_split` learns the odometry's spread and the views'
@@ -70,6 +73,7 @@ from albot1.geometry.se2 import Pose, between_pose, compose_pose, wrap_angle
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.mapping.ambiguity import Ambiguity, likelihood_ratio, threshold, view_ambiguity
 from albot1.methods.albot1.mapping.consistency import information_scale, stated_distance
+from albot1.methods.albot1.mapping.cross_noise import CrossFit, fixes
 from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_noise
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mount import MountCalibration
@@ -84,8 +88,7 @@ from albot1.methods.albot1.perception.endpoints import STABLE
 
 #: The odometry learner's fixed choices (``docs/albot1-mapper.md``, "Albot1+"): a view teaches it only when its
 #: measurement alone fixes the position to better than 5 cm and the heading to better than 0.05 rad (information
-#: above 400 per m^2 and per rad^2) after at least 5 cm of motion since the update.
-LEARN_MIN_INFO = 400.0
+#: above 400 per m^2 and per rad^2: :func:`.cross_noise.fixes`) after at least 5 cm of motion since the update.
 LEARN_MIN_MOTION_M = 0.05
 #: Variance floors of the prior (m^2, rad^2): odometry is never trusted below 1 cm and 1 mrad.
 PRIOR_FLOOR = (1e-4, 1e-6)
@@ -178,7 +181,12 @@ class PlusLocaliser:
         )
         if self.split is not None:
             self.noise, self.view_noise = self.split, None
-        self.mount = MountCalibration(params.mount_prior) if params.mount_prior > 0.0 else None  # .mount
+        #: The fit noise's scatter from two fits of a view against two update views (:mod:`.cross_noise`).
+        self.cross = (
+            CrossFit(params, kernels.refine_pose) if params.cross_fit_noise and self.view_noise is not None else None
+        )
+        mount = params.mount_prior
+        self.mount = MountCalibration(mount, params.m_per_rad) if mount > 0.0 else None  # :mod:`.mount`
         self._odometry_since: Pose = (0.0, 0.0, 0.0)  # the odometry's own increment, which the mount learns from
         #: Views whose fit left at least one direction to the odometry, and views rejected for the odometry.
         self.degenerate_views = 0
@@ -212,6 +220,8 @@ class PlusLocaliser:
 
         ``odometry``: the view's own odometry (REP-103), which the window test measures motion from.
         """
+        if self.cross is not None:
+            self.cross.reset(self._ref)
         self._ref = np.ascontiguousarray(view_map, dtype=float).reshape(-1, 4)
         self._anchor = pose
         if self.window is not None and odometry is not None:
@@ -250,6 +260,8 @@ class PlusLocaliser:
         measured, info = self._solve(starts, lm_view, lm_map, ok, points, predicted, 0.0, 0.0)
         if p.prior == "off":
             return measured
+        if self.cross is not None and self._motion(since_update) > LEARN_MIN_MOTION_M:
+            self.cross.learn(measured, info, points)
         sigmas = self._sigmas
         #: The turn bound's test of ``measured`` (limit 0), reused by the ambiguity test while ``measured`` stands.
         support: Ambiguity | None = None
@@ -405,12 +417,8 @@ class PlusLocaliser:
         motion teaches: elsewhere the disagreement is the fit's slack, not the odometry's error. Kept views (the
         ambiguity test's, with ``kept_views_teach``) come here without the fusion that follows for fused views.
         """
-        (h00, h01, _), (_, h11, _), (_, _, h22) = rows
         d_phi = wrap_angle(measured[2] - predicted[2])
-        # The smaller eigenvalue of the position block: how well the worst-fixed direction is known.
-        half_trace = 0.5 * (h00 + h11)
-        min_xy = half_trace - math.sqrt(max(0.0, half_trace * half_trace - (h00 * h11 - h01 * h01)))
-        if min_xy > LEARN_MIN_INFO and h22 > LEARN_MIN_INFO and motion > LEARN_MIN_MOTION_M:
+        if motion > LEARN_MIN_MOTION_M and fixes(rows):
             nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
             nu2_phi = d_phi * d_phi
             if self.view_noise is not None:  # the odometry's share of the disagreement (:mod:`.view_noise`)
@@ -457,7 +465,8 @@ class PlusLocaliser:
             h00, h01, h02, h11, h12, h22 = with_fit_noise((h00, h01, h02, h11, h12, h22), self.split.variance, 1.0)
         elif self.params.fit_noise > 0.0 and self.view_noise is not None:  # its measured scatter (:mod:`.fit_noise`)
             f = fit_noise_factor(self.params.fit_noise, statistic, self.params.fit_noise_statistic)
-            h00, h01, h02, h11, h12, h22 = with_fit_noise((h00, h01, h02, h11, h12, h22), self.view_noise.variance, f)
+            scatter = (self.view_noise if self.cross is None else self.cross.noise).variance
+            h00, h01, h02, h11, h12, h22 = with_fit_noise((h00, h01, h02, h11, h12, h22), scatter, f)
         p_xy, p_phi = 1.0 / v_xy, 1.0 / v_phi
         # The prediction's heading unwrapped next to the measured one, so the average does not jump by 2 pi.
         t0, t1, t2 = predicted[0], predicted[1], measured[2] - d_phi

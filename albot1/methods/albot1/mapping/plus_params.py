@@ -41,6 +41,7 @@ class PlusParams:
     turn_statistic: float = 0.0  # a view's likelihood ratio above which the turn bound does not apply
     consistency: float = 0.0  # the fit's information scaled to its likelihood ratio (:mod:`.consistency`); 0 = off
     view_noise_rate: float = 0.0  # the view's own scatter learnt and removed from the learner's samples; 0 = off
+    cross_fit_noise: bool = False  # the fit noise's scatter from two fits of a view against two update views
     fit_noise: float = 0.0  # the view noise, times this, added to a fused fit's covariance (:mod:`.fit_noise`)
     fit_noise_statistic: float = 0.0  # ... falling with the square of the view's likelihood ratio beyond this
     mount_prior: float = 0.0  # m: prior sd of the odometry-to-scanner mount learnt online (:mod:`.mount`); 0 = off

@@ -14,6 +14,14 @@ towards the samples, divided by the chi-square(1) median), and :meth:`ViewNoise.
 teaching view's squared disagreement before the odometry learner sees it:
 ``E[nu^2] = odometry variance + view variance``. Where the odometry is bad the disagreements are far larger
 than the view's scatter and little changes.
+
+A kept view's disagreement is the odometry's error too wherever the fit is precise (on ``intel-corrected
+gauss:0.1:1`` the estimate came out at the odometry's own 1 deg per step), and with perfect odometry the fit
+states a quarter to a half of the scatter the kept views show (``docs/albot1-mapper.md``, "Why `plus` leaves
+perfect odometry"). :meth:`ViewNoise.learn_cross` learns it from a disagreement that holds no odometry: the same
+view fitted against the last update view and against the one before it (:mod:`.cross_noise`, for the fit noise
+with ``fit_noise_source = "cross"``). Both fits are the view's pose in the map; they differ by the two fits' errors
+and by the placement of the last update view relative to the one before, which is the error a map update freezes.
 """
 
 from __future__ import annotations
@@ -52,6 +60,17 @@ class ViewNoise:
         nu2_xy = 0.5 * ((measured[0] - predicted[0]) ** 2 + (measured[1] - predicted[1]) ** 2)
         d_phi = wrap_angle(measured[2] - predicted[2])
         for g, nu2 in ((0, nu2_xy), (1, d_phi * d_phi)):
+            self.variance[g] = median_step(self.variance[g], nu2, self.step)
+
+    def learn_cross(self, first: Pose, second: Pose) -> None:
+        """One view fitted twice, against two update views: half the squared difference is one fit's variance.
+
+        Two independent errors of variance ``v`` differ by a variance ``2 v``; a position sample averages the two
+        axes, as :meth:`learn`'s does.
+        """
+        nu2_xy = 0.25 * ((first[0] - second[0]) ** 2 + (first[1] - second[1]) ** 2)
+        d_phi = wrap_angle(first[2] - second[2])
+        for g, nu2 in ((0, nu2_xy), (1, 0.5 * d_phi * d_phi)):
             self.variance[g] = median_step(self.variance[g], nu2, self.step)
 
     def remove(self, nu2_xy: float, nu2_phi: float) -> tuple[float, float]:

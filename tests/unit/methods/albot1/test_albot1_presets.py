@@ -72,6 +72,7 @@ OLD_DEFAULT: dict[str, Any] = {
     "view_noise_learning_rate": 0.0,
     "fit_noise_factor": 0.0,
     "fit_noise_statistic": 0.0,
+    "fit_noise_source": "kept",
     "mount_prior_m": 0.0,
     "kept_views_teach": False,
     "refutation_probability": 0.0,

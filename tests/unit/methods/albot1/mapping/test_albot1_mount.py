@@ -106,3 +106,18 @@ def test_a_teaching_view_teaches_the_mount_with_the_odometrys_own_increment() ->
     assert odometry == SINCE  # not active: the odometry's increment as it came
     assert measured == pytest.approx(true, abs=0.01) and weight > 0.0  # type: ignore[operator]
     assert localiser().mount is None
+
+
+def test_heading_disagreements_count_against_the_mount_as_what_it_cannot_explain() -> None:
+    # the same exact mount, the views' headings 0.2 rad either side of the odometry's (a mount leaves headings
+    # equal): the share explained is the translation's disagreement over it plus the heading's, at m_per_rad
+    translation = sum((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 for b in STEPS * 2 for a in [scanner(b, MOUNT)])
+    for m_per_rad, active in ((0.0, True), (1.0, False)):
+        cal = MountCalibration(0.5, m_per_rad)
+        for i, step in enumerate(STEPS * 2):
+            x, y, heading = scanner(step, MOUNT)
+            cal.learn(step, (x, y, heading + (0.2 if i % 2 else -0.2)), 1e6)
+        assert (cal.dx, cal.dy, math.atan2(cal.sin, cal.cos)) == pytest.approx(MOUNT, abs=1e-5)
+        heading_part = 2 * len(STEPS) * (m_per_rad * 0.2) ** 2
+        assert cal.explained == pytest.approx(translation / (translation + heading_part), abs=1e-6)
+        assert cal.active == active
