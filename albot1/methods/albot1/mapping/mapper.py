@@ -34,7 +34,7 @@ from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import ODOMETRY_TURNS, PlusLocaliser
 from albot1.methods.albot1.mapping.step_kernels import perceive_scan
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
@@ -263,16 +263,18 @@ class Albot1Mapper:
                 return rl, self._pose_between_updates(rl, prev.pose, step)
             c.double_updates += 1
         # Lines 13-17: update with the current view.
+        reference: int | None
         if self._plus is not None:
-            pose, loc = self._robust_pose(rl, prev.pose, step)
+            pose, reference = self._robust_pose(rl, prev.pose, step)
         else:
             loc = self._localise(rl)
             pose = compose_pose(prev.pose, step) if loc is None else loc.pose
-        if loc is None:
+            reference = None if loc is None else loc.reference_id
+        if reference is None:
             c.path_integration += 1
             source, ref = "odometry", -1
         else:
-            source, ref = ("landmark" if self._plus is None else "robust"), loc.reference_id
+            source, ref = ("landmark" if self._plus is None else "robust"), reference
         tracked = self._update(
             view,
             lms,
@@ -310,17 +312,16 @@ class Albot1Mapper:
             distance_view=self.config.goodness_distance_view,
         )
 
-    def _robust_pose(self, rl: Tracked, prev_pose: Pose, step: Pose) -> tuple[Pose, Localisation | None]:
+    def _robust_pose(self, rl: Tracked, prev_pose: Pose, step: Pose) -> tuple[Pose, int | None]:
         """Albot1+: from the thesis's pose (or the odometry step), robust least squares over every landmark.
 
-        Returns the pose and the thesis's localisation it started from (None:
-        no landmark could place the robot; the start was the odometry).
+        Returns the pose and the landmark id of the thesis's localisation it
+        started from (None: no landmark could place the robot; the start was
+        the odometry). The thesis's localisation and the start poses are one
+        kernel (:func:`~.localise_kernels.robust_starts`: ``localise`` then
+        ``start_poses``, the same bits) on the rows gathered for the fit.
         """
         assert self._plus is not None
-        loc = self._localise(rl)
-        starts = start_poses(
-            compose_pose(prev_pose, step), None if loc is None else loc.pose, None if loc is None else loc.poses
-        )
         rows: list[int] = []
         maps: list[list[float]] = []
         map_kinds: list[list[int]] = []
@@ -330,18 +331,46 @@ class Albot1Mapper:
                 rows.append(r)
                 maps.append(record[0])
                 map_kinds.append(record[1])
+        cfg = self.config
+        d_prev = rl.prev_distance if cfg.goodness_distance_view == "previous" else rl.prev_distance_current
         # Every landmark has its map record (the usual case): the arrays as they are, no copy (issue 24's cost).
-        every = len(rows) == len(rl)
-        lm_view = np.ascontiguousarray((rl.surfaces if every else rl.surfaces[rows]), dtype=float).reshape(-1, 4)
+        if len(rows) == len(rl):
+            lm_view = np.ascontiguousarray(rl.surfaces, dtype=float).reshape(-1, 4)
+            view_kinds, sides, gaps, angle_diffs = rl.kinds.reshape(-1, 2), rl.side, rl.gap, rl.angle_diff
+        else:
+            lm_view = np.ascontiguousarray(rl.surfaces[rows], dtype=float).reshape(-1, 4)
+            view_kinds, sides, gaps, angle_diffs = (
+                rl.kinds[rows].reshape(-1, 2),
+                rl.side[rows],
+                rl.gap[rows],
+                rl.angle_diff[rows],
+            )
+            d_prev = d_prev[rows]
         lm_map = np.asarray(maps, dtype=float).reshape(-1, 4)
-        kinds = (
-            (rl.kinds if every else rl.kinds[rows]).reshape(-1, 2),
-            np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2),
+        kinds = (view_kinds, np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2))
+        odometry = compose_pose(prev_pose, step)
+        starts, best = self._mk.robust_starts(
+            lm_view,
+            kinds[0],
+            lm_map,
+            kinds[1],
+            sides,
+            d_prev,
+            gaps,
+            angle_diffs,
+            odometry[0],
+            odometry[1],
+            odometry[2],
+            ODOMETRY_TURNS,
+            cfg.outlier_min_candidates,
+            cfg.goodness_gap_floor_m,
+            self._angle_floor,
         )
+        reference = None if best < 0 else int(rl.ids[rows[best]])
         since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
         return self._plus.pose(
-            starts, lm_view, lm_map, kinds, self._points, since, self._odometry, loc is not None
-        ), loc
+            starts, lm_view, lm_map, kinds, self._points, since, self._odometry, reference is not None
+        ), reference
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
         """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md).
@@ -350,8 +379,8 @@ class Albot1Mapper:
         start was the odometry still counts in ``odometry_pose_steps``.
         """
         if self._plus is not None:
-            pose, loc = self._robust_pose(rl, prev_pose, step)
-            if loc is None:
+            pose, reference = self._robust_pose(rl, prev_pose, step)
+            if reference is None:
                 self._counts.odometry_pose_steps += 1
             return pose
         if self.config.pose_between_updates == "localise":
