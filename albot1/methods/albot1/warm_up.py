@@ -96,8 +96,9 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
             (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
         ],
         "robust_starts": [
-            (seg, kinds, seg + 0.01, kinds, np.array([0, -1]), np.array([0.5, np.nan]), np.array([0.1, np.nan]))
-            + (np.array([0.01, np.nan]), 0.0, 0.0, 0.0, np.radians(np.arange(-30.0, 31.0, 10.0)), 3, 0.05, 0.02)
+            (seg, kinds, ids, np.array([0, -1]), np.array([0.5, np.nan]), np.array([0.1, np.nan]))
+            + (np.array([0.01, np.nan]), ids[::-1].copy(), seg + 0.01, kinds, 0.0, 0.0, 0.0)
+            + (np.radians(np.arange(-30.0, 31.0, 10.0)), 3, 0.05, 0.02)
         ],
         "detect_exits": [(seg, kinds, 0.6, 1.2, 0.5, 6.0, True)],
         "seen_through": [(seg, ids, np.ones(2, dtype=np.bool_), 0.5, 0.0, poly)],

@@ -28,12 +28,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel
 from albot1.methods.albot1.mapping.localisation import goodness, landmark_pose
 from albot1.methods.albot1.perception.endpoints import STABLE
 from albot1.methods.albot1.perception.recognition import IntArray
+
+BoolArray = NDArray[np.bool_]
 
 #: Veltkamp's constant 2**27 + 1: ``t - (t - x)`` with ``t = x * _SPLIT`` keeps the top 26 bits of ``x``.
 _SPLIT = 134217729.0
@@ -118,14 +121,16 @@ def python_hypot(x: float, y: float) -> float:
 
 @kernel
 def robust_starts(
-    lm_view: FloatArray,
-    view_kinds: IntArray,
-    lm_map: FloatArray,
-    map_kinds: IntArray,
+    surfaces: FloatArray,
+    kinds: IntArray,
+    ids: IntArray,
     sides: IntArray,
     d_prev: FloatArray,
     gaps: FloatArray,
     angle_diffs: FloatArray,
+    lm_ids: IntArray,
+    lm_segs: FloatArray,
+    lm_kinds: IntArray,
     odometry_x: float,
     odometry_y: float,
     odometry_phi: float,
@@ -133,56 +138,87 @@ def robust_starts(
     min_candidates: int,
     gap_floor: float,
     angle_floor: float,
-) -> tuple[FloatArray, int]:
-    """Albot1+'s start poses and the thesis localisation's chosen landmark row (-1: no landmark placed the robot).
+) -> tuple[FloatArray, FloatArray, FloatArray, BoolArray, int]:
+    """Albot1+'s start poses, its landmark rows, and the thesis localisation's chosen row (-1: none placed the robot).
 
-    Row ``r`` of every array is one recognised landmark that has a map
-    record: its surface now (``lm_view``) and in the record (``lm_map``),
-    endpoint labels now and there, matched side, ``d_R``, gap and angle
-    difference (NaN: a list reset from a view), in the order ``localise``
-    visits them. Returns what
-    ``start_poses(odometry, loc.pose, loc.poses)`` returns for ``loc =
-    localise(...)`` (the thesis pose, the odometry, every candidate; without
-    a candidate the odometry turned by each of ``turns``) and the row of
-    ``loc``'s landmark.
+    ``surfaces`` ... ``angle_diffs``: the recognised landmark list (a
+    :class:`~albot1.methods.albot1.perception.recognition.Tracked`'s arrays;
+    ``d_prev`` its ``prev_distance`` or ``prev_distance_current``, NaN for a
+    list reset from a view). ``lm_ids``, ``lm_segs``, ``lm_kinds``: the
+    landmark map, each landmark as placed at the update that introduced it;
+    a tracked landmark's record is the last row with its id (the mapper's
+    dict of them kept the last). Returns, over the tracked rows that have a
+    record (in their order):
+
+    * what ``start_poses(odometry, loc.pose, loc.poses)`` returns for ``loc
+      = localise(...)``: the thesis pose, the odometry, every candidate
+      (without a candidate: the odometry turned by each of ``turns``);
+    * their surfaces now and in the map (``(k, 4)``), and which endpoints
+      are stable both now and there (``(k, 2)``): the pose fit's inputs;
+    * the tracked row of ``loc``'s landmark (-1 when ``loc`` is None).
     """
-    k = lm_view.shape[0]
+    n = surfaces.shape[0]
+    record = np.empty(n, dtype=np.int64)
+    k = 0
+    for r in range(n):
+        record[r] = -1
+        for m in range(lm_ids.shape[0] - 1, -1, -1):
+            if lm_ids[m] == ids[r]:
+                record[r] = m
+                k += 1
+                break
+    lm_view = np.empty((k, 4))
+    lm_map = np.empty((k, 4))
+    ok = np.empty((k, 2), dtype=np.bool_)
     side_of = np.empty(k, dtype=np.int64)
+    rows = np.empty(k, dtype=np.int64)
     c = 0
-    for r in range(k):
+    j = 0
+    for r in range(n):
+        m = record[r]
+        if m < 0:
+            continue
+        for q in range(4):
+            lm_view[j, q] = surfaces[r, q]
+            lm_map[j, q] = lm_segs[m, q]
+        for s in range(2):
+            ok[j, s] = STABLE[kinds[r, s]] and STABLE[lm_kinds[m, s]]
         # localise's rule: the matched side first, then the other (P1 first when unmatched); stable now and there
         first = sides[r] if sides[r] >= 0 else 0
-        side_of[r] = -1
+        side_of[j] = -1
         for s in (first, 1 - first):
-            if STABLE[view_kinds[r, s]] and STABLE[map_kinds[r, s]]:
-                side_of[r] = s
+            if ok[j, s]:
+                side_of[j] = s
                 c += 1
                 break
+        rows[j] = r
+        j += 1
     if c == 0:
         starts = np.empty((turns.shape[0], 3))
         for i in range(turns.shape[0]):
             starts[i, 0] = odometry_x
             starts[i, 1] = odometry_y
             starts[i, 2] = odometry_phi + turns[i]
-        return starts, -1
+        return starts, lm_view, lm_map, ok, -1
     starts = np.empty((2 + c, 3))
     scores = np.empty(c)
-    rows = np.empty(c, dtype=np.int64)
-    j = 0
-    for r in range(k):
-        if side_of[r] < 0:
+    chosen = np.empty(c, dtype=np.int64)
+    i = 0
+    for j in range(k):
+        if side_of[j] < 0:
             continue
-        x, y, phi = landmark_pose(lm_map[r], lm_view[r], side_of[r])
-        starts[2 + j, 0] = x
-        starts[2 + j, 1] = y
-        starts[2 + j, 2] = phi
-        length = python_hypot(lm_view[r, 2] - lm_view[r, 0], lm_view[r, 3] - lm_view[r, 1])
+        r = rows[j]
+        x, y, phi = landmark_pose(lm_map[j], lm_view[j], side_of[j])
+        starts[2 + i, 0] = x
+        starts[2 + i, 1] = y
+        starts[2 + i, 2] = phi
+        length = python_hypot(lm_view[j, 2] - lm_view[j, 0], lm_view[j, 3] - lm_view[j, 1])
         d_r = d_prev[r] if d_prev[r] == d_prev[r] else 1.0
         g = gaps[r] if gaps[r] == gaps[r] else gap_floor
         a = angle_diffs[r] if angle_diffs[r] == angle_diffs[r] else angle_floor
-        scores[j] = goodness(length, d_r, g, a, gap_floor, angle_floor)
-        rows[j] = r
-        j += 1
+        scores[i] = goodness(length, d_r, g, a, gap_floor, angle_floor)
+        chosen[i] = r
+        i += 1
     # outlier_keep, then the first best-scored kept candidate (max's rule: only a strictly larger score replaces)
     best = -1
     if c < min_candidates:
@@ -216,4 +252,4 @@ def robust_starts(
     starts[1, 0] = odometry_x
     starts[1, 1] = odometry_y
     starts[1, 2] = odometry_phi
-    return starts, rows[best]
+    return starts, lm_view, lm_map, ok, chosen[best]

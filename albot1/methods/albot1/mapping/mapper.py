@@ -122,6 +122,12 @@ class Albot1Mapper:
         self._stationary_rad = math.radians(config.stationary_deg)
         self.map = PerceptualMap()
         self._landmark_map: dict[int, tuple[list[float], list[int]]] = {}
+        #: Albot1+'s landmark map instead: ids ``(m,)``, surfaces as placed ``(m, 4)``, endpoint labels ``(m, 2)``
+        self._landmark_rows: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]] = (
+            np.empty(0, dtype=np.int64),
+            np.empty((0, 4)),
+            np.empty((0, 2), dtype=np.int64),
+        )
         self._poses: list[Pose] = []
         self._prev: _Step | None = None
         self._u_step = -1
@@ -317,47 +323,22 @@ class Albot1Mapper:
 
         Returns the pose and the landmark id of the thesis's localisation it
         started from (None: no landmark could place the robot; the start was
-        the odometry). The thesis's localisation and the start poses are one
-        kernel (:func:`~.localise_kernels.robust_starts`: ``localise`` then
-        ``start_poses``, the same bits) on the rows gathered for the fit.
+        the odometry). The landmark rows, the thesis's localisation and the
+        start poses are one kernel (:func:`~.localise_kernels.robust_starts`:
+        ``localise`` then ``start_poses``, with the same bits).
         """
         assert self._plus is not None
-        rows: list[int] = []
-        maps: list[list[float]] = []
-        map_kinds: list[list[int]] = []
-        for r, sid in enumerate(rl.ids.tolist()):
-            record = self._landmark_map.get(sid)
-            if record is not None:
-                rows.append(r)
-                maps.append(record[0])
-                map_kinds.append(record[1])
         cfg = self.config
-        d_prev = rl.prev_distance if cfg.goodness_distance_view == "previous" else rl.prev_distance_current
-        # Every landmark has its map record (the usual case): the arrays as they are, no copy (issue 24's cost).
-        if len(rows) == len(rl):
-            lm_view = np.ascontiguousarray(rl.surfaces, dtype=float).reshape(-1, 4)
-            view_kinds, sides, gaps, angle_diffs = rl.kinds.reshape(-1, 2), rl.side, rl.gap, rl.angle_diff
-        else:
-            lm_view = np.ascontiguousarray(rl.surfaces[rows], dtype=float).reshape(-1, 4)
-            view_kinds, sides, gaps, angle_diffs = (
-                rl.kinds[rows].reshape(-1, 2),
-                rl.side[rows],
-                rl.gap[rows],
-                rl.angle_diff[rows],
-            )
-            d_prev = d_prev[rows]
-        lm_map = np.asarray(maps, dtype=float).reshape(-1, 4)
-        kinds = (view_kinds, np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2))
         odometry = compose_pose(prev_pose, step)
-        starts, best = self._mk.robust_starts(
-            lm_view,
-            kinds[0],
-            lm_map,
-            kinds[1],
-            sides,
-            d_prev,
-            gaps,
-            angle_diffs,
+        starts, lm_view, lm_map, ok, best = self._mk.robust_starts(
+            rl.surfaces,
+            rl.kinds,
+            rl.ids,
+            rl.side,
+            rl.prev_distance if cfg.goodness_distance_view == "previous" else rl.prev_distance_current,
+            rl.gap,
+            rl.angle_diff,
+            *self._landmark_rows,
             odometry[0],
             odometry[1],
             odometry[2],
@@ -366,10 +347,10 @@ class Albot1Mapper:
             cfg.goodness_gap_floor_m,
             self._angle_floor,
         )
-        reference = None if best < 0 else int(rl.ids[rows[best]])
-        since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
-        return self._plus.pose(
-            starts, lm_view, lm_map, kinds, self._points, since, self._odometry, reference is not None
+        reference = None if best < 0 else int(rl.ids[best])
+        since = motion_step(between_pose(self._update_odometry, self._odometry), cfg.motion_model)
+        return self._plus.pose_stable(
+            starts, lm_view, lm_map, ok, self._points, since, self._odometry, reference is not None
         ), reference
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
@@ -420,8 +401,11 @@ class Albot1Mapper:
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]
-        # As Python lists: localisation reads them as scalars every scan.
-        self._landmark_map = dict(zip(ids.tolist(), zip(lm_map.tolist(), lms.kinds.tolist())))
+        if self._plus is None:
+            # As Python lists: localisation reads them as scalars every scan.
+            self._landmark_map = dict(zip(ids.tolist(), zip(lm_map.tolist(), lms.kinds.tolist())))
+        else:  # as arrays: Albot1+'s kernel (robust_starts) reads them
+            self._landmark_rows = (ids, lm_map, lms.kinds)
         self._u_step = view_scan
         c.surfaces_added += len(out.added)
         c.surfaces_deleted += len(out.deleted)

@@ -238,8 +238,25 @@ class PlusLocaliser:
         view's own odometry (REP-103; the window test's); ``placed``: a
         landmark placed the robot (False: the turn bound applies).
         """
-        p = self.params
         ok = np.ascontiguousarray(STABLE[lm_kinds[0]] & STABLE[lm_kinds[1]]).reshape(-1, 2)
+        return self.pose_stable(starts, lm_view, lm_map, ok, points, since_update, odometry, placed)
+
+    def pose_stable(
+        self,
+        starts: FloatArray,
+        lm_view: FloatArray,
+        lm_map: FloatArray,
+        ok: NDArray[np.bool_],
+        points: FloatArray,
+        since_update: Pose,
+        odometry: Pose | None = None,
+        placed: bool = True,
+    ) -> Pose:
+        """:meth:`pose` given which endpoints ``ok`` ``(k, 2)`` are stable now and in the map (C-contiguous).
+
+        The mapper's kernel (:func:`~.localise_kernels.robust_starts`) computes ``ok`` with the landmark rows.
+        """
+        p = self.params
         if self.mount is not None:  # the scanner's increment, not the odometry frame's (:mod:`.mount`)
             self._odometry_since, since_update = since_update, self.mount.correct(since_update)
         predicted = compose_pose(self._anchor, since_update)

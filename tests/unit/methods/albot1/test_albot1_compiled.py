@@ -276,12 +276,14 @@ def _screen_args() -> Iterator[tuple[Any, ...]]:
 
 
 def _robust_starts_args() -> Iterator[tuple[Any, ...]]:
-    """Recognised landmarks with every endpoint label, matched or fresh (NaN match data), some outliers, ties."""
+    """Recognised landmarks with every endpoint label, matched or fresh (NaN match data), some outliers, ties,
+    some without a map record, some ids twice in the map."""
     rng = np.random.default_rng(6)
     turns = np.radians(np.arange(-30.0, 31.0, 10.0))
     for i in range(60):
         k = i % 9
         view = rng.uniform(-6.0, 6.0, (k, 4))
+        ids = rng.permutation(20)[:k].astype(np.int64)
         lm_map = view + rng.normal(0.0, 0.5 if i % 4 == 0 else 0.01, (k, 4)) + rng.uniform(-1.0, 1.0, 4)
         if i % 6 == 0 and k > 1:
             view[1], lm_map[1] = view[0], lm_map[0]  # a tie: the first candidate wins
@@ -290,8 +292,12 @@ def _robust_starts_args() -> Iterator[tuple[Any, ...]]:
         sides = np.full(k, -1, dtype=np.int64) if i % 5 == 0 else rng.integers(-1, 2, k).astype(np.int64)
         kinds = rng.integers(0, 4, (2, k, 2)).astype(np.int64)
         d_prev, gaps, angle_diffs = (np.ascontiguousarray(row) for row in match)
-        rows = (view, kinds[0], lm_map, kinds[1], sides, d_prev, gaps, angle_diffs)
-        yield (*rows, 0.3, -0.2, 1.0, turns, 2 + i % 3, 0.01, 0.002)
+        recorded = rng.permutation(k)[: k - i % 2]  # an odd case leaves one landmark without its record
+        lm_ids = np.concatenate([ids[recorded], ids[recorded[:1]]])  # one id twice: its last row counts
+        lm_rows = np.concatenate([lm_map[recorded], lm_map[recorded[:1]] + 0.5])
+        lm_kinds = np.concatenate([kinds[1][recorded], kinds[1][recorded[:1]]])
+        tracked = (view, kinds[0], ids, sides, d_prev, gaps, angle_diffs)
+        yield (*tracked, lm_ids, lm_rows, lm_kinds, 0.3, -0.2, 1.0, turns, 2 + i % 3, 0.01, 0.002)
 
 
 CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {

@@ -24,6 +24,7 @@ from albot1.methods.albot1.mapping import localise_kernels
 from albot1.methods.albot1.mapping.localisation import localise
 from albot1.methods.albot1.mapping.localise_kernels import python_hypot, robust_starts
 from albot1.methods.albot1.mapping.plus import ODOMETRY_TURNS, start_poses
+from albot1.methods.albot1.perception.endpoints import STABLE
 from albot1.methods.albot1.perception.landmarks import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
 from albot1.methods.albot1.perception.recognition import Tracked
 
@@ -120,8 +121,11 @@ def test_python_hypot_property_any_two_floats(x: float, y: float) -> None:
 KINDS = [UNSTABLE, OCCLUDING, CORNER, OCCLUDED]
 
 
-def _case(rng: np.random.Generator, k: int, fresh: bool, ties: bool) -> tuple[Tracked, dict[int, Any], list[int]]:
-    """``k`` recognised landmarks (some without a map record), their records, and the rows that have one."""
+Rows = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def _case(rng: np.random.Generator, k: int, fresh: bool, ties: bool) -> tuple[Tracked, Rows]:
+    """``k`` recognised landmarks and a landmark map: some without a record, some ids twice, other landmarks too."""
     true = rng.uniform(-3.0, 3.0, 3)
     c, s = math.cos(true[2]), math.sin(true[2])
     surfaces = rng.uniform(-6.0, 6.0, (k, 4))
@@ -149,54 +153,49 @@ def _case(rng: np.random.Generator, k: int, fresh: bool, ties: bool) -> tuple[Tr
             for a in (rl.side, rl.gap, rl.angle_diff, rl.prev_distance, rl.prev_distance_current):
                 a[1] = a[0]
             rl.kinds[1] = rl.kinds[0]
-    records: dict[int, Any] = {}
-    rows: list[int] = []
-    for r in range(k):
+    lm_ids: list[int] = []
+    segs: list[np.ndarray] = []
+    for r in rng.permutation(k):
         if rng.random() < 0.15:
-            continue  # no map record: localise skips it, the mapper gathers no row
+            continue  # no map record: localise skips it, and so does the kernel
         seg = surfaces[r].reshape(2, 2)
-        placed = np.column_stack([c * seg[:, 0] - s * seg[:, 1], s * seg[:, 0] + c * seg[:, 1]]) + true[:2]
-        placed = placed + rng.normal(0.0, 0.3 if rng.random() < 0.3 else 0.01, (2, 2))  # outliers now and then
-        records[int(ids[r])] = (placed.reshape(4).tolist(), rng.choice(KINDS, 2).tolist())
-        rows.append(r)
-    return rl, records, rows
+        for _ in range(2 if rng.random() < 0.1 else 1):  # an id twice: the last record counts
+            placed = np.column_stack([c * seg[:, 0] - s * seg[:, 1], s * seg[:, 0] + c * seg[:, 1]]) + true[:2]
+            segs.append((placed + rng.normal(0.0, 0.3 if rng.random() < 0.3 else 0.01, (2, 2))).reshape(4))
+            lm_ids.append(int(ids[r]))
+    for other in range(50, 50 + int(rng.integers(0, 3))):  # landmarks of the map not tracked now
+        segs.append(rng.uniform(-6.0, 6.0, 4))
+        lm_ids.append(other)
+    m = len(lm_ids)
+    rows = (np.asarray(lm_ids, dtype=np.int64), np.asarray(segs).reshape(m, 4), rng.choice(KINDS, (m, 2)))
+    return rl, (rows[0], rows[1], rows[2].astype(np.int64))
 
 
-def _cases() -> Iterator[tuple[Tracked, dict[int, Any], list[int], int]]:
+def _cases() -> Iterator[tuple[Tracked, Rows, int]]:
     rng = np.random.default_rng(11)
     for i in range(400):
         k = int(rng.integers(0, 9))
         yield (*_case(rng, k, fresh=i % 5 == 0, ties=i % 7 == 0), 3 if i % 3 else 2)
 
 
-def _arguments(rl: Tracked, records: dict[int, Any], rows: list[int], min_candidates: int, view: str) -> tuple:
-    """``robust_starts``' arguments as the mapper gathers them (``Albot1Mapper._robust_pose``)."""
-    d_prev = rl.prev_distance if view == "previous" else rl.prev_distance_current
-    return (
-        np.ascontiguousarray(rl.surfaces[rows], dtype=float).reshape(-1, 4),
-        rl.kinds[rows].reshape(-1, 2),
-        np.asarray([records[int(rl.ids[r])][0] for r in rows], dtype=float).reshape(-1, 4),
-        np.asarray([records[int(rl.ids[r])][1] for r in rows], dtype=np.int64).reshape(-1, 2),
-        rl.side[rows],
-        d_prev[rows],
-        rl.gap[rows],
-        rl.angle_diff[rows],
-        0.4,
-        -1.2,
-        2.9,
-        ODOMETRY_TURNS,
-        min_candidates,
-        0.01,
-        math.radians(0.5),
-    )
+def _before(rl: Tracked, records: dict[int, Any]) -> tuple[np.ndarray, ...]:
+    """The pose fit's landmark arrays as the mapper gathered them before the kernel (a dict of records)."""
+    rows = [r for r, sid in enumerate(rl.ids.tolist()) if sid in records]
+    lm_view = np.ascontiguousarray(rl.surfaces[rows], dtype=float).reshape(-1, 4)
+    lm_map = np.asarray([records[int(rl.ids[r])][0] for r in rows], dtype=float).reshape(-1, 4)
+    map_kinds = np.asarray([records[int(rl.ids[r])][1] for r in rows], dtype=np.int64).reshape(-1, 2)
+    ok = np.ascontiguousarray(STABLE[rl.kinds[rows].reshape(-1, 2)] & STABLE[map_kinds]).reshape(-1, 2)
+    return lm_view, lm_map, ok
 
 
 @pytest.mark.parametrize("fn", [robust_starts, as_written(robust_starts)], ids=["compiled", "as written"])
 def test_robust_starts_is_localise_then_start_poses(fn: Callable[..., Any]) -> None:
     chosen = none = 0
-    for rl, records, rows, min_candidates in _cases():
+    odometry = (0.4, -1.2, 2.9)
+    for rl, rows, min_candidates in _cases():
+        # the mapper's dict of records (the last of an id's rows kept), as localise reads it
+        records = dict(zip(rows[0].tolist(), zip(rows[1].tolist(), rows[2].tolist())))
         for view in ("previous", "current"):
-            args = _arguments(rl, records, rows, min_candidates, view)
             loc = localise(
                 rl,
                 records,
@@ -205,16 +204,21 @@ def test_robust_starts_is_localise_then_start_poses(fn: Callable[..., Any]) -> N
                 angle_floor=math.radians(0.5),
                 distance_view=view,
             )
-            odometry = (0.4, -1.2, 2.9)
             expected = start_poses(odometry, None if loc is None else loc.pose, None if loc is None else loc.poses)
-            starts, best = fn(*args)
+            d_prev = rl.prev_distance if view == "previous" else rl.prev_distance_current
+            tracked = (rl.surfaces, rl.kinds, rl.ids, rl.side, d_prev, rl.gap, rl.angle_diff)
+            settings = (ODOMETRY_TURNS, min_candidates, 0.01, math.radians(0.5))
+            starts, lm_view, lm_map, ok, best = fn(*tracked, *rows, *odometry, *settings)
             assert starts.shape == expected.shape and starts.flags.c_contiguous
             assert np.array_equal(starts.view(np.int64), expected.view(np.int64))
+            for got, want in zip((lm_view, lm_map, ok), _before(rl, records)):
+                assert got.dtype == want.dtype and got.shape == want.shape and got.flags.c_contiguous
+                assert got.tobytes() == want.tobytes()  # bit for bit
             if loc is None:
                 assert best == -1
                 none += 1
             else:
-                assert int(rl.ids[rows[best]]) == loc.reference_id
+                assert int(rl.ids[best]) == loc.reference_id
                 chosen += 1
     assert chosen > 400 and none > 50
 
@@ -229,40 +233,35 @@ def test_robust_starts_on_a_hand_case_keeps_the_consistent_best() -> None:
     lm_map = placed.reshape(-1, 4).copy()
     lm_map[3] += [2.0, 0.0, 2.0, 0.0]
     kinds = np.full((4, 2), OCCLUDING, dtype=np.int64)
-    gaps = np.array([0.2, 0.05, 0.1, 0.001])  # the outlier scores best, landmark 1 best among the others
+    ids = np.array([7, 8, 9, 10])
+    gaps = np.array([0.2, 0.05, 0.1, 0.001])  # the outlier scores best, landmark 8 best among the others
     ones = np.ones(4)
-    starts, best = robust_starts(
-        view,
-        kinds,
-        lm_map,
-        kinds,
-        np.zeros(4, np.int64),
-        ones,
-        gaps,
-        ones * 0.01,
-        0.5,
-        0.6,
-        0.7,
-        ODOMETRY_TURNS,
-        3,
-        0.01,
-        0.001,
-    )
+    # the map lists them in another order, with a landmark not seen now
+    order = [3, 1, 0, 2]
+    rows = (np.append(ids[order], 11), np.vstack([lm_map[order], np.zeros(4)]), np.vstack([kinds, kinds[:1]]))
+    tracked = (view, kinds, ids, np.zeros(4, np.int64), ones, gaps, ones * 0.01)
+    starts, lm_view, got_map, ok, best = robust_starts(*tracked, *rows, 0.5, 0.6, 0.7, ODOMETRY_TURNS, 3, 0.01, 0.001)
     assert best == 1
     assert starts.shape == (6, 3)
     assert starts[0] == pytest.approx(true, abs=1e-12)
     assert starts[1].tolist() == [0.5, 0.6, 0.7]
     assert starts[2 + 3, :2] == pytest.approx((true[0] + 2.0, true[1]), abs=1e-12)  # the outlier, dropped
+    assert lm_view.tolist() == view.tolist() and got_map.tolist() == lm_map.tolist()
+    assert ok.all()
 
 
 def test_robust_starts_without_a_stable_landmark_turns_the_odometry() -> None:
-    view = np.array([[-1.0, 2.0, 0.0, 2.0]])
-    kinds = np.array([[UNSTABLE, UNSTABLE]], dtype=np.int64)
-    nan = np.full(1, np.nan)
-    starts, best = robust_starts(
-        view, kinds, view, kinds, np.full(1, -1), nan, nan, nan, 0.5, 0.6, 0.7, ODOMETRY_TURNS, 3, 0.01, 0.001
-    )
+    view = np.array([[-1.0, 2.0, 0.0, 2.0], [0.0, 1.0, 1.0, 1.0]])
+    kinds = np.array([[UNSTABLE, UNSTABLE], [CORNER, CORNER]], dtype=np.int64)
+    ids = np.array([3, 4])
+    nan = np.full(2, np.nan)
+    # landmark 4 has no record: only landmark 3's rows come back, with no stable endpoint
+    tracked = (view, kinds, ids, np.full(2, -1), nan, nan, nan)
+    rows = (np.array([3]), view[:1] + 1.0, kinds[:1])
+    starts, lm_view, lm_map, ok, best = robust_starts(*tracked, *rows, 0.5, 0.6, 0.7, ODOMETRY_TURNS, 3, 0.01, 0.001)
     assert best == -1
     assert starts.shape == (ODOMETRY_TURNS.size, 3)
     assert starts[:, :2].tolist() == [[0.5, 0.6]] * ODOMETRY_TURNS.size
     assert np.array_equal(starts[:, 2], 0.7 + ODOMETRY_TURNS)
+    assert lm_view.tolist() == view[:1].tolist() and lm_map.tolist() == (view[:1] + 1.0).tolist()
+    assert ok.tolist() == [[False, False]]
