@@ -375,6 +375,8 @@ COMPILE_CPU_S: dict[str, float] = {
     # refine_pose and measurement_costs (its follower: their code reused)
     "perceive": 3.1,
     "refine_and_score": 0.31,
+    # plusfast11, under load 6-7: 3.78 and 3.20 s, scaled by update_surfaces' idle/loaded ratio (3.44 / 10.5 s)
+    "robust_starts": 1.15,
 }
 #: CPU seconds per source line for a kernel not (yet) in :data:`COMPILE_CPU_S`: about what the measured ones cost
 _CPU_S_PER_LINE = 0.012
