@@ -95,6 +95,11 @@ def _samples() -> dict[str, list[tuple[Any, ...]]]:
         "refine_and_score": [
             (starts, seg, seg + 0.01, ok, points, seg, 0.0, 0.0, 0.0, 0.05, 0.1, 0.05, 2.0, 0.5, 8, math.inf)
         ],
+        "robust_starts": [
+            (seg, kinds, ids, np.array([0, -1]), np.array([0.5, np.nan]), np.array([0.1, np.nan]))
+            + (np.array([0.01, np.nan]), ids[::-1].copy(), seg + 0.01, kinds, 0.0, 0.0, 0.0)
+            + (np.radians(np.arange(-30.0, 31.0, 10.0)), 3, 0.05, 0.02)
+        ],
         "detect_exits": [(seg, kinds, 0.6, 1.2, 0.5, 6.0, True)],
         "seen_through": [(seg, ids, np.ones(2, dtype=np.bool_), 0.5, 0.0, poly)],
         "near_exit": [(seg, ids, ids, 1, 10, 1, 0.5, 0.0, 0.5)],
@@ -370,6 +375,8 @@ COMPILE_CPU_S: dict[str, float] = {
     # refine_pose and measurement_costs (its follower: their code reused)
     "perceive": 3.1,
     "refine_and_score": 0.31,
+    # plusfast11, under load 6-7: 3.78 and 3.20 s, scaled by update_surfaces' idle/loaded ratio (3.44 / 10.5 s)
+    "robust_starts": 1.15,
 }
 #: CPU seconds per source line for a kernel not (yet) in :data:`COMPILE_CPU_S`: about what the measured ones cost
 _CPU_S_PER_LINE = 0.012

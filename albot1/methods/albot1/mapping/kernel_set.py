@@ -9,7 +9,7 @@ and the parity tests), and so that a warm-up can list what it must compile
 from __future__ import annotations
 
 from albot1.methods.albot1.compiled import select
-from albot1.methods.albot1.mapping import ambiguity, pose_kernels, screen_kernels, step_kernels
+from albot1.methods.albot1.mapping import ambiguity, localise_kernels, pose_kernels, screen_kernels, step_kernels
 from albot1.methods.albot1.mapping.kernels import place_segments
 from albot1.methods.albot1.mapping.update_kernels import update_surfaces
 
@@ -31,7 +31,15 @@ class MappingKernels:
         """
         if pose_estimate == "robust":
             return MappingKernels.FUSED
-        return ("refine_pose", "scan_points", "measurement_costs", "screen_directions", "perceive", "refine_and_score")
+        return (
+            "refine_pose",
+            "scan_points",
+            "measurement_costs",
+            "screen_directions",
+            "perceive",
+            "refine_and_score",
+            "robust_starts",
+        )
 
     def __init__(self, compiled: bool = True) -> None:
         self.compiled = compiled
@@ -44,3 +52,5 @@ class MappingKernels:
         # Fused entry points (:mod:`.step_kernels`): one call per scan where the pieces above took two or three.
         self.perceive = select(step_kernels.perceive, compiled)
         self.refine_and_score = select(step_kernels.refine_and_score, compiled)
+        # Albot1+'s start poses from the thesis's localisation (:mod:`.localise_kernels`), one call per fit
+        self.robust_starts = select(localise_kernels.robust_starts, compiled)

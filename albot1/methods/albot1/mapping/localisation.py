@@ -177,7 +177,9 @@ def localise(
     that record, the matched side first. A list freshly reset from a view
     has no match data (gap, angle, d_R): its landmarks rank by length alone.
     Runs on Python scalars: a handful of landmarks per scan, where numpy's
-    per-call overhead would cost more than the arithmetic.
+    per-call overhead would cost more than the arithmetic. Albot1+ runs the
+    same steps compiled, with its start poses, in one kernel
+    (:func:`~.localise_kernels.robust_starts`; the tests hold the two to the same bits).
     """
     ids: list[int] = []
     poses: list[Pose] = []

@@ -34,7 +34,7 @@ from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import ODOMETRY_TURNS, PlusLocaliser
 from albot1.methods.albot1.mapping.step_kernels import perceive_scan
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments
@@ -122,6 +122,12 @@ class Albot1Mapper:
         self._stationary_rad = math.radians(config.stationary_deg)
         self.map = PerceptualMap()
         self._landmark_map: dict[int, tuple[list[float], list[int]]] = {}
+        #: Albot1+'s landmark map instead: ids ``(m,)``, surfaces as placed ``(m, 4)``, endpoint labels ``(m, 2)``
+        self._landmark_rows: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]] = (
+            np.empty(0, dtype=np.int64),
+            np.empty((0, 4)),
+            np.empty((0, 2), dtype=np.int64),
+        )
         self._poses: list[Pose] = []
         self._prev: _Step | None = None
         self._u_step = -1
@@ -263,16 +269,18 @@ class Albot1Mapper:
                 return rl, self._pose_between_updates(rl, prev.pose, step)
             c.double_updates += 1
         # Lines 13-17: update with the current view.
+        reference: int | None
         if self._plus is not None:
-            pose, loc = self._robust_pose(rl, prev.pose, step)
+            pose, reference = self._robust_pose(rl, prev.pose, step)
         else:
             loc = self._localise(rl)
             pose = compose_pose(prev.pose, step) if loc is None else loc.pose
-        if loc is None:
+            reference = None if loc is None else loc.reference_id
+        if reference is None:
             c.path_integration += 1
             source, ref = "odometry", -1
         else:
-            source, ref = ("landmark" if self._plus is None else "robust"), loc.reference_id
+            source, ref = ("landmark" if self._plus is None else "robust"), reference
         tracked = self._update(
             view,
             lms,
@@ -310,38 +318,40 @@ class Albot1Mapper:
             distance_view=self.config.goodness_distance_view,
         )
 
-    def _robust_pose(self, rl: Tracked, prev_pose: Pose, step: Pose) -> tuple[Pose, Localisation | None]:
+    def _robust_pose(self, rl: Tracked, prev_pose: Pose, step: Pose) -> tuple[Pose, int | None]:
         """Albot1+: from the thesis's pose (or the odometry step), robust least squares over every landmark.
 
-        Returns the pose and the thesis's localisation it started from (None:
-        no landmark could place the robot; the start was the odometry).
+        Returns the pose and the landmark id of the thesis's localisation it
+        started from (None: no landmark could place the robot; the start was
+        the odometry). The landmark rows, the thesis's localisation and the
+        start poses are one kernel (:func:`~.localise_kernels.robust_starts`:
+        ``localise`` then ``start_poses``, with the same bits).
         """
         assert self._plus is not None
-        loc = self._localise(rl)
-        starts = start_poses(
-            compose_pose(prev_pose, step), None if loc is None else loc.pose, None if loc is None else loc.poses
+        cfg = self.config
+        odometry = compose_pose(prev_pose, step)
+        starts, lm_view, lm_map, ok, best = self._mk.robust_starts(
+            rl.surfaces,
+            rl.kinds,
+            rl.ids,
+            rl.side,
+            rl.prev_distance if cfg.goodness_distance_view == "previous" else rl.prev_distance_current,
+            rl.gap,
+            rl.angle_diff,
+            *self._landmark_rows,
+            odometry[0],
+            odometry[1],
+            odometry[2],
+            ODOMETRY_TURNS,
+            cfg.outlier_min_candidates,
+            cfg.goodness_gap_floor_m,
+            self._angle_floor,
         )
-        rows: list[int] = []
-        maps: list[list[float]] = []
-        map_kinds: list[list[int]] = []
-        for r, sid in enumerate(rl.ids.tolist()):
-            record = self._landmark_map.get(sid)
-            if record is not None:
-                rows.append(r)
-                maps.append(record[0])
-                map_kinds.append(record[1])
-        # Every landmark has its map record (the usual case): the arrays as they are, no copy (issue 24's cost).
-        every = len(rows) == len(rl)
-        lm_view = np.ascontiguousarray((rl.surfaces if every else rl.surfaces[rows]), dtype=float).reshape(-1, 4)
-        lm_map = np.asarray(maps, dtype=float).reshape(-1, 4)
-        kinds = (
-            (rl.kinds if every else rl.kinds[rows]).reshape(-1, 2),
-            np.asarray(map_kinds, dtype=np.int64).reshape(-1, 2),
-        )
-        since = motion_step(between_pose(self._update_odometry, self._odometry), self.config.motion_model)
-        return self._plus.pose(
-            starts, lm_view, lm_map, kinds, self._points, since, self._odometry, loc is not None
-        ), loc
+        reference = None if best < 0 else int(rl.ids[best])
+        since = motion_step(between_pose(self._update_odometry, self._odometry), cfg.motion_model)
+        return self._plus.pose_stable(
+            starts, lm_view, lm_map, ok, self._points, since, self._odometry, reference is not None
+        ), reference
 
     def _pose_between_updates(self, rl: Tracked, prev_pose: Pose, step: Pose) -> Pose:
         """Localise on the tracked landmarks, else compose the odometry step (note 13, docs/albot1-mapper.md).
@@ -350,8 +360,8 @@ class Albot1Mapper:
         start was the odometry still counts in ``odometry_pose_steps``.
         """
         if self._plus is not None:
-            pose, loc = self._robust_pose(rl, prev_pose, step)
-            if loc is None:
+            pose, reference = self._robust_pose(rl, prev_pose, step)
+            if reference is None:
                 self._counts.odometry_pose_steps += 1
             return pose
         if self.config.pose_between_updates == "localise":
@@ -391,8 +401,11 @@ class Albot1Mapper:
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]
-        # As Python lists: localisation reads them as scalars every scan.
-        self._landmark_map = dict(zip(ids.tolist(), zip(lm_map.tolist(), lms.kinds.tolist())))
+        if self._plus is None:
+            # As Python lists: localisation reads them as scalars every scan.
+            self._landmark_map = dict(zip(ids.tolist(), zip(lm_map.tolist(), lms.kinds.tolist())))
+        else:  # as arrays: Albot1+'s kernel (robust_starts) reads them
+            self._landmark_rows = (ids, lm_map, lms.kinds)
         self._u_step = view_scan
         c.surfaces_added += len(out.added)
         c.surfaces_deleted += len(out.deleted)

@@ -133,7 +133,8 @@ class OdometryNoise:
 #: off by tens of degrees on a turn, beyond the reach of the scan refinement's nearest-surface matching.
 ODOMETRY_TURNS_DEG = (0.0, -3.0, 3.0, -6.0, 6.0, -10.0, 10.0, -15.0, 15.0, -20.0, 20.0, -30.0, 30.0)
 
-_ODOMETRY_TURNS = np.radians(np.asarray(ODOMETRY_TURNS_DEG))
+#: :data:`ODOMETRY_TURNS_DEG` in radians (the start poses' turns, here and in :mod:`.localise_kernels`' caller)
+ODOMETRY_TURNS = np.radians(np.asarray(ODOMETRY_TURNS_DEG))
 
 
 def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | list[Pose] | None) -> FloatArray:
@@ -147,10 +148,10 @@ def start_poses(odometry: Pose, thesis: Pose | None, candidates: FloatArray | li
     """
     # Filled in place (values as the stacked arrays had them): numpy's stacking calls cost more than the copies.
     if thesis is None or candidates is None:
-        starts = np.empty((_ODOMETRY_TURNS.size, 3))
+        starts = np.empty((ODOMETRY_TURNS.size, 3))
         starts[:, 0] = odometry[0]
         starts[:, 1] = odometry[1]
-        starts[:, 2] = odometry[2] + _ODOMETRY_TURNS
+        starts[:, 2] = odometry[2] + ODOMETRY_TURNS
         return starts
     if isinstance(candidates, list):  # the same float64 values, from Python floats in one call
         return np.array([thesis, odometry, *candidates], dtype=float).reshape(-1, 3)
@@ -247,8 +248,25 @@ class PlusLocaliser:
         view's own odometry (REP-103; the window test's); ``placed``: a
         landmark placed the robot (False: the turn bound applies).
         """
-        p = self.params
         ok = np.ascontiguousarray(STABLE[lm_kinds[0]] & STABLE[lm_kinds[1]]).reshape(-1, 2)
+        return self.pose_stable(starts, lm_view, lm_map, ok, points, since_update, odometry, placed)
+
+    def pose_stable(
+        self,
+        starts: FloatArray,
+        lm_view: FloatArray,
+        lm_map: FloatArray,
+        ok: NDArray[np.bool_],
+        points: FloatArray,
+        since_update: Pose,
+        odometry: Pose | None = None,
+        placed: bool = True,
+    ) -> Pose:
+        """:meth:`pose` given which endpoints ``ok`` ``(k, 2)`` are stable now and in the map (C-contiguous).
+
+        The mapper's kernel (:func:`~.localise_kernels.robust_starts`) computes ``ok`` with the landmark rows.
+        """
+        p = self.params
         if self.mount is not None:  # the scanner's increment, not the odometry frame's (:mod:`.mount`)
             self._odometry_since, since_update = since_update, self.mount.correct(since_update)
         predicted = compose_pose(self._anchor, since_update)

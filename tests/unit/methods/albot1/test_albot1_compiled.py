@@ -29,7 +29,14 @@ from albot1.data.synthetic.worlds import load_world
 from albot1.geometry import se2, segments
 from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import as_written
-from albot1.methods.albot1.mapping import ambiguity, pose_kernels, screen_kernels, step_kernels, update_kernels
+from albot1.methods.albot1.mapping import (
+    ambiguity,
+    localise_kernels,
+    pose_kernels,
+    screen_kernels,
+    step_kernels,
+    update_kernels,
+)
 from albot1.methods.albot1.mapping import kernels as mapping_source
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
@@ -268,6 +275,31 @@ def _screen_args() -> Iterator[tuple[Any, ...]]:
         yield (0.1, -0.2, heading, info, 0.05, -0.1, -heading, 0.4, 400.0)
 
 
+def _robust_starts_args() -> Iterator[tuple[Any, ...]]:
+    """Recognised landmarks with every endpoint label, matched or fresh (NaN match data), some outliers, ties,
+    some without a map record, some ids twice in the map."""
+    rng = np.random.default_rng(6)
+    turns = np.radians(np.arange(-30.0, 31.0, 10.0))
+    for i in range(60):
+        k = i % 9
+        view = rng.uniform(-6.0, 6.0, (k, 4))
+        ids = rng.permutation(20)[:k].astype(np.int64)
+        lm_map = view + rng.normal(0.0, 0.5 if i % 4 == 0 else 0.01, (k, 4)) + rng.uniform(-1.0, 1.0, 4)
+        if i % 6 == 0 and k > 1:
+            view[1], lm_map[1] = view[0], lm_map[0]  # a tie: the first candidate wins
+        match = rng.uniform(0.0, 0.2, (3, k))
+        match[rng.random((3, k)) < (1.0 if i % 5 == 0 else 0.2)] = np.nan
+        sides = np.full(k, -1, dtype=np.int64) if i % 5 == 0 else rng.integers(-1, 2, k).astype(np.int64)
+        kinds = rng.integers(0, 4, (2, k, 2)).astype(np.int64)
+        d_prev, gaps, angle_diffs = (np.ascontiguousarray(row) for row in match)
+        recorded = rng.permutation(k)[: k - i % 2]  # an odd case leaves one landmark without its record
+        lm_ids = np.concatenate([ids[recorded], ids[recorded[:1]]])  # one id twice: its last row counts
+        lm_rows = np.concatenate([lm_map[recorded], lm_map[recorded[:1]] + 0.5])
+        lm_kinds = np.concatenate([kinds[1][recorded], kinds[1][recorded[:1]]])
+        tracked = (view, kinds[0], ids, sides, d_prev, gaps, angle_diffs)
+        yield (*tracked, lm_ids, lm_rows, lm_kinds, 0.3, -0.2, 1.0, turns, 2 + i % 3, 0.01, 0.002)
+
+
 CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "build_view": _build_view_args,
     "recognise_landmarks": _recognise_args,
@@ -284,6 +316,7 @@ CASES: dict[str, Callable[[], Iterator[tuple[Any, ...]]]] = {
     "screen_directions": _screen_args,
     "perceive": _perceive_args,
     "refine_and_score": _refine_and_score_args,
+    "robust_starts": _robust_starts_args,
 }
 
 
@@ -305,6 +338,7 @@ KERNELS: dict[str, Any] = {
     "measurement_costs": ambiguity.measurement_costs,
     "screen_directions": screen_kernels.screen_directions,
     **{name: getattr(step_kernels, name) for name in ("perceive", "refine_and_score")},
+    "robust_starts": localise_kernels.robust_starts,
 }
 
 

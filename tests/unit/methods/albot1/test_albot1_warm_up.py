@@ -90,7 +90,15 @@ def test_a_thesis_preset_s_warm_up_leaves_out_the_kernels_only_albot1_plus_calls
     # plus calls perceive, which compiles scan_points into itself (a compile in this process gives scan_points a
     # signature too, a load from the cache does not): scan_points is not warmed on its own
     assert sorted(set(found["plus"]) - {"scan_points"}) == sorted(
-        [*found["thesis"], "measurement_costs", "perceive", "refine_and_score", "refine_pose", "screen_directions"]
+        [
+            *found["thesis"],
+            "measurement_costs",
+            "perceive",
+            "refine_and_score",
+            "refine_pose",
+            "robust_starts",
+            "screen_directions",
+        ]
     )
 
 
