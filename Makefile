@@ -80,14 +80,16 @@ test-fast: $(STAMP)
 
 # The suites' grids run one after the other; each suite's report starts as soon as its own grid has ended (it
 # runs beside the next grid), the results page as soon as results/default and results/thesis are final
-# (.ci/bench has the schedule and why). Every report is built even when cells failed (the reports list them);
+# (.ci/bench has the schedule and why), at niceness REPORT_NICE (10: they take the cores the grid's cells
+# leave idle; 0 runs them at the grids' priority). Every report is built even when cells failed (the reports list them);
 # each one's output is held in a temporary file and shown whole, in order, as it ends; then a non-zero status
 # (the last one: the grids', then the reports', then the page's) is passed on. docs/results.md (+ docs/results/)
 # and the README's results block are rewritten from results/default and results/thesis (no date in them: nothing
 # new, no diff); commit them (docs/benchmarking.md). reports/thesis links the maps figures reports/default draws,
 # but which ones those are is known from the default store, so it does not wait for that report.
+REPORT_NICE ?= 10
 bench: $(STAMP)
-	BIN=$(BIN) JOBS=$(JOBS) .ci/bench $(SUITE)
+	BIN=$(BIN) JOBS=$(JOBS) REPORT_NICE=$(REPORT_NICE) .ci/bench $(SUITE)
 
 # pytest-benchmark timing suite (short real sequences); JSON kept for CI.
 bench-timing: $(STAMP)

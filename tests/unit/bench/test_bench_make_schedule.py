@@ -21,6 +21,7 @@ FAKE = r"""#!/usr/bin/env bash
 # fake albot1: "<words> start", wait for $FAKE_WAIT_<n> when this command is "bench <suite>", "<words> end"
 words="$*"
 echo "$words start" >> "$EVENTS"
+echo "$1 $(nice)" >> "$NICENESS"
 name=$(printf '%s' "$1 $2" | tr -c 'A-Za-z0-9\n' '_')
 wait_for="FAKE_WAIT_$name"
 if [ -n "${!wait_for:-}" ]; then
@@ -53,7 +54,14 @@ def run_schedule(
     events.touch()
     work = tmp_path / "clone"
     work.mkdir()
-    full_env = {"PATH": os.environ["PATH"], "BIN": str(bin_dir), "JOBS": "2", "EVENTS": str(events), **(env or {})}
+    full_env = {
+        "PATH": os.environ["PATH"],
+        "BIN": str(bin_dir),
+        "JOBS": "2",
+        "EVENTS": str(events),
+        "NICENESS": str(tmp_path / "niceness"),
+        **(env or {}),
+    }
     done = subprocess.run(
         [str(SCRIPT), *suites], cwd=work, env=full_env, capture_output=True, text=True, timeout=120, check=False
     )
@@ -135,3 +143,21 @@ def test_the_page_follows_a_lone_default_grid_and_needs_a_default_store(tmp_path
         "report results/generalisation -j 2 end",
     ]
     assert output == ["output of bench generalisation -j 2", "output of report results/generalisation -j 2"]
+
+
+@pytest.mark.parametrize(("setting", "added"), [(None, 10), ("10", 10), ("3", 3), ("0", 0)])
+def test_the_reports_and_the_page_run_at_the_report_niceness(tmp_path: Path, setting: str | None, added: int) -> None:
+    """Beside a grid, a report takes the cores its cells leave idle (REPORT_NICE, default 10; 0: the grids' priority)."""
+    status, _, _ = run_schedule(tmp_path, ["default", "thesis"], {} if setting is None else {"REPORT_NICE": setting})
+    assert status == 0
+    seen = sorted((line.split()[0], int(line.split()[1])) for line in (tmp_path / "niceness").read_text().splitlines())
+    grid = os.nice(0)  # the grids run at the niceness of make (here: of the test)
+    report = min(grid + added, 19)
+    assert seen == [("bench", grid), ("bench", grid), ("report", report), ("report", report), ("results-page", report)]
+
+
+@pytest.mark.parametrize("setting", ["high", "-5", "1.5"])
+def test_a_report_niceness_that_is_not_a_number_is_refused_before_any_grid(tmp_path: Path, setting: str) -> None:
+    status, events, _ = run_schedule(tmp_path, ["default"], {"REPORT_NICE": setting})
+    assert status == 2
+    assert events == []
