@@ -132,8 +132,9 @@ def test_the_exit_status_is_the_last_failure_of_the_grids_then_the_reports_then_
 def test_the_page_follows_a_lone_default_grid_and_needs_a_default_store(tmp_path: Path) -> None:
     _, events, _ = run_schedule(tmp_path / "a", ["default"])
     assert events[:2] == ["bench default -j 2 start", "bench default -j 2 end"]
+    edges = ("start", "end")
     assert sorted(events[2:]) == sorted(
-        [f"report results/default -j 2 {edge}" for edge in ("start", "end")] + [f"{PAGE} {edge}" for edge in ("start", "end")]
+        [f"report results/default -j 2 {e}" for e in edges] + [f"{PAGE} {e}" for e in edges]
     )
     _, events, output = run_schedule(tmp_path / "b", ["generalisation"])  # no results/default: no page
     assert events == [
@@ -147,7 +148,7 @@ def test_the_page_follows_a_lone_default_grid_and_needs_a_default_store(tmp_path
 
 @pytest.mark.parametrize(("setting", "added"), [(None, 10), ("10", 10), ("3", 3), ("0", 0)])
 def test_the_reports_and_the_page_run_at_the_report_niceness(tmp_path: Path, setting: str | None, added: int) -> None:
-    """Beside a grid, a report takes the cores its cells leave idle (REPORT_NICE, default 10; 0: the grids' priority)."""
+    """Beside a grid a report takes the cores its cells leave idle (REPORT_NICE, default 10; 0: the grids' priority)."""
     status, _, _ = run_schedule(tmp_path, ["default", "thesis"], {} if setting is None else {"REPORT_NICE": setting})
     assert status == 0
     seen = sorted((line.split()[0], int(line.split()[1])) for line in (tmp_path / "niceness").read_text().splitlines())
