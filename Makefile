@@ -78,31 +78,18 @@ test-all: $(STAMP)
 test-fast: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not slow and not integration" tests/unit tests/property
 
-# Every suite runs first, then every report is built, even when cells failed (the reports list them); then
-# a non-zero status (the last one) is passed on. docs/results.md (+ docs/results/) and the README's results
-# block are rewritten from results/default and results/thesis (no date in them: nothing new, no diff);
-# commit them (docs/benchmarking.md). The reports and the results page read the stores and write folders
-# of their own, so they are all started at once (their serial parts fill the cores the others leave idle):
-# reports/thesis links the maps figures reports/default draws, but which ones those are is known from the
-# default store, so it does not wait for that report. Each one's output is held in a temporary file and
-# shown whole, in order, when all have ended.
+# The suites' grids run one after the other; each suite's report starts as soon as its own grid has ended (it
+# runs beside the next grid), the results page as soon as results/default and results/thesis are final
+# (.ci/bench has the schedule and why), at niceness REPORT_NICE (10: they take the cores the grid's cells
+# leave idle; 0 runs them at the grids' priority). Every report is built even when cells failed (the reports list them);
+# each one's output is held in a temporary file and shown whole, in order, as it ends; then a non-zero status
+# (the last one: the grids', then the reports', then the page's) is passed on. docs/results.md (+ docs/results/)
+# and the README's results block are rewritten from results/default and results/thesis (no date in them: nothing
+# new, no diff); commit them (docs/benchmarking.md). reports/thesis links the maps figures reports/default draws,
+# but which ones those are is known from the default store, so it does not wait for that report.
+REPORT_NICE ?= 10
 bench: $(STAMP)
-	status=0; \
-	for suite in $(SUITE); do $(BIN)/albot1 bench $$suite -j $(JOBS) || status=$$?; done; \
-	logs=$$(mktemp -d); started=""; \
-	for suite in $(SUITE); do \
-	  $(BIN)/albot1 report results/$$suite -j $(JOBS) >$$logs/$$suite.log 2>&1 & started="$$started $$!:$$suite"; \
-	done; \
-	if [ -f results/default/grid.json ]; then \
-	  $(BIN)/albot1 results-page results/default --thesis results/thesis --out docs/results.md --readme README.md \
-	    >$$logs/results-page.log 2>&1 & started="$$started $$!:results-page"; \
-	fi; \
-	for job in $$started; do \
-	  wait $${job%%:*} || status=$$?; \
-	  cat $$logs/$${job#*:}.log; \
-	done; \
-	rm -rf $$logs; \
-	exit $$status
+	BIN=$(BIN) JOBS=$(JOBS) REPORT_NICE=$(REPORT_NICE) .ci/bench $(SUITE)
 
 # pytest-benchmark timing suite (short real sequences); JSON kept for CI.
 bench-timing: $(STAMP)

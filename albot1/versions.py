@@ -98,11 +98,21 @@ def commit_label(commit: str | None) -> str:
 def library_versions(
     names: tuple[str, ...] = ("numpy", "shapely", "scipy", "kiss-icp", "gtsam", "rosbags"),
 ) -> dict[str, str | None]:
-    """Installed versions of the libraries a result may depend on (None if absent)."""
-    found: dict[str, str | None] = {}
+    """Installed versions of the libraries a result may depend on (None if absent); a new dict each call."""
+    return dict(_library_versions(names))
+
+
+@lru_cache(maxsize=8)
+def _library_versions(names: tuple[str, ...]) -> tuple[tuple[str, str | None], ...]:
+    """Once per process, like :func:`code_version`: the libraries a process imported do not change under it.
+
+    Each call searches the installed distributions' metadata (~10 ms); every bench cell records them, so the
+    forkserver reads them once (:mod:`albot1.bench.preload`) and its forked cells inherit the answer.
+    """
+    found: list[tuple[str, str | None]] = []
     for name in names:
         try:
-            found[name] = metadata.version(name)
+            found.append((name, metadata.version(name)))
         except metadata.PackageNotFoundError:
-            found[name] = None
-    return found
+            found.append((name, None))
+    return tuple(found)

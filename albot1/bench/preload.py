@@ -34,6 +34,12 @@ if TYPE_CHECKING:
 # First, before the slow imports: every cell forked from this server shares this value, so the cells of
 # one grid agree on the code version the runner planned with (see albot1.bench.cells).
 versions.code_version()
+# The commit and the library versions every run records (albot1.runs.execute), once here instead of once per
+# cell: the commit is two `git` commands (describe, status of the code paths; ~20 ms of CPU and a process start
+# each cell), the library versions a search of the installed distributions' metadata (~10 ms). Read here, like
+# the code version, they are the values of the code the cells run.
+versions.git_commit()
+versions.library_versions()
 
 import matplotlib  # noqa: E402
 

@@ -15,7 +15,9 @@ from __future__ import annotations
 import functools
 import importlib.util
 import inspect
+import os
 import shutil
+import sys
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -247,6 +249,49 @@ class MethodRegistry:
         return [spec.env_prefix for spec in self if spec.name != method]
 
 
+#: The import path, each folder with its modification time, when :func:`method_registry` last read the plugins.
+_read_from: tuple[tuple[str, int | None], ...] | None = None
+
+
+def _modified(path: str) -> int | None:
+    """``path``'s modification time (ns), None where it cannot be read."""
+    try:
+        return os.stat(path).st_mtime_ns
+    except OSError:
+        return None
+
+
+def _path_state() -> tuple[tuple[str, int | None], ...]:
+    """Each ``sys.path`` entry and each distribution's ``entry_points.txt`` in it, with its modification time."""
+    state: list[tuple[str, int | None]] = []
+    for entry in sys.path:
+        folder = entry or "."
+        state.append((entry, _modified(folder)))
+        try:
+            names = sorted(e.name for e in os.scandir(folder) if e.name.endswith((".dist-info", ".egg-info")))
+        except OSError:
+            continue
+        state += [(name, _modified(os.path.join(folder, name, "entry_points.txt"))) for name in names]
+    return tuple(state)
+
+
+def forget_registry_if_changed() -> None:
+    """Read the plugins again on the next :func:`method_registry` unless nothing they are found in has changed.
+
+    Why: a bench cell is forked from a server that read the registry when it started, and a plugin may have
+    been installed since (the cell then reads it again). Reading the entry points means reading and parsing every
+    installed distribution's metadata (~17 ms of CPU per cell, issue 24); looking at their times is a few stats.
+    Installing, removing or reinstalling a distribution adds or removes an entry in a folder on the import path,
+    which changes that folder's modification time (the test :mod:`importlib.metadata` itself makes before it
+    lists a folder again); an ``entry_points.txt`` rewritten in place (a legacy editable install run again)
+    changes its own. So the registry is kept when the import path, each folder on it and each distribution's
+    ``entry_points.txt`` have the times they had when it was read. (The file system's times are a few
+    milliseconds coarse: a change in the same tick as the reading is missed, as by :mod:`importlib.metadata`.)
+    """
+    if _read_from is None or _path_state() != _read_from:
+        method_registry.cache_clear()
+
+
 @functools.cache
 def method_registry() -> MethodRegistry:
     """The registry of this process: the built-in methods and the installed plugins, read once.
@@ -254,6 +299,8 @@ def method_registry() -> MethodRegistry:
     Plugins are the entry points of group ``albot1.methods``
     (:mod:`albot1.methods.plugins`); reading them imports nothing.
     """
+    global _read_from
+    _read_from = _path_state()  # before reading: a change made while it reads is seen by the next check
     plugins = [
         MethodSpec(
             p.name,

@@ -95,3 +95,25 @@ def test_version_line_names_the_commit_or_says_it_is_unknown(
     assert result.exit_code == 0, result.output
     assert result.output.endswith(f", {versions.UNKNOWN_COMMIT})\n")
     assert "None" not in result.output
+
+
+def test_the_library_versions_are_read_once_per_process_and_each_caller_gets_its_own_dict(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    calls: list[str] = []
+
+    def version(name: str) -> str:
+        calls.append(name)
+        if name == "absent":
+            raise versions.metadata.PackageNotFoundError(name)
+        return f"{name}-1.0"
+
+    monkeypatch.setattr(versions.metadata, "version", version)
+    versions._library_versions.cache_clear()
+    try:
+        first = versions.library_versions(("numpy", "absent"))
+        first["numpy"] = "changed by a caller"
+        assert versions.library_versions(("numpy", "absent")) == {"numpy": "numpy-1.0", "absent": None}
+        assert calls == ["numpy", "absent"]
+    finally:
+        versions._library_versions.cache_clear()

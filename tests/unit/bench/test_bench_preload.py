@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import subprocess
@@ -222,3 +223,35 @@ def test_a_forkserver_child_freezes_what_it_inherited_before_it_runs_the_cell(mo
         cell_main.process_entry({"cell": "k"})
     assert ended.value.code == 0
     assert order == ["freeze", "cell k"]
+
+
+_VERSIONS_IN_A_CELL = """
+import json
+import subprocess
+from importlib import metadata
+
+import albot1.bench.preload  # what the forkserver imports before it forks any cell
+from albot1 import versions
+
+
+def refuse(*args: object, **kwargs: object) -> None:
+    raise AssertionError(f"called in the cell: {args}")
+
+
+subprocess.run = refuse  # no `git` command ...
+metadata.version = refuse  # ... and no search of the installed distributions in the cell
+print(json.dumps([versions.git_commit(), versions.library_versions()]))
+"""
+
+
+def test_a_cell_inherits_the_commit_and_library_versions_its_run_records() -> None:
+    """The preload reads them once (git_commit, library_versions); a cell then starts no `git` and reads no metadata."""
+    from albot1 import versions
+
+    env = dict(os.environ, **{ENV: ""})  # no method preloaded: only the versions matter here
+    out = subprocess.run(
+        [sys.executable, "-c", _VERSIONS_IN_A_CELL], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    versions.git_commit.cache_clear()
+    assert json.loads(out.stdout) == [versions.git_commit(), versions.library_versions()]

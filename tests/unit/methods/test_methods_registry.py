@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import Any, ClassVar
 
 import pytest
@@ -157,3 +158,43 @@ def test_a_name_registered_twice_is_refused() -> None:
     spec = MethodSpec("x", f"{__name__}:PlacesMapper")
     with pytest.raises(UnknownMethodError, match="method 'x' is registered twice"):
         MethodRegistry.of([spec, spec])
+
+
+def test_the_registry_is_read_again_only_when_what_it_was_read_from_changed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A forked bench cell keeps its server's registry unless a distribution was installed, changed or removed."""
+    from albot1.methods.plugins import ENTRY_POINT_GROUP
+
+    def names() -> set[str]:
+        return {spec.name for spec in registry.method_registry()}
+
+    site = tmp_path / "site"
+    site.mkdir()
+    monkeypatch.syspath_prepend(str(site))
+    old = (1_000_000_000, 1_000_000_000)  # times well before any change below (the file system's are coarse)
+    os.utime(site, ns=old)
+    try:
+        registry.method_registry.cache_clear()
+        first = registry.method_registry()
+        registry.forget_registry_if_changed()
+        assert registry.method_registry() is first  # nothing changed: kept, no metadata read
+        info = site / "late_plugin-0.1.dist-info"  # installed into a folder on the path
+        info.mkdir()
+        (info / "METADATA").write_text("Metadata-Version: 2.1\nName: late-plugin\nVersion: 0.1\n")
+        points = info / "entry_points.txt"
+        points.write_text(f"[{ENTRY_POINT_GROUP}]\nlate = late_plugin:Mapper\n")
+        os.utime(points, ns=old)
+        registry.forget_registry_if_changed()
+        assert "late" in names()
+        second = registry.method_registry()
+        points.write_text(f"[{ENTRY_POINT_GROUP}]\nlater = late_plugin:Mapper\n")  # rewritten in place
+        registry.forget_registry_if_changed()
+        assert registry.method_registry() is not second
+        assert "later" in names() and "late" not in names()
+        third = registry.method_registry()
+        monkeypatch.syspath_prepend(str(tmp_path / "elsewhere"))  # another import path
+        registry.forget_registry_if_changed()
+        assert registry.method_registry() is not third
+    finally:
+        registry.method_registry.cache_clear()
