@@ -229,6 +229,7 @@ def measure(
         "wall_s": round(time.perf_counter() - wall, 1),
         "cpu_s": round(time.process_time() - cpu, 1),
         "odometry_factors": result.counters.get("odometry_fused"),
+        "odometry_run_factors": result.counters.get("odometry_run_factors"),
         "loop_closures": result.counters.get("loop_closures_accepted"),
         "place_closures": result.counters.get("place_closures_accepted"),
         "velocity_matches": result.counters.get("tracking_velocity_guess"),
