@@ -165,6 +165,9 @@ class GtsamGraphConfig(BaseModel):
     odometry_trust_run_variance_ratio: float = Field(
         ge=0, description="... a run factor's variance never below this times its chain of matches' stated variance"
     )
+    odometry_trust_run_max_turn_deg: float = Field(
+        gt=0, description="... runs holding a node step whose odometry turns more than this are left out (inf: none)"
+    )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
         gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"

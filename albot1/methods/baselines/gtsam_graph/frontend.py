@@ -103,6 +103,7 @@ class FrontEnd:
                     config.odometry_trust_run_variance_ratio,
                 ),
                 config.odometry_trust_run_nodes,
+                math.radians(config.odometry_trust_run_max_turn_deg),
             )
             if config.odometry_trust_run_nodes
             else None

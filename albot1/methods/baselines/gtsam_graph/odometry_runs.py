@@ -19,10 +19,16 @@ of ``m`` matched node steps: the run's odometry heading against the chain
 of its ``m`` matches, the chain's stated variance being the sum of theirs.
 A run that passes becomes one heading factor from its first node to its
 last (a :class:`.span_edges.SpanEdge`), in addition to the per-step ones.
-A fallback (unmatched) step ends the run without a factor.
+A fallback (unmatched) step ends the run without a factor. Optionally
+(``max_turn_rad``) a run holding a step whose odometry turns more than that
+is neither learnt from nor judged: a wheel odometry slips in turns
+(fr-clinic's heading spread 2-4x wider there), and turns are rare enough
+that the straight runs set the pooled spread.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -35,15 +41,19 @@ from albot1.methods.baselines.gtsam_graph.span_edges import SpanEdge
 class OdometryRuns:
     """Non-overlapping runs of ``nodes`` matched node steps, judged as one odometry step each (module docstring)."""
 
-    def __init__(self, trust: OdometryTrust, nodes: int) -> None:
-        """``trust`` learns from and judges the runs (its own history: runs, not steps); ``nodes``: steps per run."""
+    def __init__(self, trust: OdometryTrust, nodes: int, max_turn_rad: float = math.inf) -> None:
+        """``trust`` learns from and judges the runs (its own history: runs, not steps); ``nodes``: steps per run;
+        ``max_turn_rad``: runs holding a step whose odometry turns more than this are left out (``inf``: none)."""
         self.nodes = nodes
+        self.max_turn_rad = max_turn_rad
+        self._turn = 0.0
         self._factors = OdometryFactors(trust)
         self._first: dict[int, int] = {}
         self._start = -1
         self._odometry = np.zeros(3)
         self._match = np.zeros(3)
         self._variances = np.zeros(3)
+        self._turn = 0.0
         self._steps = 0
 
     def add(
@@ -55,8 +65,12 @@ class OdometryRuns:
         self._odometry = se2.compose(self._odometry, np.asarray(odometry_step, dtype=float))
         self._match = se2.compose(self._match, np.asarray(match_step, dtype=float))
         self._variances = self._variances + np.diag(np.asarray(match_covariance, dtype=float))
+        self._turn = max(self._turn, abs(float(odometry_step[2])))
         self._steps += 1
         if self._steps < self.nodes:
+            return []
+        if self._turn > self.max_turn_rad:
+            self.reset()
             return []
         self._first[key] = self._start
         factors = self._factors.add(key, self._odometry, self._match, np.diag(self._variances))
@@ -68,4 +82,5 @@ class OdometryRuns:
         self._odometry = np.zeros(3)
         self._match = np.zeros(3)
         self._variances = np.zeros(3)
+        self._turn = 0.0
         self._steps = 0

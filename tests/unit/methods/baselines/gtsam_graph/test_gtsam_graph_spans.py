@@ -83,6 +83,19 @@ def test_a_step_without_a_match_ends_the_run_and_the_next_run_starts_after_it() 
     assert (edge.first, edge.key) == (82, 84)
 
 
+def test_runs_holding_a_step_that_turns_beyond_the_limit_are_left_out() -> None:
+    trust = OdometryTrust(50, bias_z=3.0, gate_chi2=16.27, components=(2,), bias_horizon=50, min_variance_ratio=1)
+    runs = OdometryRuns(trust, 2, max_turn_rad=math.radians(2.0))  # STEP turns 3 deg: every run here is left out
+    assert all(r == [] for r in _feed(runs, 45))
+    straight = np.array([0.5, 0.02, math.radians(1.0)])
+    for r in range(40):  # the same innovations on steps turning 1 deg: judged once 40 are known, as without the limit
+        sign = 1.0 if r % 2 else -1.0
+        first = runs.add(100 + 2 * r, straight, straight + np.array([0.0, 0.0, math.radians(sign * 0.3)]), MATCH_COV)
+        second = runs.add(101 + 2 * r, straight, straight, MATCH_COV)
+        assert list(first) == []
+    assert len(second) == 40
+
+
 def test_span_matches_target_the_nodes_ending_span_back_and_start_from_the_sequential_chain() -> None:
     assert span_target_nodes(10, 5, 3) == range(3, 6)
     assert span_target_nodes(10, 5, 10) == range(0, 6)
