@@ -22,8 +22,8 @@ edges, their lag-1 autocorrelation, the worst ones and every accepted closure
 (docs/baselines.md, gtsam-graph, "why one run of edmonton swings"). ``--moves`` adds every tracked scan whose
 match moved the odometry guess by more than 0.25 m, and which guess's match won (docs/baselines.md, gtsam-graph,
 "sequential slides"). ``earned_odometry_match`` counts the earned choice's decisions (``odometry_trust_earned_level``;
-docs/baselines.md, gtsam-graph, "the earned choice"). ``odometry_run_factors`` counts the odometry's factors over runs of
-node steps (``odometry_trust_run_nodes``; docs/baselines.md, gtsam-graph, "edges spanning runs of steps").
+docs/baselines.md, gtsam-graph, "the earned choice"). ``odometry_run_factors`` counts the odometry's factors over
+runs of node steps (``odometry_trust_run_nodes``; docs/baselines.md, gtsam-graph, "edges spanning runs of steps").
 """
 
 from __future__ import annotations
