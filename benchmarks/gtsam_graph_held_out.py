@@ -22,7 +22,8 @@ edges, their lag-1 autocorrelation, the worst ones and every accepted closure
 (docs/baselines.md, gtsam-graph, "why one run of edmonton swings"). ``--moves`` adds every tracked scan whose
 match moved the odometry guess by more than 0.25 m, and which guess's match won (docs/baselines.md, gtsam-graph,
 "sequential slides"). ``earned_odometry_match`` counts the earned choice's decisions (``odometry_trust_earned_level``;
-docs/baselines.md, gtsam-graph, "the earned choice").
+docs/baselines.md, gtsam-graph, "the earned choice"). ``odometry_run_factors`` counts the odometry's factors over
+runs of node steps (``odometry_trust_run_nodes``; docs/baselines.md, gtsam-graph, "edges spanning runs of steps").
 """
 
 from __future__ import annotations
@@ -229,6 +230,7 @@ def measure(
         "wall_s": round(time.perf_counter() - wall, 1),
         "cpu_s": round(time.process_time() - cpu, 1),
         "odometry_factors": result.counters.get("odometry_fused"),
+        "odometry_run_factors": result.counters.get("odometry_run_factors"),
         "loop_closures": result.counters.get("loop_closures_accepted"),
         "place_closures": result.counters.get("place_closures_accepted"),
         "velocity_matches": result.counters.get("tracking_velocity_guess"),

@@ -31,6 +31,7 @@ from albot1.methods.baselines.gtsam_graph.loop_closure import LoopMatch
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor
 from albot1.methods.baselines.gtsam_graph.refine import RefineTests, accept, seed_poses
 from albot1.methods.baselines.gtsam_graph.registration import Target, line_normals, rotate, try_register
+from albot1.methods.baselines.gtsam_graph.span_edges import SpanEdge
 
 
 class BackEnd:
@@ -83,11 +84,13 @@ class BackEnd:
         points: FloatArray,
         index: int,
         odometry_factors: Sequence[OdometryFactor] = (),
+        spans: Sequence[SpanEdge] = (),
     ) -> int:
         """A node at ``step`` from the newest, joined to it by the sequential edge ``relative``; its key.
 
         ``odometry_factors`` (each from node ``key - 1`` to ``key``, this new
-        node's included) go into the same update. ISAM2 updates the graph,
+        node's included) and the edges ``spans`` spanning runs of steps to it (:mod:`.span_edges`) go into the
+        same update. ISAM2 updates the graph,
         and the estimates of the nodes a local map can reach are refreshed
         from it; all of them when an odometry factor reached further back.
         """
@@ -96,11 +99,13 @@ class BackEnd:
         self.graph.add_edge(prev, key, relative, covariance)
         for factor in odometry_factors:
             self.graph.add_edge(factor.key - 1, factor.key, factor.step, factor.covariance)
+        for span in spans:
+            self.graph.add_edge(span.first, span.key, span.relative, span.covariance, kernel=self.config.span_kernel)
         self.graph.update()
         self._remember_node(odometry, relative, points, index)
         self.estimates = np.vstack([self.estimates, se2.compose(self.estimates[prev], relative)])
         first = max(0, key - self.config.local_map_nodes)
-        if any(factor.key - 1 < first for factor in odometry_factors):
+        if any(factor.key - 1 < first for factor in odometry_factors) or any(span.first < first for span in spans):
             self.estimates = self.graph.estimates()
         else:
             for k in range(first, key + 1):

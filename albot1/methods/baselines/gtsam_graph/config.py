@@ -139,6 +139,35 @@ class GtsamGraphConfig(BaseModel):
         description="... a step whose odometry and match disagree beyond this chi-square level keeps the side with the "
         "smaller earned variance along the disagreement (earned_choice.py; 0: off)",
     )
+    span_nodes: int = Field(
+        ge=0,
+        description="each new node is also matched against the scans ending this many nodes back, as a between edge "
+        "spanning the run of steps (span_edges.py; 0: off; 1 is the sequential edge itself and is refused)",
+    )
+    span_map_nodes: int = Field(
+        ge=1, description="... against this many node scans ending there (1: that node's alone)"
+    )
+    span_sigma_scale: float = Field(gt=0, description="... the match's stated standard deviations times this")
+    span_max_correction_m: float = Field(
+        gt=0, description="... a span match may move the guess the sequential edges give this far at most (m)"
+    )
+    span_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most (deg)")
+    span_translation: bool = Field(
+        description="... the span edge constrains the translation too (else the heading alone, translation sigma "
+        "fallback_sigma_xy_m x 100)"
+    )
+    span_kernel: Literal["cauchy", "huber", "none"] = Field(description="... robust kernel on those edges")
+    odometry_trust_run_nodes: int = Field(
+        ge=0,
+        description="... and the odometry's heading over non-overlapping runs of this many matched node steps as its "
+        "own factor, learnt and judged against the chain of their matches like a step (odometry_runs.py; 0: off)",
+    )
+    odometry_trust_run_variance_ratio: float = Field(
+        ge=0, description="... a run factor's variance never below this times its chain of matches' stated variance"
+    )
+    odometry_trust_run_max_turn_deg: float = Field(
+        gt=0, description="... runs holding a node step whose odometry turns more than this are left out (inf: none)"
+    )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
         gt=0, description="a sequential match needs this inlier RMS point-to-line distance or less"
@@ -301,6 +330,15 @@ class GtsamGraphConfig(BaseModel):
             raise ValueError(
                 "odometry_trust_earned_level needs odometry_trust_factors = true: without it it does nothing"
             )
+        if self.odometry_trust_run_nodes and not (self.odometry_trust and self.odometry_trust_factors):
+            raise ValueError(
+                "odometry_trust_run_nodes needs odometry_trust = true and odometry_trust_factors = true: without them "
+                "it does nothing"
+            )
+        if self.odometry_trust_run_nodes == 1:
+            raise ValueError("odometry_trust_run_nodes = 1 would repeat the per-step factors: use 0 (off) or 2 or more")
+        if self.span_nodes == 1:
+            raise ValueError("span_nodes = 1 would repeat the sequential edge: use 0 (off) or 2 or more")
         return self
 
     def track_icp(self) -> IcpParams:

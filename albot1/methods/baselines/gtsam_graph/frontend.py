@@ -29,8 +29,10 @@ from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.earned_choice import EarnedFactors
 from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
+from albot1.methods.baselines.gtsam_graph.odometry_runs import OdometryRuns
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, OdometryFactors, OdometryTrust
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
+from albot1.methods.baselines.gtsam_graph.span_edges import SpanEdge, span_guess, span_target_nodes
 from albot1.methods.baselines.gtsam_graph.velocity_slide import slide_refused
 
 
@@ -90,6 +92,24 @@ class FrontEnd:
             if config.odometry_trust_earned_level > 0
             else OdometryFactors(self._odometry_trust)
         )
+        self._odometry_runs = (
+            OdometryRuns(
+                OdometryTrust(
+                    config.odometry_trust_window,
+                    config.odometry_trust_bias_z,
+                    config.odometry_trust_gate_chi2,
+                    (2,),
+                    config.odometry_trust_bias_horizon,
+                    config.odometry_trust_run_variance_ratio,
+                ),
+                config.odometry_trust_run_nodes,
+                math.radians(config.odometry_trust_run_max_turn_deg),
+            )
+            if config.odometry_trust_run_nodes
+            else None
+        )
+        # Odometry run factors judged at the latest node (``odometry_trust_run_nodes``), for the back end to add.
+        self.run_factors: list[SpanEdge] = []
         # Odometry factors judged at the latest node (``odometry_trust_factors``), for the back end to add with it.
         self.odometry_factors: list[OdometryFactor] = []
         self.last_odometry: FloatArray | None = None
@@ -298,6 +318,38 @@ class FrontEnd:
         corr = se2.between(guess, reg.pose)
         return math.hypot(corr[0], corr[1]) <= max_m and abs(corr[2]) <= math.radians(max_deg)
 
+    def span_edges(self, relative: FloatArray, points: FloatArray) -> list[SpanEdge]:
+        """The new node's edge spanning ``span_nodes`` steps (:mod:`.span_edges`), or none (off, too early, or failed).
+
+        ``relative`` is the new node's sequential edge from the newest node;
+        the new node is not in the back end yet (its key is the node count).
+        """
+        cfg = self.config
+        key = len(self._back.odometry)
+        nodes = span_target_nodes(key, cfg.span_nodes, cfg.span_map_nodes)
+        if not nodes:
+            return []
+        first = nodes[-1]
+        guess = span_guess(self._back.estimates, first, self._back.newest, relative)
+        reg, good, _ = self.attempt(
+            self._back.target(nodes, first),
+            points,
+            guess,
+            self._seq_icp,
+            cfg.span_max_correction_m,
+            cfg.span_max_correction_deg,
+        )
+        if not good or reg is None:
+            self.counters["span_failures"] = self.counters.get("span_failures", 0) + 1
+            return []
+        self.counters["span_edges"] = self.counters.get("span_edges", 0) + 1
+        covariance = np.asarray(
+            np.linalg.inv(reg.information + self._seq_prior) * cfg.span_sigma_scale**2 + self._floor, dtype=np.float64
+        )
+        if not cfg.span_translation:
+            covariance = np.diag([(100.0 * cfg.fallback_sigma_xy_m) ** 2] * 2 + [covariance[2, 2]])
+        return [SpanEdge(first, key, reg.pose, covariance)]
+
     def sequential_edge(
         self,
         step: FloatArray,
@@ -320,6 +372,7 @@ class FrontEnd:
         """
         cfg = self.config
         self.odometry_factors = []
+        self.run_factors = []
         if cfg.track_scans:
             reg, good = tracked, tracked is not None
         else:
@@ -343,6 +396,13 @@ class FrontEnd:
                     len(self._back.odometry), odometry_step, reg.pose, covariance
                 )
                 self.counters["odometry_fused"] += len(self.odometry_factors)
+                if self._odometry_runs is not None:
+                    self.run_factors = self._odometry_runs.add(
+                        len(self._back.odometry), odometry_step, reg.pose, covariance
+                    )
+                    self.counters["odometry_run_factors"] = self.counters.get("odometry_run_factors", 0) + len(
+                        self.run_factors
+                    )
                 covariance = self._odometry_factors.match_covariance(len(self._back.odometry), covariance)
             elif cfg.odometry_trust and odometry_step is not None:
                 fused = self._odometry_trust.fuse(odometry_step, reg.pose, covariance)
@@ -352,6 +412,8 @@ class FrontEnd:
                     return fused
             return reg.pose, covariance
         self.counters["odometry_fallbacks"] += 1
+        if self._odometry_runs is not None:
+            self._odometry_runs.reset()
         self._consecutive_fallbacks += 1
         if self._consecutive_fallbacks >= cfg.max_consecutive_fallbacks:
             detail = (

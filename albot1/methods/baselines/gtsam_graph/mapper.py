@@ -135,7 +135,10 @@ class GtsamGraphMapper:
         cfg = self.config
         odometry_step = se2.between(self.back.odometry[-1], odometry)
         relative, covariance = self.front.sequential_edge(step, points, index, tracked, odometry_step)
-        key = self.back.add_node(odometry, step, relative, covariance, points, index, self.front.odometry_factors)
+        spans = [*self.front.run_factors, *(self.front.span_edges(relative, points) if cfg.span_nodes else [])]
+        key = self.back.add_node(
+            odometry, step, relative, covariance, points, index, self.front.odometry_factors, spans
+        )
         self.front.new_node()
         self.loops.travelled(math.hypot(relative[0], relative[1]))
         if key % cfg.loop_every_nodes == 0:
