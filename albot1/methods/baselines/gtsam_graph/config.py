@@ -333,7 +333,7 @@ class GtsamGraphConfig(BaseModel):
         if self.odometry_trust_run_nodes and not (self.odometry_trust and self.odometry_trust_factors):
             raise ValueError(
                 "odometry_trust_run_nodes needs odometry_trust = true and odometry_trust_factors = true: without them "
-                "it does nothing (the preset sets it to 5; set odometry_trust_run_nodes = 0 with them off)"
+                "it does nothing"
             )
         if self.odometry_trust_run_nodes == 1:
             raise ValueError("odometry_trust_run_nodes = 1 would repeat the per-step factors: use 0 (off) or 2 or more")

@@ -265,9 +265,7 @@ def test_no_velocity_guess_before_a_motion_was_tracked(monkeypatch: pytest.Monke
 def test_odometry_factors_reach_back_to_the_steps_before_the_variance_was_learnt() -> None:
     """A node per scan, perfect odometry: fused edges start at the 41st matched step, factors cover all 59."""
     seq = room_sequence(60, odometry_bias_deg=0.0)
-    fused, out_fused = run(
-        seq, node_translation_m=0.1, odometry_trust=True, odometry_trust_factors=False, odometry_trust_run_nodes=0
-    )
+    fused, out_fused = run(seq, node_translation_m=0.1, odometry_trust=True, odometry_trust_factors=False)
     factors, out_factors = run(seq, node_translation_m=0.1, odometry_trust=True, odometry_trust_factors=True)
     assert out_fused.counters["sequential_matches"] == out_factors.counters["sequential_matches"] == 59
     assert out_fused.counters["odometry_fused"] == 59 - 40

@@ -105,10 +105,10 @@ def test_span_matches_target_the_nodes_ending_span_back_and_start_from_the_seque
     assert span_guess(estimates, 0, 2, np.array([0.5, 0.0, 0.0])) == pytest.approx([1.0, 1.5, math.pi / 2])
 
 
-def test_run_factors_on_at_five_span_matches_off_and_settings_that_would_do_nothing_refused() -> None:
+def test_both_are_off_in_the_preset_and_refuse_settings_that_would_do_nothing() -> None:
     cfg = resolve_config("gtsam-graph", "default", {})
     assert isinstance(cfg, GtsamGraphConfig)
-    assert cfg.odometry_trust_run_nodes == 5 and cfg.span_nodes == 0  # baselines/gtsam-graph.toml: why
+    assert cfg.odometry_trust_run_nodes == 0 and cfg.span_nodes == 0
     base = cfg.model_dump()
     with pytest.raises(ValidationError, match="odometry_trust_run_nodes = 1"):
         GtsamGraphConfig.model_validate({**base, "odometry_trust_run_nodes": 1})
