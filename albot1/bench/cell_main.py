@@ -80,7 +80,7 @@ def _apply_environment(env: dict[str, str]) -> None:
 
 
 def _apply_import_path(paths: list[str]) -> None:
-    """Make the child's import path the runner's, and read the method registry again.
+    """Make the child's import path the runner's, and read the method registry again if anything changed.
 
     The forkserver is started once per runner process and forks every cell
     from its own state: a folder put on the runner's path after it started (a

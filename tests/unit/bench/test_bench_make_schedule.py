@@ -53,7 +53,7 @@ def run_schedule(
     events = tmp_path / "events"
     events.touch()
     work = tmp_path / "clone"
-    work.mkdir()
+    work.mkdir(exist_ok=True)
     full_env = {
         "PATH": os.environ["PATH"],
         "BIN": str(bin_dir),
@@ -157,8 +157,43 @@ def test_the_reports_and_the_page_run_at_the_report_niceness(tmp_path: Path, set
     assert seen == [("bench", grid), ("bench", grid), ("report", report), ("report", report), ("results-page", report)]
 
 
-@pytest.mark.parametrize("setting", ["high", "-5", "1.5"])
+@pytest.mark.parametrize("setting", ["high", "-5", "1.5", "20", "25"])
 def test_a_report_niceness_that_is_not_a_number_is_refused_before_any_grid(tmp_path: Path, setting: str) -> None:
     status, events, _ = run_schedule(tmp_path, ["default"], {"REPORT_NICE": setting})
     assert status == 2
     assert events == []
+
+
+def test_a_report_waits_while_a_later_grid_of_the_list_writes_a_store_it_reads(tmp_path: Path) -> None:
+    """``thesis default``: the thesis report reads results/default, so it starts after the default grid, not before.
+
+    A suite named twice: its report starts after its last grid. (The report must never read a store a grid is
+    still writing; the fake grids mark their store written when they end.)
+    """
+    _, events, output = run_schedule(tmp_path / "a", ["thesis", "default"])
+    at = {event: index for index, event in enumerate(events)}
+    assert at["bench default -j 2 end"] < at["report results/thesis -j 2 start"]
+    assert at["bench default -j 2 end"] < at["report results/default -j 2 start"]
+    assert at["bench default -j 2 end"] < at[f"{PAGE} start"]
+    assert [line for line in output if not line.startswith("output of bench ")] == [
+        "output of report results/thesis -j 2",
+        "output of report results/default -j 2",
+        f"output of {PAGE}",
+    ]
+    _, events, _ = run_schedule(tmp_path / "b", ["default", "generalisation", "default"])
+    at = {event: index for index, event in enumerate(events)}
+    assert events.count("report results/default -j 2 start") == 2  # once per place in the list, after the last grid
+    assert min(i for i, e in enumerate(events) if e == "report results/default -j 2 start") > max(
+        i for i, e in enumerate(events) if e == "bench default -j 2 end"
+    )
+    assert at["bench generalisation -j 2 end"] < at["report results/generalisation -j 2 start"]
+
+
+def test_no_suite_builds_the_page_alone_from_the_stores_there_are(tmp_path: Path) -> None:
+    store = tmp_path / "clone" / "results" / "default"
+    store.mkdir(parents=True)
+    (store / "grid.json").touch()
+    status, events, output = run_schedule(tmp_path, [])
+    assert status == 0
+    assert events == [f"{PAGE} start", f"{PAGE} end"]
+    assert output == [f"output of {PAGE}"]

@@ -100,7 +100,7 @@ class BackEnd:
         for factor in odometry_factors:
             self.graph.add_edge(factor.key - 1, factor.key, factor.step, factor.covariance)
         for span in spans:
-            self.graph.add_edge(span.first, span.key, span.relative, span.covariance, kernel=self.config.span_kernel)
+            self.graph.add_edge(span.first, span.key, span.relative, span.covariance, kernel=span.kernel)
         self.graph.update()
         self._remember_node(odometry, relative, points, index)
         self.estimates = np.vstack([self.estimates, se2.compose(self.estimates[prev], relative)])

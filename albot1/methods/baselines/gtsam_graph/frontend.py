@@ -348,7 +348,7 @@ class FrontEnd:
         )
         if not cfg.span_translation:
             covariance = np.diag([(100.0 * cfg.fallback_sigma_xy_m) ** 2] * 2 + [covariance[2, 2]])
-        return [SpanEdge(first, key, reg.pose, covariance)]
+        return [SpanEdge(first, key, reg.pose, covariance, kernel=self.config.span_kernel)]
 
     def sequential_edge(
         self,

@@ -46,7 +46,6 @@ class OdometryRuns:
         ``max_turn_rad``: runs holding a step whose odometry turns more than this are left out (``inf``: none)."""
         self.nodes = nodes
         self.max_turn_rad = max_turn_rad
-        self._turn = 0.0
         self._factors = OdometryFactors(trust)
         self._first: dict[int, int] = {}
         self._start = -1

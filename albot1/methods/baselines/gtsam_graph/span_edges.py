@@ -24,6 +24,7 @@ own plus the floor, like a sequential edge's.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -39,6 +40,8 @@ class SpanEdge:
     key: int
     relative: FloatArray
     covariance: FloatArray
+    #: the robust kernel on the edge: a span match's is ``span_kernel``; an odometry run factor has none
+    kernel: Literal["cauchy", "huber", "none"] = "none"
 
 
 def span_target_nodes(key: int, span: int, map_nodes: int) -> range:
