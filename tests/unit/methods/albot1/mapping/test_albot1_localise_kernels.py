@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import struct
+import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -27,6 +28,13 @@ from albot1.methods.albot1.mapping.plus import ODOMETRY_TURNS, start_poses
 from albot1.methods.albot1.perception.endpoints import STABLE
 from albot1.methods.albot1.perception.landmarks import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
 from albot1.methods.albot1.perception.recognition import Tracked
+
+#: The kernel writes out CPython 3.11's ``math.hypot`` and its left-to-right float ``sum`` (the thesis's Python
+#: localisation's arithmetic on that interpreter); 3.12 sums floats with compensation, so on another interpreter the
+#: kernel keeps 3.11's bits and these comparisons with the interpreter's own arithmetic do not apply.
+CPYTHON_311 = pytest.mark.skipif(
+    sys.version_info[:2] != (3, 11), reason="python_hypot and robust_starts reproduce CPython 3.11's arithmetic"
+)
 
 
 @numba.njit
@@ -81,6 +89,7 @@ EDGES = [
 ]
 
 
+@CPYTHON_311
 @pytest.mark.parametrize("fn", [_compiled_hypot, python_hypot], ids=["compiled", "as written"])
 def test_python_hypot_is_math_hypot_on_zeros_subnormals_huge_and_non_finite(
     fn: Callable[[float, float], float],
@@ -98,6 +107,7 @@ def test_python_hypot_of_pythagorean_triples_is_exact() -> None:
                 assert _compiled_hypot(x * scale, y * scale) == c * scale == math.hypot(x * scale, y * scale)
 
 
+@CPYTHON_311
 def test_python_hypot_keeps_the_bits_where_c_hypot_does_not() -> None:
     """Random landmark-sized inputs: C's ``hypot`` (numba's) differs on some, ``python_hypot`` on none."""
     rng = np.random.default_rng(24)
@@ -109,6 +119,7 @@ def test_python_hypot_keeps_the_bits_where_c_hypot_does_not() -> None:
     assert np.count_nonzero(_c_hypots(xs, ys).view(np.int64) != expected.view(np.int64)) > 0
 
 
+@CPYTHON_311
 @settings(max_examples=3000, deadline=None)
 @given(st.floats(allow_nan=True, allow_infinity=True), st.floats(allow_nan=True, allow_infinity=True))
 def test_python_hypot_property_any_two_floats(x: float, y: float) -> None:
@@ -188,6 +199,7 @@ def _before(rl: Tracked, records: dict[int, Any]) -> tuple[np.ndarray, ...]:
     return lm_view, lm_map, ok
 
 
+@CPYTHON_311
 @pytest.mark.parametrize("fn", [robust_starts, as_written(robust_starts)], ids=["compiled", "as written"])
 def test_robust_starts_is_localise_then_start_poses(fn: Callable[..., Any]) -> None:
     chosen = none = 0
