@@ -38,6 +38,7 @@ from albot1.geometry import se2
 from albot1.metrics.alignment import align, rigid_transform
 from albot1.metrics.errors import MetricsError
 from albot1.report.collect import CellRecord
+from albot1.report.mathtext_memo import share_parsed_math
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -108,12 +109,17 @@ def slug(text: str) -> str:
 
 
 def pyplot() -> Any:
-    """matplotlib.pyplot on the headless Agg backend (imported on first use: it is slow to import)."""
+    """matplotlib.pyplot on the headless Agg backend (imported on first use: it is slow to import).
+
+    Every figure of the reports is made through here, so this is also where the process's math-text
+    parses start being shared across figures (:func:`~albot1.report.mathtext_memo.share_parsed_math`).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    share_parsed_math()
     return plt
 
 
