@@ -34,7 +34,8 @@ from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
-from albot1.methods.albot1.mapping.plus import ODOMETRY_TURNS, PlusLocaliser
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.start_poses import ODOMETRY_TURNS
 from albot1.methods.albot1.mapping.step_kernels import perceive_scan
 from albot1.methods.albot1.mapping.update import UpdateOutcome, UpdateParams, update_map
 from albot1.methods.albot1.perception.frames import thesis_to_rep_pose, thesis_to_rep_segments

@@ -1,7 +1,7 @@
 """Albot1+'s turn bound: a view no landmark places must refute the odometry strongly to turn the robot.
 
 When no recognised landmark places the robot, Albot1+ starts its pose fit from the odometry's prediction
-turned by each of :data:`~albot1.methods.albot1.mapping.plus.ODOMETRY_TURNS_DEG` (up to 30 deg): a raw odometry
+turned by each of :data:`~albot1.methods.albot1.mapping.start_poses.ODOMETRY_TURNS_DEG` (up to 30 deg): a raw odometry
 step can be off by tens of degrees, beyond the reach of the scan refinement's nearest-surface matching. Where
 the odometry is that bad, the scan says so loudly: the ambiguity test's likelihood ratio of the odometry's
 prediction against the turned fit (:mod:`.ambiguity`) is in the hundreds or thousands on aces, intel,

@@ -19,7 +19,8 @@ from albot1.methods.albot1.mapping.ambiguity import (
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.start_poses import start_poses
 
 KERNELS = MappingKernels(False)
 SIGMAS = (0.05, 0.1, 0.05, 2.0, 0.5)  # line, point, scan sigma, Huber (sigmas), gate: the plus preset's

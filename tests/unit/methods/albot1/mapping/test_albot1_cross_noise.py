@@ -12,7 +12,8 @@ from pydantic import ValidationError
 from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.start_poses import start_poses
 from albot1.methods.albot1.mapping.view_noise import START, ViewNoise
 
 CROSS = {"fit_noise_factor": 1.0, "fit_noise_source": "cross"}

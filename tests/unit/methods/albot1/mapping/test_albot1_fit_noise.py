@@ -11,7 +11,8 @@ from plus_room import NO_KINDS, SINCE, localiser, scan_from
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.fit_noise import fit_noise_factor, with_fit_noise
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.start_poses import start_poses
 
 TRUE = (0.02, 0.5, math.radians(2.0))  # the view's true pose: 2 cm aside and turned 2 deg
 

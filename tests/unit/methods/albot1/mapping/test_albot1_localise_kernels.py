@@ -24,7 +24,7 @@ from albot1.methods.albot1.compiled import as_written
 from albot1.methods.albot1.mapping import localise_kernels
 from albot1.methods.albot1.mapping.localisation import localise
 from albot1.methods.albot1.mapping.localise_kernels import python_hypot, robust_starts
-from albot1.methods.albot1.mapping.plus import ODOMETRY_TURNS, start_poses
+from albot1.methods.albot1.mapping.start_poses import ODOMETRY_TURNS, start_poses
 from albot1.methods.albot1.perception.endpoints import STABLE
 from albot1.methods.albot1.perception.landmarks import CORNER, OCCLUDED, OCCLUDING, UNSTABLE
 from albot1.methods.albot1.perception.recognition import Tracked

@@ -12,7 +12,8 @@ from albot1.geometry.se2 import between_pose, compose_pose
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
 from albot1.methods.albot1.mapping.mount import SOLVE_EVERY, MountCalibration
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.start_poses import start_poses
 
 #: A mount 0.2 m ahead, 0.05 m aside and turned 2 deg (the generalisation suite's wrong offset, thesis frame).
 MOUNT = (-0.05, 0.2, math.radians(2.0))

@@ -13,13 +13,9 @@ from albot1.geometry.segments import transform_segments
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.mapping.plus import (
-    ODOMETRY_TURNS_DEG,
-    OdometryNoise,
-    PlusLocaliser,
-    start_poses,
-)
+from albot1.methods.albot1.mapping.plus import OdometryNoise, PlusLocaliser
 from albot1.methods.albot1.mapping.screen import screen_measurement
+from albot1.methods.albot1.mapping.start_poses import ODOMETRY_TURNS_DEG, start_poses
 from albot1.methods.albot1.mapping.view_noise import CHI2_1_MEDIAN
 from albot1.methods.albot1.perception.endpoints import CORNER, UNSTABLE
 from albot1.metrics.ate import ate

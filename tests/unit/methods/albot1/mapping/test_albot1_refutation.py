@@ -11,8 +11,9 @@ from pydantic import ValidationError
 
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
 from albot1.methods.albot1.mapping.refutation import refutation_statistic, refutes
+from albot1.methods.albot1.mapping.start_poses import start_poses
 
 
 def test_the_statistic_is_the_departure_in_units_of_the_fit_and_view_variances() -> None:

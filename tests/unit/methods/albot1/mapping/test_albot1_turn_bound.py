@@ -11,7 +11,8 @@ from plus_room import NO_KINDS, SINCE, localiser, scan_from
 from albot1.geometry import se2
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.mapping.plus import ODOMETRY_TURNS_DEG, PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.start_poses import ODOMETRY_TURNS_DEG, start_poses
 from albot1.methods.albot1.mapping.turn_bound import allowance, beyond, bounded_starts
 
 

@@ -13,7 +13,8 @@ from albot1.methods.albot1.mapping.ambiguity import threshold
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
 from albot1.methods.albot1.mapping.mapper import Albot1Mapper
-from albot1.methods.albot1.mapping.plus import PlusLocaliser, start_poses
+from albot1.methods.albot1.mapping.plus import PlusLocaliser
+from albot1.methods.albot1.mapping.start_poses import start_poses
 from albot1.methods.albot1.mapping.window import WINDOW_HISTORY, OdometryWindow, UpdateRecord
 
 KERNELS = MappingKernels(False)
