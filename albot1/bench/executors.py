@@ -140,30 +140,43 @@ def _quiet_client_logs() -> Iterator[None]:
 
 
 class _DropCancellations(logging.Filter):
-    """Drop tornado's "Exception in callback" records whose exception is a cancelled future.
+    """Drop records of the runner's own cancellations and of connections Dask closed, with their tracebacks.
 
     When the runner halts a grid it cancels the queued cells;
     ``distributed.cfexecutor`` then re-raises each cancellation inside a
     tornado callback, and tornado logs it with a traceback on the user's
     terminal. The cancellation is the runner's own doing and is reported as
-    ``halted: ...`` with the cells not started; every other record passes.
+    ``halted: ...`` with the cells not started. A connection that closed under
+    a worker or scheduler the runner refused or lost (``CommClosedError``,
+    tornado's ``StreamClosedError``) can reach the terminal the same way, or
+    through asyncio's "Task exception was never retrieved" (seen under load:
+    a worker with other code, whose refusal the runner reports as one line).
+    Every other record passes.
     """
+
+    _DROPPED = frozenset({"FutureCancelledError", "CancelledError", "CommClosedError", "StreamClosedError"})
 
     def filter(self, record: logging.LogRecord) -> bool:
         exc = record.exc_info[1] if record.exc_info else None
-        return not (exc is not None and type(exc).__name__ in ("FutureCancelledError", "CancelledError"))
+        return not (exc is not None and any(kind.__name__ in self._DROPPED for kind in type(exc).__mro__))
+
+
+#: The loggers that print a traceback for a closed connection or a cancellation: tornado's callbacks, asyncio's tasks.
+_CALLBACK_LOGGERS = ("tornado.application", "asyncio")
 
 
 @contextmanager
 def _quiet_cancellations() -> Iterator[None]:
-    """:class:`_DropCancellations` on tornado's callback logger while a Dask executor is in use."""
-    logger = logging.getLogger("tornado.application")
+    """:class:`_DropCancellations` on tornado's and asyncio's loggers while a Dask executor is in use."""
+    loggers = [logging.getLogger(name) for name in _CALLBACK_LOGGERS]
     drop = _DropCancellations()
-    logger.addFilter(drop)
+    for logger in loggers:
+        logger.addFilter(drop)
     try:
         yield
     finally:
-        logger.removeFilter(drop)
+        for logger in loggers:
+            logger.removeFilter(drop)
 
 
 def _dask_client(executor: cf.Executor) -> Any:

@@ -35,6 +35,17 @@ def brute_force(walls: np.ndarray, pose: np.ndarray, angles: np.ndarray, slack: 
     return out
 
 
+def distance_to_walls(walls: np.ndarray, x: float, y: float) -> float:
+    """The distance from (x, y) to the nearest point of any wall (a degenerate wall is its end point)."""
+    start, end = walls[:, :2], walls[:, 2:]
+    along = end - start
+    length2 = np.einsum("ij,ij->i", along, along)
+    safe = np.where(length2 > 0.0, length2, 1.0)
+    u = np.where(length2 > 0.0, np.clip(np.einsum("ij,ij->i", np.array([x, y]) - start, along) / safe, 0.0, 1.0), 0.0)
+    nearest = start + u[:, None] * along
+    return float(np.min(np.hypot(nearest[:, 0] - x, nearest[:, 1] - y)))
+
+
 @settings(max_examples=60, deadline=None)
 @given(
     st.lists(st.tuples(COORD, COORD, COORD, COORD), min_size=1, max_size=8), COORD, COORD, st.floats(-math.pi, math.pi)
@@ -43,6 +54,9 @@ def test_ranges_agree_with_brute_force(
     segments: list[tuple[float, float, float, float]], x: float, y: float, heading: float
 ) -> None:
     walls = np.array(segments)
+    # The sensor is never placed on a wall (albot1.data.synthetic.lidar): from a point on a wall, a beam along it
+    # has no defined range (found by hypothesis: a pose 2e-16 m from a wall's end, a beam along the wall).
+    assume(distance_to_walls(walls, x, y) > 1e-6)
     pose = np.array([x, y, heading])
     got = cast(walls, pose, ANGLES, 30.0)
     got = np.where(np.isnan(got), np.inf, got)

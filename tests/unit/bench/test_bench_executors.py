@@ -172,6 +172,30 @@ def test_the_runner_s_own_cancellations_never_print_a_traceback_and_other_errors
     assert logger.filters == []
 
 
+def test_a_connection_dask_closed_prints_no_traceback_from_asyncio_or_tornado(caplog: pytest.LogCaptureFixture) -> None:
+    from distributed.comm.core import CommClosedError
+    from tornado.iostream import StreamClosedError
+
+    def record(name: str, exc: BaseException) -> logging.LogRecord:
+        try:
+            raise exc
+        except BaseException:
+            return logging.getLogger(name).makeRecord(
+                name, logging.ERROR, __file__, 1, "Task exception was never retrieved", (), sys.exc_info()
+            )
+
+    with caplog.at_level(logging.ERROR), _quiet_cancellations():
+        for name in ("asyncio", "tornado.application"):
+            logging.getLogger(name).handle(record(name, CommClosedError("in <TCP (closed)>: Stream is closed")))
+            logging.getLogger(name).handle(record(name, StreamClosedError()))
+            logging.getLogger(name).handle(record(name, RuntimeError(f"a real fault in {name}")))
+    assert [str(r.exc_info[1]) for r in caplog.records if r.exc_info] == [
+        "a real fault in asyncio",
+        "a real fault in tornado.application",
+    ]
+    assert logging.getLogger("asyncio").filters == [] and logging.getLogger("tornado.application").filters == []
+
+
 class PendingWhileRunningExecutor(cf.Executor):
     """Futures that stay pending while their job runs, as a Dask client's do; a cancelled one is never notified.
 
