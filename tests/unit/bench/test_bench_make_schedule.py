@@ -10,7 +10,9 @@ would fail. No wall-clock assertion: the waits only bound a broken schedule.
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -32,6 +34,13 @@ if [ -n "${!wait_for:-}" ]; then
   done
 fi
 if [ "$1" = bench ]; then mkdir -p "results/$2" && touch "results/$2/grid.json"; fi
+child_of="FAKE_CHILD_$name"
+if [ -n "${!child_of:-}" ]; then  # a worker process, as a report's drawing pool: its pid into the file named
+  sleep 300 &
+  echo "$!" > "${!child_of}"
+  echo "$words child" >> "$EVENTS"
+  while :; do sleep 0.05; done
+fi
 echo "output of $words"
 echo "$words end" >> "$EVENTS"
 status_of="FAKE_STATUS_$name"
@@ -41,10 +50,8 @@ exit "${!status_of:-0}"
 PAGE = "results-page results/default --thesis results/thesis --out docs/results.md --readme README.md"
 
 
-def run_schedule(
-    tmp_path: Path, suites: list[str], env: dict[str, str] | None = None
-) -> tuple[int, list[str], list[str]]:
-    """Run ``.ci/bench SUITES`` with the fake albot1; (exit status, events in order, output lines)."""
+def schedule_env(tmp_path: Path, env: dict[str, str] | None = None) -> dict[str, str]:
+    """The fake albot1 in ``tmp_path/bin``, the event file ``tmp_path/events`` and the environment naming them."""
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir(parents=True)
     fake = bin_dir / "albot1"
@@ -52,9 +59,8 @@ def run_schedule(
     fake.chmod(0o755)
     events = tmp_path / "events"
     events.touch()
-    work = tmp_path / "clone"
-    work.mkdir(exist_ok=True)
-    full_env = {
+    (tmp_path / "clone").mkdir(exist_ok=True)
+    return {
         "PATH": os.environ["PATH"],
         "BIN": str(bin_dir),
         "JOBS": "2",
@@ -62,10 +68,23 @@ def run_schedule(
         "NICENESS": str(tmp_path / "niceness"),
         **(env or {}),
     }
+
+
+def run_schedule(
+    tmp_path: Path, suites: list[str], env: dict[str, str] | None = None
+) -> tuple[int, list[str], list[str]]:
+    """Run ``.ci/bench SUITES`` with the fake albot1; (exit status, events in order, output lines)."""
+    full_env = schedule_env(tmp_path, env)
     done = subprocess.run(
-        [str(SCRIPT), *suites], cwd=work, env=full_env, capture_output=True, text=True, timeout=120, check=False
+        [str(SCRIPT), *suites],
+        cwd=tmp_path / "clone",
+        env=full_env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
     )
-    return done.returncode, events.read_text().splitlines(), done.stdout.splitlines()
+    return done.returncode, (tmp_path / "events").read_text().splitlines(), done.stdout.splitlines()
 
 
 def test_each_report_starts_when_its_grid_ends_and_runs_beside_the_next_grid(tmp_path: Path) -> None:
@@ -197,3 +216,52 @@ def test_no_suite_builds_the_page_alone_from_the_stores_there_are(tmp_path: Path
     assert status == 0
     assert events == [f"{PAGE} start", f"{PAGE} end"]
     assert output == [f"output of {PAGE}"]
+
+
+def test_a_term_stops_each_running_report_with_the_processes_it_started(tmp_path: Path) -> None:
+    """TERM while the default report draws beside the thesis grid: the report's worker goes with it, exit 143.
+
+    A report draws in a pool of worker processes; killing the report's pid alone left them waiting for work
+    forever. The fake report starts a ``sleep`` as its worker and never ends by itself.
+    """
+    child = tmp_path / "child.pid"
+    env = schedule_env(
+        tmp_path,
+        {
+            "FAKE_CHILD_report_results_default": str(child),
+            "FAKE_WAIT_bench_thesis": "report results/default -j 2 child",
+        },
+    )
+    script = subprocess.Popen(
+        [str(SCRIPT), "default", "thesis"],
+        cwd=tmp_path / "clone",
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        for _ in range(600):
+            if "report results/default -j 2 child" in (tmp_path / "events").read_text().splitlines():
+                break
+            time.sleep(0.05)
+        worker = int(child.read_text())
+        script.send_signal(signal.SIGTERM)
+        assert script.wait(timeout=60) == 143
+        for _ in range(200):  # the group's kill is sent before the script exits; the worker is reaped by init
+            if not _alive(worker):
+                break
+            time.sleep(0.05)
+        assert not _alive(worker)
+    finally:
+        script.kill()
+        if child.exists() and _alive(int(child.read_text())):
+            os.kill(int(child.read_text()), signal.SIGKILL)
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` is a live process (a zombie counts as gone)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False

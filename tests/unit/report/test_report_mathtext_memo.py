@@ -18,13 +18,14 @@ if sys.argv[1] == "shared":
     from albot1.report.mathtext_memo import share_parsed_math
     assert share_parsed_math()
 digests = []
-for k in range(2):
+# the third figure under another math-text setting: a label parsed before must be parsed again under it
+for settings in ({}, {}, {"mathtext.default": "rm"}):
     fig, ax = plt.subplots(figsize=(4, 3), layout="constrained")
     ax.semilogy([1, 2, 3], [1e-3, 1e-1, 1e2])
-    ax.set_title(r"$\\alpha^2$ and a fraction $\\frac{1}{2}$")
+    ax.set_title(r"$\\alpha^2$ and a fraction $\\frac{1}{2}$ of $x$")
     for fmt in ("png", "svg"):
         out = io.BytesIO()
-        with matplotlib.rc_context({"svg.hashsalt": "x"}):
+        with matplotlib.rc_context({"svg.hashsalt": "x", **settings}):
             fig.savefig(out, format=fmt, dpi=120, metadata={"Date": None} if fmt == "svg" else None)
         digests.append(hashlib.sha256(out.getvalue()).hexdigest())
     plt.close(fig)
@@ -39,8 +40,10 @@ def _digests(mode: str) -> list[str]:
 
 def test_figures_drawn_with_the_shared_memo_have_the_bytes_of_those_drawn_without() -> None:
     plain, shared = _digests("plain"), _digests("shared")
-    assert len(plain) == 4
-    assert shared == plain  # both formats, the first figure (memo filled) and the second (memo hits)
+    assert len(plain) == 6
+    assert plain[4:] != plain[:2]  # the setting changes the drawing
+    # both formats: the first figure (memo filled), the second (memo hits), the third (parsed again: other setting)
+    assert shared == plain
 
 
 def test_two_parsers_of_one_kind_share_a_parse_and_kinds_stay_apart() -> None:
