@@ -27,7 +27,8 @@ class MappingKernels:
         Albot1+ (``robust``) calls the fused kernels of :mod:`.step_kernels` instead of :data:`FUSED`, which
         ``perceive`` compiles into itself; the other presets call neither Albot1+'s pose kernels nor
         ``perceive`` (which saves them no time: docs/albot1-mapper.md, "Fewer kernel calls"), so their first run
-        does not pay for compiling them (:func:`albot1.methods.albot1.warm_up.warm_up`).
+        does not pay for compiling them (:func:`albot1.methods.albot1.warm_up.warm_up`). Every preset calls
+        ``robust_starts``: it is the thesis's localisation, compiled.
         """
         if pose_estimate == "robust":
             return MappingKernels.FUSED
@@ -38,7 +39,6 @@ class MappingKernels:
             "screen_directions",
             "perceive",
             "refine_and_score",
-            "robust_starts",
         )
 
     def __init__(self, compiled: bool = True) -> None:
@@ -52,5 +52,5 @@ class MappingKernels:
         # Fused entry points (:mod:`.step_kernels`): one call per scan where the pieces above took two or three.
         self.perceive = select(step_kernels.perceive, compiled)
         self.refine_and_score = select(step_kernels.refine_and_score, compiled)
-        # Albot1+'s start poses from the thesis's localisation (:mod:`.localise_kernels`), one call per fit
+        # The thesis's localisation, with Albot1+'s start poses from it (:mod:`.localise_kernels`): one call a scan
         self.robust_starts = select(localise_kernels.robust_starts, compiled)

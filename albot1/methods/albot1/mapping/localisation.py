@@ -176,10 +176,10 @@ def localise(
     A landmark is usable through an endpoint that is stable both now and in
     that record, the matched side first. A list freshly reset from a view
     has no match data (gap, angle, d_R): its landmarks rank by length alone.
-    Runs on Python scalars: a handful of landmarks per scan, where numpy's
-    per-call overhead would cost more than the arithmetic. Albot1+ runs the
-    same steps compiled, with its start poses, in one kernel
-    (:func:`~.localise_kernels.robust_starts`; the tests hold the two to the same bits).
+    Runs on Python scalars: the thesis's steps as written, kept as the
+    reference. The mapper runs the same steps compiled, for every preset
+    (:func:`~.localise_kernels.robust_starts`, which adds Albot1+'s start
+    poses; the tests hold the two to the same bits).
     """
     ids: list[int] = []
     poses: list[Pose] = []

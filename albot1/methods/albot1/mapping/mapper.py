@@ -32,7 +32,6 @@ from albot1.geometry.se2 import Pose, between_pose, compose_pose
 from albot1.methods.albot1.mapping.config import Albot1Config
 from albot1.methods.albot1.mapping.errors import MappingError
 from albot1.methods.albot1.mapping.kernel_set import MappingKernels
-from albot1.methods.albot1.mapping.localisation import Localisation, localise
 from albot1.methods.albot1.mapping.perceptual_map import PerceptualMap
 from albot1.methods.albot1.mapping.plus import PlusLocaliser
 from albot1.methods.albot1.mapping.start_poses import ODOMETRY_TURNS
@@ -44,6 +43,9 @@ from albot1.methods.albot1.perception.landmarks import Landmarks, find_landmarks
 from albot1.methods.albot1.perception.recognition import Tracked, motion_step, recognise
 from albot1.methods.albot1.perception.view import View, construct_view
 from albot1.methods.albot1.warm_up import together, warm_up
+
+#: The thesis presets' localisation asks ``robust_starts`` for no odometry turns (Albot1+'s start poses only).
+_NO_TURNS = np.empty(0)
 
 
 @dataclass(slots=True)
@@ -122,8 +124,8 @@ class Albot1Mapper:
         self._angle_floor = math.radians(config.goodness_angle_floor_deg)
         self._stationary_rad = math.radians(config.stationary_deg)
         self.map = PerceptualMap()
-        self._landmark_map: dict[int, tuple[list[float], list[int]]] = {}
-        #: Albot1+'s landmark map instead: ids ``(m,)``, surfaces as placed ``(m, 4)``, endpoint labels ``(m, 2)``
+        #: The landmark map: ids ``(m,)``, surfaces as placed ``(m, 4)``, endpoint labels ``(m, 2)`` (the last row
+        #: of an id is its record), read by the compiled localisation (:func:`~.localise_kernels.robust_starts`)
         self._landmark_rows: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]] = (
             np.empty(0, dtype=np.int64),
             np.empty((0, 4)),
@@ -275,8 +277,8 @@ class Albot1Mapper:
             pose, reference = self._robust_pose(rl, prev.pose, step)
         else:
             loc = self._localise(rl)
-            pose = compose_pose(prev.pose, step) if loc is None else loc.pose
-            reference = None if loc is None else loc.reference_id
+            pose = compose_pose(prev.pose, step) if loc is None else loc[0]
+            reference = None if loc is None else loc[1]
         if reference is None:
             c.path_integration += 1
             source, ref = "odometry", -1
@@ -309,15 +311,36 @@ class Albot1Mapper:
             kernels=self._pk,
         )
 
-    def _localise(self, rl: Tracked) -> Localisation | None:
-        return localise(
-            rl,
-            self._landmark_map,
-            min_candidates=self.config.outlier_min_candidates,
-            gap_floor=self.config.goodness_gap_floor_m,
-            angle_floor=self._angle_floor,
-            distance_view=self.config.goodness_distance_view,
+    def _localise(self, rl: Tracked) -> tuple[Pose, int] | None:
+        """The thesis's ``localize``: the pose from the best recognised landmark and that landmark's id, or None.
+
+        :func:`~.localisation.localise` is the thesis's steps in Python; this is the same steps compiled, in
+        the kernel Albot1+ starts from (:func:`~.localise_kernels.robust_starts`: the same operations in the
+        same order, held to the same bits by the tests), without Albot1+'s start poses (no turns; the
+        odometry it would add is not read). One kernel call a scan instead of a Python loop over the landmarks.
+        """
+        cfg = self.config
+        starts, _, _, _, best = self._mk.robust_starts(
+            rl.surfaces,
+            rl.kinds,
+            rl.ids,
+            rl.side,
+            rl.prev_distance if cfg.goodness_distance_view == "previous" else rl.prev_distance_current,
+            rl.gap,
+            rl.angle_diff,
+            *self._landmark_rows,
+            0.0,
+            0.0,
+            0.0,
+            _NO_TURNS,
+            cfg.outlier_min_candidates,
+            cfg.goodness_gap_floor_m,
+            self._angle_floor,
         )
+        if best < 0:
+            return None
+        x, y, phi = starts[0].tolist()  # the chosen candidate's pose, as the Python floats localise returns
+        return (x, y, phi), int(rl.ids[best])
 
     def _robust_pose(self, rl: Tracked, prev_pose: Pose, step: Pose) -> tuple[Pose, int | None]:
         """Albot1+: from the thesis's pose (or the odometry step), robust least squares over every landmark.
@@ -368,7 +391,7 @@ class Albot1Mapper:
         if self.config.pose_between_updates == "localise":
             loc = self._localise(rl)
             if loc is not None:
-                return loc.pose
+                return loc[0]
         self._counts.odometry_pose_steps += 1
         return compose_pose(prev_pose, step)
 
@@ -402,11 +425,7 @@ class Albot1Mapper:
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
         lm_map = view_map[lms.index]
-        if self._plus is None:
-            # As Python lists: localisation reads them as scalars every scan.
-            self._landmark_map = dict(zip(ids.tolist(), zip(lm_map.tolist(), lms.kinds.tolist())))
-        else:  # as arrays: Albot1+'s kernel (robust_starts) reads them
-            self._landmark_rows = (ids, lm_map, lms.kinds)
+        self._landmark_rows = (ids, lm_map, lms.kinds)  # the compiled localisation reads them (robust_starts)
         self._u_step = view_scan
         c.surfaces_added += len(out.added)
         c.surfaces_deleted += len(out.deleted)
