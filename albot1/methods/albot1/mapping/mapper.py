@@ -319,8 +319,18 @@ class Albot1Mapper:
         same order, held to the same bits by the tests), without Albot1+'s start poses (no turns; the
         odometry it would add is not read). One kernel call a scan instead of a Python loop over the landmarks.
         """
+        starts, _, _, _, best = self._starts(rl, (0.0, 0.0, 0.0), _NO_TURNS)
+        if best < 0:
+            return None
+        x, y, phi = starts[0].tolist()  # the chosen candidate's pose, as the Python floats localise returns
+        return (x, y, phi), int(rl.ids[best])
+
+    def _starts(
+        self, rl: Tracked, odometry: Pose, turns: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], int]:
+        """:func:`~.localise_kernels.robust_starts` on the tracked list ``rl`` and the landmark map."""
         cfg = self.config
-        starts, _, _, _, best = self._mk.robust_starts(
+        return self._mk.robust_starts(
             rl.surfaces,
             rl.kinds,
             rl.ids,
@@ -329,18 +339,14 @@ class Albot1Mapper:
             rl.gap,
             rl.angle_diff,
             *self._landmark_rows,
-            0.0,
-            0.0,
-            0.0,
-            _NO_TURNS,
+            odometry[0],
+            odometry[1],
+            odometry[2],
+            turns,
             cfg.outlier_min_candidates,
             cfg.goodness_gap_floor_m,
             self._angle_floor,
         )
-        if best < 0:
-            return None
-        x, y, phi = starts[0].tolist()  # the chosen candidate's pose, as the Python floats localise returns
-        return (x, y, phi), int(rl.ids[best])
 
     def _robust_pose(self, rl: Tracked, prev_pose: Pose, step: Pose) -> tuple[Pose, int | None]:
         """Albot1+: from the thesis's pose (or the odometry step), robust least squares over every landmark.
@@ -354,23 +360,7 @@ class Albot1Mapper:
         assert self._plus is not None
         cfg = self.config
         odometry = compose_pose(prev_pose, step)
-        starts, lm_view, lm_map, ok, best = self._mk.robust_starts(
-            rl.surfaces,
-            rl.kinds,
-            rl.ids,
-            rl.side,
-            rl.prev_distance if cfg.goodness_distance_view == "previous" else rl.prev_distance_current,
-            rl.gap,
-            rl.angle_diff,
-            *self._landmark_rows,
-            odometry[0],
-            odometry[1],
-            odometry[2],
-            ODOMETRY_TURNS,
-            cfg.outlier_min_candidates,
-            cfg.goodness_gap_floor_m,
-            self._angle_floor,
-        )
+        starts, lm_view, lm_map, ok, best = self._starts(rl, odometry, ODOMETRY_TURNS)
         reference = None if best < 0 else int(rl.ids[best])
         since = motion_step(between_pose(self._update_odometry, self._odometry), cfg.motion_model)
         return self._plus.pose_stable(
