@@ -102,16 +102,6 @@ def library_versions(
     return dict(_library_versions(names))
 
 
-def forget_library_versions() -> None:
-    """Search the installed distributions again at the next :func:`library_versions`.
-
-    Why: a bench cell inherits the versions its forkserver read when it started; when a distribution was
-    installed or removed on the import path since (the cell reads the method registry again then), a library
-    the server never imported may be there now, or gone, and the cell records what it runs with.
-    """
-    _library_versions.cache_clear()
-
-
 @lru_cache(maxsize=8)
 def _library_versions(names: tuple[str, ...]) -> tuple[tuple[str, str | None], ...]:
     """Once per process, like :func:`code_version`: the libraries a process imported do not change under it.

@@ -97,10 +97,7 @@ def _apply_import_path(paths: list[str]) -> None:
         importlib.invalidate_caches()
     from albot1.methods.registry import forget_registry_if_changed
 
-    if forget_registry_if_changed():  # something installed or removed since: the versions the run records too
-        from albot1.versions import forget_library_versions
-
-        forget_library_versions()
+    forget_registry_if_changed()
 
 
 def _write_error(run_dir: Path, kind: str, exc: BaseException) -> None:

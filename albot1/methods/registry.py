@@ -275,11 +275,8 @@ def _path_state() -> tuple[tuple[str, int | None], ...]:
     return tuple(state)
 
 
-def forget_registry_if_changed() -> bool:
+def forget_registry_if_changed() -> None:
     """Read the plugins again on the next :func:`method_registry` unless nothing they are found in has changed.
-
-    Returns whether it was forgotten: something was installed, changed or removed on the import path (the cell
-    then reads the library versions again too, :func:`albot1.versions.forget_library_versions`).
 
     Why: a bench cell is forked from a server that read the registry when it started, and a plugin may have
     been installed since (the cell then reads it again). Reading the entry points means reading and parsing every
@@ -293,8 +290,6 @@ def forget_registry_if_changed() -> bool:
     """
     if _read_from is None or _path_state() != _read_from:
         method_registry.cache_clear()
-        return True
-    return False
 
 
 @functools.cache
