@@ -147,8 +147,8 @@ def robust_starts(
     ``d_prev`` its ``prev_distance`` or ``prev_distance_current``, NaN for a
     list reset from a view). ``lm_ids``, ``lm_segs``, ``lm_kinds``: the
     landmark map, each landmark as placed at the update that introduced it;
-    a tracked landmark's record is the last row with its id (the mapper's
-    dict of them kept the last). Returns, over the tracked rows that have a
+    a tracked landmark's record is the last row with its id (as the dict
+    :func:`~.localisation.localise` reads keeps the last). Returns, over the tracked rows that have a
     record (in their order):
 
     * what ``start_poses(odometry, loc.pose, loc.poses)`` returns for ``loc
