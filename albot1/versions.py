@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import json
 import subprocess
+import sys
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
@@ -98,21 +99,33 @@ def commit_label(commit: str | None) -> str:
 def library_versions(
     names: tuple[str, ...] = ("numpy", "shapely", "scipy", "kiss-icp", "gtsam", "rosbags"),
 ) -> dict[str, str | None]:
-    """Installed versions of the libraries a result may depend on (None if absent); a new dict each call."""
-    return dict(_library_versions(names))
+    """The version of each library as this process runs it (None if absent); a new dict each call.
 
-
-@lru_cache(maxsize=8)
-def _library_versions(names: tuple[str, ...]) -> tuple[tuple[str, str | None], ...]:
-    """Once per process, like :func:`code_version`: the libraries a process imported do not change under it.
-
-    Each call searches the installed distributions' metadata (~10 ms); every bench cell records them, so the
-    forkserver reads them once (:mod:`albot1.bench.preload`) and its forked cells inherit the answer.
+    For a library this process has imported: the version read the first time it was seen imported (the
+    installed distribution then is the one its module came from). So a long-lived process, such as the bench's
+    forkserver and the cells it forks, goes on recording the library it runs even when another version is
+    installed under it meanwhile. For a library not imported (the run did not use it): the installed version,
+    read once; once the process imports it, it is read again, so a cell that imports a library its forkserver
+    had not records what it imported.
     """
-    found: list[tuple[str, str | None]] = []
-    for name in names:
+    return {name: _version(name) for name in names}
+
+
+#: Distributions whose import name is not the distribution name with "-" as "_".
+_IMPORT_NAMES = {"kiss-icp": "kiss_icp"}
+#: Per process, what :func:`library_versions` read: of libraries imported when read, and of the others. Each
+#: search of the installed metadata costs ~2 ms; the bench's forkserver reads them after its imports
+#: (:mod:`albot1.bench.preload`) and the cells it forks inherit both.
+_IMPORTED: dict[str, str | None] = {}
+_NOT_IMPORTED: dict[str, str | None] = {}
+
+
+def _version(name: str) -> str | None:
+    """``name``'s version, as :func:`library_versions` says."""
+    kept = _IMPORTED if _IMPORT_NAMES.get(name, name.replace("-", "_")) in sys.modules else _NOT_IMPORTED
+    if name not in kept:
         try:
-            found.append((name, metadata.version(name)))
+            kept[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
-            found.append((name, None))
-    return tuple(found)
+            kept[name] = None
+    return kept[name]

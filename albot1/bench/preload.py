@@ -34,12 +34,10 @@ if TYPE_CHECKING:
 # First, before the slow imports: every cell forked from this server shares this value, so the cells of
 # one grid agree on the code version the runner planned with (see albot1.bench.cells).
 versions.code_version()
-# The commit and the library versions every run records (albot1.runs.execute), once here instead of once per
-# cell: the commit is two `git` commands (describe, status of the code paths; ~20 ms of CPU and a process start
-# each cell), the library versions a search of the installed distributions' metadata (~10 ms). Read here, like
-# the code version, they are the values of the code the cells run.
+# The commit every run records (albot1.runs.execute), once here instead of once per cell: two `git` commands
+# (describe, status of the code paths; ~20 ms of CPU and a process start each cell). Read here, like the code
+# version, it is the value of the code the cells run. The library versions are read after the imports (_warm).
 versions.git_commit()
-versions.library_versions()
 
 import matplotlib  # noqa: E402
 
@@ -127,6 +125,10 @@ def _warm() -> None:
     for failure in warm(methods=methods_to_preload()):
         _log.warning("albot1 bench: preloading %s (each cell that needs it will fail with this reason)", failure)
     _warm_matplotlib()
+    # The versions of the libraries just imported, read once here for every cell (a search of the installed
+    # metadata, ~2 ms per library) and kept while this server lives: they name the modules its cells run, even if
+    # another version is installed meanwhile (albot1.versions.library_versions).
+    versions.library_versions()
 
 
 def collect_garbage() -> None:

@@ -85,6 +85,9 @@ def run_method(
     if callable(warm_up):
         warm_up(announce)
     startup_s = time.perf_counter() - wall_start
+    # The versions of the libraries the mapper has imported by now are kept from here on (the record below names
+    # what ran, not what another install put in place during the run: albot1.versions.library_versions).
+    versions.library_versions()
     per_scan: list[int] = []
     stamps: list[float] = []
     odometry: list[np.ndarray] = []

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import subprocess
+import sys
+import types
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -109,11 +111,34 @@ def test_the_library_versions_are_read_once_per_process_and_each_caller_gets_its
         return f"{name}-1.0"
 
     monkeypatch.setattr(versions.metadata, "version", version)
-    versions._library_versions.cache_clear()
-    try:
-        first = versions.library_versions(("numpy", "absent"))
-        first["numpy"] = "changed by a caller"
-        assert versions.library_versions(("numpy", "absent")) == {"numpy": "numpy-1.0", "absent": None}
-        assert calls == ["numpy", "absent"]
-    finally:
-        versions._library_versions.cache_clear()
+    monkeypatch.setattr(versions, "_IMPORTED", {})
+    monkeypatch.setattr(versions, "_NOT_IMPORTED", {})
+    first = versions.library_versions(("numpy", "absent"))
+    first["numpy"] = "changed by a caller"
+    assert versions.library_versions(("numpy", "absent")) == {"numpy": "numpy-1.0", "absent": None}
+    assert calls == ["numpy", "absent"]
+
+
+def test_an_imported_library_keeps_the_version_it_was_imported_with_and_a_new_import_is_read_again(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A long-lived process (the bench's forkserver, its cells) records the library it runs, not a later install.
+
+    The installed version changes under the process (an upgrade while a grid runs): a library imported when it
+    was first read keeps that version; one that was not imported is read again once it is (a cell importing a
+    library its forkserver had not), and kept from then on.
+    """
+    installed = {"kiss-icp": "1.0", "made-up-lib": "2.0"}
+    monkeypatch.setattr(versions.metadata, "version", lambda name: installed[name])
+    monkeypatch.setattr(versions, "_IMPORTED", {})
+    monkeypatch.setattr(versions, "_NOT_IMPORTED", {})
+    monkeypatch.delitem(sys.modules, "kiss_icp", raising=False)
+    monkeypatch.setitem(sys.modules, "made_up_lib", types.ModuleType("made_up_lib"))  # imported
+    names = ("kiss-icp", "made-up-lib")
+    assert versions.library_versions(names) == {"kiss-icp": "1.0", "made-up-lib": "2.0"}
+    installed.update({"kiss-icp": "1.1", "made-up-lib": "2.1"})  # both upgraded on disk meanwhile
+    assert versions.library_versions(names) == {"kiss-icp": "1.0", "made-up-lib": "2.0"}  # 2.0 is what runs
+    monkeypatch.setitem(sys.modules, "kiss_icp", types.ModuleType("kiss_icp"))  # now imported: the new install runs
+    assert versions.library_versions(names) == {"kiss-icp": "1.1", "made-up-lib": "2.0"}
+    installed["kiss-icp"] = "1.2"
+    assert versions.library_versions(names) == {"kiss-icp": "1.1", "made-up-lib": "2.0"}
