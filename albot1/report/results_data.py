@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +63,8 @@ class StandardRow:
     held_in: bool | None
     source: str
     note: str
+    #: The results folder of a measured row taken from another store than the default suite's ("": the default's).
+    store: str = ""
 
 
 @dataclass(frozen=True)
@@ -215,10 +217,41 @@ def _verdicts(thesis_dir: Path) -> tuple[dict[str, str], list[VerdictRow], list[
     return columns, rows, list(ev.notes)
 
 
+#: Why a standard-log row read from the thesis suite's store shows no speed.
+THESIS_SPEED_NOTE = "no speed shown: make bench runs this grid beside the default suite's report"
+
+
+def thesis_rows(default: list[StandardRow], thesis: list[Any], store: str) -> list[StandardRow]:
+    """The thesis store's whole-log rows on the standard logs, of the methods the default store has none of.
+
+    Why: the thesis suite runs the Albot1 variants the default suite leaves out (``albot1:literal``,
+    ``albot1:plus``) on every default-suite dataset, the five standard logs whole among them, so the standard
+    table can show Albot1+ beside the others without running it twice. The rows name their store (``source``);
+    their speed is left out, since ``make bench`` runs the thesis grid while the default report is drawn, so its
+    timings are those of a loaded machine (the default suite's cells run alone).
+    """
+    shown = {row.method for row in default}
+    rows: list[StandardRow] = []
+    for row in map(_standard_row, measured_rows(thesis)):
+        if row.method in shown:
+            continue
+        note = "; ".join(part for part in (row.note, f"from {store}", THESIS_SPEED_NOTE if row.speed else "") if part)
+        source = (
+            f"{store}, {row.source.removeprefix('this suite, ')}"
+            if row.source.startswith("this suite, ")
+            else row.source
+        )
+        rows.append(replace(row, speed=None, source=source, note=note, store=store))
+    return rows
+
+
 def build_data(
     default_dir: Path, thesis_dir: Path | None, command: str, *, shown: dict[Path, str] | None = None
 ) -> ResultsData:
-    """The record of ``default_dir`` (standard benchmark) and ``thesis_dir`` (verdicts; None: not shown)."""
+    """The record of ``default_dir`` (standard benchmark) and ``thesis_dir`` (verdicts; None: not shown).
+
+    The standard table also takes from ``thesis_dir`` the methods ``default_dir`` lacks (:func:`thesis_rows`).
+    """
     names = shown or {}
     stamp, plan, records = _stamp(default_dir, names.get(default_dir, default_dir.as_posix()))
     stores = [stamp]
@@ -241,8 +274,9 @@ def build_data(
     elif not (thesis_dir / "grid.json").is_file():
         data.notes.append(f"{thesis_dir.as_posix()} is not a results folder (no grid.json): no verdicts.")
     else:
-        tstamp, _, _ = _stamp(thesis_dir, names.get(thesis_dir, thesis_dir.as_posix()))
+        tstamp, _, trecords = _stamp(thesis_dir, names.get(thesis_dir, thesis_dir.as_posix()))
         data.stores.append(tstamp)
+        data.standard = [*measured, *thesis_rows(measured, trecords, tstamp.path), *published]
         data.verdict_columns, data.verdicts, notes = _verdicts(thesis_dir)
         data.notes += notes
     return data

@@ -124,6 +124,20 @@ def _detail_lines(data: ResultsData) -> list[str]:
     return lines
 
 
+def _other_store_lines(data: ResultsData) -> list[str]:
+    """Which measured columns come from another store than the default suite's (the thesis suite's), and why."""
+    stores: dict[str, dict[str, None]] = {}
+    for row in data.standard:
+        if row.kind == "measured" and row.store:
+            stores.setdefault(row.store, {})[row.method] = None
+    return [
+        f"{', '.join(md_text(m) for m in methods)}: from `{store}`, whose suite runs them on the default suite's "
+        "datasets (the default suite does not); no speed is shown, as `make bench` runs that grid while the "
+        "default report is drawn."
+        for store, methods in stores.items()
+    ]
+
+
 def _published_lines(data: ResultsData) -> list[str]:
     """Each published system once, with the sources (and notes) of its numbers."""
     sources: dict[str, dict[str, None]] = {}
@@ -222,6 +236,7 @@ def render_page(data: ResultsData) -> str:
         "",
         *standard_table(data),
         "",
+        *(line for text in _other_store_lines(data) for line in (text, "")),
         "Every measured row (`reports/default/standard-benchmark.md` adds maxima, loop relations and CPU time):",
         "",
         *_detail_lines(data),
@@ -266,6 +281,7 @@ def render_readme_block(data: ResultsData | None) -> str:
             "",
             *standard_table(data),
             "",
+            *(line for text in _other_store_lines(data) for line in (text, "")),
             *ate_table(data),
             "",
             _counts_line(data),

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-from albot1.report.results_data import load_data
+from albot1.report.collect import collect
+from albot1.report.results_data import THESIS_SPEED_NOTE, load_data
 from albot1.report.results_page import readme_block, render_readme_block
 
 pytestmark = pytest.mark.slow
@@ -72,3 +74,37 @@ def test_results_page_quotes_the_stored_ate_and_is_byte_stable(tmp_path: Path) -
     before = {p: p.read_bytes() for p in (tmp_path / "docs").rglob("*") if p.is_file()}
     assert _albot1(*args, "--readme", "README.md", cwd=tmp_path).returncode == 0
     assert {p: p.read_bytes() for p in (tmp_path / "docs").rglob("*") if p.is_file()} == before
+
+
+def test_the_standard_table_takes_the_methods_the_default_store_lacks_from_the_thesis_store(tmp_path: Path) -> None:
+    """As `make bench` shows Albot1+: the thesis suite runs it on the standard logs, the default suite does not.
+
+    Stand-ins (cheap): the "thesis" store runs odometry (also in the default store: not taken again) and
+    odometry's `sparse-map` preset (taken, with its store named and no speed) on the whole ACES log.
+    """
+    if not (Path(os.environ.get("ALBOT1_DATA_DIR", "/nonexistent")) / "radish" / "aces.clf.bz2").is_file():
+        pytest.skip("the ACES log is not in ALBOT1_DATA_DIR")
+    (tmp_path / "std.toml").write_text('[[methods]]\nname = "odometry"\n\n[[datasets]]\nname = "aces"\n')
+    (tmp_path / "th.toml").write_text(
+        '[[methods]]\nname = "odometry"\n\n[[methods]]\nname = "odometry"\npreset = "sparse-map"\n\n'
+        '[[datasets]]\nname = "aces"\n'
+    )
+    for suite in ("std.toml", "th.toml"):
+        done = _albot1("bench", suite, "-j", "1", "--results", "results", "--no-progress", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+    args = ("results-page", "results/std", "--thesis", "results/th", "--out", "docs/results.md")
+    done = _albot1(*args, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    data = load_data(tmp_path / "docs" / "results" / "results.json")
+    assert data is not None
+    rows = {row.method: row for row in data.standard if row.kind == "measured"}
+    assert set(rows) == {"odometry", "odometry:sparse-map"}
+    ours, taken = rows["odometry"], rows["odometry:sparse-map"]
+    assert ours.store == "" and ours.speed is not None and ours.source.startswith("this suite, run ")
+    assert taken.store == "results/th" and taken.speed is None and taken.source.startswith("results/th, run ")
+    assert taken.note == f"from results/th; {THESIS_SPEED_NOTE}"
+    (record,) = (r for r in collect(tmp_path / "results" / "th")[1] if r.cell.method_label == "odometry:sparse-map")
+    stored = json.loads((record.run_dir / "metrics.json").read_text(encoding="utf-8"))["relations"]
+    assert taken.translation_mean_m == stored["translation_m"]["mean"]
+    page = (tmp_path / "docs" / "results.md").read_text(encoding="utf-8")
+    assert "odometry:sparse-map: from `results/th`, whose suite runs them" in page

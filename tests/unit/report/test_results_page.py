@@ -78,6 +78,27 @@ def test_standard_table_keeps_published_apart_and_marks_tuned() -> None:
     ]
 
 
+def test_a_column_from_the_thesis_store_is_named_with_its_store_on_the_page_and_in_the_readme() -> None:
+    data = _data()
+    plus = _row(
+        "aces", "measured", "albot1:plus", 0.338, held_in=True, store="results/thesis", note="from results/thesis"
+    )
+    data.standard.insert(2, plus)
+    assert standard_table(data)[:3] == [
+        "| log | gtsam-graph | albot1:plus | GM (published) |",
+        "|---|---|---|---|",
+        "| aces | 0.0348, 0.319° † | 0.3380 † | 0.0440, 0.400° |",
+    ]
+    said = (
+        "albot1:plus: from `results/thesis`, whose suite runs them on the default suite's datasets (the default "
+        "suite does not); no speed is shown, as `make bench` runs that grid while the default report is drawn."
+    )
+    page, block = render_page(data), render_readme_block(data)
+    assert said in page.splitlines() and said in block.splitlines()
+    assert said not in render_page(_data())  # the default store's columns alone: no such line
+    assert "| aces | albot1:plus † | 0.3380 | n/a |  |  | from results/thesis |" in page.splitlines()
+
+
 def test_ate_table_lists_each_seed_in_order() -> None:
     assert ate_table(_data()) == [
         "| dataset | degradation (seeds) | gtsam-graph |",
