@@ -232,7 +232,7 @@ def render_page(data: ResultsData) -> str:
         "## The standard benchmark (relation metric, five whole raw logs, own odometry)",
         "",
         "Translational relation error, mean (m), and rotational mean (deg) (Kuemmerle et al. 2009; "
-        "`reports/default/standard-benchmark.md` has every column):",
+        "`reports/default/standard-benchmark.md` has every column of the default suite's methods):",
         "",
         *standard_table(data),
         "",
