@@ -226,7 +226,7 @@ def thesis_rows(default: list[StandardRow], thesis: list[Any], store: str) -> li
 
     Why: the thesis suite runs the Albot1 variants the default suite leaves out (``albot1:literal``,
     ``albot1:plus``) on every default-suite dataset, the five standard logs whole among them, so the standard
-    table can show Albot1+ beside the others without running it twice. The rows name their store (``source``);
+    table can show Albot1+ beside the others without running it twice. The rows name their store (``store``);
     their speed is left out, since ``make bench`` runs the thesis grid while the default report is drawn, so its
     timings are those of a loaded machine (the default suite's cells run alone).
     """
