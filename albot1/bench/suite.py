@@ -124,7 +124,9 @@ class GridSpec(_Strict):
     """The degradation sweep applied to datasets with reference poses."""
 
     degradations: tuple[str, ...] = ()
-    seeds: tuple[Seed, ...] = (0,)
+    # At least one: an empty list would drop every swept degradation without a word (undegraded_seeds may be
+    # empty: a suite of degraded runs only).
+    seeds: tuple[Seed, ...] = Field((0,), min_length=1)
     undegraded_seeds: tuple[Seed, ...] = (0,)
 
     @field_validator("degradations")
@@ -144,8 +146,10 @@ class MethodEntry(_Strict):
     memory_mb: MemoryMb | None = None
     datasets: tuple[str, ...] | None = Field(
         None,
+        min_length=1,
         description="globs over dataset names: this entry runs only on the datasets the suite selects that match "
-        "one of them (default: on every one); an expensive method runs on the logs it is there for",
+        "one of them (default: on every one); an expensive method runs on the logs it is there for; an empty list "
+        "(which would leave the entry out of the grid without a word) is refused",
     )
     allow_failure: bool = Field(
         False,
@@ -207,14 +211,16 @@ class DatasetEntry(_Strict):
     stride: int | None = Field(None, ge=1, description="then every STRIDE-th of them")
     sweep: bool | Literal["auto"] = "auto"
     degradations: tuple[str, ...] | None = None
-    seeds: tuple[Seed, ...] | None = None
+    seeds: tuple[Seed, ...] | None = Field(None, min_length=1)
     undegraded_seeds: tuple[Seed, ...] | None = None
     time_s: TimeS | None = None
     memory_mb: MemoryMb | None = None
     methods: tuple[str, ...] | None = Field(
         None,
+        min_length=1,
         description="labels of the method entries that run on these datasets (default: every entry); a suite "
-        "that asks different questions of different data keeps its grid small this way",
+        "that asks different questions of different data keeps its grid small this way (an empty list is "
+        "refused: `skip = true` leaves datasets out)",
     )
     tags: tuple[str, ...] = Field(
         (),

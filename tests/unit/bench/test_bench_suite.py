@@ -87,6 +87,30 @@ def test_invalid_suites_name_file_and_key(tmp_path: Path, text: str, expected: s
         load_suite(write(tmp_path, text))
 
 
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        # an empty list that would drop cells without a word (adversarial test, session 13): refused, one line
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n[grid]\nseeds = []\n', "grid.seeds: "),
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", seeds = []}]\n', "datasets.0.seeds: "),
+        ('methods = [{name = "odometry", datasets = []}]\ndatasets = [{name = "*"}]\n', "methods.0.datasets: "),
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", methods = []}]\n', "datasets.0.methods: "),
+        # a bad key in the only entry: that key alone, not also "methods: at least 1 item"
+        ('methods = [{name = "odometry", presett = "x"}]\ndatasets = [{name = "*"}]\n', "methods.0.presett: "),
+    ],
+)
+def test_empty_lists_and_a_bad_entry_are_one_problem_each(tmp_path: Path, text: str, expected: str) -> None:
+    with pytest.raises(SuiteError) as caught:
+        load_suite(write(tmp_path, text))
+    problems = str(caught.value).split(": invalid suite: ", 1)[1].split("; ")
+    assert len(problems) == 1 and problems[0].startswith(expected), str(caught.value)
+
+
+def test_a_suite_of_degraded_runs_only_may_leave_the_undegraded_seeds_empty(tmp_path: Path) -> None:
+    text = 'methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n[grid]\nundegraded_seeds = []\n'
+    assert load_suite(write(tmp_path, text)).grid.undegraded_seeds == ()
+
+
 def test_suite_name_defaults_to_file_stem(tmp_path: Path) -> None:
     path = write(tmp_path, 'methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n')
     assert load_suite(path).name == "s"
