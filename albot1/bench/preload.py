@@ -106,6 +106,11 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
         if (methods is None or spec.name in methods) and spec.available():
             _attempt(f"method {spec.name} ({spec.target})", spec.load_class, failures)
             warmed.append(spec.name)
+    # The versions of the libraries just imported, read here, right after the imports, for every cell (a search of
+    # the installed metadata, ~2 ms per library) and kept while this server lives: they name the modules its cells
+    # run even if another version is installed meanwhile. A library no preloaded method imports is read again by
+    # the cell that imports it (albot1.versions.library_versions).
+    versions.library_versions()
     # Every preset's warm-up, once, here, before any fork: every cell forked from this server then starts with the
     # kernels in memory, so a cell's start-up is not paid once per cell (1.3-1.9 s for Albot1 with numba's cache
     # filled).
@@ -125,10 +130,6 @@ def _warm() -> None:
     for failure in warm(methods=methods_to_preload()):
         _log.warning("albot1 bench: preloading %s (each cell that needs it will fail with this reason)", failure)
     _warm_matplotlib()
-    # The versions of the libraries just imported, read once here for every cell (a search of the installed
-    # metadata, ~2 ms per library) and kept while this server lives: they name the modules its cells run, even if
-    # another version is installed meanwhile (albot1.versions.library_versions).
-    versions.library_versions()
 
 
 def collect_garbage() -> None:

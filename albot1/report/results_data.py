@@ -1,7 +1,8 @@
 """The record behind ``docs/results.md`` and the README's results block: numbers and what produced them.
 
 Built from the stores ``make bench`` fills (the default suite: standard
-benchmark and key ATE cells; the thesis suite: verdicts), written as
+benchmark and key ATE cells; the thesis suite: verdicts and the standard-log
+columns of the methods only it runs), written as
 ``docs/results/results.json`` and read back by :mod:`albot1.report.results_page`,
 which renders the page and the README block from it alone. Measured and
 published rows are kept apart by ``kind``; nothing here reads the clock.
@@ -235,7 +236,9 @@ def thesis_rows(default: list[StandardRow], thesis: list[Any], store: str) -> li
     for row in map(_standard_row, measured_rows(thesis)):
         if row.method in shown:
             continue
-        note = "; ".join(part for part in (row.note, f"from {store}", THESIS_SPEED_NOTE if row.speed else "") if part)
+        said = row.note.replace("this suite's", f"{store}'s")  # "this suite" would read as the default suite
+        speed = THESIS_SPEED_NOTE if row.speed is not None else ""
+        note = "; ".join(part for part in (said, f"from {store}", speed) if part)
         source = (
             f"{store}, {row.source.removeprefix('this suite, ')}"
             if row.source.startswith("this suite, ")
@@ -267,18 +270,23 @@ def build_data(
         standard=measured + published,
         ate=ate_cells(records),
     )
-    if not measured:
-        data.notes.append(f"{stamp.path} holds no whole-log run on the five standard logs: no measured row.")
+    taken: list[StandardRow] = []
     if thesis_dir is None:
-        data.notes.append("No thesis suite given: no verdicts.")
+        data.notes.append("No thesis suite given: no verdicts, and no column of the methods only it runs.")
     elif not (thesis_dir / "grid.json").is_file():
-        data.notes.append(f"{thesis_dir.as_posix()} is not a results folder (no grid.json): no verdicts.")
+        data.notes.append(
+            f"{thesis_dir.as_posix()} is not a results folder (no grid.json): no verdicts, and no column of the "
+            "methods only the thesis suite runs (albot1:plus, albot1:literal)."
+        )
     else:
         tstamp, _, trecords = _stamp(thesis_dir, names.get(thesis_dir, thesis_dir.as_posix()))
         data.stores.append(tstamp)
-        data.standard = [*measured, *thesis_rows(measured, trecords, tstamp.path), *published]
+        taken = thesis_rows(measured, trecords, tstamp.path)
+        data.standard = [*measured, *taken, *published]
         data.verdict_columns, data.verdicts, notes = _verdicts(thesis_dir)
         data.notes += notes
+    if not measured and not taken:
+        data.notes.append(f"{stamp.path} holds no whole-log run on the five standard logs: no measured row.")
     return data
 
 

@@ -79,15 +79,16 @@ def run_method(
     offset = seq.metadata.sensor_offset
     seen = sensor_frame(seq)
     mapper = spec.load_class()(config, seed=seed)
+    # The versions of the libraries the mapper has imported by now are kept from here on (the record below names
+    # what ran, not what another install put in place during the run: albot1.versions.library_versions); read
+    # before the run's clock starts, so the metadata search is not in its timings.
+    versions.library_versions()
 
     wall_start, cpu_start = time.perf_counter(), cpu_time_s()
     warm_up = getattr(mapper, "warm_up", None)
     if callable(warm_up):
         warm_up(announce)
     startup_s = time.perf_counter() - wall_start
-    # The versions of the libraries the mapper has imported by now are kept from here on (the record below names
-    # what ran, not what another install put in place during the run: albot1.versions.library_versions).
-    versions.library_versions()
     per_scan: list[int] = []
     stamps: list[float] = []
     odometry: list[np.ndarray] = []
