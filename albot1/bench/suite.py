@@ -134,6 +134,12 @@ class GridSpec(_Strict):
     def _valid_specs(cls, value: tuple[str, ...]) -> tuple[str, ...]:
         return _check_degradations(value)
 
+    @field_validator("seeds", "undegraded_seeds")
+    @classmethod
+    def _distinct_seeds(cls, value: tuple[int, ...]) -> tuple[int, ...]:
+        _check_seeds(value)
+        return value
+
 
 class MethodEntry(_Strict):
     """One method column of the grid: a registered method (built in or a plugin) with preset and overrides."""
@@ -231,6 +237,11 @@ class DatasetEntry(_Strict):
     @classmethod
     def _valid_specs(cls, value: tuple[str, ...] | None) -> tuple[str, ...] | None:
         return None if value is None else _check_degradations(value)
+
+    @field_validator("seeds", "undegraded_seeds")
+    @classmethod
+    def _distinct_seeds(cls, value: tuple[int, ...] | None) -> tuple[int, ...] | None:
+        return _check_seeds(value)
 
     @property
     def is_pattern(self) -> bool:
@@ -346,12 +357,26 @@ class Suite(_Strict):
 
 
 def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
+    """Each spec valid, and none twice: a repeated one, or one written two ways (``gauss:0.05:2`` and
+    ``gauss:0.050:2.0``), would plan its cells twice, and a report would weight its seeds twice."""
+    seen: dict[object, str] = {}
     for spec in specs:
         try:
-            parse_spec(spec)
+            parsed = parse_spec(spec)
         except DegradationSpecError as exc:
             raise ValueError(str(exc)) from None
+        if parsed in seen:
+            raise ValueError(f"{spec!r} repeats {seen[parsed]!r} (the same perturbation): list each once")
+        seen[parsed] = spec
     return specs
+
+
+def _check_seeds(seeds: tuple[int, ...] | None) -> tuple[int, ...] | None:
+    """No seed twice: a repeated seed plans the same cell twice and would be counted twice in a mean."""
+    repeated = sorted({seed for seed in seeds or () if (seeds or ()).count(seed) > 1})
+    if repeated:
+        raise ValueError(f"seed(s) {', '.join(map(str, repeated))} listed more than once: list each seed once")
+    return seeds
 
 
 def parse_suite(data: dict[str, Any], *, name: str, source: str, path: Path | None = None) -> Suite:

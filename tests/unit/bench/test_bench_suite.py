@@ -95,6 +95,14 @@ def test_invalid_suites_name_file_and_key(tmp_path: Path, text: str, expected: s
         ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", seeds = []}]\n', "datasets.0.seeds: "),
         ('methods = [{name = "odometry", datasets = []}]\ndatasets = [{name = "*"}]\n', "methods.0.datasets: "),
         ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", methods = []}]\n', "datasets.0.methods: "),
+        # a seed or perturbation listed twice would plan its cells twice and weight them twice in a mean
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n[grid]\nseeds = [0, 0, 1]\n', "grid.seeds: "),
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", undegraded_seeds = [2, 2]}]\n', "datasets.0.undeg"),
+        (
+            'methods = [{name = "odometry"}]\ndatasets = [{name = "*"}]\n[grid]\n'
+            'degradations = ["gauss:0.05:2", "gauss:0.050:2.0"]\n',
+            "grid.degradations: ",
+        ),
         # a bad key in the only entry: that key alone, not also "methods: at least 1 item"
         ('methods = [{name = "odometry", presett = "x"}]\ndatasets = [{name = "*"}]\n', "methods.0.presett: "),
     ],
