@@ -78,7 +78,7 @@ import fnmatch
 import re
 import tomllib
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
@@ -137,8 +137,7 @@ class GridSpec(_Strict):
     @field_validator("seeds", "undegraded_seeds")
     @classmethod
     def _distinct_seeds(cls, value: tuple[int, ...]) -> tuple[int, ...]:
-        _check_seeds(value)
-        return value
+        return _check_seeds(value)
 
 
 class MethodEntry(_Strict):
@@ -356,6 +355,9 @@ class Suite(_Strict):
         return out
 
 
+_Seeds = TypeVar("_Seeds", tuple[int, ...], tuple[int, ...] | None)
+
+
 def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
     """Each spec valid, and none twice: a repeated one, or one written two ways (``gauss:0.05:2`` and
     ``gauss:0.050:2.0``), would plan its cells twice, and a report would weight its seeds twice."""
@@ -371,9 +373,10 @@ def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
     return specs
 
 
-def _check_seeds(seeds: tuple[int, ...] | None) -> tuple[int, ...] | None:
+def _check_seeds(seeds: _Seeds) -> _Seeds:
     """No seed twice: a repeated seed plans the same cell twice and would be counted twice in a mean."""
-    repeated = sorted({seed for seed in seeds or () if (seeds or ()).count(seed) > 1})
+    listed = seeds or ()
+    repeated = sorted({seed for seed in listed if listed.count(seed) > 1})
     if repeated:
         raise ValueError(f"seed(s) {', '.join(map(str, repeated))} listed more than once: list each seed once")
     return seeds
