@@ -345,6 +345,7 @@ class Sequence:
             "scan_geometry": scan_geometry(arr.beams, arr.angle_span),
             "sensor_offset": [float(v) for v in self.metadata.sensor_offset],
             "sensor_offset_source": str(self.metadata.extra.get("sensor_offset_source", "")),
+            "skipped_messages": str(self.metadata.extra.get("skipped_messages", "")),
         }
 
 

@@ -119,6 +119,8 @@ class ParsedChunk:
     first_laser: str | None = None
     #: lines holding a message (not blank, not a comment) in this chunk
     message_lines: int = 0
+    #: the last line read (set by the probe: how far its counts reach)
+    last_line: int = 0
 
 
 _KNOWN = frozenset(LASER_MESSAGES + POSE_MESSAGES + ("PARAM",))
