@@ -52,6 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.data.errors import DataError, ParseError
+from albot1.data.model import MAX_COORDINATE_M
 from albot1.data.text import TEXT_ENCODING
 
 TrajectoryFormat = Literal["tum", "kitti", "carmen"]
@@ -59,8 +60,6 @@ TRAJECTORY_FORMATS: tuple[TrajectoryFormat, ...] = get_args(TrajectoryFormat)
 TUM_COLUMNS = "t x y z qx qy qz qw"
 #: Suffixes of CARMEN logs (plain or compressed) for :func:`guess_format`.
 CARMEN_SUFFIXES = (".clf", ".log", ".gfs", ".carmen")
-#: Largest accepted |x|, |y| (m) of a pose; beyond it a coordinate is refused as absurd.
-MAX_COORDINATE_M = 1e8
 #: Largest accepted |timestamp| (s): year 5138 in Unix time; nanosecond stamps (1.7e18) are refused, not misread.
 MAX_TIMESTAMP_S = 1e11
 #: Largest accepted | |q| - 1 | of a TUM quaternion; within it the quaternion is normalised.

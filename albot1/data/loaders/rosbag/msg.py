@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from albot1.data.model import MAX_COORDINATE_M
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 
@@ -116,6 +117,26 @@ def laserscan_problem(
             f"the count to agree with the angles (to within one beam)"
         )
     return None
+
+
+def reading_problem(ranges: ArrayLike, range_min: float, range_max: float) -> str | None:
+    """A reading the scan keeps (within ``[range_min, range_max]``) beyond :data:`MAX_COORDINATE_M`, or None.
+
+    A ``range_max`` of float32's largest value lets any reading through; one of
+    1e30 m is no measurement, and its point would overflow the maps' grid
+    arithmetic far from the message that holds it. Beams are counted in the
+    message's order, from 1.
+    """
+    r = np.asarray(ranges, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        far = (r > MAX_COORDINATE_M) & (r >= range_min) & (r <= range_max)
+    if not far.any():
+        return None
+    k = int(np.argmax(far))
+    return (
+        f"range {k + 1} of {r.shape[0]} is {float(r[k]):.6g} m (range_max {range_max:.6g} m), expected at most "
+        f"{MAX_COORDINATE_M:g} m: no laser measures farther (a reading beyond range_max is no return)"
+    )
 
 
 def quaternion_from_yaw(theta: float) -> tuple[float, float, float, float]:

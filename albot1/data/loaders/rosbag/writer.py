@@ -28,7 +28,7 @@ Because odometry is written at exactly the scan stamps, the loader's
 interpolation returns the written poses unchanged; this needs strictly
 increasing scan stamps, which the writer checks (see ``convert(retime=)``
 for logs whose stamps jitter or repeat). Each LaserScan and pose is checked
-with the reader's own rules (:func:`.msg.laserscan_problem`, on the float32
+with the reader's own rules (:func:`.msg.laserscan_problem`, :func:`.msg.reading_problem`, on the float32
 values as stored; :func:`.msg.pose_problem`) before it is written, so the
 writer never produces a bag its reader refuses. The output must not exist;
 a failed write removes what it created (output rules:
@@ -55,6 +55,7 @@ from albot1.data.loaders.rosbag.msg import (
     laserscan_problem,
     pose_problem,
     quaternion_from_yaw,
+    reading_problem,
     seconds_to_ns,
     split_ns,
 )
@@ -117,7 +118,7 @@ class RosMessages:
             ranges = np.where(np.isfinite(scan.ranges), scan.ranges, np.inf).astype(np.float32)
             angle_min, step = spacing
             fields = [float(np.float32(v)) for v in (angle_min, scan.angles[-1], step, 0.0, scan.max_range)]
-        problem = laserscan_problem(scan.beams, *fields)
+        problem = laserscan_problem(scan.beams, *fields) or reading_problem(ranges, fields[3], fields[4])
         if problem is not None:
             raise UnwritableError(f"scan #{frame.index}: LaserScan {problem}; the bag reader would refuse it")
         return self.LaserScan(
