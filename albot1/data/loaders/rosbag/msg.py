@@ -37,13 +37,30 @@ def stamp_seconds(sec: int, nanosec: int) -> float:
 
 
 def seconds_to_ns(seconds: float) -> int:
-    """Float seconds -> integer nanoseconds (the bag's clock); rounds to the nearest ns."""
-    return int(round(seconds * 1e9))
+    """Float seconds -> integer nanoseconds (the bag's clock); rounds to the nearest ns.
+
+    Whole seconds and the fraction are converted apart: ``seconds * 1e9`` of a
+    Unix time (1.7e18 ns) is a float 256 ns apart from its neighbours, so
+    1700000000.75 s became 1700000000.750000128 s in the bag and read back as
+    another float; split, it is stored and read back exactly.
+    """
+    whole = math.floor(seconds)
+    return int(whole) * 1_000_000_000 + round((seconds - whole) * 1e9)
 
 
 def split_ns(ns: int) -> tuple[int, int]:
     """Nanoseconds -> ROS ``(sec, nanosec)`` with ``0 <= nanosec < 1e9``."""
     return ns // 1_000_000_000, ns % 1_000_000_000
+
+
+def ns_text(ns: int) -> str:
+    """Integer nanoseconds as the exact decimal seconds a bag stores (``1200000000`` -> ``"1.200000000"``).
+
+    Said from the integer, not from float seconds, so a message shows the
+    stamps the writer compared, without float noise (``1.2000000000000002``).
+    """
+    sec, nanosec = split_ns(ns)
+    return f"{sec}.{nanosec:09d}"
 
 
 def quaternion_problem(x: float, y: float, z: float, w: float) -> str | None:

@@ -53,6 +53,7 @@ from albot1.data.loaders.beams import even_spacing
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.loaders.rosbag.msg import (
     laserscan_problem,
+    ns_text,
     pose_problem,
     quaternion_from_yaw,
     reading_problem,
@@ -215,9 +216,9 @@ def _write_frames(
         ns = _frame_ns(frame)
         if ns <= previous:
             raise UnwritableError(
-                f"scan #{frame.index}: timestamp {frame.scan.timestamp!r} s is not after the previous "
-                f"scan's ({previous * 1e-9!r} s); a bag orders scans and matches poses by time, so "
-                f"stamps must strictly increase (convert with --retime to shift such scans forward)"
+                f"scan #{frame.index}: timestamp {ns_text(ns)} s is not after the previous scan's "
+                f"{ns_text(previous)} s (stamps on the bag's nanosecond clock); a bag orders scans and matches "
+                f"poses by time, so stamps must strictly increase (convert with --retime to shift such scans forward)"
             )
         if previous < 0:
             write(static_conn, ns, serialize(msgs.tf(mount, ns, BASE_FRAME, LASER_FRAME, 0), TF_MESSAGE))
