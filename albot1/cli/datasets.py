@@ -188,6 +188,8 @@ def info(
     typer.echo(f"  odometry: {summary.get('odometry_source', '')}")
     for line in geometry_lines(summary):
         typer.echo(f"  {line}")
+    if summary.get("skipped_messages"):
+        typer.echo(f"  skipped: {summary['skipped_messages']}")
     typer.echo(f"  source: {summary.get('source', '')} ({summary.get('format', '')})")
     checksums = summary["data_sha256"]
     typer.echo(

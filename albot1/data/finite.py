@@ -8,7 +8,7 @@ Every frame a file loader yields passes :func:`checked` (applied by
 with its source, index and timestamp:
 
 * odometry and reference poses: every component finite, and ``|x|, |y|``
-  at most :data:`MAX_COORDINATE_M` (the bound of trajectory files);
+  at most :data:`~albot1.data.model.MAX_COORDINATE_M` (the bound of trajectory files);
 * the scan's timestamp finite, its beam angles finite. Ranges may be NaN or
   infinite: loaders use those for "no return" (``docs/formats.md``).
 """
@@ -21,8 +21,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from albot1.data.errors import ParseError
-from albot1.data.model import Frame, Sequence
-from albot1.data.trajectory import MAX_COORDINATE_M
+from albot1.data.model import MAX_COORDINATE_M, Frame, Sequence
 
 
 def pose_problem(pose: object, what: str) -> str | None:

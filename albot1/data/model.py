@@ -29,6 +29,12 @@ from numpy.typing import NDArray
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 
+#: Largest accepted |x|, |y| (m) of a pose and largest accepted laser reading (m): 1e8 m (100 000 km) is no
+#: planar map, and larger values overflow to infinity once squared in a metric or cast to a grid cell. Trajectory
+#: files (:mod:`albot1.data.trajectory`), every loaded frame (:mod:`albot1.data.finite`), the bag reader's ranges
+#: and a method's map (:mod:`albot1.runs.execute`) are held to it.
+MAX_COORDINATE_M = 1e8
+
 
 class _BeamDirections:
     """cos and sin of the last read-only beam-angle array seen.
@@ -345,6 +351,7 @@ class Sequence:
             "scan_geometry": scan_geometry(arr.beams, arr.angle_span),
             "sensor_offset": [float(v) for v in self.metadata.sensor_offset],
             "sensor_offset_source": str(self.metadata.extra.get("sensor_offset_source", "")),
+            "skipped_messages": str(self.metadata.extra.get("skipped_messages", "")),
         }
 
 

@@ -50,6 +50,7 @@ from numpy.typing import ArrayLike, NDArray
 from albot1.atomic import atomic_write
 from albot1.data.errors import DataError, ParseError
 from albot1.data.model import Relations
+from albot1.data.text import TEXT_ENCODING
 from albot1.data.tokens import parse_floats
 
 log = logging.getLogger(__name__)
@@ -86,7 +87,7 @@ def read_relations(path: str | Path, *, warn_repeats: bool = True, repeats: Repe
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8", errors="replace")
+        text = p.read_text(encoding=TEXT_ENCODING, errors="replace")  # a leading byte-order mark dropped
     except OSError as exc:
         raise ParseError(p, f"cannot read relations file ({exc.strerror or exc})") from None
     first_line = text.split("\n", 1)[0].strip()

@@ -35,6 +35,8 @@ expected (:class:`~albot1.data.errors.ParseError`). What is refused, and why:
   identity by more than :data:`ROTATION_TOLERANCE`, or a reflection);
 * (:func:`read_trajectory`) two poses with one timestamp: which of the two
   is meant cannot be told, so both line numbers are named.
+
+A byte-order mark at the start of a file is dropped (:mod:`albot1.data.text`).
 """
 
 from __future__ import annotations
@@ -50,14 +52,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.data.errors import DataError, ParseError
+from albot1.data.model import MAX_COORDINATE_M
+from albot1.data.text import TEXT_ENCODING
 
 TrajectoryFormat = Literal["tum", "kitti", "carmen"]
 TRAJECTORY_FORMATS: tuple[TrajectoryFormat, ...] = get_args(TrajectoryFormat)
 TUM_COLUMNS = "t x y z qx qy qz qw"
 #: Suffixes of CARMEN logs (plain or compressed) for :func:`guess_format`.
 CARMEN_SUFFIXES = (".clf", ".log", ".gfs", ".carmen")
-#: Largest accepted |x|, |y| (m) of a pose; beyond it a coordinate is refused as absurd.
-MAX_COORDINATE_M = 1e8
 #: Largest accepted |timestamp| (s): year 5138 in Unix time; nanosecond stamps (1.7e18) are refused, not misread.
 MAX_TIMESTAMP_S = 1e11
 #: Largest accepted | |q| - 1 | of a TUM quaternion; within it the quaternion is normalised.
@@ -117,7 +119,7 @@ def _rows(path: Path, columns: int, expected: str) -> NDArray[np.float64]:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data": an empty file is no poses
-            rows = np.loadtxt(path, ndmin=2, comments="#", dtype=float)
+            rows = np.loadtxt(path, ndmin=2, comments="#", dtype=float, encoding=TEXT_ENCODING)
     except OSError as exc:
         raise DataError(f"{path}: cannot read the trajectory: {exc.strerror or exc}") from None
     except ValueError:
@@ -129,7 +131,7 @@ def _rows(path: Path, columns: int, expected: str) -> NDArray[np.float64]:
 
 
 def _locate_problem(path: Path, columns: int, expected: str) -> None:
-    with path.open(encoding="utf-8", errors="replace") as lines:
+    with path.open(encoding=TEXT_ENCODING, errors="replace") as lines:
         for number, line in enumerate(lines, start=1):
             text = line.split("#", 1)[0].strip()
             if not text:
@@ -266,7 +268,7 @@ def guess_format(path: Path) -> TrajectoryFormat:
     if name.endswith(".kitti"):
         return "kitti"
     try:
-        with path.open(encoding="utf-8", errors="replace") as lines:
+        with path.open(encoding=TEXT_ENCODING, errors="replace") as lines:
             for line in lines:
                 text = line.split("#", 1)[0].strip()
                 if text:
@@ -332,7 +334,7 @@ def _refuse_duplicate_stamps(path: Path, stamps: NDArray[np.float64], *, by_line
 def _line_of(path: Path, row: int) -> int:
     """The 1-based line number of data row ``row`` (comments and blank lines skipped)."""
     seen = -1
-    with path.open(encoding="utf-8", errors="replace") as lines:
+    with path.open(encoding=TEXT_ENCODING, errors="replace") as lines:
         for number, line in enumerate(lines, start=1):
             if line.split("#", 1)[0].strip():
                 seen += 1

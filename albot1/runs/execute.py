@@ -24,8 +24,7 @@ import numpy as np
 from albot1 import versions
 from albot1.contract import MapData, MapperOutput, RunResult
 from albot1.data.degrade import degrade
-from albot1.data.model import Frame, Sequence
-from albot1.data.trajectory import MAX_COORDINATE_M
+from albot1.data.model import MAX_COORDINATE_M, Frame, Sequence
 from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
 from albot1.methods.registry import MethodRegistry, get_method, resolve_config

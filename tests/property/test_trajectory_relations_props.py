@@ -18,8 +18,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from albot1.data.errors import DataError
+from albot1.data.model import MAX_COORDINATE_M
 from albot1.data.relations import read_relations
-from albot1.data.trajectory import MAX_COORDINATE_M, read_trajectory
+from albot1.data.trajectory import read_trajectory
 
 NUMBERS = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True).map(repr),

@@ -25,6 +25,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Protocol
 
+from albot1.data.text import without_bom
+
 GZIP_MAGIC = b"\x1f\x8b"
 BZ2_MAGIC = b"BZh"
 #: bzip2 marks each block and the end of a stream with these 48-bit patterns, at any *bit* offset.
@@ -181,10 +183,11 @@ def iter_decompressed(path: Path, compression: str | None = None) -> Iterator[by
 
 
 def read_head(path: Path, size: int = 4096) -> bytes:
-    """The first ``size`` decompressed bytes (for sniffing); what could be decoded when the data is damaged."""
+    """The first ``size`` decompressed bytes (for sniffing), without a leading byte-order mark
+    (:mod:`albot1.data.text`); what could be decoded when the data is damaged."""
     out = b""
     try:
-        for block in iter_decompressed(path):
+        for block in without_bom(iter_decompressed(path)):
             out += block
             if len(out) >= size:
                 break
@@ -197,10 +200,10 @@ def iter_lines(path: Path) -> Iterator[bytes]:
     """The decompressed file's lines (newline removed); :class:`DamagedStream` after the last complete one.
 
     A final line without a newline is yielded when the data is intact, dropped
-    (it may be cut off) when it is not.
+    (it may be cut off) when it is not. A leading byte-order mark is dropped (:mod:`albot1.data.text`).
     """
     carry = b""
-    for block in iter_decompressed(path):
+    for block in without_bom(iter_decompressed(path)):
         lines = (carry + block).split(b"\n")
         carry = lines.pop()
         yield from lines

@@ -204,7 +204,7 @@ def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | Non
         stripped = text.strip()
         if not stripped or stripped.startswith("#"):
             continue
-        key, _, value = stripped.partition(" ")
+        key, value = (*stripped.split(None, 1), "")[:2]  # fields split by any whitespace, as in the VIEW lines
         if key in ("SENSOR", "SENSOR-ANGLES", "VIEW"):
             missing = [k for k in ("UNITS", "FRAME") if k not in seen]
             if missing:

@@ -40,8 +40,11 @@ Streaming: the log is decoded chunk by chunk (2 MiB of text); only scans
 waiting for a later ODOM/TRUEPOS line and the ODOM lines that can still
 bracket them are buffered. Message types other than the chosen laser, ODOM,
 TRUEPOS and PARAM (SYNC, NEFF, NMEA-GGA, a rear laser, ...) are skipped
-by design; the names seen at the start of the log are listed in
-``metadata.extra["ignored_messages"]``.
+by design, never silently: the kinds seen at the start of the log are listed in
+``metadata.extra["ignored_messages"]``, and counted with their first lines in
+``metadata.extra["skipped_messages"]``, which ``albot1 datasets info`` prints
+and every load logs as a warning (unless only kinds without sensor data,
+:data:`.probe.QUIET_SKIPS`, are skipped).
 
 Old and new front-laser messages (FLASER, ROBOTLASER1, RAWLASER1) in one
 log are refused unless the ``laser`` option names the kind to read: they may
@@ -61,6 +64,7 @@ geometry), :mod:`.interp` (pose look-ahead buffers) and :mod:`.checks`.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -69,11 +73,13 @@ from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.frames import FrameStream
 from albot1.data.loaders.carmen.options import describe_odometry, describe_reference, parse_options
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES
-from albot1.data.loaders.carmen.probe import probe, refuse_mixed
+from albot1.data.loaders.carmen.probe import noteworthy_skips, probe, refuse_mixed, skipped_note
 from albot1.data.loaders.carmen.source import read_head
 from albot1.data.model import Sequence, SequenceMetadata
 from albot1.data.relations import read_relations
 from albot1.geometry import se2
+
+log = logging.getLogger(__name__)
 
 #: A file is taken for a CARMEN log if a line of its first 64 KiB starts with one of these messages
 #: (or the "# CARMEN" comment the logger writes first).
@@ -153,8 +159,11 @@ class CarmenLoader:
                 "no_return_rule": f"r >= max_range - {geom.NO_RETURN_MARGIN} m or r == 0",
                 "time_tolerance_s": opts.time_tolerance,
                 "ignored_messages": sorted(head.ignored),
+                "skipped_messages": skipped_note(laser, head),
             },
         )
+        if noteworthy_skips(head):
+            log.warning("%s: skipped: %s", path, metadata.extra["skipped_messages"])
         relations = (
             read_relations(given.relations, repeats=given.relations_repeats) if given.relations is not None else None
         )

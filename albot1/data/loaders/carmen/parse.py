@@ -119,6 +119,8 @@ class ParsedChunk:
     first_laser: str | None = None
     #: lines holding a message (not blank, not a comment) in this chunk
     message_lines: int = 0
+    #: the last line read (set by the probe: how far its counts reach)
+    last_line: int = 0
 
 
 _KNOWN = frozenset(LASER_MESSAGES + POSE_MESSAGES + ("PARAM",))
@@ -173,6 +175,22 @@ def _describe(token: bytes) -> str:
     return repr(token[:20].decode("utf-8", "replace"))
 
 
+def _is_number(token: bytes) -> bool:
+    """Whether the bulk conversion (``np.loadtxt``) reads ``token`` as a number.
+
+    ``float()`` alone is not that test: it also takes Python's digit grouping
+    (``3_05``), which numpy refuses, and a line it passed would leave the
+    group's failure unexplained (reported at the group's first line).
+    """
+    if b"_" in token:
+        return False
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
 def _check_line(path: Path, line: int, name: str, tokens: list[bytes], expected: int, text_at: int) -> None:
     """Raise the precise error for one line whose bulk conversion failed."""
     layout = _LAYOUT["RAWLASER" if name.startswith("RAWLASER") else name]
@@ -181,14 +199,8 @@ def _check_line(path: Path, line: int, name: str, tokens: list[bytes], expected:
             path, f"{name} has {len(tokens)} fields after the name, expected {expected} ({layout})", line=line
         )
     for i, tok in enumerate(tokens):
-        if i == text_at % expected:
-            continue
-        try:
-            float(tok)
-        except ValueError:
-            raise ParseError(
-                path, f"{name} field {i + 1} is {_describe(tok)}, expected a number ({layout})", line=line
-            ) from None
+        if i != text_at % expected and not _is_number(tok):
+            raise ParseError(path, f"{name} field {i + 1} is {_describe(tok)}, expected a number ({layout})", line=line)
 
 
 def _bulk(path: Path, name: str, rows: list[tuple[int, bytes]], expected: int) -> FloatArray:
@@ -219,11 +231,29 @@ def _bulk(path: Path, name: str, rows: list[tuple[int, bytes]], expected: int) -
     except ValueError as exc:
         for line, rest in rows:
             _check_line(path, line, name, rest.split(), expected, host_at)
+        line, reason = _failing_line(name, rows, expected, host_at, single_spaced, exc)
         raise ParseError(
-            path,
-            f"{name} lines could not be read as numbers ({exc}); expected {_LAYOUT.get(name, name)}",
-            line=rows[0][0],
+            path, f"{name} line could not be read as numbers ({reason}); expected {_LAYOUT.get(name, name)}", line=line
         ) from None
+
+
+def _failing_line(
+    name: str, rows: list[tuple[int, bytes]], expected: int, host_at: int, single_spaced: bool, exc: ValueError
+) -> tuple[int, str]:
+    """The line (and numpy's reason) that fails the bulk conversion when every token passed
+    :func:`_is_number`: each line is converted alone, so the error names the true line."""
+    for line, rest in rows:
+        try:
+            np.loadtxt(
+                [rest.decode("latin-1")],
+                dtype=np.float64,
+                comments=None,
+                delimiter=" " if single_spaced else None,
+                usecols=[i for i in range(expected) if i != host_at],
+            )
+        except ValueError as alone:
+            return line, str(alone)
+    return rows[0][0], str(exc)  # pragma: no cover - the group failed, so one of its lines does
 
 
 class _Lines:

@@ -3,7 +3,8 @@
 :func:`probe` reads the log until its first scan (at most 2 MiB, in small
 reads so it stays cheap on compressed logs): which front laser it holds, its
 PARAM values, whether it has TRUEPOS lines, and the message names the loader
-will skip. :func:`refuse_mixed` turns front-laser messages of two kinds
+will skip (:func:`skipped_note`: the sentence the loader logs and ``datasets
+info`` prints). :func:`refuse_mixed` turns front-laser messages of two kinds
 (FLASER, ROBOTLASER1, RAWLASER1) into one clear ParseError, counting each
 kind over the whole log only on that error path.
 """
@@ -14,11 +15,21 @@ from contextlib import closing
 from pathlib import Path
 
 from albot1.data.errors import ParseError
-from albot1.data.loaders.carmen.parse import FRONT_LASERS, ParsedChunk, probe_chunk, split_messages
+from albot1.data.loaders.carmen.parse import (
+    FRONT_LASERS,
+    LASER_MESSAGES,
+    ParsedChunk,
+    probe_chunk,
+    split_messages,
+)
 from albot1.data.loaders.carmen.source import CHUNK_BYTES, iter_line_chunks
 
 PROBE_BYTES = 1 << 18
 PROBE_LIMIT = CHUNK_BYTES
+#: Skipped message kinds that hold no sensor data, so skipping them is not worth a warning at every load
+#: (``datasets info`` still lists them): GMapping's effective particle count, after every scan of the
+#: corrected logs (``radish-corrected/``).
+QUIET_SKIPS = frozenset(("NEFF",))
 
 
 def probe(path: Path, laser: str | None) -> ParsedChunk:
@@ -40,6 +51,7 @@ def probe(path: Path, laser: str | None) -> ParsedChunk:
             seen += sum(len(line) + 1 for line in chunk.lines)
             if part.first_laser is not None or seen >= PROBE_LIMIT:
                 merged.first_laser, merged.lasers = part.first_laser, part.lasers
+                merged.last_line = lines
                 return merged
     if seen == 0:
         raise ParseError(path, "the file is empty; expected a CARMEN log (one message per line)")
@@ -47,7 +59,30 @@ def probe(path: Path, laser: str | None) -> ParsedChunk:
         raise ParseError(
             path, f"the log holds only comments and blank lines ({lines} lines); expected CARMEN messages", line=lines
         )
+    merged.last_line = lines
     return merged
+
+
+def skipped_note(laser: str, parsed: ParsedChunk) -> str:
+    """The message kinds the loader skips, as one sentence ('' when none): each with its count and first line
+    among the lines :func:`probe` read (the log's head), so a user learns what is not read without a pass."""
+    if not parsed.ignored:
+        return ""
+    kinds = sorted(parsed.ignored, key=lambda name: parsed.ignored_first[name])
+    listed = ", ".join(
+        f"{parsed.ignored[name]} {name} lines from line {parsed.ignored_first[name]}"
+        + (f" (a laser: read it with laser={name})" if name in LASER_MESSAGES else "")
+        for name in kinds
+    )
+    return (
+        f"{listed}, counted in the first {parsed.last_line} lines; message kinds other than {laser}, ODOM, "
+        f"TRUEPOS and PARAM are not read"
+    )
+
+
+def noteworthy_skips(parsed: ParsedChunk) -> bool:
+    """Whether a skipped kind may hold data a user wants (anything but :data:`QUIET_SKIPS`)."""
+    return any(name not in QUIET_SKIPS for name in parsed.ignored)
 
 
 def refuse_mixed(path: Path, laser: str, parsed: ParsedChunk) -> None:

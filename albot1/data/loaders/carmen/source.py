@@ -21,6 +21,7 @@ from pathlib import Path
 from albot1.data.errors import ParseError
 from albot1.data.loaders.carmen.bz2_parallel import iter_bz2_parallel
 from albot1.data.loaders.compressed import DamagedStream, compression_of, iter_decompressed, read_head
+from albot1.data.text import without_bom
 
 __all__ = ["CHUNK_BYTES", "LineChunk", "compression_of", "damaged_error", "iter_line_chunks", "read_head"]
 
@@ -58,6 +59,7 @@ def iter_line_chunks(
         blocks = iter_bz2_parallel(path)
     else:
         blocks = iter_decompressed(path, compression)
+    blocks = without_bom(blocks)  # a leading byte-order mark is no part of the first line
     next_line = 1
     carry = b""
     pending: list[bytes] = []

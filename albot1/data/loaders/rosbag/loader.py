@@ -35,7 +35,7 @@ from albot1.data.errors import DataError, ParseError, TopicError
 from albot1.data.loaders.base import COMMON_OPTIONS
 from albot1.data.loaders.rosbag.bag1_check import version_problem
 from albot1.data.loaders.rosbag.mounting import bag_mounting
-from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, scan_arrays
+from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, reading_problem, scan_arrays
 from albot1.data.loaders.rosbag.reader import header_stamp, odometry_track, opened_bag, tf_track, topic_messages
 from albot1.data.loaders.rosbag.topics import LASER_SCAN, TopicChoice, TopicInfo, choose_topics, normalize_type
 from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
@@ -123,9 +123,12 @@ class _BagSource:
         geometry = (float(msg.angle_min), float(msg.angle_increment), float(msg.range_min), float(msg.range_max))
         n = len(msg.ranges)
         problem = laserscan_problem(n, geometry[0], float(msg.angle_max), *geometry[1:])
+        raw = np.asarray(msg.ranges)
+        if problem is None:
+            problem = reading_problem(raw, geometry[2], geometry[3])
         if problem is not None:
             raise ParseError(self.shown, f"topic {self.choice.scan}: LaserScan {problem}", index=index)
-        ranges, angles = scan_arrays(np.asarray(msg.ranges), *geometry)
+        ranges, angles = scan_arrays(raw, *geometry)
         return Scan(ranges=ranges, angles=angles, timestamp=t, max_range=geometry[3])
 
 

@@ -12,8 +12,11 @@ links (``base_link -> laser_mount -> laser`` composes in 3D, then is
 projected onto the plane) until the base frame: the named or odometry's
 child frame, else the frame whose parent is ``odom_frame``, else the root of
 the tree. ``/tf_static`` is preferred; ``/tf`` is read only when the static
-tree does not reach the laser (older bags publish mounts on ``/tf``), taking
-each link's first transform (a mount is rigid). A laser tilted more than
+tree does not reach the laser (older bags publish mounts on ``/tf``), adding
+the links the static tree lacks and taking each link's first transform (a
+mount is rigid). Odometry on ``/tf`` names its base as an Odometry topic does
+(the child of ``odom_frame``), so a laser tree that does not reach it gets
+the same warning, never an unrelated root's mount. A laser tilted more than
 :data:`MAX_TILT_DEG` from the base's plane (mounted upside down, or looking
 at the floor) cannot be put on the plane by an (x, y, yaw) offset and is
 refused. When no transform is found the offset is zero and the result says
@@ -76,6 +79,20 @@ def odometry_child_frame(reader: AnyReader, topic: str, shown: Path) -> str | No
     for _, msg in topic_messages(reader, topic, shown):
         child = str(msg.child_frame_id).lstrip("/")
         return child or None
+    return None
+
+
+def tf_child_frame(reader: AnyReader, topic: str, odom_frame: str, shown: Path) -> str | None:
+    """The child of the first ``odom_frame -> child`` transform on a TFMessage topic (the robot's base), or None.
+
+    What :func:`odometry_child_frame` is for a ``nav_msgs/Odometry`` topic:
+    odometry read from ``/tf`` moves this frame, so the mount is looked up
+    from it, not from whatever root the laser's tree happens to have.
+    """
+    for _, msg in topic_messages(reader, topic, shown):
+        for tf in msg.transforms:
+            if str(tf.header.frame_id).lstrip("/") == odom_frame:
+                return str(tf.child_frame_id).lstrip("/") or None
     return None
 
 
@@ -155,19 +172,24 @@ def read_mounting(
         return Mounting((0.0, 0.0, 0.0), False, f"{scan_topic} has no header frame_id, so no laser mount to look up")
     if laser == base_frame:
         return Mounting((0.0, 0.0, 0.0), True, f"the scans' frame {laser!r} is the base frame")
-    searched = []
+    searched: list[str] = []
+    links: dict[str, _Link] = {}
     for topic in (STATIC_TOPIC, DYNAMIC_TOPIC):
         if topics.get(topic, TopicInfo("", 0)).msgtype != TF_MESSAGE:
             continue
         searched.append(topic)
-        path = _chain(_links(reader, topic, shown), laser, base_frame, odom_frame)
+        # /tf adds the links /tf_static lacks (a tree split over both: odom -> base_footprint -> base_link on
+        # /tf, base_link -> laser static); a link both publish keeps its static transform.
+        links = {**_links(reader, topic, shown), **links}
+        path = _chain(links, laser, base_frame, odom_frame)
+        where = " + ".join(searched)
         if path is not None and not path:
-            return Mounting((0.0, 0.0, 0.0), True, f"the scans' frame {laser!r} is the base frame ({topic})")
+            return Mounting((0.0, 0.0, 0.0), True, f"the scans' frame {laser!r} is the base frame ({where})")
         if path is not None:
             base = base_frame or path[0].parent
             offset = _planar(path, laser, base, shown)
             shown_offset = ", ".join(f"{v:.6g}" for v in offset)
-            return Mounting(offset, True, f"{topic} {base} -> {laser}: (x, y, yaw) = ({shown_offset})")
+            return Mounting(offset, True, f"{where} {base} -> {laser}: (x, y, yaw) = ({shown_offset})")
     where = " or ".join(searched) if searched else "the bag (it has no /tf_static or /tf topic)"
     base = base_frame or "the base frame"
     return Mounting(
@@ -186,13 +208,18 @@ def bag_mounting(
     base_frame: str | None,
     odom_frame: str,
 ) -> Mounting:
-    """:func:`read_mounting` for a bag with chosen topics; the base frame defaults to the odometry's child frame.
+    """:func:`read_mounting` for a bag with chosen topics; the base frame defaults to the frame odometry moves
+    (an Odometry topic's child frame, or the child of ``odom_frame`` on ``/tf``).
 
     A missing mount is logged as a warning (and the caller records the note in the sequence metadata).
     """
     with opened_bag(bag, shown) as reader:
-        if base_frame is None and not choice.odom_is_tf:
-            base_frame = odometry_child_frame(reader, choice.odom, shown)
+        if base_frame is None:
+            base_frame = (
+                tf_child_frame(reader, choice.odom, odom_frame, shown)
+                if choice.odom_is_tf
+                else odometry_child_frame(reader, choice.odom, shown)
+            )
         mounting = read_mounting(reader, topics, choice.scan, base_frame, odom_frame, shown)
     if not mounting.found:
         log.warning("%s: %s", shown, mounting.note)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from albot1.data.model import MAX_COORDINATE_M
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 
@@ -36,13 +37,30 @@ def stamp_seconds(sec: int, nanosec: int) -> float:
 
 
 def seconds_to_ns(seconds: float) -> int:
-    """Float seconds -> integer nanoseconds (the bag's clock); rounds to the nearest ns."""
-    return int(round(seconds * 1e9))
+    """Float seconds -> integer nanoseconds (the bag's clock); rounds to the nearest ns.
+
+    Whole seconds and the fraction are converted apart: ``seconds * 1e9`` of a
+    Unix time (1.7e18 ns) is a float 256 ns apart from its neighbours, so
+    1700000000.75 s became 1700000000.750000128 s in the bag and read back as
+    another float; split, it is stored and read back exactly.
+    """
+    whole = math.floor(seconds)
+    return int(whole) * 1_000_000_000 + round((seconds - whole) * 1e9)
 
 
 def split_ns(ns: int) -> tuple[int, int]:
     """Nanoseconds -> ROS ``(sec, nanosec)`` with ``0 <= nanosec < 1e9``."""
     return ns // 1_000_000_000, ns % 1_000_000_000
+
+
+def ns_text(ns: int) -> str:
+    """Integer nanoseconds as the exact decimal seconds a bag stores (``1200000000`` -> ``"1.200000000"``).
+
+    Said from the integer, not from float seconds, so a message shows the
+    stamps the writer compared, without float noise (``1.2000000000000002``).
+    """
+    sec, nanosec = split_ns(ns)
+    return f"{sec}.{nanosec:09d}"
 
 
 def quaternion_problem(x: float, y: float, z: float, w: float) -> str | None:
@@ -116,6 +134,26 @@ def laserscan_problem(
             f"the count to agree with the angles (to within one beam)"
         )
     return None
+
+
+def reading_problem(ranges: ArrayLike, range_min: float, range_max: float) -> str | None:
+    """A reading the scan keeps (within ``[range_min, range_max]``) beyond :data:`MAX_COORDINATE_M`, or None.
+
+    A ``range_max`` of float32's largest value lets any reading through; one of
+    1e30 m is no measurement, and its point would overflow the maps' grid
+    arithmetic far from the message that holds it. Beams are counted in the
+    message's order, from 1.
+    """
+    r = np.asarray(ranges, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        far = (r > MAX_COORDINATE_M) & (r >= range_min) & (r <= range_max)
+    if not far.any():
+        return None
+    k = int(np.argmax(far))
+    return (
+        f"range {k + 1} of {r.shape[0]} is {float(r[k]):.6g} m (range_max {range_max:.6g} m), expected at most "
+        f"{MAX_COORDINATE_M:g} m: no laser measures farther (a reading beyond range_max is no return)"
+    )
 
 
 def quaternion_from_yaw(theta: float) -> tuple[float, float, float, float]:

@@ -28,7 +28,7 @@ Because odometry is written at exactly the scan stamps, the loader's
 interpolation returns the written poses unchanged; this needs strictly
 increasing scan stamps, which the writer checks (see ``convert(retime=)``
 for logs whose stamps jitter or repeat). Each LaserScan and pose is checked
-with the reader's own rules (:func:`.msg.laserscan_problem`, on the float32
+with the reader's own rules (:func:`.msg.laserscan_problem`, :func:`.msg.reading_problem`, on the float32
 values as stored; :func:`.msg.pose_problem`) before it is written, so the
 writer never produces a bag its reader refuses. The output must not exist;
 a failed write removes what it created (output rules:
@@ -53,8 +53,10 @@ from albot1.data.loaders.beams import even_spacing
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.loaders.rosbag.msg import (
     laserscan_problem,
+    ns_text,
     pose_problem,
     quaternion_from_yaw,
+    reading_problem,
     seconds_to_ns,
     split_ns,
 )
@@ -117,7 +119,7 @@ class RosMessages:
             ranges = np.where(np.isfinite(scan.ranges), scan.ranges, np.inf).astype(np.float32)
             angle_min, step = spacing
             fields = [float(np.float32(v)) for v in (angle_min, scan.angles[-1], step, 0.0, scan.max_range)]
-        problem = laserscan_problem(scan.beams, *fields)
+        problem = laserscan_problem(scan.beams, *fields) or reading_problem(ranges, fields[3], fields[4])
         if problem is not None:
             raise UnwritableError(f"scan #{frame.index}: LaserScan {problem}; the bag reader would refuse it")
         return self.LaserScan(
@@ -214,9 +216,9 @@ def _write_frames(
         ns = _frame_ns(frame)
         if ns <= previous:
             raise UnwritableError(
-                f"scan #{frame.index}: timestamp {frame.scan.timestamp!r} s is not after the previous "
-                f"scan's ({previous * 1e-9!r} s); a bag orders scans and matches poses by time, so "
-                f"stamps must strictly increase (convert with --retime to shift such scans forward)"
+                f"scan #{frame.index}: timestamp {ns_text(ns)} s is not after the previous scan's "
+                f"{ns_text(previous)} s (stamps on the bag's nanosecond clock); a bag orders scans and matches "
+                f"poses by time, so stamps must strictly increase (convert with --retime to shift such scans forward)"
             )
         if previous < 0:
             write(static_conn, ns, serialize(msgs.tf(mount, ns, BASE_FRAME, LASER_FRAME, 0), TF_MESSAGE))

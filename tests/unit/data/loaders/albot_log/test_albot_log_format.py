@@ -80,6 +80,21 @@ def test_a_hand_written_log_loads(tmp_path: Path) -> None:
     assert frames[1].scan.ranges == pytest.approx([1.5, 3.25, 1.75])
 
 
+@pytest.mark.parametrize("gap", ["\t", " \t ", "  ", "\x0b"], ids=["tab", "mixed", "two-spaces", "vtab"])
+def test_header_fields_are_split_by_any_whitespace_as_views_are(tmp_path: Path, gap: str) -> None:
+    """A header written with tabs (a spreadsheet, a hand edit) reads as the space-separated one; the tab used
+    to make the whole line one unknown keyword ('UNITS\\tlength=m...')."""
+    header = (
+        f"ALBOT1-LOG{gap}1\nUNITS{gap}length=m{gap}angle=rad{gap}time=s\nFRAME{gap}thesis\nNAME{gap}my{gap}demo\n"
+        f"SENSOR{gap}3{gap}10.0{gap}-1.5707963267948966{gap}1.5707963267948966\n"
+    )
+    path = tmp_path / "log.albotlog"
+    path.write_text(header + "VIEW 0 0.0 0.0 0.0 0.0 - -2.0 0.0 0.0 3.5 nan nan\n")
+    sequence = AlbotLogLoader().load(path)
+    assert sequence.name == "my demo"
+    assert np.allclose(next(iter(sequence.frames())).scan.ranges, [np.nan, 3.5, 2.0], equal_nan=True)
+
+
 def test_the_example_in_the_docs_loads(tmp_path: Path) -> None:
     doc = (Path(__file__).resolve().parents[5] / "docs" / "formats.md").read_text(encoding="utf-8")
     match = re.search(r"```text\n(ALBOT1-LOG 1\n.*?)```", doc, re.S)

@@ -41,6 +41,29 @@ def test_bad_lines_name_file_line_and_expectation(tmp_path: Path, line: str, mes
         run(tmp_path, GOOD.format(t=0.5) + "\n" + line + "\n")
 
 
+@pytest.mark.parametrize(
+    ("token", "shown"),
+    [("2_0", "'2_0'"), ("\uff12.0", "'\uff12.0'"), ("\u0662.0", "'\u0662.0'")],
+    ids=["digit-grouping", "full-width", "arabic-indic"],
+)
+def test_a_number_numpy_refuses_is_named_at_its_own_line(tmp_path: Path, token: str, shown: str) -> None:
+    """``float()`` takes ``2_0``; numpy's bulk conversion does not. The error names the true line and token,
+    not the first line of the group (line 1), which used to be reported."""
+    lines = [GOOD.format(t=k) for k in range(6)]
+    lines[4] = lines[4].replace(" 2.0 ", f" {token} ", 1)
+    with pytest.raises(ParseError, match=rf"bad\.clf:5: FLASER field 3 is {shown}, expected a number \(n r1"):
+        run(tmp_path, "\n".join(lines) + "\n")
+
+
+def test_a_line_numpy_alone_refuses_is_named(tmp_path: Path) -> None:
+    """A carriage return between two fields splits into the right count of numbers, yet numpy refuses the
+    line: the error still names that line (each line converted alone), not the group's first."""
+    lines = [GOOD.format(t=k) for k in range(6)]
+    lines[3] = lines[3].replace(" 2.0 ", " 2.0\r", 1)
+    with pytest.raises(ParseError, match=r"bad\.clf:4: FLASER line could not be read as numbers \(.*\); expected n r1"):
+        run(tmp_path, "\n".join(lines) + "\n")
+
+
 def test_bad_odom_line_when_odom_is_used(tmp_path: Path) -> None:
     text = GOOD.format(t=0.5) + "\nODOM 1 2 host\n"
     with pytest.raises(ParseError, match=r"bad\.clf:2: ODOM has 3 fields after the name, expected 9"):

@@ -12,7 +12,7 @@ import pytest
 
 from albot1.data.errors import DataError, ParseError, TopicError
 from albot1.data.loaders.rosbag.loader import Ros1BagLoader, Ros2BagLoader
-from albot1.data.loaders.rosbag.msg import seconds_to_ns
+from albot1.data.loaders.rosbag.msg import ns_text, seconds_to_ns
 from albot1.data.loaders.rosbag.writer import Ros1BagWriter, Ros2McapWriter, Ros2Sqlite3Writer, RosMessages
 from albot1.data.model import Frame, Scan, Sequence
 from albot1.geometry import se2
@@ -91,6 +91,31 @@ def test_writer_refuses_scan_stamps_that_do_not_increase(tmp_path: Path, times: 
     with pytest.raises(DataError, match=r"scan #2: timestamp .* is not after the previous scan's .* --retime"):
         Ros1BagWriter().write(Sequence.from_frames("jitter", frames), tmp_path / "j.bag")
     assert not (tmp_path / "j.bag").exists()
+
+
+@pytest.mark.parametrize(
+    ("times", "shown"),
+    [
+        ([1.0, 1.2, 1.2], ("1.200000000", "1.200000000")),  # 1.2 s used to read 1.2000000000000002
+        ([1.0, 1.2, 1.2 + 1e-10], ("1.200000000", "1.200000000")),  # equal on the bag's clock: why it is refused
+        ([1700000000.5, 1700000001.25, 1700000000.75], ("1700000000.750000000", "1700000001.250000000")),
+    ],
+)
+def test_the_refused_stamps_are_said_in_nanoseconds_without_float_noise(
+    tmp_path: Path, times: list[float], shown: tuple[str, str]
+) -> None:
+    base = list(synthetic(3, reference=False).frames())
+    frames = [
+        Frame(i, Scan(f.scan.ranges, f.scan.angles, t, 30.0), f.odometry) for i, (f, t) in enumerate(zip(base, times))
+    ]
+    with pytest.raises(DataError) as info:
+        Ros1BagWriter().write(Sequence.from_frames("jitter", frames), tmp_path / "j.bag")
+    assert str(info.value) == (
+        f"{tmp_path / 'j.bag'}: scan #2: timestamp {shown[0]} s is not after the previous scan's {shown[1]} s "
+        "(stamps on the bag's nanosecond clock); a bag orders scans and matches poses by time, so stamps must "
+        "strictly increase (convert with --retime to shift such scans forward)"
+    )
+    assert ns_text(1_200_000_000) == "1.200000000" and ns_text(0) == "0.000000000"
 
 
 # --- bags with other layouts, written directly with rosbags -------------------------------------------

@@ -207,5 +207,78 @@ def test_scans_in_the_frame_odometry_moves_need_no_mount(tmp_path: Path, caplog:
     with caplog.at_level(logging.WARNING):
         loaded = Ros2BagLoader().load(tmp_path / "onbase")
     assert loaded.metadata.sensor_offset == (0.0, 0.0, 0.0)
-    assert loaded.metadata.extra["sensor_offset_source"] == "the scans' frame 'base_link' is the base frame (/tf)"
+    # odometry on /tf names its base (the child of odom), so the scans' frame is known to be it without a tree
+    assert loaded.metadata.extra["sensor_offset_source"] == "the scans' frame 'base_link' is the base frame"
     assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+
+
+def write_tf_odometry_bag(
+    path: Path,
+    child: str,
+    static: list[tuple[str, str, tuple[float, ...], tuple[float, ...]]],
+    dynamic: list[tuple[str, str, tuple[float, ...], tuple[float, ...]]] = (),  # type: ignore[assignment]
+    *,
+    odometry_topic: bool = False,
+) -> None:
+    """Scans in frame ``laser``; odometry as ``odom -> child`` on /tf (or, with ``odometry_topic``, as
+    nav_msgs/Odometry of ``child`` on /odom); ``static`` links on /tf_static, ``dynamic`` ones beside odom on /tf."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    msgs = RosMessages(ts, ros1=False)
+    with Writer(path, version=9) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        tf = bag.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=ts)
+        tf_static = bag.add_connection("/tf_static", "tf2_msgs/msg/TFMessage", typestore=ts)
+        odom = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts) if odometry_topic else None
+        bag.write(tf_static, 0, ts.serialize_cdr(_tf(ts, msgs, 0, static), "tf2_msgs/msg/TFMessage"))
+        for f in sequence(3).frames():
+            ns = seconds_to_ns(f.scan.timestamp)
+            moved = [("odom", child, (float(f.odometry[0]), 0.0, 0.0), yaw_q(float(f.odometry[2])))]
+            if odom is not None:
+                message = msgs.odometry(f.odometry, ns, "odom", f.index)
+                message.child_frame_id = child
+                bag.write(odom, ns, ts.serialize_cdr(message, "nav_msgs/msg/Odometry"))
+                moved = []
+            bag.write(tf, ns, ts.serialize_cdr(_tf(ts, msgs, ns, moved + list(dynamic)), "tf2_msgs/msg/TFMessage"))
+            bag.write(scan, ns, ts.serialize_cdr(msgs.scan(f, ns), "sensor_msgs/msg/LaserScan"))
+
+
+def test_odometry_on_tf_whose_base_the_laser_tree_misses_warns_as_odometry_messages_do(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """odom -> base_footprint on /tf, base_link -> laser static and no link between the two bases: the mount
+    used to be taken from base_link, the static tree's unrelated root, without a word."""
+    mount = [("base_link", "laser", (0.2, 0.0, 0.0), yaw_q(0.0))]
+    write_tf_odometry_bag(tmp_path / "tf", "base_footprint", mount)
+    write_tf_odometry_bag(tmp_path / "odom", "base_footprint", mount, odometry_topic=True)
+    note = (
+        "no transform base_footprint -> 'laser' (the scans' frame) in /tf_static or /tf; the laser is taken to sit "
+        "at the base's origin (sensor_offset 0)"
+    )
+    for name in ("tf", "odom"):
+        caplog.clear()
+        with caplog.at_level(logging.WARNING):
+            loaded = Ros2BagLoader().load(tmp_path / name)
+        assert loaded.metadata.sensor_offset == (0.0, 0.0, 0.0)
+        assert loaded.metadata.extra["sensor_offset_source"] == note
+        assert [r.getMessage() for r in caplog.records] == [f"{tmp_path / name}: {note}"]
+    assert Ros2BagLoader().load(tmp_path / "tf").metadata.odometry_source.startswith("/tf transforms odom -> ")
+
+
+def test_a_tree_split_over_tf_and_tf_static_reaches_the_odometry_base(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """base_footprint -> base_link on /tf (older bags), base_link -> laser static: the two are joined."""
+    write_tf_odometry_bag(
+        tmp_path / "split",
+        "base_footprint",
+        [("base_link", "laser", (0.2, 0.0, 0.0), yaw_q(0.0))],
+        [("base_footprint", "base_link", (0.05, 0.0, 0.1), yaw_q(math.pi / 2))],
+    )
+    with caplog.at_level(logging.WARNING):
+        loaded = Ros2BagLoader().load(tmp_path / "split")
+    assert loaded.metadata.sensor_offset == pytest.approx((0.05, 0.2, math.pi / 2), abs=1e-12)
+    assert loaded.metadata.extra["sensor_offset_source"].startswith("/tf_static + /tf base_footprint -> laser: (")
+    assert caplog.records == []

@@ -55,6 +55,17 @@ def test_stamp_conversions() -> None:
     assert stamp_seconds(*split_ns(ns)) == pytest.approx(70.2899, abs=1e-12)
 
 
+@pytest.mark.parametrize(
+    ("seconds", "ns"),
+    [(1700000000.75, 1_700_000_000_750_000_000), (1700000001.25, 1_700_000_001_250_000_000), (1.9999999999, 2 * 10**9)],
+)
+def test_unix_stamps_reach_the_bag_clock_exactly(seconds: float, ns: int) -> None:
+    """``seconds * 1e9`` made 1700000000.75 s into ...750000128 ns (floats 256 ns apart at 1.7e18)."""
+    assert seconds_to_ns(seconds) == ns
+    if seconds != 1.9999999999:
+        assert stamp_seconds(*split_ns(ns)) == seconds  # and read back as the same float
+
+
 def test_pose_track_returns_stored_poses_exactly_at_their_stamps() -> None:
     poses = np.array([[0.0, 0.0, 3.0], [1.0, 2.0, 3.1], [2.0, 2.0, -3.1]])
     track = PoseTrack.build([1.0, 2.0, 3.0], poses)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import struct
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +16,12 @@ from albot1.data.errors import DataError, ParseError, TopicError, UnwritableErro
 from albot1.data.loaders.registry import load
 from albot1.data.loaders.rosbag.bag1_check import damage, version_problem
 from albot1.data.loaders.rosbag.loader import Ros1BagLoader
-from albot1.data.loaders.rosbag.msg import laserscan_problem, quaternion_problem, yaw_from_quaternion
+from albot1.data.loaders.rosbag.msg import (
+    laserscan_problem,
+    quaternion_problem,
+    reading_problem,
+    yaw_from_quaternion,
+)
 from albot1.data.loaders.rosbag.writer import Ros1BagWriter
 from albot1.data.model import Frame, Scan, Sequence
 
@@ -123,6 +129,28 @@ def test_a_range_count_that_disagrees_with_the_angles_is_refused(tmp_path: Path)
         frames(bad)
 
 
+def test_a_reading_of_1e30_m_is_one_line_naming_the_message_without_a_numpy_warning(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """range_max = float32's largest value lets any reading through: a 1e30 m reading used to reach the map's
+    grid (a numpy cast warning on stderr) and fail there naming a map point, not the message."""
+    far = np.full(180, 2.0, np.float32)
+    far[4] = 1e30
+    big = float(np.finfo(np.float32).max)
+    path = write_bag(tmp_path / "far.bag", [{"range_max": big}, {"range_max": big, "ranges": far}])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ParseError) as info:
+            frames(path)
+    assert str(info.value) == (
+        f"{path}[message #1]: topic /scan: LaserScan range 5 of 180 is 1e+30 m (range_max 3.40282e+38 m), "
+        "expected at most 1e+08 m: no laser measures farther (a reading beyond range_max is no return)"
+    )
+    assert capfd.readouterr().err == ""
+    assert reading_problem(far, 0.0, 30.0) is None  # beyond a real range_max it is no return, as before
+    assert reading_problem(np.array([np.nan, np.inf, 1e8]), 0.0, big) is None
+
+
 def test_a_zero_quaternion_is_refused_not_read_as_yaw_zero(tmp_path: Path) -> None:
     path = write_bag(tmp_path / "q.bag", [{}, {}], [(0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0)])
     with pytest.raises(ParseError, match=r"q\.bag\[message #1\]: topic /odom: orientation quaternion .* has norm 0"):
@@ -212,6 +240,13 @@ def test_the_bag_writer_refuses_what_the_reader_refuses(tmp_path: Path) -> None:
     )
     with pytest.raises(UnwritableError, match=r"p\.bag: scan #0: odom pose \[0\.0, nan, 0\.0\] is not three finite"):
         Ros1BagWriter().write(nan_pose, tmp_path / "p.bag")
+    far = Sequence.from_frames(
+        "f", [Frame(0, Scan(np.array([1.0, 1e30]), np.array([0.0, 0.1]), 1.0, 1e31), np.zeros(3))]
+    )
+    with pytest.raises(
+        UnwritableError, match=r"f\.bag: scan #0: LaserScan range 2 of 2 is 1e\+30 m .* at most 1e\+08 m"
+    ):
+        Ros1BagWriter().write(far, tmp_path / "f.bag")
     with pytest.raises(UnwritableError, match=r"e\.bag: the sequence has no scans"):
         Ros1BagWriter().write(Sequence.from_frames("e", []), tmp_path / "e.bag")
     assert list(tmp_path.iterdir()) == []
