@@ -15,6 +15,8 @@ from albot1.data.errors import ParseError
 def parse_floats(path: str | Path, line: int, tokens: list[str], what: str, expected: str = "") -> NDArray[np.float64]:
     """``tokens`` as float64; else ParseError ``path:line: <what> 'tok' is not a number[; expected ...]``."""
     try:
+        if any("_" in t for t in tokens):
+            raise ValueError("digit grouping")
         return np.array(list(map(float, tokens)), dtype=np.float64)
     except ValueError:
         bad = next(t for t in tokens if not _is_float(t))
@@ -23,6 +25,10 @@ def parse_floats(path: str | Path, line: int, tokens: list[str], what: str, expe
 
 
 def _is_float(token: str) -> bool:
+    """Whether ``token`` is a number as the logs write them: what ``float()`` reads, but not Python's digit
+    grouping (``3_05`` would be read as 305; numpy, and so the CARMEN parser, refuses it)."""
+    if "_" in token:
+        return False
     try:
         float(token)
     except ValueError:

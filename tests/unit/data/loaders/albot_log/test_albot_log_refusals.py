@@ -59,3 +59,18 @@ def test_negative_beam_spacing_cannot_be_converted_into_a_log_the_reader_refuses
     ):
         convert(Sequence.from_frames("neg", frames), tmp_path / "neg.albotlog")
     assert not (tmp_path / "neg.albotlog").exists()
+
+
+def test_a_number_in_python_s_digit_grouping_is_refused_at_its_line_not_read(tmp_path: Path) -> None:
+    """``float("1_0")`` is 10.0: a log's typo would silently become a range ten times too far (CARMEN refuses it)."""
+    path = tmp_path / "g.albotlog"
+    frames = [Frame(i, Scan(np.ones(3), ANGLES, float(i), 10.0), np.zeros(3)) for i in range(2)]
+    AlbotLogWriter().write(Sequence.from_frames("g", frames), path)
+    lines = path.read_text().splitlines()
+    view = next(i for i, text in enumerate(lines) if text.startswith("VIEW"))
+    fields = lines[view].split()
+    fields[-1] = "1_0"
+    lines[view] = " ".join(fields)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ParseError, match=rf"g\.albotlog:{view + 1}: .*'1_0' is not a number"):
+        AlbotLogLoader().load(path).frames().__next__()
