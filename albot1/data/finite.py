@@ -10,7 +10,8 @@ with its source, index and timestamp:
 * odometry and reference poses: every component finite, and ``|x|, |y|``
   at most :data:`~albot1.data.model.MAX_COORDINATE_M` (the bound of trajectory files);
 * the scan's timestamp finite, its beam angles finite. Ranges may be NaN or
-  infinite: loaders use those for "no return" (``docs/formats.md``).
+  infinite: loaders use those for "no return" (``docs/formats.md``); a
+  kept reading is at most ``MAX_COORDINATE_M`` (a max range of 1e31 m lets 1e30 m through).
 """
 
 from __future__ import annotations
@@ -46,7 +47,30 @@ def frame_problem(frame: Frame) -> str | None:
     # radians sum to a finite number unless one of them is NaN or infinite
     if problem is None and not math.isfinite(float(frame.scan.angles.sum())):
         problem = "a beam angle is not finite; expected finite radians"
+    if problem is None and not frame.scan.max_range <= MAX_COORDINATE_M:
+        problem = _far_reading(frame.scan.ranges, frame.scan.max_range)
     return problem
+
+
+def _far_reading(ranges: np.ndarray, max_range: float) -> str | None:
+    """A kept reading beyond :data:`MAX_COORDINATE_M`, possible only when the scan's max range lets it through.
+
+    A CARMEN ``ROBOTLASER1`` or a bag may declare a max range of 1e31 m; a
+    reading of 1e30 m under it is no measurement, and its point would
+    overflow the maps' grid arithmetic far from the line that holds it.
+    Loaders turn readings beyond the max range into NaN, so the finite ones
+    are the kept ones; the scalar test in :func:`frame_problem` keeps this
+    off the per-scan path of every ordinary log.
+    """
+    with np.errstate(invalid="ignore"):
+        far = np.flatnonzero(ranges > MAX_COORDINATE_M)
+    if far.size == 0:
+        return None
+    k = int(far[0])
+    return (
+        f"range {k + 1} of {ranges.shape[0]} is {float(ranges[k]):.6g} m (max range {max_range:.6g} m), "
+        f"expected at most {MAX_COORDINATE_M:g} m: no laser measures farther"
+    )
 
 
 def checked(sequence: Sequence) -> Sequence:

@@ -39,6 +39,16 @@ def test_frame_problems_are_named(frame: Frame, problem: str) -> None:
     assert found is not None and found.startswith(problem)
 
 
+def test_a_reading_a_huge_max_range_lets_through_is_named_and_no_return_is_not() -> None:
+    """A ROBOTLASER1 line may declare 1e31 m: a kept 1e30 m reading is refused at its scan, NaN (no return) is not."""
+    far = Frame(0, Scan(np.array([1.0, 1e30, np.nan]), np.array([-0.1, 0.0, 0.1]), 1.0, 1e31), np.zeros(3))
+    assert frame_problem(far) == (
+        "range 2 of 3 is 1e+30 m (max range 1e+31 m), expected at most 1e+08 m: no laser measures farther"
+    )
+    near = Frame(0, Scan(np.array([1.0, 5e7, np.nan]), np.array([-0.1, 0.0, 0.1]), 1.0, float("inf")), np.zeros(3))
+    assert frame_problem(near) is None
+
+
 def test_a_good_frame_has_no_problem() -> None:
     assert frame_problem(_frame([1e7, -1e7, 3.0], [0, 0, -3.0])) is None
     assert pose_problem([1.0, 2.0, 3.0], "x") is None
