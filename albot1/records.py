@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Annotated, Any, ClassVar, Literal, TypeVar, Union, cast, get_args, get_origin
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -106,6 +107,26 @@ def _finite_or_none(value: object) -> object:
 OptFloat = Annotated[float | None, BeforeValidator(_finite_or_none)]
 
 
+def _not_negative(value: float | None) -> float | None:
+    if value is not None and value < 0:
+        raise ValueError(f"found {value!r}; expected a number >= 0 (an error, a distance or a time is never negative)")
+    return value
+
+
+def _a_fraction(value: float | None) -> float | None:
+    if value is not None and not 0.0 <= value <= 1.0:
+        raise ValueError(f"found {value!r}; expected a fraction from 0 to 1")
+    return value
+
+
+#: An error magnitude, distance, duration or size: a negative one is a hand edit or a bug, never a result.
+NonNegative = Annotated[float, AfterValidator(_not_negative)]
+OptNonNegative = Annotated[float | None, BeforeValidator(_finite_or_none), AfterValidator(_not_negative)]
+#: A share of a whole (precision, coverage, recall).
+Fraction = Annotated[float, AfterValidator(_a_fraction)]
+OptFraction = Annotated[float | None, BeforeValidator(_finite_or_none), AfterValidator(_a_fraction)]
+
+
 class Record(BaseModel):
     """Base of every record: unknown keys are errors, values are read-only, NaN is refused."""
 
@@ -142,10 +163,40 @@ def read_record(model: type[RecordT], path: Path) -> RecordT:
     if problem is not None:
         raise RecordError(f"{path}: {problem}; expected a {model.__name__} file")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(path.read_text(encoding="utf-8"), parse_constant=_NonFinite)
     except (OSError, json.JSONDecodeError) as exc:
         raise RecordError(f"{path}: cannot read a {model.__name__}: {exc}") from None
+    where = _non_finite_at(data)
+    if where is not None:
+        field, token = where
+        raise RecordError(
+            f"{path}: {field or '(top level)'}: found {token}; expected a finite number "
+            "(a record's writer stores an undefined number as null)"
+        )
     return parse_record(model, data, str(path))
+
+
+class _NonFinite:
+    """``NaN``, ``Infinity`` or ``-Infinity`` as read from a record file (Python's json reads them, JSON has none)."""
+
+    def __init__(self, token: str) -> None:
+        self.token = token
+
+
+def _non_finite_at(data: object, where: str = "") -> tuple[str, str] | None:
+    """The dotted field path and token of the first non-finite constant in ``data``, or None.
+
+    The writers never store one (:func:`json_value` makes it null), so it is a hand edit: refused with its
+    field, not read as a number or silently as null.
+    """
+    if isinstance(data, _NonFinite):
+        return where, data.token
+    items = data.items() if isinstance(data, dict) else enumerate(data) if isinstance(data, list) else ()
+    for key, value in items:
+        found = _non_finite_at(value, f"{where}.{key}" if where else str(key))
+        if found is not None:
+            return found
+    return None
 
 
 def dump_record(record: Record) -> dict[str, Any]:
@@ -160,19 +211,19 @@ def dump_record(record: Record) -> dict[str, Any]:
 class Timing(Record):
     """``result.json`` ``timing``: per-scan time of ``process`` (ms; null for a run of no scans), seconds, MiB."""
 
-    per_scan_ms_median: OptFloat
-    per_scan_ms_p95: OptFloat
-    per_scan_ms_mean: OptFloat
-    finish_s: float
-    total_s: float
-    wall_s: float
-    peak_mb: float
+    per_scan_ms_median: OptNonNegative
+    per_scan_ms_p95: OptNonNegative
+    per_scan_ms_mean: OptNonNegative
+    finish_s: NonNegative
+    total_s: NonNegative
+    wall_s: NonNegative
+    peak_mb: NonNegative
     #: CPU seconds (user + system, threads and waited children) over the span of ``wall_s``: the cost a shared
     #: machine's load does not inflate; absent in results written before it was recorded
-    cpu_s: OptFloat = None
+    cpu_s: OptNonNegative = None
     #: seconds before the first scan (the method's warm-up, e.g. compiling kernels), outside the per-scan figures;
     #: absent in results written before it was recorded
-    startup_s: OptFloat = None
+    startup_s: OptNonNegative = None
 
 
 class DatasetInfo(Record):

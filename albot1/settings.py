@@ -32,6 +32,9 @@ def _default_cache_dir() -> Path:
 
 
 #: The file of :mod:`albot1.data.identity`'s checksum cache.
+#: ``albot1 bench``'s results root when ``--results`` is not given (relative to the working directory): a
+#: page's "Regenerate" command names ``--results`` only for another one
+RESULTS_ROOT = Path("results")
 CHECKSUM_CACHE = "checksums.json"
 
 

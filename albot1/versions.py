@@ -96,9 +96,14 @@ def commit_label(commit: str | None) -> str:
     return f"commit {commit}" if commit else UNKNOWN_COMMIT
 
 
-def library_versions(
-    names: tuple[str, ...] = ("numpy", "shapely", "scipy", "kiss-icp", "gtsam", "rosbags"),
-) -> dict[str, str | None]:
+#: What :func:`library_versions` records by default: the libraries a result is computed with. numba and llvmlite
+#: compile Albot1's kernels (and gtsam-graph's grid search): another numba or LLVM may compile them into
+#: different machine code (fused or reordered floating-point operations), so they name what ran as much as
+#: numpy does.
+RECORDED_LIBRARIES = ("numpy", "shapely", "scipy", "numba", "llvmlite", "kiss-icp", "gtsam", "rosbags")
+
+
+def library_versions(names: tuple[str, ...] = RECORDED_LIBRARIES) -> dict[str, str | None]:
     """The version of each library as this process runs it (None if absent); a new dict each call.
 
     For a library this process has imported: the version read the first time it was seen imported (the

@@ -10,7 +10,7 @@ import typer
 
 from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
-from albot1.settings import get_settings
+from albot1.settings import RESULTS_ROOT, get_settings
 
 
 def register(app: typer.Typer) -> None:
@@ -28,9 +28,7 @@ def bench(
         str | None,
         typer.Option(help="HOST:PORT (or tcp://HOST:PORT) of a running Dask scheduler: --executor dask://HOST:PORT"),
     ] = None,
-    results: Annotated[Path, typer.Option(help="results root; cells go to RESULTS/<suite>/runs/<key>")] = Path(
-        "results"
-    ),
+    results: Annotated[Path, typer.Option(help="results root; cells go to RESULTS/<suite>/runs/<key>")] = RESULTS_ROOT,
     data_dir: Annotated[Path | None, typer.Option(help="dataset folder (default: $ALBOT1_DATA_DIR)")] = None,
     progress: Annotated[bool, typer.Option(help="show the progress bar")] = True,
     dry_run: Annotated[bool, typer.Option("--dry-run", help="print the planned cells per dataset and stop")] = False,

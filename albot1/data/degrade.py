@@ -57,6 +57,8 @@ EXPECTED_SPEC = (
 )
 #: kind -> how many values its SPEC carries after the kind
 _ARITY = {"gauss": 2, "bias": 2, "offset": 3, "dropout": 1}
+#: The metadata ``extra`` key a dropout sets ("dropout:P seed S"): the scans are a thinned subset of the source's.
+SCAN_DROPOUT = "scan_dropout"
 #: Seeds are what ``numpy.random.default_rng`` accepts and a suite's TOML integer can hold: 0 .. 2**63 - 1.
 MAX_SEED = 2**63 - 1
 
@@ -195,6 +197,6 @@ def _dropout(sequence: Sequence, deg: Degradation, seed: int) -> Sequence:
             yield replace(frame, index=kept)
             kept += 1
 
-    extra = {**sequence.metadata.extra, "scan_dropout": f"{deg.spec} seed {seed}"}
+    extra = {**sequence.metadata.extra, SCAN_DROPOUT: f"{deg.spec} seed {seed}"}
     meta = replace(sequence.metadata, extra=extra)
     return sequence.with_frames(frames, metadata=meta, scan_count=sequence.known_scan_count if deg.a == 0 else None)

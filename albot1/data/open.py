@@ -41,6 +41,7 @@ from albot1.config.keyvalue import KeyValueError, parse_query
 from albot1.config.suggest import did_you_mean
 from albot1.data import catalog
 from albot1.data.attach import REFERENCE_KEYWORDS, with_reference, with_relations
+from albot1.data.degrade import degrade
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
 from albot1.data.filekind import check_input
 from albot1.data.finite import checked
@@ -105,6 +106,21 @@ def open_sequence(
         f"{text!r} is neither a dataset name nor an existing file"
         f"{did_you_mean(text, known)}; `albot1 datasets list` lists all {len(known)} datasets"
     )
+
+
+def open_as_run(
+    ref: str, degradation: str = "none", seed: int | None = None, *, settings: Settings | None = None
+) -> Sequence:
+    """``ref`` opened as a stored run saw it: with the run's degradation and seed (``result.json``).
+
+    The runner degrades after opening (:func:`albot1.runs.execute.run_method`),
+    and a degradation may change the scans themselves (``dropout:P`` leaves
+    scans out and renumbers the rest), so whatever reopens a run's data
+    (evaluation's reference map, the thesis page's replay) reopens it with
+    the same SPEC and seed, or it compares the run with other scans. A
+    source without a seed (an external trajectory) was not degraded.
+    """
+    return degrade(open_sequence(ref, settings=settings), degradation, seed=0 if seed is None else seed)
 
 
 def _checksums(path: Path | None, options: dict[str, Any]) -> dict[str, str]:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import ClassVar, Literal, TypeVar
 
-from albot1.records import OmitsAbsentReasons, OptFloat, Record, parse_record
+from albot1.records import OmitsAbsentReasons, OptNonNegative, Record, parse_record
 
 BlockT = TypeVar("BlockT", bound=Record)
 
@@ -33,12 +33,12 @@ def block_of(model: type[BlockT], data: object) -> BlockT:
 class Stats(Record):
     """The shared summary of a sample (:func:`albot1.metrics.stats.summarize`); null statistics when ``n`` is 0."""
 
-    mean: OptFloat
-    std: OptFloat
-    median: OptFloat
-    min: OptFloat
-    max: OptFloat
-    rmse: OptFloat
+    mean: OptNonNegative
+    std: OptNonNegative
+    median: OptNonNegative
+    min: OptNonNegative
+    max: OptNonNegative
+    rmse: OptNonNegative
     n: int
     std_ddof: int
 
@@ -46,12 +46,12 @@ class Stats(Record):
 class RotationStats(Record):
     """:class:`Stats` of a heading error with the unit in the key (``_deg``)."""
 
-    mean_deg: OptFloat
-    std_deg: OptFloat
-    median_deg: OptFloat
-    min_deg: OptFloat
-    max_deg: OptFloat
-    rmse_deg: OptFloat
+    mean_deg: OptNonNegative
+    std_deg: OptNonNegative
+    median_deg: OptNonNegative
+    min_deg: OptNonNegative
+    max_deg: OptNonNegative
+    rmse_deg: OptNonNegative
     n: int
     std_ddof: int
 

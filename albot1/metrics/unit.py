@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Generic, Literal, Protocol, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.data.degrade import SCAN_DROPOUT
 from albot1.errors import Albot1Error
 from albot1.geometry.types import FloatArray
 from albot1.records import Record, Timing
@@ -98,7 +99,8 @@ def route_declared_closed(inputs: MetricInputs) -> bool:
 
     Only then may the end-to-start gap be reported without reference poses:
     the reference offset is zero by declaration, not by assumption. A run
-    on a prefix of a closed route does not end at its start. Counting the
+    on a prefix of a closed route does not end at its start, nor need one
+    whose scans a dropout thinned (``dropout:P``). Counting the
     dataset's scans is free for the synthetic worlds (the ones that declare
     closed routes) and a full pass for a streamed log, so the answer is
     worked out once per evaluation.
@@ -106,8 +108,12 @@ def route_declared_closed(inputs: MetricInputs) -> bool:
     if "closed_route" not in inputs.memo:
         try:
             sequence = inputs.open_dataset()
-            closed = bool(sequence.metadata.extra.get("closed_loop", False)) and sequence.count_scans() == len(
-                inputs.poses
+            extra = sequence.metadata.extra
+            # A scan dropout may have left the route's last scans out: its kept scans need not end at the start.
+            closed = (
+                bool(extra.get("closed_loop", False))
+                and SCAN_DROPOUT not in extra
+                and sequence.count_scans() == len(inputs.poses)
             )
         except Albot1Error:
             closed = False

@@ -41,7 +41,7 @@ from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
 from albot1.metrics.paired import BLOCKS, CONFIDENCE, RESAMPLES, ZERO_ERROR, bootstrap_ratio, verdict
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
-from albot1.report.provenance import bench_argument
+from albot1.report.provenance import regenerate_command
 from albot1.report.tuning import LEGEND, MARK, held_in, marked
 
 PAGE = "generalisation.md"
@@ -181,8 +181,11 @@ def failed_groups(records: list[CellRecord]) -> list[str]:
     return [f"{m} on {d} ({g})" for (m, d, g), statuses in groups.items() if "done" not in statuses]
 
 
-def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None = None) -> str:
-    """The Markdown page (see the module docstring)."""
+def render_page(
+    plan: GridPlan, rows: list[Comparison], failed: list[str] | None = None, *, regenerate: str | None = None
+) -> str:
+    """The Markdown page (see the module docstring); ``regenerate``: the commands that write it again
+    (:func:`albot1.report.provenance.regenerate_command`; None: those of the default folders)."""
     pct = f"{CONFIDENCE:.0%}"
     lines = [
         "# Every method against the odometry it was given",
@@ -197,7 +200,7 @@ def render_page(plan: GridPlan, rows: list[Comparison], failed: list[str] | None
         "",
         LEGEND,
         "",
-        f"Regenerate: `albot1 bench {bench_argument(plan)} && albot1 report results/{plan.suite}`.",
+        f"Regenerate: `{regenerate or regenerate_command(plan)}`.",
         "",
         "## Where a method is worse than its own odometry",
         "",
@@ -300,13 +303,18 @@ def _csv(rows: list[Comparison]) -> str:
     return buffer.getvalue()
 
 
-def write_generalisation(plan: GridPlan, records: list[CellRecord], out: Path) -> tuple[Path, Path] | None:
-    """Write ``generalisation.md`` and ``.csv`` into ``out`` when any run can be compared with its odometry."""
+def write_generalisation(
+    plan: GridPlan, records: list[CellRecord], out: Path, results_dir: Path | None = None
+) -> tuple[Path, Path] | None:
+    """Write ``generalisation.md`` and ``.csv`` into ``out`` when any run can be compared with its odometry.
+
+    ``results_dir``: the store the records were read from, as given (its "Regenerate" line names it).
+    """
     rows = comparisons(records)
     if not rows:
         return None
     page, table = out / PAGE, out / TABLE
-    text = render_page(plan, rows, failed_groups(records))
+    text = render_page(plan, rows, failed_groups(records), regenerate=regenerate_command(plan, results_dir, out))
     atomic_write(page, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     atomic_write(table, lambda tmp: tmp.write_text(_csv(rows), encoding="utf-8"))
     return page, table

@@ -35,7 +35,7 @@ from albot1.report.external_notes import external_html
 from albot1.report.interactive_page import VIEWS_DIR, View, view_html, views_scripts
 from albot1.report.paired_tables import PairedRow, html_table
 from albot1.report.plots import vector_of
-from albot1.report.provenance import data_by_dataset, describe_data
+from albot1.report.provenance import data_by_dataset, describe_data, rerun_command
 from albot1.report.tables import cell_text, columns_present, na_notes, na_outline
 from albot1.report.tuning import LEGEND, marked
 from albot1.versions import commit_label
@@ -311,7 +311,8 @@ def write_html(
     if not_run:
         parts += [
             "<h2>Cells not run</h2><p>The runner stopped before these cells finished; run "
-            "<code>albot1 bench</code> again to complete them.</p><ul>",
+            f"<code>{_e(rerun_command(plan, results_dir))}</code> again to complete "
+            "them.</p><ul>",
             *[f"<li>{_e(r.cell.describe())}</li>" for r in not_run],
             "</ul>",
         ]

@@ -29,7 +29,7 @@ from albot1.report.map_plots import MapStyle
 from albot1.report.markdown import code, text
 from albot1.report.paired_tables import paired_rows
 from albot1.report.plots import method_colors, vector_of
-from albot1.report.provenance import data_by_dataset, describe_data, separate_data
+from albot1.report.provenance import data_by_dataset, describe_data, rerun_command, separate_data
 from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
 from albot1.report.standard import on_standard_logs, write_standard
@@ -179,7 +179,8 @@ def write_index(
         lines += [
             "## Cells not run",
             "",
-            "The runner stopped before these cells finished; run `albot1 bench` again to complete them.",
+            "The runner stopped before these cells finished; run "
+            f"{code(rerun_command(plan, results_dir))} again to complete them.",
             "",
             *[f"- {text(r.cell.describe())}" for r in not_run],
             "",
@@ -244,8 +245,8 @@ def build_report(
         paired = paired_rows(records)  # the accuracy tables' paired comparisons (metrics.md, paired.csv, index.html)
         tables = write_tables(records, target, paired, columns, tabled)
         if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
-            tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target)
-        generalisation = write_generalisation(plan, records, target)
+            tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target, results)
+        generalisation = write_generalisation(plan, records, target, results)
         if generalisation is not None:
             tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
         views = write_views(pictured, target, colors) if plots else None

@@ -22,6 +22,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from html import escape
 from pathlib import Path
@@ -31,7 +32,7 @@ import numpy as np
 from albot1.atomic import atomic_write
 from albot1.metrics.measures.ate import METRIC as ATE
 from albot1.metrics.measures.relations import METRIC as RELATIONS
-from albot1.metrics.paired import CONFIDENCE, MIN_PAIRS, ZERO_ERROR, Comparison, method_text
+from albot1.metrics.paired import CONFIDENCE, MIN_PAIRS, ZERO_ERROR, Comparison, method_text, not_applicable
 from albot1.report.collect import CellRecord
 from albot1.report.comparisons import (
     FIGURE,
@@ -49,6 +50,10 @@ TABLE = "paired.csv"
 ODOMETRY = "odometry"
 REFERENCE = "reference"
 BEST = "best"
+#: why a degradation has no best method: no method's errors could be read back (each run's reason is noted)
+NO_ERRORS = "no method has errors that could be read back, so none is the best"
+#: why the method with the lowest pooled error is not called the best: no other method's runs paired with its
+NO_EVIDENCE = "lowest pooled error, but no run of another method could be compared with its runs"
 
 
 @dataclass(frozen=True)
@@ -61,8 +66,9 @@ class PairedRow:
     kind: Kind
     runs: int
     reference: str
-    best: str
-    #: None: this method is the reference / the best
+    #: None: no method has errors to rank (every ``against_best`` is then n/a with the reason)
+    best: str | None
+    #: None: this method is the reference / the best (the best only when a comparison against it applies)
     against_reference: Comparison | None
     against_best: Comparison | None
     #: why the method's runs give no errors to compare (every comparison of the row is then n/a)
@@ -114,9 +120,21 @@ def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str,
     errors = {rec.cell.key: read(rec) for recs in by_method.values() for rec in recs}
     pooled = {m: _pooled([errors[r.cell.key] for r in rs], kind) for m, rs in by_method.items()}
     reference = ODOMETRY if ODOMETRY in by_method else next(iter(by_method))
-    # the first of equals, in suite order; a perfect method (the reference poses given as odometry) is no yardstick
-    rated = [m for m in by_method if pooled[m] >= ZERO_ERROR] or list(by_method)
-    best = min(rated, key=lambda m: pooled[m])
+    # the first of equals, in suite order, of the methods with errors (an infinite pooled error: none could be read
+    # back); a perfect method (the reference poses given as odometry) is no yardstick
+    ranked = [m for m in by_method if math.isfinite(pooled[m])]
+    rated = [m for m in ranked if pooled[m] >= ZERO_ERROR] or ranked
+    best = min(rated, key=lambda m: pooled[m]) if rated else None
+    against_best = {
+        method: not_applicable(NO_ERRORS)
+        if best is None
+        else None
+        if method == best
+        else compare_runs(seeds_paired(mine, by_method[best], errors), kind)
+        for method, mine in by_method.items()
+    }
+    if best is not None and not any(found is not None and found.applies for found in against_best.values()):
+        against_best[best] = not_applicable(NO_EVIDENCE)  # the lowest pooled error, but never paired with another's
     rows = []
     for method, mine in by_method.items():
         missing = next((errors[r.cell.key].missing for r in mine if errors[r.cell.key].missing), None)
@@ -130,7 +148,7 @@ def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str,
                 reference,
                 best,
                 None if method == reference else compare_runs(seeds_paired(mine, by_method[reference], errors), kind),
-                None if method == best else compare_runs(seeds_paired(mine, by_method[best], errors), kind),
+                against_best[method],
                 missing,
             )
         )
@@ -144,13 +162,19 @@ def _cell(found: Comparison | None, role: str) -> str:
     return f"{found.verdict} {found.text()}" if found.applies else "n/a"
 
 
+def _against(other: str | None, method: str, quote: Callable[[str], str] = str) -> str:
+    """`` (other)``: the method a cell compares with; nothing for the row's own role or when there is none."""
+    return "" if other is None or other == method else f" ({quote(other)})"
+
+
 def _notes(rows: list[PairedRow]) -> list[str]:
     """Why comparisons are n/a or runs left out, each reason once with the comparisons it applies to."""
     why: dict[str, list[str]] = {}
     for r in rows:
         for other, found in ((r.reference, r.against_reference), (r.best, r.against_best)):
             if found is not None and not found.applies:
-                why.setdefault(f"n/a: {found.reason}", []).append(f"{r.method} against {other} ({r.degradation})")
+                where = f"{r.method} as the best" if other == r.method else f"{r.method} against {other or BEST}"
+                why.setdefault(f"n/a: {found.reason}", []).append(f"{where} ({r.degradation})")
         if r.missing is not None:
             why.setdefault(f"a run not compared: {r.missing}", []).append(f"{r.method} ({r.degradation})")
     return [f"{reason}: {'; '.join(dict.fromkeys(where))}" for reason, where in why.items()]
@@ -173,8 +197,8 @@ def intro() -> str:
         "error to the other's "
         f"(< 1: lower) with its {CONFIDENCE:.0%} interval; test: {method_text()}. *pairs (runs)*: the errors "
         f"paired and the pairs of runs they come from. Fewer than {MIN_PAIRS} pairs, or a run whose errors cannot "
-        "be read back, is n/a with the reason. A claim that one method beats another holds only where its row "
-        "says better or worse."
+        "be read back, is n/a with the reason; so is the best's own cell when no other method's runs could be "
+        "compared with its. A claim that one method beats another holds only where its row says better or worse."
     )
 
 
@@ -194,8 +218,7 @@ def markdown_lines(rows: list[PairedRow], dataset: str) -> list[str]:
         best = _cell(r.against_best, BEST)
         lines.append(
             f"| {md_text(r.method)} | {md_text(r.degradation)} | {_counts(r)} | "
-            f"{ref}{'' if r.against_reference is None else f' ({md_text(r.reference)})'} | "
-            f"{best}{'' if r.against_best is None else f' ({md_text(r.best)})'} |"
+            f"{ref}{_against(r.reference, r.method, md_text)} | {best}{_against(r.best, r.method, md_text)} |"
         )
     notes = [f"- {md_text(note)}" for note in _notes(mine)]
     return [*lines, "", *notes, *([""] if notes else [])]
@@ -211,8 +234,8 @@ def html_table(rows: list[PairedRow], dataset: str) -> str:
     )
     body = []
     for r in mine:
-        ref = _cell(r.against_reference, REFERENCE) + ("" if r.against_reference is None else f" ({r.reference})")
-        best = _cell(r.against_best, BEST) + ("" if r.against_best is None else f" ({r.best})")
+        ref = _cell(r.against_reference, REFERENCE) + _against(r.reference, r.method)
+        best = _cell(r.against_best, BEST) + _against(r.best, r.method)
         body.append(
             f"<tr><td>{escape(r.method)}</td><td>{escape(r.degradation)}</td><td>{escape(_counts(r))}</td>"
             f"<td>{escape(ref)}</td><td>{escape(best)}</td></tr>"
@@ -241,7 +264,8 @@ def write_paired_csv(rows: list[PairedRow], out: Path) -> Path:
                 continue
             numbers = ["" if math.isnan(v) else f"{v:.9g}" for v in (found.ratio, found.low, found.high)]
             writer.writerow(
-                [r.dataset, r.degradation, r.method, other, role, r.kind, found.pairs, found.groups, *numbers]
+                [r.dataset, r.degradation, r.method, "" if other in (None, r.method) else other, role, r.kind]
+                + [found.pairs, found.groups, *numbers]
                 + [found.verdict, found.reason or ""]
             )
     path = out / TABLE

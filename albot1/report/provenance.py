@@ -12,6 +12,7 @@ any table or plot groups them (:func:`separate_data`).
 from __future__ import annotations
 
 import hashlib
+import shlex
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,6 +21,8 @@ from albot1.bench.grid import GridPlan
 from albot1.bench.suite import find_suite
 from albot1.data.identity import short
 from albot1.report.collect import CellRecord
+from albot1.report.folders import default_out
+from albot1.settings import RESULTS_ROOT
 
 
 def data_checksums(record: CellRecord) -> dict[str, str]:
@@ -114,3 +117,38 @@ def bench_argument(plan: GridPlan) -> str:
     except SuiteError:
         same = False
     return plan.suite if same else plan.suite_path
+
+
+def bench_command(suite: str, results_root: Path) -> str:
+    """``albot1 bench SUITE``, with ``--results ROOT`` unless ``results_root`` is the default (``results``).
+
+    ``albot1 bench`` writes into ``ROOT/<suite>``: a page drawn from a store
+    elsewhere that printed the bare command would send a re-run (or the
+    resume of unfinished cells) into another folder than the one it shows.
+    """
+    option = "" if results_root == RESULTS_ROOT else f" --results {shlex.quote(str(results_root))}"
+    return f"albot1 bench {shlex.quote(suite)}{option}"
+
+
+def rerun_command(plan: GridPlan, results_dir: Path) -> str:
+    """``albot1 bench`` of the plan's suite into the store at ``results_dir`` (a run again, or the resume)."""
+    return bench_command(bench_argument(plan), Path(results_dir).parent)
+
+
+def regenerate_command(plan: GridPlan, results_dir: Path | None = None, out: Path | None = None) -> str:
+    """The commands that write a page again: the suite run into its store, then the report of it into ``out``.
+
+    ``results_dir`` is the store as the report was given it (printed as
+    given, as the pages link relative to it). ``albot1 bench`` writes into
+    ``<its parent>/<suite>``: that is the folder the report reads again (the
+    same one unless the store was renamed). ``--out`` is named when the report
+    did not go to its default place. None: the defaults (``results/<suite>``,
+    ``reports/<suite>``).
+    """
+    results_dir = RESULTS_ROOT / plan.suite if results_dir is None else Path(results_dir)
+    store = results_dir.parent / plan.suite
+    out = default_out(store) if out is None else out
+    report = f"albot1 report {shlex.quote(str(store))}"
+    if Path(out).resolve() != default_out(store).resolve():
+        report += f" --out {shlex.quote(str(out))}"
+    return f"{rerun_command(plan, results_dir)} && {report}"

@@ -33,6 +33,11 @@ END = "<!-- results:end -->"
 PLACEHOLDER = "No results page has been generated yet: run `make bench` (docs/results.md)."
 
 
+def _paragraph(lines: list[str]) -> list[str]:
+    """``lines`` and the blank line that ends them; nothing for none (an empty part leaves no second blank line)."""
+    return [*lines, ""] if lines else []
+
+
 def _num(value: float | None, digits: int) -> str:
     return "n/a" if value is None else f"{value:.{digits}f}"
 
@@ -252,8 +257,7 @@ def render_page(data: ResultsData) -> str:
         "",
         *(ate_table(data) or ["The default suite's store holds none of these cells."]),
         "",
-        *_ate_notes(data),
-        "",
+        *_paragraph(_ate_notes(data)),
         "## The thesis's claims at a glance",
         "",
         _counts_line(data),
@@ -283,8 +287,7 @@ def render_readme_block(data: ResultsData | None) -> str:
             *standard_table(data),
             "",
             *(line for text in _other_store_lines(data) for line in (text, "")),
-            *ate_table(data),
-            "",
+            *_paragraph(ate_table(data)),
             _counts_line(data),
         ]
     return "\n".join([BEGIN, *body, END])

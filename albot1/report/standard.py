@@ -34,7 +34,7 @@ from albot1.report.collect import CellRecord
 from albot1.report.comparisons import Cell, Errors, all_pairs, matrix_lines, relation_errors_of
 from albot1.report.limits import known_limit_of
 from albot1.report.markdown import text as md_text
-from albot1.report.provenance import bench_argument, data_lines
+from albot1.report.provenance import data_lines, regenerate_command
 from albot1.report.tuning import LEGEND, held_in, marked
 
 #: The five logs of the standard benchmark, with the names the published tables use.
@@ -330,9 +330,15 @@ def _unpublished() -> list[str]:
 
 
 def render_page(
-    plan: GridPlan, rows: list[Row], skipped: dict[str, str], paired: dict[str, Paired] | None = None
+    plan: GridPlan,
+    rows: list[Row],
+    skipped: dict[str, str],
+    paired: dict[str, Paired] | None = None,
+    *,
+    regenerate: str | None = None,
 ) -> str:
-    """The Markdown page (see the module docstring)."""
+    """The Markdown page (see the module docstring); ``regenerate``: the commands that write it again
+    (:func:`albot1.report.provenance.regenerate_command`; None: those of the default folders)."""
     lines = [
         "# The standard benchmark: relation metric on five Freiburg logs",
         "",
@@ -350,8 +356,7 @@ def render_page(
         "per CPU second. Published timings are Hess et al.'s (Table V), measured on "
         "an Intel Xeon E5-1650 at 3.2 GHz: compare the ratios, not the seconds.",
         "",
-        f"Regenerate: `albot1 bench {bench_argument(plan)} && albot1 report results/{plan.suite}` "
-        "(`make bench` does this for the default suite).",
+        f"Regenerate: `{regenerate or regenerate_command(plan)}` (`make bench` does this for the default suite).",
         "",
         f"**Paired comparisons.** Under each log, every two measured methods are compared on the same "
         f"ground-truth relations: the ratio of the row method's mean relation error to the column method's, "
@@ -438,8 +443,13 @@ def on_standard_logs(plan: GridPlan, records: list[CellRecord]) -> bool:
     )
 
 
-def write_standard(plan: GridPlan, records: list[CellRecord], out: Path) -> tuple[Path, Path]:
-    """Write ``standard-benchmark.md`` and ``.csv`` into ``out``; returns both paths."""
+def write_standard(
+    plan: GridPlan, records: list[CellRecord], out: Path, results_dir: Path | None = None
+) -> tuple[Path, Path]:
+    """Write ``standard-benchmark.md`` and ``.csv`` into ``out``; returns both paths.
+
+    ``results_dir``: the store the records were read from, as given (its "Regenerate" line names it).
+    """
     measured = measured_rows(records)
     durations = {r.log: r.duration_s for r in measured if r.duration_s is not None}
     rows = [*measured, *published_rows(durations)]
@@ -448,7 +458,13 @@ def write_standard(plan: GridPlan, records: list[CellRecord], out: Path) -> tupl
     skipped = {s.name: s.reason + (f" (`{s.hint}`)" if s.hint else "") for s in plan.skipped_datasets}
     page, table = out / PAGE, out / TABLE
     paired = paired_by_log(records)
-    text = render_page(plan, rows, {k: v for k, v in skipped.items() if k in STANDARD_LOGS}, paired)
+    text = render_page(
+        plan,
+        rows,
+        {k: v for k, v in skipped.items() if k in STANDARD_LOGS},
+        paired,
+        regenerate=regenerate_command(plan, results_dir, out),
+    )
     data = data_lines([r for r in records if r.cell.dataset_label in STANDARD_LOGS])
     if data:  # which data the measured rows come from (albot1.report.provenance)
         text = text.rstrip("\n") + "\n\n## Data\n\n" + "".join(f"- {md_text(line)}\n" for line in data)

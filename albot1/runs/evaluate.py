@@ -6,7 +6,8 @@ digit:
 
 * :func:`evaluate_run`: a run folder in, ``metrics.json`` written there. It
   reads the run with :func:`albot1.runs.folder.read_run` and reopens the
-  dataset when the map-shape metric needs the scans.
+  dataset, degraded as the run was (:func:`reopen`), when a metric needs the
+  scans (the map-shape metric's reference map).
 * :func:`evaluate_trajectory`: a trajectory file from another tool (TUM,
   KITTI or a corrected CARMEN log; :mod:`albot1.data.trajectory`) scored
   against the reference poses and relations of a dataset
@@ -32,7 +33,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from albot1.data.open import open_sequence
+from albot1.data.open import open_as_run
 from albot1.errors import Albot1Error
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.record import MISSING_NOTE, MetricsRecord, build_metrics_record
@@ -155,7 +156,7 @@ def metric_inputs(scored: Scored, settings: Settings | None = None) -> MetricInp
         relations_source=scored.relations_source,
         relation_timestamps=scored.relation_timestamps,
         relation_poses=scored.relation_poses,
-        open_dataset=lambda: same_data(open_sequence(scored.dataset, settings=settings), scored),
+        open_dataset=lambda: same_data(reopen(scored, settings), scored),
         load_map=scored.load_map,
         counters=scored.counters,
         per_scan_ns=scored.per_scan_ns,
@@ -164,6 +165,16 @@ def metric_inputs(scored: Scored, settings: Settings | None = None) -> MetricInp
         alignment=scored.alignment,
         n_to_align=scored.n_to_align,
     )
+
+
+def reopen(scored: Scored, settings: Settings | None = None) -> Sequence:
+    """The dataset of ``scored`` as its run saw it: its degradation and seed applied (:func:`open_as_run`).
+
+    Without them a ``dropout`` run's scans would be compared with every scan
+    of the log, and the reference map would be refused as data that changed.
+    """
+    header = scored.header
+    return open_as_run(scored.dataset, header.get("degradation") or "none", header.get("seed"), settings=settings)
 
 
 def same_data(sequence: Sequence, scored: Scored) -> Sequence:

@@ -106,7 +106,7 @@ def test_a_declared_closed_route_gets_its_end_to_start_gap_without_reference(
     frames = [Frame(i, Scan(np.full(31, 2.0), angles, float(i), 8.0), odometry[i], None) for i in range(n)]
     closed = Sequence.from_frames("ring", frames, metadata=SequenceMetadata(extra={"closed_loop": True}))
     run_dir = write_run(run_method("odometry", closed, dataset_name="ring"), tmp_path)
-    monkeypatch.setattr("albot1.runs.evaluate.open_sequence", lambda ref, **_: closed)
+    monkeypatch.setattr("albot1.runs.evaluate.open_as_run", lambda ref, *_, **__: closed)
     block = evaluate_run(run_dir).loop_gap
     assert isinstance(block, ClosedRouteGapBlock)
     assert np.allclose(truth[-1, :2], 0.0, atol=1e-9)

@@ -142,3 +142,27 @@ def test_an_imported_library_keeps_the_version_it_was_imported_with_and_a_new_im
     assert versions.library_versions(names) == {"kiss-icp": "1.1", "made-up-lib": "2.0"}
     installed["kiss-icp"] = "1.2"
     assert versions.library_versions(names) == {"kiss-icp": "1.1", "made-up-lib": "2.0"}
+
+
+def test_numba_and_llvmlite_are_recorded_as_imported(monkeypatch: pytest.MonkeyPatch) -> None:
+    """They compile Albot1's kernels: a run records them like numpy, the version of the module it imported."""
+    import llvmlite
+    import numba
+
+    monkeypatch.setattr(versions, "_IMPORTED", {})
+    monkeypatch.setattr(versions, "_NOT_IMPORTED", {})
+    recorded = versions.library_versions()
+    assert {"numba", "llvmlite"} <= recorded.keys()
+    assert (recorded["numba"], recorded["llvmlite"]) == (numba.__version__, llvmlite.__version__)
+    assert {"numba", "llvmlite"} <= versions._IMPORTED.keys()  # read while imported: kept for the process
+
+
+def test_a_run_records_the_numba_that_compiled_its_kernels() -> None:
+    import numba
+
+    from albot1.data.open import open_sequence
+    from albot1.runs.execute import run_method
+
+    result = run_method("odometry", open_sequence("synthetic-office-startstop[:3]"))
+    assert result.versions["numba"] == numba.__version__
+    assert result.versions["llvmlite"] is not None

@@ -5,15 +5,15 @@ from __future__ import annotations
 from albot1.metrics.ate import ate
 from albot1.metrics.blocks import Alignment, AlignmentTransform, RotationStats, block_of, fmt
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import Record
+from albot1.records import NonNegative, Record
 
 
 class AlignmentSummary(Record):
     """ATE under another alignment, for comparison."""
 
-    rmse_m: float
-    mean_m: float
-    max_m: float
+    rmse_m: NonNegative
+    mean_m: NonNegative
+    max_m: NonNegative
 
 
 class AteBlock(Record):
@@ -21,12 +21,12 @@ class AteBlock(Record):
 
     alignment: Alignment
     units: dict[str, str]
-    mean_m: float
-    std_m: float
-    median_m: float
-    min_m: float
-    max_m: float
-    rmse_m: float
+    mean_m: NonNegative
+    std_m: NonNegative
+    median_m: NonNegative
+    min_m: NonNegative
+    max_m: NonNegative
+    rmse_m: NonNegative
     n: int
     std_ddof: int
     rotation: RotationStats

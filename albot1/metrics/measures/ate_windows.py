@@ -5,18 +5,18 @@ from __future__ import annotations
 from albot1.metrics.ate import windowed_ate
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import Record
+from albot1.records import NonNegative, Record
 
 
 class WindowStats(Record):
     """:class:`albot1.metrics.blocks.Stats` of the windows' RMSE with the unit in the key (``_m``)."""
 
-    mean_m: float
-    std_m: float
-    median_m: float
-    min_m: float
-    max_m: float
-    rmse_m: float
+    mean_m: NonNegative
+    std_m: NonNegative
+    median_m: NonNegative
+    min_m: NonNegative
+    max_m: NonNegative
+    rmse_m: NonNegative
     n: int
     std_ddof: int
 
@@ -26,19 +26,19 @@ class AteWindow(Record):
 
     first_scan: int
     last_scan: int
-    rmse_m: float
-    max_m: float
+    rmse_m: NonNegative
+    max_m: NonNegative
 
 
 class AteWindowsBlock(Record):
     """``ate_windows``: ATE of consecutive windows of ``window_m`` reference travel, each aligned on its own."""
 
     alignment: str
-    window_m: float
+    window_m: NonNegative
     windows: int
-    uncovered_m: float
+    uncovered_m: float  # may be -1e-9 m: the window count tolerates rounding (albot1.metrics.ate.windowed_ate)
     units: dict[str, str]
-    mean_rmse_m: float
+    mean_rmse_m: NonNegative
     window_rmse: WindowStats
     per_window: list[AteWindow]
 

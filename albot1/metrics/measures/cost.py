@@ -9,7 +9,7 @@ from __future__ import annotations
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.cost import cost
 from albot1.metrics.unit import TIMING, Metric, MetricInputs
-from albot1.records import OptFloat, Record, dump_record
+from albot1.records import NonNegative, OptFloat, OptNonNegative, Record, dump_record
 
 
 class CostByPosition(Record):
@@ -24,16 +24,16 @@ class CostBlock(Record):
 
     units: dict[str, str]
     scans: int
-    per_scan_ms_median: float
-    per_scan_ms_p95: float
-    per_scan_ms_mean: float
-    per_scan_ms_max: float
-    process_total_s: float
-    total_s: OptFloat
-    finish_s: OptFloat
+    per_scan_ms_median: NonNegative
+    per_scan_ms_p95: NonNegative
+    per_scan_ms_mean: NonNegative
+    per_scan_ms_max: NonNegative
+    process_total_s: NonNegative
+    total_s: OptNonNegative
+    finish_s: OptNonNegative
     #: seconds before the first scan (compiling or loading kernels); None for runs recorded before it was measured
-    startup_s: OptFloat = None
-    peak_mb: OptFloat
+    startup_s: OptNonNegative = None
+    peak_mb: OptNonNegative
     by_position: CostByPosition
     growth_slope_ms_per_1000_scans: OptFloat
     last_over_first_decile: OptFloat

@@ -7,13 +7,13 @@ from pydantic import model_validator
 from albot1.metrics.blocks import Stats, block_of, fmt
 from albot1.metrics.drift import drift
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import OmitsAbsentReasons, Record
+from albot1.records import NonNegative, OmitsAbsentReasons, Record
 
 
 class DriftEntry(Record):
     """``drift.sweep`` entry: errors of every segment of ``length_m`` reference travel."""
 
-    length_m: float
+    length_m: NonNegative
     pairs: int
     translation_m: Stats
     rotation_deg: Stats
@@ -22,8 +22,8 @@ class DriftEntry(Record):
 class DriftAt10m(Record):
     """``drift.at_10m``: mean errors of the 10 m segments (the headline)."""
 
-    translation_m: float
-    rotation_deg: float
+    translation_m: NonNegative
+    rotation_deg: NonNegative
     pairs: int
 
 
@@ -35,8 +35,8 @@ class DriftBlock(OmitsAbsentReasons):
 
     alignment: str
     pairs_from: str
-    start_spacing_m: float
-    route_m: float
+    start_spacing_m: NonNegative
+    route_m: NonNegative
     units: dict[str, str]
     sweep: list[DriftEntry]
     lengths_beyond_route_m: list[float]

@@ -11,7 +11,7 @@ from albot1.metrics.blocks import Stats, block_of, fmt
 from albot1.metrics.loop_gap import pair_gaps, route_gap
 from albot1.metrics.measures.drift import METRIC as DRIFT
 from albot1.metrics.unit import NO_REFERENCE, RETURNING_ROUTE, BlockLookup, ColumnSpec, Metric, MetricInputs
-from albot1.records import Record
+from albot1.records import NonNegative, Record
 
 #: A loop gap applies to a route whose reference returns near its start: within this many metres ...
 ROUTE_RETURN_M = 1.0
@@ -22,18 +22,18 @@ ROUTE_RETURN_FRACTION = 0.02
 class RouteGap(Record):
     """``loop_gap.route``: start-to-end error (m, deg)."""
 
-    estimated_offset_m: float
-    reference_offset_m: float
+    estimated_offset_m: NonNegative
+    reference_offset_m: NonNegative
     reference: str
-    gap_m: float
-    heading_gap_deg: float
+    gap_m: NonNegative
+    heading_gap_deg: NonNegative
 
 
 class WorstPair(Record):
     """The revisit pair with the largest gap."""
 
     scans: list[int]
-    gap_m: float
+    gap_m: NonNegative
 
 
 class LoopGapBlock(Record):
@@ -45,9 +45,9 @@ class LoopGapBlock(Record):
     units: dict[str, str]
     alignment: str
     route: RouteGap
-    radius_m: float
-    min_dt_s: float
-    min_travel_m: float
+    radius_m: NonNegative
+    min_dt_s: NonNegative
+    min_travel_m: NonNegative
     pairs: int
     translation_m: Stats | None
     rotation_deg: Stats | None

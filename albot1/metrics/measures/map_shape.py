@@ -21,7 +21,7 @@ from albot1.metrics.errors import MetricsError
 from albot1.metrics.map_shape import MAX_POINTS, VOXEL_M, map_agreement, thin
 from albot1.metrics.reference_map import entry_key, reference_cloud
 from albot1.metrics.unit import MAP, REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import Record
+from albot1.records import Fraction, NonNegative, Record
 
 if TYPE_CHECKING:
     from albot1.data.model import Sequence
@@ -34,16 +34,16 @@ class MapShapeBlock(Record):
     alignment: str
     alignment_transform: AlignmentTransform
     reference_map: str
-    tolerance_m: float
-    voxel_m: float
+    tolerance_m: NonNegative
+    voxel_m: NonNegative
     map_points: int
     reference_points: int
-    precision: float
-    coverage: float
-    map_to_reference_mean_m: float
-    map_to_reference_median_m: float
-    reference_to_map_mean_m: float
-    reference_to_map_median_m: float
+    precision: Fraction
+    coverage: Fraction
+    map_to_reference_mean_m: NonNegative
+    map_to_reference_median_m: NonNegative
+    reference_to_map_mean_m: NonNegative
+    reference_to_map_median_m: NonNegative
 
 
 def reference_points(inputs: MetricInputs, reference: FloatArray) -> FloatArray:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.orientation import orientation_table
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import OptFloat, Record
+from albot1.records import OptFloat, OptNonNegative, Record
 
 
 class OrientationRow(Record):
@@ -31,10 +31,10 @@ class OrientationBlock(Record):
     min_distance_m: float
     stops: int
     bearing_undefined: int
-    bearing_abs_error_mean_deg: OptFloat
-    bearing_abs_error_max_deg: OptFloat
-    distance_abs_error_mean_m: OptFloat
-    distance_abs_error_max_m: OptFloat
+    bearing_abs_error_mean_deg: OptNonNegative
+    bearing_abs_error_max_deg: OptNonNegative
+    distance_abs_error_mean_m: OptNonNegative
+    distance_abs_error_max_m: OptNonNegative
     rows: list[OrientationRow]
 
 

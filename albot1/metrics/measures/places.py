@@ -20,7 +20,7 @@ from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.places import PLACES_JSON, judge_network
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs, method_file
-from albot1.records import OmitsAbsentReasons, OptFloat, Record
+from albot1.records import NonNegative, OmitsAbsentReasons, OptFraction, OptNonNegative, Record
 
 PLACES_FILE = method_file(PLACES_JSON, f"the method keeps no network of places (no {PLACES_JSON})")
 
@@ -39,9 +39,9 @@ class ExitPrediction(Record):
     scan: int
     exit: int | str
     doorway: str
-    perceived_error_m: float
-    aligned_error_m: float
-    not_aligned_error_m: float
+    perceived_error_m: NonNegative
+    aligned_error_m: NonNegative
+    not_aligned_error_m: NonNegative
 
 
 class ExitsJudgement(Record):
@@ -49,8 +49,8 @@ class ExitsJudgement(Record):
 
     exit_predictions: list[ExitPrediction]
     crossing_scans: int
-    exit_prediction_aligned_true_mean_m: OptFloat
-    exit_prediction_not_aligned_true_mean_m: OptFloat
+    exit_prediction_aligned_true_mean_m: OptNonNegative
+    exit_prediction_not_aligned_true_mean_m: OptNonNegative
     crossings_true: int
     crossings_false: int
     crossings_missed: int
@@ -78,8 +78,8 @@ class PlacesBlock(OmitsAbsentReasons):
     revisits_false: int
     revisits_missed: int
     revisits_actual: int
-    revisit_precision: OptFloat
-    revisit_recall: OptFloat
+    revisit_precision: OptFraction
+    revisit_recall: OptFraction
     visits: list[VisitJudgement]
     exits: ExitsJudgement | None
     exits_reason: str | None = None

@@ -21,6 +21,7 @@ from albot1.metrics.measures.places import METRIC as PLACES
 from albot1.metrics.measures.places import ExitsJudgement, PlacesBlock
 from albot1.metrics.measures.updates import METRIC as UPDATES
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, Column, collect
+from albot1.report.provenance import bench_command
 from albot1.report.thesis.verdicts import Number
 
 #: The stores read beside ``results/thesis``, as sibling folders of it (``results/<name>``), in search order.
@@ -178,8 +179,8 @@ def open_stores(results_dir: Path, companions: tuple[str, ...] = COMPANION_SUITE
             continue
         if not (path / "grid.json").is_file():
             notes.append(
-                f"`{path}` holds no results (run `albot1 bench {name}`, or `make bench`): the public-log rows of "
-                "Experiments 1, 2 and 6 are not comparable"
+                f"`{path}` holds no results (run `{bench_command(name, path.parent)}`, or `make bench`): the "
+                "public-log rows of Experiments 1, 2 and 6 are not comparable"
             )
             continue
         try:

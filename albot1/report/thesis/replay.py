@@ -21,8 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from albot1.data.degrade import degrade
-from albot1.data.open import open_sequence
+from albot1.data.open import open_as_run
 from albot1.errors import Albot1Error
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
@@ -66,7 +65,7 @@ def replay_run(run_dir: Path, settings: Settings | None = None) -> Replay:
     if info.method != "albot1":
         raise ReportError(f"{run_dir}: a run of {info.method}, not of albot1: it has no perceptual-map updates")
     try:
-        sequence = degrade(open_sequence(info.dataset, settings=settings), info.degradation, seed=info.seed)
+        sequence = open_as_run(info.dataset, info.degradation, info.seed, settings=settings)
         mapper = Albot1Mapper(Albot1Config.model_validate(info.config), seed=info.seed)
     except Albot1Error as exc:
         raise ReportError(f"{run_dir}: cannot replay {info.dataset}: {exc}") from None

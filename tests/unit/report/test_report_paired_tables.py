@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ from albot1.metrics.paired import BETTER, PERFECT_REFERENCE, SAME, WORSE
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
-from albot1.report.paired_tables import TABLE, error_kind, markdown_lines, paired_rows
+from albot1.report.paired_tables import NO_ERRORS, NO_EVIDENCE, TABLE, error_kind, markdown_lines, paired_rows
 from albot1.report.tables import write_tables
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
@@ -120,3 +121,40 @@ def test_with_perfect_odometry_the_best_is_the_best_imperfect_method(tmp_path: P
     assert found is not None and found.reason == PERFECT_REFERENCE  # no ratio to a perfect odometry
     against = rows["gtsam-graph"].against_best
     assert against is not None and against.verdict == WORSE and against.ratio == pytest.approx(5.0, rel=0.05)
+
+
+def test_a_method_never_paired_with_another_is_not_called_the_best(records: list[CellRecord], tmp_path: Path) -> None:
+    # kiss-icp has the lowest pooled error but only seed 0, every other method only seed 1: no pair at all.
+    apart = [r for r in records if (r.cell.method == "kiss-icp") == (r.cell.seed == 0)]
+    rows = {r.method: r for r in paired_rows(apart)}
+    assert rows["kiss-icp"].best == "kiss-icp"
+    own = rows["kiss-icp"].against_best
+    assert own is not None and (own.verdict, own.reason) == ("n/a", NO_EVIDENCE)
+    lines = markdown_lines(list(rows.values()), "drive")
+    assert "| kiss-icp | gauss:0.1:1 | – | n/a (odometry) | n/a |" in lines
+    assert f"- n/a: {NO_EVIDENCE}: kiss-icp as the best (gauss:0.1:1)" in lines
+    assert all("| best |" not in line for line in lines)
+
+
+def test_with_no_errors_to_read_back_no_method_is_the_best(records: list[CellRecord], tmp_path: Path) -> None:
+    """Runs of one degradation without an ATE: nothing to rank, so every 'against the best' is n/a."""
+    unreadable = []
+    for rec in records:
+        if rec.cell.seed == 0 and rec.metrics is not None:
+            metrics = rec.metrics.model_copy(update={"ate": None, "ate_reason": "hand-made: no ATE"})
+            cell = replace(rec.cell, degradation="dropout:0.5")
+            unreadable.append(CellRecord(cell, "done", rec.run_dir, rec.result, metrics, None))
+    rows = [r for r in paired_rows(records + unreadable) if r.degradation == "dropout:0.5"]
+    assert [(r.method, r.best) for r in rows] == [("odometry", None), ("kiss-icp", None), ("gtsam-graph", None)]
+    assert {(r.against_best.verdict, r.against_best.reason) for r in rows if r.against_best is not None} == {
+        ("n/a", NO_ERRORS)
+    }
+    assert all(r.against_best is not None for r in rows)
+    lines = markdown_lines(rows, "drive")
+    assert lines[4:7] == [
+        "| odometry | dropout:0.5 | – | reference | n/a |",
+        "| kiss-icp | dropout:0.5 | – | n/a (odometry) | n/a |",
+        "| gtsam-graph | dropout:0.5 | – | n/a (odometry) | n/a |",
+    ]
+    note = f"- n/a: {NO_ERRORS}: odometry against best (dropout:0.5); kiss-icp against best (dropout:0.5); "
+    assert f"{note}gtsam-graph against best (dropout:0.5)" in lines

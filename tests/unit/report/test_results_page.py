@@ -192,3 +192,20 @@ def test_readme_without_markers_is_refused_before_writing(tmp_path: Path) -> Non
         write_results(_data(), tmp_path / "docs" / "results.md", readme)
     assert not (tmp_path / "docs").exists()
     assert readme.read_text(encoding="utf-8") == "no block here\n"
+
+
+def test_an_empty_ate_table_leaves_one_blank_line_in_the_readme_block_and_the_page() -> None:
+    data = _data()
+    data.ate.clear()
+    block = render_readme_block(data).splitlines()
+    assert "" not in [a for a, b in zip(block, block[1:], strict=False) if a == b]  # no two blank lines in a row
+    counts = next(i for i, line in enumerate(block) if line.startswith("Thesis verdicts"))
+    assert block[counts - 2 :] == ["| fr-clinic | – | – |", "", block[counts], END]  # the standard table ends
+    page = render_page(data)
+    assert "\n\n\n" not in page
+    assert "The default suite's store holds none of these cells.\n\n## The thesis's claims at a glance" in page
+    full = render_readme_block(_data()).splitlines()  # with a table: table, one blank line, the counts
+    assert full[-4:-2] == [
+        "| `intel-corrected?odometry=laser-pose` | `gauss:0.1:1` (0, 1, 2) | 0.0782 / 0.0692 / n/a |",
+        "",
+    ]

@@ -88,7 +88,7 @@ def test_a_closed_route_without_reference_round_trips_with_its_pairs_reason(
 ) -> None:
     closed = _circle(with_reference=False, closed=True)
     run_dir = write_run(run_method("odometry", closed, dataset_name="ring"), tmp_path)
-    monkeypatch.setattr("albot1.runs.evaluate.open_sequence", lambda ref, **_: closed)
+    monkeypatch.setattr("albot1.runs.evaluate.open_as_run", lambda ref, *_, **__: closed)
     block = evaluate_run(run_dir).loop_gap
     assert isinstance(block, ClosedRouteGapBlock)
     assert block.pairs is None and block.pairs_reason == "the dataset has no reference poses"
