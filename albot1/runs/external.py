@@ -192,4 +192,4 @@ def _as_stored(relations: Relations | None) -> Relations | None:
     with tempfile.TemporaryDirectory(prefix="albot1-relations-") as folder:
         path = Path(folder) / "relations.txt"
         write_relations(path, relations)
-        return read_relations(path)
+        return read_relations(path, empty_ok=True)
