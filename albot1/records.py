@@ -272,12 +272,20 @@ class ResultRecord(Record):
 # --------------------------------------------------------------------------- attempt.json
 
 
-class AttemptRecord(Record):
-    """The bench's ``attempt.json``: wall time of the cell's successful attempt (run + store + evaluation)."""
+class AttemptRecord(OmitsAbsentReasons):
+    """The bench's ``attempt.json``: wall time of the cell's successful attempt (run + store + evaluation).
+
+    ``elapsed_s`` counts from the moment the cell's process existed; ``launch_s`` is the time spent starting
+    it before that, which holds the forkserver's preload for the cells that waited for a server still
+    starting (:class:`albot1.bench.limits.ChildExit`); absent in attempts written before it was recorded.
+    """
+
+    OMITTED_WHEN_NULL: ClassVar[frozenset[str]] = frozenset({"launch_s"})
 
     elapsed_s: float
     host: str
     finished: str
+    launch_s: OptFloat = None
 
 
 # --------------------------------------------------------------------------- dotted paths (report columns)

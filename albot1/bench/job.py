@@ -140,13 +140,16 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
                     elapsed_s=ended.elapsed_s,
                     host=socket.gethostname(),
                     finished=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                    launch_s=ended.launch_s,
                 ),
             )
         except OSError as exc:  # the run is complete; only its wall-time record did not fit
             return _storage_failure(store, cell, exc, ended.elapsed_s, completed=True)
         return CellOutcome.of(cell, "done", ended.elapsed_s)
     kind, reason = verdict
-    problem = store.record_failure(cell, reason, kind, exit_code=ended.exit_code, elapsed_s=ended.elapsed_s)
+    problem = store.record_failure(
+        cell, reason, kind, exit_code=ended.exit_code, elapsed_s=ended.elapsed_s, launch_s=ended.launch_s
+    )
     if problem is not None:
         reason = f"{reason} [not recorded: {problem}]"
     halts = kind == "storage" or ended.pool_lost is not None

@@ -70,6 +70,13 @@ class ChildExit:
     supervisor saw (the child and its own children). ``pool_lost``: how the
     forkserver that started the child ended, when it died under the running
     cell (the child was then stopped and its exit status is unknown).
+
+    ``elapsed_s`` is the cell's wall time from the moment its process existed
+    (the moment its time limit starts counting) to its end; ``launch_s`` the
+    time before that, spent starting the process. Why apart: a forkserver
+    still starting makes its first children wait for its preload (imports and
+    every method's warm-up: 46 s on a cold numba cache, once per grid), which
+    is no cost of the cells that happen to be forked first.
     """
 
     exit_code: int | None
@@ -78,6 +85,7 @@ class ChildExit:
     memory_exceeded: bool = False
     peak_rss_mb: float | None = None
     pool_lost: str | None = None
+    launch_s: float | None = None
 
 
 class ForkserverChild:
@@ -247,6 +255,7 @@ def run_limited(
     """Run ``cell`` in a child; kill it when it passes ``cell.time_s`` seconds or ``cell.memory_mb`` resident.
 
     ``preview`` is the ``module:function`` of the run preview renderer (``bench.cells.renderer_target``).
+    The child's wall time is counted from the moment it exists (:class:`ChildExit`: ``elapsed_s``, ``launch_s``).
     """
     args = child_args(cell, runs_root, log_path, preview)
     start = time.monotonic()
@@ -254,7 +263,9 @@ def run_limited(
         # The forkserver, not this process, is the child's parent; it exits when this process dies.
         args["parent_pid"] = None
         start_forkserver((cell.method,))  # where no runner started it (a Dask worker), or after it was lost
+        # Returns once the server has forked the child: after its preload when the server is still starting.
         forked = ForkserverChild(process_entry, (args,), name=f"cell-{cell.key}")
+        launched = time.monotonic()
         process = watch(forked.pid)
         server = _parent_of(process)
         stop, peak = supervise(process, forked.ended, cell.time_s, cell.memory_mb)
@@ -266,7 +277,9 @@ def run_limited(
         lost = _server_fate(server) if code == 255 else None  # 255: the forkserver's pipe closed, no status
         if lost is not None and process is not None:
             kill_tree(process)  # the cell may outlive its server: stop it before it writes anything more
-        return ChildExit(code, stop == "timeout", time.monotonic() - start, stop == "memory", peak, lost)
+        return ChildExit(
+            code, stop == "timeout", time.monotonic() - launched, stop == "memory", peak, lost, launched - start
+        )
     args_file = runs_root / cell.key / ".child-args.json"
     write_json(args_file, args)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
@@ -277,6 +290,7 @@ def run_limited(
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     ) as child:
+        launched = time.monotonic()
 
         def child_ended(timeout: float) -> bool:
             try:
@@ -292,5 +306,10 @@ def run_limited(
         code = child.wait()
     args_file.unlink(missing_ok=True)
     return ChildExit(
-        None if stop is not None else code, stop == "timeout", time.monotonic() - start, stop == "memory", peak
+        None if stop is not None else code,
+        stop == "timeout",
+        time.monotonic() - launched,
+        stop == "memory",
+        peak,
+        launch_s=launched - start,
     )

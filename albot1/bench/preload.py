@@ -23,6 +23,7 @@ import gc
 import importlib
 import logging
 import os
+import signal
 from collections.abc import Callable, Collection, Iterable
 from typing import TYPE_CHECKING
 
@@ -30,6 +31,16 @@ from albot1 import versions
 
 if TYPE_CHECKING:
     from albot1.methods.registry import MethodRegistry
+
+# Ctrl-C reaches the whole process group, this server too, and its preload (a cold numba compile takes tens of
+# seconds) is what it interrupts. Python's KeyboardInterrupt escaped ``multiprocessing.forkserver.main``, which
+# catches only ImportError, and printed a traceback above the runner's clean "interrupted" line; an exception
+# raised by a handler of our own could land in a finalizer and print "Exception ignored in: ...". So while it
+# preloads, the server takes SIGINT's default action: it ends at once and says nothing (the runner says what
+# happened, and its compile helpers end the same way, :func:`albot1.methods.albot1.warm_up.helper_main`).
+# Put back at the end (:func:`_preloaded`): the server hands its SIGINT handler to every cell it forks, which
+# records Ctrl-C as "interrupted".
+_SIGINT_BEFORE = signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 # First, before the slow imports: every cell forked from this server shares this value, so the cells of
 # one grid agree on the code version the runner planned with (see albot1.bench.cells).
@@ -163,5 +174,11 @@ def _warm_matplotlib() -> None:
     plt.close(fig)
 
 
+def _preloaded() -> None:
+    """Give SIGINT back the handler it had before the preload (Python's KeyboardInterrupt), for the cells."""
+    signal.signal(signal.SIGINT, signal.default_int_handler if _SIGINT_BEFORE is None else _SIGINT_BEFORE)
+
+
 _warm()
-collect_garbage()  # last: every cell forked from here starts with no garbage and no collection due
+collect_garbage()  # every cell forked from here starts with no garbage and no collection due
+_preloaded()  # last: a cell interrupted by Ctrl-C raises KeyboardInterrupt, as anywhere else

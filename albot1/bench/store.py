@@ -163,9 +163,13 @@ class ResultsStore:
         *,
         exit_code: int | None = None,
         elapsed_s: float = 0.0,
+        launch_s: float | None = None,
         traceback_text: str | None = None,
     ) -> str | None:
         """Write FAILED.json (and append a traceback to the cell log) for ``cell``.
+
+        ``elapsed_s``: the cell's wall time from the moment its process existed; ``launch_s``: the time spent
+        starting that process (the forkserver's preload when the cell waited for it), when known.
 
         Never raises for the file system: returns None when the record was
         written, else why it could not be (the caller still reports the
@@ -194,6 +198,7 @@ class ResultsStore:
                     "kind": kind,
                     "exit_code": exit_code,
                     "elapsed_s": elapsed_s,
+                    **({} if launch_s is None else {"launch_s": launch_s}),
                     "log": LOG if log.is_file() else None,
                     "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                     "host": socket.gethostname(),

@@ -39,6 +39,8 @@ class FailureRecord(Record):
     kind: FailureKind
     exit_code: int | None = None
     elapsed_s: NonNegativeFloat = 0.0
+    #: the time spent starting the cell's process before ``elapsed_s`` began (absent when unknown)
+    launch_s: NonNegativeFloat | None = None
     log: str | None = None
     key: str | None = None
     cell: str | None = None

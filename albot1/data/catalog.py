@@ -127,13 +127,18 @@ def copy_problem(name: str, settings: Settings) -> str | None:
     return None
 
 
-def open_dataset(name: str, settings: Settings, **options: Any) -> Sequence:
-    """The dataset as a streamed Sequence; ``options`` override the manifest's loader options."""
+def open_dataset(name: str, settings: Settings, *, manifest_relations: bool = True, **options: Any) -> Sequence:
+    """The dataset as a streamed Sequence; ``options`` override the manifest's loader options.
+
+    ``manifest_relations=False``: the manifest's relations file is neither
+    verified nor read nor recorded (the caller attaches a file of its own,
+    ``?relations=FILE``, :func:`albot1.data.open.open_sequence`).
+    """
     manifest = get(name)
     path = locate(name, settings)
     merged: dict[str, Any] = {**manifest.loader, **options}
     checksums = {path.name: manifest.log.sha256}
-    relations = manifest.file("relations")
+    relations = manifest.file("relations") if manifest_relations else None
     if relations is not None and "relations" not in options:
         found = verified_file(manifest, relations, settings)
         merged["relations"] = found

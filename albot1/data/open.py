@@ -82,6 +82,22 @@ def open_sequence(
         return _with_own_files(text, settings, format_name, options)
     if options.get("odometry") == REFERENCE or "views" in options:
         return _with_reference_options(text, settings, format_name, options)
+    return _open_source(text, settings, format_name, options)
+
+
+def _open_source(
+    text: str,
+    settings: Settings | None,
+    format_name: str | None,
+    options: dict[str, Any],
+    *,
+    manifest_relations: bool = True,
+) -> Sequence:
+    """``text`` (a world, a catalog name or a path; no slice, no query) opened with its loader's ``options``.
+
+    ``manifest_relations=False``: a catalog dataset's own relations file is
+    left unread, as ``?relations=FILE`` replaces it (:func:`_with_own_files`).
+    """
     if text in worlds.WORLDS:
         if "odometry" in options:  # not REFERENCE (handled above): a world's odometry has no other source
             raise DatasetNotFoundError(
@@ -93,7 +109,8 @@ def open_sequence(
     _check_option_files(options, text)
     if text in catalog.names():
         checksums = _checksums(None, options)
-        return _attach(checked(catalog.open_dataset(text, settings, **options)), checksums)
+        dataset = catalog.open_dataset(text, settings, manifest_relations=manifest_relations, **options)
+        return _attach(checked(dataset), checksums)
     path = Path(text).expanduser()
     if _exists(text):
         # The file (or every file of a bag folder) is checked and hashed before a loader opens it: a FIFO
@@ -269,7 +286,9 @@ def _with_own_files(text: str, settings: Settings | None, format_name: str | Non
         del rest["odometry"]
     own = {key: value for key, value in (("relations", relations), ("reference", reference)) if value is not None}
     _check_option_files(own, text)  # a FIFO or device is refused before anything reads it
-    sequence = open_sequence(text, settings=settings, format_name=format_name, **rest)
+    # the source's own relations are not read when a file of one's own replaces them: neither its warnings
+    # (repeated lines) nor its checksum (in the run's key) belong to what the run is scored on
+    sequence = _open_source(text, settings, format_name, rest, manifest_relations=relations is None)
     if relations is not None:
         sequence = with_relations(sequence, relations, text, repeats)
     if reference is not None:

@@ -5,8 +5,10 @@ One relation per line: ``t1 t2 x y z roll pitch yaw`` -- the pose at time
 the ipc timestamps of the dataset's scans. Only the planar part (x, y, yaw)
 is kept: z, roll and pitch are zero in every published 2D relations file,
 and a non-zero value is reported rather than silently dropped. Blank lines
-and ``#`` comments are allowed; a file without relations gives zero relations
-(a run folder of a dataset with an empty relation set round-trips).
+and ``#`` comments are allowed. A file without one relation is refused
+(a wrong or truncated file would otherwise score as "0 relations"), except
+where the caller reads a copy this project wrote (``empty_ok``): a run folder of
+a dataset with an empty relation set round-trips.
 
 A relation names its two poses by timestamp, and those are the timestamps
 of scans, so :func:`match_stamps` is the one place where a relation end is
@@ -75,11 +77,14 @@ REPEAT_POLICIES: tuple[RepeatPolicy, ...] = ("drop", "keep")
 _REPEATS_NOTE = "# albot1: relations_repeats="
 
 
-def read_relations(path: str | Path, *, warn_repeats: bool = True, repeats: RepeatPolicy = "drop") -> Relations:
+def read_relations(
+    path: str | Path, *, warn_repeats: bool = True, repeats: RepeatPolicy = "drop", empty_ok: bool = False
+) -> Relations:
     """Parse a relations file; ParseError naming ``file:line`` on any malformed line.
 
     Identical repeated lines are left out (``repeats="drop"``) or kept as listed (``"keep"``); see the
-    module docstring.
+    module docstring. A file without a relation is a ParseError unless ``empty_ok`` (a copy this project
+    wrote of an empty relation set).
 
     ``warn_repeats=False`` for a copy this project wrote (a run folder's
     ``relations.txt``): its repeats were reported when the dataset's own file
@@ -126,6 +131,10 @@ def read_relations(path: str | Path, *, warn_repeats: bool = True, repeats: Repe
         else:
             seen[pair] = (number, values)
         rows.append(values)
+    if not rows and not repeated and not empty_ok:
+        lines = text.splitlines()
+        found = "the file is empty" if not lines else f"its {len(lines)} line(s) are all blank or '#' comments"
+        raise ParseError(p, f"no relation: {found}; expected one relation per line ({_FIELDS})")
     if repeated and warn_repeats:
         log.warning(
             "%s: %d relation line(s) repeat an earlier line identically; %s: line %s",

@@ -104,10 +104,19 @@ def as_stored(timestamps: NDArray[np.float64], poses: NDArray[np.float64]) -> ND
     numbers digit for digit, even where a metric compares travelled
     distance with a threshold (RPE pairs every metre).
     """
+    return _planar(_stored_rows(timestamps, poses))
+
+
+def stamps_as_stored(timestamps: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``timestamps`` exactly as a TUM file of this module stores them (9 decimals): a run's ``trajectory.tum``."""
+    return _stored_rows(timestamps, np.zeros((len(timestamps), 3)))[:, 0]
+
+
+def _stored_rows(timestamps: NDArray[np.float64], poses: NDArray[np.float64]) -> NDArray[np.float64]:
     buffer = io.StringIO()
     write_tum(buffer, timestamps, poses)
     buffer.seek(0)
-    return _planar(np.loadtxt(buffer, ndmin=2, comments="#", dtype=float).reshape(-1, 8))
+    return np.loadtxt(buffer, ndmin=2, comments="#", dtype=float).reshape(-1, 8)
 
 
 def _rows(path: Path, columns: int, expected: str) -> NDArray[np.float64]:
@@ -286,8 +295,12 @@ def guess_format(path: Path) -> TrajectoryFormat:
     )
 
 
-def read_trajectory(path: str | Path, format_name: str | None = None) -> PoseFile:
-    """Read a trajectory file in ``format_name`` (guessed from the file when None)."""
+def read_trajectory(path: str | Path, format_name: str | None = None, *, repeated_stamps: bool = False) -> PoseFile:
+    """Read a trajectory file in ``format_name`` (guessed from the file when None).
+
+    Two poses with one timestamp are refused (:func:`refuse_repeated_stamps`) unless ``repeated_stamps``:
+    a caller that pairs the poses by line, not by time, checks them itself.
+    """
     file = Path(path)
     if file.is_dir():
         raise DataError(f"{file}: is a folder; expected a trajectory file ({' | '.join(TRAJECTORY_FORMATS)})")
@@ -301,22 +314,33 @@ def read_trajectory(path: str | Path, format_name: str | None = None) -> PoseFil
     if fmt == "kitti":
         return PoseFile(file, fmt, read_kitti(file), None)
     stamps, poses = read_tum(file) if fmt == "tum" else read_carmen_poses(file)
-    _refuse_duplicate_stamps(file, stamps, by_line=fmt == "tum")
-    return PoseFile(file, fmt, poses, stamps)
+    pose_file = PoseFile(file, fmt, poses, stamps)
+    if not repeated_stamps:
+        refuse_repeated_stamps(pose_file)
+    return pose_file
 
 
-def _refuse_duplicate_stamps(path: Path, stamps: NDArray[np.float64], *, by_line: bool) -> None:
-    """ParseError naming both places of the first timestamp that two poses share.
+def has_repeated_stamps(stamps: NDArray[np.float64] | None) -> bool:
+    """Whether two of ``stamps`` are equal (None, a file without timestamps: no)."""
+    return stamps is not None and len(np.unique(stamps)) < len(stamps)
 
-    Which of two poses at one time is meant cannot be told, and scoring
-    either silently can be far off; the file must be fixed.
+
+def refuse_repeated_stamps(file: PoseFile) -> None:
+    """ParseError naming both places of the first timestamp that two poses of ``file`` share.
+
+    Matched by time, which of two poses at one time is meant cannot be
+    told, and scoring either silently can be far off; the file must be fixed.
     """
+    stamps = file.timestamps
+    if stamps is None:
+        return
+    path = file.path
     order = np.argsort(stamps, kind="stable")
     same = np.flatnonzero(np.diff(stamps[order]) == 0)
     if not len(same):
         return
     first, second = sorted((int(order[same[0]]), int(order[same[0] + 1])))
-    if by_line:
+    if file.format == "tum":
         first_line, second_line = _line_of(path, first), _line_of(path, second)
         raise ParseError(
             path,

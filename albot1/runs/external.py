@@ -12,7 +12,13 @@ against:
   out is counted in the ``trajectory`` block of ``metrics.json`` and by
   the CLI, never dropped silently;
 * **by order** (KITTI, no timestamps): the file must hold exactly one pose
-  per scan of the dataset (``NAME[:N]`` selects a prefix).
+  per scan of the dataset (``NAME[:N]`` selects a prefix);
+* **by line**, when the file's timestamps are the scans' own, line for line,
+  and some repeat (:func:`paired_by_line`): a run's ``trajectory.tum`` on a
+  log whose scans share a stamp (the corrected Radish logs stamp every scan
+  0). Two poses at one time cannot be told apart by time, so any other file
+  with a repeated timestamp is refused; this one pairs as the run itself
+  scored it, scan by scan.
 
 The relation metric needs only times, so it looks relations up in every
 pose of the file (matched or not). Map shape, update counts and cost need
@@ -35,7 +41,14 @@ from albot1 import versions
 from albot1.data.model import Relations, Sequence
 from albot1.data.open import open_sequence
 from albot1.data.relations import match_stamps, read_relations, write_relations
-from albot1.data.trajectory import PoseFile, as_stored, read_trajectory
+from albot1.data.trajectory import (
+    PoseFile,
+    as_stored,
+    has_repeated_stamps,
+    read_trajectory,
+    refuse_repeated_stamps,
+    stamps_as_stored,
+)
 from albot1.runs.errors import RunError
 from albot1.runs.folder import EXTERNAL_PRESET
 from albot1.runs.scored import Scored
@@ -80,6 +93,20 @@ def match_by_time(pose_times: NDArray[np.float64], scan_times: NDArray[np.float6
     )
 
 
+def paired_by_line(stamps: NDArray[np.float64] | None, other: NDArray[np.float64] | None) -> bool:
+    """Whether poses stamped ``stamps`` pair with those stamped ``other`` line by line rather than by time.
+
+    So they do when both hold the same timestamps in the same order and some
+    repeat: the TUM files a run writes for a log whose scans share a stamp,
+    which the run scored scan by scan. Matched by time, two poses at one
+    time could not be told apart. Stamps that never repeat pair by time, as
+    any file does (a time offset shifts one side, so its lines then differ).
+    """
+    return (
+        stamps is not None and other is not None and has_repeated_stamps(other) and bool(np.array_equal(stamps, other))
+    )
+
+
 def load_external(
     path: Path,
     dataset: str,
@@ -96,7 +123,7 @@ def load_external(
     ``wrap`` may wrap the opened dataset before its one decoding pass (the CLI's progress bar);
     ``time_offset_s`` is added to the file's timestamps before matching (evo's ``--t_offset``).
     """
-    file = read_trajectory(path, format_name)
+    file = read_trajectory(path, format_name, repeated_stamps=True)
     if time_offset_s and file.timestamps is None:
         raise RunError(f"{file.path}: --time-offset needs timestamps; a {file.format} file has none")
     if time_offset_s and file.timestamps is not None:
@@ -112,7 +139,12 @@ def load_external(
     scan_times, reference = arrays.timestamps, arrays.reference
     if reference is not None:
         reference = as_stored(scan_times, reference)  # as a run folder's reference.tum holds it
-    if file.timestamps is None:
+    stamps = file.timestamps
+    if stamps is not None and has_repeated_stamps(stamps) and paired_by_line(stamps, stamps_as_stored(scan_times)):
+        dt = None
+        matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
+        pose_times = stamps
+    elif file.timestamps is None:
         if len(file.poses) != len(scan_times):
             raise RunError(
                 f"{file.path}: {len(file.poses)} poses without timestamps ({file.format}), but dataset {dataset!r} "
@@ -122,6 +154,7 @@ def load_external(
         matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
         pose_times = scan_times
     else:
+        refuse_repeated_stamps(file)
         dt = MAX_DT_S if max_dt_s is None else max_dt_s
         matching = match_by_time(file.timestamps, scan_times, dt)
         pose_times = file.timestamps
@@ -192,4 +225,4 @@ def _as_stored(relations: Relations | None) -> Relations | None:
     with tempfile.TemporaryDirectory(prefix="albot1-relations-") as folder:
         path = Path(folder) / "relations.txt"
         write_relations(path, relations)
-        return read_relations(path)
+        return read_relations(path, empty_ok=True)

@@ -11,7 +11,14 @@ Like ``evo_ape``/``evo_rpe``, no dataset is needed: the reference file
   dataset). Estimate poses left out and reference poses without an estimate
   are counted in the ``trajectory`` block and by the CLI. Without
   timestamps on either side (KITTI), the two files must hold as many poses,
-  matched in order, and a time offset does not apply.
+  matched in order, and a time offset does not apply. Two poses of one
+  file with one timestamp cannot be told apart by time and are refused,
+  except where both files hold the very same timestamps line for line: the
+  ``trajectory.tum`` and ``reference.tum`` of one run on a log whose scans
+  share stamps (the corrected Radish logs stamp every scan 0). Those pair
+  in order, one line with the same line of the other, as the run's own
+  scoring pairs them scan by scan (``max_dt_s`` null, as for KITTI;
+  :func:`albot1.runs.external.paired_by_line`, the rule of scoring against a dataset).
 * **Alignment** of the ATE (:func:`parse_alignment`): ``se2`` (rigid, the
   default; evo's ``--align`` without scale), ``origin`` (evo's
   ``--align_origin``), ``first:N`` (rigid, estimated on the first N pairs;
@@ -33,9 +40,9 @@ from pathlib import Path
 import numpy as np
 
 from albot1 import versions
-from albot1.data.trajectory import PoseFile, read_trajectory
+from albot1.data.trajectory import PoseFile, read_trajectory, refuse_repeated_stamps
 from albot1.runs.errors import RunError
-from albot1.runs.external import MAX_DT_S, NO_COUNTERS, NO_MAP, NO_TIMING, Matching, match_by_time
+from albot1.runs.external import MAX_DT_S, NO_COUNTERS, NO_MAP, NO_TIMING, Matching, match_by_time, paired_by_line
 from albot1.runs.folder import EXTERNAL_PRESET
 from albot1.runs.scored import Scored
 
@@ -99,12 +106,20 @@ def load_pair(
     offset = check_time_offset(time_offset_s)
     if max_dt_s is not None and not (math.isfinite(max_dt_s) and max_dt_s > 0):
         raise RunError(f"--max-dt is {max_dt_s} s; expected a positive number of seconds")
-    est = read_trajectory(estimate, format_name)
-    ref = read_trajectory(reference, reference_format)
+    est = read_trajectory(estimate, format_name, repeated_stamps=True)
+    ref = read_trajectory(reference, reference_format, repeated_stamps=True)
     for file, role in ((est, "trajectory"), (ref, "reference")):
         if not len(file.poses):
             raise RunError(f"{file.path}: the {role} holds no poses")
-    if est.timestamps is None or ref.timestamps is None:
+    if (
+        ref.timestamps is not None
+        and est.timestamps is not None
+        and paired_by_line(est.timestamps + offset, ref.timestamps)
+    ):
+        dt = None
+        matching = Matching(np.arange(len(ref.poses)), np.arange(len(ref.poses)), 0, 0)
+        est_times = ref_times = ref.timestamps
+    elif est.timestamps is None or ref.timestamps is None:
         if offset:
             raise RunError("--time-offset needs timestamps in both files; a KITTI file has none")
         if len(est.poses) != len(ref.poses):
@@ -116,6 +131,8 @@ def load_pair(
         matching = Matching(np.arange(len(ref.poses)), np.arange(len(ref.poses)), 0, 0)
         est_times = ref_times = np.arange(len(ref.poses), dtype=float)
     else:
+        refuse_repeated_stamps(est)
+        refuse_repeated_stamps(ref)
         dt = MAX_DT_S if max_dt_s is None else max_dt_s
         est_times, ref_times = est.timestamps + offset, ref.timestamps
         matching = match_by_time(est_times, ref_times, dt)

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
+import psutil
 import pytest
 from typer.testing import CliRunner
 
@@ -205,3 +208,66 @@ def test_a_suite_with_no_cell_to_run_exits_1_and_its_report_says_so(tmp_path: Pa
     assert report.returncode == 0, report.stderr
     text = (tmp_path / "report" / "README.md").read_text()
     assert "Cells: 0 planned" in text and "`aces`: not downloaded" in text
+
+
+#: A grid of one Albot1 cell: its forkserver compiles Albot1's kernels before it forks it (cold: tens of seconds).
+ONE_ALBOT1_CELL = (
+    "[limits]\ntime_s = 300\nmemory_mb = 3072\n\n[grid]\ndegradations = []\nseeds = [0]\n\n"
+    '[[methods]]\nname = "albot1"\n\n[[datasets]]\nname = "synthetic-office-startstop[:5]"\n'
+)
+
+
+def _compile_helpers(runner: psutil.Process) -> tuple[psutil.Process | None, list[psutil.Process]]:
+    """The runner's forkserver and the compile helpers it has forked (none yet: an empty list).
+
+    A helper is a fork of the server (its command line); the server's other children (``git``) are not.
+    """
+    for child in runner.children():
+        try:
+            command = child.cmdline()
+            if "forkserver" in " ".join(command):
+                return child, [c for c in child.children() if c.cmdline() == command]
+        except psutil.Error:
+            continue
+    return None, []
+
+
+@pytest.mark.slow
+def test_ctrl_c_during_the_forkservers_cold_warm_up_prints_only_the_interrupted_line(tmp_path: Path) -> None:
+    """Ctrl-C reaches the whole process group: the forkserver and its compile helpers end without a traceback."""
+    suite = tmp_path / "one.toml"
+    suite.write_text(ONE_ALBOT1_CELL)
+    cache = tmp_path / "cache"  # numba's cache lives under the user cache folder (methods/albot1/compiled.py): cold
+    cache.mkdir()
+    env = dict(os.environ, XDG_CACHE_HOME=str(cache), ALBOT1_COMPILE_PROCESSES="2")
+    env.pop("NUMBA_DISABLE_JIT", None)
+    runner = subprocess.Popen(
+        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+        + ["--results", str(tmp_path / "results"), "--no-progress"],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # a process group of its own, as a terminal's foreground job
+    )
+    try:
+        server, helpers = None, []
+        deadline = time.monotonic() + 120
+        while not helpers and runner.poll() is None and time.monotonic() < deadline:
+            server, helpers = _compile_helpers(psutil.Process(runner.pid))
+            time.sleep(0.05)
+        assert server is not None and helpers, "the forkserver started no compile helper (was numba's cache warm?)"
+        os.killpg(runner.pid, signal.SIGINT)  # what Ctrl-C does
+        _, stderr = runner.communicate(timeout=120)
+    finally:
+        if runner.poll() is None:
+            os.killpg(runner.pid, signal.SIGKILL)
+            runner.wait()
+    assert runner.returncode == 130, stderr
+    assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
+    assert stderr.splitlines() == [
+        "albot1: interrupted; completed cells are kept, run the same command again to resume"
+    ], stderr
+    _, alive = psutil.wait_procs([server, *helpers], timeout=30)
+    assert alive == [], f"the forkserver or its compile helpers went on after Ctrl-C: {alive}"

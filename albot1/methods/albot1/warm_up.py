@@ -27,6 +27,7 @@ import inspect
 import math
 import multiprocessing
 import os
+import signal
 import tempfile
 import threading
 import time
@@ -146,6 +147,20 @@ def compile_claimed(claims: str, kernel_sets: list[str], names: list[str]) -> No
     _compile(Path(claims), list(sample_calls(*sets)), names)
 
 
+def helper_main(claims: str, kernel_sets: list[str], names: list[str]) -> None:
+    """A helper process's entry: :func:`compile_claimed`, ended by Ctrl-C at once and silently.
+
+    Ctrl-C reaches the whole process group, the helpers too: a
+    KeyboardInterrupt in a helper made multiprocessing print its traceback
+    above the clean line of the process that started it, which is
+    interrupted too and says so. SIGINT's default action ends the helper
+    without a word; whatever it did not compile, the process that started
+    it compiles itself (or, interrupted, no longer needs).
+    """
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    compile_claimed(claims, kernel_sets, names)
+
+
 #: Kernels that share dear callees with another: claimed right after it, by the same process, when they are cold.
 #: ``measurement_costs`` calls ``pose_cost``, ``nearest_surface`` and ``huber_cost`` as ``refine_pose`` does: about
 #: 0.7 CPU s compiled once instead of once in each of two processes. A fused kernel (:mod:`.mapping.step_kernels`)
@@ -182,7 +197,7 @@ def _helpers(claims: Path, kernel_sets: tuple[object, ...], names: list[str]) ->
     context = multiprocessing.get_context("fork") if forking else multiprocessing.get_context("spawn")
     specs = [f"{type(k).__module__}:{type(k).__qualname__}" for k in kernel_sets]
     helpers: list[BaseProcess] = [
-        context.Process(target=compile_claimed, args=(str(claims), specs, names), daemon=True) for _ in range(count)
+        context.Process(target=helper_main, args=(str(claims), specs, names), daemon=True) for _ in range(count)
     ]
     before = sum(1 for _ in claims.iterdir())
     for helper in helpers:

@@ -29,9 +29,23 @@ def test_round_trip(tmp_path: Path) -> None:
     assert not list(tmp_path.glob(".*tmp"))
 
 
-def test_empty_file_is_zero_relations(tmp_path: Path) -> None:
-    (tmp_path / "e.txt").write_text("")
-    assert len(read_relations(tmp_path / "e.txt")) == 0
+def test_an_empty_copy_this_project_wrote_is_zero_relations(tmp_path: Path) -> None:
+    write_relations(tmp_path / "e.txt", Relations(np.zeros(0), np.zeros(0), np.zeros((0, 3))))
+    assert len(read_relations(tmp_path / "e.txt", empty_ok=True)) == 0
+
+
+@pytest.mark.parametrize(
+    ("text", "found"),
+    [("", "the file is empty"), ("# relations\n\n   \n", "its 3 line(s) are all blank or '#' comments")],
+)
+def test_a_relations_file_without_a_relation_is_refused_in_one_line(tmp_path: Path, text: str, found: str) -> None:
+    path = tmp_path / "e.relations"
+    path.write_text(text)
+    with pytest.raises(ParseError) as refused:
+        read_relations(path)
+    assert str(refused.value) == (
+        f"{path}: no relation: {found}; expected one relation per line (t1 t2 x y z roll pitch yaw)"
+    )
 
 
 @pytest.mark.parametrize(

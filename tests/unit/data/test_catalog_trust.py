@@ -190,6 +190,35 @@ def test_the_catalog_listing_names_a_wrong_copy(tmp_path: Path) -> None:
     assert SHA in problem
 
 
+CATALOG_RELATIONS = b"1.0 2.0 0.5 0 0 0 0 0\n1.0 2.0 0.5 0 0 0 0 0\n"  # a repeated line: reading it warns
+
+
+def test_a_relations_option_replaces_the_catalogs_file_unread(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """``NAME?relations=FILE`` reads FILE only: the catalog's own file is not read, warned about nor in the key."""
+    toml = manifest(tmp_path)
+    toml.write_text(
+        toml.read_text() + f'\n[[files]]\nrole = "relations"\npath = "radish/tiny.relations"\n'
+        f'sha256 = "{hashlib.sha256(CATALOG_RELATIONS).hexdigest()}"\nurls = ["http://127.0.0.1:9/r"]\n'
+    )
+    put(tmp_path / "data", PAYLOAD)
+    (tmp_path / "data" / "radish" / "tiny.relations").write_bytes(CATALOG_RELATIONS)
+    own = tmp_path / "own.relations"
+    own.write_text("1.0 3.0 0.25 0 0 0 0 0\n")
+    settings = Settings(tmp_path / "data", tmp_path / "cache")
+    assert len(open_sequence("tiny", settings=settings).relations or ()) == 1  # the catalog's, its repeat said
+    assert "repeat an earlier line" in caplog.text
+    caplog.clear()
+    sequence = open_sequence(f"tiny?relations={own}", settings=settings)
+    assert sequence.relations is not None and sequence.relations.t2.tolist() == [3.0]
+    assert sequence.metadata.checksums == {
+        "tiny.clf": SHA,
+        "own.relations": hashlib.sha256(own.read_bytes()).hexdigest(),
+    }
+    assert caplog.text == ""
+    (tmp_path / "data" / "radish" / "tiny.relations").unlink()  # not even looked for
+    assert open_sequence(f"tiny?relations={own}", settings=settings).relations is not None
+
+
 @pytest.mark.timeout(30)
 @pytest.mark.parametrize("special", ["fifo", "/dev/zero", "folder"])
 def test_a_relations_option_naming_a_special_file_is_refused_before_reading(tmp_path: Path, special: str) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -316,3 +317,22 @@ print(json.dumps({"cache": sorted(str(p) for p in compiled.CACHE_DIR.rglob("*"))
 def test_numba_s_set_up_before_the_fork_writes_nothing_to_the_kernel_cache(tmp_path: Path) -> None:
     """The throw-away function that pays numba's set-up is not a kernel: no cache entry, nothing to invalidate."""
     assert json.loads(_python(_SET_UP, str(tmp_path))) == {"cache": True}
+
+
+_INTERRUPTED_HELPER = """
+import os, signal, time
+from albot1.methods.albot1 import warm_up
+def compiling(*args):
+    os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C in the middle of a compile
+    time.sleep(30)
+warm_up.compile_claimed = compiling
+warm_up.helper_main("claims", [], [])
+"""
+
+
+def test_ctrl_c_ends_a_compile_helper_at_once_and_silently(tmp_path: Path) -> None:
+    """Ctrl-C reaches the helpers too: a KeyboardInterrupt's traceback (multiprocessing prints it) must not appear."""
+    done = subprocess.run(
+        [sys.executable, "-c", _INTERRUPTED_HELPER], capture_output=True, text=True, timeout=120, cwd=tmp_path
+    )
+    assert (done.returncode, done.stdout, done.stderr) == (-signal.SIGINT, "", "")
