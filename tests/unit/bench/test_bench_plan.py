@@ -11,7 +11,7 @@ from albot1.bench.errors import SuiteError
 from albot1.bench.grid import GridPlan
 from albot1.bench.plan import plan_suite
 from albot1.bench.suite import load_suite
-from albot1.methods.registry import MethodRegistry, method_registry
+from albot1.methods.registry import MethodRegistry, MethodSpec, method_registry
 from albot1.settings import Settings
 
 WORLD = "synthetic-office-startstop"
@@ -92,10 +92,10 @@ def test_a_bad_slice_is_an_error_of_the_suite(tmp_path: Path) -> None:
         _plan(tmp_path, f'[[datasets]]\nname = "{WORLD}[:0]"\n')
 
 
-def _methods_plan(tmp_path: Path, methods: str) -> GridPlan:
+def _methods_plan(tmp_path: Path, methods: str, registry: MethodRegistry | None = None) -> GridPlan:
     path = tmp_path / "two.toml"
     path.write_text(f'{methods}\n[[datasets]]\nname = "{WORLD}"\n')
-    return plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    return plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"), registry)
 
 
 def test_cells_that_differ_only_in_their_limits_are_an_error_not_one_folder(tmp_path: Path) -> None:
@@ -115,3 +115,53 @@ def test_two_labels_for_the_same_run_with_the_same_limits_share_one_folder(tmp_p
     plan = _methods_plan(tmp_path, '[[methods]]\nname = "odometry"\n[[methods]]\nname = "odometry"\nlabel = "dr"\n')
     assert [c.method_label for c in plan.cells] == ["odometry", "dr"]
     assert len({c.key for c in plan.cells}) == 1
+
+
+@pytest.mark.parametrize(
+    "method", ["odometry", "albot1", "albot1-places", "kiss-icp", "gtsam-graph", "mrpt-icp", "mrpt-rbpf"]
+)
+def test_an_unknown_preset_is_an_error_of_the_suite_naming_file_entry_and_preset(tmp_path: Path, method: str) -> None:
+    """Every cell of the entry would fail the same way: planning (and so `--dry-run`) refuses it with one line."""
+    if not method_registry().get(method).available():
+        pytest.skip(f"{method} is not installed here")
+    with pytest.raises(SuiteError) as caught:
+        _methods_plan(tmp_path, f'[[methods]]\nname = "odometry"\n[[methods]]\nname = "{method}"\npreset = "nosuch"\n')
+    assert str(caught.value).startswith(
+        f"{tmp_path / 'two.toml'}: invalid suite: methods.1 ('{method}:nosuch'): method '{method}' has no preset "
+        "'nosuch'; expected one of: default"
+    )
+    assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    "method", ["odometry", "albot1", "albot1-places", "kiss-icp", "gtsam-graph", "mrpt-icp", "mrpt-rbpf"]
+)
+def test_an_unknown_override_key_is_an_error_of_the_suite_naming_file_entry_and_key(
+    tmp_path: Path, method: str
+) -> None:
+    if not method_registry().get(method).available():
+        pytest.skip(f"{method} is not installed here")
+    with pytest.raises(SuiteError) as caught:
+        _methods_plan(tmp_path, f'[[methods]]\nname = "{method}"\nlabel = "mine"\nset = {{ nosuch_field = 1 }}\n')
+    assert str(caught.value) == (
+        f"{tmp_path / 'two.toml'}: invalid suite: methods.0 ('mine'): invalid config for method '{method}' "
+        "(preset 'default'): nosuch_field: Extra inputs are not permitted (from set)"
+    )
+
+
+def test_an_override_value_the_method_rejects_is_an_error_of_the_suite(tmp_path: Path) -> None:
+    with pytest.raises(SuiteError) as caught:
+        _methods_plan(tmp_path, '[[methods]]\nname = "odometry"\nset = { map_voxel_m = -1 }\n')
+    assert str(caught.value).startswith(
+        f"{tmp_path / 'two.toml'}: invalid suite: methods.0 ('odometry'): invalid config for method 'odometry' "
+        "(preset 'default'): map_voxel_m: Input should be greater than 0 (from set)"
+    )
+
+
+def test_a_method_whose_class_does_not_load_is_a_failed_cell_not_a_suite_error(tmp_path: Path) -> None:
+    """A broken method is the method's fault: its cells are planned and recorded as failed with the reason."""
+    broken = method_registry().with_methods(MethodSpec("broken", "no_such_module_here:Mapper"))
+    plan = _methods_plan(tmp_path, '[[methods]]\nname = "broken"\npreset = "nosuch"\n', broken)
+    assert [c.method for c in plan.cells] == ["broken"]
+    reason = plan.config_failures[plan.cells[0].key]
+    assert reason.startswith("cannot load method 'broken': TargetError: no_such_module_here:Mapper: the module")
