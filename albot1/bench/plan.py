@@ -28,7 +28,7 @@ from albot1.config.suggest import unknown_name_message
 from albot1.data import catalog
 from albot1.data.degrade import parse_spec
 from albot1.data.errors import DatasetNotFoundError
-from albot1.data.open import open_sequence
+from albot1.data.open import open_sequence, split_slice
 from albot1.data.synthetic import worlds
 from albot1.errors import Albot1Error, ConfigError
 from albot1.methods.plugins import ENTRY_POINT_GROUP
@@ -159,7 +159,8 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
     literal suite entry that is an error unless the entry is ``optional``.
     A registered dataset that is merely not downloaded is known.
     """
-    base = name.partition("?")[0]  # a reference with loader options needs its catalog file all the same
+    # A sliced reference, or one with loader options, needs its catalog files all the same.
+    base = split_slice(name)[0].partition("?")[0]
     if base in catalog.names():
         try:
             catalog.locate(base, settings)

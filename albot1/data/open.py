@@ -63,10 +63,9 @@ def open_sequence(
     text = str(ref)
     # "NAME[:STOP]" / "NAME[:STOP:STEP]" / "NAME[::STEP]": the first STOP scans, every STEP-th of them
     # (the benchmark suites name their slices of long logs this way, so a run's dataset reopens as run).
-    sliced = re.fullmatch(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]", text)
-    if sliced is not None and not _exists(text):
-        stop, step = parse_slice(sliced["body"], text)
-        sequence = open_sequence(sliced["ref"], settings=settings, format_name=format_name, **options)
+    base, stop, step = split_slice(text)
+    if base != text:
+        sequence = open_sequence(base, settings=settings, format_name=format_name, **options)
         if stop is not None:
             sequence = head(sequence, stop)
         if step is not None:
@@ -163,6 +162,36 @@ def _exists(text: str) -> bool:
         return Path(text).expanduser().exists()
     except (OSError, ValueError):
         return False
+
+
+#: ``REF[BODY]``: a reference followed by a slice (unless the whole text names an existing path).
+_SLICED = re.compile(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]")
+
+
+def split_slice(ref: str) -> tuple[str, int | None, int | None]:
+    """``"intel[:300][::2]"`` -> ``("intel", 300, 2)``: the reference under its trailing slices, and the STOP
+    and STEP of the one slice they select together (None = not given).
+
+    The one reading of a reference's slices: :func:`open_sequence` opens the reference under them and keeps
+    those scans, and the bench finds a sliced dataset's catalog entry by it (``intel[:50]`` of a log that is
+    not downloaded is skipped like ``intel``). A text that names an existing path is not sliced. Slices
+    apply left to right: a later ``[:B:T]`` keeps the first B of what the earlier ``[:A:S]`` kept (the first
+    ``min(A, B*S)`` scans of the log) and every T-th of those (every ``S*T``-th scan of the log). SliceError
+    for a slice :func:`parse_slice` refuses.
+    """
+    slices: list[tuple[str, str]] = []  # (body, the reference it ends), outermost first
+    text = ref
+    while (sliced := _SLICED.fullmatch(text)) is not None and not _exists(text):
+        slices.append((sliced["body"], text))
+        text = sliced["ref"]
+    stop: int | None = None
+    step = 1
+    for body, whole in reversed(slices):
+        outer_stop, outer_step = parse_slice(body, whole)
+        if outer_stop is not None:
+            stop = outer_stop * step if stop is None else min(stop, outer_stop * step)
+        step *= outer_step or 1
+    return text, stop, step if step != 1 else None
 
 
 def parse_slice(body: str, ref: str) -> tuple[int | None, int | None]:

@@ -45,6 +45,27 @@ def test_a_registered_dataset_not_downloaded_is_skipped_not_an_error(tmp_path: P
     assert [s.name for s in plan.skipped_datasets] == ["aces"]
 
 
+@pytest.mark.parametrize(
+    "entry",
+    [
+        'name = "intel[:50]"',
+        'name = "intel[:50:2]"',
+        'name = "intel[::3]"',
+        'name = "intel[:100][:50]"',
+        'name = "intel-corrected?odometry=laser-pose[::3]"',
+        'name = "intel"\nlimit = 50',
+    ],
+)
+def test_a_sliced_dataset_not_downloaded_is_skipped_like_the_whole_one(tmp_path: Path, entry: str) -> None:
+    """A slice names part of a registered log: absent, it is skipped with the fetch command, not a suite error."""
+    _, plan = _plan(tmp_path, f"[[datasets]]\n{entry}\n")
+    [skipped] = plan.skipped_datasets
+    base = "intel-corrected" if "corrected" in entry else "intel"
+    assert skipped.name == entry.split('"')[1] and skipped.hint == f"albot1 datasets fetch {base}"
+    assert skipped.reason.startswith(f"not downloaded: dataset '{base}': ")
+    assert {c.dataset for c in plan.cells} == {WORLD}
+
+
 def test_deterministic_degradations_run_once_and_random_ones_once_per_seed(tmp_path: Path) -> None:
     grid = (
         '[grid]\ndegradations = ["thesis", "bias:0.01:0.1", "gauss:0.1:1"]\n'
