@@ -86,13 +86,16 @@ from pydantic_core import PydanticCustomError
 from albot1.bench.errors import SuiteError
 from albot1.config.validation import describe_errors
 from albot1.data.degrade import MAX_SEED, DegradationSpecError, parse_spec
+from albot1.data.errors import SliceError
+from albot1.data.open import canonical_reference, slice_reference
 from albot1.resources import list_resources, resource_dirs
 
 # "?" is not a glob character here: in a dataset reference it introduces loader options
 # (``intel-corrected?odometry=laser-pose``, see albot1.data.open), so such an entry is a literal.
 GLOB_CHARS = frozenset("*[")
-#: A trailing ``[:STOP]`` / ``[:STOP:STEP]`` / ``[::STEP]`` is a slice of a dataset reference, not a glob class.
-_TRAILING_SLICE = re.compile(r"\[:[^\[\]]*\]$")
+#: A trailing ``[:STOP]`` / ``[:STOP:STEP]`` / ``[::STEP]`` (or ``[0:STOP]``) is a slice of a dataset reference,
+#: not a glob class.
+_TRAILING_SLICE = re.compile(r"\[\d*:[^\[\]]*\]$")
 #: Upper bounds of the per-cell limits: beyond them a value is a typo, and a timer or a byte count would overflow.
 MAX_TIME_S = 7 * 24 * 3600.0
 MAX_MEMORY_MB = 1024.0 * 1024.0
@@ -292,10 +295,17 @@ class DatasetOptions(_Strict):
 
     @property
     def label(self) -> str:
-        """Name plus the slice actually used, e.g. ``intel[:4000:2]``: it is part of the run's identity."""
-        if self.limit is None and self.stride is None:
-            return self.name
-        return f"{self.name}[:{self.limit or ''}{f':{self.stride}' if self.stride else ''}]"
+        """Name plus the slice actually used, e.g. ``intel[:4000:2]``: it is part of the run's identity.
+
+        In the one spelling of :func:`~albot1.data.open.canonical_reference`, so that ``intel[:300]``,
+        ``intel[:300:1]``, ``intel[0:300]`` and ``intel`` with ``limit = 300`` name one run key and one run
+        folder (each spelling used to compute the same cells again under a key of its own).
+        """
+        text = self.name + slice_reference("", self.limit, self.stride)
+        try:
+            return canonical_reference(text)
+        except SliceError:  # a slice its dataset refuses: planning stops on it before any cell is labelled
+            return text
 
 
 class Suite(_Strict):

@@ -194,17 +194,42 @@ def split_slice(ref: str) -> tuple[str, int | None, int | None]:
     return text, stop, step if step != 1 else None
 
 
+def slice_reference(ref: str, stop: int | None, step: int | None) -> str:
+    """The one spelling of ``ref`` sliced: ``intel[:300]``, ``intel[::2]``, ``intel[:300:2]``, or ``ref`` itself
+    for every scan (no STOP, STEP 1).
+
+    A slice names part of a run's identity (the bench's run key and run folder), so every spelling of the
+    same scans (``intel[:300:1]``, ``intel[0:300]``, ``intel[:0300]``, ``intel[:600][:300]``, ``intel`` with
+    ``limit = 300``) is written this one way: :func:`canonical_reference`.
+    """
+    step = None if step == 1 else step
+    if stop is None and step is None:
+        return ref
+    return f"{ref}[:{'' if stop is None else stop}{'' if step is None else f':{step}'}]"
+
+
+def canonical_reference(ref: str) -> str:
+    """``ref`` with its trailing slices in their one spelling (:func:`split_slice`, :func:`slice_reference`)."""
+    return slice_reference(*split_slice(ref))
+
+
 def parse_slice(body: str, ref: str) -> tuple[int | None, int | None]:
     """``":100:5"`` -> ``(100, 5)``: the STOP and STEP of a reference's ``[:STOP:STEP]`` (None = not given).
 
     Only prefixes and strides exist (a run must reopen exactly the scans it
-    used); both must be positive integers. Anything else is a SliceError
-    naming the reference.
+    used); both must be positive integers. Python's ``[0:STOP]`` is
+    accepted as the same prefix (:func:`slice_reference` spells it
+    ``[:STOP]``). Anything else is a SliceError naming the reference.
     """
     forms = "[:STOP], [:STOP:STEP] or [::STEP] with positive integers (the first STOP scans, every STEP-th of them)"
-    found = re.fullmatch(r":(?P<stop>\d*)(?::(?P<step>\d*))?", body)
+    found = re.fullmatch(r"(?P<start>\d*):(?P<stop>\d*)(?::(?P<step>\d*))?", body)
     if found is None or len(body) > 40:
         raise SliceError(f"{ref!r}: slice [{body[:40]}] is not understood; expected {forms}")
+    if found["start"] and int(found["start"]) != 0:
+        raise SliceError(
+            f"{ref!r}: slice START is {int(found['start'])}, but only prefixes exist (a START, if given, is 0); "
+            f"expected {forms}"
+        )
     stop = int(found["stop"]) if found["stop"] else None
     step = int(found["step"]) if found["step"] else None
     for what, value in (("STOP", stop), ("STEP", step)):

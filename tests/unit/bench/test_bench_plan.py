@@ -108,6 +108,24 @@ def test_a_sliced_reference_is_a_dataset_of_its_own(tmp_path: Path) -> None:
     assert len({c.key for c in plan.cells}) == 3
 
 
+def test_spellings_of_one_slice_plan_one_run_key(tmp_path: Path) -> None:
+    """`[:5]`, `[:5:1]`, `[0:5]` and `limit = 5` are the same scans: one key, one run folder, computed once."""
+    _, plan = _plan(
+        tmp_path,
+        f'[[datasets]]\nname = "{WORLD}[:5]"\n[[datasets]]\nname = "{WORLD}[:5:1]"\n'
+        f'[[datasets]]\nname = "{WORLD}[0:5]"\n[[datasets]]\nname = "{WORLD}[:10][:5]"\n',
+    )
+    sliced = [c for c in plan.cells if c.dataset != WORLD]
+    assert len(sliced) == 4 and {c.dataset_label for c in sliced} == {f"{WORLD}[:5]"}
+    assert len({c.key for c in sliced}) == 1
+    [whole] = [c for c in plan.cells if c.dataset == WORLD]
+    assert whole.key != sliced[0].key
+    path = tmp_path / "limited.toml"
+    path.write_text(f'[[methods]]\nname = "odometry"\n[[datasets]]\nname = "{WORLD}"\nlimit = 5\nstride = 1\n')
+    by_limit = plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    assert [c.key for c in by_limit.cells] == [sliced[0].key]
+
+
 def test_a_bad_slice_is_an_error_of_the_suite(tmp_path: Path) -> None:
     with pytest.raises(SuiteError, match=rf"tiny\.toml: dataset '{WORLD}\[:0\]': .*slice STOP is 0"):
         _plan(tmp_path, f'[[datasets]]\nname = "{WORLD}[:0]"\n')

@@ -44,7 +44,7 @@ def test_later_entries_override_earlier_ones_field_by_field() -> None:
     intel = suite.options_for("intel-corrected")
     assert intel is not None
     assert (intel.limit, intel.stride, intel.time_s) == (100, 1, 30)
-    assert intel.label == "intel-corrected[:100:1]"
+    assert intel.label == "intel-corrected[:100]"  # a stride of 1 is no stride: one spelling, one run key
     other = suite.options_for("fr079")
     assert other is not None and other.label == "fr079[::2]"
     assert suite.options_for("aces") is None
@@ -217,6 +217,7 @@ def test_entry_limits_and_seeds_are_bounded_too() -> None:
         ("intel[:100:2]", False),
         ("intel[::2]", False),
         ("intel[:30][:20]", False),
+        ("intel[0:300]", False),
         ("intel-corrected?odometry=laser-pose[:100]", False),
         ("intel*", True),
         ("intel*[:100]", True),
@@ -345,3 +346,27 @@ def test_integers_stand_for_floats_and_arrays_for_lists(tmp_path: Path) -> None:
     assert isinstance(suite.limits.time_s, float) and suite.grid.seeds == (0, 1)
     assert suite.methods[0].time_s == 30.0 and suite.methods[0].datasets == ("a*",)
     assert suite.datasets[0].memory_mb == 100.0 and suite.datasets[0].tags == ("t",)
+
+
+@pytest.mark.parametrize(
+    ("entry", "label"),
+    [
+        ('name = "intel[:300]"', "intel[:300]"),
+        ('name = "intel[:300:1]"', "intel[:300]"),
+        ('name = "intel[0:300]"', "intel[:300]"),
+        ('name = "intel[:0300]"', "intel[:300]"),
+        ('name = "intel[:600][:300]"', "intel[:300]"),
+        ('name = "intel"\nlimit = 300', "intel[:300]"),
+        ('name = "intel"\nlimit = 300\nstride = 1', "intel[:300]"),
+        ('name = "intel[:600]"\nlimit = 300', "intel[:300]"),
+        ('name = "intel[::1]"', "intel"),
+        ('name = "intel[::3]"\nlimit = 100', "intel[:300:3]"),
+        ('name = "intel"\nlimit = 4000\nstride = 2', "intel[:4000:2]"),
+        ('name = "x-corrected?odometry=laser-pose[::3]"', "x-corrected?odometry=laser-pose[::3]"),
+    ],
+)
+def test_every_spelling_of_a_slice_is_labelled_one_way(tmp_path: Path, entry: str, label: str) -> None:
+    """The label is hashed into the run key: equal slices share one key, so their cells are computed once."""
+    suite = load_suite(write(tmp_path, f'[[methods]]\nname = "odometry"\n[[datasets]]\n{entry}\n'))
+    options = suite.options_for(suite.datasets[0].name)
+    assert options is not None and options.label == label

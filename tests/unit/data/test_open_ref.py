@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from albot1.data.errors import DatasetNotFoundError, SliceError
-from albot1.data.open import open_sequence, parse_options, split_slice
+from albot1.data.open import canonical_reference, open_sequence, parse_options, split_slice
 from albot1.data.transforms import head, stride
 
 
@@ -63,6 +63,7 @@ def test_corrected_log_with_clean_odometry(data_file) -> None:  # type: ignore[n
         ("synthetic-office-startstop[-5:]", r"slice \[-5:\] is not understood"),
         ("synthetic-office-startstop[:-5]", r"slice \[:-5\] is not understood"),
         ("synthetic-office-startstop[:" + "9" * 5000 + "]", r"is not understood"),
+        ("synthetic-office-startstop[5:10]", r"slice START is 5, but only prefixes exist \(a START, if given, is 0\)"),
     ],
 )
 def test_bad_slices_are_one_line_errors_naming_the_reference(ref: str, message: str) -> None:
@@ -107,6 +108,8 @@ def test_split_slice_selects_what_the_slices_select_one_after_another(
         ("intel[::2][:300]", ("intel", 600, 2)),
         ("intel-corrected?odometry=laser-pose[::3]", ("intel-corrected?odometry=laser-pose", None, 3)),
         ("a[b]c", ("a[b]c", None, None)),
+        ("intel[0:300]", ("intel", 300, None)),
+        ("intel[00::2]", ("intel", None, 2)),
     ],
 )
 def test_split_slice_examples(ref: str, expected: tuple[str, int | None, int | None]) -> None:
@@ -124,3 +127,40 @@ def test_nested_slices_open_the_scans_of_the_one_slice_they_make() -> None:
     nested = open_sequence("synthetic-office-startstop[::2][:7]")
     single = open_sequence("synthetic-office-startstop[:14:2]")
     assert len(nested) == len(single) == 7 and (nested.timestamps == single.timestamps).all()
+
+
+@pytest.mark.parametrize(
+    ("ref", "canonical"),
+    [
+        ("intel", "intel"),
+        ("intel[:]", "intel"),
+        ("intel[::1]", "intel"),
+        ("intel[:300]", "intel[:300]"),
+        ("intel[:300:1]", "intel[:300]"),
+        ("intel[0:300]", "intel[:300]"),
+        ("intel[:0300:]", "intel[:300]"),
+        ("intel[:600][:300]", "intel[:300]"),
+        ("intel[::2]", "intel[::2]"),
+        ("intel[:300:2]", "intel[:300:2]"),
+        ("intel[::2][:150]", "intel[:300:2]"),
+        ("intel-corrected?odometry=laser-pose[::3]", "intel-corrected?odometry=laser-pose[::3]"),
+    ],
+)
+def test_canonical_reference_spells_each_slice_one_way(ref: str, canonical: str) -> None:
+    assert canonical_reference(ref) == canonical
+
+
+@given(_SLICES)
+def test_the_canonical_spelling_is_a_fixed_point_that_selects_the_same_scans(
+    slices: list[tuple[int | None, int | None]],
+) -> None:
+    text = "world" + "".join(f"[:{stop or ''}{'' if step is None else f':{step}'}]" for stop, step in slices)
+    canonical = canonical_reference(text)
+    assert canonical_reference(canonical) == canonical
+    assert split_slice(canonical) == split_slice(text)
+
+
+def test_a_stop_or_step_beyond_any_log_is_every_scan_or_the_first_not_a_crash() -> None:
+    whole = open_sequence("synthetic-office-startstop").count_scans()
+    assert sum(1 for _ in open_sequence("synthetic-office-startstop[:" + "9" * 30 + "]").frames()) == whole
+    assert sum(1 for _ in open_sequence("synthetic-office-startstop[::" + "9" * 30 + "]").frames()) == 1
