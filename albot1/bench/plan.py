@@ -3,7 +3,9 @@
 Datasets that are not downloaded and methods whose libraries are missing are
 *skipped* with the command that fixes it, never failed: a fresh machine must
 still produce a complete report from the synthetic worlds. A method entry
-whose config does not resolve (a bad override, a plugin module that does not
+whose config does not resolve (a preset the method lacks, an override it
+rejects) is an error of the suite, raised before any cell runs (``--dry-run``
+included). A method whose class does not load (a plugin module that does not
 import) is not skipped: its cells are planned and recorded as failed with the
 reason, so the report shows the problem next to the results that did run.
 """
@@ -26,9 +28,9 @@ from albot1.config.suggest import unknown_name_message
 from albot1.data import catalog
 from albot1.data.degrade import parse_spec
 from albot1.data.errors import DatasetNotFoundError
-from albot1.data.open import open_sequence
+from albot1.data.open import open_sequence, split_slice
 from albot1.data.synthetic import worlds
-from albot1.errors import Albot1Error
+from albot1.errors import Albot1Error, ConfigError
 from albot1.methods.plugins import ENTRY_POINT_GROUP
 from albot1.methods.registry import MethodRegistry, method_registry, resolve_config
 from albot1.runs.folder import run_key
@@ -64,14 +66,31 @@ def cpu_model() -> str:
     return platform.processor() or platform.machine()
 
 
-def _resolve(entry: MethodEntry, registry: MethodRegistry) -> tuple[dict[str, Any] | None, str | None]:
-    """(resolved config as JSON, None) or (None, reason it does not resolve)."""
+def _resolve(suite: Suite, entry: MethodEntry, registry: MethodRegistry) -> tuple[dict[str, Any] | None, str | None]:
+    """(resolved config as JSON, None) or (None, reason the method's class does not load).
+
+    The config is resolved by :func:`~albot1.methods.registry.resolve_config`, the validation every run
+    does (:func:`albot1.runs.execute.run_method`). A preset the method does not have, an override it
+    rejects (an unknown key, a bad value) or a variable under its environment prefix that names no field
+    is a SuiteError naming the file and the entry: every cell of the entry would fail the same way, and
+    ``--dry-run`` must say so. A class that does not load (a plugin whose module does not import) is the
+    method's fault, not the suite's: its cells are recorded as failed with the reason.
+    """
     try:
-        config = resolve_config(entry.name, entry.preset, dict(entry.set), registry)
-    except Albot1Error as exc:
-        return None, f"{type(exc).__name__}: {exc}"
+        registry.get(entry.name).load_class()
     except Exception as exc:  # the method's module itself is broken: a cell failure, not a runner crash
         return None, f"cannot load method {entry.name!r}: {type(exc).__name__}: {exc}"
+    try:
+        config = resolve_config(entry.name, entry.preset, dict(entry.set), registry, override_origin="set")
+    except ConfigError as exc:
+        where = (
+            f"methods.{suite.methods.index(entry)} ({entry.display!r})"
+            if entry in suite.methods
+            else f"method {entry.display!r} (added by registered_methods = true)"
+        )
+        raise SuiteError(f"{suite.path or suite.name}: invalid suite: {where}: {exc}") from None
+    except Exception as exc:  # the method's config model itself is broken
+        return None, f"cannot resolve the config of method {entry.name!r}: {type(exc).__name__}: {exc}"
     return config.model_dump(mode="json"), None
 
 
@@ -140,7 +159,8 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
     literal suite entry that is an error unless the entry is ``optional``.
     A registered dataset that is merely not downloaded is known.
     """
-    base = name.partition("?")[0]  # a reference with loader options needs its catalog file all the same
+    # A sliced reference, or one with loader options, needs its catalog files all the same.
+    base = split_slice(name)[0].partition("?")[0]
     if base in catalog.names():
         try:
             catalog.locate(base, settings)
@@ -220,7 +240,7 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
     registry = registry or method_registry()
     code = versions.code_version()
     methods, skipped_methods = _methods(suite, registry)
-    resolved = {entry.display: _resolve(entry, registry) for entry in methods if entry.trajectories is None}
+    resolved = {entry.display: _resolve(suite, entry, registry) for entry in methods if entry.trajectories is None}
     cells: list[Cell] = []
     skipped_datasets: list[Skipped] = []
     config_failures: dict[str, str] = {}

@@ -80,18 +80,22 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal, TypeVar
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator, model_validator
+from pydantic_core import PydanticCustomError
 
 from albot1.bench.errors import SuiteError
 from albot1.config.validation import describe_errors
 from albot1.data.degrade import MAX_SEED, DegradationSpecError, parse_spec
+from albot1.data.errors import SliceError
+from albot1.data.open import canonical_reference, slice_reference
 from albot1.resources import list_resources, resource_dirs
 
 # "?" is not a glob character here: in a dataset reference it introduces loader options
 # (``intel-corrected?odometry=laser-pose``, see albot1.data.open), so such an entry is a literal.
 GLOB_CHARS = frozenset("*[")
-#: A trailing ``[:STOP]`` / ``[:STOP:STEP]`` / ``[::STEP]`` is a slice of a dataset reference, not a glob class.
-_TRAILING_SLICE = re.compile(r"\[:[^\[\]]*\]$")
+#: A trailing ``[:STOP]`` / ``[:STOP:STEP]`` / ``[::STEP]`` (or ``[0:STOP]``) is a slice of a dataset reference,
+#: not a glob class.
+_TRAILING_SLICE = re.compile(r"\[\d*:[^\[\]]*\]$")
 #: Upper bounds of the per-cell limits: beyond them a value is a typo, and a timer or a byte count would overflow.
 MAX_TIME_S = 7 * 24 * 3600.0
 MAX_MEMORY_MB = 1024.0 * 1024.0
@@ -101,6 +105,11 @@ MemoryMb = Annotated[
     Field(gt=0, le=MAX_MEMORY_MB, description="resident memory of the cell and the processes it starts, MiB"),
 ]
 Seed = Annotated[int, Field(ge=0, le=MAX_SEED)]
+# A TOML array is a Python list: ``Strict(False)`` lets a list stand for the tuple, its items stay strict.
+#: Names, globs or degradation specs (a TOML array of strings).
+Names = Annotated[tuple[str, ...], Strict(False)]
+#: Seeds (a TOML array of integers; ``true`` is not seed 1).
+Seeds = Annotated[tuple[Seed, ...], Strict(False)]
 #: A suite's name is the folder of its results (``RESULTS/<name>``): a plain name that cannot climb out of it.
 SUITE_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}")
 
@@ -110,7 +119,14 @@ REMOVED_METHOD_KEYS = ("target", "error_class", "requires")
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    """No unknown key, and no value of the wrong TOML type turned into another (``memory_mb = true`` is not 1 MiB).
+
+    Strict validation refuses a boolean for a number, a string for a number and a float for an integer
+    (``limit = 5.0``); an integer stays accepted where a float is expected (``time_s = 60``). TOML arrays
+    arrive as lists, so the tuple fields take a list (:data:`Names`, :data:`Seeds`) while their items stay strict.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
 
 
 class Limits(_Strict):
@@ -123,11 +139,11 @@ class Limits(_Strict):
 class GridSpec(_Strict):
     """The degradation sweep applied to datasets with reference poses."""
 
-    degradations: tuple[str, ...] = ()
+    degradations: Names = ()
     # At least one: an empty list would drop every swept degradation without a word (undegraded_seeds may be
     # empty: a suite of degraded runs only).
-    seeds: tuple[Seed, ...] = Field((0,), min_length=1)
-    undegraded_seeds: tuple[Seed, ...] = (0,)
+    seeds: Seeds = Field((0,), min_length=1)
+    undegraded_seeds: Seeds = (0,)
 
     @field_validator("degradations")
     @classmethod
@@ -149,7 +165,7 @@ class MethodEntry(_Strict):
     label: str | None = None
     time_s: TimeS | None = None
     memory_mb: MemoryMb | None = None
-    datasets: tuple[str, ...] | None = Field(
+    datasets: Names | None = Field(
         None,
         min_length=1,
         description="globs over dataset names: this entry runs only on the datasets the suite selects that match "
@@ -215,22 +231,30 @@ class DatasetEntry(_Strict):
     limit: int | None = Field(None, ge=1, description="use the first LIMIT scans of the log")
     stride: int | None = Field(None, ge=1, description="then every STRIDE-th of them")
     sweep: bool | Literal["auto"] = "auto"
-    degradations: tuple[str, ...] | None = None
-    seeds: tuple[Seed, ...] | None = Field(None, min_length=1)
-    undegraded_seeds: tuple[Seed, ...] | None = None
+    degradations: Names | None = None
+    seeds: Seeds | None = Field(None, min_length=1)
+    undegraded_seeds: Seeds | None = None
     time_s: TimeS | None = None
     memory_mb: MemoryMb | None = None
-    methods: tuple[str, ...] | None = Field(
+    methods: Names | None = Field(
         None,
         min_length=1,
         description="labels of the method entries that run on these datasets (default: every entry); a suite "
         "that asks different questions of different data keeps its grid small this way (an empty list is "
         "refused: `skip = true` leaves datasets out)",
     )
-    tags: tuple[str, ...] = Field(
+    tags: Names = Field(
         (),
         description="names a report finds this entry's datasets by (the thesis page's experiments); they change no run",
     )
+
+    @field_validator("sweep", mode="before")
+    @classmethod
+    def _sweep_type(cls, value: object) -> object:
+        """One problem for a bad ``sweep``, not one per member of ``bool | "auto"``."""
+        if isinstance(value, bool) or value == "auto":
+            return value
+        raise PydanticCustomError("sweep_type", 'Input should be true, false or "auto"')
 
     @field_validator("degradations")
     @classmethod
@@ -271,10 +295,17 @@ class DatasetOptions(_Strict):
 
     @property
     def label(self) -> str:
-        """Name plus the slice actually used, e.g. ``intel[:4000:2]``: it is part of the run's identity."""
-        if self.limit is None and self.stride is None:
-            return self.name
-        return f"{self.name}[:{self.limit or ''}{f':{self.stride}' if self.stride else ''}]"
+        """Name plus the slice actually used, e.g. ``intel[:4000:2]``: it is part of the run's identity.
+
+        In the one spelling of :func:`~albot1.data.open.canonical_reference`, so that ``intel[:300]``,
+        ``intel[:300:1]``, ``intel[0:300]`` and ``intel`` with ``limit = 300`` name one run key and one run
+        folder (each spelling used to compute the same cells again under a key of its own).
+        """
+        text = self.name + slice_reference("", self.limit, self.stride)
+        try:
+            return canonical_reference(text)
+        except SliceError:  # a slice its dataset refuses: planning stops on it before any cell is labelled
+            return text
 
 
 class Suite(_Strict):
@@ -286,8 +317,8 @@ class Suite(_Strict):
     registered_methods: bool = False
     limits: Limits = Field(default_factory=Limits)
     grid: GridSpec = Field(default_factory=GridSpec)
-    methods: tuple[MethodEntry, ...] = Field(min_length=1)
-    datasets: tuple[DatasetEntry, ...] = Field(min_length=1)
+    methods: Annotated[tuple[MethodEntry, ...], Strict(False)] = Field(min_length=1)
+    datasets: Annotated[tuple[DatasetEntry, ...], Strict(False)] = Field(min_length=1)
 
     @model_validator(mode="before")
     @classmethod
@@ -389,7 +420,7 @@ def parse_suite(data: dict[str, Any], *, name: str, source: str, path: Path | No
     try:
         return Suite.model_validate({"name": name, **data, "path": path})
     except ValidationError as exc:
-        raise SuiteError(f"{source}: invalid suite: {describe_errors(exc)}") from None
+        raise SuiteError(f"{source}: invalid suite: {describe_errors(exc, found=True)}") from None
 
 
 def load_suite(path: str | Path) -> Suite:

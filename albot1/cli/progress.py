@@ -35,14 +35,9 @@ def slice_bound(ref: str) -> int | None:
     bounds it: the bar of ``run 'intel[:3000]'`` gets a total and an ETA
     (it ends early only when the log is shorter than the slice).
     """
-    import re
+    from albot1.data.open import split_slice
 
-    from albot1.data.open import parse_slice
-
-    sliced = re.fullmatch(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]", ref)
-    if sliced is None:
-        return None
-    stop, step = parse_slice(sliced["body"], ref)
+    _, stop, step = split_slice(ref)
     if stop is None:
         return None
     return -(-stop // step) if step is not None else stop

@@ -74,12 +74,14 @@ def resolve(
     other_prefixes: Iterable[str] = (),
     overrides: Mapping[str, Any] | None = None,
     owner: str = "",
+    override_origin: str = FROM_OVERRIDE,
 ) -> ResolvedConfig[ModelT]:
     """Validate ``model`` from ``presets[preset]``, the environment and ``overrides`` (highest last).
 
-    ``owner`` names the method in messages. Raises ConfigError for an
-    unknown preset, an environment variable that names no field, or a value
-    the model rejects (the message names the field and where its value came from).
+    ``owner`` names the method in messages; ``override_origin`` says where ``overrides`` came from
+    (``--set``, or a suite's ``set``), so that a rejected one is traced to what the user wrote. Raises
+    ConfigError for an unknown preset, an environment variable that names no field, or a value the model
+    rejects (the message names the field and where its value came from).
     """
     label = owner or model.__name__
     if preset not in presets:
@@ -94,7 +96,7 @@ def resolve(
         sources[name] = f"env {variable}"
     for name, value in (overrides or {}).items():
         values[name] = value
-        sources[name] = FROM_OVERRIDE
+        sources[name] = override_origin
     try:
         config = model.model_validate(values)
     except ValidationError as exc:

@@ -13,12 +13,16 @@ from typing import Any
 from pydantic import ValidationError
 
 
-def describe_errors(exc: ValidationError, sources: Mapping[str, str] | None = None) -> str:
+def describe_errors(exc: ValidationError, sources: Mapping[str, str] | None = None, *, found: bool = False) -> str:
     """``"a.b: Input should be ...; c: Extra inputs are not permitted"``.
 
     ``sources`` maps a top-level field name to where its value came from
     (e.g. an environment variable); when given, the problem says so, so a bad
     value is traced to the flag, variable or file line that set it.
+
+    ``found``: a value of the wrong type also says what it was (``memory_mb: Input should be a valid number,
+    found the boolean true``): under strict validation "a valid number" alone does not tell a user that the
+    ``true`` or ``"5"`` they wrote is the problem.
     """
     problems = []
     errors = exc.errors()
@@ -30,10 +34,33 @@ def describe_errors(exc: ValidationError, sources: Mapping[str, str] | None = No
         location = ".".join(str(part) for part in error["loc"]) or "(top level)"
         origin = sources.get(str(error["loc"][0])) if sources and error["loc"] else None
         suffix = f" (from {origin})" if origin else ""
-        problems.append(f"{location}: {error['msg']}{suffix}")
+        what = f", found {_describe_value(error['input'])}" if found and _is_type_error(error["type"]) else ""
+        problems.append(f"{location}: {error['msg']}{what}{suffix}")
     return "; ".join(problems)
 
 
 def _an_item_failed(loc: tuple[int | str, ...], errors: list[Any]) -> bool:
     """Whether some other error lies inside an item of the list at ``loc``."""
     return any(len(e["loc"]) > len(loc) and tuple(e["loc"][: len(loc)]) == tuple(loc) for e in errors)
+
+
+def _is_type_error(kind: str) -> bool:
+    """Whether a pydantic error type says the value had the wrong type (not a wrong value of the right one)."""
+    return kind.endswith(("_type", "_parsing")) or kind == "literal_error"
+
+
+def _describe_value(value: Any) -> str:
+    """A value as its source file wrote it, in a few words: ``the boolean true``, ``the string '5'``, ``a list``."""
+    if isinstance(value, bool):
+        return f"the boolean {str(value).lower()}"
+    if isinstance(value, int):
+        return f"the integer {value}"
+    if isinstance(value, float):
+        return f"the number {value!r}"
+    if isinstance(value, str):
+        return f"the string {value[:40]!r}{'...' if len(value) > 40 else ''}"
+    if isinstance(value, list | tuple):
+        return f"a list of {len(value)} item{'' if len(value) == 1 else 's'}"
+    if isinstance(value, Mapping):
+        return f"a table (keys {', '.join(map(str, list(value)[:5]))}{', ...' if len(value) > 5 else ''})"
+    return f"a {type(value).__name__}"

@@ -64,10 +64,9 @@ def open_sequence(
     text = str(ref)
     # "NAME[:STOP]" / "NAME[:STOP:STEP]" / "NAME[::STEP]": the first STOP scans, every STEP-th of them
     # (the benchmark suites name their slices of long logs this way, so a run's dataset reopens as run).
-    sliced = re.fullmatch(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]", text)
-    if sliced is not None and not _exists(text):
-        stop, step = parse_slice(sliced["body"], text)
-        sequence = open_sequence(sliced["ref"], settings=settings, format_name=format_name, **options)
+    base, stop, step = split_slice(text)
+    if base != text:
+        sequence = open_sequence(base, settings=settings, format_name=format_name, **options)
         if stop is not None:
             sequence = head(sequence, stop)
         if step is not None:
@@ -198,17 +197,72 @@ def _exists(text: str) -> bool:
         return False
 
 
+#: ``REF[BODY]``: a reference followed by a slice (unless the whole text names an existing path).
+_SLICED = re.compile(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]")
+
+
+def split_slice(ref: str) -> tuple[str, int | None, int | None]:
+    """``"intel[:300][::2]"`` -> ``("intel", 300, 2)``: the reference under its trailing slices, and the STOP
+    and STEP of the one slice they select together (None = not given).
+
+    The one reading of a reference's slices: :func:`open_sequence` opens the reference under them and keeps
+    those scans, and the bench finds a sliced dataset's catalog entry by it (``intel[:50]`` of a log that is
+    not downloaded is skipped like ``intel``). A text that names an existing path is not sliced. Slices
+    apply left to right: a later ``[:B:T]`` keeps the first B of what the earlier ``[:A:S]`` kept (the first
+    ``min(A, B*S)`` scans of the log) and every T-th of those (every ``S*T``-th scan of the log). SliceError
+    for a slice :func:`parse_slice` refuses.
+    """
+    slices: list[tuple[str, str]] = []  # (body, the reference it ends), outermost first
+    text = ref
+    while (sliced := _SLICED.fullmatch(text)) is not None and not _exists(text):
+        slices.append((sliced["body"], text))
+        text = sliced["ref"]
+    stop: int | None = None
+    step = 1
+    for body, whole in reversed(slices):
+        outer_stop, outer_step = parse_slice(body, whole)
+        if outer_stop is not None:
+            stop = outer_stop * step if stop is None else min(stop, outer_stop * step)
+        step *= outer_step or 1
+    return text, stop, step if step != 1 else None
+
+
+def slice_reference(ref: str, stop: int | None, step: int | None) -> str:
+    """The one spelling of ``ref`` sliced: ``intel[:300]``, ``intel[::2]``, ``intel[:300:2]``, or ``ref`` itself
+    for every scan (no STOP, STEP 1).
+
+    A slice names part of a run's identity (the bench's run key and run folder), so every spelling of the
+    same scans (``intel[:300:1]``, ``intel[0:300]``, ``intel[:0300]``, ``intel[:600][:300]``, ``intel`` with
+    ``limit = 300``) is written this one way: :func:`canonical_reference`.
+    """
+    step = None if step == 1 else step
+    if stop is None and step is None:
+        return ref
+    return f"{ref}[:{'' if stop is None else stop}{'' if step is None else f':{step}'}]"
+
+
+def canonical_reference(ref: str) -> str:
+    """``ref`` with its trailing slices in their one spelling (:func:`split_slice`, :func:`slice_reference`)."""
+    return slice_reference(*split_slice(ref))
+
+
 def parse_slice(body: str, ref: str) -> tuple[int | None, int | None]:
     """``":100:5"`` -> ``(100, 5)``: the STOP and STEP of a reference's ``[:STOP:STEP]`` (None = not given).
 
     Only prefixes and strides exist (a run must reopen exactly the scans it
-    used); both must be positive integers. Anything else is a SliceError
-    naming the reference.
+    used); both must be positive integers. Python's ``[0:STOP]`` is
+    accepted as the same prefix (:func:`slice_reference` spells it
+    ``[:STOP]``). Anything else is a SliceError naming the reference.
     """
     forms = "[:STOP], [:STOP:STEP] or [::STEP] with positive integers (the first STOP scans, every STEP-th of them)"
-    found = re.fullmatch(r":(?P<stop>\d*)(?::(?P<step>\d*))?", body)
+    found = re.fullmatch(r"(?P<start>\d*):(?P<stop>\d*)(?::(?P<step>\d*))?", body)
     if found is None or len(body) > 40:
         raise SliceError(f"{ref!r}: slice [{body[:40]}] is not understood; expected {forms}")
+    if found["start"] and int(found["start"]) != 0:
+        raise SliceError(
+            f"{ref!r}: slice START is {int(found['start'])}, but only prefixes exist (a START, if given, is 0); "
+            f"expected {forms}"
+        )
     stop = int(found["stop"]) if found["stop"] else None
     step = int(found["step"]) if found["step"] else None
     for what, value in (("STOP", stop), ("STEP", step)):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import sys
 from collections.abc import Iterator
 from dataclasses import replace
 
@@ -22,8 +23,10 @@ def head(sequence: Sequence, count: int) -> Sequence:
     if count < 1:
         raise SliceError(f"expected a positive number of scans (a limit or slice stop of at least 1), got {count}")
     known = sequence.known_scan_count
+    # islice takes at most sys.maxsize: a larger count (``intel[:99999999999999999999]``) is every scan, not a crash
     return sequence.with_frames(
-        lambda frames: itertools.islice(frames, count), scan_count=None if known is None else min(count, known)
+        lambda frames: itertools.islice(frames, min(count, sys.maxsize)),
+        scan_count=None if known is None else min(count, known),
     )
 
 
@@ -33,7 +36,7 @@ def stride(sequence: Sequence, step: int) -> Sequence:
         raise SliceError(f"expected a positive stride (every STEP-th scan, STEP >= 1), got {step}")
 
     def pick(frames: Iterator[Frame]) -> Iterator[Frame]:
-        for i, frame in enumerate(itertools.islice(frames, 0, None, step)):
+        for i, frame in enumerate(itertools.islice(frames, 0, None, min(step, sys.maxsize))):
             yield replace(frame, index=i)
 
     known = sequence.known_scan_count

@@ -27,7 +27,7 @@ from pydantic import BaseModel
 
 from albot1.config.env import method_prefix
 from albot1.config.keyvalue import parse_key_values
-from albot1.config.resolve import ResolvedConfig, resolve
+from albot1.config.resolve import FROM_OVERRIDE, ResolvedConfig, resolve
 from albot1.config.suggest import unknown_name_message
 from albot1.config.targets import TargetError, check_target, resolve_class
 from albot1.methods.errors import UnknownMethodError
@@ -328,8 +328,11 @@ def resolve_method_config(
     preset: str = "default",
     overrides: dict[str, Any] | None = None,
     registry: MethodRegistry | None = None,
+    override_origin: str = FROM_OVERRIDE,
 ) -> ResolvedConfig[BaseModel]:
     """The validated config of ``method`` for ``preset`` plus env and explicit overrides, with each value's origin.
+
+    ``override_origin``: where ``overrides`` came from, as messages name it (default ``--set``).
 
     Environment variables of the other registered methods are left to them:
     with nested prefixes (``albot1`` and a method ``albot1-places``) a
@@ -346,6 +349,7 @@ def resolve_method_config(
         other_prefixes=registry.other_prefixes(method),
         overrides=overrides,
         owner=method,
+        override_origin=override_origin,
     )
 
 
@@ -354,9 +358,10 @@ def resolve_config(
     preset: str = "default",
     overrides: dict[str, Any] | None = None,
     registry: MethodRegistry | None = None,
+    override_origin: str = FROM_OVERRIDE,
 ) -> BaseModel:
     """The validated config of ``method`` (see :func:`resolve_method_config`)."""
-    return resolve_method_config(method, preset, overrides, registry).config
+    return resolve_method_config(method, preset, overrides, registry, override_origin).config
 
 
 def parse_overrides(pairs: list[str]) -> dict[str, str]:

@@ -248,13 +248,36 @@ def thesis_rows(default: list[StandardRow], thesis: list[Any], store: str) -> li
     return rows
 
 
+def check_thesis_store(thesis_dir: Path) -> None:
+    """ReportError (one line) when ``thesis_dir`` holds the results of a suite other than the thesis suite.
+
+    Why: the verdicts are the thesis page's experiments, which read their datasets and methods by the thesis
+    suite's tags and labels; on another store (``--thesis results/default``) they would be "not comparable"
+    or drawn from the wrong runs, and its methods would join the standard table as "the thesis suite's".
+    A store names its suite in its ``grid.json`` (the plan ``albot1 bench`` wrote).
+    """
+    from albot1.bench.store import ResultsStore
+    from albot1.report.thesis.experiments.datasets import THESIS_SUITE
+
+    suite = ResultsStore(thesis_dir).read_plan().suite
+    if suite != THESIS_SUITE:
+        raise ReportError(
+            f"{thesis_dir.as_posix()}: --thesis expects the results of the {THESIS_SUITE!r} suite (`albot1 bench "
+            f"{THESIS_SUITE}`), found those of suite {suite!r}; give its results folder, e.g. results/{THESIS_SUITE}"
+        )
+
+
 def build_data(
     default_dir: Path, thesis_dir: Path | None, command: str, *, shown: dict[Path, str] | None = None
 ) -> ResultsData:
     """The record of ``default_dir`` (standard benchmark) and ``thesis_dir`` (verdicts; None: not shown).
 
     The standard table also takes from ``thesis_dir`` the methods ``default_dir`` lacks (:func:`thesis_rows`).
+    A ``thesis_dir`` that is no results folder yet is a note (``make bench`` may not have run the thesis
+    suite); one that holds another suite's results is a ReportError (:func:`check_thesis_store`).
     """
+    if thesis_dir is not None and (thesis_dir / "grid.json").is_file():
+        check_thesis_store(thesis_dir)
     names = shown or {}
     stamp, plan, records = _stamp(default_dir, names.get(default_dir, default_dir.as_posix()))
     stores = [stamp]

@@ -88,11 +88,6 @@ label = "fault:crash"
 {FAULT}
 set = {{ mode = "crash", at_scan = 2 }}
 
-[[methods]]
-name = "odometry"
-label = "odometry:bad-config"
-set = {{ map_voxel_m = -1 }}
-
 [[datasets]]
 name = "{WORLD}"
 undegraded_seeds = []
@@ -106,14 +101,13 @@ def test_failures_are_isolated_recorded_and_reported(tmp_path: Path) -> None:
     for outcome in summary.outcomes:
         by_label.setdefault(outcome.method_label, set()).add(outcome.status)
     assert by_label["odometry"] == {"done"}
-    for label in ("fault:raise", "fault:hang", "fault:memory", "fault:crash", "odometry:bad-config"):
+    for label in ("fault:raise", "fault:hang", "fault:memory", "fault:crash"):
         assert by_label[label] == {"failed"}, label
     kinds = {o.method_label: (o.kind, o.reason) for o in summary.failures}
     assert kinds["fault:raise"][0] == "exception" and "injected fault at scan 3" in kinds["fault:raise"][1]
     assert kinds["fault:hang"][0] == "timeout" and "3 s" in kinds["fault:hang"][1]
     assert kinds["fault:memory"][0] == "memory" and "300 MB" in kinds["fault:memory"][1]
     assert kinds["fault:crash"][0] == "crash" and "SIGSEGV" in kinds["fault:crash"][1]
-    assert kinds["odometry:bad-config"][0] == "config" and "map_voxel_m" in kinds["odometry:bad-config"][1]
 
     raised = next(c for c in plan.cells if c.method_label == "fault:raise")
     failed = json.loads((store.run_dir(raised.key) / "FAILED.json").read_text())

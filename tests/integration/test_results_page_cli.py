@@ -79,20 +79,28 @@ def test_results_page_quotes_the_stored_ate_and_is_byte_stable(tmp_path: Path) -
 def test_the_standard_table_takes_the_methods_the_default_store_lacks_from_the_thesis_store(tmp_path: Path) -> None:
     """As `make bench` shows Albot1+: the thesis suite runs it on the standard logs, the default suite does not.
 
-    Stand-ins (cheap): the "thesis" store runs odometry (also in the default store: not taken again) and
-    odometry's `sparse-map` preset (taken, with its store named and no speed) on the whole ACES log.
+    Stand-ins (cheap): the "thesis" store (a suite named thesis: --thesis refuses another suite's store) runs
+    odometry (also in the default store: not taken again) and odometry's `sparse-map` preset (taken, with its
+    store named and no speed) on the whole ACES log.
     """
     if not (Path(os.environ.get("ALBOT1_DATA_DIR", "/nonexistent")) / "radish" / "aces.clf.bz2").is_file():
         pytest.skip("the ACES log is not in ALBOT1_DATA_DIR")
     (tmp_path / "std.toml").write_text('[[methods]]\nname = "odometry"\n\n[[datasets]]\nname = "aces"\n')
-    (tmp_path / "th.toml").write_text(
+    (tmp_path / "thesis.toml").write_text(
         '[[methods]]\nname = "odometry"\n\n[[methods]]\nname = "odometry"\npreset = "sparse-map"\n\n'
         '[[datasets]]\nname = "aces"\n'
     )
-    for suite in ("std.toml", "th.toml"):
+    for suite in ("std.toml", "thesis.toml"):
         done = _albot1("bench", suite, "-j", "1", "--results", "results", "--no-progress", cwd=tmp_path)
         assert done.returncode == 0, done.stderr
-    args = ("results-page", "results/std", "--thesis", "results/th", "--out", "docs/results.md")
+    args = ("results-page", "results/std", "--thesis", "results/thesis", "--out", "docs/results.md")
+    refused = _albot1(
+        "results-page", "results/std", "--thesis", "results/std", "--out", "docs/results.md", cwd=tmp_path
+    )
+    assert refused.returncode == 1 and refused.stderr.strip().splitlines() == [
+        "albot1: error: results/std: --thesis expects the results of the 'thesis' suite (`albot1 bench thesis`), "
+        "found those of suite 'std'; give its results folder, e.g. results/thesis"
+    ]
     done = _albot1(*args, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     data = load_data(tmp_path / "docs" / "results" / "results.json")
@@ -101,10 +109,10 @@ def test_the_standard_table_takes_the_methods_the_default_store_lacks_from_the_t
     assert set(rows) == {"odometry", "odometry:sparse-map"}
     ours, taken = rows["odometry"], rows["odometry:sparse-map"]
     assert ours.store == "" and ours.speed is not None and ours.source.startswith("this suite, run ")
-    assert taken.store == "results/th" and taken.speed is None and taken.source.startswith("results/th, run ")
-    assert taken.note == f"from results/th; {THESIS_SPEED_NOTE}"
-    (record,) = (r for r in collect(tmp_path / "results" / "th")[1] if r.cell.method_label == "odometry:sparse-map")
+    assert taken.store == "results/thesis" and taken.speed is None and taken.source.startswith("results/thesis, run ")
+    assert taken.note == f"from results/thesis; {THESIS_SPEED_NOTE}"
+    (record,) = (r for r in collect(tmp_path / "results" / "thesis")[1] if r.cell.method_label == "odometry:sparse-map")
     stored = json.loads((record.run_dir / "metrics.json").read_text(encoding="utf-8"))["relations"]
     assert taken.translation_mean_m == stored["translation_m"]["mean"]
     page = (tmp_path / "docs" / "results.md").read_text(encoding="utf-8")
-    assert "odometry:sparse-map: from `results/th`, whose suite runs them" in page
+    assert "odometry:sparse-map: from `results/thesis`, whose suite runs them" in page

@@ -44,7 +44,7 @@ def test_later_entries_override_earlier_ones_field_by_field() -> None:
     intel = suite.options_for("intel-corrected")
     assert intel is not None
     assert (intel.limit, intel.stride, intel.time_s) == (100, 1, 30)
-    assert intel.label == "intel-corrected[:100:1]"
+    assert intel.label == "intel-corrected[:100]"  # a stride of 1 is no stride: one spelling, one run key
     other = suite.options_for("fr079")
     assert other is not None and other.label == "fr079[::2]"
     assert suite.options_for("aces") is None
@@ -217,6 +217,7 @@ def test_entry_limits_and_seeds_are_bounded_too() -> None:
         ("intel[:100:2]", False),
         ("intel[::2]", False),
         ("intel[:30][:20]", False),
+        ("intel[0:300]", False),
         ("intel-corrected?odometry=laser-pose[:100]", False),
         ("intel*", True),
         ("intel*[:100]", True),
@@ -255,3 +256,117 @@ def test_a_suite_cannot_name_code_to_import(tmp_path: Path, key: str, value: str
     assert "\n" not in message
     assert message.startswith(f"{tmp_path / 's.toml'}: invalid suite: ")
     assert f"methods.1 ('mine'): `{key}` is not read" in message and "entry point group albot1.methods" in message
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        # a value of the wrong TOML type is refused, never converted (adversarial test: `memory_mb = true` was 1 MiB)
+        ("[limits]\nmemory_mb = true\n", "limits.memory_mb: Input should be a valid number, found the boolean true"),
+        ('[limits]\ntime_s = "60"\n', "limits.time_s: Input should be a valid number, found the string '60'"),
+        ("[grid]\nseeds = [true]\n", "grid.seeds.0: Input should be a valid integer, found the boolean true"),
+        ('[grid]\nseeds = ["5"]\n', "grid.seeds.0: Input should be a valid integer, found the string '5'"),
+        ("[grid]\nseeds = 5\n", "grid.seeds: Input should be a valid tuple, found the integer 5"),
+        (
+            "[grid]\nundegraded_seeds = [1.0]\n",
+            "grid.undegraded_seeds.0: Input should be a valid integer, found the number 1.0",
+        ),
+        ("registered_methods = 1\n", "registered_methods: Input should be a valid boolean, found the integer 1"),
+        ("description = 3\n", "description: Input should be a valid string, found the integer 3"),
+    ],
+)
+def test_a_value_of_the_wrong_type_is_one_problem_naming_what_was_found(
+    tmp_path: Path, text: str, expected: str
+) -> None:
+    with pytest.raises(SuiteError) as caught:
+        load_suite(write(tmp_path, text + '[[methods]]\nname = "odometry"\n[[datasets]]\nname = "*"\n'))
+    assert str(caught.value) == f"{tmp_path / 's.toml'}: invalid suite: {expected}"
+
+
+@pytest.mark.parametrize(
+    ("entry", "expected"),
+    [
+        ('{name = "*", limit = 5.0}', "datasets.0.limit: Input should be a valid integer, found the number 5.0"),
+        ('{name = "*", stride = "2"}', "datasets.0.stride: Input should be a valid integer, found the string '2'"),
+        ('{name = "*", sweep = 1}', 'datasets.0.sweep: Input should be true, false or "auto", found the integer 1'),
+        (
+            '{name = "*", sweep = "yes"}',
+            "datasets.0.sweep: Input should be true, false or \"auto\", found the string 'yes'",
+        ),
+        (
+            '{name = "*", seeds = [false]}',
+            "datasets.0.seeds.0: Input should be a valid integer, found the boolean false",
+        ),
+        (
+            '{name = "*", memory_mb = false}',
+            "datasets.0.memory_mb: Input should be a valid number, found the boolean false",
+        ),
+        ('{name = "*", skip = "no"}', "datasets.0.skip: Input should be a valid boolean, found the string 'no'"),
+        ("{name = 5}", "datasets.0.name: Input should be a valid string, found the integer 5"),
+        ('{name = "*", tags = "x"}', "datasets.0.tags: Input should be a valid tuple, found the string 'x'"),
+    ],
+)
+def test_a_dataset_entry_value_of_the_wrong_type_is_refused(tmp_path: Path, entry: str, expected: str) -> None:
+    with pytest.raises(SuiteError) as caught:
+        load_suite(write(tmp_path, f'methods = [{{name = "odometry"}}]\ndatasets = [{entry}]\n'))
+    assert str(caught.value) == f"{tmp_path / 's.toml'}: invalid suite: {expected}"
+
+
+@pytest.mark.parametrize(
+    ("entry", "expected"),
+    [
+        (
+            '{name = "odometry", time_s = true}',
+            "methods.0.time_s: Input should be a valid number, found the boolean true",
+        ),
+        (
+            '{name = "odometry", allow_failure = "yes"}',
+            "methods.0.allow_failure: Input should be a valid boolean, found",
+        ),
+        ('{name = "odometry", set = [1]}', "methods.0.set: Input should be a valid dictionary, found a list of 1 item"),
+        ('{name = "odometry", preset = 1}', "methods.0.preset: Input should be a valid string, found the integer 1"),
+    ],
+)
+def test_a_method_entry_value_of_the_wrong_type_is_refused(tmp_path: Path, entry: str, expected: str) -> None:
+    with pytest.raises(SuiteError) as caught:
+        load_suite(write(tmp_path, f'methods = [{entry}]\ndatasets = [{{name = "*"}}]\n'))
+    message = str(caught.value)
+    assert message.startswith(f"{tmp_path / 's.toml'}: invalid suite: {expected}") and "; " not in message, message
+
+
+def test_integers_stand_for_floats_and_arrays_for_lists(tmp_path: Path) -> None:
+    """TOML writes `time_s = 60` for a float field and arrays where the model holds tuples: both stay accepted."""
+    text = (
+        '[limits]\ntime_s = 60\nmemory_mb = 512\n[grid]\nseeds = [0, 1]\ndegradations = ["thesis"]\n'
+        '[[methods]]\nname = "odometry"\ntime_s = 30\ndatasets = ["a*"]\n'
+        '[[datasets]]\nname = "*"\nmemory_mb = 100\nsweep = "auto"\ntags = ["t"]\nmethods = ["odometry"]\n'
+    )
+    suite = load_suite(write(tmp_path, text))
+    assert (suite.limits.time_s, suite.limits.memory_mb) == (60.0, 512.0)
+    assert isinstance(suite.limits.time_s, float) and suite.grid.seeds == (0, 1)
+    assert suite.methods[0].time_s == 30.0 and suite.methods[0].datasets == ("a*",)
+    assert suite.datasets[0].memory_mb == 100.0 and suite.datasets[0].tags == ("t",)
+
+
+@pytest.mark.parametrize(
+    ("entry", "label"),
+    [
+        ('name = "intel[:300]"', "intel[:300]"),
+        ('name = "intel[:300:1]"', "intel[:300]"),
+        ('name = "intel[0:300]"', "intel[:300]"),
+        ('name = "intel[:0300]"', "intel[:300]"),
+        ('name = "intel[:600][:300]"', "intel[:300]"),
+        ('name = "intel"\nlimit = 300', "intel[:300]"),
+        ('name = "intel"\nlimit = 300\nstride = 1', "intel[:300]"),
+        ('name = "intel[:600]"\nlimit = 300', "intel[:300]"),
+        ('name = "intel[::1]"', "intel"),
+        ('name = "intel[::3]"\nlimit = 100', "intel[:300:3]"),
+        ('name = "intel"\nlimit = 4000\nstride = 2', "intel[:4000:2]"),
+        ('name = "x-corrected?odometry=laser-pose[::3]"', "x-corrected?odometry=laser-pose[::3]"),
+    ],
+)
+def test_every_spelling_of_a_slice_is_labelled_one_way(tmp_path: Path, entry: str, label: str) -> None:
+    """The label is hashed into the run key: equal slices share one key, so their cells are computed once."""
+    suite = load_suite(write(tmp_path, f'[[methods]]\nname = "odometry"\n[[datasets]]\n{entry}\n'))
+    options = suite.options_for(suite.datasets[0].name)
+    assert options is not None and options.label == label

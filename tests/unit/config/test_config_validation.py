@@ -41,3 +41,27 @@ def test_sources_name_where_a_value_came_from() -> None:
 
 def test_top_level_problems_are_labelled() -> None:
     assert describe_errors(_error(3)).startswith("(top level): Input should be a valid dictionary")
+
+
+@pytest.mark.parametrize(
+    ("data", "expected"),
+    [
+        ({"size_m": [1, 2], "inner": {"count": 1}}, "size_m: Input should be a valid number, found a list of 2 items"),
+        (
+            {"size_m": 1, "inner": 2},
+            "inner: Input should be a valid dictionary or instance of _Inner, found the integer 2",
+        ),
+        (
+            {"size_m": 1, "inner": {"count": "x" * 50}},
+            f"inner.count: Input should be a valid integer, unable to parse string as an integer, found the string "
+            f"'{'x' * 40}'...",
+        ),
+        ({"size_m": -1, "inner": {"count": 1}}, "size_m: Input should be greater than 0"),
+    ],
+)
+def test_found_says_what_a_value_of_the_wrong_type_was(data: object, expected: str) -> None:
+    """Only type errors name the value (a bound's own message says enough); long strings are cut."""
+    described = describe_errors(_error(data), found=True)
+    assert described.startswith(expected), described
+    assert ("found" in described) == ("found" in expected)
+    assert "x" * 41 not in described

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from albot1.data.errors import DatasetNotFoundError, SliceError
-from albot1.data.open import open_sequence, parse_options
+from albot1.data.open import canonical_reference, open_sequence, parse_options, split_slice
 from albot1.data.transforms import head, stride
 
 
@@ -59,6 +63,7 @@ def test_corrected_log_with_clean_odometry(data_file) -> None:  # type: ignore[n
         ("synthetic-office-startstop[-5:]", r"slice \[-5:\] is not understood"),
         ("synthetic-office-startstop[:-5]", r"slice \[:-5\] is not understood"),
         ("synthetic-office-startstop[:" + "9" * 5000 + "]", r"is not understood"),
+        ("synthetic-office-startstop[5:10]", r"slice START is 5, but only prefixes exist \(a START, if given, is 0\)"),
     ],
 )
 def test_bad_slices_are_one_line_errors_naming_the_reference(ref: str, message: str) -> None:
@@ -73,3 +78,89 @@ def test_zero_limits_and_strides_are_data_errors() -> None:
     with pytest.raises(SliceError, match="expected a positive stride .* got -1"):
         stride(seq, -1)
     assert sum(1 for _ in open_sequence("synthetic-office-startstop[:]").frames()) == seq.count_scans()
+
+
+_SLICES = st.lists(st.tuples(st.none() | st.integers(1, 40), st.none() | st.integers(1, 5)), max_size=4)
+
+
+@given(_SLICES)
+def test_split_slice_selects_what_the_slices_select_one_after_another(
+    slices: list[tuple[int | None, int | None]],
+) -> None:
+    """One (STOP, STEP) keeps exactly the scans the slices keep applied left to right (as Python slices would)."""
+    text = "world" + "".join(f"[:{stop or ''}{'' if step is None else f':{step}'}]" for stop, step in slices)
+    expected = list(range(100))
+    for stop, step in slices:
+        expected = expected[:stop][::step]
+    base, stop, step = split_slice(text)
+    assert base == "world" and list(range(100))[:stop][::step] == expected
+    assert step != 1  # a step of 1 is no step
+
+
+@pytest.mark.parametrize(
+    ("ref", "expected"),
+    [
+        ("intel", ("intel", None, None)),
+        ("intel[:]", ("intel", None, None)),
+        ("intel[:300:1]", ("intel", 300, None)),
+        ("intel[:0300]", ("intel", 300, None)),
+        ("intel[:300][::2]", ("intel", 300, 2)),
+        ("intel[::2][:300]", ("intel", 600, 2)),
+        ("intel-corrected?odometry=laser-pose[::3]", ("intel-corrected?odometry=laser-pose", None, 3)),
+        ("a[b]c", ("a[b]c", None, None)),
+        ("intel[0:300]", ("intel", 300, None)),
+        ("intel[00::2]", ("intel", None, 2)),
+    ],
+)
+def test_split_slice_examples(ref: str, expected: tuple[str, int | None, int | None]) -> None:
+    assert split_slice(ref) == expected
+
+
+def test_an_existing_path_with_brackets_is_not_sliced(tmp_path: Path) -> None:
+    log = tmp_path / "log[:5]"
+    log.write_text("")
+    assert split_slice(str(log)) == (str(log), None, None)
+    assert split_slice(f"{log}[:3]") == (str(log), 3, None)
+
+
+def test_nested_slices_open_the_scans_of_the_one_slice_they_make() -> None:
+    nested = open_sequence("synthetic-office-startstop[::2][:7]")
+    single = open_sequence("synthetic-office-startstop[:14:2]")
+    assert len(nested) == len(single) == 7 and (nested.timestamps == single.timestamps).all()
+
+
+@pytest.mark.parametrize(
+    ("ref", "canonical"),
+    [
+        ("intel", "intel"),
+        ("intel[:]", "intel"),
+        ("intel[::1]", "intel"),
+        ("intel[:300]", "intel[:300]"),
+        ("intel[:300:1]", "intel[:300]"),
+        ("intel[0:300]", "intel[:300]"),
+        ("intel[:0300:]", "intel[:300]"),
+        ("intel[:600][:300]", "intel[:300]"),
+        ("intel[::2]", "intel[::2]"),
+        ("intel[:300:2]", "intel[:300:2]"),
+        ("intel[::2][:150]", "intel[:300:2]"),
+        ("intel-corrected?odometry=laser-pose[::3]", "intel-corrected?odometry=laser-pose[::3]"),
+    ],
+)
+def test_canonical_reference_spells_each_slice_one_way(ref: str, canonical: str) -> None:
+    assert canonical_reference(ref) == canonical
+
+
+@given(_SLICES)
+def test_the_canonical_spelling_is_a_fixed_point_that_selects_the_same_scans(
+    slices: list[tuple[int | None, int | None]],
+) -> None:
+    text = "world" + "".join(f"[:{stop or ''}{'' if step is None else f':{step}'}]" for stop, step in slices)
+    canonical = canonical_reference(text)
+    assert canonical_reference(canonical) == canonical
+    assert split_slice(canonical) == split_slice(text)
+
+
+def test_a_stop_or_step_beyond_any_log_is_every_scan_or_the_first_not_a_crash() -> None:
+    whole = open_sequence("synthetic-office-startstop").count_scans()
+    assert sum(1 for _ in open_sequence("synthetic-office-startstop[:" + "9" * 30 + "]").frames()) == whole
+    assert sum(1 for _ in open_sequence("synthetic-office-startstop[::" + "9" * 30 + "]").frames()) == 1

@@ -6,8 +6,18 @@ from pathlib import Path
 
 import pytest
 
+from albot1.bench.grid import GridPlan
+from albot1.bench.store import ResultsStore
 from albot1.report.errors import ReportError
-from albot1.report.results_data import AteCell, ResultsData, StandardRow, StoreStamp, VerdictRow
+from albot1.report.results_data import (
+    AteCell,
+    ResultsData,
+    StandardRow,
+    StoreStamp,
+    VerdictRow,
+    build_data,
+    check_thesis_store,
+)
 from albot1.report.results_page import (
     BEGIN,
     END,
@@ -209,3 +219,16 @@ def test_an_empty_ate_table_leaves_one_blank_line_in_the_readme_block_and_the_pa
         "| `intel-corrected?odometry=laser-pose` | `gauss:0.1:1` (0, 1, 2) | 0.0782 / 0.0692 / n/a |",
         "",
     ]
+
+
+def test_a_thesis_store_of_another_suite_is_refused_in_one_line(tmp_path: Path) -> None:
+    """`--thesis results/default` used to draw the verdicts from the default suite's runs without a word."""
+    for suite in ("default", "thesis"):
+        ResultsStore(tmp_path / suite).write_plan(GridPlan(suite, None, "", [], [], [], {}, [0], ["none"], {}))
+    with pytest.raises(ReportError) as caught:
+        build_data(tmp_path / "default", tmp_path / "default", "albot1 results-page")
+    assert str(caught.value) == (
+        f"{(tmp_path / 'default').as_posix()}: --thesis expects the results of the 'thesis' suite (`albot1 bench "
+        "thesis`), found those of suite 'default'; give its results folder, e.g. results/thesis"
+    )
+    check_thesis_store(tmp_path / "thesis")  # the thesis suite's store is taken
