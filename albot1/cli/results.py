@@ -43,6 +43,15 @@ def results_page(
     # Imported by the command, not by this module: see albot1.cli.app.
     from albot1.report import rebuild
 
+    if thesis is not None and not (thesis / "grid.json").is_file():
+        # Not an error: `make bench SUITE=default` names results/thesis before the thesis suite ever ran. But a
+        # mistyped folder must not drop the verdicts with only a note deep in the page.
+        typer.echo(
+            f"results-page: NOTICE: --thesis {thesis.as_posix()} is not a results folder (no grid.json): the page "
+            "shows no verdicts and no column of the methods only the thesis suite runs",
+            err=True,
+        )
+
     if not force:  # the check reads the stamp and the stores' files, and imports nothing heavy
         current = rebuild.current_results_page(default, thesis, out, readme)
         if current is not None:

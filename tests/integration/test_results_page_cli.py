@@ -49,6 +49,11 @@ def test_results_page_quotes_the_stored_ate_and_is_byte_stable(tmp_path: Path) -
     args = ("results-page", "results/small", "--thesis", "results/none", "--out", "docs/results.md")
     done = _albot1(*args, "--readme", "README.md", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
+    notice = (
+        "results-page: NOTICE: --thesis results/none is not a results folder (no grid.json): the page shows no "
+        "verdicts and no column of the methods only the thesis suite runs"
+    )
+    assert done.stderr.splitlines() == [notice]  # a mistyped --thesis is said, not only noted deep in the page
     data = load_data(tmp_path / "docs" / "results" / "results.json")
     assert data is not None
     stored: dict[tuple[str, int], list[float]] = {}
@@ -72,7 +77,8 @@ def test_results_page_quotes_the_stored_ate_and_is_byte_stable(tmp_path: Path) -
     stamp = data.stores[0]
     assert (stamp.suite, stamp.cells, stamp.done, stamp.failed) == ("small", 3, 3, 0)
     before = {p: p.read_bytes() for p in (tmp_path / "docs").rglob("*") if p.is_file()}
-    assert _albot1(*args, "--readme", "README.md", cwd=tmp_path).returncode == 0
+    again = _albot1(*args, "--readme", "README.md", cwd=tmp_path)
+    assert again.returncode == 0 and again.stderr.splitlines() == [notice]  # said on an up-to-date run too
     assert {p: p.read_bytes() for p in (tmp_path / "docs").rglob("*") if p.is_file()} == before
 
 
