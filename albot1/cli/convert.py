@@ -81,3 +81,6 @@ def convert(
     done = run_conversion(with_progress(sequence, f"converting {source}"), output, format_name, retime=retime)
     shifted = f"; {done.retimed} timestamps shifted by --retime" if done.retimed else ""
     typer.echo(f"wrote {done.scans} scans from {done.source} to {done.output} ({done.format_name}){shifted}")
+    if done.not_carried:  # ground truth no format holds: said, never dropped silently
+        lost = ", ".join(done.not_carried)
+        typer.echo(f"note: not carried over ({done.format_name} cannot hold it): {lost}", err=True)
