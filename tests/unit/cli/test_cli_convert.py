@@ -33,3 +33,24 @@ def test_convert_says_which_ground_truth_the_output_cannot_hold(
         "note: not carried over (albot-log cannot hold it): "
         "the floor plan (144 wall segments, 6 rooms, 7 doorways, 10 doorway crossings), licence\n"
     )
+
+
+def test_the_format_help_lists_what_the_registry_reads_and_writes() -> None:
+    from albot1.cli import convert as command
+    from albot1.data.loaders.registry import FORMATS, WRITE_ONLY_FORMATS
+
+    assert command.READ_FORMATS == tuple(FORMATS)
+    assert command.WRITE_FORMATS == (*[n for n, (_, w) in FORMATS.items() if w], *WRITE_ONLY_FORMATS)
+    assert command.FORMAT_HELP.startswith("carmen | ros1 | ros2-sqlite3 | ros2-mcap | albot-log | rawlog (")
+    assert "rawlog is write-only" in command.FORMAT_HELP and "rawlog" not in command.FROM_HELP
+
+
+def test_converting_a_rawlog_back_names_it_write_only(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rawlog = tmp_path / "pl.rawlog"
+    assert run_cli(monkeypatch, capsys, "convert", "synthetic-places-loop[:5]", str(rawlog))[0] == 0
+    code, _, err = run_cli(monkeypatch, capsys, "convert", str(rawlog), str(tmp_path / "x.clf"))
+    assert code == 1
+    assert err.startswith(f"albot1: error: {rawlog}: an MRPT rawlog; albot1 writes rawlogs only as input for MRPT's")
+    assert err.count("\n") == 1 and not (tmp_path / "x.clf").exists()
