@@ -1,4 +1,4 @@
-"""``albot1 convert`` as a user runs it, on synthetic worlds (no dataset needed): what it says it did not carry
+"""``albot1 convert`` (and one `albot1 run --set`) as a user runs it, on synthetic worlds: what it did not carry
 over, and the paths its errors name."""
 
 from __future__ import annotations
@@ -54,3 +54,14 @@ def test_converting_a_rawlog_back_names_it_write_only(
     assert code == 1
     assert err.startswith(f"albot1: error: {rawlog}: an MRPT rawlog; albot1 writes rawlogs only as input for MRPT's")
     assert err.count("\n") == 1 and not (tmp_path / "x.clf").exists()
+
+
+def test_a_rejected_override_repeats_the_value_found(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = run_cli(monkeypatch, capsys, "run", "odometry", "synthetic-places-loop[:5]", "--set", "map_every=0")
+    assert code == 1
+    assert err == (
+        "albot1: error: invalid config for method 'odometry' (preset 'default'): "
+        "map_every: Input should be greater than or equal to 1, found 0 (from --set)\n"
+    )
