@@ -87,9 +87,16 @@ class ResultsStore:
     def read_plan(self) -> GridPlan:
         path = self.root / PLAN
         if not path.exists():
-            raise BenchError(
-                f"{self.root}: not a results folder of `albot1 bench` (no {PLAN}); run `albot1 bench SUITE` first"
-            )
+            # what the user named is said first: a typo ("does not exist") is not a folder missing its grid
+            if not self.root.exists():
+                found = "does not exist; expected a results folder of `albot1 bench`"
+            elif self.root.is_file():
+                found = "is a file, not a results folder of `albot1 bench`"
+            elif not self.root.is_dir():
+                found = "is not a folder; expected a results folder of `albot1 bench`"
+            else:
+                found = f"not a results folder of `albot1 bench` (no {PLAN})"
+            raise BenchError(f"{self.root}: {found}; run `albot1 bench SUITE` first")
         return parse_plan(read_json_file(path, "grid plan written by `albot1 bench`"), path)
 
     # -- locking ----------------------------------------------------------

@@ -10,7 +10,12 @@ import typer
 from albot1.cli.progress import with_progress
 from albot1.settings import get_settings
 
-FORMAT_HELP = "carmen | ros1 | ros2-sqlite3 | ros2-mcap | albot-log (default: from OUT's name)"
+#: The formats each side takes, spelled out here because this module may not import the data layer (it is
+#: heavy; see albot1.cli.app); a unit test keeps them equal to albot1.data.loaders.registry.
+READ_FORMATS = ("carmen", "ros1", "ros2-sqlite3", "ros2-mcap", "albot-log")
+WRITE_FORMATS = (*READ_FORMATS, "rawlog")
+FORMAT_HELP = f"{' | '.join(WRITE_FORMATS)} (default: from OUT's name; rawlog is write-only, for MRPT's applications)"
+FROM_HELP = f"IN's format, when sniffing is not enough: {' | '.join(READ_FORMATS)}"
 
 
 def register(app: typer.Typer) -> None:
@@ -24,9 +29,7 @@ def convert(
     ],
     output: Annotated[Path, typer.Argument(metavar="OUT", help="the file (or ROS2 bag folder) to create")],
     format_name: Annotated[str | None, typer.Option("--format", help=FORMAT_HELP)] = None,
-    source_format: Annotated[
-        str | None, typer.Option("--from", help="IN's format, when sniffing is not enough")
-    ] = None,
+    source_format: Annotated[str | None, typer.Option("--from", help=FROM_HELP)] = None,
     scan_topic: Annotated[str | None, typer.Option(help="bag input: the LaserScan topic")] = None,
     odom_topic: Annotated[str | None, typer.Option(help="bag input: the Odometry topic, or /tf")] = None,
     reference_topic: Annotated[str | None, typer.Option(help="bag input: a ground-truth Odometry topic")] = None,
@@ -49,7 +52,8 @@ def convert(
 
     OUT's name picks the format unless --format is given: .bag (ROS1),
     .db3 / .mcap (ROS2 bag folder), .albotlog[.gz] (the robot's own log),
-    .clf / .log [.gz|.bz2] (CARMEN).
+    .clf / .log [.gz|.bz2] (CARMEN), .rawlog[.gz] (MRPT; written for
+    MRPT's applications, never read back).
 
     Examples:\n
       albot1 convert aces aces.bag\n
@@ -81,3 +85,6 @@ def convert(
     done = run_conversion(with_progress(sequence, f"converting {source}"), output, format_name, retime=retime)
     shifted = f"; {done.retimed} timestamps shifted by --retime" if done.retimed else ""
     typer.echo(f"wrote {done.scans} scans from {done.source} to {done.output} ({done.format_name}){shifted}")
+    if done.not_carried:  # ground truth no format holds: said, never dropped silently
+        lost = ", ".join(done.not_carried)
+        typer.echo(f"note: not carried over ({done.format_name} cannot hold it): {lost}", err=True)

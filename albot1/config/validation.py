@@ -7,6 +7,7 @@ user sees the same shape of message whatever file or flag they got wrong.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from typing import Any
 
@@ -34,9 +35,43 @@ def describe_errors(exc: ValidationError, sources: Mapping[str, str] | None = No
         location = ".".join(str(part) for part in error["loc"]) or "(top level)"
         origin = sources.get(str(error["loc"][0])) if sources and error["loc"] else None
         suffix = f" (from {origin})" if origin else ""
-        what = f", found {_describe_value(error['input'])}" if found and _is_type_error(error["type"]) else ""
-        problems.append(f"{location}: {error['msg']}{what}{suffix}")
+        problems.append(f"{location}: {error['msg']}{_found(error, typed=found)}{suffix}")
     return "; ".join(problems)
+
+
+#: Error kinds whose input is not the problem: a missing field has none, an unknown field's value is beside the point.
+_NO_VALUE_SHOWN = frozenset({"missing", "extra_forbidden"})
+#: A string shown bare (``found 0``, ``found inf``): what a person types for one value; anything else is quoted.
+_BARE = re.compile(r"[\w.+\-]{1,40}")
+#: A quoted string is cut to this many characters, so one bad value cannot flood the line.
+_SHOWN_CHARS = 60
+
+
+def _found(error: Any, *, typed: bool = False) -> str:
+    """``", found 0"``: the value that was rejected, when it is one number, boolean or string.
+
+    Why: "Input should be greater than or equal to 1" says what was expected;
+    the value found tells a user which of their inputs it was (a ``--set``, an
+    environment variable and a preset may all set the same field).
+    Containers (a whole table, a list) are not repeated: their own items'
+    errors name them. ``typed`` (:func:`describe_errors`' ``found``): a value
+    of the wrong type is named with its type (``found the boolean true``).
+    """
+    if error["type"] in _NO_VALUE_SHOWN or "input" not in error:
+        return ""
+    value = error["input"]
+    if typed and _is_type_error(error["type"]):
+        return f", found {_describe_value(value)}"
+    if isinstance(value, str):
+        if _BARE.fullmatch(value):
+            return f", found {value}"
+        shown = value if len(value) <= _SHOWN_CHARS else value[:_SHOWN_CHARS] + "..."
+        return f", found {shown!r}"
+    if value is None or isinstance(value, bool):
+        return f", found {str(value).lower() if isinstance(value, bool) else 'null'}"  # as TOML and JSON spell them
+    if isinstance(value, int | float):
+        return f", found {value}"
+    return ""
 
 
 def _an_item_failed(loc: tuple[int | str, ...], errors: list[Any]) -> bool:

@@ -55,13 +55,49 @@ def guess_format(path: str | Path) -> str:
 
 @dataclass(frozen=True)
 class Conversion:
-    """What :func:`convert` did; ``retimed`` counts scans whose timestamp was shifted."""
+    """What :func:`convert` did; ``retimed`` counts scans whose timestamp was shifted.
+
+    ``not_carried`` names what the source holds beyond its frames that the output cannot hold
+    (:func:`not_carried`), so the caller can say so instead of dropping it silently.
+    """
 
     source: str
     output: Path
     format_name: str
     scans: int
     retimed: int = 0
+    not_carried: tuple[str, ...] = ()
+
+
+#: ``metadata.extra`` keys of a synthetic world's floor plan (:func:`albot1.data.synthetic.generate.world_metadata`),
+#: the truth the places metrics score against, with the noun each count is shown with.
+_FLOOR_PLAN = (("spaces", "rooms"), ("doorways", "doorways"), ("doorway_crossings", "doorway crossings"))
+
+
+def not_carried(sequence: Sequence) -> tuple[str, ...]:
+    """What of ``sequence`` beyond its frames no writer stores, e.g. ``("1279 relations", "licence and citation")``.
+
+    Every output format holds scans, odometry, reference poses and the sensor
+    mounting, nothing else: ground-truth relations (scored by the relations
+    metric), a synthetic world's rooms, doorways and crossings (scored by the
+    places metrics) and the data's licence and citation are lost in the
+    conversion. A relations file can be attached again (``OUT?relations=FILE``).
+    """
+    out = []
+    if sequence.relations is not None and len(sequence.relations):
+        out.append(f"{len(sequence.relations)} relations")
+    extra = sequence.metadata.extra
+    plan = [f"{len(extra[key])} {noun}" for key, noun in _FLOOR_PLAN if isinstance(extra.get(key), list) and extra[key]]
+    walls = extra.get("wall_segments")
+    if isinstance(walls, int) and walls:
+        plan.insert(0, f"{walls} wall segments")
+    if plan:
+        out.append(f"the floor plan ({', '.join(plan)})")
+    meta = sequence.metadata
+    told = [what for what, text in (("licence", meta.license), ("citation", meta.citation)) if text]
+    if told:
+        out.append(" and ".join(told))
+    return tuple(out)
 
 
 def retimed(frames: Iterator[Frame], shifted: list[int]) -> Iterator[Frame]:
@@ -130,4 +166,5 @@ def convert(
         format_name=target,
         scans=count[0],
         retimed=shifted[0],
+        not_carried=not_carried(sequence),
     )

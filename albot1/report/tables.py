@@ -357,10 +357,34 @@ def markdown(
     return "\n".join(lines)
 
 
+#: Characters LaTeX reads as markup, or that the default OT1 font encoding prints as another glyph
+#: (``|`` as an em dash, ``<`` and ``>`` as inverted marks, ``"`` as a closing curly quote), and what to write.
+#: ``\textbar``, ``\textless`` and ``\textgreater`` work in every encoding (the kernel's fallbacks);
+#: ``\textquotedbl`` exists only with T1 (an error under OT1), so ``"`` is the typewriter font's straight
+#: quote, character 34 in both OT1 and T1, which needs no package in a table pasted into any preamble.
+_LATEX_ESCAPES = {
+    "\\": r"\textbackslash{}",
+    "&": r"\&",
+    "%": r"\%",
+    "$": r"\$",
+    "#": r"\#",
+    "_": r"\_",
+    "{": r"\{",
+    "}": r"\}",
+    "~": r"\textasciitilde{}",
+    "^": r"\textasciicircum{}",
+    "|": r"\textbar{}",
+    "<": r"\textless{}",
+    ">": r"\textgreater{}",
+    '"': r"{\ttfamily\char34}",
+    "–": "--",
+    "…": r"\dots{}",
+}
+
+
 def _latex_escape(text: str) -> str:
-    table = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{"}
-    table |= {"}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "–": "--", "…": r"\dots{}"}
-    return "".join(table.get(ch, ch) for ch in str(text))
+    """``text`` as LaTeX prints it literally (names of datasets, methods, degradations come from users)."""
+    return "".join(_LATEX_ESCAPES.get(ch, ch) for ch in str(text))
 
 
 def latex(table: pd.DataFrame, columns: dict[str, Column], title: str, selected: str | None = None) -> str:

@@ -187,7 +187,9 @@ def test_results_that_cannot_be_a_folder_are_refused_before_planning(
         "(it is made when missing)"
     )
     line = _one_line(_albot1_in_process(tmp_path, monkeypatch, capsys, "report", "results"))
-    assert "not a results folder" in line or "no grid.json" in line
+    assert line == (
+        "albot1: error: results: is a file, not a results folder of `albot1 bench`; run `albot1 bench SUITE` first"
+    )
 
 
 def test_a_suite_with_no_cell_to_run_exits_1_and_its_report_says_so(tmp_path: Path) -> None:

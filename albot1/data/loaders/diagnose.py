@@ -20,6 +20,11 @@ EXPECTED = (
     "an albot log (first line 'ALBOT1-LOG 1'), a ROS1 bag ('#ROSBAG V2.0') or a ROS2 bag folder "
     "(metadata.yaml beside .db3/.mcap files)"
 )
+#: Why a rawlog is refused as input: the one wording for a rawlog found by its name or content, or named by --from.
+RAWLOG_WRITE_ONLY = (
+    "albot1 writes rawlogs only as input for MRPT's applications and cannot read them (rawlog is write-only); "
+    "give the log it was converted from, or read it with MRPT's own tools"
+)
 #: Decompressed lines looked at before giving up on finding a first message (the rest is not needed to
 #: describe the file, except when it is damaged, which only a full pass can show).
 _MAX_LINES = 1_000_000
@@ -28,6 +33,18 @@ _MAX_LINES = 1_000_000
 def _is_binary(line: bytes) -> bool:
     sample = line[:256]
     return b"\0" in sample or sum(b < 9 or 13 < b < 32 for b in sample) > len(sample) // 10
+
+
+def _is_rawlog(path: Path, head: bytes) -> bool:
+    """A ``.rawlog[.gz]`` name, or data that begins like MRPT's serialization (a class-name header, ``mrpt::...``).
+
+    Both, because a user who converted to a rawlog and tries to read it back deserves the true reason
+    ("write-only") rather than "binary data of no known format", whatever the file is called.
+    """
+    if path.name.lower().endswith((".rawlog", ".rawlog.gz")):
+        return True
+    length = head[0] & 0x7F if head else 0
+    return bool(head) and head[0] & 0x80 != 0 and head[1 : 1 + length].startswith(b"mrpt::") and length > 6
 
 
 def unrecognised(path: Path) -> DataError:
@@ -39,6 +56,8 @@ def unrecognised(path: Path) -> DataError:
     compression = compression_of(path)
     packed = "" if compression == "none" else f"{compression}-compressed "
     head = read_head(path)
+    if _is_rawlog(path, head):
+        return UnknownFormatError(f"{path}: an MRPT rawlog; {RAWLOG_WRITE_ONLY}")
     if _is_binary(head):
         return UnknownFormatError(f"{path}: binary {packed}data of no known format; {EXPECTED}")
     count = 0

@@ -2,8 +2,9 @@
 
 Every writer (CARMEN, albot log, ROS1, ROS2) and ``albot1 convert`` follow
 one policy: the output must not exist; missing parent folders are created;
-a parent that is a file, a folder that is not writable or a read-only file
-system is refused *before* anything is read or written, naming the path; an
+a parent that is a file, a folder that is not writable, a read-only file
+system or a kernel pseudo-file system (``/proc``, ``/sys``) is refused
+*before* anything is read or written, naming the path; an
 ``OSError`` while writing (disk full, permissions changed, ...) becomes a
 :class:`~albot1.data.errors.WriteError` naming the path, never a traceback.
 """
@@ -52,10 +53,16 @@ def check_output(path: str | Path) -> Path:
     existing = _first_existing(parent.absolute())
     if not existing.is_dir():
         raise WriteError(f"{out}: cannot be created, {existing} is a file, not a folder")
+    if _without_storage(existing):
+        raise WriteError(f"{out}: cannot be created in {existing}: {NO_STORAGE}")
     if not os.access(existing, os.W_OK | os.X_OK):
         how = "the file system is read-only" if _read_only(existing) else "permission denied"
         raise WriteError(f"{out}: cannot be created in {existing}: {how}")
     return out
+
+
+#: Why a folder of /proc or /sys cannot take an output, even for root (whom ``os.access`` always lets write).
+NO_STORAGE = "it is on a kernel pseudo-file system (like /proc and /sys), where no file can be created"
 
 
 def _read_only(folder: Path) -> bool:
@@ -63,6 +70,21 @@ def _read_only(folder: Path) -> bool:
         return bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
     except OSError:
         return False
+
+
+def _without_storage(folder: Path) -> bool:
+    """A file system with neither blocks nor inodes (procfs, sysfs).
+
+    Creating a file there fails (ENOENT) only once the writer opens it, after
+    the whole input was read, and reads as "a folder on the way does not
+    exist" though the folder exists; root passes ``os.access``, so the stat
+    of the file system is what tells.
+    """
+    try:
+        stats = os.statvfs(folder)
+    except OSError:
+        return False
+    return stats.f_blocks == 0 and stats.f_files == 0
 
 
 def prepare_output(path: str | Path) -> Path:

@@ -14,7 +14,7 @@ from albot1.data import decoded
 from albot1.data.errors import DataError, UnknownFormatError
 from albot1.data.filekind import check_input
 from albot1.data.loaders.base import SequenceLoader, SequenceWriter
-from albot1.data.loaders.diagnose import unrecognised
+from albot1.data.loaders.diagnose import RAWLOG_WRITE_ONLY, unrecognised
 from albot1.data.model import Sequence
 
 #: format name -> (loader "module:Class", writer "module:Class" or None)
@@ -51,7 +51,8 @@ def _import(target: str) -> Any:
 
 def _check_format(name: str) -> tuple[str, str | None]:
     if name in WRITE_ONLY_FORMATS:
-        raise UnknownFormatError(f"format {name!r} can be written but not read")
+        why = f"; {RAWLOG_WRITE_ONLY}" if name == "rawlog" else ""
+        raise UnknownFormatError(f"format {name!r} can be written but not read{why}")
     try:
         return FORMATS[name]
     except KeyError:

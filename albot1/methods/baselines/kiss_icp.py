@@ -61,8 +61,9 @@ import math
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
+from albot1.config.method_model import MethodConfig
 from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
@@ -80,13 +81,11 @@ if TYPE_CHECKING:
 _LISTED_FALLBACKS = 200
 
 
-class KissIcpConfig(BaseModel):
+class KissIcpConfig(MethodConfig):
     """Types, bounds and meaning of the KISS-ICP baseline's settings.
 
     The values live in ``baselines/kiss-icp.toml`` (see :mod:`albot1.config.presets`).
     """
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     voxel_size_m: float = Field(
         gt=0,

@@ -16,8 +16,9 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
+from albot1.config.method_model import MethodConfig
 from albot1.config.presets import TomlPresets
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
@@ -25,10 +26,8 @@ from albot1.geometry import se2
 from albot1.methods.baselines.point_map import ThinnedPointMap
 
 
-class OdometryConfig(BaseModel):
+class OdometryConfig(MethodConfig):
     """Config of the odometry baseline."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     map_voxel_m: float = Field(0.05, gt=0, description="grid cell for thinning the projected map points")
     map_every: int = Field(1, ge=1, description="project every n-th scan into the map")

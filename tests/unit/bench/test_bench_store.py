@@ -99,6 +99,18 @@ def test_read_plan_of_a_folder_that_is_not_a_results_folder(tmp_path: Path) -> N
         ResultsStore(tmp_path).read_plan()
 
 
+def test_read_plan_says_what_the_path_is_when_it_is_no_folder(tmp_path: Path) -> None:
+    """A typo or a file is named as such, not as a folder missing its grid.json."""
+    (tmp_path / "afile").write_text("x")
+    for name, found in [
+        ("nonexist", "does not exist; expected a results folder of `albot1 bench`"),
+        ("afile", "is a file, not a results folder of `albot1 bench`"),
+    ]:
+        with pytest.raises(BenchError) as info:
+            ResultsStore(tmp_path / name).read_plan()
+        assert str(info.value) == f"{tmp_path / name}: {found}; run `albot1 bench SUITE` first"
+
+
 @pytest.mark.parametrize(
     ("ended", "error", "kind", "words"),
     [

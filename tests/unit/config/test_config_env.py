@@ -90,7 +90,7 @@ def test_project_settings_are_never_method_variables(monkeypatch: pytest.MonkeyP
 
 def test_a_bad_value_names_its_variable(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("ALBOT1_TOY_MODE", "c")
-    with pytest.raises(ConfigError, match=r"mode: Input should be 'a' or 'b' \(from env ALBOT1_TOY_MODE\)"):
+    with pytest.raises(ConfigError, match=r"mode: Input should be 'a' or 'b', found c \(from env ALBOT1_TOY_MODE\)"):
         resolve(_Toy, PRESETS, "default", env_prefix="ALBOT1_TOY_", owner="toy")
 
 

@@ -10,7 +10,7 @@ import pytest
 from albot1.data.convert import convert, guess_format
 from albot1.data.errors import UnknownFormatError
 from albot1.data.loaders.registry import load
-from albot1.data.model import Frame, Scan, Sequence
+from albot1.data.model import Frame, Relations, Scan, Sequence, SequenceMetadata
 
 
 @pytest.mark.parametrize(
@@ -56,3 +56,18 @@ def test_retime_shifts_only_repeated_or_backward_stamps(tmp_path: Path) -> None:
     back = [f.scan.timestamp for f in load(tmp_path / "j.mcap").frames()]
     assert back == pytest.approx([10.0, 10.000001, 10.000002, 12.0, 12.000001], abs=1e-9)
     assert [f.odometry[0] for f in load(tmp_path / "j.mcap").frames()] == [0.0, 1.0, 2.0, 3.0, 4.0]
+
+
+def test_what_no_format_holds_is_named_not_dropped_silently(tmp_path: Path) -> None:
+    angles = np.linspace(-1.0, 1.0, 5)
+    frames = [Frame(i, Scan(np.full(5, 1.0), angles, float(i), 5.0), np.array([i, 0.0, 0.0])) for i in range(3)]
+    relations = Relations(np.array([0.0, 1.0, 0.0]), np.array([1.0, 2.0, 2.0]), np.zeros((3, 3)))
+    metadata = SequenceMetadata(
+        license="CC-BY",
+        extra={"wall_segments": 4, "spaces": [{"name": "a"}, {"name": "b"}], "doorways": [{}], "doorway_crossings": []},
+    )
+    done = convert(Sequence.from_frames("truth", frames, metadata, relations), tmp_path / "t.clf")
+    assert done.not_carried == ("3 relations", "the floor plan (4 wall segments, 2 rooms, 1 doorways)", "licence")
+    plain = convert(Sequence.from_frames("plain", frames, SequenceMetadata(citation="X")), tmp_path / "p.albotlog")
+    assert plain.not_carried == ("citation",)
+    assert convert(Sequence.from_frames("bare", frames), tmp_path / "b.albotlog").not_carried == ()

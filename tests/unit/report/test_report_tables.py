@@ -259,6 +259,18 @@ def test_latex_tables_are_booktabs_with_escaped_labels(tmp_path: Path) -> None:
     assert "odometry & gauss:0.1:1 & 1.50 $\\pm$ 0.71 (1.00--2.00)" in tex
 
 
+def test_latex_escapes_every_character_tex_or_ot1_would_misprint(tmp_path: Path) -> None:
+    """``| < > "`` printed as other glyphs under OT1 (an em dash, inverted marks, a curly quote)."""
+    name = 'a|b<c>"d" \\&%$#_{}~^e'
+    written = write_tables([record(name, "odometry", "none", 0, 1.0)], tmp_path)
+    caption = next(line for line in written["metrics.tex"].read_text().splitlines() if line.startswith("\\caption"))
+    assert caption == (
+        "\\caption{Accuracy per dataset, method and degradation: "
+        "a\\textbar{}b\\textless{}c\\textgreater{}{\\ttfamily\\char34}d{\\ttfamily\\char34} "
+        "\\textbackslash{}\\&\\%\\$\\#\\_\\{\\}\\textasciitilde{}\\textasciicircum{}e}"
+    )
+
+
 def test_write_tables_keeps_cost_out_of_the_accuracy_files(tmp_path: Path) -> None:
     import pandas as pd
 

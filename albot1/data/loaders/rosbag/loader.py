@@ -249,6 +249,11 @@ class Ros2BagLoader:
         path = Path(path)
         if not path.exists():
             raise DataError(f"{path}: no such ROS2 bag folder")
+        if not (path.is_dir() or path.suffix in self.suffixes or path.name == "metadata.yaml"):  # a ROS1 .bag
+            raise DataError(
+                f"{path}: not a ROS2 bag; expected its folder (metadata.yaml beside .db3/.mcap storage files) "
+                "or one of its .db3/.mcap storage files"
+            )
         folder = self.bag_dir(path)
         if folder is None:
             where = path if path.is_dir() else path.parent

@@ -15,18 +15,17 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
+from albot1.config.method_model import MethodConfig
 from albot1.methods.albot1.mapping.noise_split import MIN_WEIGHT
 from albot1.methods.albot1.mapping.overlap import NO_LIMIT
 from albot1.methods.albot1.mapping.plus_params import PlusParams
 from albot1.methods.albot1.perception.view import ViewParams
 
 
-class Albot1Config(BaseModel):
+class Albot1Config(MethodConfig):
     """Config of the Albot1 mapper (lengths in metres, angles in degrees)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     # 3.1.3 view construction
     max_range_m: float = Field(30.0, gt=0, description="3.1.3 step 1: readings beyond this are deleted")

@@ -17,8 +17,9 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
+from albot1.config.method_model import MethodConfig
 from albot1.methods.albot1.mapping.config import Albot1Config
 
 
@@ -59,10 +60,8 @@ class MatchParams:
     max_shift: float = 3.0
 
 
-class PlacesFields(BaseModel):
+class PlacesFields(MethodConfig):
     """The chapter-4 fields alone (lengths in metres, angles in degrees), set by ``baselines/albot1-places.toml``."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     # exits (4.1.1: "a gap whose typical size is about 1 meter")
     exit_min_width_m: float = Field(0.6, gt=0, description="4.1.1: narrowest gap between two endpoints that is an exit")
@@ -226,5 +225,3 @@ class PlacesFields(BaseModel):
 
 class Albot1PlacesConfig(Albot1Config, PlacesFields):
     """Config of ``albot1-places``: every chapter-3 field (:class:`Albot1Config`) and the chapter-4 ones."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)

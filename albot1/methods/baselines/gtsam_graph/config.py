@@ -13,15 +13,14 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
+from albot1.config.method_model import MethodConfig
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams
 
 
-class GtsamGraphConfig(BaseModel):
+class GtsamGraphConfig(MethodConfig):
     """Every knob of the graph SLAM baseline, with units in the field names."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     # Nodes (Grisetti et al. 2010: a node when the robot moved enough to see something new).
     node_translation_m: float = Field(gt=0, description="odometry translation since the last node that creates a node")
@@ -36,11 +35,9 @@ class GtsamGraphConfig(BaseModel):
 
     # Registration (point-to-line ICP, albot1.methods.baselines.gtsam_graph.registration).
     icp_max_iterations: int = Field(ge=1, description="Gauss-Newton iterations per registration")
-    icp_max_correspondence_m: float = Field(
-        gt=0, allow_inf_nan=False, description="initial correspondence gate (annealed down)"
-    )
+    icp_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate (annealed down)")
     icp_min_correspondence_m: float = Field(
-        gt=0, allow_inf_nan=False, description="final correspondence gate; inliers are counted within it"
+        gt=0, description="final correspondence gate; inliers are counted within it"
     )
     point_sigma_m: float = Field(gt=0, description="std dev of one point-to-line residual (sets the match information)")
     normal_neighbours: int = Field(ge=3, description="neighbours used to fit each target point's line")
@@ -70,9 +67,7 @@ class GtsamGraphConfig(BaseModel):
         gt=0, description="prior std dev of the odometry guess over one scan period (x, y), used inside tracking ICP"
     )
     track_prior_sigma_theta_deg: float = Field(gt=0, description="... (theta)")
-    track_max_correspondence_m: float = Field(
-        gt=0, allow_inf_nan=False, description="initial correspondence gate of tracking matches"
-    )
+    track_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of tracking matches")
     track_max_correction_m: float = Field(gt=0, description="a tracking match may move its guess this far at most")
     track_max_correction_deg: float = Field(gt=0, description="... and rotate it this much at most")
     track_wide_correction_deg: float = Field(
@@ -127,6 +122,7 @@ class GtsamGraphConfig(BaseModel):
     )
     odometry_trust_turn_deg: float = Field(
         gt=0,
+        allow_inf_nan=True,  # inf (the preset's value) means "one population"; gt=0 still refuses NaN
         description="... steps whose odometry turns more than this learnt and judged apart from the others "
         "(odometry_trust.OdometryTrust.kind; inf: one population)",
     )
@@ -166,7 +162,9 @@ class GtsamGraphConfig(BaseModel):
         ge=0, description="... a run factor's variance never below this times its chain of matches' stated variance"
     )
     odometry_trust_run_max_turn_deg: float = Field(
-        gt=0, description="... runs holding a node step whose odometry turns more than this are left out (inf: none)"
+        gt=0,
+        allow_inf_nan=True,  # inf (the preset's value) means "no run is left out"; gt=0 still refuses NaN
+        description="... runs holding a node step whose odometry turns more than this are left out (inf: none)",
     )
     seq_min_fitness: float = Field(ge=0, le=1, description="a sequential match needs this inlier fraction")
     seq_max_rmse_m: float = Field(
@@ -210,9 +208,7 @@ class GtsamGraphConfig(BaseModel):
     loop_submap_nodes: int = Field(
         ge=0, description="a candidate's submap is its scan plus this many node scans either side"
     )
-    loop_max_correspondence_m: float = Field(
-        gt=0, allow_inf_nan=False, description="initial correspondence gate of loop matches"
-    )
+    loop_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of loop matches")
     loop_coarse_max_half_width_m: float = Field(
         ge=0, description="failed loop matches are retried from a correlative search this wide at most (0 = off)"
     )
@@ -311,9 +307,7 @@ class GtsamGraphConfig(BaseModel):
     refine_nodes_either_side: int = Field(
         ge=0, description="the refinement's local map: the scan's node and this many node scans either side"
     )
-    refine_max_correspondence_m: float = Field(
-        gt=0, allow_inf_nan=False, description="initial correspondence gate of the refinement"
-    )
+    refine_max_correspondence_m: float = Field(gt=0, description="initial correspondence gate of the refinement")
     refine_min_fitness: float = Field(ge=0, le=1, description="a refined pose needs this inlier fraction")
     refine_max_rmse_m: float = Field(gt=0, description="... and this inlier RMS point-to-line distance or less")
     refine_max_correction_m: float = Field(gt=0, description="... and may move its seed this far at most (m)")

@@ -11,7 +11,9 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
+
+from albot1.config.method_model import MethodConfig
 
 #: Upper bounds of the run limits: a day and 1 TB are beyond any machine this runs on, and
 #: bounding them keeps a typo (``timeout_s = 1e12``) from passing validation.
@@ -19,10 +21,8 @@ MAX_TIMEOUT_S = 86_400.0
 MAX_MEMORY_MB = 1_048_576.0
 
 
-class MrptRunConfig(BaseModel):
+class MrptRunConfig(MethodConfig):
     """What every MRPT baseline shares: run limits and output checks."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
     timeout_s: float = Field(
         gt=0, le=MAX_TIMEOUT_S, description="wall-clock limit of the MRPT process; beyond it the process is killed"

@@ -107,6 +107,19 @@ def _refuse_mkdir(root: Path, real):  # type: ignore[no-untyped-def]
     return mkdir
 
 
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+def test_a_pseudo_file_system_is_refused_before_reading(tmp_path: Path) -> None:
+    """/proc takes no file even for root (whom os.access lets write): refused up front, naming /proc."""
+    with pytest.raises(WriteError) as info:
+        check_output("/proc/x.clf")
+    assert str(info.value) == (
+        "/proc/x.clf: cannot be created in /proc: it is on a kernel pseudo-file system (like /proc and /sys), "
+        "where no file can be created"
+    )
+    with pytest.raises(WriteError, match=r"^/proc/x\.clf: cannot be created in /proc: it is on a kernel"):
+        convert(tmp_path / "does-not-exist.clf", "/proc/x.clf")  # the input is never opened
+
+
 def test_convert_checks_the_output_before_reading_the_input(tmp_path: Path) -> None:
     (tmp_path / "file").write_text("")
     with pytest.raises(WriteError, match="is a file, not a folder"):

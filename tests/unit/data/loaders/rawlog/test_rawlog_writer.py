@@ -175,6 +175,33 @@ def test_rawlog_is_write_only_in_the_registry(tmp_path: Path) -> None:
         writer_for("nope")
 
 
+WRITE_ONLY = (
+    "albot1 writes rawlogs only as input for MRPT's applications and cannot read them (rawlog is write-only); "
+    "give the log it was converted from, or read it with MRPT's own tools"
+)
+
+
+@pytest.mark.parametrize("name", ["back.rawlog", "back.rawlog.gz", "renamed.bin"])
+def test_reading_a_rawlog_back_says_it_is_write_only(tmp_path: Path, name: str) -> None:
+    """By its name, or by MRPT's serialization header under any name (not "binary data of no known format")."""
+    written = tmp_path / ("back.rawlog.gz" if name.endswith(".gz") else "back.rawlog")
+    RawlogWriter().write(Sequence.from_frames("r", [_frame(0, (0.0, 0.0, 0.0))]), written)
+    path = written if name != "renamed.bin" else written.rename(tmp_path / name)
+    with pytest.raises(UnknownFormatError) as info:
+        loader_for(path)
+    assert str(info.value) == f"{path}: an MRPT rawlog; {WRITE_ONLY}"
+    with pytest.raises(UnknownFormatError) as info:
+        loader_for(path, "rawlog")
+    assert str(info.value) == f"format 'rawlog' can be written but not read; {WRITE_ONLY}"
+
+
+def test_other_binary_data_is_not_called_a_rawlog(tmp_path: Path) -> None:
+    path = tmp_path / "x.bin"
+    path.write_bytes(bytes([0x86]) + b"mrpt::" + bytes(range(200)))  # a header too short for a class name
+    with pytest.raises(UnknownFormatError, match=r"binary data of no known format"):
+        loader_for(path)
+
+
 def test_an_empty_sequence_leaves_no_file(tmp_path: Path) -> None:
     with pytest.raises(DataError, match="no scans"):
         RawlogWriter().write(Sequence.from_frames("empty", []), tmp_path / "e.rawlog")

@@ -184,6 +184,19 @@ def test_ros2_folder_without_metadata_names_the_missing_file(tmp_path: Path) -> 
             load(target)
 
 
+@pytest.mark.parametrize("fmt", ["ros2-mcap", "ros2-sqlite3"])
+def test_a_file_read_as_a_ros2_bag_is_named_not_its_folder(tmp_path: Path, fmt: str) -> None:
+    """``--from ros2-mcap`` on a ROS1 ``.bag`` used to blame the folder it sits in (``.: not a ROS2 bag folder``)."""
+    bag = tmp_path / "pl.bag"
+    bag.write_bytes(b"#ROSBAG V2.0\n")  # never read: the path alone is refused
+    with pytest.raises(DataError) as info:
+        load(bag, fmt)
+    assert str(info.value) == (
+        f"{bag}: not a ROS2 bag; expected its folder (metadata.yaml beside .db3/.mcap storage files) "
+        "or one of its .db3/.mcap storage files"
+    )
+
+
 def test_old_bag_versions_say_what_is_supported() -> None:
     assert version_problem(b"#ROSBAG V2.0") is None
     problem = str(version_problem(b"#ROSRECORD V1.2"))
