@@ -33,7 +33,9 @@ inv(estimate[s]) * point``): where the robot believed it was relative to
 itself. Each prediction compared at a crossing is then measured against the
 true doorway (the one nearest the exit perceived there), aligned and not
 aligned; each detected crossing is matched to a true doorway crossing within
-``crossing_scans`` scans.
+``crossing_scans`` scans, the true crossings numbered by the scans the run
+saw (:func:`crossings_in_run`: by time, so slices, view spacing and dropout
+renumber them as they renumber the run's scans).
 """
 
 from __future__ import annotations
@@ -48,6 +50,8 @@ from albot1.geometry.types import FloatArray
 from albot1.metrics.errors import MetricsError
 
 PLACES_JSON = "places.json"
+#: Slack of a crossing's time against the scored scans' times (``trajectory.tum`` keeps nine decimals).
+TIME_SLACK_S = 1e-6
 
 
 def visit_region(reference: FloatArray, first: int, last: int, buffer_m: float) -> Any:
@@ -151,8 +155,40 @@ def _midpoint(segment: Any) -> FloatArray:
     return mid
 
 
+def crossings_in_run(true_crossings: list[Mapping[str, Any]], timestamps: FloatArray) -> list[int]:
+    """The run's scan number of each true doorway crossing it saw: its first scan at or after the crossing's time.
+
+    The dataset numbers its crossings by its own scans (``scan``, the first
+    one beyond the threshold, and that scan's time ``t``). A run may have
+    seen a selection of them, numbered afresh from 0: a prefix (``[:N]``,
+    ``--limit``), every STEP-th (``[::STEP]``), views spaced by ``?views=``
+    or a dropout's survivors. The scored scans keep their source times
+    through all of these, so the time finds the first scan the run saw on
+    the far side, the scan a detector could first notice it at. A crossing
+    outside the scored scans' times (after the last) is not in the run.
+    """
+    t = np.asarray(timestamps, dtype=float)
+    if t.size == 0:
+        return []
+    if np.any(np.diff(t) <= 0):
+        k = int(np.flatnonzero(np.diff(t) <= 0)[0])
+        raise MetricsError(
+            f"scan {k + 1}: time {t[k + 1]:.6f} s does not follow scan {k}'s {t[k]:.6f} s; the true doorway "
+            f"crossings are found among the scans by their times, which must increase"
+        )
+    out = []
+    for k, crossing in enumerate(true_crossings):
+        if "t" not in crossing:
+            raise MetricsError(f"doorway_crossings[{k}] of the dataset's metadata has no time 't' (s)")
+        when = float(crossing["t"])
+        if t[0] - TIME_SLACK_S <= when <= t[-1] + TIME_SLACK_S:
+            out.append(int(np.searchsorted(t, when - TIME_SLACK_S, side="left")))
+    return out
+
+
 def judge_exits(
     record: Mapping[str, Any],
+    timestamps: FloatArray,
     poses: FloatArray,
     reference: FloatArray,
     doorways: list[Mapping[str, Any]],
@@ -193,7 +229,7 @@ def judge_exits(
             np.mean([e["not_aligned_error_m"] for e in per_exit])
         )
     detected = [c["scan"] for c in record["crossings"]]
-    truth = [c["scan"] for c in true_crossings if c["scan"] < len(reference)]  # a run may cover a prefix
+    truth = crossings_in_run(true_crossings, timestamps)
     used: set[int] = set()
     matched = 0
     for s in detected:
@@ -212,19 +248,26 @@ def judge_exits(
 
 
 def judge_network(
-    record: Mapping[str, Any], poses: FloatArray, reference: FloatArray, dataset: Mapping[str, Any]
+    record: Mapping[str, Any],
+    timestamps: FloatArray,
+    poses: FloatArray,
+    reference: FloatArray,
+    dataset: Mapping[str, Any],
 ) -> dict[str, Any]:
     """Everything above for one run: the ``places`` block of ``metrics.json`` as plain data.
 
-    ``record`` is the run's ``places.json``; ``dataset`` is the sequence's
+    ``record`` is the run's ``places.json``; ``timestamps``, ``poses`` and
+    ``reference`` are the scored scans' (row by row); ``dataset`` is the sequence's
     metadata ``extra`` (doorways and their crossings for the synthetic worlds;
     the exit checks are left out, with the reason, without them). Undefined
     ratios (no claim, no re-visit) are NaN, null in the file.
     """
     poses = se2.as_poses(poses)
     reference = se2.as_poses(reference)
-    if len(poses) != len(reference):
-        raise MetricsError(f"{len(poses)} estimated poses but {len(reference)} reference poses")
+    if not len(poses) == len(reference) == len(timestamps):
+        raise MetricsError(
+            f"{len(poses)} estimated poses but {len(reference)} reference poses and {len(timestamps)} timestamps"
+        )
     counters, truth, summary = judge_revisits(record, reference, list(dataset.get("spaces") or []))
     nan = float("nan")
     block: dict[str, Any] = {
@@ -244,7 +287,7 @@ def judge_network(
     if not doorways:
         return {**block, "exits": None, "exits_reason": "the dataset knows no doorways (exit checks need them)"}
     exit_counters, exit_summary = judge_exits(
-        record, poses, reference, list(doorways), list(dataset.get("doorway_crossings", []))
+        record, timestamps, poses, reference, list(doorways), list(dataset.get("doorway_crossings", []))
     )
     return {
         **block,

@@ -96,7 +96,7 @@ def compute(inputs: MetricInputs) -> PlacesBlock:
     except Albot1Error as exc:
         raise MetricsError(f"cannot reopen dataset {inputs.dataset!r} for its rooms and doorways: {exc}") from exc
     try:
-        data = judge_network(record, inputs.poses, reference, extra)
+        data = judge_network(record, inputs.timestamps, inputs.poses, reference, extra)
     except (KeyError, TypeError, IndexError) as exc:
         raise MetricsError(f"{PLACES_JSON}: unexpected content ({type(exc).__name__}: {exc})") from None
     return block_of(PlacesBlock, data)

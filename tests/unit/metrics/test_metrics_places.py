@@ -8,11 +8,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from albot1.data.degrade import degrade
+from albot1.data.open import open_sequence
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.measures.places import METRIC as PLACES
 from albot1.metrics.measures.places import compute as places_compute
 from albot1.metrics.measures.places import headline as places_headline
-from albot1.metrics.places import believed_in_world, judge_network, judge_revisits
+from albot1.metrics.places import believed_in_world, crossings_in_run, judge_network, judge_revisits
 from albot1.metrics.unit import MetricInputs
 
 # Two rooms side by side, x 0..5 (room-a) and 5.2..10 (room-b), joined by a doorway at x = 5.1, y 2..3.
@@ -101,8 +103,9 @@ def test_judge_network_scores_exit_predictions_and_crossings() -> None:
     }
     rec = record([0, 1, 0, 1], [(2, 0, "structure"), (3, 1, "exit")])
     rec["crossings"] = [crossing, {"scan": 19, "exit": 0, "segment": [4.1, 2.0, 4.1, 3.0], "prediction": None}]
-    dataset = {"spaces": SPACES, "doorways": DOORWAYS, "doorway_crossings": [{"scan": 20}, {"scan": 40}, {"scan": 60}]}
-    block = judge_network(rec, est, ref, dataset)
+    true_crossings = [{"scan": 20, "t": 20.0}, {"scan": 40, "t": 40.0}, {"scan": 60, "t": 60.0}]
+    dataset = {"spaces": SPACES, "doorways": DOORWAYS, "doorway_crossings": true_crossings}
+    block = judge_network(rec, np.arange(80.0), est, ref, dataset)
     exits = block["exits"]
     assert exits["exit_prediction_aligned_true_mean_m"] == pytest.approx(0.1)
     assert exits["exit_prediction_not_aligned_true_mean_m"] == pytest.approx(math.hypot(1.0, 0.5))
@@ -113,23 +116,25 @@ def test_judge_network_scores_exit_predictions_and_crossings() -> None:
 
 
 def test_judge_network_without_doorways_says_why_there_is_no_exit_check() -> None:
-    block = judge_network(record([0, 1, 2, 3], []), route(), route(), {"spaces": SPACES})
+    block = judge_network(record([0, 1, 2, 3], []), np.arange(80.0), route(), route(), {"spaces": SPACES})
     assert block["exits"] is None and block["exits_reason"].startswith("the dataset knows no doorways")
     assert math.isnan(block["revisit_precision"]) and block["revisit_recall"] == 0.0  # no claim: undefined, not 0
 
 
 def test_judge_network_refuses_mismatched_inputs() -> None:
-    with pytest.raises(MetricsError, match="80 estimated poses but 79 reference poses"):
-        judge_network(record([0, 1, 0, 1], []), route(), route()[:79], {})
+    with pytest.raises(MetricsError, match="80 estimated poses but 79 reference poses and 80 timestamps"):
+        judge_network(record([0, 1, 0, 1], []), np.arange(80.0), route(), route()[:79], {})
 
 
-def _places_inputs(rec: dict | None, extra: dict, estimate: np.ndarray | None = None) -> MetricInputs:
+def _places_inputs(
+    rec: dict | None, extra: dict, estimate: np.ndarray | None = None, timestamps: np.ndarray | None = None
+) -> MetricInputs:
     ref = route()
     est = ref if estimate is None else estimate
     files = {"places.json": rec} if rec is not None else {}
     return MetricInputs(
         dataset="two-rooms",
-        timestamps=np.arange(80.0),
+        timestamps=np.arange(80.0) if timestamps is None else timestamps,
         poses=est,
         reference=ref,
         relations=None,
@@ -163,3 +168,69 @@ def test_a_claims_file_of_the_wrong_shape_is_one_clear_error() -> None:
     bad = {"visits": [{"id": 0}], "revisits": []}
     with pytest.raises(MetricsError, match=r"^places.json: unexpected content \(KeyError: 'first_scan'\)$"):
         places_compute(_places_inputs(bad, {}))
+
+
+def _crossing(scan: int) -> dict:
+    return {"scan": scan, "exit": 0, "segment": [5.1, 2.0, 5.1, 3.0], "prediction": None}
+
+
+def test_true_crossings_are_renumbered_by_time_like_the_scans_the_run_saw() -> None:
+    """The run saw every 2nd scan of a 160-scan source (0.1 s apart): the truth's source numbers must follow.
+
+    The true crossings are at source scans 40, 80 and 121 and 170 (4.0, 8.0, 12.1, 17.0 s); the run's
+    scans are 0.2 s apart, so they are its scans 20, 40 and 61 (the first at or after each time), and the
+    last is after the run's end (15.8 s). The method detected 20, 40 and 61: all true, none missed.
+    """
+    rec = record([0, 1, 0, 1], [])
+    rec["crossings"] = [_crossing(20), _crossing(40), _crossing(61)]
+    truth = [{"scan": s, "t": round(0.1 * s, 9)} for s in (40, 80, 121, 170)]
+    assert crossings_in_run(truth, 0.2 * np.arange(80)) == [20, 40, 61]
+    extra = {"spaces": SPACES, "doorways": DOORWAYS, "doorway_crossings": truth}
+    block = places_compute(_places_inputs(rec, extra, timestamps=0.2 * np.arange(80)))
+    assert block.exits is not None
+    assert (block.exits.crossings_true, block.exits.crossings_false, block.exits.crossings_missed) == (3, 0, 0)
+
+
+def test_true_crossings_in_uneven_views_go_to_the_first_view_at_or_after_them() -> None:
+    # views kept at 0, 1.5, 1.7, 4.0, 9.0 s (view spacing, dropout); crossings at 1.5, 1.6, 3.999 9999 995, 9.5 s
+    times = np.array([0.0, 1.5, 1.7, 4.0, 9.0])
+    truth = [{"scan": 15, "t": 1.5}, {"scan": 16, "t": 1.6}, {"scan": 40, "t": 3.9999999995}, {"scan": 95, "t": 9.5}]
+    assert crossings_in_run(truth, times) == [1, 2, 3]
+
+
+def test_crossings_need_their_times_and_increasing_scan_times() -> None:
+    with pytest.raises(MetricsError, match=r"^doorway_crossings\[0\] of the dataset's metadata has no time 't' \(s\)$"):
+        crossings_in_run([{"scan": 3}], np.arange(5.0))
+    with pytest.raises(MetricsError, match=r"^scan 2: time 1.000000 s does not follow scan 1's 1.000000 s"):
+        crossings_in_run([{"scan": 3, "t": 3.0}], np.array([0.0, 1.0, 1.0, 2.0]))
+
+
+@pytest.mark.parametrize(
+    ("selection", "expected"),
+    [
+        ("", [66, 338, 649, 1024, 1284, 1421, 1643, 1794, 1942, 2079]),
+        ("[::4]", [17, 85, 163, 256, 321, 356, 411, 449, 486, 520]),  # ceil(scan / 4): the first kept beyond
+        ("[:700]", [66, 338, 649]),
+        ("?views=0.5:15", [8, 35, 64, 103, 128, 141, 163, 180, 195, 209]),
+    ],
+)
+def test_a_worlds_true_crossings_follow_a_selection_of_its_scans(selection: str, expected: list[int]) -> None:
+    """The double loop's ten crossings (source scans 66 ... 2079) numbered as each selection numbers its scans."""
+    sequence = open_sequence(f"synthetic-places-double-loop{selection}")
+    times = np.array([frame.scan.timestamp for frame in sequence])
+    got = crossings_in_run(sequence.metadata.extra["doorway_crossings"], times)
+    assert got == expected
+    for scan, crossing in zip(got, sequence.metadata.extra["doorway_crossings"]):
+        assert times[scan] >= crossing["t"] and (scan == 0 or times[scan - 1] < crossing["t"])
+
+
+def test_a_worlds_true_crossings_follow_a_dropout() -> None:
+    full = open_sequence("synthetic-places-loop[:700]")
+    kept = degrade(full, "dropout:0.5", seed=1)
+    source_of = {frame.scan.timestamp: frame.index for frame in full}
+    survivors = [source_of[frame.scan.timestamp] for frame in kept]  # the source scan of each kept scan
+    got = crossings_in_run(full.metadata.extra["doorway_crossings"], np.array([f.scan.timestamp for f in kept]))
+    # the crossings are at source scans 66, 338 and 649; seed 1 dropped 66, 67 and 338, so the first
+    # survivors on the far side are 68, 339 and 649
+    assert {66, 67, 338}.isdisjoint(survivors) and {68, 339, 649} <= set(survivors)
+    assert got == [survivors.index(68), survivors.index(339), survivors.index(649)]
