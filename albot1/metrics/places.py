@@ -10,7 +10,9 @@ wrote its claims during the run, and they are scored afterwards, into
 **Where a visit was.** When the dataset knows its rooms (the synthetic
 worlds' ``spaces``), a visit was in the room that holds most of its
 reference positions, and two visits were in the same place when their rooms
-are the same. Otherwise (the real logs) a visit's region is the convex hull
+are the same and they belong to different stays (consecutive visits in one
+room are one stay: a false crossing inside a room splits a stay but is no
+re-visit). Otherwise (the real logs) a visit's region is the convex hull
 of the reference positions it passed through, grown by ``buffer_m``, and two
 visits were in the same place when their regions *overlap*: they share at
 least ``min_overlap`` of the smaller one's area. A visit never counts the
@@ -85,6 +87,20 @@ def visit_rooms(reference: FloatArray, visits: list[Mapping[str, Any]], spaces: 
     return out
 
 
+def room_stays(rooms: list[str]) -> list[int]:
+    """The number of the stay each visit belongs to: consecutive visits in one room are one stay.
+
+    Why: a visit ends at a crossing the method detected, and a false
+    crossing (the robot never left the room) splits one stay into two
+    visits. The second is no re-visit of the room; only a visit in a later
+    stay is.
+    """
+    stays: list[int] = []
+    for k, room in enumerate(rooms):
+        stays.append(0 if k == 0 else stays[-1] + (room != rooms[k - 1]))
+    return stays
+
+
 def judge_revisits(
     record: Mapping[str, Any],
     reference: FloatArray,
@@ -104,9 +120,10 @@ def judge_revisits(
             )
     if spaces:
         rooms = visit_rooms(reference, visits, spaces)
+        stays = room_stays(rooms)
 
         def same(a: int, b: int) -> bool:
-            return bool(rooms[a]) and rooms[a] == rooms[b]
+            return bool(rooms[a]) and rooms[a] == rooms[b] and stays[a] != stays[b]
 
         rule: dict[str, Any] = {"rule": "rooms", "rooms": rooms}
     else:

@@ -59,7 +59,9 @@ class ExitsJudgement(Record):
 class PlacesBlock(OmitsAbsentReasons):
     """``places``: re-visits judged by the reference positions (``rule``), and exits when the dataset knows doorways.
 
-    ``rule`` is ``rooms`` (the dataset's rooms; ``rooms`` names each visit's)
+    ``rule`` is ``rooms`` (the dataset's rooms; ``rooms`` names each visit's;
+    a re-visit is a visit in a later stay in the room, consecutive visits in
+    one room being one stay)
     or ``overlap`` (hulls of reference positions grown by ``buffer_m``
     sharing ``min_overlap``). ``claims_true`` flags each claimed re-visit of
     ``places.json`` in its order. Precision is null without a claim, recall

@@ -234,3 +234,34 @@ def test_a_worlds_true_crossings_follow_a_dropout() -> None:
     # survivors on the far side are 68, 339 and 649
     assert {66, 67, 338}.isdisjoint(survivors) and {68, 339, 649} <= set(survivors)
     assert got == [survivors.index(68), survivors.index(339), survivors.index(649)]
+
+
+def test_a_false_crossing_inside_a_room_is_no_revisit_of_it() -> None:
+    """Visits 1 and 2 are one stay in room-b (a false crossing at scan 30 split it): only 3 and 4 are re-visits."""
+    bounds = [(0, 19), (20, 29), (30, 39), (40, 59), (60, 79)]
+    visits = [{"id": k, "place": k, "first_scan": a, "last_scan": b} for k, (a, b) in enumerate(bounds)]
+    visits[4]["place"] = 2  # visit 4 (room-b again) recognised as visit 2's place; visit 3 made a new place
+    rec = {"visits": visits, "revisits": [{"scan": 60, "visit": 4, "place_now": 2}], "crossings": []}
+    counters, truth, summary = judge_revisits(rec, route(), SPACES)
+    assert summary["rooms"] == ["room-a", "room-b", "room-b", "room-a", "room-b"]
+    assert [v["same_place_as"] for v in summary["visits"]] == [[], [], [], [0], [1, 2]]
+    assert truth == [True]
+    assert counters == {
+        "revisits_true": 1,
+        "revisits_false": 0,
+        "revisits_missed": 1,
+        "revisits_actual": 2,
+        "revisit_precision": 1.0,
+        "revisit_recall": 0.5,
+    }
+
+
+def test_a_claim_of_the_stay_it_never_left_is_false() -> None:
+    bounds = [(0, 19), (20, 29), (30, 39)]
+    visits = [
+        {"id": k, "place": p, "first_scan": a, "last_scan": b} for k, (p, (a, b)) in enumerate(zip([0, 1, 1], bounds))
+    ]
+    rec = {"visits": visits, "revisits": [{"scan": 30, "visit": 2, "place_now": 1}], "crossings": []}
+    counters, truth, _ = judge_revisits(rec, route()[:40], SPACES)
+    assert truth == [False] and (counters["revisits_actual"], counters["revisits_false"]) == (0, 1)
+    assert "revisit_recall" not in counters  # no true re-visit: undefined, not 0
