@@ -240,11 +240,11 @@ def judge_exits(
             }
         )
     counters: dict[str, int | float] = {}
-    if per_exit:
-        counters["exit_prediction_aligned_true_mean_m"] = float(np.mean([e["aligned_error_m"] for e in per_exit]))
-        counters["exit_prediction_not_aligned_true_mean_m"] = float(
-            np.mean([e["not_aligned_error_m"] for e in per_exit])
-        )
+    for key in ("aligned", "not_aligned"):
+        if per_exit:
+            sample = np.array([e[f"{key}_error_m"] for e in per_exit], dtype=float)
+            counters[f"exit_prediction_{key}_true_mean_m"] = float(np.mean(sample))
+            counters[f"exit_prediction_{key}_true_median_m"] = float(np.median(sample))
     detected = [c["scan"] for c in record["crossings"]]
     truth = crossings_in_run(true_crossings, timestamps)
     used: set[int] = set()
@@ -261,7 +261,49 @@ def judge_exits(
     counters.update(
         crossings_true=matched, crossings_false=len(detected) - matched, crossings_missed=len(truth) - matched
     )
-    return counters, {"exit_predictions": per_exit, "crossing_scans": crossing_scans}
+    summary: dict[str, Any] = {"exit_predictions": per_exit, "crossing_scans": crossing_scans}
+    if not per_exit:
+        summary["exit_predictions_reason"] = no_comparison_reason(record)
+    return counters, summary
+
+
+def no_comparison_reason(record: Mapping[str, Any]) -> str:
+    """Why no exit prediction was compared at a crossing, in the terms of the method's own ``places.json``.
+
+    The mapper predicts a place's other exits when it recognises the place
+    (``predictions``, one batch per visit) and compares them when that visit
+    is left: with the predicted exit nearest the exit crossed, if one lies
+    within twice ``exit_link_distance_m`` (farther, the exit is a new way
+    out). So nothing is compared when no place was recognised, when the
+    places recognised knew no exit but the one entered by, when the run
+    ended in a visit with predictions, or when such a visit was left by an
+    exit none of them predicted.
+    """
+    claims = len(record["revisits"])
+    if not claims:
+        return "no exit prediction compared: no place was recognised (no re-visit claimed), so none was made"
+    visits = sorted({int(p["visit"]) for p in record["predictions"]})
+    if not visits:
+        return (
+            f"no exit prediction compared: none was made, as the places of the {claims} re-visit(s) claimed knew no "
+            f"exit but the one they were entered by"
+        )
+    left = {int(c["from_visit"]): c for c in record["crossings"]}
+    within = 2.0 * float(record["config"]["exit_link_distance_m"])
+    parts = []
+    for v in visits:
+        if v not in left:
+            parts.append(f"the run ended in visit {v} before an exit was crossed")
+            continue
+        crossed = _midpoint(left[v]["segment"])
+        nearest = min(
+            float(np.hypot(*(_midpoint(p["aligned"]) - crossed))) for p in record["predictions"] if p["visit"] == v
+        )
+        parts.append(
+            f"visit {v} was left at scan {left[v]['scan']} by an exit {nearest:.2f} m from the nearest prediction "
+            f"(beyond {within:g} m the mapper takes it for a new way out)"
+        )
+    return f"no exit prediction compared: exits were predicted in {len(visits)} visit(s), but " + "; ".join(parts)
 
 
 def judge_network(
@@ -310,10 +352,11 @@ def judge_network(
         **block,
         "exits": {
             **exit_summary,
-            "exit_prediction_aligned_true_mean_m": exit_counters.get("exit_prediction_aligned_true_mean_m", nan),
-            "exit_prediction_not_aligned_true_mean_m": exit_counters.get(
-                "exit_prediction_not_aligned_true_mean_m", nan
-            ),
+            **{
+                f"exit_prediction_{key}_true_{stat}_m": exit_counters.get(f"exit_prediction_{key}_true_{stat}_m", nan)
+                for key in ("aligned", "not_aligned")
+                for stat in ("mean", "median")
+            },
             **{key: exit_counters[key] for key in ("crossings_true", "crossings_false", "crossings_missed")},
         },
     }

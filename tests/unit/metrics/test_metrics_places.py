@@ -155,7 +155,8 @@ def test_the_places_metric_judges_the_claims_file_into_its_block_and_headline() 
     assert (block.revisit_precision, block.revisit_recall, block.rooms) == (1.0, 0.5, ["room-a", "room-b"] * 2)
     assert block.exits is None and block.exits_reason == "the dataset knows no doorways (exit checks need them)"
     assert places_headline(block) == (
-        "1 of 1 claimed re-visits true (precision 1.00), recall 0.50 of 2 true re-visits (rooms)"
+        "1 of 1 claimed re-visits true (precision 1.00), recall 0.50 of 2 true re-visits (rooms); "
+        "the dataset knows no doorways (exit checks need them)"
     )
 
 
@@ -265,3 +266,83 @@ def test_a_claim_of_the_stay_it_never_left_is_false() -> None:
     counters, truth, _ = judge_revisits(rec, route()[:40], SPACES)
     assert truth == [False] and (counters["revisits_actual"], counters["revisits_false"]) == (0, 1)
     assert "revisit_recall" not in counters  # no true re-visit: undefined, not 0
+
+
+def _exit_record(claims: list[tuple[int, int, str]], predictions: list[dict], crossings: list[dict]) -> dict:
+    rec = record([0, 1, 0, 1], claims)
+    rec.update(predictions=predictions, crossings=crossings, config={"exit_link_distance_m": 1.0})
+    return rec
+
+
+def _left(visit: int, scan: int, segment: list[float], prediction: dict | None = None) -> dict:
+    return {"scan": scan, "exit": 0, "from_visit": visit, "segment": segment, "prediction": prediction}
+
+
+DOOR = [5.1, 2.0, 5.1, 3.0]
+THREE = [_left(0, 20, DOOR), _left(1, 40, DOOR), _left(2, 60, DOOR)]  # visits 0-2 left at each true crossing
+TRUTH = {
+    "spaces": SPACES,
+    "doorways": DOORWAYS,
+    "doorway_crossings": [{"scan": s, "t": float(s)} for s in (20, 40, 60)],
+}
+
+
+@pytest.mark.parametrize(
+    ("claims", "predictions", "crossings", "reason"),
+    [
+        ([], [], THREE, "no place was recognised (no re-visit claimed), so none was made"),
+        (
+            [(2, 0, "structure")],
+            [],
+            THREE,
+            "none was made, as the places of the 1 re-visit(s) claimed knew no exit but the one they were entered by",
+        ),
+        (
+            [(2, 0, "structure"), (3, 1, "exit")],
+            [{"visit": 2, "aligned": [8.0, 2.0, 8.0, 3.0]}, {"visit": 2, "aligned": [5.1, 6.0, 5.1, 7.0]}],
+            THREE,
+            "exits were predicted in 1 visit(s), but visit 2 was left at scan 60 by an exit 2.90 m from the "
+            "nearest prediction (beyond 2 m the mapper takes it for a new way out)",
+        ),
+        (
+            [(2, 0, "structure"), (3, 1, "exit")],
+            [{"visit": 3, "aligned": DOOR}],
+            THREE,
+            "exits were predicted in 1 visit(s), but the run ended in visit 3 before an exit was crossed",
+        ),
+    ],
+)
+def test_no_exit_prediction_compared_says_why_in_the_runs_own_terms(
+    claims: list[tuple[int, int, str]], predictions: list[dict], crossings: list[dict], reason: str
+) -> None:
+    block = places_compute(_places_inputs(_exit_record(claims, predictions, crossings), TRUTH))
+    assert block.exits is not None and block.exits.exit_prediction_aligned_true_mean_m is None
+    assert block.exits.exit_predictions_reason == f"no exit prediction compared: {reason}"
+    assert places_headline(block).endswith(
+        f"; 3 of 3 true crossings found, 0 false; {block.exits.exit_predictions_reason}"
+    )
+    assert (
+        PLACES.columns[4].applies is not None
+        and PLACES.columns[4].applies(block, None) == block.exits.exit_predictions_reason
+    )
+
+
+def test_the_headline_shows_false_crossings_and_the_medians_beside_the_means() -> None:
+    def compared(scan: int, aligned_x: float) -> dict:
+        # the estimate is the reference, so the believed positions are the map's: errors |aligned_x - 5.1|, 1.0
+        prediction = {"aligned": [aligned_x, 2.0, aligned_x, 3.0], "not_aligned": [6.1, 2.0, 6.1, 3.0]}
+        return _left(0, scan, DOOR, prediction)
+
+    crossings = [compared(20, 5.2), compared(40, 5.4), compared(60, 6.1), _left(1, 10, DOOR)]  # scan 10: false
+    block = places_compute(_places_inputs(_exit_record([(2, 0, "structure")], [], crossings), TRUTH))
+    exits = block.exits
+    assert exits is not None and (exits.crossings_true, exits.crossings_false, exits.crossings_missed) == (3, 1, 0)
+    assert exits.exit_prediction_aligned_true_mean_m == pytest.approx(1.4 / 3)
+    assert exits.exit_prediction_aligned_true_median_m == pytest.approx(0.3)
+    assert exits.exit_prediction_not_aligned_true_median_m == pytest.approx(1.0)
+    assert exits.exit_predictions_reason is None
+    assert places_headline(block) == (
+        "1 of 1 claimed re-visits true (precision 1.00), recall 1.00 of 2 true re-visits (rooms); "
+        "3 of 3 true crossings found, 1 false; 3 exit predictions compared, mean (median) 0.467 (0.300) m aligned, "
+        "1.000 (1.000) m not"
+    )
