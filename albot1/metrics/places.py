@@ -10,7 +10,9 @@ wrote its claims during the run, and they are scored afterwards, into
 **Where a visit was.** When the dataset knows its rooms (the synthetic
 worlds' ``spaces``), a visit was in the room that holds most of its
 reference positions, and two visits were in the same place when their rooms
-are the same. Otherwise (the real logs) a visit's region is the convex hull
+are the same and they belong to different stays (consecutive visits in one
+room are one stay: a false crossing inside a room splits a stay but is no
+re-visit). Otherwise (the real logs) a visit's region is the convex hull
 of the reference positions it passed through, grown by ``buffer_m``, and two
 visits were in the same place when their regions *overlap*: they share at
 least ``min_overlap`` of the smaller one's area. A visit never counts the
@@ -33,7 +35,9 @@ inv(estimate[s]) * point``): where the robot believed it was relative to
 itself. Each prediction compared at a crossing is then measured against the
 true doorway (the one nearest the exit perceived there), aligned and not
 aligned; each detected crossing is matched to a true doorway crossing within
-``crossing_scans`` scans.
+``crossing_scans`` scans, the true crossings numbered by the scans the run
+saw (:func:`crossings_in_run`: by time, so slices, view spacing and dropout
+renumber them as they renumber the run's scans).
 """
 
 from __future__ import annotations
@@ -48,6 +52,8 @@ from albot1.geometry.types import FloatArray
 from albot1.metrics.errors import MetricsError
 
 PLACES_JSON = "places.json"
+#: Slack of a crossing's time against the scored scans' times (``trajectory.tum`` keeps nine decimals).
+TIME_SLACK_S = 1e-6
 
 
 def visit_region(reference: FloatArray, first: int, last: int, buffer_m: float) -> Any:
@@ -81,6 +87,20 @@ def visit_rooms(reference: FloatArray, visits: list[Mapping[str, Any]], spaces: 
     return out
 
 
+def room_stays(rooms: list[str]) -> list[int]:
+    """The number of the stay each visit belongs to: consecutive visits in one room are one stay.
+
+    Why: a visit ends at a crossing the method detected, and a false
+    crossing (the robot never left the room) splits one stay into two
+    visits. The second is no re-visit of the room; only a visit in a later
+    stay is.
+    """
+    stays: list[int] = []
+    for k, room in enumerate(rooms):
+        stays.append(0 if k == 0 else stays[-1] + (room != rooms[k - 1]))
+    return stays
+
+
 def judge_revisits(
     record: Mapping[str, Any],
     reference: FloatArray,
@@ -100,9 +120,10 @@ def judge_revisits(
             )
     if spaces:
         rooms = visit_rooms(reference, visits, spaces)
+        stays = room_stays(rooms)
 
         def same(a: int, b: int) -> bool:
-            return bool(rooms[a]) and rooms[a] == rooms[b]
+            return bool(rooms[a]) and rooms[a] == rooms[b] and stays[a] != stays[b]
 
         rule: dict[str, Any] = {"rule": "rooms", "rooms": rooms}
     else:
@@ -151,8 +172,40 @@ def _midpoint(segment: Any) -> FloatArray:
     return mid
 
 
+def crossings_in_run(true_crossings: list[Mapping[str, Any]], timestamps: FloatArray) -> list[int]:
+    """The run's scan number of each true doorway crossing it saw: its first scan at or after the crossing's time.
+
+    The dataset numbers its crossings by its own scans (``scan``, the first
+    one beyond the threshold, and that scan's time ``t``). A run may have
+    seen a selection of them, numbered afresh from 0: a prefix (``[:N]``,
+    ``--limit``), every STEP-th (``[::STEP]``), views spaced by ``?views=``
+    or a dropout's survivors. The scored scans keep their source times
+    through all of these, so the time finds the first scan the run saw on
+    the far side, the scan a detector could first notice it at. A crossing
+    outside the scored scans' times (after the last) is not in the run.
+    """
+    t = np.asarray(timestamps, dtype=float)
+    if t.size == 0:
+        return []
+    if np.any(np.diff(t) <= 0):
+        k = int(np.flatnonzero(np.diff(t) <= 0)[0])
+        raise MetricsError(
+            f"scan {k + 1}: time {t[k + 1]:.6f} s does not follow scan {k}'s {t[k]:.6f} s; the true doorway "
+            f"crossings are found among the scans by their times, which must increase"
+        )
+    out = []
+    for k, crossing in enumerate(true_crossings):
+        if "t" not in crossing:
+            raise MetricsError(f"doorway_crossings[{k}] of the dataset's metadata has no time 't' (s)")
+        when = float(crossing["t"])
+        if t[0] - TIME_SLACK_S <= when <= t[-1] + TIME_SLACK_S:
+            out.append(int(np.searchsorted(t, when - TIME_SLACK_S, side="left")))
+    return out
+
+
 def judge_exits(
     record: Mapping[str, Any],
+    timestamps: FloatArray,
     poses: FloatArray,
     reference: FloatArray,
     doorways: list[Mapping[str, Any]],
@@ -187,13 +240,13 @@ def judge_exits(
             }
         )
     counters: dict[str, int | float] = {}
-    if per_exit:
-        counters["exit_prediction_aligned_true_mean_m"] = float(np.mean([e["aligned_error_m"] for e in per_exit]))
-        counters["exit_prediction_not_aligned_true_mean_m"] = float(
-            np.mean([e["not_aligned_error_m"] for e in per_exit])
-        )
+    for key in ("aligned", "not_aligned"):
+        if per_exit:
+            sample = np.array([e[f"{key}_error_m"] for e in per_exit], dtype=float)
+            counters[f"exit_prediction_{key}_true_mean_m"] = float(np.mean(sample))
+            counters[f"exit_prediction_{key}_true_median_m"] = float(np.median(sample))
     detected = [c["scan"] for c in record["crossings"]]
-    truth = [c["scan"] for c in true_crossings if c["scan"] < len(reference)]  # a run may cover a prefix
+    truth = crossings_in_run(true_crossings, timestamps)
     used: set[int] = set()
     matched = 0
     for s in detected:
@@ -208,23 +261,72 @@ def judge_exits(
     counters.update(
         crossings_true=matched, crossings_false=len(detected) - matched, crossings_missed=len(truth) - matched
     )
-    return counters, {"exit_predictions": per_exit, "crossing_scans": crossing_scans}
+    summary: dict[str, Any] = {"exit_predictions": per_exit, "crossing_scans": crossing_scans}
+    if not per_exit:
+        summary["exit_predictions_reason"] = no_comparison_reason(record)
+    return counters, summary
+
+
+def no_comparison_reason(record: Mapping[str, Any]) -> str:
+    """Why no exit prediction was compared at a crossing, in the terms of the method's own ``places.json``.
+
+    The mapper predicts a place's other exits when it recognises the place
+    (``predictions``, one batch per visit) and compares them when that visit
+    is left: with the predicted exit nearest the exit crossed, if one lies
+    within twice ``exit_link_distance_m`` (farther, the exit is a new way
+    out). So nothing is compared when no place was recognised, when the
+    places recognised knew no exit but the one entered by, when the run
+    ended in a visit with predictions, or when such a visit was left by an
+    exit none of them predicted.
+    """
+    claims = len(record["revisits"])
+    if not claims:
+        return "no exit prediction compared: no place was recognised (no re-visit claimed), so none was made"
+    visits = sorted({int(p["visit"]) for p in record["predictions"]})
+    if not visits:
+        return (
+            f"no exit prediction compared: none was made, as the places of the {claims} re-visit(s) claimed knew no "
+            f"exit but the one they were entered by"
+        )
+    left = {int(c["from_visit"]): c for c in record["crossings"]}
+    within = 2.0 * float(record["config"]["exit_link_distance_m"])
+    parts = []
+    for v in visits:
+        if v not in left:
+            parts.append(f"the run ended in visit {v} before an exit was crossed")
+            continue
+        crossed = _midpoint(left[v]["segment"])
+        nearest = min(
+            float(np.hypot(*(_midpoint(p["aligned"]) - crossed))) for p in record["predictions"] if p["visit"] == v
+        )
+        parts.append(
+            f"visit {v} was left at scan {left[v]['scan']} by an exit {nearest:.2f} m from the nearest prediction "
+            f"(beyond {within:g} m the mapper takes it for a new way out)"
+        )
+    return f"no exit prediction compared: exits were predicted in {len(visits)} visit(s), but " + "; ".join(parts)
 
 
 def judge_network(
-    record: Mapping[str, Any], poses: FloatArray, reference: FloatArray, dataset: Mapping[str, Any]
+    record: Mapping[str, Any],
+    timestamps: FloatArray,
+    poses: FloatArray,
+    reference: FloatArray,
+    dataset: Mapping[str, Any],
 ) -> dict[str, Any]:
     """Everything above for one run: the ``places`` block of ``metrics.json`` as plain data.
 
-    ``record`` is the run's ``places.json``; ``dataset`` is the sequence's
+    ``record`` is the run's ``places.json``; ``timestamps``, ``poses`` and
+    ``reference`` are the scored scans' (row by row); ``dataset`` is the sequence's
     metadata ``extra`` (doorways and their crossings for the synthetic worlds;
     the exit checks are left out, with the reason, without them). Undefined
     ratios (no claim, no re-visit) are NaN, null in the file.
     """
     poses = se2.as_poses(poses)
     reference = se2.as_poses(reference)
-    if len(poses) != len(reference):
-        raise MetricsError(f"{len(poses)} estimated poses but {len(reference)} reference poses")
+    if not len(poses) == len(reference) == len(timestamps):
+        raise MetricsError(
+            f"{len(poses)} estimated poses but {len(reference)} reference poses and {len(timestamps)} timestamps"
+        )
     counters, truth, summary = judge_revisits(record, reference, list(dataset.get("spaces") or []))
     nan = float("nan")
     block: dict[str, Any] = {
@@ -244,16 +346,17 @@ def judge_network(
     if not doorways:
         return {**block, "exits": None, "exits_reason": "the dataset knows no doorways (exit checks need them)"}
     exit_counters, exit_summary = judge_exits(
-        record, poses, reference, list(doorways), list(dataset.get("doorway_crossings", []))
+        record, timestamps, poses, reference, list(doorways), list(dataset.get("doorway_crossings", []))
     )
     return {
         **block,
         "exits": {
             **exit_summary,
-            "exit_prediction_aligned_true_mean_m": exit_counters.get("exit_prediction_aligned_true_mean_m", nan),
-            "exit_prediction_not_aligned_true_mean_m": exit_counters.get(
-                "exit_prediction_not_aligned_true_mean_m", nan
-            ),
+            **{
+                f"exit_prediction_{key}_true_{stat}_m": exit_counters.get(f"exit_prediction_{key}_true_{stat}_m", nan)
+                for key in ("aligned", "not_aligned")
+                for stat in ("mean", "median")
+            },
             **{key: exit_counters[key] for key in ("crossings_true", "crossings_false", "crossings_missed")},
         },
     }

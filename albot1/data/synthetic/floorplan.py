@@ -235,9 +235,16 @@ def check_route(plan: FloorPlan, waypoints: Sequence[tuple[float, float]], *, cl
 
 @dataclass(frozen=True)
 class DoorwayCrossing:
-    """The route passing through a doorway: the first scan at or beyond the threshold, and where it crossed."""
+    """The route passing through a doorway: the first scan at or beyond the threshold, its time, and where it crossed.
+
+    ``time`` (s) is that scan's timestamp: a run that saw a selection of the
+    scans (a ``[::STEP]`` slice, ``?views=`` spacing, a dropout) numbers them
+    afresh, and the scan's time is what finds the crossing among them
+    (:func:`albot1.metrics.places.crossings_in_run`).
+    """
 
     scan: int
+    time: float
     position: tuple[float, float]
     doorway: str
     from_space: str
@@ -246,6 +253,7 @@ class DoorwayCrossing:
     def as_dict(self) -> dict[str, Any]:
         return {
             "scan": self.scan,
+            "t": self.time,
             "x": self.position[0],
             "y": self.position[1],
             "doorway": self.doorway,
@@ -254,8 +262,8 @@ class DoorwayCrossing:
         }
 
 
-def doorway_crossings(plan: FloorPlan, poses: ArrayLike) -> list[DoorwayCrossing]:
-    """Every crossing of a doorway threshold by the polyline through ``poses`` (N, 3), in route order.
+def doorway_crossings(plan: FloorPlan, poses: ArrayLike, times: ArrayLike) -> list[DoorwayCrossing]:
+    """Every crossing of a doorway threshold by the polyline through ``poses`` (N, 3) at ``times`` (N,), in route order.
 
     The route crosses when it passes from one strict side of the threshold to
     the other; the crossing's scan is the first one on the threshold or
@@ -264,6 +272,7 @@ def doorway_crossings(plan: FloorPlan, poses: ArrayLike) -> list[DoorwayCrossing
     that touches a threshold and turns back has not crossed it.
     """
     p = np.asarray(poses, dtype=float)[:, :2]
+    t = np.asarray(times, dtype=float)
     found: list[DoorwayCrossing] = []
     for door in plan.doorways:
         ax, ay = door.a
@@ -281,6 +290,6 @@ def doorway_crossings(plan: FloorPlan, poses: ArrayLike) -> list[DoorwayCrossing
             if not 0.0 <= along <= 1.0:
                 continue
             src, dst = (door.spaces[0], door.spaces[1]) if side[i] > 0 else (door.spaces[1], door.spaces[0])
-            found.append(DoorwayCrossing(int(i + 1), (float(x), float(y)), door.id, src, dst))
+            found.append(DoorwayCrossing(int(i + 1), float(t[i + 1]), (float(x), float(y)), door.id, src, dst))
     found.sort(key=lambda c: c.scan)
     return found

@@ -88,14 +88,15 @@ def generate(spec: WorldSpec) -> WorldData:
     lap_ranges = lidar.cast_many(plan.walls, lap, spec.laser.angles, spec.laser.max_range)
     for shared in (plan.walls, reference, odometry, lap_ranges):
         shared.setflags(write=False)  # a cached world is shared by every caller in the process
+    times = timestamps(reference, spec.sampling)
     return WorldData(
         spec=spec,
         plan=plan,
         reference=reference,
         odometry=odometry,
-        timestamps=timestamps(reference, spec.sampling),
+        timestamps=times,
         lap_ranges=lap_ranges,
-        crossings=tuple(find_crossings(plan, reference)),
+        crossings=tuple(find_crossings(plan, reference, times)),
         route_length=se2.path_length(reference),
     )
 

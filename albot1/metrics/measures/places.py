@@ -44,22 +44,34 @@ class ExitPrediction(Record):
     not_aligned_error_m: NonNegative
 
 
-class ExitsJudgement(Record):
-    """Exit predictions against the true doorways, and detected crossings against the true ones."""
+class ExitsJudgement(OmitsAbsentReasons):
+    """Exit predictions against the true doorways, and detected crossings against the true ones.
+
+    The errors' means and medians are null when no prediction was compared,
+    ``exit_predictions_reason`` then saying why in the run's own terms (no
+    place recognised, none with another exit, the run ended first, or a new
+    way out). The medians are absent from a file written before they
+    existed (read as null).
+    """
 
     exit_predictions: list[ExitPrediction]
     crossing_scans: int
     exit_prediction_aligned_true_mean_m: OptNonNegative
     exit_prediction_not_aligned_true_mean_m: OptNonNegative
+    exit_prediction_aligned_true_median_m: OptNonNegative = None
+    exit_prediction_not_aligned_true_median_m: OptNonNegative = None
     crossings_true: int
     crossings_false: int
     crossings_missed: int
+    exit_predictions_reason: str | None = None
 
 
 class PlacesBlock(OmitsAbsentReasons):
     """``places``: re-visits judged by the reference positions (``rule``), and exits when the dataset knows doorways.
 
-    ``rule`` is ``rooms`` (the dataset's rooms; ``rooms`` names each visit's)
+    ``rule`` is ``rooms`` (the dataset's rooms; ``rooms`` names each visit's;
+    a re-visit is a visit in a later stay in the room, consecutive visits in
+    one room being one stay)
     or ``overlap`` (hulls of reference positions grown by ``buffer_m``
     sharing ``min_overlap``). ``claims_true`` flags each claimed re-visit of
     ``places.json`` in its order. Precision is null without a claim, recall
@@ -96,7 +108,7 @@ def compute(inputs: MetricInputs) -> PlacesBlock:
     except Albot1Error as exc:
         raise MetricsError(f"cannot reopen dataset {inputs.dataset!r} for its rooms and doorways: {exc}") from exc
     try:
-        data = judge_network(record, inputs.poses, reference, extra)
+        data = judge_network(record, inputs.timestamps, inputs.poses, reference, extra)
     except (KeyError, TypeError, IndexError) as exc:
         raise MetricsError(f"{PLACES_JSON}: unexpected content ({type(exc).__name__}: {exc})") from None
     return block_of(PlacesBlock, data)
@@ -110,14 +122,25 @@ def headline(block: PlacesBlock) -> str:
     )
     exits = block.exits
     if exits is None:
-        return text
-    crossings = f"{exits.crossings_true} of {exits.crossings_true + exits.crossings_missed} true crossings found"
-    if not exits.exit_predictions:
-        return f"{text}; {crossings}, no exit prediction compared"
-    return (
-        f"{text}; {crossings}, exit predictions {fmt(exits.exit_prediction_aligned_true_mean_m)} m aligned, "
-        f"{fmt(exits.exit_prediction_not_aligned_true_mean_m)} m not"
+        return f"{text}; {block.exits_reason or 'no exit checks'}"
+    crossings = (
+        f"{exits.crossings_true} of {exits.crossings_true + exits.crossings_missed} true crossings found, "
+        f"{exits.crossings_false} false"
     )
+    if not exits.exit_predictions:
+        return f"{text}; {crossings}; {exits.exit_predictions_reason or 'no exit prediction compared'}"
+    return (
+        f"{text}; {crossings}; {len(exits.exit_predictions)} exit prediction"
+        f"{'' if len(exits.exit_predictions) == 1 else 's'} compared, mean (median) "
+        f"{fmt(exits.exit_prediction_aligned_true_mean_m)} ({fmt(exits.exit_prediction_aligned_true_median_m)}) m "
+        f"aligned, {fmt(exits.exit_prediction_not_aligned_true_mean_m)} "
+        f"({fmt(exits.exit_prediction_not_aligned_true_median_m)}) m not"
+    )
+
+
+def _exit_errors_apply(block: PlacesBlock, _: object) -> str | None:
+    """The run's own reason when no exit prediction was compared (None: the errors apply, or exits are null)."""
+    return None if block.exits is None else block.exits.exit_predictions_reason
 
 
 METRIC = Metric(
@@ -137,7 +160,20 @@ METRIC = Metric(
         ColumnSpec(
             "revisit_recall", "revisit_recall", "re-visit recall", undefined="no true re-visit (revisits_actual: 0)"
         ),
-        ColumnSpec("exit_aligned_m", "exits.exit_prediction_aligned_true_mean_m", "exit pred. aligned (m)"),
-        ColumnSpec("exit_not_aligned_m", "exits.exit_prediction_not_aligned_true_mean_m", "exit pred. not aligned (m)"),
+        # null exits: the block's exits_reason; no prediction compared: the run's exit_predictions_reason
+        # (a file written before that reason existed: the undefined note)
+        *(
+            ColumnSpec(
+                key,
+                f"exits.exit_prediction_{which}_true_mean_m",
+                header,
+                applies=_exit_errors_apply,
+                undefined="no exit prediction compared (exits.exit_predictions: [])",
+            )
+            for key, which, header in (
+                ("exit_aligned_m", "aligned", "exit pred. aligned (m)"),
+                ("exit_not_aligned_m", "not_aligned", "exit pred. not aligned (m)"),
+            )
+        ),
     ),
 )

@@ -193,7 +193,7 @@ def test_an_override_value_the_method_rejects_is_an_error_of_the_suite(tmp_path:
         _methods_plan(tmp_path, '[[methods]]\nname = "odometry"\nset = { map_voxel_m = -1 }\n')
     assert str(caught.value).startswith(
         f"{tmp_path / 'two.toml'}: invalid suite: methods.0 ('odometry'): invalid config for method 'odometry' "
-        "(preset 'default'): map_voxel_m: Input should be greater than 0 (from set)"
+        "(preset 'default'): map_voxel_m: Input should be greater than 0, found -1 (from set)"
     )
 
 

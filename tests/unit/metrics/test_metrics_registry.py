@@ -273,3 +273,44 @@ def test_a_ratio_without_a_denominator_is_not_applicable_with_the_metrics_words(
     assert METRIC_COLUMNS["revisit_recall"].reason(record) == "no true re-visit (revisits_actual: 0)"
     assert METRIC_COLUMNS["exit_aligned_m"].reason(record) == places["exits_reason"]
     assert METRIC_COLUMNS["relation_iqr_m"].reason(record) == NOT_IN_FILE
+
+
+@pytest.mark.parametrize("reason", ["no exit prediction compared: no place was recognised (no re-visit claimed)", None])
+def test_exit_errors_without_a_comparison_are_not_applicable_with_the_runs_reason(reason: str | None) -> None:
+    """The block's exit_predictions_reason; a file written before that reason existed: the column's own note."""
+    from albot1.bench.grid import Cell
+    from albot1.report.collect import CellRecord
+
+    exits = {
+        "exit_predictions": [],
+        "crossing_scans": 15,
+        "exit_prediction_aligned_true_mean_m": None,
+        "exit_prediction_not_aligned_true_mean_m": None,
+        "crossings_true": 2,
+        "crossings_false": 1,
+        "crossings_missed": 0,
+        **({"exit_predictions_reason": reason} if reason else {}),
+    }
+    places = {
+        "units": {},
+        "rule": "rooms",
+        "rooms": ["a"],
+        "buffer_m": None,
+        "min_overlap": None,
+        "claims": 0,
+        "claims_true": [],
+        "revisits_true": 0,
+        "revisits_false": 0,
+        "revisits_missed": 0,
+        "revisits_actual": 0,
+        "revisit_precision": None,
+        "revisit_recall": None,
+        "visits": [],
+        "exits": exits,
+    }
+    metrics = parse_record(MetricsRecord, {"run": RUN, "places": places}, "m")
+    cell = Cell("s", "d", "d", "m", "m", "p", "none", 0, "k", "v", 1, 1)
+    record = CellRecord(cell, "done", Path("/nonexistent"), None, metrics, None)
+    expected = reason or "no exit prediction compared (exits.exit_predictions: [])"
+    assert METRIC_COLUMNS["exit_aligned_m"].reason(record) == expected
+    assert METRIC_COLUMNS["exit_not_aligned_m"].reason(record) == expected

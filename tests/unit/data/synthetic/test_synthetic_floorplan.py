@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 
 from albot1.data.synthetic.errors import SyntheticWorldError
-from albot1.data.synthetic.floorplan import DoorwaySpec, Space, build_plan, check_route, doorway_crossings
+from albot1.data.synthetic.floorplan import (
+    DoorwayCrossing,
+    DoorwaySpec,
+    FloorPlan,
+    Space,
+    build_plan,
+    check_route,
+    doorway_crossings,
+)
 
 
 def edges(walls: np.ndarray) -> set[frozenset[tuple[float, float]]]:
@@ -126,16 +134,22 @@ def _poses(*xy: tuple[float, float]) -> np.ndarray:
     return np.array([[x, y, 0.0] for x, y in xy])
 
 
+def _crossings(plan: FloorPlan, *xy: tuple[float, float]) -> list[DoorwayCrossing]:
+    """The crossings of the route through ``xy``, one scan every 0.5 s from t = 10 s."""
+    return doorway_crossings(plan, _poses(*xy), 10.0 + 0.5 * np.arange(len(xy)))
+
+
 def test_a_crossing_is_found_exactly_on_the_threshold() -> None:
     plan = two_rooms()
-    (crossing,) = doorway_crossings(plan, _poses((2.0, 0.0), (3.95, 0.1), (4.35, 0.3), (6.0, 0.3)))
-    assert crossing.scan == 2  # the first scan beyond the threshold
+    (crossing,) = _crossings(plan, (2.0, 0.0), (3.95, 0.1), (4.35, 0.3), (6.0, 0.3))
+    assert crossing.scan == 2 and crossing.time == 11.0  # the first scan beyond the threshold, and its time
     assert crossing.doorway == "d1"
     assert (crossing.from_space, crossing.to_space) == ("room", "hall")
     assert crossing.position[0] == pytest.approx(4.1, abs=1e-12)
     assert crossing.position[1] == pytest.approx(0.1 + 0.2 * 0.15 / 0.4, abs=1e-12)
     assert crossing.as_dict() == {
         "scan": 2,
+        "t": 11.0,
         "x": crossing.position[0],
         "y": crossing.position[1],
         "doorway": "d1",
@@ -145,25 +159,25 @@ def test_a_crossing_is_found_exactly_on_the_threshold() -> None:
 
 
 def test_there_and_back_gives_two_crossings_in_route_order() -> None:
-    got = doorway_crossings(two_rooms(), _poses((3.0, 0.0), (5.0, 0.0), (6.0, 0.0), (3.5, -0.2)))
+    got = _crossings(two_rooms(), (3.0, 0.0), (5.0, 0.0), (6.0, 0.0), (3.5, -0.2))
     assert [(c.scan, c.from_space, c.to_space) for c in got] == [(1, "room", "hall"), (3, "hall", "room")]
 
 
 def test_a_pose_on_the_threshold_is_one_crossing_at_that_scan() -> None:
     plan = two_rooms()
-    forward = doorway_crossings(plan, _poses((3.0, 0.0), (4.1, 0.0), (5.0, 0.0)))
-    backward = doorway_crossings(plan, _poses((5.0, 0.0), (4.1, 0.0), (3.0, 0.0)))
+    forward = _crossings(plan, (3.0, 0.0), (4.1, 0.0), (5.0, 0.0))
+    backward = _crossings(plan, (5.0, 0.0), (4.1, 0.0), (3.0, 0.0))
     assert [(c.scan, c.position) for c in forward] == [(1, (4.1, 0.0))]
     assert [(c.scan, c.position, c.to_space) for c in backward] == [(1, (4.1, 0.0), "room")]
 
 
 def test_touching_a_threshold_and_turning_back_is_not_a_crossing() -> None:
-    assert doorway_crossings(two_rooms(), _poses((3.0, 0.0), (4.1, 0.0), (4.1, 0.0), (3.0, 0.2))) == []
+    assert _crossings(two_rooms(), (3.0, 0.0), (4.1, 0.0), (4.1, 0.0), (3.0, 0.2)) == []
 
 
 def test_crossing_the_wall_line_outside_the_doorway_is_not_a_doorway_crossing() -> None:
-    assert doorway_crossings(two_rooms(), _poses((3.0, 1.0), (5.0, 1.0))) == []
-    assert doorway_crossings(two_rooms(), _poses((3.0, 0.0))) == []
+    assert _crossings(two_rooms(), (3.0, 1.0), (5.0, 1.0)) == []
+    assert _crossings(two_rooms(), (3.0, 0.0)) == []
 
 
 def test_routes_must_stay_on_the_free_floor_with_clearance() -> None:
