@@ -19,15 +19,15 @@ def parse_floats(path: str | Path, line: int, tokens: list[str], what: str, expe
             raise ValueError("digit grouping")
         return np.array(list(map(float, tokens)), dtype=np.float64)
     except ValueError:
-        bad = next(t for t in tokens if not _is_float(t))
+        bad = next(t for t in tokens if not is_number(t))
         suffix = f"; expected {expected}" if expected else ""
         raise ParseError(path, f"{what} {bad!r} is not a number{suffix}", line=line) from None
 
 
-def _is_float(token: str) -> bool:
+def is_number(token: str | bytes) -> bool:
     """Whether ``token`` is a number as the logs write them: what ``float()`` reads, but not Python's digit
-    grouping (``3_05`` would be read as 305; numpy, and so the CARMEN parser, refuses it)."""
-    if "_" in token:
+    grouping (``3_05`` would be read as 305; numpy, whose bulk conversion the CARMEN parser uses, refuses it)."""
+    if ("_" in token) if isinstance(token, str) else (b"_" in token):
         return False
     try:
         float(token)

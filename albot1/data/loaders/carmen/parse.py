@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from albot1.data.errors import ParseError
 from albot1.data.loaders.carmen.checks import MAX_BEAMS, geometry_problem, ranges_problem
 from albot1.data.loaders.carmen.geometry import param_problem
+from albot1.data.tokens import is_number
 from albot1.geometry.types import FloatArray
 
 OLD_LASERS = ("FLASER", "RLASER")
@@ -175,22 +176,6 @@ def _describe(token: bytes) -> str:
     return repr(token[:20].decode("utf-8", "replace"))
 
 
-def _is_number(token: bytes) -> bool:
-    """Whether the bulk conversion (``np.loadtxt``) reads ``token`` as a number.
-
-    ``float()`` alone is not that test: it also takes Python's digit grouping
-    (``3_05``), which numpy refuses, and a line it passed would leave the
-    group's failure unexplained (reported at the group's first line).
-    """
-    if b"_" in token:
-        return False
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
-
-
 def _check_line(path: Path, line: int, name: str, tokens: list[bytes], expected: int, text_at: int) -> None:
     """Raise the precise error for one line whose bulk conversion failed."""
     layout = _LAYOUT["RAWLASER" if name.startswith("RAWLASER") else name]
@@ -199,7 +184,7 @@ def _check_line(path: Path, line: int, name: str, tokens: list[bytes], expected:
             path, f"{name} has {len(tokens)} fields after the name, expected {expected} ({layout})", line=line
         )
     for i, tok in enumerate(tokens):
-        if i != text_at % expected and not _is_number(tok):
+        if i != text_at % expected and not is_number(tok):
             raise ParseError(path, f"{name} field {i + 1} is {_describe(tok)}, expected a number ({layout})", line=line)
 
 
@@ -241,7 +226,7 @@ def _failing_line(
     name: str, rows: list[tuple[int, bytes]], expected: int, host_at: int, single_spaced: bool, exc: ValueError
 ) -> tuple[int, str]:
     """The line (and numpy's reason) that fails the bulk conversion when every token passed
-    :func:`_is_number`: each line is converted alone, so the error names the true line."""
+    :func:`~albot1.data.tokens.is_number`: each line is converted alone, so the error names the true line."""
     for line, rest in rows:
         try:
             np.loadtxt(
