@@ -242,12 +242,9 @@ def test_the_docs_list_the_fields_of_every_metric_of_the_registry() -> None:
     assert [name for name in table if name.strip("`") in ORDER] == [f"`{name}`" for name in ORDER]
 
 
-def test_a_ratio_without_a_denominator_is_not_applicable_with_the_metrics_words() -> None:
-    from albot1.bench.grid import Cell
-    from albot1.metrics.measures.places import PlacesBlock
-    from albot1.report.collect import CellRecord
-
-    places = {
+def _places(**rest: object) -> dict[str, object]:
+    """A places block of a run that claimed no re-visit (rooms rule), with ``rest`` (its exits) added."""
+    return {
         "units": {},
         "rule": "rooms",
         "rooms": ["a"],
@@ -262,9 +259,16 @@ def test_a_ratio_without_a_denominator_is_not_applicable_with_the_metrics_words(
         "revisit_precision": None,
         "revisit_recall": None,
         "visits": [],
-        "exits": None,
-        "exits_reason": "the dataset knows no doorways (exit checks need them)",
+        **rest,
     }
+
+
+def test_a_ratio_without_a_denominator_is_not_applicable_with_the_metrics_words() -> None:
+    from albot1.bench.grid import Cell
+    from albot1.metrics.measures.places import PlacesBlock
+    from albot1.report.collect import CellRecord
+
+    places = _places(exits=None, exits_reason="the dataset knows no doorways (exit checks need them)")
     block_of(PlacesBlock, places)
     metrics = parse_record(MetricsRecord, {"run": RUN, "places": places}, "m")
     cell = Cell("s", "d", "d", "m", "m", "p", "none", 0, "k", "v", 1, 1)
@@ -291,23 +295,7 @@ def test_exit_errors_without_a_comparison_are_not_applicable_with_the_runs_reaso
         "crossings_missed": 0,
         **({"exit_predictions_reason": reason} if reason else {}),
     }
-    places = {
-        "units": {},
-        "rule": "rooms",
-        "rooms": ["a"],
-        "buffer_m": None,
-        "min_overlap": None,
-        "claims": 0,
-        "claims_true": [],
-        "revisits_true": 0,
-        "revisits_false": 0,
-        "revisits_missed": 0,
-        "revisits_actual": 0,
-        "revisit_precision": None,
-        "revisit_recall": None,
-        "visits": [],
-        "exits": exits,
-    }
+    places = _places(exits=exits)
     metrics = parse_record(MetricsRecord, {"run": RUN, "places": places}, "m")
     cell = Cell("s", "d", "d", "m", "m", "p", "none", 0, "k", "v", 1, 1)
     record = CellRecord(cell, "done", Path("/nonexistent"), None, metrics, None)
