@@ -57,8 +57,8 @@ def _found(error: Any, *, typed: bool = False) -> str:
     errors name them. ``typed`` (:func:`describe_errors`' ``found``): a value
     of the wrong type is named with its type (``found the boolean true``).
     """
-    if error["type"] in _NO_VALUE_SHOWN or "input" not in error:
-        return ""
+    if error["type"] in _NO_VALUE_SHOWN or "input" not in error or "found " in error["msg"]:
+        return ""  # (a validator of this project's own says what it found in its message: not twice)
     value = error["input"]
     if typed and _is_type_error(error["type"]):
         return f", found {_describe_value(value)}"
