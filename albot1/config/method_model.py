@@ -13,10 +13,22 @@ once, covers every method and every way of setting a field. A field where
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict
+import math
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, field_serializer
 
 
 class MethodConfig(BaseModel):
     """A method's settings: unknown fields, mutation and non-finite numbers are refused."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @field_serializer("*", when_used="json")
+    def _infinity_as_text(self, value: Any) -> Any:
+        """A "no limit" ``inf`` as ``"inf"`` in JSON: a run records its config in ``result.json``, where a bare
+        infinity is no JSON and would be written as ``null``, which no config accepts back; the text ``"inf"``
+        is read back as the same float (so the recorded config reproduces the run)."""
+        if isinstance(value, float) and math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return value

@@ -7,6 +7,7 @@ same resolution ``albot1 run --set`` and a suite's ``set`` use.
 
 from __future__ import annotations
 
+import json
 import math
 
 import pytest
@@ -67,3 +68,14 @@ def test_the_inf_the_graph_preset_uses_stays_accepted() -> None:
     config = resolve_config("gtsam-graph", "default", {})
     assert config.model_dump()["odometry_trust_turn_deg"] == math.inf
     assert config.model_dump()["odometry_trust_run_max_turn_deg"] == math.inf
+
+
+def test_a_no_limit_infinity_is_recorded_as_text_and_read_back_as_the_same_config() -> None:
+    """``result.json`` used to hold ``null`` for gtsam-graph's ``inf`` ("no limit"): no config accepts that back."""
+    from albot1.records import json_value
+
+    config = resolve_config("gtsam-graph", "default")
+    recorded = json.loads(json.dumps(json_value(config.model_dump(mode="json")), allow_nan=False))
+    assert {field: recorded[field] for _, field in INF_ALLOWED} == dict.fromkeys((f for _, f in INF_ALLOWED), "inf")
+    assert type(config).model_validate(recorded) == config
+    assert config.model_dump() == type(config).model_validate(recorded).model_dump()  # floats, not text, inside
