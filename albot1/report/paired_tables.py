@@ -202,6 +202,16 @@ def intro() -> str:
     )
 
 
+def no_pairs() -> str:
+    """What the metrics page says when it has no paired table at all (a store of one method, say), so an empty
+    ``paired.csv`` is not taken for a comparison that found nothing."""
+    return (
+        "**Paired comparisons**: none. No dataset and degradation here has two methods whose completed runs "
+        "report errors that can be paired (position errors against reference poses, or relation errors), so "
+        "`paired.csv` holds only its header."
+    )
+
+
 def markdown_lines(rows: list[PairedRow], dataset: str) -> list[str]:
     """The paired table of one dataset (no lines when it has none)."""
     mine = [r for r in rows if r.dataset == dataset]

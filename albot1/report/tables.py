@@ -44,7 +44,7 @@ from albot1.report.collect import (
 )
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.markdown import text as md_text
-from albot1.report.paired_tables import PairedRow, intro, markdown_lines, paired_rows, write_paired_csv
+from albot1.report.paired_tables import PairedRow, intro, markdown_lines, no_pairs, paired_rows, write_paired_csv
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tuning import LEGEND, held_in, marked
 
@@ -325,7 +325,7 @@ def markdown(
         "",
         *([md_text(selected), ""] if selected else []),
         *([LEGEND, ""] if any_held_in(table) else []),
-        *([intro(), ""] if paired else []),
+        *([intro(), ""] if paired else [no_pairs(), ""] if paired is not None else []),
     ]
     if table.empty:
         return "\n".join([*lines, "No planned cells.", ""])

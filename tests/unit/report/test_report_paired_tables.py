@@ -15,7 +15,15 @@ from albot1.metrics.paired import BETTER, PERFECT_REFERENCE, SAME, WORSE
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
-from albot1.report.paired_tables import NO_ERRORS, NO_EVIDENCE, TABLE, error_kind, markdown_lines, paired_rows
+from albot1.report.paired_tables import (
+    NO_ERRORS,
+    NO_EVIDENCE,
+    TABLE,
+    error_kind,
+    markdown_lines,
+    no_pairs,
+    paired_rows,
+)
 from albot1.report.tables import write_tables
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
@@ -158,3 +166,13 @@ def test_with_no_errors_to_read_back_no_method_is_the_best(records: list[CellRec
     ]
     note = f"- n/a: {NO_ERRORS}: odometry against best (dropout:0.5); kiss-icp against best (dropout:0.5); "
     assert f"{note}gtsam-graph against best (dropout:0.5)" in lines
+
+
+def test_a_store_of_one_method_says_there_is_no_paired_comparison(records: list[CellRecord], tmp_path: Path) -> None:
+    """An empty paired.csv used to come with no word on the page: it read as a comparison that found nothing."""
+    written = write_tables([r for r in records if r.cell.method == "odometry"], tmp_path)
+    text = written["metrics.md"].read_text()
+    assert no_pairs() in text and "Paired comparison, " not in text
+    assert no_pairs() not in written["cost.md"].read_text()
+    assert written["paired.csv"].read_text().count("\n") == 1  # its header only
+    assert no_pairs() not in write_tables(records, tmp_path / "all")["metrics.md"].read_text()
