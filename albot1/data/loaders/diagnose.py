@@ -47,6 +47,17 @@ def _is_rawlog(path: Path, head: bytes) -> bool:
     return bool(head) and head[0] & 0x80 != 0 and head[1 : 1 + length].startswith(b"mrpt::") and length > 6
 
 
+def _wide_text(head: bytes) -> str | None:
+    """``"UTF-16"``/``"UTF-32"`` when ``head`` starts with that encoding's byte-order mark (a file saved as
+    "Unicode" by a Windows editor), else None: named, because "binary data" or a garbled first field would
+    hide that the text is fine, only its encoding is not read."""
+    if head.startswith((b"\xff\xfe\x00\x00", b"\x00\x00\xfe\xff")):
+        return "UTF-32"
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return "UTF-16"
+    return None
+
+
 def unrecognised(path: Path) -> DataError:
     """The error for a path that no loader sniffed as its format."""
     if path.is_dir():
@@ -58,6 +69,12 @@ def unrecognised(path: Path) -> DataError:
     head = read_head(path)
     if _is_rawlog(path, head):
         return UnknownFormatError(f"{path}: an MRPT rawlog; {RAWLOG_WRITE_ONLY}")
+    wide = _wide_text(head)
+    if wide:
+        return UnknownFormatError(
+            f"{path}: {packed}{wide} text (its byte-order mark says so); the logs are read as UTF-8 or ASCII text: "
+            f"convert it first (e.g. iconv -f {wide} -t UTF-8); {EXPECTED}"
+        )
     if _is_binary(head):
         return UnknownFormatError(f"{path}: binary {packed}data of no known format; {EXPECTED}")
     count = 0
@@ -78,6 +95,8 @@ def unrecognised(path: Path) -> DataError:
     except OSError as exc:
         return DataError(f"{path}: cannot be read ({exc.strerror or exc})")
     if first is None:
+        if count == 0 and compression == "none":  # not empty (checked above): a UTF-8 byte-order mark alone
+            return UnknownFormatError(f"{path}: the file holds no data, only a UTF-8 byte-order mark; {EXPECTED}")
         if count == 0:
             return UnknownFormatError(f"{path}: the {packed}file holds no data (0 bytes decompressed); {EXPECTED}")
         return UnknownFormatError(

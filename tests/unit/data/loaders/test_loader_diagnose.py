@@ -36,6 +36,20 @@ def write(tmp_path: Path, name: str, data: bytes | str) -> Path:
         ("z.gz", gzip.compress(b"", mtime=0), UnknownFormatError, r"z\.gz: the gzip-compressed file holds no data"),
         ("b.bin", b"\x00\x01\x02binary\xff" * 20, UnknownFormatError, r"b\.bin: binary data of no known format"),
         (
+            "w.clf",
+            (FLASER.format(t=0) + "\n").encode("utf-16"),
+            UnknownFormatError,
+            r"w\.clf: UTF-16 text \(its byte-order mark says so\); the logs are read as UTF-8 or ASCII text: "
+            r"convert it first \(e\.g\. iconv -f UTF-16 -t UTF-8\)",
+        ),
+        ("w4.clf", (FLASER.format(t=0) + "\n").encode("utf-32"), UnknownFormatError, r"w4\.clf: UTF-32 text"),
+        (
+            "bom.clf",
+            b"\xef\xbb\xbf",
+            UnknownFormatError,
+            r"bom\.clf: the file holds no data, only a UTF-8 byte-order mark; expected a CARMEN log",
+        ),
+        (
             "t.txt",
             "# header\nhello world\n",
             ParseError,
