@@ -70,7 +70,8 @@ def skipped_note(laser: str, parsed: ParsedChunk) -> str:
         return ""
     kinds = sorted(parsed.ignored, key=lambda name: parsed.ignored_first[name])
     listed = ", ".join(
-        f"{parsed.ignored[name]} {name} lines from line {parsed.ignored_first[name]}"
+        f"{parsed.ignored[name]} {name} line{'' if parsed.ignored[name] == 1 else 's'} "
+        f"{'at' if parsed.ignored[name] == 1 else 'from'} line {parsed.ignored_first[name]}"
         + (f" (a laser: read it with laser={name})" if name in LASER_MESSAGES else "")
         for name in kinds
     )

@@ -84,3 +84,11 @@ def test_datasets_info_prints_what_is_skipped(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert f"  skipped: {note}\n" in done.stdout
     assert done.stderr == f"{path}: skipped: {note}\n"
+
+
+def test_one_skipped_line_is_said_in_the_singular(tmp_path: Path) -> None:
+    path = write(tmp_path)
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join([lines[0], "SONAR 1 2 3", *lines[1:]]) + "\n")
+    sequence = CarmenLoader().load(path)
+    assert sequence.metadata.extra["skipped_messages"].startswith("1 SONAR line at line 2, counted in the first 5")
