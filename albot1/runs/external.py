@@ -196,7 +196,7 @@ def load_external(
     if reference is not None:
         reference = as_stored(scan_times, reference)  # as a run folder's reference.tum holds it
     stamps = file.timestamps
-    if paired_by_line(stamps, stamps_as_stored(scan_times), (file.path,), dataset=dataset):
+    if stamps is not None and paired_by_line(stamps, stamps_as_stored(scan_times), (file.path,), dataset=dataset):
         dt = None
         matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
         pose_times = stamps
