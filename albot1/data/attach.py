@@ -7,7 +7,9 @@ the same everywhere (``docs/formats.md``, "Options of every source"):
 
 ``relations=FILE``
     a relations file (:mod:`albot1.data.relations`) replaces the source's own
-    relations (if any); the relation metric then scores against it.
+    relations (if any); the relation metric then scores against it. A file
+    none of whose relation stamps lies within the log's time span (another
+    log's relations) is refused on the first full pass over the scans.
     ``relations_repeats=drop|keep`` says how its identically repeated lines
     count: once (drop, the default) or as listed (keep, the published
     evaluator's reading).
@@ -28,6 +30,7 @@ which lines hold the reference); any other value of ``reference`` names a file.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -35,8 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from albot1.data.errors import DataError, ReferenceOptionError
-from albot1.data.model import Frame, Sequence
-from albot1.data.relations import read_relations, repeat_policy
+from albot1.data.model import Frame, Relations, Sequence
+from albot1.data.relations import STAMP_TOLERANCE_S, read_relations, repeat_policy
 from albot1.data.trajectory import read_trajectory
 
 #: Largest gap (s) between a scan and the reference pose it takes (evo's default ``t_max_diff``).
@@ -54,10 +57,41 @@ def with_relations(sequence: Sequence, value: object, ref: str, repeats: object 
     relations = read_relations(path, repeats="drop" if repeats is None else repeat_policy(repeats, repr(ref)))
     extra = {**sequence.metadata.extra, "relations_file": str(path)}
     out = sequence.with_frames(
-        lambda frames: frames, metadata=replace(sequence.metadata, extra=extra), scan_count=sequence.known_scan_count
+        lambda frames: _of_this_log(frames, relations, path, ref),
+        metadata=replace(sequence.metadata, extra=extra),
+        scan_count=sequence.known_scan_count,
     )
     out.relations = relations
     return out
+
+
+def _of_this_log(frames: Iterator[Frame], relations: Relations, path: Path, ref: str) -> Iterator[Frame]:
+    """``frames`` unchanged; once they are all seen, ReferenceOptionError if no relation stamp lies in their time.
+
+    Relations of another log would otherwise be counted (``datasets info``)
+    and then all left out by the relation metric as naming scans the run did
+    not see. The log's time span is known only after a pass over its scans,
+    so the check rides on the first full pass that is made anyway (a sliced
+    reference stops early and is not checked: its relations may well lie
+    outside the slice). Any overlap, within :data:`STAMP_TOLERANCE_S` (the
+    relation metric's matching tolerance), passes: partial overlap is
+    counted and reported by the metric.
+    """
+    first = last = math.nan
+    for frame in frames:
+        t = frame.scan.timestamp
+        if math.isfinite(t):
+            first, last = (t, t) if math.isnan(first) else (min(first, t), max(last, t))
+        yield frame
+    if not len(relations) or math.isnan(first):
+        return
+    stamps = np.concatenate([relations.t1, relations.t2])
+    if not np.any((stamps >= first - STAMP_TOLERANCE_S) & (stamps <= last + STAMP_TOLERANCE_S)):
+        raise ReferenceOptionError(
+            f"{path}: its {len(relations)} relations span {stamps.min():.3f}-{stamps.max():.3f} s, but the scans "
+            f"of {ref!r} span {first:.3f}-{last:.3f} s: no relation lies within the log's time; expected the "
+            "relations of this log"
+        )
 
 
 def with_reference(sequence: Sequence, value: object, ref: str, max_dt: object = None) -> Sequence:

@@ -14,11 +14,14 @@ against:
 * **by order** (KITTI, no timestamps): the file must hold exactly one pose
   per scan of the dataset (``NAME[:N]`` selects a prefix);
 * **by line**, when the file's timestamps are the scans' own, line for line,
-  and some repeat (:func:`paired_by_line`): a run's ``trajectory.tum`` on a
-  log whose scans share a stamp (the corrected Radish logs stamp every scan
-  0). Two poses at one time cannot be told apart by time, so any other file
-  with a repeated timestamp is refused; this one pairs as the run itself
-  scored it, scan by scan.
+  and some repeat, and the file is a run's own ``trajectory.tum`` in its run
+  folder, whose ``result.json`` records this dataset reference and as many
+  scans (:func:`paired_by_line`): a log whose scans share a stamp (the
+  corrected Radish logs stamp every scan 0). It pairs as the run itself
+  scored it, scan by scan. Two poses at one time cannot be told apart by
+  time, and equal stamps do not prove equal scans (``NAME[:200:2]`` and
+  ``NAME[:100]`` both stamp 0), so any other file whose timestamps repeat
+  is refused, suggesting ``albot1 evaluate RUN_DIR``.
 
 The relation metric needs only times, so it looks relations up in every
 pose of the file (matched or not). Map shape, update counts and cost need
@@ -46,11 +49,11 @@ from albot1.data.trajectory import (
     as_stored,
     has_repeated_stamps,
     read_trajectory,
-    refuse_repeated_stamps,
     stamps_as_stored,
 )
+from albot1.errors import Albot1Error
 from albot1.runs.errors import RunError
-from albot1.runs.folder import EXTERNAL_PRESET
+from albot1.runs.folder import EXTERNAL_PRESET, read_result
 from albot1.runs.scored import Scored
 from albot1.settings import Settings
 
@@ -59,6 +62,8 @@ MAX_DT_S = 0.01
 NO_MAP = "an external trajectory comes without a map"
 NO_COUNTERS = "an external trajectory comes without the method's counters (views, updates)"
 NO_TIMING = "an external trajectory comes without per-scan timings"
+#: The TUM files a run folder holds, one pose per scan of the run (``albot1.runs.folder``).
+RUN_TUM_FILES = ("trajectory.tum", "odometry.tum", "reference.tum")
 
 
 @dataclass(frozen=True)
@@ -93,17 +98,68 @@ def match_by_time(pose_times: NDArray[np.float64], scan_times: NDArray[np.float6
     )
 
 
-def paired_by_line(stamps: NDArray[np.float64] | None, other: NDArray[np.float64] | None) -> bool:
+def paired_by_line(
+    stamps: NDArray[np.float64] | None,
+    other: NDArray[np.float64] | None,
+    files: tuple[Path, ...],
+    *,
+    dataset: str | None = None,
+) -> bool:
     """Whether poses stamped ``stamps`` pair with those stamped ``other`` line by line rather than by time.
 
-    So they do when both hold the same timestamps in the same order and some
-    repeat: the TUM files a run writes for a log whose scans share a stamp,
-    which the run scored scan by scan. Matched by time, two poses at one
-    time could not be told apart. Stamps that never repeat pair by time, as
-    any file does (a time offset shifts one side, so its lines then differ).
+    So they do when both hold the same timestamps in the same order, some
+    repeat, and ``files`` are a run's own TUM files in its run folder
+    (:func:`from_one_run`, of ``dataset`` when given): the files a run writes
+    for a log whose scans share a stamp, which the run scored scan by scan.
+    Equal stamps alone prove nothing: every scan of a corrected Radish log is
+    stamped 0, so ``belgioioso-corrected[:200:2]`` and ``[:100]`` hold the
+    same stamps but other scans. Matched by time, two poses at one time
+    could not be told apart. Stamps that never repeat pair by time, as any
+    file does (a time offset shifts one side, so its lines then differ).
     """
     return (
-        stamps is not None and other is not None and has_repeated_stamps(other) and bool(np.array_equal(stamps, other))
+        stamps is not None
+        and other is not None
+        and has_repeated_stamps(other)
+        and bool(np.array_equal(stamps, other))
+        and from_one_run(files, len(other), dataset=dataset)
+    )
+
+
+def from_one_run(files: tuple[Path, ...], scans: int, *, dataset: str | None = None) -> bool:
+    """Whether ``files`` are TUM files a run wrote (:data:`RUN_TUM_FILES`) in one complete run folder.
+
+    That folder's ``result.json`` must record ``scans`` scans, and ``dataset``
+    as its dataset reference when given: then every file holds one pose per
+    scan of that one selection of scans, the proof that line pairs with line.
+    A file copied out of its folder, or renamed, proves nothing and is refused.
+    """
+    real = [file.resolve() for file in files]
+    folders = {file.parent for file in real}
+    if len(folders) != 1 or any(file.name not in RUN_TUM_FILES for file in real):
+        return False
+    try:
+        result = read_result(folders.pop())
+    except Albot1Error:
+        return False
+    return result.scans == scans and (dataset is None or result.dataset == dataset)
+
+
+def refuse_repeated_stamps_by_time(file: PoseFile, others: int, what: str) -> None:
+    """RunError when ``file``'s timestamps repeat and its poses must be matched to ``others`` ``what`` by time.
+
+    Which of two poses at one time is meant cannot be told, so the file is
+    refused; the one case that pairs line by line is a run's own files
+    (:func:`paired_by_line`), which ``albot1 evaluate RUN_DIR`` scores.
+    """
+    stamps = file.timestamps
+    if stamps is None or not has_repeated_stamps(stamps):
+        return
+    distinct = len(np.unique(stamps))
+    raise RunError(
+        f"{file.path}: {len(file.poses)} poses for {others} {what}, and its timestamps repeat ({distinct} distinct "
+        f"value{'s' if distinct != 1 else ''}), so the poses cannot be matched by time; only a run's own files in "
+        "its run folder pair line by line: to score a run, give `albot1 evaluate RUN_DIR`"
     )
 
 
@@ -140,7 +196,7 @@ def load_external(
     if reference is not None:
         reference = as_stored(scan_times, reference)  # as a run folder's reference.tum holds it
     stamps = file.timestamps
-    if stamps is not None and has_repeated_stamps(stamps) and paired_by_line(stamps, stamps_as_stored(scan_times)):
+    if stamps is not None and paired_by_line(stamps, stamps_as_stored(scan_times), (file.path,), dataset=dataset):
         dt = None
         matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
         pose_times = stamps
@@ -154,7 +210,7 @@ def load_external(
         matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
         pose_times = scan_times
     else:
-        refuse_repeated_stamps(file)
+        refuse_repeated_stamps_by_time(file, len(scan_times), f"scans of {dataset!r}")
         dt = MAX_DT_S if max_dt_s is None else max_dt_s
         matching = match_by_time(file.timestamps, scan_times, dt)
         pose_times = file.timestamps

@@ -13,9 +13,12 @@ Like ``evo_ape``/``evo_rpe``, no dataset is needed: the reference file
   timestamps on either side (KITTI), the two files must hold as many poses,
   matched in order, and a time offset does not apply. Two poses of one
   file with one timestamp cannot be told apart by time and are refused,
-  except where both files hold the very same timestamps line for line: the
+  except where both files hold the very same timestamps line for line and
+  are TUM files of one run folder with as many scans: the
   ``trajectory.tum`` and ``reference.tum`` of one run on a log whose scans
-  share stamps (the corrected Radish logs stamp every scan 0). Those pair
+  share stamps (the corrected Radish logs stamp every scan 0; equal stamps
+  alone do not prove equal scans, as ``NAME[:200:2]`` and ``NAME[:100]``
+  both stamp 0). Those pair
   in order, one line with the same line of the other, as the run's own
   scoring pairs them scan by scan (``max_dt_s`` null, as for KITTI;
   :func:`albot1.runs.external.paired_by_line`, the rule of scoring against a dataset).
@@ -40,9 +43,18 @@ from pathlib import Path
 import numpy as np
 
 from albot1 import versions
-from albot1.data.trajectory import PoseFile, read_trajectory, refuse_repeated_stamps
+from albot1.data.trajectory import PoseFile, read_trajectory
 from albot1.runs.errors import RunError
-from albot1.runs.external import MAX_DT_S, NO_COUNTERS, NO_MAP, NO_TIMING, Matching, match_by_time, paired_by_line
+from albot1.runs.external import (
+    MAX_DT_S,
+    NO_COUNTERS,
+    NO_MAP,
+    NO_TIMING,
+    Matching,
+    match_by_time,
+    paired_by_line,
+    refuse_repeated_stamps_by_time,
+)
 from albot1.runs.folder import EXTERNAL_PRESET
 from albot1.runs.scored import Scored
 
@@ -114,7 +126,7 @@ def load_pair(
     if (
         ref.timestamps is not None
         and est.timestamps is not None
-        and paired_by_line(est.timestamps + offset, ref.timestamps)
+        and paired_by_line(est.timestamps + offset, ref.timestamps, (est.path, ref.path))
     ):
         dt = None
         matching = Matching(np.arange(len(ref.poses)), np.arange(len(ref.poses)), 0, 0)
@@ -131,8 +143,8 @@ def load_pair(
         matching = Matching(np.arange(len(ref.poses)), np.arange(len(ref.poses)), 0, 0)
         est_times = ref_times = np.arange(len(ref.poses), dtype=float)
     else:
-        refuse_repeated_stamps(est)
-        refuse_repeated_stamps(ref)
+        refuse_repeated_stamps_by_time(est, len(ref.poses), f"reference poses of {ref.path}")
+        refuse_repeated_stamps_by_time(ref, len(est.poses), f"poses of {est.path}")
         dt = MAX_DT_S if max_dt_s is None else max_dt_s
         est_times, ref_times = est.timestamps + offset, ref.timestamps
         matching = match_by_time(est_times, ref_times, dt)

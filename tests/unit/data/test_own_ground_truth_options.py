@@ -127,3 +127,26 @@ def test_relations_repeats_goes_with_a_relations_file_on_every_source(sources: d
         assert (len(kept.relations), kept.relations.repeats, kept.relations.repeats_counted) == (2, 1, True)
         with pytest.raises(DataError, match=r"relations_repeats='twice'; expected drop"):
             open_sequence(f"{path}?relations={relations}&relations_repeats=twice")
+
+
+def test_relations_of_another_log_are_refused_on_the_first_full_pass(sources: dict[str, Path], tmp_path: Path) -> None:
+    """No relation stamp within the log's time (another log's file) is refused; partial overlap is kept."""
+    foreign = tmp_path / "other-log.relations"
+    foreign.write_text("976052905.167303 976052911.885496 1 0 0 0 0 0\n976052896.784509 976052905.167303 1 0 0 0 0 0\n")
+    stamps = open_sequence(sources["carmen"]).arrays.timestamps
+    sequence = open_sequence(f"{sources['carmen']}?relations={foreign}")
+    assert sequence.relations is not None and len(sequence.relations) == 2  # attaching reads the file only
+    expected = (
+        f"{foreign}: its 2 relations span 976052896.785-976052911.885 s, but the scans of {str(sources['carmen'])!r} "
+        f"span {stamps.min():.3f}-{stamps.max():.3f} s: no relation lies within the log's time; expected the "
+        "relations of this log"
+    )
+    with pytest.raises(DataError) as caught:
+        sequence.arrays  # noqa: B018 - the one full pass over the scans
+    assert str(caught.value) == expected
+    # one end within the log's time (within the matching tolerance) is overlap: counted, as before
+    partial = tmp_path / "partial.relations"
+    partial.write_text(f"{float(stamps[-1]) + 5e-5!r} 976052911.885496 1 0 0 0 0 0\n")
+    assert len(open_sequence(f"{sources['carmen']}?relations={partial}").arrays.timestamps) == len(stamps)
+    # a slice stops before the end of the log: its relations may lie beyond it, so it is not refused here
+    assert len(open_sequence(f"{sources['carmen']}?relations={foreign}[:10]").arrays.timestamps) == 10

@@ -27,6 +27,8 @@ def test_tum_round_trip_keeps_nanometres_and_the_heading(tmp_path: Path) -> None
         ("# t x y z qx qy qz qw\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n", 3, "found 7 values, expected 8"),
         ("1 0 0 0 0 0 0 1\n\n2 0 zero 0 0 0 0 1\n", 3, "value 3 is 'zero', expected a number"),
         ("1 0 0 0 0 0 0 1\n2 nan 0 0 0 0 0 1\n", 2, "value 2 is 'nan', expected a finite number"),
+        # numpy refuses Python's digit grouping, float() takes it: the line must still be named
+        ("1 0 0 0 0 0 0 1\n2 0_0.8 0 0 0 0 0 1\n", 2, "value 2 is '0_0.8', expected a number"),
         ("1 0 0 0 0 0 0 1\n# a comment\n2 0 0 0 0 0 0 0\n", 3, "quaternion (qx qy qz qw) has length 0"),
     ],
 )
@@ -80,6 +82,7 @@ def test_the_format_comes_from_the_name_or_the_first_line(tmp_path: Path) -> Non
             ":2: the 3x3 part of [R | t] is not a rotation",
         ),
         ("m.kitti", "1 0 0 0 0 -1 0 0 0 0 1 0\n", ":1: the 3x3 part of [R | t] is not a rotation"),
+        ("g.kitti", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0_5 0 1 0 0 0 0 1 0\n", ":2: value 4 is '0_5', expected a number"),
         ("big.tum", "0 0 0 0 0 0 0 1\n1 1e308 0 0 0 0 0 1\n", ":2: position (1e+308, 0) m is beyond 1e+08 m"),
         ("ns.tum", "1.7e18 0 0 0 0 0 0 1\n", ":1: timestamp 1.7e+18 is beyond 1e+11; expected seconds"),
     ],
