@@ -21,6 +21,15 @@ def test_parse_options_converts_numbers() -> None:
     }
 
 
+def test_parse_options_leaves_grouped_and_unicode_digits_as_text() -> None:
+    """``int()`` reads ``1_0`` and ``１０`` as 10; an option so written stays text for its loader to refuse."""
+    assert parse_options("max_range=1_0&tol=\uff10.5&n=\u0663", "x") == {
+        "max_range": "1_0",
+        "tol": "\uff10.5",
+        "n": "\u0663",
+    }
+
+
 def test_bad_option_names_the_ref() -> None:
     with pytest.raises(DatasetNotFoundError, match="'x': loader option 'novalue' is not of the form KEY=VALUE"):
         parse_options("novalue", "x")
