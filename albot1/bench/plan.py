@@ -81,7 +81,9 @@ def _resolve(suite: Suite, entry: MethodEntry, registry: MethodRegistry) -> tupl
     except Exception as exc:  # the method's module itself is broken: a cell failure, not a runner crash
         return None, f"cannot load method {entry.name!r}: {type(exc).__name__}: {exc}"
     try:
-        config = resolve_config(entry.name, entry.preset, dict(entry.set), registry, override_origin="set")
+        config = resolve_config(
+            entry.name, entry.preset, dict(entry.set), registry, override_origin="set", typed_overrides=True
+        )
     except ConfigError as exc:
         where = (
             f"methods.{suite.methods.index(entry)} ({entry.display!r})"

@@ -95,7 +95,7 @@ from albot1.resources import list_resources, resource_dirs
 GLOB_CHARS = frozenset("*[")
 #: A trailing ``[:STOP]`` / ``[:STOP:STEP]`` / ``[::STEP]`` (or ``[0:STOP]``) is a slice of a dataset reference,
 #: not a glob class.
-_TRAILING_SLICE = re.compile(r"\[\d*:[^\[\]]*\]$")
+_TRAILING_SLICE = re.compile(r"\[[0-9]*:[^\[\]]*\]$")
 #: Upper bounds of the per-cell limits: beyond them a value is a typo, and a timer or a byte count would overflow.
 MAX_TIME_S = 7 * 24 * 3600.0
 MAX_MEMORY_MB = 1024.0 * 1024.0

@@ -54,7 +54,7 @@ def run(
     # The layers that do the work are imported by the command, not by this module: see albot1.cli.app.
     from albot1.data.degrade import check_seed
     from albot1.data.errors import SliceError
-    from albot1.data.open import open_sequence
+    from albot1.data.open import canonical_reference, open_sequence
     from albot1.methods.registry import parse_overrides
     from albot1.records import dump_record
     from albot1.report.preview import render_preview
@@ -69,7 +69,9 @@ def run(
     writable_folder(out, "--out")
     # The limit is part of the dataset's name (NAME[:N], as in the bench), so it is in the run's key and
     # result.json: runs on different prefixes get different folders, and `albot1 evaluate` reopens the prefix.
-    dataset = dataset if limit is None else f"{dataset}[:{limit}]"
+    # In the one spelling of its slice (as a suite's cells are): `NAME[0:30]`, `NAME[:030]`, `NAME[::1][:30]`
+    # and `NAME --limit 30` are one run, so one key and one folder, not five.
+    dataset = canonical_reference(dataset if limit is None else f"{dataset}[:{limit}]")
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
     sequence = with_progress(sequence, f"{method} on {dataset}", at_most=slice_bound(dataset))
     result = run_method(

@@ -20,6 +20,7 @@ from typing import Any, Generic, TypeVar
 from pydantic import BaseModel, ValidationError
 
 from albot1.config.env import env_values
+from albot1.config.numbers import is_number
 from albot1.config.suggest import did_you_mean
 from albot1.config.validation import describe_errors
 from albot1.errors import ConfigError
@@ -75,6 +76,7 @@ def resolve(
     overrides: Mapping[str, Any] | None = None,
     owner: str = "",
     override_origin: str = FROM_OVERRIDE,
+    typed_overrides: bool = False,
 ) -> ResolvedConfig[ModelT]:
     """Validate ``model`` from ``presets[preset]``, the environment and ``overrides`` (highest last).
 
@@ -82,6 +84,11 @@ def resolve(
     (``--set``, or a suite's ``set``), so that a rejected one is traced to what the user wrote. Raises
     ConfigError for an unknown preset, an environment variable that names no field, or a value the model
     rejects (the message names the field and where its value came from).
+
+    A number given as text (an environment variable, ``--set``) must be :func:`is_number` text: pydantic's lax
+    conversion would read ``1_0`` as 10 and ``１`` as 1. ``typed_overrides``: ``overrides`` come typed (a
+    suite's TOML ``set``), so they must have the field's type as written: a boolean or a string is not a
+    number, ``2.0`` is not an int, a number is not a boolean (an int for a float field is fine).
     """
     label = owner or model.__name__
     if preset not in presets:
@@ -103,4 +110,46 @@ def resolve(
         raise ConfigError(
             f"invalid config for method {label!r} (preset {preset!r}): {describe_errors(exc, sources)}"
         ) from None
+    textual = {name for name, origin in sources.items() if origin.startswith("env ")}
+    typed = set(overrides or {}) if typed_overrides else set()
+    textual |= set(overrides or {}) - typed
+    for name in sorted((textual | typed) & set(model.model_fields)):
+        problem = _as_written(values[name], getattr(config, name), text=name in textual)
+        if problem:
+            raise ConfigError(
+                f"invalid config for method {label!r} (preset {preset!r}): {name}: {problem} (from {sources[name]})"
+            )
     return ResolvedConfig(config, {name: sources[name] for name in model.model_fields})
+
+
+def _as_written(given: Any, got: Any, *, text: bool) -> str:
+    """Why the value ``given`` for a field must not become ``got``, or "" when it may.
+
+    Only scalar fields are checked (a number or a boolean as validated); ``text``: ``given`` is user text
+    (``--set``, an environment variable), which pydantic must convert, else a typed value (TOML).
+    """
+    if not isinstance(got, bool | int | float):
+        return ""
+    if text:
+        if isinstance(given, str) and not isinstance(got, bool) and not is_number(given):
+            return f"found {given[:40]!r}, expected a number in ASCII digits without '_' grouping (e.g. 10 or 0.5)"
+        return ""
+    if isinstance(got, bool):
+        ok = isinstance(given, bool)
+        expected = "a boolean (true or false)"
+    elif isinstance(got, int):
+        ok = isinstance(given, int) and not isinstance(given, bool)
+        expected = "an integer"
+    else:
+        ok = isinstance(given, int | float) and not isinstance(given, bool)
+        expected = "a number"
+    return "" if ok else f"found {_typed(given)}, expected {expected}"
+
+
+def _typed(value: Any) -> str:
+    """``the boolean true``, ``the string '2'``, ``the float 2.0``: a TOML value named with its type."""
+    if isinstance(value, bool):
+        return f"the boolean {str(value).lower()}"
+    if isinstance(value, str):
+        return f"the string {value[:40]!r}"
+    return f"the {type(value).__name__} {value!r}"

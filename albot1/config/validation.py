@@ -33,10 +33,22 @@ def describe_errors(exc: ValidationError, sources: Mapping[str, str] | None = No
             # "methods.0.presett: ..." blames a list that has its entry (the entry's own error says what is wrong)
             continue
         location = ".".join(str(part) for part in error["loc"]) or "(top level)"
-        origin = sources.get(str(error["loc"][0])) if sources and error["loc"] else None
-        suffix = f" (from {origin})" if origin else ""
+        if error["loc"]:
+            origin = sources.get(str(error["loc"][0])) if sources else None
+            suffix = f" (from {origin})" if origin else ""
+        else:
+            suffix = _named_origins(error["msg"], sources or {})
         problems.append(f"{location}: {error['msg']}{_found(error, typed=found)}{suffix}")
     return "; ".join(problems)
+
+
+def _named_origins(message: str, sources: Mapping[str, str]) -> str:
+    """``" (exit_min_width_m from --set)"``: where the fields a cross-field (top level) error names came from,
+    so that a rule between two fields is traced to the flag or variable that broke it."""
+    named = [
+        f"{name} from {origin}" for name, origin in sources.items() if re.search(rf"\b{re.escape(name)}\b", message)
+    ]
+    return f" ({'; '.join(named)})" if named else ""
 
 
 #: Error kinds whose input is not the problem: a missing field has none, an unknown field's value is beside the point.

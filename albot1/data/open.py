@@ -255,7 +255,7 @@ def parse_slice(body: str, ref: str) -> tuple[int | None, int | None]:
     ``[:STOP]``). Anything else is a SliceError naming the reference.
     """
     forms = "[:STOP], [:STOP:STEP] or [::STEP] with positive integers (the first STOP scans, every STEP-th of them)"
-    found = re.fullmatch(r"(?P<start>\d*):(?P<stop>\d*)(?::(?P<step>\d*))?", body)
+    found = re.fullmatch(r"(?P<start>[0-9]*):(?P<stop>[0-9]*)(?::(?P<step>[0-9]*))?", body)
     if found is None or len(body) > 40:
         raise SliceError(f"{ref!r}: slice [{body[:40]}] is not understood; expected {forms}")
     if found["start"] and int(found["start"]) != 0:

@@ -9,14 +9,17 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from albot1.config.numbers import is_number, is_plain
 from albot1.data.errors import ParseError
+
+__all__ = ["is_number", "parse_floats", "parse_scalar"]
 
 
 def parse_floats(path: str | Path, line: int, tokens: list[str], what: str, expected: str = "") -> NDArray[np.float64]:
     """``tokens`` as float64; else ParseError ``path:line: <what> 'tok' is not a number[; expected ...]``."""
     try:
-        if any("_" in t for t in tokens):
-            raise ValueError("digit grouping")
+        if not all(map(is_plain, tokens)):
+            raise ValueError("digit grouping or non-ASCII digits")
         return np.array(list(map(float, tokens)), dtype=np.float64)
     except ValueError:
         bad = next(t for t in tokens if not is_number(t))
@@ -24,25 +27,16 @@ def parse_floats(path: str | Path, line: int, tokens: list[str], what: str, expe
         raise ParseError(path, f"{what} {bad!r} is not a number{suffix}", line=line) from None
 
 
-def is_number(token: str | bytes) -> bool:
-    """Whether ``token`` is a number as the logs write them: what ``float()`` reads, but not Python's digit
-    grouping (``3_05`` would be read as 305; numpy, whose bulk conversion the CARMEN parser uses, refuses it)."""
-    if ("_" in token) if isinstance(token, str) else (b"_" in token):
-        return False
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
-
-
 def parse_scalar(token: str) -> int | float | str:
     """``"80"`` -> 80, ``"0.5"`` -> 0.5, anything else (``"laser-pose"``) unchanged.
 
     A dataset reference option is passed to its loader as a keyword, so a
     number typed in the reference must arrive as a number; an int is tried
-    first so counts stay ints.
+    first so counts stay ints. Only :func:`is_number` text is a number (``1_0`` and ``１０`` stay strings, which
+    the loader then refuses by name, rather than silently becoming 10).
     """
+    if not is_number(token):
+        return token
     for convert in (int, float):
         try:
             return convert(token)

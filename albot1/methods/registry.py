@@ -329,10 +329,12 @@ def resolve_method_config(
     overrides: dict[str, Any] | None = None,
     registry: MethodRegistry | None = None,
     override_origin: str = FROM_OVERRIDE,
+    typed_overrides: bool = False,
 ) -> ResolvedConfig[BaseModel]:
     """The validated config of ``method`` for ``preset`` plus env and explicit overrides, with each value's origin.
 
-    ``override_origin``: where ``overrides`` came from, as messages name it (default ``--set``).
+    ``override_origin``: where ``overrides`` came from, as messages name it (default ``--set``);
+    ``typed_overrides``: they are typed TOML values, validated as written (:func:`albot1.config.resolve.resolve`).
 
     Environment variables of the other registered methods are left to them:
     with nested prefixes (``albot1`` and a method ``albot1-places``) a
@@ -350,6 +352,7 @@ def resolve_method_config(
         overrides=overrides,
         owner=method,
         override_origin=override_origin,
+        typed_overrides=typed_overrides,
     )
 
 
@@ -359,9 +362,10 @@ def resolve_config(
     overrides: dict[str, Any] | None = None,
     registry: MethodRegistry | None = None,
     override_origin: str = FROM_OVERRIDE,
+    typed_overrides: bool = False,
 ) -> BaseModel:
     """The validated config of ``method`` (see :func:`resolve_method_config`)."""
-    return resolve_method_config(method, preset, overrides, registry, override_origin).config
+    return resolve_method_config(method, preset, overrides, registry, override_origin, typed_overrides).config
 
 
 def parse_overrides(pairs: list[str]) -> dict[str, str]:

@@ -70,7 +70,7 @@ def parse_alignment(text: str) -> tuple[str, int | None]:
         return "rigid", None
     if value in ("origin", "none"):
         return ("first" if value == "origin" else "none"), None
-    found = re.fullmatch(r"first:(\d{1,9})", value)
+    found = re.fullmatch(r"first:([0-9]{1,9})", value)
     if found is not None and int(found[1]) >= 1:
         return "rigid", int(found[1])
     raise RunError(

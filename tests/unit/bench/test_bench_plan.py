@@ -204,3 +204,30 @@ def test_a_method_whose_class_does_not_load_is_a_failed_cell_not_a_suite_error(t
     assert [c.method for c in plan.cells] == ["broken"]
     reason = plan.config_failures[plan.cells[0].key]
     assert reason.startswith("cannot load method 'broken': TargetError: no_such_module_here:Mapper: the module")
+
+
+@pytest.mark.parametrize(
+    ("setting", "problem"),
+    [
+        ("map_voxel_m = true", "map_voxel_m: found the boolean true, expected a number"),
+        ('map_every = "2"', "map_every: found the string '2', expected an integer"),
+        ("map_every = 2.0", "map_every: found the float 2.0, expected an integer"),
+        ('map_voxel_m = "0.1"', "map_voxel_m: found the string '0.1', expected a number"),
+    ],
+)
+def test_a_suite_set_value_of_another_type_is_an_error_not_converted(
+    tmp_path: Path, setting: str, problem: str
+) -> None:
+    """TOML values are typed: ``true`` is not 1.0 and ``"2"`` or ``2.0`` is not 2 (``--dry-run`` must say so)."""
+    with pytest.raises(SuiteError) as caught:
+        _methods_plan(tmp_path, f'[[methods]]\nname = "odometry"\nset = {{ {setting} }}\n')
+    assert str(caught.value) == (
+        f"{tmp_path / 'two.toml'}: invalid suite: methods.0 ('odometry'): invalid config for method 'odometry' "
+        f"(preset 'default'): {problem} (from set)"
+    )
+
+
+def test_a_suite_set_int_for_a_float_field_is_fine(tmp_path: Path) -> None:
+    plan = _methods_plan(tmp_path, '[[methods]]\nname = "odometry"\nset = { map_voxel_m = 1, map_every = 3 }\n')
+    config = plan.cells[0].config
+    assert (config["map_voxel_m"], config["map_every"]) == (1.0, 3)

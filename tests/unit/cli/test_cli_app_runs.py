@@ -39,3 +39,24 @@ def test_runs_lists_the_run_folders_and_marks_the_latest(tmp_path: Path) -> None
     text = runner.invoke(app, ["runs", str(tmp_path)]).stdout
     assert "odometry:default on synthetic-corridor[:30] [none, seed 0], 30 scans <- latest" in text
     assert text.strip().endswith(f"2 run folders in {tmp_path}")
+
+
+def test_every_spelling_of_one_slice_is_one_run_folder_under_the_canonical_name(tmp_path: Path) -> None:
+    """``[0:30]``, ``[:30:1]``, ``[:030]``, ``[::1][:30]`` and ``--limit 30`` are the scans of ``[:30]``: one run,
+    so one key and one folder, recorded as ``synthetic-corridor[:30]`` (a suite's cells already share it)."""
+    spellings = [
+        ["synthetic-corridor[:30]"],
+        ["synthetic-corridor[0:30]"],
+        ["synthetic-corridor[:30:1]"],
+        ["synthetic-corridor[:030]"],
+        ["synthetic-corridor[::1][:30]"],
+        ["synthetic-corridor", "--limit", "30"],
+    ]
+    summaries = []
+    for spelling in spellings:
+        done = runner.invoke(app, ["run", "odometry", *spelling, "--out", str(tmp_path), "--json"])
+        assert done.exit_code == 0, done.output
+        summaries.append(json.loads(done.stdout))
+    assert {s["run_dir"] for s in summaries} == {summaries[0]["run_dir"]}
+    assert {s["dataset"] for s in summaries} == {"synthetic-corridor[:30]"}
+    assert len([p for p in tmp_path.iterdir() if p.name != "latest"]) == 1

@@ -55,6 +55,7 @@ REGISTRY_HELP_MODULES = {
     "albot1.config.env",
     "albot1.config.keyvalue",
     "albot1.config.known_limits",
+    "albot1.config.numbers",
     "albot1.config.presets",
     "albot1.config.resolve",
     "albot1.config.suggest",

@@ -21,6 +21,15 @@ def test_parse_options_converts_numbers() -> None:
     }
 
 
+def test_parse_options_leaves_grouped_and_unicode_digits_as_text() -> None:
+    """``int()`` reads ``1_0`` and ``１０`` as 10; an option so written stays text for its loader to refuse."""
+    assert parse_options("max_range=1_0&tol=\uff10.5&n=\u0663", "x") == {
+        "max_range": "1_0",
+        "tol": "\uff10.5",
+        "n": "\u0663",
+    }
+
+
 def test_bad_option_names_the_ref() -> None:
     with pytest.raises(DatasetNotFoundError, match="'x': loader option 'novalue' is not of the form KEY=VALUE"):
         parse_options("novalue", "x")
@@ -64,6 +73,10 @@ def test_corrected_log_with_clean_odometry(data_file) -> None:  # type: ignore[n
         ("synthetic-office-startstop[:-5]", r"slice \[:-5\] is not understood"),
         ("synthetic-office-startstop[:" + "9" * 5000 + "]", r"is not understood"),
         ("synthetic-office-startstop[5:10]", r"slice START is 5, but only prefixes exist \(a START, if given, is 0\)"),
+        # Python's ``\d`` and ``int()`` read full-width and Arabic-Indic digits; a slice is ASCII digits only
+        ("synthetic-office-startstop[:\uff13\uff10]", r"slice \[:\uff13\uff10\] is not understood"),
+        ("synthetic-office-startstop[::\u0662]", r"slice \[::\u0662\] is not understood"),
+        ("synthetic-office-startstop[\uff10:5]", r"is not understood"),
     ],
 )
 def test_bad_slices_are_one_line_errors_naming_the_reference(ref: str, message: str) -> None:

@@ -101,7 +101,7 @@ def test_alignment_choices(text: str, expected: tuple[str, int | None]) -> None:
     assert parse_alignment(text) == expected
 
 
-@pytest.mark.parametrize("text", ["first:0", "first:", "first:-1", "umeyama", "", "first:1e3"])
+@pytest.mark.parametrize("text", ["first:0", "first:", "first:-1", "umeyama", "", "first:1e3", "first:\uff17"])
 def test_bad_alignment_choices_are_one_line(text: str) -> None:
     with pytest.raises(Albot1Error, match=r"--align .* expected se2 \| origin \| first:N \| none"):
         parse_alignment(text)
