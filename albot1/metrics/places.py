@@ -70,35 +70,30 @@ def overlap(a: Any, b: Any) -> float:
     return float(a.intersection(b).area / small) if small > 0 else 0.0
 
 
-def visit_rooms(reference: FloatArray, visits: list[Mapping[str, Any]], spaces: list[Mapping[str, Any]]) -> list[str]:
-    """The room (space name) holding most of each visit's reference positions ("" when none does)."""
-    out = []
-    for v in visits:
-        pts = np.asarray(reference, dtype=float)[v["first_scan"] : v["last_scan"] + 1, :2]
-        votes: dict[str, int] = {}
-        for space in spaces:
-            x0, y0, x1, y1 = space["rect"]
-            inside = int(
-                np.count_nonzero((pts[:, 0] >= x0) & (pts[:, 0] <= x1) & (pts[:, 1] >= y0) & (pts[:, 1] <= y1))
-            )
-            votes[space["name"]] = votes.get(space["name"], 0) + inside
-        best = max(votes.items(), key=lambda item: item[1], default=("", 0))
-        out.append(best[0] if best[1] > 0 else "")
-    return out
-
-
 def room_stays(rooms: list[str]) -> list[int]:
-    """The number of the stay each visit belongs to: consecutive visits in one room are one stay.
-
-    Why: a visit ends at a crossing the method detected, and a false
-    crossing (the robot never left the room) splits one stay into two
-    visits. The second is no re-visit of the room; only a visit in a later
-    stay is.
-    """
+    """The number of the stay each scan belongs to: consecutive scans in one room are one stay."""
     stays: list[int] = []
     for k, room in enumerate(rooms):
         stays.append(0 if k == 0 else stays[-1] + (room != rooms[k - 1]))
     return stays
+
+
+def true_stays(reference: FloatArray, spaces: list[Mapping[str, Any]]) -> tuple[list[str], list[int]]:
+    """The route's true room stays over the scored scans: the room and the stay number of each scan.
+
+    Why: recall must count the route's re-visits, not the method's; a method
+    that misses doorways has fewer visits but the route re-enters rooms all
+    the same. A scan in no room (a doorway) belongs to the stay before it.
+    """
+    pts = np.asarray(reference, dtype=float)[:, :2]
+    rooms: list[str] = []
+    for x, y in pts:
+        room = next(
+            (s["name"] for s in spaces if s["rect"][0] <= x <= s["rect"][2] and s["rect"][1] <= y <= s["rect"][3]),
+            "",
+        )
+        rooms.append(room or (rooms[-1] if rooms else ""))
+    return rooms, room_stays(rooms)
 
 
 def judge_revisits(
@@ -119,8 +114,9 @@ def judge_revisits(
                 f"{n} reference poses"
             )
     if spaces:
-        rooms = visit_rooms(reference, visits, spaces)
-        stays = room_stays(rooms)
+        scan_room, scan_stay = true_stays(reference, spaces)
+        stays = [_majority(scan_stay[v["first_scan"] : v["last_scan"] + 1]) for v in visits]
+        rooms = [scan_room[scan_stay.index(stay)] for stay in stays]
 
         def same(a: int, b: int) -> bool:
             return bool(rooms[a]) and rooms[a] == rooms[b] and stays[a] != stays[b]
@@ -146,6 +142,8 @@ def judge_revisits(
         revisiting += bool(earlier)
         recognised += correct
         per_visit.append({"visit": vid, "same_place_as": earlier, "recognised": correct})
+    if spaces:
+        revisiting, recognised = _route_revisits(reference, visits, spaces, per_visit)
     claims_true = int(sum(truth))
     counters: dict[str, int | float] = {
         "revisits_true": claims_true,
@@ -158,6 +156,37 @@ def judge_revisits(
     if revisiting:
         counters["revisit_recall"] = recognised / revisiting
     return counters, truth, {**rule, "visits": per_visit}
+
+
+def _majority(span: list[int]) -> int:
+    """The stay holding most of a visit's scans (the earliest on a tie)."""
+    return max(sorted(set(span)), key=span.count)
+
+
+def _route_revisits(
+    reference: FloatArray,
+    visits: list[Mapping[str, Any]],
+    spaces: list[Mapping[str, Any]],
+    per_visit: list[dict[str, Any]],
+) -> tuple[int, int]:
+    """The route's true re-visits (later stays in a room seen before) and how many of them the method recognised.
+
+    A visit maps to the true stay holding most of its scans; a true re-visit
+    stay is recognised when a visit mapped to it is a recognised re-visit.
+    """
+    scan_room, scan_stay = true_stays(reference, spaces)
+    first_stay_of: dict[str, int] = {}
+    for room, stay in zip(scan_room, scan_stay, strict=True):
+        if room:
+            first_stay_of.setdefault(room, stay)
+    stay_room = dict(zip(scan_stay, scan_room, strict=True))
+    revisit_stays = {stay for stay, room in stay_room.items() if room and first_stay_of[room] != stay}
+    hit: set[int] = set()
+    for v, judged in zip(visits, per_visit, strict=True):
+        stay = _majority(scan_stay[v["first_scan"] : v["last_scan"] + 1])
+        if judged["recognised"] and stay in revisit_stays:
+            hit.add(stay)
+    return len(revisit_stays), len(hit)
 
 
 def believed_in_world(point: FloatArray, estimate: FloatArray, reference: FloatArray) -> FloatArray:

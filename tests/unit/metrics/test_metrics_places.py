@@ -346,3 +346,27 @@ def test_the_headline_shows_false_crossings_and_the_medians_beside_the_means() -
         "3 of 3 true crossings found, 1 false; 3 exit predictions compared, mean (median) 0.467 (0.300) m aligned, "
         "1.000 (1.000) m not"
     )
+
+
+def _merged_record(places: list[int | None], bounds: list[tuple[int, int]]) -> dict:
+    visits = [
+        {"id": k, "place": p, "first_scan": b[0], "last_scan": b[1]} for k, (p, b) in enumerate(zip(places, bounds))
+    ]
+    return {"visits": visits, "revisits": [], "crossings": []}
+
+
+def test_true_revisits_are_the_routes_stays_not_the_methods_visits() -> None:
+    # the method missed every doorway: one visit over all 80 scans, yet the route re-entered a and b (D10)
+    counters, truth, _ = judge_revisits(_merged_record([0], [(0, 79)]), route(), SPACES)
+    assert truth == []
+    assert (counters["revisits_actual"], counters["revisits_missed"], counters["revisit_recall"]) == (2, 2, 0.0)
+
+
+def test_a_claim_counts_for_the_true_stay_holding_most_of_its_visit() -> None:
+    # two doorways found of three: visits a | b+a (mostly b: 20-55) | b; the last visit re-visits b, claimed right
+    rec = _merged_record([0, 1, 1], [(0, 19), (20, 55), (56, 79)])
+    rec["revisits"] = [{"scan": 60, "visit": 2, "place": 1, "place_now": 1, "how": "structure"}]
+    counters, truth, _ = judge_revisits(rec, route(), SPACES)
+    assert truth == [True]
+    assert (counters["revisits_actual"], counters["revisits_true"], counters["revisits_missed"]) == (2, 1, 1)
+    assert counters["revisit_recall"] == 0.5
