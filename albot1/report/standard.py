@@ -446,10 +446,8 @@ def on_standard_logs(plan: GridPlan, records: list[CellRecord]) -> bool:
 def write_standard(
     plan: GridPlan, records: list[CellRecord], out: Path, results_dir: Path | None = None
 ) -> tuple[Path, Path]:
-    """Write ``standard-benchmark.md`` and ``.csv`` into ``out``; returns both paths.
-
-    ``results_dir``: the store the records were read from, as given (its "Regenerate" line names it).
-    """
+    """Write ``standard-benchmark.md`` and ``.csv`` into ``out`` (both paths returned); ``results_dir``: the store
+    the records were read from, as given (the page's "Regenerate" line names it)."""
     measured = measured_rows(records)
     durations = {r.log: r.duration_s for r in measured if r.duration_s is not None}
     rows = [*measured, *published_rows(durations)]
