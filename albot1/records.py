@@ -47,6 +47,7 @@ from pydantic import (
     BaseModel,
     BeforeValidator,
     ConfigDict,
+    Field,
     SerializerFunctionWrapHandler,
     StringConstraints,
     ValidationError,
@@ -130,7 +131,7 @@ OptFraction = Annotated[float | None, BeforeValidator(_finite_or_none), AfterVal
 class Record(BaseModel):
     """Base of every record: unknown keys are errors, values are read-only, NaN is refused."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
 class OmitsAbsentReasons(Record):
@@ -235,7 +236,7 @@ class DatasetInfo(Record):
     reference_source: str
     #: the laser's pose on the robot (x m, y m, yaw rad) the runner applied (albot1.data.transforms.sensor_frame);
     #: absent in results written before it was recorded
-    sensor_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    sensor_offset: Annotated[tuple[float, float, float], Field(strict=False)] = (0.0, 0.0, 0.0)
     #: sha256 of every file the sequence was read from, by file name (albot1.data.identity); empty for a
     #: synthetic world (its code version names it) and in results written before it was recorded
     data_sha256: dict[str, Sha256] = {}
