@@ -123,6 +123,8 @@ def _a_fraction(value: float | None) -> float | None:
 #: An error magnitude, distance, duration or size: a negative one is a hand edit or a bug, never a result.
 NonNegative = Annotated[float, AfterValidator(_not_negative)]
 OptNonNegative = Annotated[float | None, BeforeValidator(_finite_or_none), AfterValidator(_not_negative)]
+#: A count or a scan index: a negative one is a hand edit or a bug (json_value has made numpy ints plain ints).
+Count = Annotated[int, Field(ge=0)]
 #: A share of a whole (precision, coverage, recall).
 Fraction = Annotated[float, AfterValidator(_a_fraction)]
 OptFraction = Annotated[float | None, BeforeValidator(_finite_or_none), AfterValidator(_a_fraction)]
@@ -259,7 +261,7 @@ class ResultRecord(Record):
     preset: str
     degradation: str
     seed: int
-    scans: int
+    scans: Count
     config: dict[str, Any]
     versions: dict[str, str | None]
     dataset_info: DatasetInfo
@@ -267,7 +269,7 @@ class ResultRecord(Record):
     timing: Timing
     map_file: Literal["map.geojson", "map.npz"]
     has_reference: bool
-    relations: int
+    relations: Count
 
 
 # --------------------------------------------------------------------------- attempt.json
