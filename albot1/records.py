@@ -47,6 +47,7 @@ from pydantic import (
     BaseModel,
     BeforeValidator,
     ConfigDict,
+    Field,
     SerializerFunctionWrapHandler,
     StringConstraints,
     ValidationError,
@@ -122,6 +123,8 @@ def _a_fraction(value: float | None) -> float | None:
 #: An error magnitude, distance, duration or size: a negative one is a hand edit or a bug, never a result.
 NonNegative = Annotated[float, AfterValidator(_not_negative)]
 OptNonNegative = Annotated[float | None, BeforeValidator(_finite_or_none), AfterValidator(_not_negative)]
+#: A count or a scan index: a negative one is a hand edit or a bug (json_value has made numpy ints plain ints).
+Count = Annotated[int, Field(ge=0)]
 #: A share of a whole (precision, coverage, recall).
 Fraction = Annotated[float, AfterValidator(_a_fraction)]
 OptFraction = Annotated[float | None, BeforeValidator(_finite_or_none), AfterValidator(_a_fraction)]
@@ -130,7 +133,7 @@ OptFraction = Annotated[float | None, BeforeValidator(_finite_or_none), AfterVal
 class Record(BaseModel):
     """Base of every record: unknown keys are errors, values are read-only, NaN is refused."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
 class OmitsAbsentReasons(Record):
@@ -235,7 +238,7 @@ class DatasetInfo(Record):
     reference_source: str
     #: the laser's pose on the robot (x m, y m, yaw rad) the runner applied (albot1.data.transforms.sensor_frame);
     #: absent in results written before it was recorded
-    sensor_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    sensor_offset: Annotated[tuple[float, float, float], Field(strict=False)] = (0.0, 0.0, 0.0)
     #: sha256 of every file the sequence was read from, by file name (albot1.data.identity); empty for a
     #: synthetic world (its code version names it) and in results written before it was recorded
     data_sha256: dict[str, Sha256] = {}
@@ -258,7 +261,7 @@ class ResultRecord(Record):
     preset: str
     degradation: str
     seed: int
-    scans: int
+    scans: Count
     config: dict[str, Any]
     versions: dict[str, str | None]
     dataset_info: DatasetInfo
@@ -266,7 +269,7 @@ class ResultRecord(Record):
     timing: Timing
     map_file: Literal["map.geojson", "map.npz"]
     has_reference: bool
-    relations: int
+    relations: Count
 
 
 # --------------------------------------------------------------------------- attempt.json

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import ClassVar, Literal, TypeVar
 
-from albot1.records import OmitsAbsentReasons, OptNonNegative, Record, parse_record
+from albot1.records import Count, OmitsAbsentReasons, OptNonNegative, Record, parse_record
 
 BlockT = TypeVar("BlockT", bound=Record)
 
@@ -39,8 +39,8 @@ class Stats(Record):
     min: OptNonNegative
     max: OptNonNegative
     rmse: OptNonNegative
-    n: int
-    std_ddof: int
+    n: Count
+    std_ddof: Count
 
 
 class RotationStats(Record):
@@ -52,8 +52,8 @@ class RotationStats(Record):
     min_deg: OptNonNegative
     max_deg: OptNonNegative
     rmse_deg: OptNonNegative
-    n: int
-    std_ddof: int
+    n: Count
+    std_ddof: Count
 
 
 class AlignmentTransform(OmitsAbsentReasons):

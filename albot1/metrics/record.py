@@ -26,7 +26,7 @@ from pydantic import create_model, model_validator
 
 from albot1.metrics.registry import MetricRegistry, metric_registry
 from albot1.metrics.unit import Metric
-from albot1.records import OmitsAbsentReasons, Record, Sha256
+from albot1.records import Count, OmitsAbsentReasons, Record, Sha256
 
 BlockT = TypeVar("BlockT", bound=Record)
 
@@ -50,7 +50,7 @@ class RunHeader(Record):
     preset: str
     degradation: str
     seed: int | None
-    scans: int
+    scans: Count
     has_reference: bool
     #: the sha256 of the dataset's files the run read (result.json ``dataset_info.data_sha256``); empty for a
     #: synthetic world, an external trajectory, and metrics written before it was recorded
@@ -71,10 +71,10 @@ class TrajectorySource(OmitsAbsentReasons):
     file: str
     format: Literal["tum", "kitti", "carmen"]
     sha256: str
-    poses: int
-    matched: int
-    unmatched: int
-    duplicates: int
+    poses: Count
+    matched: Count
+    unmatched: Count
+    duplicates: Count
     max_dt_s: float | None
     versions: dict[str, str | None]
     #: reference poses (the dataset's scans, or the poses of ``reference_file``) that no pose of the file

@@ -41,6 +41,7 @@ from albot1.records import (
     read_record,
 )
 from albot1.runs.folder import RESULT_FILE, StoredRun, read_run
+from albot1.runs.folder import is_complete as run_is_complete
 
 Source = Literal["metrics", "result", "attempt"]
 #: the record model behind each column source (``metrics.json``, ``result.json``, ``attempt.json``)
@@ -230,14 +231,18 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
 
     A completed cell whose ``result.json`` or ``metrics.json`` does not fit
     its model is a RecordError naming the file and the field (e.g. a results
-    folder made by an older version: run ``albot1 bench`` again).
+    folder made by an older version: run ``albot1 bench`` again). A run marked
+    DONE whose ``metrics.json`` is there but unreadable (truncated, edited) is
+    such a cell too, not "not run": that would blame a stopped runner for a
+    damaged file. Only a DONE run with no ``metrics.json`` at all was stopped
+    between its run and its evaluation.
     """
     store = ResultsStore(results_dir)
     plan = store.read_plan()
     records: list[CellRecord] = []
     for cell in plan.cells:
         run_dir = store.run_dir(cell.key)
-        if store.is_complete(cell.key):
+        if store.is_complete(cell.key) or (run_is_complete(run_dir) and (run_dir / METRICS).exists()):
             attempt = run_dir / ATTEMPT  # absent when the runner stopped right after the evaluation
             records.append(
                 CellRecord(

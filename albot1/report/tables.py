@@ -207,9 +207,14 @@ def decimals(value: float, significant: int = SIGNIFICANT) -> int | None:
     return max(0, significant - 1 - math.floor(math.log10(magnitude)))
 
 
+#: From this magnitude on a number is shown in scientific notation whatever its decimals: a diverged run's
+#: 1e308 m would otherwise fill a table cell with 309 digits.
+LARGE = 1e6
+
+
 def fmt(value: float, places: int | None) -> str:
-    """``value`` with ``places`` decimals (None: scientific, ``significant`` digits)."""
-    if places is None:
+    """``value`` with ``places`` decimals (None, or a magnitude of :data:`LARGE` or more: scientific)."""
+    if places is None or abs(value) >= LARGE:
         return f"{value:.{SIGNIFICANT - 1}e}"
     return f"{value:.{places}f}"
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from albot1.metrics.ate import ate
 from albot1.metrics.blocks import Alignment, AlignmentTransform, RotationStats, block_of, fmt
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import NonNegative, Record
+from albot1.records import Count, NonNegative, Record
 
 
 class AlignmentSummary(Record):
@@ -27,8 +27,8 @@ class AteBlock(Record):
     min_m: NonNegative
     max_m: NonNegative
     rmse_m: NonNegative
-    n: int
-    std_ddof: int
+    n: Count
+    std_ddof: Count
     rotation: RotationStats
     alignment_transform: AlignmentTransform
     other_alignments: dict[str, AlignmentSummary]

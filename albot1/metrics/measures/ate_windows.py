@@ -5,7 +5,7 @@ from __future__ import annotations
 from albot1.metrics.ate import windowed_ate
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import NonNegative, Record
+from albot1.records import Count, NonNegative, Record
 
 
 class WindowStats(Record):
@@ -17,15 +17,15 @@ class WindowStats(Record):
     min_m: NonNegative
     max_m: NonNegative
     rmse_m: NonNegative
-    n: int
-    std_ddof: int
+    n: Count
+    std_ddof: Count
 
 
 class AteWindow(Record):
     """One window of ``ate_windows``: its scans (inclusive) and its ATE."""
 
-    first_scan: int
-    last_scan: int
+    first_scan: Count
+    last_scan: Count
     rmse_m: NonNegative
     max_m: NonNegative
 
@@ -35,7 +35,7 @@ class AteWindowsBlock(Record):
 
     alignment: str
     window_m: NonNegative
-    windows: int
+    windows: Count
     uncovered_m: float  # may be -1e-9 m: the window count tolerates rounding (albot1.metrics.ate.windowed_ate)
     units: dict[str, str]
     mean_rmse_m: NonNegative

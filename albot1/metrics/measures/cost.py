@@ -9,7 +9,7 @@ from __future__ import annotations
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.cost import cost
 from albot1.metrics.unit import TIMING, Metric, MetricInputs
-from albot1.records import NonNegative, OptFloat, OptNonNegative, Record, dump_record
+from albot1.records import Count, NonNegative, OptFloat, OptNonNegative, Record, dump_record
 
 
 class CostByPosition(Record):
@@ -23,7 +23,7 @@ class CostBlock(Record):
     """``cost``: per-scan time (ms), totals (s), peak memory (MiB) and growth with position."""
 
     units: dict[str, str]
-    scans: int
+    scans: Count
     per_scan_ms_median: NonNegative
     per_scan_ms_p95: NonNegative
     per_scan_ms_mean: NonNegative

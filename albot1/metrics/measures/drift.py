@@ -7,14 +7,14 @@ from pydantic import model_validator
 from albot1.metrics.blocks import Stats, block_of, fmt
 from albot1.metrics.drift import drift
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import NonNegative, OmitsAbsentReasons, Record
+from albot1.records import Count, NonNegative, OmitsAbsentReasons, Record
 
 
 class DriftEntry(Record):
     """``drift.sweep`` entry: errors of every segment of ``length_m`` reference travel."""
 
     length_m: NonNegative
-    pairs: int
+    pairs: Count
     translation_m: Stats
     rotation_deg: Stats
 
@@ -24,7 +24,7 @@ class DriftAt10m(Record):
 
     translation_m: NonNegative
     rotation_deg: NonNegative
-    pairs: int
+    pairs: Count
 
 
 class DriftBlock(OmitsAbsentReasons):

@@ -11,7 +11,7 @@ from albot1.metrics.blocks import Stats, block_of, fmt
 from albot1.metrics.loop_gap import pair_gaps, route_gap
 from albot1.metrics.measures.drift import METRIC as DRIFT
 from albot1.metrics.unit import NO_REFERENCE, RETURNING_ROUTE, BlockLookup, ColumnSpec, Metric, MetricInputs
-from albot1.records import NonNegative, Record
+from albot1.records import Count, NonNegative, Record
 
 #: A loop gap applies to a route whose reference returns near its start: within this many metres ...
 ROUTE_RETURN_M = 1.0
@@ -48,7 +48,7 @@ class LoopGapBlock(Record):
     radius_m: NonNegative
     min_dt_s: NonNegative
     min_travel_m: NonNegative
-    pairs: int
+    pairs: Count
     translation_m: Stats | None
     rotation_deg: Stats | None
     worst_pair: WorstPair | None

@@ -21,7 +21,7 @@ from albot1.metrics.errors import MetricsError
 from albot1.metrics.map_shape import MAX_POINTS, VOXEL_M, map_agreement, thin
 from albot1.metrics.reference_map import entry_key, reference_cloud
 from albot1.metrics.unit import MAP, REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import Fraction, NonNegative, Record
+from albot1.records import Count, Fraction, NonNegative, Record
 
 if TYPE_CHECKING:
     from albot1.data.model import Sequence
@@ -36,8 +36,8 @@ class MapShapeBlock(Record):
     reference_map: str
     tolerance_m: NonNegative
     voxel_m: NonNegative
-    map_points: int
-    reference_points: int
+    map_points: Count
+    reference_points: Count
     precision: Fraction
     coverage: Fraction
     map_to_reference_mean_m: NonNegative

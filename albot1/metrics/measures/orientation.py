@@ -5,13 +5,13 @@ from __future__ import annotations
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.orientation import orientation_table
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import OptFloat, OptNonNegative, Record
+from albot1.records import Count, OptFloat, OptNonNegative, Record
 
 
 class OrientationRow(Record):
     """One stop point of the thesis's Table 3.1 (deg, m); the bearing error is null near the start."""
 
-    scan: int
+    scan: Count
     timestamp: OptFloat
     travel_m: float
     estimate_bearing_deg: float
@@ -29,8 +29,8 @@ class OrientationBlock(Record):
     units: dict[str, str]
     every_m: float
     min_distance_m: float
-    stops: int
-    bearing_undefined: int
+    stops: Count
+    bearing_undefined: Count
     bearing_abs_error_mean_deg: OptNonNegative
     bearing_abs_error_max_deg: OptNonNegative
     distance_abs_error_mean_m: OptNonNegative

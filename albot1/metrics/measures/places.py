@@ -20,7 +20,7 @@ from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.places import PLACES_JSON, judge_network
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs, method_file
-from albot1.records import NonNegative, OmitsAbsentReasons, OptFraction, OptNonNegative, Record
+from albot1.records import Count, NonNegative, OmitsAbsentReasons, OptFraction, OptNonNegative, Record
 
 PLACES_FILE = method_file(PLACES_JSON, f"the method keeps no network of places (no {PLACES_JSON})")
 
@@ -28,7 +28,7 @@ PLACES_FILE = method_file(PLACES_JSON, f"the method keeps no network of places (
 class VisitJudgement(Record):
     """One visit: the earlier visits it was in the same place as, and whether the network recognised that."""
 
-    visit: int
+    visit: Count
     same_place_as: list[int]
     recognised: bool
 
@@ -36,7 +36,7 @@ class VisitJudgement(Record):
 class ExitPrediction(Record):
     """One exit prediction compared at a crossing, against the true doorway nearest the perceived exit (m)."""
 
-    scan: int
+    scan: Count
     exit: int | str
     doorway: str
     perceived_error_m: NonNegative
@@ -55,14 +55,14 @@ class ExitsJudgement(OmitsAbsentReasons):
     """
 
     exit_predictions: list[ExitPrediction]
-    crossing_scans: int
+    crossing_scans: Count
     exit_prediction_aligned_true_mean_m: OptNonNegative
     exit_prediction_not_aligned_true_mean_m: OptNonNegative
     exit_prediction_aligned_true_median_m: OptNonNegative = None
     exit_prediction_not_aligned_true_median_m: OptNonNegative = None
-    crossings_true: int
-    crossings_false: int
-    crossings_missed: int
+    crossings_true: Count
+    crossings_false: Count
+    crossings_missed: Count
     exit_predictions_reason: str | None = None
 
 
@@ -84,12 +84,12 @@ class PlacesBlock(OmitsAbsentReasons):
     rooms: list[str] | None
     buffer_m: float | None
     min_overlap: float | None
-    claims: int
+    claims: Count
     claims_true: list[bool]
-    revisits_true: int
-    revisits_false: int
-    revisits_missed: int
-    revisits_actual: int
+    revisits_true: Count
+    revisits_false: Count
+    revisits_missed: Count
+    revisits_actual: Count
     revisit_precision: OptFraction
     revisit_recall: OptFraction
     visits: list[VisitJudgement]

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.relations import relation_errors
 from albot1.metrics.unit import RELATIONS, ColumnSpec, Metric, MetricInputs
-from albot1.records import OptFloat, Record
+from albot1.records import Count, OptFloat, Record
 
 #: The whiskers' reach beyond the box, in IQRs (Tukey's; matplotlib's default ``whis``).
 WHISKER_IQR = 1.5
@@ -33,7 +33,7 @@ WHISKER_IQR = 1.5
 class Quartiles(Record):
     """Box-plot numbers of one error sample (null statistics when ``n`` is 0)."""
 
-    n: int
+    n: Count
     min: OptFloat
     q1: OptFloat
     median: OptFloat
@@ -42,7 +42,7 @@ class Quartiles(Record):
     iqr: OptFloat
     whisker_low: OptFloat
     whisker_high: OptFloat
-    outliers: int
+    outliers: Count
 
 
 class RelationBoxBlock(Record):
@@ -51,7 +51,7 @@ class RelationBoxBlock(Record):
     units: dict[str, str]
     quantiles: str
     whisker_iqr: float
-    relations_used: int
+    relations_used: Count
     translation_m: Quartiles
     rotation_deg: Quartiles
 

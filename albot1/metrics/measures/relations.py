@@ -12,7 +12,7 @@ from __future__ import annotations
 from albot1.metrics.blocks import Stats, block_of, fmt
 from albot1.metrics.relations import relation_metric
 from albot1.metrics.unit import RELATIONS, ColumnSpec, Metric, MetricInputs
-from albot1.records import Record
+from albot1.records import Count, Record
 
 
 class RelationLoops(Record):
@@ -39,11 +39,11 @@ class RelationsBlock(Record):
 
     alignment: str
     error: str
-    std_ddof: int
-    relations_total: int
-    relations_used: int
-    relations_outside_run: int
-    relations_repeated_lines: int = 0
+    std_ddof: Count
+    relations_total: Count
+    relations_used: Count
+    relations_outside_run: Count
+    relations_repeated_lines: Count = 0
     relations_repeats_counted: bool = False
     max_time_gap_s: float
     translation_m: Stats

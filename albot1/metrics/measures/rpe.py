@@ -7,7 +7,7 @@ from typing import Literal
 from albot1.metrics.blocks import Stats, block_of, fmt
 from albot1.metrics.rpe import rpe_set
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import Record
+from albot1.records import Count, Record
 
 
 class RpeEntry(Record):
@@ -15,7 +15,7 @@ class RpeEntry(Record):
 
     delta: int | float
     delta_unit: Literal["frames", "m"]
-    pairs: int
+    pairs: Count
     translation_m: Stats
     rotation_deg: Stats
 
@@ -28,7 +28,7 @@ class RpeBlock(Record):
     units: dict[str, str]
     delta: int | float
     delta_unit: Literal["frames", "m"]
-    pairs: int
+    pairs: Count
     translation_m: Stats
     rotation_deg: Stats
     deltas: list[RpeEntry]

@@ -118,3 +118,39 @@ def test_the_report_command_refuses_it_in_one_line(pristine: Path, tmp_path: Pat
         done.stderr == f"albot1: error: {path}: not a valid MetricsRecord: ate.rmse_m: Value error, found -0.5; "
         f"{NEGATIVE}\n"
     )
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "problem"),
+    [
+        ("ate.rmse_m", "true", "Input should be a valid number"),
+        ("ate.rmse_m", '"0.1"', "Input should be a valid number"),
+        ("ate.n", "-3", "Input should be greater than or equal to 0, found -3"),
+        ("ate.n", "2.0", "Input should be a valid integer, found 2.0"),
+        ("rpe.translation_m.n", "-1", "Input should be greater than or equal to 0, found -1"),
+    ],
+)
+def test_a_bool_a_string_or_a_negative_count_is_not_a_stored_number(
+    pristine: Path, field: str, value: str, problem: str
+) -> None:
+    """``true`` was read as 1.0 m, ``"0.1"`` as 0.1 m and ``"n": -3`` as a count: each a hand edit shown as measured."""
+    path = _edited(pristine, METRICS_FILE, field, value)
+    with pytest.raises(RecordError) as err:
+        collect(pristine)
+    assert str(err.value).startswith(f"{path}: not a valid MetricsRecord: {field}: {problem}")
+
+
+def test_a_truncated_metrics_json_of_a_done_run_is_named_not_reported_as_not_run(pristine: Path) -> None:
+    """The cell completed (DONE); calling it "not run" blamed a stopped runner for a damaged file."""
+    path = next((pristine / "runs").iterdir()) / METRICS_FILE
+    path.write_text(path.read_text()[:40])
+    with pytest.raises(RecordError) as err:
+        collect(pristine)
+    assert str(err.value).startswith(f"{path}: cannot read a MetricsRecord: ")
+
+
+def test_a_done_run_without_metrics_json_is_not_run(pristine: Path) -> None:
+    """Stopped between the run and its evaluation: the bench evaluates it on its next pass."""
+    path = next((pristine / "runs").iterdir()) / METRICS_FILE
+    path.unlink()
+    assert [r.status for r in collect(pristine)[1]] == ["not run"]

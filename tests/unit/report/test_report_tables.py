@@ -22,6 +22,7 @@ from albot1.report.tables import (
     aggregate,
     cell_text,
     cells_frame,
+    fmt,
     markdown,
     pick,
     stats_text,
@@ -284,3 +285,12 @@ def test_write_tables_keeps_cost_out_of_the_accuracy_files(tmp_path: Path) -> No
     assert cost.loc[0, "per_scan_ms_median_mean"] == 3.0
     assert list(cells["status"]) == ["done", "failed"] and cells.loc[1, "reason"] == "RuntimeError: boom"
     assert list(metrics["status"]) == ["ok", "failed (exception: RuntimeError: boom)"]
+
+
+@pytest.mark.parametrize(
+    ("value", "places", "text"),
+    [(1e308, 0, "1.00e+308"), (-2.5e6, 3, "-2.50e+06"), (999999.4, 0, "999999"), (0.1234, 4, "0.1234")],
+)
+def test_a_huge_number_is_scientific_not_hundreds_of_digits(value: float, places: int, text: str) -> None:
+    """A diverged run's 1e308 m filled a table cell with 309 digits."""
+    assert fmt(value, places) == text
