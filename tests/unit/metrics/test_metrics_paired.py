@@ -152,7 +152,7 @@ def test_a_nan_error_and_an_empty_group_give_the_gathers_numbers(power: int) -> 
 
 
 def test_a_reference_zero_on_nearly_every_pair_has_no_interval_and_says_why() -> None:
-    """Most resamples draw only zeros of B: the upper end is inf or NaN, never printed as a bound (old: "3.47 [2.12–n/a]", worse)."""
+    """Many resamples draw only zeros of B: the upper end is inf or NaN, never a bound (old: "3.47 [2.12–n/a]")."""
     a = np.random.default_rng(3).uniform(0.1, 1.0, 50)
     b = a.copy()
     b[:45] = 0.0
