@@ -133,6 +133,33 @@ def test_rpe_of_a_constant_per_step_heading_bias() -> None:
     assert block["translation_m"] == block["deltas"][0]["translation_m"]
 
 
+@pytest.mark.parametrize("outside", ["error", "exclude"])
+def test_a_relation_end_on_a_stamp_several_scans_share_is_refused_naming_its_line(outside: str) -> None:
+    """Stamps 0, 0, 0, 1, 1, 1: the lookup took the first scan of each stamp and scored 0.0 m (old code)."""
+    ref = np.column_stack([np.arange(6.0), np.zeros(6), np.zeros(6)])
+    stamps = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0])
+    rel = Relations(t1=np.array([0.0]), t2=np.array([1.0]), poses=np.array([[3.0, 0.0, 0.0]]))
+    message = (
+        "r.relations:1: time 0.000000 is the stamp of 3 scans, so which one the relation names cannot be told; "
+        "expected each relation end to name one scan, its own (1 relation(s) affected)"
+    )
+    with pytest.raises(MetricsError) as caught:
+        relation_metric(stamps, ref, rel, outside=outside, source="r.relations")  # type: ignore[arg-type]
+    assert str(caught.value) == message
+
+
+def test_a_relation_whose_two_ends_find_one_scan_is_refused() -> None:
+    """t1 != t2 (the reader's check) but both within the 0.1 ms tolerance of scan 2: old code scored it 0.3 m."""
+    ref = np.column_stack([np.arange(6.0), np.zeros(6), np.zeros(6)])
+    rel = Relations(t1=np.array([2.0]), t2=np.array([2.00005]), poses=np.array([[0.3, 0.0, 0.0]]))
+    with pytest.raises(MetricsError) as caught:
+        relation_metric(np.arange(6.0), ref, rel)
+    assert str(caught.value) == (
+        "relations:1: both ends name scan 2 (time 2.000000): a relation from a scan to itself; expected each "
+        "relation end to name one scan, its own (1 relation(s) affected)"
+    )
+
+
 def test_an_rpe_step_without_a_pair_is_null_and_says_why() -> None:
     """A step longer than the log, a robot that stands still: null statistics and the reason (old: nulls only)."""
     _, ref = straight(3)
