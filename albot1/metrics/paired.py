@@ -93,7 +93,9 @@ class Comparison:
 
         When A is the perfect one (its pooled error below :data:`ZERO_ERROR`), or a resample quantile of A's
         error is zero (the reciprocal interval unbounded), B against A does not apply, with the reason
-        :func:`compare` gives for those errors in that order: never a ratio of ``inf``.
+        :func:`compare` gives for those errors in that order: never a ratio of ``inf``. An n/a about B's
+        errors (:data:`PERFECT_REFERENCE`, :data:`UNBOUNDED`) stays that n/a here, though it says nothing of
+        B against A: compare that direction itself (``albot1.report.comparisons.all_pairs`` does).
         """
         if self.applies and self.error_a < ZERO_ERROR:
             reason: str | None = PERFECT_REFERENCE
