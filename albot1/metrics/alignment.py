@@ -96,6 +96,11 @@ def alignment_transform(
     if n_to_align is not None:
         if method != "rigid" or n_to_align < 1:
             raise MetricsError(f"n_to_align={n_to_align} goes with the rigid alignment and a positive count")
+        if n_to_align > len(est):
+            # evo slices silently; the block would then name an N the alignment never used
+            raise MetricsError(
+                f"n_to_align={n_to_align}: the trajectories have {len(est)} pose pairs; expected at most {len(est)}"
+            )
         return rigid_transform(est[:n_to_align], ref[:n_to_align])
     if method == "none":
         return np.zeros(3)

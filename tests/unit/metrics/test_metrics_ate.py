@@ -107,3 +107,12 @@ def test_a_straight_corridor_determines_the_rotation_in_the_plane() -> None:
     est = se2.compose([-4.0, 7.0, 2.5], ref)
     _, transform = align(est, ref, "rigid")
     assert transform == pytest.approx(se2.inverse([-4.0, 7.0, 2.5]), abs=1e-12)
+
+
+def test_n_to_align_beyond_the_pairs_is_refused_rather_than_named_but_not_used() -> None:
+    """Old code aligned on the 5 pairs there are and wrote ``n_to_align: 1000`` into the block."""
+    ref = np.column_stack([np.arange(5.0), np.zeros(5), np.zeros(5)])
+    with pytest.raises(MetricsError) as caught:
+        ate(ref, ref, "rigid", n_to_align=1000)
+    assert str(caught.value) == "n_to_align=1000: the trajectories have 5 pose pairs; expected at most 5"
+    assert ate(ref, ref, "rigid", n_to_align=5)["alignment_transform"]["n_to_align"] == 5
