@@ -2,7 +2,12 @@
 
 One relation per line: ``t1 t2 x y z roll pitch yaw`` -- the pose at time
 ``t2`` seen from the pose at time ``t1`` (``inv(T1) * T2``); the times are
-the ipc timestamps of the dataset's scans. Only the planar part (x, y, yaw)
+the ipc timestamps of the dataset's scans (s), x and y in metres, the angles
+in **radians** (the metricEvaluator's unit; every published file's yaw lies
+in [-pi, pi], the largest |yaw| being 3.14157 in fr079's). A |yaw| beyond
+pi is refused naming its line (:data:`MAX_YAW_RAD`): it is the sign of a
+file written in degrees, which read as radians would score a wrong heading
+for every relation turning more than a few degrees. Only the planar part (x, y, yaw)
 is kept: z, roll and pitch are zero in every published 2D relations file,
 and a non-zero value is reported rather than silently dropped. Blank lines
 and ``#`` comments are allowed. A file without one relation is refused
@@ -67,6 +72,8 @@ _PLANAR_TOLERANCE = 1e-6
 STAMP_TOLERANCE_S = 1e-4
 #: Largest accepted |x|, |y| (m) of a relation's motion.
 MAX_MOTION_M = 1e8
+#: Largest accepted |yaw| (rad) of a relation's motion: pi, with room for pi printed rounded up (3.1416, 3.141593).
+MAX_YAW_RAD = math.pi + 1e-5
 #: Largest accepted |t1|, |t2| (s): Unix seconds until year 5138; nanosecond stamps are refused, not misread.
 MAX_TIMESTAMP_S = 1e11
 #: How identical repeated lines are read: ``drop`` counts each relation once (the default), ``keep`` as listed.
@@ -176,7 +183,7 @@ def _noted_repeats(path: Path, line: str) -> tuple[RepeatPolicy, int]:
 
 def _check_row(path: Path, number: int, values: list[float]) -> None:
     """ParseError for an absurd or self-referencing relation (see the module docstring)."""
-    t1, t2, x, y = values[0], values[1], values[2], values[3]
+    t1, t2, x, y, yaw = values[0], values[1], values[2], values[3], values[7]
     if max(abs(t1), abs(t2)) > MAX_TIMESTAMP_S:
         raise ParseError(
             path, f"timestamp beyond {MAX_TIMESTAMP_S:g}; expected seconds (the scans' timestamps)", line=number
@@ -184,6 +191,12 @@ def _check_row(path: Path, number: int, values: list[float]) -> None:
     if max(abs(x), abs(y)) > MAX_MOTION_M:
         raise ParseError(
             path, f"motion ({x:.6g}, {y:.6g}) m is beyond {MAX_MOTION_M:g} m; expected metres", line=number
+        )
+    if abs(yaw) > MAX_YAW_RAD:
+        raise ParseError(
+            path,
+            f"yaw {yaw:g} is beyond pi; expected radians in [-pi, pi] (a file written in degrees?)",
+            line=number,
         )
     if t1 == t2:
         raise ParseError(

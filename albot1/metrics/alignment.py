@@ -16,8 +16,13 @@ every absolute metric names its alignment:
     error (Umeyama 1991 without scale, evo's ``--align``), in closed form for
     the plane: the rotation angle is ``atan2(sum cross, sum dot)`` of the
     centred positions, which is the 2-D case of the SVD solution and can
-    never return a reflection. Scale is never estimated: a metric map has
-    no free scale. With ``n_to_align = N`` the motion is estimated on the
+    never return a reflection. Positions on a line (a straight corridor, two
+    poses) determine it too: unlike 3-D Umeyama (evo refuses them, "degenerate
+    covariance rank") a rotation in the plane has no axis left free. Only
+    when the positions cannot (one pose, or every position the same: a robot
+    turning on the spot) is the rotation taken from the headings, the
+    circular mean of their differences, among the equally good ones. Scale
+    is never estimated: a metric map has no free scale. With ``n_to_align = N`` the motion is estimated on the
     first N pose pairs only and applied to all (evo's ``--align
     --n_to_align N``): the error then shows how far the run strays from
     where its beginning put it.
@@ -65,8 +70,16 @@ def rigid_transform(estimate: ArrayLike, reference: ArrayLike) -> FloatArray:
     pc, qc = p - mp, q - mq
     dot = float(np.sum(pc[:, 0] * qc[:, 0] + pc[:, 1] * qc[:, 1]))
     cross = float(np.sum(pc[:, 0] * qc[:, 1] - pc[:, 1] * qc[:, 0]))
-    # One pose, or all positions equal: the rotation is undetermined; keep 0.
-    angle = np.arctan2(cross, dot) if (abs(dot) + abs(cross)) > 1e-12 else 0.0
+    if abs(dot) + abs(cross) > 1e-12:
+        angle = float(np.arctan2(cross, dot))
+    else:
+        # One pose, or all positions equal (a robot turning on the spot): every angle gives the same position
+        # error, so the positions do not determine the rotation. Of those equal optima take the one that best
+        # matches the headings (their differences' circular mean); a fixed 0 would score a perfect estimate in
+        # a rotated frame with the frames' angle as its heading error.
+        turn = ref[:, 2] - est[:, 2]
+        sin, cos = float(np.sum(np.sin(turn))), float(np.sum(np.cos(turn)))
+        angle = float(np.arctan2(sin, cos)) if abs(sin) + abs(cos) > 1e-12 else 0.0
     c, s = np.cos(angle), np.sin(angle)
     t = mq - np.array([c * mp[0] - s * mp[1], s * mp[0] + c * mp[1]])
     return np.array([t[0], t[1], se2.wrap(angle)])
@@ -83,6 +96,11 @@ def alignment_transform(
     if n_to_align is not None:
         if method != "rigid" or n_to_align < 1:
             raise MetricsError(f"n_to_align={n_to_align} goes with the rigid alignment and a positive count")
+        if n_to_align > len(est):
+            # evo slices silently; the block would then name an N the alignment never used
+            raise MetricsError(
+                f"n_to_align={n_to_align}: the trajectories have {len(est)} pose pairs; expected at most {len(est)}"
+            )
         return rigid_transform(est[:n_to_align], ref[:n_to_align])
     if method == "none":
         return np.zeros(3)

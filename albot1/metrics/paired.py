@@ -21,14 +21,19 @@ make the interval reproducible: the same errors give the same page. A is
 **better** when the whole ``CONFIDENCE`` interval is below 1, **worse** when
 it is above 1, else **indistinguishable**. A comparison with fewer than
 :data:`MIN_PAIRS` pairs, or where B's error is zero, does not apply and says
-why (a bootstrap over a handful of values claims more than it knows).
+why (a bootstrap over a handful of values claims more than it knows). Nor
+does one whose interval is unbounded: when B's errors are zero on nearly
+every pair, more than ``(1 - CONFIDENCE) / 2`` of the resamples draw only
+zeros of B, their ratio has no value, and an interval end of "inf" (or NaN,
+where numpy's quantile interpolates between two of them) would be printed
+as if it were a number.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Final
 
@@ -53,6 +58,9 @@ WORSE: Final = "worse"
 SAME: Final = "indistinguishable"
 NOT_APPLICABLE: Final = "n/a"
 PERFECT_REFERENCE: Final = f"the reference error is below {ZERO_ERROR:g} (perfect): no ratio"
+UNBOUNDED: Final = (
+    "the reference error is zero in too many resamples (zero on nearly every pair): the interval is unbounded"
+)
 #: the verdict read from the other side (B against A)
 MIRROR: Final = {BETTER: WORSE, WORSE: BETTER, SAME: SAME, NOT_APPLICABLE: NOT_APPLICABLE}
 #: one character per verdict, for compact matrices: A's error is smaller / larger / not told apart
@@ -72,13 +80,31 @@ class Comparison:
     pairs: int
     groups: int
     reason: str | None = None
+    #: A's and B's pooled errors (``(mean e^p) ** (1/p)``): the mirror needs A's to know whether A is perfect
+    error_a: float = math.nan
+    error_b: float = math.nan
 
     @property
     def applies(self) -> bool:
         return self.verdict != NOT_APPLICABLE
 
     def mirrored(self) -> Comparison:
-        """B against A: the reciprocal ratio and interval, the opposite verdict (the same evidence)."""
+        """B against A: the reciprocal ratio and interval, the opposite verdict (the same evidence).
+
+        When A is the perfect one (its pooled error below :data:`ZERO_ERROR`), or a resample quantile of A's
+        error is zero (the reciprocal interval unbounded), B against A does not apply, with the reason
+        :func:`compare` gives for those errors in that order: never a ratio of ``inf``. An n/a about B's
+        errors (:data:`PERFECT_REFERENCE`, :data:`UNBOUNDED`) stays that n/a here, though it says nothing of
+        B against A: compare that direction itself (``albot1.report.comparisons.all_pairs`` does).
+        """
+        if self.applies and self.error_a < ZERO_ERROR:
+            reason: str | None = PERFECT_REFERENCE
+        elif self.applies and self.low == 0.0:
+            reason = UNBOUNDED
+        else:
+            reason = None
+        if reason is not None:
+            return replace(not_applicable(reason, self.pairs, self.groups), error_a=self.error_b, error_b=self.error_a)
         return Comparison(
             _reciprocal(self.ratio),
             _reciprocal(self.high),
@@ -87,6 +113,8 @@ class Comparison:
             self.pairs,
             self.groups,
             self.reason,
+            self.error_b,
+            self.error_a,
         )
 
     def text(self) -> str:
@@ -101,14 +129,13 @@ class Comparison:
 
 
 def _reciprocal(value: float) -> float:
-    if math.isnan(value):
-        return value
-    return math.inf if value == 0 else 1.0 / value
+    """``1 / value`` of a ratio that is finite and positive (:meth:`Comparison.mirrored` leaves out the rest)."""
+    return value if math.isnan(value) else 1.0 / value
 
 
 def _g(value: float) -> str:
-    """3 significant digits; ``inf`` is the mirror of a ratio of 0 (a method without error against one with)."""
-    return "n/a" if math.isnan(value) else f"{value:.3g}"
+    """3 significant digits; ``n/a`` for a value that is not a number (never printed as ``nan`` or ``inf``)."""
+    return f"{value:.3g}" if math.isfinite(value) else "n/a"
 
 
 def method_text(resamples: int = RESAMPLES) -> str:
@@ -190,7 +217,8 @@ def bootstrap_ratio(
             den[lo : lo + CHUNK] += np.ascontiguousarray(windows_b[chunk].reshape(len(chunk), -1)[:, :n]).sum(axis=1)
     draws = _pooled_all(num, den, power)
     tail = (1.0 - confidence) / 2
-    low, high = np.quantile(draws, [tail, 1.0 - tail])
+    with np.errstate(invalid="ignore"):  # inf - inf between two infinite draws: NaN, which compare() refuses
+        low, high = np.quantile(draws, [tail, 1.0 - tail])
     return ratio, float(low), float(high)
 
 
@@ -235,8 +263,11 @@ def compare(
         return not_applicable(f"{count} pairs, fewer than {MIN_PAIRS}", count, len(arrays))
     if not all(np.isfinite(x).all() and np.isfinite(y).all() for x, y in arrays):
         return not_applicable("a non-finite error", count, len(arrays))
+    error_a = _pooled(sum(float(np.sum(np.abs(x) ** power)) for x, _ in arrays), float(count), power)
     reference = _pooled(sum(float(np.sum(np.abs(y) ** power)) for _, y in arrays), float(count), power)
     if reference < ZERO_ERROR:
-        return not_applicable(PERFECT_REFERENCE, count, len(arrays))
+        return replace(not_applicable(PERFECT_REFERENCE, count, len(arrays)), error_a=error_a, error_b=reference)
     ratio, low, high = bootstrap_ratio(arrays, power=power, resamples=resamples, seed=seed)
-    return Comparison(ratio, low, high, verdict(low, high), count, len(arrays))
+    if not math.isfinite(high):
+        return replace(not_applicable(UNBOUNDED, count, len(arrays)), error_a=error_a, error_b=reference)
+    return Comparison(ratio, low, high, verdict(low, high), count, len(arrays), None, error_a, reference)

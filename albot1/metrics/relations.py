@@ -84,8 +84,38 @@ def relation_errors(
             f"{max(gap1[k], gap2[k]):.6f} s away); expected relation times to match scan timestamps"
             f" ({len(bad)} relation(s) affected)"
         )
+    _refuse_ambiguous(t, i1, i2, used, source)
     d_est = se2.between(est[i1[used]], est[i2[used]])
     return se2.between(relations.poses[used], d_est), used
+
+
+def _refuse_ambiguous(
+    t: NDArray[np.float64], i1: NDArray[np.int64], i2: NDArray[np.int64], used: NDArray[np.bool_], source: str
+) -> None:
+    """MetricsError naming the first used relation whose end is a stamp several scans share, or whose ends are one scan.
+
+    A relation names its poses by time only: where scans repeat a stamp the lookup would take the first of
+    them, which may be another scan than the relation's author meant, and a relation from a scan to itself
+    measures nothing. Neither is scored silently.
+    """
+    _, inverse, counts = np.unique(t, return_inverse=True, return_counts=True)
+    shared = counts[inverse] > 1
+    bad = used & (shared[i1] | shared[i2] | (i1 == i2))
+    if not bad.any():
+        return
+    k = int(np.flatnonzero(bad)[0])
+    if i1[k] == i2[k]:
+        problem = f"both ends name scan {int(i1[k])} (time {t[i1[k]]:.6f}): a relation from a scan to itself"
+    else:
+        end = i1[k] if shared[i1[k]] else i2[k]
+        problem = (
+            f"time {t[end]:.6f} is the stamp of {int(counts[inverse[end]])} scans, so which one the relation "
+            "names cannot be told"
+        )
+    raise MetricsError(
+        f"{source}:{k + 1}: {problem}; expected each relation end to name one scan, its own"
+        f" ({int(bad.sum())} relation(s) affected)"
+    )
 
 
 def _block(errors: NDArray[np.float64]) -> dict[str, Any]:

@@ -64,17 +64,29 @@ def relative_errors(estimate: ArrayLike, reference: ArrayLike, pairs: NDArray[np
 
 
 def rpe(estimate: ArrayLike, reference: ArrayLike, delta: float = 1, unit: DeltaUnit = "frames") -> dict[str, Any]:
-    """One RPE block: ``delta``, ``delta_unit``, ``pairs``, ``translation_m`` and ``rotation_deg`` statistics."""
+    """One RPE block: ``delta``, ``delta_unit``, ``pairs``, ``translation_m`` and ``rotation_deg`` statistics.
+
+    No pair (a step longer than the trajectory, or a robot that never moves ``delta`` metres): null
+    statistics and ``pairs_reason`` saying why (evo refuses such a delta; a block with one step too long
+    for a short log keeps its other steps).
+    """
     est, ref = check_pair(estimate, reference, "RPE")
     pairs = pair_indices(ref, delta, unit)
     err = relative_errors(est, ref, pairs)
-    return {
+    block: dict[str, Any] = {
         "delta": delta,
         "delta_unit": unit,
         "pairs": int(len(pairs)),
         "translation_m": summarize(np.hypot(err[:, 0], err[:, 1]), ddof=0),
         "rotation_deg": summarize(np.degrees(np.abs(err[:, 2])), ddof=0),
     }
+    if len(pairs) == 0:
+        block["pairs_reason"] = (
+            f"{len(ref)} pose(s): none {delta:g} frames after another"
+            if unit == "frames"
+            else f"the reference travels {se2.path_length(ref):.3g} m in all, less than one step of {delta:g} m"
+        )
+    return block
 
 
 def rpe_set(

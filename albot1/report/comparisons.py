@@ -39,7 +39,7 @@ from albot1.errors import Albot1Error
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
 from albot1.metrics.measures.relations import METRIC as RELATIONS
-from albot1.metrics.paired import Comparison, compare, not_applicable
+from albot1.metrics.paired import PERFECT_REFERENCE, UNBOUNDED, Comparison, compare, not_applicable
 from albot1.metrics.relations import relation_errors
 from albot1.report.collect import CellRecord
 
@@ -150,18 +150,28 @@ def seeds_paired(
     ]
 
 
+#: the reasons a comparison does not apply that are about B's errors alone (its mirror would misstate them)
+ABOUT_B: Final = (PERFECT_REFERENCE, UNBOUNDED)
+
 #: a matrix cell's two comparisons: relation translation, relation rotation (or a single kind twice over)
 Cell = tuple[Comparison, ...]
 
 
 def all_pairs(labels: Sequence[str], errors: dict[str, Errors], kinds: Sequence[Kind]) -> dict[tuple[str, str], Cell]:
-    """Every ordered pair of ``labels`` compared on each of ``kinds`` (one run each); B-vs-A mirrors A-vs-B."""
+    """Every ordered pair of ``labels`` compared on each of ``kinds`` (one run each); B-vs-A mirrors A-vs-B.
+
+    Except where A-vs-B does not apply because of B's errors (B perfect, or zero on nearly every pair): that
+    says nothing of B against A (a perfect method is *better*), so that direction is compared on its own.
+    """
     found: dict[tuple[str, str], Cell] = {}
     for i, a in enumerate(labels):
         for b in labels[i + 1 :]:
             cell = tuple(compare_runs([(errors[a], errors[b])], kind) for kind in kinds)
             found[(a, b)] = cell
-            found[(b, a)] = tuple(c.mirrored() for c in cell)
+            found[(b, a)] = tuple(
+                compare_runs([(errors[b], errors[a])], kind) if c.reason in ABOUT_B else c.mirrored()
+                for c, kind in zip(cell, kinds, strict=True)
+            )
     return found
 
 

@@ -18,7 +18,10 @@ moving-block bootstrap over scans (blocks of 1/20 of a run, resampled within
 each seed, the same indices for both errors; the alignment is kept fixed)
 from a fixed seed, so the page is reproducible. A cell is **worse** when the
 whole interval is above 1, **better** when it is below 1, else
-**indistinguishable** at :data:`~albot1.metrics.paired.CONFIDENCE`. RPE@10 m and
+**indistinguishable** at :data:`~albot1.metrics.paired.CONFIDENCE`; where that
+comparison does not apply (fewer than :data:`~albot1.metrics.paired.MIN_PAIRS`
+scans, an unbounded interval) the cell says ``n/a`` and why, and a ratio to
+perfect odometry is never formed (``perfect odometry``). RPE@10 m and
 the loop gap are shown beside the odometry method's own cell of the same
 dataset, degradation and seed (when the suite ran it).
 """
@@ -39,7 +42,7 @@ from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
-from albot1.metrics.paired import BLOCKS, CONFIDENCE, RESAMPLES, ZERO_ERROR, bootstrap_ratio, verdict
+from albot1.metrics.paired import BLOCKS, CONFIDENCE, NOT_APPLICABLE, RESAMPLES, ZERO_ERROR, compare
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
 from albot1.report.provenance import regenerate_command
 from albot1.report.tuning import LEGEND, MARK, held_in, marked
@@ -68,12 +71,14 @@ class Comparison:
     ratio: float
     ratio_low: float
     ratio_high: float
-    verdict: str  # better | worse | indistinguishable | perfect odometry
+    verdict: str  # better | worse | indistinguishable | perfect odometry | n/a
     rpe10_m: float | None
     odometry_rpe10_m: float | None
     loop_gap_m: float | None
     odometry_loop_gap_m: float | None
     held_in: bool | None
+    #: why the paired comparison does not apply (verdict n/a), else None
+    reason: str | None = None
 
 
 def paired_errors(rec: CellRecord) -> tuple[np.ndarray, np.ndarray] | None:
@@ -90,10 +95,6 @@ def paired_errors(rec: CellRecord) -> tuple[np.ndarray, np.ndarray] | None:
         position_errors(run.poses[ok], run.reference[ok]),
         position_errors(run.odometry[ok], run.reference[ok]),
     )
-
-
-def _verdict(odometry_ate_m: float, low: float, high: float) -> str:
-    return PERFECT if odometry_ate_m < PERFECT_M else verdict(low, high)
 
 
 def _mean(values: list[float | None]) -> float | None:
@@ -120,7 +121,8 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
             continue
         pairs = [errors for _, errors in scored]
         odometry_ate = math.sqrt(sum(float(np.sum(o**2)) for _, o in pairs) / sum(len(o) for _, o in pairs))
-        ratio, low, high = bootstrap_ratio(pairs) if odometry_ate >= PERFECT_M else (math.nan,) * 3
+        # perfect odometry first: its table shows the method's ATE whatever the number of scans
+        paired = compare(pairs) if odometry_ate >= PERFECT_M else None
         odo = [odometry_cells.get((dataset, degradation, rec.cell.seed)) for rec, _ in scored]
         out.append(
             Comparison(
@@ -131,15 +133,16 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
                 failed=sum(rec.status == "failed" for rec in recs),
                 ate_m=math.sqrt(sum(float(np.sum(m**2)) for m, _ in pairs) / sum(len(m) for m, _ in pairs)),
                 odometry_ate_m=odometry_ate,
-                ratio=ratio,
-                ratio_low=low,
-                ratio_high=high,
-                verdict=_verdict(odometry_ate, low, high),
+                ratio=math.nan if paired is None else paired.ratio,
+                ratio_low=math.nan if paired is None else paired.low,
+                ratio_high=math.nan if paired is None else paired.high,
+                verdict=PERFECT if paired is None else paired.verdict,
                 rpe10_m=_mean([rpe.value(rec) for rec, _ in scored]),
                 odometry_rpe10_m=_mean([rpe.value(o) for o in odo if o is not None]),
                 loop_gap_m=_mean([gap.value(rec) for rec, _ in scored]),
                 odometry_loop_gap_m=_mean([gap.value(o) for o in odo if o is not None]),
                 held_in=held_in(scored[0][0].cell),
+                reason=None if paired is None else paired.reason,
             )
         )
     return out
@@ -154,9 +157,13 @@ def _ratio(value: float) -> str:
 
 
 def _interval(row: Comparison) -> str:
-    if row.verdict == PERFECT:
+    if row.verdict in (PERFECT, NOT_APPLICABLE):
         return NA
     return f"{_ratio(row.ratio)} [{_ratio(row.ratio_low)}–{_ratio(row.ratio_high)}]"
+
+
+def _verdict(row: Comparison) -> str:
+    return f"{NA} ({row.reason})" if row.verdict == NOT_APPLICABLE else row.verdict
 
 
 def _seeds(row: Comparison) -> str:
@@ -232,7 +239,7 @@ def render_page(
         "| largest ratio (where) |",
         "|---|---:|---:|---:|---:|---:|---:|---|",
     ]
-    compared = [r for r in rows if r.verdict != PERFECT]
+    compared = [r for r in rows if r.verdict not in (PERFECT, NOT_APPLICABLE)]
     for method in dict.fromkeys(r.method for r in compared):
         mine = [r for r in compared if r.method == method]
         top = max(mine, key=lambda r: r.ratio)
@@ -242,6 +249,14 @@ def render_page(
             f"| {method} | {len(mine)} | {tuned} | {counts[0]} | {counts[1]} | {counts[2]} | "
             f"{_ratio(median(r.ratio for r in mine))} | {_ratio(top.ratio)} ({top.dataset}, {top.degradation}) |"
         )
+    uncompared = [r for r in rows if r.verdict == NOT_APPLICABLE]
+    if uncompared:
+        lines += [
+            "",
+            "Not compared (no paired comparison applies): "
+            + "; ".join(f"{r.method} on {r.dataset} ({r.degradation}): {r.reason}" for r in uncompared)
+            + ".",
+        ]
     perfect = [r for r in rows if r.verdict == PERFECT]
     if perfect:
         # One column per dataset and perturbation: a perturbation of the set-up that leaves the odometry exact
@@ -278,7 +293,7 @@ def render_page(
         for r in (r for r in rows if r.dataset == dataset):
             lines.append(
                 f"| {marked(r.method, r.held_in)} | {r.degradation} | {_seeds(r)} | {_num(r.ate_m)} | "
-                f"{_num(r.odometry_ate_m)} | {_interval(r)} | {r.verdict} | "
+                f"{_num(r.odometry_ate_m)} | {_interval(r)} | {_verdict(r)} | "
                 f"{_pair(r.rpe10_m, r.odometry_rpe10_m)} | {_pair(r.loop_gap_m, r.odometry_loop_gap_m)} |"
             )
     if failed:
@@ -299,7 +314,15 @@ def _csv(rows: list[Comparison]) -> str:
     writer.writerow(names)
     for row in rows:
         values: list[Any] = [getattr(row, name) for name in names]
-        writer.writerow(["" if v is None else (f"{v:.9g}" if isinstance(v, float) else v) for v in values])
+        # no ratio (perfect odometry, n/a: the reason column says why) is an empty cell, never "nan"
+        writer.writerow(
+            [
+                ""
+                if v is None or (isinstance(v, float) and not math.isfinite(v))
+                else (f"{v:.9g}" if isinstance(v, float) else v)
+                for v in values
+            ]
+        )
     return buffer.getvalue()
 
 

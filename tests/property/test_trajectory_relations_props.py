@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 from albot1.data.errors import DataError
 from albot1.data.model import MAX_COORDINATE_M
-from albot1.data.relations import read_relations
+from albot1.data.relations import MAX_YAW_RAD, read_relations
 from albot1.data.trajectory import read_trajectory
 
 NUMBERS = st.one_of(
@@ -76,6 +76,7 @@ def test_the_relations_reader_returns_finite_relations_or_a_data_error(text: str
             return
     assert np.isfinite(relations.poses).all() and np.isfinite(relations.t1).all()
     assert not (relations.t1 == relations.t2).any()
+    assert (np.abs(relations.poses[:, 2]) <= MAX_YAW_RAD).all()  # radians: a file in degrees is refused
 
 
 POSES = st.lists(st.tuples(COORDS, COORDS, ANGLES), min_size=1, max_size=15)

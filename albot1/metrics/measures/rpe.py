@@ -7,20 +7,24 @@ from typing import Literal
 from albot1.metrics.blocks import Stats, block_of, fmt
 from albot1.metrics.rpe import rpe_set
 from albot1.metrics.unit import REFERENCE, ColumnSpec, Metric, MetricInputs
-from albot1.records import Count, Record
+from albot1.records import Count, OmitsAbsentReasons
 
 
-class RpeEntry(Record):
-    """One RPE step: ``delta`` frames (an integer) or metres of reference travel."""
+class RpeEntry(OmitsAbsentReasons):
+    """One RPE step: ``delta`` frames (an integer) or metres of reference travel.
+
+    ``pairs_reason``: why there is no pair (``pairs`` 0, null statistics); absent otherwise.
+    """
 
     delta: int | float
     delta_unit: Literal["frames", "m"]
     pairs: Count
     translation_m: Stats
     rotation_deg: Stats
+    pairs_reason: str | None = None
 
 
-class RpeBlock(Record):
+class RpeBlock(OmitsAbsentReasons):
     """``rpe``: the first step's numbers at the top level, every step under ``deltas``."""
 
     alignment: str
@@ -32,6 +36,7 @@ class RpeBlock(Record):
     translation_m: Stats
     rotation_deg: Stats
     deltas: list[RpeEntry]
+    pairs_reason: str | None = None
 
 
 def compute(inputs: MetricInputs) -> RpeBlock:
@@ -40,6 +45,8 @@ def compute(inputs: MetricInputs) -> RpeBlock:
 
 
 def headline(block: RpeBlock) -> str:
+    if block.pairs_reason is not None:
+        return f"delta {block.delta} {block.delta_unit}: n/a ({block.pairs_reason})"
     return (
         f"delta {block.delta} {block.delta_unit}: {fmt(block.translation_m.rmse)} m, "
         f"{fmt(block.rotation_deg.rmse)} deg rmse"

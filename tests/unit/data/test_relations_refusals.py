@@ -22,6 +22,11 @@ from albot1.data.relations import read_relations, repeat_policy, write_relations
         ("0 0.2 1e308 0 0 0 0 0\n", ":1: motion (1e+308, 0) m is beyond 1e+08 m"),
         ("0 1e300 1 0 0 0 0 0\n", ":1: timestamp beyond 1e+11"),
         ("0 0.2 1e400 0 0 0 0 0\n", ":1: non-finite value"),
+        (  # a file in degrees: 90 deg read as 90 rad would score a wrong heading, silently
+            "0 0.2 1 0 0 0 0 0\n0.2 0.4 1 1 0 0 0 90.0\n",
+            ":2: yaw 90 is beyond pi; expected radians in [-pi, pi] (a file written in degrees?)",
+        ),
+        ("0 0.2 1 0 0 0 0 -3.15\n", ":1: yaw -3.15 is beyond pi"),
         (
             "0 0.2 1 0 0 0 0 0\n# x\n0 0.2 2 0 0 0 0 0\n",
             ":3: the relation t1=0.0 t2=0.2 is listed twice with different",
@@ -114,3 +119,11 @@ def test_an_unknown_reading_is_refused_in_one_line() -> None:
     assert str(caught.value) == (
         "x.clf: relations_repeats='twice'; expected drop (count each relation once) or keep (as listed)"
     )
+
+
+@pytest.mark.parametrize("yaw", ["3.141593", "-3.141593", "3.1416", "3.14159265358979", "-3.141592654", "0"])
+def test_a_yaw_of_pi_as_printed_is_read(tmp_path: Path, yaw: str) -> None:
+    """pi printed with 4 or 6 decimals rounds up past pi (3.1416, 3.141593): still radians, still read."""
+    path = tmp_path / "r.relations"
+    path.write_text(f"0 0.2 1 0 0 0 0 {yaw}\n")
+    assert read_relations(path).poses[0, 2] == float(yaw)

@@ -85,3 +85,34 @@ def test_bad_inputs_raise_metrics_error_naming_the_problem(est: np.ndarray, ref:
 def test_unknown_alignment_is_rejected() -> None:
     with pytest.raises(MetricsError, match="unknown alignment 'scale'"):
         ate(line(), line(), "scale")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("n", [1, 2, 7])
+def test_a_robot_turning_on_the_spot_takes_the_rotation_from_the_headings(n: int) -> None:
+    """All positions equal: every rotation fits them; a perfect estimate in a frame turned by 1 rad is perfect.
+
+    Old code: the rotation kept at 0, so the heading error was the frames' angle, 57.2958 deg, for a perfect run.
+    """
+    ref = np.column_stack([np.full(n, 3.0), np.full(n, -2.0), se2.wrap(1.0 + 0.4 * np.arange(n))])
+    est = se2.compose([5.0, 1.0, -1.0], ref)  # the same motion seen from another frame
+    block = ate(est, ref, "rigid")
+    assert block["rmse_m"] == pytest.approx(0.0, abs=1e-12)
+    assert block["rotation"]["max_deg"] == pytest.approx(0.0, abs=1e-9)
+    assert block["alignment_transform"]["theta_deg"] == pytest.approx(np.degrees(1.0), abs=1e-9)
+
+
+def test_a_straight_corridor_determines_the_rotation_in_the_plane() -> None:
+    """Collinear positions (evo's 3-D Umeyama refuses them) fix a planar rotation: a known motion is recovered."""
+    ref = np.column_stack([np.linspace(0.0, 20.0, 30), np.zeros(30), np.zeros(30)])
+    est = se2.compose([-4.0, 7.0, 2.5], ref)
+    _, transform = align(est, ref, "rigid")
+    assert transform == pytest.approx(se2.inverse([-4.0, 7.0, 2.5]), abs=1e-12)
+
+
+def test_n_to_align_beyond_the_pairs_is_refused_rather_than_named_but_not_used() -> None:
+    """Old code aligned on the 5 pairs there are and wrote ``n_to_align: 1000`` into the block."""
+    ref = np.column_stack([np.arange(5.0), np.zeros(5), np.zeros(5)])
+    with pytest.raises(MetricsError) as caught:
+        ate(ref, ref, "rigid", n_to_align=1000)
+    assert str(caught.value) == "n_to_align=1000: the trajectories have 5 pose pairs; expected at most 5"
+    assert ate(ref, ref, "rigid", n_to_align=5)["alignment_transform"]["n_to_align"] == 5

@@ -13,6 +13,7 @@ from albot1.metrics.paired import (
     NOT_APPLICABLE,
     PERFECT_REFERENCE,
     SAME,
+    UNBOUNDED,
     WORSE,
     bootstrap_ratio,
     compare,
@@ -76,7 +77,15 @@ def test_too_few_pairs_or_no_reference_error_is_not_applicable_with_its_reason()
     assert compare([(np.ones(20), np.full(20, 1e-9))]).reason == PERFECT_REFERENCE  # numerical noise: no ratio
     perfect = compare([(np.zeros(20), np.ones(20))], resamples=20)
     assert perfect.verdict == BETTER and perfect.short() == "< 0"  # a perfect method is better
-    assert perfect.mirrored().short() == "> inf" and perfect.mirrored().verdict == WORSE
+    # B against a perfect A is what compare(B, A) says: no ratio (never "inf" printed as a number)
+    back = perfect.mirrored()
+    assert (back.verdict, back.reason, back.text(), back.short()) == (
+        NOT_APPLICABLE,
+        PERFECT_REFERENCE,
+        f"n/a ({PERFECT_REFERENCE})",
+        "–",
+    )
+    assert compare([(np.ones(20), np.zeros(20))], resamples=20).reason == back.reason
     assert compare([(np.full(20, np.nan), np.ones(20))]).reason == "a non-finite error"
     with pytest.raises(ValueError, match="differ in length"):
         compare([(np.ones(20), np.ones(21))])
@@ -140,3 +149,30 @@ def test_a_nan_error_and_an_empty_group_give_the_gathers_numbers(power: int) -> 
     _, low, high = bootstrap_ratio(pairs, power=power, resamples=300, seed=2)
     expected = _gathered_one_index_at_a_time(pairs, power, 300, 2)
     assert np.array_equal([low, high], expected, equal_nan=True), ((low, high), expected)
+
+
+def test_a_reference_zero_on_nearly_every_pair_has_no_interval_and_says_why() -> None:
+    """Many resamples draw only zeros of B: the upper end is inf or NaN, never a bound (old: "3.47 [2.12–n/a]")."""
+    a = np.random.default_rng(3).uniform(0.1, 1.0, 50)
+    b = a.copy()
+    b[:45] = 0.0
+    _, low, high = bootstrap_ratio([(a, b)], resamples=2000)
+    assert math.isfinite(low) and not math.isfinite(high)  # what compare must not pass on as an interval
+    found = compare([(a, b)])
+    assert (found.verdict, found.reason, found.text()) == (NOT_APPLICABLE, UNBOUNDED, f"n/a ({UNBOUNDED})")
+    assert (found.pairs, found.groups) == (50, 1)
+    # the same errors the other way round: A's resampled error is zero in over 2.5 % of the draws, so the
+    # interval's lower end is 0 and its mirror would reach inf; mirrored says what compare(B, A) says
+    forward = compare([(b, a)])
+    assert forward.verdict == BETTER and forward.low == 0.0
+    assert (forward.mirrored().verdict, forward.mirrored().reason) == (NOT_APPLICABLE, UNBOUNDED)
+
+
+def test_a_mirror_swaps_the_pooled_errors_and_keeps_the_evidence() -> None:
+    rng = np.random.default_rng(9)
+    a, b = rng.uniform(0.1, 0.5, 40), rng.uniform(0.6, 1.0, 40)
+    found = compare([(a, b)], resamples=200)
+    back = found.mirrored()
+    assert (found.error_a, found.error_b) == (math.sqrt(np.mean(a * a)), math.sqrt(np.mean(b * b)))
+    assert (back.error_a, back.error_b) == (found.error_b, found.error_a)
+    assert (back.ratio, back.low, back.high, back.verdict) == (1 / found.ratio, 1 / found.high, 1 / found.low, WORSE)

@@ -7,7 +7,9 @@ import pytest
 
 from albot1.data.model import Relations
 from albot1.geometry import se2
+from albot1.metrics.blocks import block_of
 from albot1.metrics.errors import MetricsError
+from albot1.metrics.measures.rpe import RpeBlock, headline
 from albot1.metrics.relations import relation_metric
 from albot1.metrics.rpe import pair_indices, rpe, rpe_set
 
@@ -129,6 +131,58 @@ def test_rpe_of_a_constant_per_step_heading_bias() -> None:
     block = rpe_set(est, ref)
     assert [d["delta_unit"] for d in block["deltas"]] == ["frames", "m", "m"]
     assert block["translation_m"] == block["deltas"][0]["translation_m"]
+
+
+@pytest.mark.parametrize("outside", ["error", "exclude"])
+def test_a_relation_end_on_a_stamp_several_scans_share_is_refused_naming_its_line(outside: str) -> None:
+    """Stamps 0, 0, 0, 1, 1, 1: the lookup took the first scan of each stamp and scored 0.0 m (old code)."""
+    ref = np.column_stack([np.arange(6.0), np.zeros(6), np.zeros(6)])
+    stamps = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0])
+    rel = Relations(t1=np.array([0.0]), t2=np.array([1.0]), poses=np.array([[3.0, 0.0, 0.0]]))
+    message = (
+        "r.relations:1: time 0.000000 is the stamp of 3 scans, so which one the relation names cannot be told; "
+        "expected each relation end to name one scan, its own (1 relation(s) affected)"
+    )
+    with pytest.raises(MetricsError) as caught:
+        relation_metric(stamps, ref, rel, outside=outside, source="r.relations")  # type: ignore[arg-type]
+    assert str(caught.value) == message
+
+
+def test_a_relation_whose_two_ends_find_one_scan_is_refused() -> None:
+    """t1 != t2 (the reader's check) but both within the 0.1 ms tolerance of scan 2: old code scored it 0.3 m."""
+    ref = np.column_stack([np.arange(6.0), np.zeros(6), np.zeros(6)])
+    rel = Relations(t1=np.array([2.0]), t2=np.array([2.00005]), poses=np.array([[0.3, 0.0, 0.0]]))
+    with pytest.raises(MetricsError) as caught:
+        relation_metric(np.arange(6.0), ref, rel)
+    assert str(caught.value) == (
+        "relations:1: both ends name scan 2 (time 2.000000): a relation from a scan to itself; expected each "
+        "relation end to name one scan, its own (1 relation(s) affected)"
+    )
+
+
+def test_an_rpe_step_without_a_pair_is_null_and_says_why() -> None:
+    """A step longer than the log, a robot that stands still: null statistics and the reason (old: nulls only)."""
+    _, ref = straight(3)
+    long = rpe(ref, ref, 5, "frames")
+    assert (long["pairs"], long["translation_m"]["n"], long["pairs_reason"]) == (
+        0,
+        0,
+        "3 pose(s): none 5 frames after another",
+    )
+    still = np.tile([1.0, 2.0, 0.3], (20, 1))
+    parked = rpe(still + 0.001, still, 1.0, "m")
+    assert parked["pairs"] == 0 and np.isnan(parked["translation_m"]["rmse"])
+    assert parked["pairs_reason"] == "the reference travels 0 m in all, less than one step of 1 m"
+    assert "pairs_reason" not in rpe(ref, ref, 1, "frames")  # a step with pairs has none
+    block = block_of(RpeBlock, rpe_set(still, still))
+    assert block.pairs == 19 and block.pairs_reason is None  # 1 frame: pairs; 1 m and 10 m: none
+    assert [d.pairs_reason for d in block.deltas][1:] == [
+        "the reference travels 0 m in all, less than one step of 1 m",
+        "the reference travels 0 m in all, less than one step of 10 m",
+    ]
+    assert "pairs_reason" not in block.model_dump()  # written only when set
+    single = block_of(RpeBlock, rpe_set(still[:1], still[:1]))
+    assert headline(single) == "delta 1 frames: n/a (1 pose(s): none 1 frames after another)"
 
 
 @pytest.mark.parametrize(("counted", "n", "reading"), [(False, 1, "counted once"), (True, 2, "counted as listed")])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -13,7 +14,7 @@ from albot1.data.model import Frame, Scan, Sequence
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
-from albot1.report.generalisation import PERFECT, Comparison, comparisons, render_page
+from albot1.report.generalisation import PERFECT, Comparison, _csv, comparisons, render_page
 from albot1.report.tuning import LEGEND, MARK
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
@@ -76,21 +77,21 @@ def test_scan_dropout_with_exact_odometry_is_a_column_of_its_own_beside_the_undi
     assert "| gtsam-graph | 0.304 | 0.411 |" in text
 
 
-def _drive(name: str) -> Sequence:
-    """A straight 40-scan drive with reference poses; the odometry is 10 % long and turns 0.5 deg per step."""
-    t = np.arange(40, dtype=float)
-    truth = np.column_stack([t * 0.5, np.zeros(40), np.zeros(40)])
-    odometry = np.column_stack([t * 0.55, np.zeros(40), np.radians(0.5) * t])
+def _drive(name: str, scans: int = 40) -> Sequence:
+    """A straight drive with reference poses; the odometry is 10 % long and turns 0.5 deg per step."""
+    t = np.arange(scans, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(scans), np.zeros(scans)])
+    odometry = np.column_stack([t * 0.55, np.zeros(scans), np.radians(0.5) * t])
     angles = np.radians(np.linspace(-90.0, 90.0, 181))
     frames = [
         Frame(i, Scan(np.full(181, 5.0), angles, 100.0 + t[i], 30.0), odometry[i], reference=truth[i])
-        for i in range(40)
+        for i in range(scans)
     ]
     return Sequence.from_frames(name, frames)
 
 
-def _stored(tmp_path: Path, method_label: str, method: str) -> CellRecord:
-    result = run_method("odometry", _drive("drive"), dataset_name="drive")
+def _stored(tmp_path: Path, method_label: str, method: str, scans: int = 40) -> CellRecord:
+    result = run_method("odometry", _drive("drive", scans), dataset_name="drive")
     run_dir = write_run(result, tmp_path)
     evaluate_run(run_dir)
     cell = Cell("t", "drive", "drive", method, method_label, "default", "none", 0, run_dir.name, "v", 1.0, 1.0)
@@ -108,3 +109,29 @@ def test_a_run_whose_poses_are_its_odometry_has_ratio_one_from_its_own_run_folde
     assert row.ratio == pytest.approx(1.0) and row.ratio_low == pytest.approx(1.0)
     assert row.verdict == "indistinguishable" and row.ate_m == pytest.approx(row.odometry_ate_m) and row.ate_m > 0.1
     assert row.held_in is False  # kiss-icp is not tuned on "drive"
+
+
+def test_a_run_of_fewer_scans_than_a_paired_comparison_needs_is_n_a_with_the_reason(tmp_path: Path) -> None:
+    """6 scans: the project's one paired comparison does not apply (old: a bootstrap over 6 values, a verdict)."""
+    rows = comparisons([_stored(tmp_path, "kiss-icp", "kiss-icp", scans=6)])
+    row = rows[0]
+    assert (row.verdict, row.reason, row.seeds) == ("n/a", "6 pairs, fewer than 10", 1)
+    assert math.isnan(row.ratio) and row.ate_m == pytest.approx(row.odometry_ate_m) and row.ate_m > 0.01
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    text = render_page(plan, rows)
+    assert (
+        f"| kiss-icp | none | 1 | {row.ate_m:.3f} | {row.odometry_ate_m:.3f} | n/a | n/a (6 pairs, fewer than 10) |"
+        in text
+    )
+    assert "Not compared (no paired comparison applies): kiss-icp on drive (none): 6 pairs, fewer than 10." in text
+    assert "| kiss-icp | 0 |" not in text and "nan" not in text  # not a cell of the per-method counts
+
+
+def test_the_csv_leaves_a_missing_ratio_empty_and_says_why(tmp_path: Path) -> None:
+    """Perfect odometry has no ratio: an empty cell, never "nan" (old: nan,nan,nan)."""
+    row = replace(_row("gtsam-graph", math.nan, math.nan, math.nan, PERFECT, False), ate_m=0.126, odometry_ate_m=0.0)
+    lines = _csv([row]).splitlines()
+    assert lines[0].endswith(",held_in,reason")
+    assert lines[1] == (
+        "fhw-corrected?odometry=laser-pose,gtsam-graph,none,1,0,0.126,0,,,,perfect odometry,0.2,0.1,,2,False,"
+    )

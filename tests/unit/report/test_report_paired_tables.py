@@ -15,6 +15,7 @@ from albot1.metrics.paired import BETTER, PERFECT_REFERENCE, SAME, WORSE
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
+from albot1.report.comparisons import Errors, all_pairs
 from albot1.report.paired_tables import (
     NO_ERRORS,
     NO_EVIDENCE,
@@ -176,3 +177,17 @@ def test_a_store_of_one_method_says_there_is_no_paired_comparison(records: list[
     assert no_pairs() not in written["cost.md"].read_text()
     assert written["paired.csv"].read_text().count("\n") == 1  # its header only
     assert no_pairs() not in write_tables(records, tmp_path / "all")["metrics.md"].read_text()
+
+
+@pytest.mark.parametrize("order", [("noisy", "perfect"), ("perfect", "noisy")])
+def test_a_perfect_method_is_better_in_the_matrix_whichever_label_comes_first(order: tuple[str, str]) -> None:
+    """Old code mirrored "noisy vs perfect: n/a (perfect reference)" into "perfect vs noisy: –" (n/a)."""
+    keys = np.arange(20, dtype=np.int64)
+    errors = {
+        "noisy": Errors(keys, {"position": np.linspace(0.1, 0.5, 20)}),
+        "perfect": Errors(keys, {"position": np.zeros(20)}),
+    }
+    found = all_pairs(list(order), errors, ["position"])
+    ahead, behind = found[("perfect", "noisy")][0], found[("noisy", "perfect")][0]
+    assert (ahead.verdict, ahead.ratio, ahead.low, ahead.high, ahead.short()) == (BETTER, 0.0, 0.0, 0.0, "< 0")
+    assert (behind.verdict, behind.reason, behind.short()) == ("n/a", PERFECT_REFERENCE, "–")
