@@ -8,16 +8,24 @@ resolving symlinks) and the download stops at the manifest's ``size`` (or
 :data:`DEFAULT_MAX_BYTES`). Any HTTP/network error, size or checksum mismatch raises
 :class:`~albot1.data.errors.FetchError` and leaves no file behind. A copy
 already present under a search root with the right checksum is used as is.
+
+A refused download says what arrived, in one line: a connection closed
+before the announced length, an HTML page (a proxy's login or error page),
+a reply that is not HTTP, a server silent for :data:`TIMEOUT_S`, a redirect
+loop; a disk that fills up names the file being written, not the URL.
 """
 
 from __future__ import annotations
 
+import errno
 import hashlib
+import http.client
 import os
 import tempfile
 import urllib.error
 import urllib.request
 from pathlib import Path
+from typing import IO, NamedTuple
 
 from albot1.atomic import normal_mode
 from albot1.data.errors import FetchError
@@ -30,6 +38,15 @@ TIMEOUT_S = 60.0
 #: The most a download may write when its manifest entry gives no ``size`` (the largest public log of the
 #: catalog is about 60 MB): a URL that never ends (``file:///dev/zero``) stops here, not at a full disk.
 DEFAULT_MAX_BYTES = 2 * 1024**3
+
+
+class _Received(NamedTuple):
+    """What one download brought: its length, sha256, announced length and content type."""
+
+    written: int
+    sha256: str
+    announced: int | None
+    content_type: str
 
 
 def sha256_of(path: Path) -> str:
@@ -55,6 +72,108 @@ def confined(root: Path, relative: str) -> Path:
     return dest
 
 
+def _reason(exc: BaseException) -> str:
+    """The error's reason on one line (urllib's redirect-loop message spans three), without ``[Errno N]``."""
+    reason = getattr(exc, "reason", None) or exc
+    text = reason.strerror if isinstance(reason, OSError) and reason.strerror else str(reason)
+    return " ".join(text.split()) or type(reason).__name__
+
+
+def _unwritable(path: Path, exc: OSError, doing: str) -> FetchError:
+    """The one line for a local write that failed (full disk, read-only or missing folder): it names ``path``."""
+    fix = "free space there" if exc.errno == errno.ENOSPC else "make it writable"
+    return FetchError(
+        f"{path}: cannot {doing} ({_reason(exc).lower()}); nothing kept -- {fix}, or set ALBOT1_CACHE_DIR "
+        "to another folder"
+    )
+
+
+def make_folder(folder: Path) -> None:
+    """``folder`` and its parents, or a FetchError naming it (a file in the way, a read-only file system)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise FetchError(
+            f"{folder}: a file is in the way; expected a folder for the downloads (set ALBOT1_CACHE_DIR)"
+        ) from None
+    except OSError as exc:
+        raise _unwritable(folder, exc, "create the download folder") from None
+
+
+def _write(out: IO[bytes], block: bytes | None, dest: Path) -> None:
+    """Write ``block`` (None: flush); an OSError becomes a FetchError naming ``dest``."""
+    try:
+        if block is None:
+            out.flush()
+        else:
+            out.write(block)
+    except OSError as exc:
+        raise _unwritable(dest, exc, "write the download") from None
+
+
+def _receive(url: str, out: IO[bytes], dest: Path, limit: int, what: str, timeout: float) -> _Received:
+    """Stream ``url`` into ``out`` (at most ``limit`` bytes); FetchError for every network or HTTP failure."""
+    digest = hashlib.sha256()
+    written = 0
+    try:
+        with urllib.request.urlopen(url, timeout=timeout) as response:
+            headers = response.headers
+            announced = headers.get("Content-Length") if headers else None
+            length = int(announced) if announced is not None and announced.isdigit() else None
+            if length is not None and length > limit:
+                raise FetchError(f"{url}: the server announces {announced} bytes, more than {what}; not downloaded")
+            while block := response.read(min(_BLOCK, limit + 1 - written)):
+                written += len(block)
+                if written > limit:
+                    raise FetchError(f"{url}: more than {what}; download stopped and discarded")
+                digest.update(block)
+                _write(out, block, dest)
+            _write(out, None, dest)
+            content_type = headers.get_content_type() if headers and "Content-Type" in headers else ""
+    except urllib.error.HTTPError as exc:
+        if 300 <= exc.code < 400:
+            raise FetchError(
+                f"{url}: HTTP {exc.code}, a redirect loop or too many redirects; expected the dataset file"
+            ) from None
+        raise FetchError(f"{url}: HTTP {exc.code} {_reason(exc)}; expected the dataset file") from None
+    except (TimeoutError, urllib.error.URLError) as exc:
+        if isinstance(exc, TimeoutError) or isinstance(getattr(exc, "reason", None), TimeoutError):
+            raise FetchError(
+                f"{url}: no data from the server for {timeout:g} s after {written} bytes (timed out); "
+                "download discarded -- retry, or use a mirror (--base-url)"
+            ) from None
+        raise FetchError(f"{url}: download failed ({_reason(exc)})") from None
+    except http.client.IncompleteRead:
+        raise FetchError(
+            f"{url}: the connection closed in the middle of the body after {written} bytes; download discarded (retry)"
+        ) from None
+    except http.client.HTTPException as exc:
+        raise FetchError(
+            f"{url}: the reply is not valid HTTP ({type(exc).__name__}: {_reason(exc)[:80]}); expected the dataset "
+            "file (is the URL's port a web server's?)"
+        ) from None
+    except (OSError, ValueError) as exc:
+        raise FetchError(f"{url}: download failed after {written} bytes ({_reason(exc)})") from None
+    return _Received(written, digest.hexdigest(), length, content_type)
+
+
+def _refusal(url: str, got: _Received, sha256: str, size: int | None) -> str:
+    """Why a download that does not match the manifest is refused: the most telling fact first."""
+    if got.announced is not None and got.written < got.announced:
+        return (
+            f"{url}: the connection closed after {got.written} of the {got.announced} bytes the server announced; "
+            "file discarded (retry)"
+        )
+    if got.content_type == "text/html" and not url.lower().endswith((".html", ".htm")):
+        return (
+            f"{url}: the server sent an HTML page ({got.written} bytes, Content-Type text/html), not the dataset "
+            "file (a proxy's login or error page?); file discarded"
+        )
+    if size is not None and got.written != size:
+        return f"{url}: {got.written} bytes, but the manifest's size is {size}; file discarded"
+    return f"{url}: sha256 {got.sha256} does not match the manifest's {sha256}; file discarded"
+
+
 def download_verified(
     url: str, dest: Path, sha256: str, *, size: int | None = None, timeout: float = TIMEOUT_S
 ) -> Path:
@@ -62,38 +181,27 @@ def download_verified(
 
     The download stops with a FetchError once it exceeds ``size`` (the
     manifest's byte count) or, when no size is given, :data:`DEFAULT_MAX_BYTES`.
+    A file whose length and sha256 match is taken even when the server
+    announced another length: the checksum, not the headers, says it is the file.
     """
     limit = size if size is not None else DEFAULT_MAX_BYTES
     what = f"the manifest's size of {limit} bytes" if size is not None else f"the default limit of {limit} bytes"
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=".part")
+    make_folder(dest.parent)
+    try:
+        fd, tmp_name = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=".part")
+    except OSError as exc:
+        raise _unwritable(dest, exc, "write the download") from None
     tmp = Path(tmp_name)
     try:
-        digest = hashlib.sha256()
-        written = 0
+        with os.fdopen(fd, "wb") as out:
+            got = _receive(url, out, dest, limit, what, timeout)
+        if got.sha256 != sha256 or (size is not None and got.written != size):
+            raise FetchError(_refusal(url, got, sha256, size))
         try:
-            with os.fdopen(fd, "wb") as out, urllib.request.urlopen(url, timeout=timeout) as response:
-                announced = response.headers.get("Content-Length") if response.headers else None
-                if announced is not None and announced.isdigit() and int(announced) > limit:
-                    raise FetchError(f"{url}: the server announces {announced} bytes, more than {what}; not downloaded")
-                while block := response.read(min(_BLOCK, limit + 1 - written)):
-                    written += len(block)
-                    if written > limit:
-                        raise FetchError(f"{url}: more than {what}; download stopped and discarded")
-                    digest.update(block)
-                    out.write(block)
-        except urllib.error.HTTPError as exc:
-            raise FetchError(f"{url}: HTTP {exc.code} {exc.reason}; expected the dataset file") from None
-        except (urllib.error.URLError, OSError, ValueError) as exc:
-            reason = getattr(exc, "reason", exc)
-            raise FetchError(f"{url}: download failed ({reason})") from None
-        if size is not None and written != size:
-            raise FetchError(f"{url}: {written} bytes, but the manifest's size is {size}; file discarded")
-        got = digest.hexdigest()
-        if got != sha256:
-            raise FetchError(f"{url}: sha256 {got} does not match the manifest's {sha256}; file discarded")
-        os.chmod(tmp, normal_mode())  # mkstemp's file is private (0o600); a dataset file is not
-        os.replace(tmp, dest)
+            os.chmod(tmp, normal_mode())  # mkstemp's file is private (0o600); a dataset file is not
+            os.replace(tmp, dest)
+        except OSError as exc:
+            raise _unwritable(dest, exc, "put the verified download in place") from None
         return dest
     finally:
         tmp.unlink(missing_ok=True)
@@ -107,7 +215,7 @@ def ensure_file(data_file: DataFile, urls: tuple[str, ...], settings: Settings) 
             return candidate
     if not urls:
         raise FetchError(f"{data_file.path}: no verified local copy and no download URL in the manifest")
-    settings.cache_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(settings.cache_dir)
     dest = confined(settings.cache_dir, data_file.path)
     errors = []
     for url in urls:

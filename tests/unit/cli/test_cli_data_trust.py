@@ -6,11 +6,14 @@ process, so the one-line error handling of ``main`` is what is checked.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
+import socket
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -201,3 +204,29 @@ def test_fetch_says_when_a_wrong_copy_would_still_be_read_first(tmp_path: Path) 
     assert done.stdout.strip() == f"tiny: {tmp_path / 'cache' / 'radish' / 'tiny.clf'}"
     assert line.startswith(f"albot1: error: fetched, but the dataset cannot be used yet: {wrong}: sha256 ")
     assert f"a verified copy is at {tmp_path / 'cache' / 'radish' / 'tiny.clf'}" in line
+
+
+@pytest.mark.timeout(120)
+def test_fetch_from_a_port_that_does_not_speak_http_is_one_line(tmp_path: Path) -> None:
+    """A reply that is not HTTP (here an SSH banner) used to end ``datasets fetch`` in a traceback."""
+    listener = socket.create_server(("127.0.0.1", 0))
+
+    def banner() -> None:
+        with contextlib.suppress(OSError):
+            connection, _ = listener.accept()
+            with connection:
+                connection.sendall(b"SSH-2.0-OpenSSH_9.6\r\n\r\n")
+
+    threading.Thread(target=banner, daemon=True).start()
+    url = f"http://127.0.0.1:{listener.getsockname()[1]}/tiny.clf"
+    env = {"ALBOT1_CONFIG_DIR": str(project(tmp_path, "radish/tiny.clf", "c" * 64, url))}
+    env["ALBOT1_CACHE_DIR"] = str(tmp_path / "cache")
+    try:
+        line = one_line_error(albot1("datasets", "fetch", "tiny", env=env))
+    finally:
+        listener.close()
+    assert line == (
+        f"albot1: error: {url}: the reply is not valid HTTP (BadStatusLine: SSH-2.0-OpenSSH_9.6); expected the "
+        "dataset file (is the URL's port a web server's?)"
+    )
+    assert [p.name for p in (tmp_path / "cache" / "radish").iterdir()] == []
