@@ -13,14 +13,20 @@ A refused download says what arrived, in one line: a connection closed
 before the announced length, an HTML page (a proxy's login or error page),
 a reply that is not HTTP, a server silent for :data:`TIMEOUT_S`, a redirect
 loop; a disk that fills up names the file being written, not the URL.
+The part file of a fetch killed with SIGKILL is removed by the next fetch
+of that file (:func:`_claim_part`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
+import fcntl
+import glob
 import hashlib
 import http.client
 import os
+import stat
 import tempfile
 import urllib.error
 import urllib.request
@@ -188,10 +194,10 @@ def download_verified(
     what = f"the manifest's size of {limit} bytes" if size is not None else f"the default limit of {limit} bytes"
     make_folder(dest.parent)
     try:
-        fd, tmp_name = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=".part")
+        fd, tmp = _claim_part(dest)
     except OSError as exc:
         raise _unwritable(dest, exc, "write the download") from None
-    tmp = Path(tmp_name)
+    held = os.dup(fd)  # keeps the part's lock until it is renamed or removed (closing ``out`` does not)
     try:
         with os.fdopen(fd, "wb") as out:
             got = _receive(url, out, dest, limit, what, timeout)
@@ -205,6 +211,52 @@ def download_verified(
         return dest
     finally:
         tmp.unlink(missing_ok=True)
+        os.close(held)
+
+
+def _claim_part(dest: Path) -> tuple[int, Path]:
+    """A new ``.NAME.*.part`` beside ``dest``, locked by this process; leftovers of killed fetches removed first.
+
+    A fetch killed by SIGKILL (or a power cut) cannot remove its part file;
+    its ``flock`` went with the process, so a part nobody holds is such a
+    leftover and is removed (it is never read: only a verified file is
+    renamed to ``dest``). The folder's own lock makes "remove the unheld
+    parts" and "create and lock a new one" one step, so a concurrent fetch's
+    part is never taken for a leftover.
+    """
+    folder = os.open(dest.parent, os.O_RDONLY)
+    try:
+        try:
+            fcntl.flock(folder, fcntl.LOCK_EX)
+        except OSError:  # a file system without locks (some NFS setups): leftovers stay, as before
+            pass
+        else:
+            for part in dest.parent.glob(f".{glob.escape(dest.name)}.*.part"):
+                _remove_if_unheld(part)
+        fd, name = tempfile.mkstemp(dir=dest.parent, prefix=f".{dest.name}.", suffix=".part")
+        with contextlib.suppress(OSError):
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return fd, Path(name)
+    finally:
+        os.close(folder)  # releases the folder's lock
+
+
+def _remove_if_unheld(part: Path) -> None:
+    """Remove ``part`` unless a running fetch holds its lock (a symlink or a folder is left alone)."""
+    try:
+        fd = os.open(part, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return  # another fetch is writing it (or the file system cannot tell)
+        part.unlink(missing_ok=True)
+    finally:
+        os.close(fd)
 
 
 def ensure_file(data_file: DataFile, urls: tuple[str, ...], settings: Settings) -> Path:

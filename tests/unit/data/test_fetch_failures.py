@@ -8,6 +8,7 @@ the path: a dropped connection, a chunked body cut short, an HTML page with
 from __future__ import annotations
 
 import errno
+import fcntl
 import hashlib
 import http.server
 import io
@@ -178,3 +179,20 @@ def test_a_file_where_the_cache_folder_should_be_is_named(tmp_path: Path, in_the
     assert str(caught.value) == (
         f"{folder}: a file is in the way; expected a folder for the downloads (set ALBOT1_CACHE_DIR)"
     )
+
+
+def test_a_killed_fetchs_part_file_is_removed_and_a_running_ones_kept(tmp_path: Path) -> None:
+    """A part nobody holds a lock on is a killed fetch's leftover; one that is locked belongs to a running fetch."""
+    source = tmp_path / "src.clf"
+    source.write_bytes(PAYLOAD)
+    dest = tmp_path / "dl" / "tiny.clf"
+    dest.parent.mkdir()
+    leftover = dest.parent / ".tiny.clf.k1ll3d.part"
+    leftover.write_bytes(PAYLOAD[:100])
+    running = dest.parent / ".tiny.clf.run1ng.part"
+    other = dest.parent / ".other.clf.x.part"  # another file's part is not this fetch's business
+    other.write_bytes(b"")
+    with running.open("wb") as held:
+        fcntl.flock(held.fileno(), fcntl.LOCK_EX)
+        assert fetch.download_verified(source.as_uri(), dest, SHA).read_bytes() == PAYLOAD
+        assert sorted(p.name for p in dest.parent.iterdir()) == [other.name, running.name, "tiny.clf"]
