@@ -60,7 +60,7 @@ def find_file(data_file: DataFile, settings: Settings) -> Path | None:
 
 
 def _missing(manifest: DatasetManifest, data_file: DataFile, settings: Settings) -> DatasetNotFoundError:
-    roots = ", ".join(str(r) for r in settings.search_roots())
+    roots = settings.roots_text()
     hint = (
         "it is derived locally and cannot be downloaded"
         if manifest.local_only or not data_file.urls

@@ -230,3 +230,36 @@ def test_fetch_from_a_port_that_does_not_speak_http_is_one_line(tmp_path: Path) 
         "dataset file (is the URL's port a web server's?)"
     )
     assert [p.name for p in (tmp_path / "cache" / "radish").iterdir()] == []
+
+
+@pytest.mark.parametrize("how", ["env", "option"])
+def test_a_data_folder_that_is_a_file_is_refused_not_ignored(tmp_path: Path, how: str) -> None:
+    """It used to be searched as an empty folder: `fetch` downloaded instead and `list` said "missing (fetch)"."""
+    not_a_folder = tmp_path / "datasets.txt"
+    not_a_folder.write_text("x\n")
+    env = {"ALBOT1_CONFIG_DIR": str(project(tmp_path, "radish/tiny.clf", "c" * 64)), "ALBOT1_CACHE_DIR": str(tmp_path)}
+    option: tuple[str, ...] = ("--data-dir", str(not_a_folder)) if how == "option" else ()
+    if how == "env":
+        env["ALBOT1_DATA_DIR"] = str(not_a_folder)
+    named = f"ALBOT1_DATA_DIR={not_a_folder}" if how == "env" else f"--data-dir {not_a_folder}"
+    for command in (("datasets", "list"), ("datasets", "fetch", "tiny")):
+        assert one_line_error(albot1(*command, *option, env=env)) == (
+            f"albot1: error: {named}: a file, not a folder; expected a folder of dataset copies laid out like "
+            "radish/, radish-corrected/ (or leave it unset to use the download cache only)"
+        )
+
+
+def test_a_data_folder_that_does_not_exist_is_marked_where_the_roots_are_named(tmp_path: Path) -> None:
+    env = {
+        "ALBOT1_CONFIG_DIR": str(project(tmp_path, "radish/tiny.clf", "c" * 64)),
+        "ALBOT1_DATA_DIR": str(tmp_path / "typo"),
+        "ALBOT1_CACHE_DIR": str(tmp_path),
+    }
+    listing = albot1("datasets", "list", env=env)
+    assert listing.returncode == 0 and listing.stdout.splitlines()[-1] == (
+        f"searched: {tmp_path / 'typo'} (no such folder), {tmp_path}"
+    )
+    assert one_line_error(albot1("datasets", "info", "tiny", env=env)) == (
+        f"albot1: error: dataset 'tiny': radish/tiny.clf not found under {tmp_path / 'typo'} (no such folder), "
+        f"{tmp_path}; run `albot1 datasets fetch tiny` or set ALBOT1_DATA_DIR"
+    )
