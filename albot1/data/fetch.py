@@ -149,6 +149,8 @@ def _receive(url: str, out: IO[bytes], dest: Path, limit: int, what: str, timeou
                 "download discarded -- retry, or use a mirror (--base-url)"
             ) from None
         raise FetchError(f"{url}: download failed ({_reason(exc)})") from None
+    except http.client.InvalidURL as exc:
+        raise FetchError(f"{url}: not a valid URL ({_reason(exc)}); expected a URL of the dataset file") from None
     except http.client.IncompleteRead:
         raise FetchError(
             f"{url}: the connection closed in the middle of the body after {written} bytes; download discarded (retry)"

@@ -196,3 +196,11 @@ def test_a_killed_fetchs_part_file_is_removed_and_a_running_ones_kept(tmp_path: 
         fcntl.flock(held.fileno(), fcntl.LOCK_EX)
         assert fetch.download_verified(source.as_uri(), dest, SHA).read_bytes() == PAYLOAD
         assert sorted(p.name for p in dest.parent.iterdir()) == [other.name, running.name, "tiny.clf"]
+
+
+def test_an_invalid_url_is_named_as_such_not_as_a_bad_reply(tmp_path: Path) -> None:
+    url = "http://127.0.0.1:9/a b.clf"
+    assert refusal(url, tmp_path / "dl" / "tiny.clf") == (
+        f"{url}: not a valid URL (URL can't contain control characters. '/a b.clf' (found at least ' ')); "
+        "expected a URL of the dataset file"
+    )
