@@ -172,6 +172,8 @@ def _refusal(url: str, got: _Received, sha256: str, size: int | None) -> str:
             f"{url}: the connection closed after {got.written} of the {got.announced} bytes the server announced; "
             "file discarded (retry)"
         )
+    if got.written == 0:
+        return f"{url}: the server sent an empty reply (0 bytes), not the dataset file; nothing kept"
     if got.content_type == "text/html" and not url.lower().endswith((".html", ".htm")):
         return (
             f"{url}: the server sent an HTML page ({got.written} bytes, Content-Type text/html), not the dataset "

@@ -61,6 +61,8 @@ class _Misbehaving(http.server.BaseHTTPRequestHandler):
             self.send_header("Location", self.path)
             self.send_header("Content-Length", "0")
             self.end_headers()
+        elif mode == "empty":
+            self._head(200, 0)
         elif mode == "silent":
             self._head(200, len(PAYLOAD))
             time.sleep(3)
@@ -203,4 +205,12 @@ def test_an_invalid_url_is_named_as_such_not_as_a_bad_reply(tmp_path: Path) -> N
     assert refusal(url, tmp_path / "dl" / "tiny.clf") == (
         f"{url}: not a valid URL (URL can't contain control characters. '/a b.clf' (found at least ' ')); "
         "expected a URL of the dataset file"
+    )
+
+
+@pytest.mark.timeout(30)
+def test_an_empty_reply_is_named(base: str, tmp_path: Path) -> None:
+    url = f"{base}/empty/tiny.clf"
+    assert refusal(url, tmp_path / "dl" / "tiny.clf") == (
+        f"{url}: the server sent an empty reply (0 bytes), not the dataset file; nothing kept"
     )
