@@ -13,6 +13,8 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from albot1.errors import ConfigError
+
 DATA_DIR_ENV = "ALBOT1_DATA_DIR"
 CACHE_DIR_ENV = "ALBOT1_CACHE_DIR"
 #: Where decoded logs are cached (:mod:`albot1.data.decoded`): a folder, or ``off`` to decode every time.
@@ -79,12 +81,30 @@ class Settings:
 
     data_dir: Path | None
     cache_dir: Path
+    #: Where ``data_dir`` came from, as the user wrote it (named by the error of a data folder that is a file).
+    data_dir_origin: str = DATA_DIR_ENV
 
     def search_roots(self) -> list[Path]:
-        """Folders searched for dataset files, most preferred first."""
+        """Folders searched for dataset files, most preferred first.
+
+        A data folder that is a file is refused (ConfigError): nothing could
+        ever be found under it, so taking it as an empty folder would hide
+        the mistake behind a download or another copy. A data folder that
+        does not exist yet is searched as empty (:meth:`roots_text` says so).
+        """
         roots = [self.data_dir] if self.data_dir is not None else []
+        if self.data_dir is not None and self.data_dir.exists() and not self.data_dir.is_dir():
+            raise ConfigError(
+                f"{self.data_dir_origin}{'=' if self.data_dir_origin == DATA_DIR_ENV else ' '}{self.data_dir}: "
+                "a file, not a folder; expected a folder of dataset copies "
+                "laid out like radish/, radish-corrected/ (or leave it unset to use the download cache only)"
+            )
         roots.append(self.cache_dir)
         return roots
+
+    def roots_text(self) -> str:
+        """The search roots for a message, each missing one marked ``(no such folder)`` (a typo shows at once)."""
+        return ", ".join(f"{r}{'' if r.is_dir() else ' (no such folder)'}" for r in self.search_roots())
 
 
 def get_settings(data_dir: str | Path | None = None, cache_dir: str | Path | None = None) -> Settings:
@@ -94,4 +114,5 @@ def get_settings(data_dir: str | Path | None = None, cache_dir: str | Path | Non
     return Settings(
         data_dir=Path(data).expanduser() if data else None,
         cache_dir=Path(cache).expanduser() if cache else _default_cache_dir(),
+        data_dir_origin="--data-dir" if data_dir is not None else DATA_DIR_ENV,
     )

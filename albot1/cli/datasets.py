@@ -88,7 +88,7 @@ def list_(
         lines.append((row["name"], state, _first_sentence(row["description"])))
     for line in aligned(lines):
         typer.echo(line)
-    typer.echo(f"searched: {', '.join(str(r) for r in settings.search_roots())}")
+    typer.echo(f"searched: {settings.roots_text()}")
 
 
 def _first_sentence(text: str, width: int = 80) -> str:

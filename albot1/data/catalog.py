@@ -18,6 +18,7 @@ from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 from albot1.config.suggest import unknown_name_message
 from albot1.data.errors import ChecksumError, DatasetNotFoundError
@@ -60,7 +61,7 @@ def find_file(data_file: DataFile, settings: Settings) -> Path | None:
 
 
 def _missing(manifest: DatasetManifest, data_file: DataFile, settings: Settings) -> DatasetNotFoundError:
-    roots = ", ".join(str(r) for r in settings.search_roots())
+    roots = settings.roots_text()
     hint = (
         "it is derived locally and cannot be downloaded"
         if manifest.local_only or not data_file.urls
@@ -157,12 +158,13 @@ def fetch(name: str, settings: Settings, *, base_url: str | None = None) -> Path
     """Download the dataset's missing files into the cache, verified; returns the log's path.
 
     See :func:`albot1.data.fetch.download_verified` for the atomic, checksum-first
-    write. ``base_url`` replaces the manifest URLs by ``base_url/<path>`` (mirrors, tests).
+    write. ``base_url`` replaces the manifest URLs by ``base_url/<path>`` (mirrors, tests), the path
+    percent-encoded (a space or a non-ASCII letter in a path is no valid URL as it stands).
     """
     manifest = get(name)
     log_path: Path | None = None
     for data_file in manifest.files:
-        urls = (f"{base_url.rstrip('/')}/{data_file.path}",) if base_url else data_file.urls
+        urls = (f"{base_url.rstrip('/')}/{quote(data_file.path)}",) if base_url else data_file.urls
         if manifest.local_only and not base_url:
             found = find_file(data_file, settings)
             if found is None:

@@ -4,11 +4,14 @@ A result must name the data it was computed from, not just the data's name:
 a log edited after its benchmark cell ran must give a new cell key, and a
 catalog file must be the one its manifest's checksum names. Hashing a
 100 MB log on every command would cost seconds, so the checksum of a file is
-cached under its resolved path together with its size, ``mtime_ns``, inode
-and device; a file whose ``stat`` still matches is not read again (a warm
+cached under its resolved path together with its size, ``mtime_ns``,
+``ctime_ns``, inode and device; a file whose ``stat`` still matches is not read again (a warm
 check costs a ``stat`` and a small JSON read; ``docs/datasets.md``,
 "Checksums"). Anything else in ``stat`` changed -- an edit, a copy, a
-``touch`` -- and the file is hashed again.
+``touch`` -- and the file is hashed again. The change time is part of the
+key because no user can set it: an edit that puts the old modification
+time back (``touch -r``, ``rsync --times``, a tool restoring stamps) still
+changes it, so a flipped byte is never taken for the verified content.
 
 The cache (:func:`albot1.settings.checksum_cache_file`) is a convenience
 and never trusted beyond that: a cache that does not parse, or an entry of
@@ -43,7 +46,7 @@ _BLOCK = 1 << 20
 #: Files modified less than this many seconds before they were hashed are not cached (their mtime may not
 #: change on a second edit within the file system's timestamp resolution).
 RACY_S = 2.0
-_FORMAT = 2
+_FORMAT = 3
 #: A cache file larger than this is not read (it holds a few hundred bytes per data file).
 _MAX_CACHE_BYTES = 16 * 1024 * 1024
 #: Above this many entries, a write drops the entries of files that no longer exist.
@@ -95,8 +98,8 @@ class _Cache:
     def get(self, key: str, signature: list[int]) -> str | None:
         self._load(checksum_cache_file())
         entry = self._entries.get(key)
-        if entry is not None and entry[:4] == signature:
-            return str(entry[4])
+        if entry is not None and entry[:5] == signature:
+            return str(entry[5])
         return None
 
     def put(self, key: str, signature: list[int], sha256: str) -> None:
@@ -120,22 +123,22 @@ def _seal(key: str, signature: list[int], sha256: str) -> str:
 
 
 def _valid_entry(key: str, value: object) -> bool:
-    """``[size, mtime_ns, inode, device, sha256, seal]`` with the types and the seal it must have."""
+    """``[size, mtime_ns, ctime_ns, inode, device, sha256, seal]`` with the types and the seal it must have."""
     if not (
         isinstance(value, list)
-        and len(value) == 6
-        and all(isinstance(v, int) and not isinstance(v, bool) for v in value[:4])
-        and all(isinstance(v, str) for v in value[4:])
+        and len(value) == 7
+        and all(isinstance(v, int) and not isinstance(v, bool) for v in value[:5])
+        and all(isinstance(v, str) for v in value[5:])
     ):
         return False
-    return bool(value[5] == _seal(key, value[:4], value[4]))
+    return bool(value[6] == _seal(key, value[:5], value[5]))
 
 
 _CACHE = _Cache()
 
 
 def _signature(st: os.stat_result) -> list[int]:
-    return [st.st_size, st.st_mtime_ns, st.st_ino, st.st_dev]
+    return [st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino, st.st_dev]
 
 
 def _file_sha256(path: Path, st: os.stat_result) -> str:

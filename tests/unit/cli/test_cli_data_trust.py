@@ -6,11 +6,14 @@ process, so the one-line error handling of ``main`` is what is checked.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
+import socket
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -201,3 +204,62 @@ def test_fetch_says_when_a_wrong_copy_would_still_be_read_first(tmp_path: Path) 
     assert done.stdout.strip() == f"tiny: {tmp_path / 'cache' / 'radish' / 'tiny.clf'}"
     assert line.startswith(f"albot1: error: fetched, but the dataset cannot be used yet: {wrong}: sha256 ")
     assert f"a verified copy is at {tmp_path / 'cache' / 'radish' / 'tiny.clf'}" in line
+
+
+@pytest.mark.timeout(120)
+def test_fetch_from_a_port_that_does_not_speak_http_is_one_line(tmp_path: Path) -> None:
+    """A reply that is not HTTP (here an SSH banner) used to end ``datasets fetch`` in a traceback."""
+    listener = socket.create_server(("127.0.0.1", 0))
+
+    def banner() -> None:
+        with contextlib.suppress(OSError):
+            connection, _ = listener.accept()
+            with connection:
+                connection.sendall(b"SSH-2.0-OpenSSH_9.6\r\n\r\n")
+
+    threading.Thread(target=banner, daemon=True).start()
+    url = f"http://127.0.0.1:{listener.getsockname()[1]}/tiny.clf"
+    env = {"ALBOT1_CONFIG_DIR": str(project(tmp_path, "radish/tiny.clf", "c" * 64, url))}
+    env["ALBOT1_CACHE_DIR"] = str(tmp_path / "cache")
+    try:
+        line = one_line_error(albot1("datasets", "fetch", "tiny", env=env))
+    finally:
+        listener.close()
+    assert line == (
+        f"albot1: error: {url}: the reply is not valid HTTP (BadStatusLine: SSH-2.0-OpenSSH_9.6); expected the "
+        "dataset file (is the URL's port a web server's?)"
+    )
+    assert [p.name for p in (tmp_path / "cache" / "radish").iterdir()] == []
+
+
+@pytest.mark.parametrize("how", ["env", "option"])
+def test_a_data_folder_that_is_a_file_is_refused_not_ignored(tmp_path: Path, how: str) -> None:
+    """It used to be searched as an empty folder: `fetch` downloaded instead and `list` said "missing (fetch)"."""
+    not_a_folder = tmp_path / "datasets.txt"
+    not_a_folder.write_text("x\n")
+    env = {"ALBOT1_CONFIG_DIR": str(project(tmp_path, "radish/tiny.clf", "c" * 64)), "ALBOT1_CACHE_DIR": str(tmp_path)}
+    option: tuple[str, ...] = ("--data-dir", str(not_a_folder)) if how == "option" else ()
+    if how == "env":
+        env["ALBOT1_DATA_DIR"] = str(not_a_folder)
+    named = f"ALBOT1_DATA_DIR={not_a_folder}" if how == "env" else f"--data-dir {not_a_folder}"
+    for command in (("datasets", "list"), ("datasets", "fetch", "tiny")):
+        assert one_line_error(albot1(*command, *option, env=env)) == (
+            f"albot1: error: {named}: a file, not a folder; expected a folder of dataset copies laid out like "
+            "radish/, radish-corrected/ (or leave it unset to use the download cache only)"
+        )
+
+
+def test_a_data_folder_that_does_not_exist_is_marked_where_the_roots_are_named(tmp_path: Path) -> None:
+    env = {
+        "ALBOT1_CONFIG_DIR": str(project(tmp_path, "radish/tiny.clf", "c" * 64)),
+        "ALBOT1_DATA_DIR": str(tmp_path / "typo"),
+        "ALBOT1_CACHE_DIR": str(tmp_path),
+    }
+    listing = albot1("datasets", "list", env=env)
+    assert listing.returncode == 0 and listing.stdout.splitlines()[-1] == (
+        f"searched: {tmp_path / 'typo'} (no such folder), {tmp_path}"
+    )
+    assert one_line_error(albot1("datasets", "info", "tiny", env=env)) == (
+        f"albot1: error: dataset 'tiny': radish/tiny.clf not found under {tmp_path / 'typo'} (no such folder), "
+        f"{tmp_path}; run `albot1 datasets fetch tiny` or set ALBOT1_DATA_DIR"
+    )

@@ -111,3 +111,15 @@ def test_unreachable_host_is_a_fetch_error(tmp_path: Path) -> None:
     with pytest.raises(FetchError, match="download failed"):
         download_verified("http://127.0.0.1:9/none", tmp_path / "f", "0" * 64, timeout=2)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_base_url_percent_encodes_a_path_with_a_space_or_an_accent(server, project, tmp_path: Path) -> None:
+    """``base_url/<path>`` used to be sent as typed: urllib refuses a space, so such a file never came from a mirror."""
+    base, root, requests = server
+    (root / "radish" / "ti ny é.clf").write_bytes(PAYLOAD)
+    _manifest(tmp_path, "http://127.0.0.1:9/x", hashlib.sha256(PAYLOAD).hexdigest())
+    toml = tmp_path / "project" / "datasets" / "tiny.toml"
+    toml.write_text(toml.read_text().replace("radish/tiny.clf", "radish/ti ny é.clf"))
+    path = catalog.fetch("tiny", Settings(data_dir=None, cache_dir=tmp_path / "cache"), base_url=base)
+    assert path == tmp_path / "cache" / "radish" / "ti ny é.clf" and path.read_bytes() == PAYLOAD
+    assert requests == ["/radish/ti%20ny%20%C3%A9.clf"]

@@ -54,6 +54,21 @@ def test_a_changed_file_of_the_same_size_gets_its_new_checksum(tmp_path: Path) -
     assert content_sha256(log) == hashlib.sha256(b"ODOM 1 2 4\n").hexdigest() != first
 
 
+def test_a_byte_flipped_behind_a_restored_modification_time_is_seen(tmp_path: Path) -> None:
+    """An edit that puts the old mtime back (``touch -r``, ``rsync --times``) still changes the ctime."""
+    log = old_file(tmp_path / "a.clf", b"ODOM 1 2 3\n", age_s=100)
+    assert content_sha256(log) == hashlib.sha256(b"ODOM 1 2 3\n").hexdigest()
+    before = log.stat()
+    time.sleep(0.05)  # a ctime tick apart, whatever the file system's resolution
+    with log.open("r+b") as fh:  # same size, same inode
+        fh.seek(9)
+        fh.write(b"4")
+    os.utime(log, ns=(before.st_atime_ns, before.st_mtime_ns))
+    after = log.stat()
+    assert (after.st_size, after.st_mtime_ns, after.st_ino) == (before.st_size, before.st_mtime_ns, before.st_ino)
+    assert content_sha256(log) == hashlib.sha256(b"ODOM 1 2 4\n").hexdigest()
+
+
 def test_a_file_modified_just_now_is_not_cached(tmp_path: Path) -> None:
     log = tmp_path / "fresh.clf"
     log.write_bytes(b"x\n")
@@ -62,14 +77,14 @@ def test_a_file_modified_just_now_is_not_cached(tmp_path: Path) -> None:
     assert not cache.exists() or str(log.resolve()) not in json.loads(cache.read_text())["files"]
 
 
-@pytest.mark.parametrize("damage", ["{not json", '{"format": 2, "files": {"/x": [1, 2]}}', "[]", '{"format": 2}'])
+@pytest.mark.parametrize("damage", ["{not json", '{"format": 3, "files": {"/x": [1, 2]}}', "[]", '{"format": 3}'])
 def test_a_damaged_cache_is_ignored_and_rebuilt(tmp_path: Path, damage: str) -> None:
     log = old_file(tmp_path / "a.clf", b"abc")
     cache = checksum_cache_file()
     cache.parent.mkdir(parents=True)
     cache.write_text(damage)
     assert content_sha256(log) == hashlib.sha256(b"abc").hexdigest()
-    assert json.loads(cache.read_text())["files"][str(log.resolve())][4] == hashlib.sha256(b"abc").hexdigest()
+    assert json.loads(cache.read_text())["files"][str(log.resolve())][5] == hashlib.sha256(b"abc").hexdigest()
 
 
 def test_a_cache_entry_with_a_wrong_checksum_for_another_stat_is_never_used(tmp_path: Path) -> None:
@@ -77,8 +92,8 @@ def test_a_cache_entry_with_a_wrong_checksum_for_another_stat_is_never_used(tmp_
     cache = checksum_cache_file()
     cache.parent.mkdir(parents=True)
     st = log.stat()
-    wrong = [st.st_size, st.st_mtime_ns + 1, st.st_ino, st.st_dev, "0" * 64, "x"]  # not this file's stat
-    cache.write_text(json.dumps({"format": 2, "files": {str(log.resolve()): wrong}}))
+    wrong = [st.st_size, st.st_mtime_ns + 1, st.st_ctime_ns, st.st_ino, st.st_dev, "0" * 64, "x"]  # another stat
+    cache.write_text(json.dumps({"format": 3, "files": {str(log.resolve()): wrong}}))
     assert content_sha256(log) == hashlib.sha256(b"abc").hexdigest()
 
 
@@ -87,7 +102,7 @@ def test_a_hand_edited_checksum_in_the_cache_is_not_trusted(tmp_path: Path) -> N
     content_sha256(log)
     cache = checksum_cache_file()
     data = json.loads(cache.read_text())
-    data["files"][str(log.resolve())][4] = "0" * 64  # the stat still matches, the seal does not
+    data["files"][str(log.resolve())][5] = "0" * 64  # the stat still matches, the seal does not
     cache.write_text(json.dumps(data))
     assert content_sha256(log) == hashlib.sha256(b"abc").hexdigest()
 
