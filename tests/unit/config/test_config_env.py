@@ -104,3 +104,17 @@ def test_sources_of_a_partial_dict_preset() -> None:
     resolved = resolve(_Toy, {"default": {}, "b": {"mode": "b"}}, "b", env_prefix="ALBOT1_TOY_")
     assert resolved.config == _Toy(mode="b")
     assert resolved.sources == {"size_m": "model default", "mode": "preset b", "on": "model default"}
+
+
+def test_a_value_from_the_environment_is_said_once(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    from albot1.config import resolve as resolve_module
+
+    monkeypatch.setattr(resolve_module, "_said", set())
+    monkeypatch.setenv("ALBOT1_TOY_SIZE_M", "0.25")
+    with caplog.at_level("WARNING", logger="albot1.config.resolve"):
+        for _ in range(3):  # a bench resolves every cell's config
+            resolve(_Toy, PRESETS, "big", env_prefix="ALBOT1_TOY_", owner="toy")
+        resolve(_Toy, PRESETS, "big", env_prefix="ALBOT1_TOY_", owner="toy", overrides={"size_m": "7"})  # not used
+    assert [r.getMessage() for r in caplog.records] == ["toy: size_m = 0.25 from the environment (ALBOT1_TOY_SIZE_M)"]
