@@ -111,7 +111,7 @@ def test_a_value_from_the_environment_is_said_once(
 ) -> None:
     from albot1.config import resolve as resolve_module
 
-    monkeypatch.setattr(resolve_module, "_said", set())
+    monkeypatch.setattr(resolve_module, "_said", set(), raising=False)
     monkeypatch.setenv("ALBOT1_TOY_SIZE_M", "0.25")
     with caplog.at_level("WARNING", logger="albot1.config.resolve"):
         for _ in range(3):  # a bench resolves every cell's config
