@@ -7,7 +7,9 @@ the repository, not the import package. They are found in this order:
 
 1. ``ALBOT1_CONFIG_DIR`` (optional): a user's folder laid out the same way
    (``datasets/``, ``baselines/``, ``benchmarks/``). A file there adds to the
-   project's files, or replaces the project's file of the same name.
+   project's files, or replaces the project's file of the same name, which is
+   said once per process (a warning naming both files): a replaced preset
+   changes what ``--preset default`` means.
 2. The checkout around the package (an editable install or a source tree):
    ``<checkout>/datasets/`` etc., recognised by the ``pyproject.toml`` beside
    the package.
@@ -22,6 +24,7 @@ bypasses this search altogether.
 
 from __future__ import annotations
 
+import logging
 import os
 from pathlib import Path
 from typing import Literal
@@ -33,6 +36,10 @@ Folder = Literal["datasets", "baselines", "benchmarks"]
 FOLDERS: tuple[Folder, ...] = ("datasets", "baselines", "benchmarks")
 
 CONFIG_DIR_ENV = "ALBOT1_CONFIG_DIR"
+
+log = logging.getLogger(__name__)
+#: The user's files already said to replace the project's (in this process).
+_said: set[Path] = set()
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
 #: Where the build step puts the copies inside the package (``setup.py`` uses the same name).
@@ -86,6 +93,7 @@ def find_resource(folder: Folder, name: str) -> Path:
     for directory in dirs:
         candidate = directory / name
         if candidate.is_file():
+            _say_replacing(candidate, folder)
             return candidate
     raise ConfigError(f"no {folder}/{name} in {' or '.join(str(d) for d in dirs)}")
 
@@ -100,4 +108,17 @@ def list_resources(folder: Folder, pattern: str = "*.toml") -> list[Path]:
         for path in directory.glob(pattern):
             if path.is_file():
                 chosen[path.name] = path
+    for path in chosen.values():
+        _say_replacing(path, folder)
     return [chosen[name] for name in sorted(chosen)]
+
+
+def _say_replacing(found: Path, folder: Folder) -> None:
+    """Warn, once per process, when ``found`` is a user's file replacing the project's file of the same name."""
+    shipped = shipped_dir(folder) / found.name
+    if found in _said or found.parent == shipped.parent or not shipped.is_file():
+        return
+    if found.resolve() == shipped.resolve():  # ALBOT1_CONFIG_DIR naming the checkout itself
+        return
+    _said.add(found)
+    log.warning("%s replaces the project's %s (%s)", found, shipped, CONFIG_DIR_ENV)

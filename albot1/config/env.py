@@ -36,6 +36,20 @@ from albot1.settings import CACHE_DIR_ENV, DATA_DIR_ENV
 
 #: The project's settings: they start with ``ALBOT1_`` but never configure a method.
 SETTINGS_VARIABLES = frozenset({DATA_DIR_ENV, CACHE_DIR_ENV, CONFIG_DIR_ENV})
+#: Every other ``ALBOT1_`` variable the project reads (defined beside their readers, which this layer must not
+#: import: the decoded-log cache, numba's compile processes, the bench's preload and Dask wait, the wheel build,
+#: the scaling benchmark); ``tests/unit/config/test_config_env.py`` checks the list against the sources.
+OTHER_SETTINGS = frozenset(
+    {
+        "ALBOT1_DECODED_CACHE",
+        "ALBOT1_COMPILE_PROCESSES",
+        "ALBOT1_PRELOAD_METHODS",
+        "ALBOT1_DASK_CONNECT_TIMEOUT",
+        "ALBOT1_BUILD_COMMIT",
+        "ALBOT1_BUILD_KERNELS",
+        "ALBOT1_SCALING_CELLS",
+    }
+)
 
 ENV_ROOT = "ALBOT1_"
 
@@ -104,3 +118,30 @@ def env_values(
                 f"{hint}valid names: {', '.join(valid)}"
             )
     return {name: (prefix + name.upper(), value) for name, value in raw.items()}
+
+
+def stray_variables(environ: Iterable[str], prefixes: Iterable[str], valid: Iterable[str]) -> list[tuple[str, str]]:
+    """``(variable, message)`` per ``ALBOT1_`` variable in ``environ`` that no method prefix owns nor setting names.
+
+    Why: ``ALBOT1_KISSICP_VOXEL_SIZE_M`` (the method's name misspelt) belongs
+    to no method, so the per-method check never sees it and the run silently
+    keeps the preset's value. ``valid``: every method variable, for the hint.
+    """
+    known = SETTINGS_VARIABLES | OTHER_SETTINGS
+    owned = list(prefixes)
+    candidates = sorted(set(valid) | known)
+    messages = []
+    for variable in sorted(environ):
+        upper = variable.upper()
+        if not upper.startswith(ENV_ROOT) or upper in known or owner_of(upper, owned) is not None:
+            continue
+        close = difflib.get_close_matches(upper, candidates, n=1)
+        hint = f"; did you mean {close[0]}?" if close else ""
+        messages.append(
+            (
+                variable,
+                f"environment variable {variable} names no registered method's field nor a setting of "
+                f"albot1-bench (ignored){hint}",
+            )
+        )
+    return messages

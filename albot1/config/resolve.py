@@ -13,6 +13,7 @@ it, and an invalid value's message names its origin.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
@@ -26,6 +27,10 @@ from albot1.config.validation import describe_errors
 from albot1.errors import ConfigError
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
+
+log = logging.getLogger(__name__)
+#: The environment values already said in this process (a bench resolves each cell's config).
+_said: set[tuple[str, str, str]] = set()
 
 #: Origin of a value that only the config model sets (a preset given as a partial dict).
 FROM_MODEL = "model default"
@@ -119,7 +124,24 @@ def resolve(
             raise ConfigError(
                 f"invalid config for method {label!r} (preset {preset!r}): {name}: {problem} (from {sources[name]})"
             )
+    _say_environment(label, sources, config)
     return ResolvedConfig(config, {name: sources[name] for name in model.model_fields})
+
+
+def _say_environment(label: str, sources: Mapping[str, str], config: BaseModel) -> None:
+    """One line per value an ``ALBOT1_<METHOD>_<FIELD>`` variable set, once per process.
+
+    Why: a variable exported in a shell long ago changes every run of the
+    method without a word on the command line; the run's config and key
+    record it, but a user comparing with earlier results must be told.
+    """
+    for name, origin in sources.items():
+        if not origin.startswith("env "):
+            continue
+        value = repr(getattr(config, name))
+        if (label, origin, value) not in _said:
+            _said.add((label, origin, value))
+            log.warning("%s: %s = %s from the environment (%s)", label, name, value, origin.removeprefix("env "))
 
 
 def _as_written(given: Any, got: Any, *, text: bool) -> str:

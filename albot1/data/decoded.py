@@ -22,10 +22,13 @@ values, shared read-only beam-angle arrays and write flags); a test checks
 it on real logs.
 
 The cache is never trusted beyond that: an entry that does not load (a
-truncated or damaged file: zip CRC, shapes, stored key) is ignored and
-rebuilt; entries are written atomically (:func:`albot1.atomic.atomic_write`),
-so two cells decoding one log at once both write a whole entry and the last
-rename wins; a folder that cannot be written means decoding every time.
+truncated or damaged file: zip CRC or any other zip error, shapes, dtypes), or
+whose stored ``key`` is not its file name (an entry of another log or code
+version copied or renamed into its place), is ignored, rebuilt and said once
+(a warning naming the entry and why); entries are written atomically
+(:func:`albot1.atomic.atomic_write`), so two cells decoding one log at once
+both write a whole entry and the last rename wins; a folder that cannot be
+written means decoding every time, said once per folder and process.
 Only loaders that report nothing while they stream are cached (CARMEN
 today): a loader that logs warnings during decoding (the ROS bag loader's
 dropped scans) would lose them on a cached read.
@@ -37,7 +40,10 @@ import hashlib
 import inspect
 import io
 import json
+import logging
+import struct
 import zipfile
+import zlib
 from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
@@ -50,11 +56,43 @@ from albot1.data.identity import content_sha256
 from albot1.data.model import Frame, Scan, Sequence
 from albot1.settings import decoded_cache_dir
 
+log = logging.getLogger(__name__)
+
 #: Bumped by hand when the layout of an entry changes (the loader's own changes are caught by its source digest).
-LAYOUT = 1
+LAYOUT = 2
 #: Formats whose decoding is cached (their loaders emit no warning while streaming frames).
 CACHED_FORMATS = frozenset(("carmen",))
-_ARRAYS = ("ranges", "offsets", "angles", "angle_offsets", "angle_of", "stamps", "max_range", "odometry", "reference")
+#: Every array of an entry and its one dtype: an entry holding another (an old layout, a hand-made file) is
+#: refused, since frames of another dtype would give a run other numbers than a fresh decode.
+_DTYPES = {
+    "ranges": np.dtype(np.float64),
+    "offsets": np.dtype(np.int64),
+    "angles": np.dtype(np.float64),
+    "angle_offsets": np.dtype(np.int64),
+    "angle_of": np.dtype(np.int64),
+    "stamps": np.dtype(np.float64),
+    "max_range": np.dtype(np.float64),
+    "odometry": np.dtype(np.float64),
+    "reference": np.dtype(np.float64),
+    "has_reference": np.dtype(np.bool_),
+    "writeable": np.dtype(np.bool_),
+}
+#: What reading a damaged ``.npz`` raises: zipfile alone raises RuntimeError ("encrypted") and
+#: NotImplementedError (a compression method) for one flipped header bit, besides the obvious ones.
+UNREADABLE = (
+    OSError,
+    ValueError,
+    EOFError,
+    KeyError,
+    RuntimeError,
+    NotImplementedError,
+    OverflowError,
+    MemoryError,
+    struct.error,
+    zlib.error,
+    zipfile.BadZipFile,
+)
+_warned_folders: set[Path] = set()
 
 
 @cache
@@ -105,12 +143,15 @@ def cached(sequence: Sequence, path: Path, format_name: str, loader_module: str,
 
     def frames() -> Iterator[Frame]:
         if "arrays" not in held:
-            arrays = read_entry(entry)
+            arrays, problem = load_entry(entry)
+            if problem is not None:
+                log.warning("%s: decoded-log cache entry %s; decoding %s again and replacing it", entry, problem, path)
             if arrays is None:
                 arrays = encode(sequence.frames())
                 if arrays is None:  # frames the layout cannot hold: stream them as decoded, every time
                     return sequence.frames()
-                write_entry(entry, arrays)
+                arrays["key"] = np.array(entry.stem)
+                _store(entry, arrays, path)
             held["arrays"] = arrays
         return decode(held["arrays"])
 
@@ -177,9 +218,9 @@ def _flags(frame: Frame) -> tuple[bool, ...]:
 
 
 def _uniform(groups: list[list[np.ndarray]]) -> bool:
-    """Every array of a group is 1-D of one dtype (poses of 3 values): what the concatenated layout can hold."""
+    """Every array of a group is 1-D float64 (poses of 3 values): what the concatenated layout holds."""
     for group in groups:
-        if len({(a.dtype.str, a.ndim) for a in group}) != 1 or group[0].ndim != 1:
+        if {(a.dtype, a.ndim) for a in group} != {(np.dtype(np.float64), 1)}:
             return False
     return all(a.shape == (3,) for a in groups[2] + groups[3])
 
@@ -208,18 +249,48 @@ def _flagged(array: np.ndarray, writeable: bool) -> np.ndarray:
 
 
 def read_entry(entry: Path) -> dict[str, np.ndarray] | None:
-    """The arrays of a cache entry, or None when it is missing, truncated, damaged or inconsistent."""
+    """The arrays of a cache entry, or None when it is missing, truncated, damaged, inconsistent or another's."""
+    return load_entry(entry)[0]
+
+
+def load_entry(entry: Path) -> tuple[dict[str, np.ndarray] | None, str | None]:
+    """``(arrays, None)`` for a usable entry, ``(None, None)`` for none, ``(None, why)`` for one that is unusable.
+
+    An entry is usable when it loads, its stored ``key`` is its file name (the
+    name is the sha256 of the log and of the decoder: an entry of another log
+    renamed into place must not pass for this one) and its arrays fit together.
+    """
+    arrays = load_npz(entry)
+    if arrays is None or isinstance(arrays, str):
+        return None, arrays
+    key = arrays.get("key")
+    if key is None or key.shape != () or key.dtype.kind != "U" or str(key) != entry.stem:
+        found = str(key)[:100] if key is not None and key.shape == () else "none"
+        return None, f"holds another key ({found}; expected its own name)"
+    if not _consistent(arrays):
+        return None, "holds arrays of other dtypes or shapes than the layout's"
+    return arrays, None
+
+
+def load_npz(entry: Path) -> dict[str, np.ndarray] | str | None:
+    """Every array of the ``.npz`` file ``entry``; None when there is none; why, when it does not load.
+
+    The one reader of this cache's files and of the reference maps' beside them
+    (:mod:`albot1.metrics.reference_map`): whatever a damaged zip raises is a reason to rebuild, never an error.
+    """
     try:
         with np.load(entry, allow_pickle=False) as npz:  # zip CRCs are checked as members are read
-            arrays = {name: npz[name] for name in npz.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError):
+            return {name: npz[name] for name in npz.files}
+    except (FileNotFoundError, NotADirectoryError):
         return None
-    return arrays if _consistent(arrays) else None
+    except UNREADABLE as exc:
+        said = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)[:120]  # the path is named
+        return f"does not load ({type(exc).__name__}: {said})"
 
 
 def _consistent(arrays: dict[str, np.ndarray]) -> bool:
-    """Whether the arrays of an entry fit together (a damaged entry that still unzipped is caught here)."""
-    if not set(_ARRAYS) | {"has_reference", "writeable"} <= set(arrays):
+    """Whether the arrays of an entry have the layout's dtypes and fit together (damage that still unzipped)."""
+    if not all(name in arrays and arrays[name].dtype == dtype for name, dtype in _DTYPES.items()):
         return False
     offsets, bounds = arrays["offsets"], arrays["angle_offsets"]
     n = int(offsets.shape[0]) - 1
@@ -249,6 +320,11 @@ def _consistent(arrays: dict[str, np.ndarray]) -> bool:
 
 def write_entry(entry: Path, arrays: dict[str, np.ndarray]) -> bool:
     """Store ``arrays`` atomically at ``entry``; False (and nothing stored) when the folder cannot be written."""
+    return _write(entry, arrays) is None
+
+
+def _write(entry: Path, arrays: dict[str, np.ndarray]) -> OSError | None:
+    """Store ``arrays`` atomically at ``entry``; the error when it cannot be stored."""
 
     def write(tmp: Path) -> None:
         buffer = io.BytesIO()
@@ -259,9 +335,23 @@ def write_entry(entry: Path, arrays: dict[str, np.ndarray]) -> bool:
     try:
         entry.parent.mkdir(parents=True, exist_ok=True)
         atomic_write(entry, write)
-    except OSError:
-        return False
-    return True
+    except OSError as exc:
+        return exc
+    return None
+
+
+def _store(entry: Path, arrays: dict[str, np.ndarray], path: Path) -> None:
+    """Write an entry; a folder that cannot be written is said once per process (the log is decoded each time)."""
+    error = _write(entry, arrays)
+    if error is not None and entry.parent not in _warned_folders:
+        _warned_folders.add(entry.parent)
+        log.warning(
+            "%s: cannot store the decoded log (%s); %s is decoded on every read "
+            "(point ALBOT1_DECODED_CACHE at a writable folder, or set it to off)",
+            entry,
+            error.strerror or type(error).__name__,
+            path,
+        )
 
 
 def clear(folder: Path | None = None) -> int:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 import importlib.util
 import inspect
+import logging
 import os
 import shutil
 import sys
@@ -25,13 +26,15 @@ from typing import TYPE_CHECKING, Any, cast
 
 from pydantic import BaseModel
 
-from albot1.config.env import method_prefix
+from albot1.config.env import method_prefix, stray_variables
 from albot1.config.keyvalue import parse_key_values
 from albot1.config.resolve import FROM_OVERRIDE, ResolvedConfig, resolve
 from albot1.config.suggest import unknown_name_message
 from albot1.config.targets import TargetError, check_target, resolve_class
 from albot1.methods.errors import UnknownMethodError
 from albot1.methods.plugins import PLUGIN_ERROR_CLASS, installed_plugins
+
+_log = logging.getLogger(__name__)
 
 if TYPE_CHECKING:
     # For the types only: the contract imports the data layer (numpy, the records), which listing the
@@ -343,6 +346,7 @@ def resolve_method_config(
     registry = registry or method_registry()
     spec = registry.get(method)
     cls = spec.load_class()
+    _say_stray_variables(registry, spec, cls.config_model)
     return resolve(
         cls.config_model,
         cls.presets,
@@ -354,6 +358,22 @@ def resolve_method_config(
         override_origin=override_origin,
         typed_overrides=typed_overrides,
     )
+
+
+def _say_stray_variables(registry: MethodRegistry, spec: MethodSpec, model: type[BaseModel]) -> None:
+    """Warn, once per process and variable, about ``ALBOT1_`` variables no method or setting reads.
+
+    The hint names the closest of this method's variables and the settings
+    (loading every method's model for it would import them all).
+    """
+    prefixes = [other.env_prefix for other in registry]
+    valid = [spec.env_prefix + name.upper() for name in model.model_fields]
+    for variable, message in stray_variables([v for v in os.environ if v not in _said_stray], prefixes, valid):
+        _said_stray.add(variable)
+        _log.warning("%s", message)
+
+
+_said_stray: set[str] = set()
 
 
 def resolve_config(

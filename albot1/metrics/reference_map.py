@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import zipfile
 from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -108,11 +107,10 @@ def reference_cloud(key: str, build: Callable[[], FloatArray]) -> FloatArray:
 
 def read_entry(entry: Path, key: str) -> FloatArray | None:
     """The cloud of ``entry``, or None when it is missing, damaged, of another key or not a finite (K, 2) cloud."""
-    try:
-        with np.load(entry, allow_pickle=False) as npz:  # zip CRCs are checked as members are read
-            stored_key, cloud = npz["key"], npz["points"]
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError):
+    arrays = decoded.load_npz(entry)  # any damage, whatever zipfile raises for it, is a miss
+    if not isinstance(arrays, dict) or "key" not in arrays or "points" not in arrays:
         return None
+    stored_key, cloud = arrays["key"], arrays["points"]
     if stored_key.shape != () or str(stored_key) != key:
         return None
     if cloud.dtype != np.float64 or cloud.ndim != 2 or cloud.shape[1] != 2 or not np.isfinite(cloud).all():

@@ -48,6 +48,35 @@ def test_user_folder_adds_and_replaces_files(tmp_path: Path, monkeypatch: pytest
     assert resource_dirs("datasets") == [CHECKOUT / "datasets"]  # no datasets/ in the user's folder
 
 
+def test_a_user_file_replacing_the_projects_is_said_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    (tmp_path / "baselines").mkdir()
+    (tmp_path / "baselines" / "kiss-icp.toml").write_text("# mine\n")
+    (tmp_path / "baselines" / "mine.toml").write_text("# a file of my own: adds, replaces nothing\n")
+    monkeypatch.setenv(resources.CONFIG_DIR_ENV, str(tmp_path))
+    monkeypatch.setattr(resources, "_said", set(), raising=False)
+    with caplog.at_level("WARNING", logger="albot1.resources"):
+        for _ in range(2):
+            find_resource("baselines", "kiss-icp.toml")
+            list_resources("baselines")
+            find_resource("baselines", "mine.toml")
+    assert [r.getMessage() for r in caplog.records] == [
+        f"{tmp_path / 'baselines' / 'kiss-icp.toml'} replaces the project's {CHECKOUT / 'baselines' / 'kiss-icp.toml'} "
+        "(ALBOT1_CONFIG_DIR)"
+    ]
+
+
+def test_the_checkout_named_as_the_user_folder_replaces_nothing(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    monkeypatch.setenv(resources.CONFIG_DIR_ENV, str(CHECKOUT))
+    with caplog.at_level("WARNING", logger="albot1.resources"):
+        assert find_resource("baselines", "kiss-icp.toml") == CHECKOUT / "baselines" / "kiss-icp.toml"
+        list_resources("datasets")
+    assert caplog.records == []
+
+
 def test_user_folder_that_is_not_a_folder_is_one_clear_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv(resources.CONFIG_DIR_ENV, str(tmp_path / "missing"))
     with pytest.raises(ConfigError, match=r"ALBOT1_CONFIG_DIR=.*missing: not a folder"):

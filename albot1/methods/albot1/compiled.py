@@ -68,6 +68,7 @@ from numba.extending import register_jitable  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
 from albot1 import versions  # noqa: E402
+from albot1.config.numbers import is_plain  # noqa: E402
 from albot1.errors import ConfigError  # noqa: E402
 from albot1.geometry import se2, segments  # noqa: E402
 
@@ -212,13 +213,10 @@ def compile_processes() -> int:
     """
     value = os.environ.get(PROCESSES_ENV, "").strip()
     if value:
-        try:
-            count = int(value)
-        except ValueError:
-            raise ConfigError(f"{PROCESSES_ENV}={value!r}: expected a whole number of processes (1 or more)") from None
-        if count < 1:
+        # ASCII digits only: int() alone reads "1_0" as 10 and "٣" as 3 (config/numbers.py's rule for user text)
+        if not (is_plain(value) and value.isdigit()) or int(value) < 1:
             raise ConfigError(f"{PROCESSES_ENV}={value!r}: expected a whole number of processes (1 or more)")
-        return count
+        return int(value)
     affinity = getattr(os, "sched_getaffinity", None)
     return len(affinity(0)) if affinity is not None else os.cpu_count() or 1
 

@@ -53,6 +53,24 @@ def test_the_methods_warm_up_failures_are_returned_with_the_import_failures(
     assert failures[-2:] == ["method odometry: warm-up: E: x", "methods odometry: j"]
 
 
+def test_a_name_no_method_has_is_said(
+    preload: ModuleType, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """``ALBOT1_PRELOAD_METHODS=bogus`` preloaded nothing without a word (every cell then warmed up alone)."""
+    from albot1.methods import warm_ups
+    from albot1.methods.registry import method_registry
+
+    monkeypatch.setattr(warm_ups, "warm_up_methods", lambda *a, **k: warm_ups.WarmUpOutcome(failures=[]))
+    with caplog.at_level(logging.WARNING, logger=preload.__name__):
+        preload.warm([], methods=frozenset({"odometry", "kiss icp", "bogus"}))
+        preload.warm([], methods=frozenset({"odometry"}))
+    names = ", ".join(spec.name for spec in method_registry())
+    assert [r.getMessage() for r in caplog.records] == [
+        "albot1 bench: ALBOT1_PRELOAD_METHODS names no registered method: 'bogus', 'kiss icp' "
+        f"(nothing preloaded for it); expected names from: {names}"
+    ]
+
+
 def test_failures_are_logged_once_each(
     preload: ModuleType, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:

@@ -104,3 +104,52 @@ def test_sources_of_a_partial_dict_preset() -> None:
     resolved = resolve(_Toy, {"default": {}, "b": {"mode": "b"}}, "b", env_prefix="ALBOT1_TOY_")
     assert resolved.config == _Toy(mode="b")
     assert resolved.sources == {"size_m": "model default", "mode": "preset b", "on": "model default"}
+
+
+def test_a_value_from_the_environment_is_said_once(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    from albot1.config import resolve as resolve_module
+
+    monkeypatch.setattr(resolve_module, "_said", set(), raising=False)
+    monkeypatch.setenv("ALBOT1_TOY_SIZE_M", "0.25")
+    with caplog.at_level("WARNING", logger="albot1.config.resolve"):
+        for _ in range(3):  # a bench resolves every cell's config
+            resolve(_Toy, PRESETS, "big", env_prefix="ALBOT1_TOY_", owner="toy")
+        resolve(_Toy, PRESETS, "big", env_prefix="ALBOT1_TOY_", owner="toy", overrides={"size_m": "7"})  # not used
+    assert [r.getMessage() for r in caplog.records] == ["toy: size_m = 0.25 from the environment (ALBOT1_TOY_SIZE_M)"]
+
+
+def test_a_variable_no_method_owns_is_said_once(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """``ALBOT1_KISSICP_VOXEL_SIZE_M`` (the method misspelt) was ignored without a word (the preset's 0.15 m)."""
+    from albot1.methods import registry
+
+    monkeypatch.setattr(registry, "_said_stray", set(), raising=False)
+    monkeypatch.setenv("ALBOT1_KISSICP_VOXEL_SIZE_M", "2")
+    monkeypatch.setenv("ALBOT1_DECODED_CACHE", "off")  # a setting: never said
+    with caplog.at_level("WARNING", logger="albot1.methods.registry"):
+        for _ in range(2):
+            config = registry.resolve_config("kiss-icp")
+    assert config.voxel_size_m == 0.15  # type: ignore[attr-defined]  # the preset's
+    assert [r.getMessage() for r in caplog.records] == [
+        "environment variable ALBOT1_KISSICP_VOXEL_SIZE_M names no registered method's field nor a setting of "
+        "albot1-bench (ignored); did you mean ALBOT1_KISS_ICP_VOXEL_SIZE_M?"
+    ]
+
+
+def test_the_known_settings_are_every_setting_the_sources_read() -> None:
+    """Every ``"ALBOT1_..."`` name in the package, setup.py and the benchmarks is a setting or a method's variable."""
+    import re
+    from pathlib import Path
+
+    from albot1.config.env import OTHER_SETTINGS, SETTINGS_VARIABLES
+    from albot1.methods.registry import method_registry
+
+    root = Path(__file__).resolve().parents[3]
+    sources = [*root.glob("albot1/**/*.py"), root / "setup.py", *root.glob("benchmarks/*.py")]
+    found = {m for path in sources for m in re.findall(r"[\"'](ALBOT1_[A-Z0-9_]*[A-Z0-9])[\"']", path.read_text())}
+    prefixes = [spec.env_prefix for spec in method_registry()]
+    settings = {name for name in found if owner_of(name, prefixes) is None}
+    assert settings == SETTINGS_VARIABLES | OTHER_SETTINGS

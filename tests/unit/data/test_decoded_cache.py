@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import stat
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -167,3 +168,138 @@ def test_a_failing_write_means_decoding(tmp_path: Path, cache: Path, monkeypatch
     log = _log(tmp_path / "a.clf", 8)
     _same(_fresh(str(log), monkeypatch), list(open_sequence(str(log))))
     assert not list(cache.glob("*.npz"))
+
+
+def _entry_of(log: Path, cache: Path) -> Path:
+    from albot1.data.identity import content_sha256
+
+    (entry,) = cache.glob(f"{content_sha256(log)}-*.npz")
+    return entry
+
+
+def test_an_entry_of_another_log_in_its_place_is_refused_said_and_rebuilt(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    a, b = _log(tmp_path / "a.clf", 8), _log(tmp_path / "b.clf", 8, shift=0.5)
+    list(open_sequence(str(a)))
+    list(open_sequence(str(b)))
+    entry_a, entry_b = _entry_of(a, cache), _entry_of(b, cache)
+    entry_a.write_bytes(entry_b.read_bytes())  # b's decode under a's name: it used to be read as a's frames
+    with caplog.at_level("WARNING", logger="albot1.data.decoded"):
+        got = list(open_sequence(str(a)))
+    _same(_fresh(str(a), monkeypatch), got)
+    assert got[0].scan.ranges[0] == pytest.approx(1.0)
+    assert [r.getMessage() for r in caplog.records] == [
+        f"{entry_a}: decoded-log cache entry holds another key ({entry_b.stem}; expected its own name); "
+        f"decoding {a} again and replacing it"
+    ]
+    arrays = decoded.read_entry(entry_a)
+    assert arrays is not None and str(arrays["key"]) == entry_a.stem
+
+
+def test_an_entry_without_a_key_is_refused(tmp_path: Path, cache: Path) -> None:
+    log = _log(tmp_path / "a.clf", 8)
+    list(open_sequence(str(log)))
+    entry = _entry_of(log, cache)
+    arrays = decoded.read_entry(entry)
+    assert arrays is not None
+    del arrays["key"]  # what an entry of the first layout holds
+    np.savez(entry, **arrays)
+    assert decoded.read_entry(entry) is None
+    assert decoded.load_entry(entry) == (None, "holds another key (none; expected its own name)")
+
+
+@pytest.mark.parametrize("name", ["ranges", "odometry", "stamps", "offsets"])
+def test_an_entry_of_another_dtype_is_refused(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch, name: str
+) -> None:
+    log = _log(tmp_path / "a.clf", 8)
+    list(open_sequence(str(log)))
+    entry = _entry_of(log, cache)
+    arrays = decoded.read_entry(entry)
+    assert arrays is not None
+    arrays[name] = arrays[name].astype(np.float32 if arrays[name].dtype == np.float64 else np.int32)
+    np.savez(entry, **arrays)
+    _same(_fresh(str(log), monkeypatch), list(open_sequence(str(log))))  # float64 again, as decoded
+    np.savez(entry, **arrays)
+    assert decoded.load_entry(entry) == (None, "holds arrays of other dtypes or shapes than the layout's")
+
+
+def test_no_flipped_bit_of_an_entry_raises_or_reads_as_other_frames(tmp_path: Path, cache: Path) -> None:
+    log = _log(tmp_path / "a.clf", 3)
+    list(open_sequence(str(log)))
+    entry = _entry_of(log, cache)
+    good = entry.read_bytes()
+    arrays = decoded.read_entry(entry)
+    assert arrays is not None
+    expected = [(f.scan.ranges.tobytes(), f.odometry.tobytes(), f.scan.timestamp) for f in decoded.decode(arrays)]
+    # zipfile raised RuntimeError ("encrypted") and NotImplementedError (compression) for the flag and method
+    # bits of the local and central headers; those, and every 16th byte elsewhere (every byte took 19 s)
+    with zipfile.ZipFile(entry) as archive:
+        local = [info.header_offset + k for info in archive.infolist() for k in (6, 8)]
+    central = [p + k for p in range(len(good) - 4) if good[p : p + 4] == b"PK\x01\x02" for k in (8, 10)]
+    assert len(local) == len(central) >= 20
+    for i in sorted({*local, *central, *range(0, len(good), 16)}):
+        damaged = bytearray(good)
+        damaged[i] ^= 0x01
+        entry.write_bytes(bytes(damaged))
+        read = decoded.read_entry(entry)
+        if read is not None:
+            got = [(f.scan.ranges.tobytes(), f.odometry.tobytes(), f.scan.timestamp) for f in decoded.decode(read)]
+            assert got == expected, f"bit 0 of byte {i} flipped"
+
+
+def test_a_damaged_entry_is_said_once(tmp_path: Path, cache: Path, caplog: pytest.LogCaptureFixture) -> None:
+    log = _log(tmp_path / "a.clf", 8)
+    list(open_sequence(str(log)))
+    entry = _entry_of(log, cache)
+    entry.write_bytes(b"")
+    with caplog.at_level("WARNING", logger="albot1.data.decoded"):
+        list(open_sequence(str(log)))
+        list(open_sequence(str(log)))  # rebuilt: read back without a word
+    (record,) = caplog.records
+    assert record.getMessage().startswith(f"{entry}: decoded-log cache entry does not load (")
+    assert record.getMessage().endswith(f"); decoding {log} again and replacing it")
+
+
+def test_a_folder_in_place_of_an_entry_means_decoding_said(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    log = _log(tmp_path / "a.clf", 8)
+    list(open_sequence(str(log)))
+    entry = _entry_of(log, cache)
+    entry.unlink()
+    entry.mkdir()
+    monkeypatch.setattr(decoded, "_warned_folders", set(), raising=False)
+    with caplog.at_level("WARNING", logger="albot1.data.decoded"):
+        _same(_fresh(str(log), monkeypatch), list(open_sequence(str(log))))
+    assert [r.getMessage().split(";")[0] for r in caplog.records] == [
+        f"{entry}: decoded-log cache entry does not load (IsADirectoryError: Is a directory)",
+        f"{entry}: cannot store the decoded log (Is a directory)",
+    ]
+    assert entry.is_dir()
+
+
+def test_an_unwritable_folder_is_said_once(
+    tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    def refuse(path: object, writer: object) -> None:
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr(decoded, "atomic_write", refuse)
+    monkeypatch.setattr(decoded, "_warned_folders", set(), raising=False)
+    a, b = _log(tmp_path / "a.clf", 8), _log(tmp_path / "b.clf", 8, shift=0.5)
+    with caplog.at_level("WARNING", logger="albot1.data.decoded"):
+        for log in (a, b, a):
+            list(open_sequence(str(log)))
+    (record,) = caplog.records
+    assert record.getMessage() == (
+        f"{cache / _key_name(a)}: cannot store the decoded log (Permission denied); {a} is decoded on every read "
+        "(point ALBOT1_DECODED_CACHE at a writable folder, or set it to off)"
+    )
+
+
+def _key_name(log: Path) -> str:
+    from albot1.data.loaders.carmen import loader as carmen
+
+    return f"{decoded.entry_key(log, 'carmen', carmen.__name__, {})}.npz"

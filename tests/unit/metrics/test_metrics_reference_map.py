@@ -156,3 +156,16 @@ def test_a_failed_build_stores_nothing(cache: Path) -> None:
         reference_cloud("k", fail)
     assert not list(cache.glob("*.npz")) if cache.exists() else True
     assert reference_cloud("k", lambda: np.zeros((1, 2))).tolist() == [[0.0, 0.0]]
+
+
+def test_a_flipped_zip_header_bit_is_a_miss_not_an_error(tmp_path: Path) -> None:
+    """zipfile raises RuntimeError ("encrypted") or NotImplementedError (compression) for these bits."""
+    entry = tmp_path / f"{'ab' * 32}.npz"
+    assert reference_map.write_entry(entry, "ab" * 32, np.zeros((4, 2)))
+    good = entry.read_bytes()
+    central = good.index(b"PK\x01\x02")
+    for position in (central + 8, central + 10):  # the central header's flags and method (zipfile reads these)
+        damaged = bytearray(good)
+        damaged[position] ^= 0x01
+        entry.write_bytes(bytes(damaged))
+        assert read_entry(entry, "ab" * 32) is None, position

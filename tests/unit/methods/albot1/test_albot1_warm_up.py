@@ -181,6 +181,18 @@ def test_the_number_of_compile_processes_comes_from_the_environment(monkeypatch:
     assert compiled.compile_processes() >= 1
 
 
+@pytest.mark.parametrize("bad", ["1_0", "\u0663", "\uff12", "+2", "2e0"])
+def test_a_process_count_must_be_ascii_digits(monkeypatch: pytest.MonkeyPatch, bad: str) -> None:
+    """``int()`` read ``1_0`` as 10 and Arabic-Indic ``٣`` as 3: a count the user did not write, silently."""
+    from albot1.errors import ConfigError
+    from albot1.methods.albot1 import compiled
+
+    monkeypatch.setenv(compiled.PROCESSES_ENV, bad)
+    with pytest.raises(ConfigError) as caught:
+        compiled.compile_processes()
+    assert str(caught.value) == f"ALBOT1_COMPILE_PROCESSES={bad!r}: expected a whole number of processes (1 or more)"
+
+
 def test_every_kernel_has_a_measured_compile_cost() -> None:
     """A cold warm-up claims kernels by measured compile CPU (``COMPILE_CPU_S``): a new kernel needs a measurement."""
     from albot1.methods.albot1.mapping.kernel_set import MappingKernels
