@@ -14,6 +14,10 @@ beams      angle step           beams at
 other n    180/(n-1) deg        -90 ... +90 deg
 =========  ===================  ====================================
 
+A beam count other than 180, 181, 360, 361 without PARAM geometry is
+probably not a SICK LMS 2xx: the default still applies (as in CARMEN) and
+the frame stream warns once (:func:`guessed_geometry_note`).
+
 PARAM lines that override the defaults (front laser; ``rear`` for RLASER):
 ``laser_front_laser_resolution`` / ``laser_frontlaser_resolution`` (degrees),
 ``laser_front_laser_fov`` (degrees, or radians when <= 2*pi as in the CSAIL
@@ -50,6 +54,23 @@ class BeamGeometry:
     step: float
     max_range: float
     source: str
+
+
+#: Beam counts of a 180-degree SICK LMS 2xx at 1 and 0.5 deg, which CARMEN's defaults describe. A FLASER line
+#: of another count without PARAM geometry gets the same 180-degree spread, but it is likely another scanner
+#: (a 270-degree Hokuyo's 1081 readings, a 360-degree scanner's 1440), so the loader warns.
+SICK_BEAM_COUNTS = (180, 181, 360, 361)
+
+
+def guessed_geometry_note(source: object, laser: str, beams: int) -> str:
+    """The warning for FLASER/RLASER lines whose beam count CARMEN's defaults do not describe (once per load)."""
+    which = "rear" if laser == "RLASER" else "front"
+    return (
+        f"{source}: {laser} lines of {beams} readings and no PARAM laser_{which}_laser_fov or "
+        f"laser_{which}_laser_resolution before them: their beams are taken to span -90..+90 deg (CARMEN's "
+        f"default, made for a 180-degree SICK LMS 2xx, which gives {', '.join(map(str, SICK_BEAM_COUNTS))} "
+        f"readings); a scanner with another field of view needs those PARAM lines (or ROBOTLASER1 lines)"
+    )
 
 
 def default_geometry(beams: int) -> tuple[float, float]:
