@@ -10,7 +10,6 @@ scans and the pose lines that can still bracket them are kept in memory.
 
 from __future__ import annotations
 
-import logging
 import math
 from collections.abc import Iterator
 from pathlib import Path
@@ -18,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from albot1.data.errors import ParseError
-from albot1.data.loaders.beams import seam_note, seam_repeat
+from albot1.data.loaders.beams import seam_repeat
 from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.checks import span_problem, time_problem
 from albot1.data.loaders.carmen.options import CarmenOptions
@@ -28,21 +27,15 @@ from albot1.data.loaders.carmen.probe import refuse_mixed
 from albot1.data.loaders.carmen.source import iter_line_chunks
 from albot1.data.model import Frame, Scan
 
-log = logging.getLogger(__name__)
-
 
 class FrameStream:
-    """Turns parsed chunks into frames; one instance serves every iteration (it holds no state but whether
-    a warning (the dropped seam beam of 360-degree scans, a FLASER beam count CARMEN's defaults do not
-    describe) was logged: each is said once per load, not once per pass)."""
+    """Turns parsed chunks into frames; one instance serves every iteration (it holds no state)."""
 
     def __init__(self, path: Path, opts: CarmenOptions, laser: str, reference: str) -> None:
         self.path = path
         self.opts = opts
         self.laser = laser
         self.reference = reference
-        self.seam_said = False
-        self.guess_said = False
 
     def frames(self) -> Iterator[Frame]:
         return _FrameIterator(self).run()
@@ -96,9 +89,6 @@ class _FrameIterator:
             g = cache.get(n)
             if g is None:
                 g = cache[n] = geom.param_geometry(n, state, rear=rear)
-                if g.source.startswith("default") and n not in geom.SICK_BEAM_COUNTS and not self.s.guess_said:
-                    self.s.guess_said = True
-                    log.warning(geom.guessed_geometry_note(f"{self.path}:{line}", self.s.laser, n))
                 problem = span_problem(n, g.step)
                 if problem is not None:
                     raise ParseError(
@@ -126,7 +116,7 @@ class _FrameIterator:
                 angles = [shared] * len(block.lines)
             else:
                 angles = [geom.beam_angles(block.beams, a, d) for a, d in zip(start.tolist(), step.tolist())]
-            ranges = self._without_seam(list(geom.clean_block(block.ranges, max_range)), angles, int(block.lines[0]))
+            ranges = _without_seam(list(geom.clean_block(block.ranges, max_range)), angles)
             decoded.append((block, ranges, angles, block.stamps.tolist(), max_range.tolist()))
             rows.extend(zip(block.lines.tolist(), [b] * len(block.lines), range(len(block.lines))))
         for _, name, value in params:
@@ -152,26 +142,6 @@ class _FrameIterator:
         self.poses.feed(parsed)
         yield from self._emit(final=False)
 
-    def _without_seam(self, ranges: list[np.ndarray], angles: list[np.ndarray], line: int) -> list[np.ndarray]:
-        """Rows of a block without the repeated last beam of 360-degree scans (``angles`` is edited in place).
-
-        A ``ROBOTLASER1`` line with a 360-degree field of view over ``n - 1``
-        steps measures its first direction twice (:func:`seam_repeat`); the
-        last beam is dropped and the first such line is named once per load.
-        Rows that share one angle array keep sharing one (read-only) view.
-        """
-        trimmed: dict[int, np.ndarray | None] = {}
-        for i, a in enumerate(angles):
-            cut = trimmed.get(id(a), a)
-            if cut is a:
-                cut = trimmed[id(a)] = a[:-1] if seam_repeat(a) else None
-            if cut is not None:
-                angles[i], ranges[i] = cut, ranges[i][:-1]
-                if not self.s.seam_said:
-                    self.s.seam_said = True
-                    log.warning(seam_note(f"{self.path}:{line}", self.s.laser, a.shape[0]))
-        return ranges
-
     def _check_time(self, line: int, stamp: float) -> None:
         last = self.last_stamp
         if last is not None:
@@ -196,3 +166,21 @@ class _FrameIterator:
         del self.pending[:done]
         oldest = self.pending[0].timestamp if self.pending else (self.last_stamp or (math.inf, 0))[0]
         poses.trim(oldest)
+
+
+def _without_seam(ranges: list[np.ndarray], angles: list[np.ndarray]) -> list[np.ndarray]:
+    """Rows of a block without the repeated last beam of 360-degree scans (``angles`` is edited in place).
+
+    A line with a 360-degree field of view over ``n - 1`` steps measures its
+    first direction twice (:func:`seam_repeat`); the last beam is dropped (the
+    loader says so when it opens the log: :func:`.geometry.first_line_notes`).
+    Rows that share one angle array keep sharing one (read-only) view.
+    """
+    trimmed: dict[int, np.ndarray | None] = {}
+    for i, a in enumerate(angles):
+        if id(a) not in trimmed:
+            trimmed[id(a)] = a[:-1] if seam_repeat(a) else None
+        cut = trimmed[id(a)]
+        if cut is not None:
+            angles[i], ranges[i] = cut, ranges[i][:-1]
+    return ranges

@@ -16,7 +16,7 @@ other n    180/(n-1) deg        -90 ... +90 deg
 
 A beam count other than 180, 181, 360, 361 without PARAM geometry is
 probably not a SICK LMS 2xx: the default still applies (as in CARMEN) and
-the frame stream warns once (:func:`guessed_geometry_note`).
+the loader warns when the log's first laser line is such a line (:func:`first_line_notes`).
 
 PARAM lines that override the defaults (front laser; ``rear`` for RLASER):
 ``laser_front_laser_resolution`` / ``laser_frontlaser_resolution`` (degrees),
@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from albot1.data.loaders.beams import seam_note, seam_repeat
 from albot1.geometry.types import FloatArray
 
 #: SICK LMS 2xx maximum (8191 cm is its "no echo" code); used when a log states no maximum.
@@ -71,6 +72,29 @@ def guessed_geometry_note(source: object, laser: str, beams: int) -> str:
         f"default, made for a 180-degree SICK LMS 2xx, which gives {', '.join(map(str, SICK_BEAM_COUNTS))} "
         f"readings); a scanner with another field of view needs those PARAM lines (or ROBOTLASER1 lines)"
     )
+
+
+def first_line_notes(
+    where: str, laser: str, beams: int, start: float | None, step: float | None, params: dict[str, str]
+) -> list[str]:
+    """The warnings the log's first laser line calls for: a FLASER/RLASER beam count CARMEN's defaults do not
+    describe, a 360-degree scan whose last beam repeats its first (:func:`seam_repeat`).
+
+    Said by the loader when it opens the log (from its head, :mod:`.probe`), not
+    while frames stream: decoded frames are cached (:mod:`albot1.data.decoded`)
+    and a cached read decodes nothing, so a warning logged while streaming
+    would be lost. ``start``/``step``: the line's own geometry (ROBOTLASER1,
+    RAWLASER), None for FLASER/RLASER, whose geometry comes from ``params``.
+    """
+    notes = []
+    if start is None or step is None:
+        geometry = param_geometry(beams, params, rear=laser == "RLASER")
+        start, step = geometry.start, geometry.step
+        if geometry.source.startswith("default") and beams not in SICK_BEAM_COUNTS:
+            notes.append(guessed_geometry_note(where, laser, beams))
+    if seam_repeat(beam_angles(beams, start, step)):
+        notes.append(seam_note(where, laser, beams))
+    return notes
 
 
 def default_geometry(beams: int) -> tuple[float, float]:

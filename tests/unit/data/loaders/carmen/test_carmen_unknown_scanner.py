@@ -60,3 +60,23 @@ def test_param_geometry_silences_the_warning_and_a_full_turn_measures_each_direc
     assert angles.shape == (1439,)
     assert angles[0] == pytest.approx(-math.pi)
     assert angles[1] - angles[0] == pytest.approx(2 * math.pi / 1439)
+
+
+def test_the_warnings_survive_a_read_from_the_decoded_cache(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Decoded CARMEN frames are cached: the second load decodes nothing, so the warnings are said on opening."""
+    from albot1.data import open_sequence
+
+    monkeypatch.setenv("ALBOT1_DECODED_CACHE", str(tmp_path / "cache"))
+    path = tmp_path / "ring.log"
+    path.write_text("\n".join([flaser(1440, 1.0), flaser(1440, 2.0)]) + "\n")
+    said = []
+    for _ in range(2):
+        caplog.clear()
+        with caplog.at_level(logging.WARNING):
+            frames = list(open_sequence(str(path)))
+        assert len(frames) == 2
+        said.append([r.getMessage()[: len(str(path)) + 24] for r in caplog.records if r.levelno >= logging.WARNING])
+    assert list((tmp_path / "cache").iterdir())  # the second load read the cache
+    assert said == [[f"{path}:1: FLASER lines of 1440"]] * 2
