@@ -13,6 +13,7 @@ same span as ``wall_s`` (:func:`cpu_time_s`).
 
 from __future__ import annotations
 
+import logging
 import resource
 import sys
 import time
@@ -29,6 +30,8 @@ from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
 from albot1.methods.registry import MethodRegistry, get_method, resolve_config
 from albot1.runs.errors import RunError
+
+log = logging.getLogger(__name__)
 
 
 def peak_rss_mb() -> float:
@@ -89,6 +92,7 @@ def run_method(
         warm_up(announce)
     startup_s = time.perf_counter() - wall_start
     per_scan: list[int] = []
+    blind_scans = 0
     stamps: list[float] = []
     odometry: list[np.ndarray] = []
     reference: list[np.ndarray] | None = []
@@ -100,6 +104,8 @@ def run_method(
             start = time.perf_counter_ns()
             mapper.process(blind)
             per_scan.append(time.perf_counter_ns() - start)
+            if not frame.scan.valid().any():
+                blind_scans += 1
             stamps.append(frame.scan.timestamp)
             odometry.append(frame.odometry)
             if reference is not None:
@@ -124,6 +130,9 @@ def run_method(
         raise error_class(f"{method} on {dataset} failed at scan {index}: {type(exc).__name__}: {exc}") from exc
 
     _check_output(output, len(per_scan), method, dataset, error_class)
+    note = blind_note(blind_scans, len(per_scan), method, dataset)
+    if note is not None:
+        log.warning(note)
     per_scan_ns = np.asarray(per_scan, dtype=np.int64)
     poses = robot_frame(np.asarray(output.poses, dtype=float), offset)
     reference_poses = robot_frame(np.asarray(reference, dtype=float).reshape(-1, 3), offset) if reference else None
@@ -162,6 +171,26 @@ def run_method(
             "sensor_offset": [float(v) for v in offset],
             "data_sha256": dict(seq.metadata.checksums),
         },
+    )
+
+
+def blind_note(blind: int, scans: int, method: str, dataset: str) -> str | None:
+    """The warning for a run where at least half the scans had no return (None below that).
+
+    A scan whose every range is NaN (beyond the scanner's range, ``+inf`` or
+    ``-inf`` under REP 117, NaN) gives a method nothing to match, so it can
+    only follow the odometry there; the run still succeeds, which without
+    this line would read as a scan matcher that agreed with the odometry (a
+    driver's ``range_max`` set below every reading does exactly that).
+    """
+    if scans == 0 or 2 * blind < scans:
+        return None
+    which = (
+        f"none of the {scans} scans had a return" if blind == scans else f"{blind} of the {scans} scans had no return"
+    )
+    return (
+        f"{method} on {dataset}: {which} (every range NaN, infinite or outside the scanner's limits); "
+        f"in those the method had only the odometry to go by"
     )
 
 

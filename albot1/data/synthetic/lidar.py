@@ -62,14 +62,26 @@ class LaserSpec:
             raise SyntheticWorldError(f"laser: expected a range sigma >= 0, got {self.range_sigma}")
 
     @property
+    def full_turn(self) -> bool:
+        """A 360-degree scanner: its beams split the turn into ``beams`` equal steps, none measured twice."""
+        return self.fov_deg == 360.0
+
+    @property
     def angles(self) -> FloatArray:
-        """Beam angles (rad), ascending and symmetric about 0 (forward)."""
+        """Beam angles (rad), ascending; symmetric about 0 (forward) for a field of view under 360 deg.
+
+        A 360-degree scanner starts at -180 deg and stops one step short of
+        +180 deg: spreading its beams from -180 to +180 deg would aim the last
+        beam where the first points, one direction measured twice.
+        """
+        if self.full_turn:
+            return -math.pi + np.arange(self.beams, dtype=np.float64) * (2 * math.pi / self.beams)
         half = math.radians(self.fov_deg) / 2.0
         return np.linspace(-half, half, self.beams)
 
     @property
     def resolution_deg(self) -> float:
-        return self.fov_deg / (self.beams - 1)
+        return self.fov_deg / (self.beams if self.full_turn else self.beams - 1)
 
 
 def as_segments(walls: ArrayLike) -> FloatArray:

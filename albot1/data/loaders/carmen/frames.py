@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from albot1.data.errors import ParseError
+from albot1.data.loaders.beams import seam_repeat
 from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.checks import span_problem, time_problem
 from albot1.data.loaders.carmen.options import CarmenOptions
@@ -115,9 +116,8 @@ class _FrameIterator:
                 angles = [shared] * len(block.lines)
             else:
                 angles = [geom.beam_angles(block.beams, a, d) for a, d in zip(start.tolist(), step.tolist())]
-            decoded.append(
-                (block, geom.clean_block(block.ranges, max_range), angles, block.stamps.tolist(), max_range.tolist())
-            )
+            ranges = _without_seam(list(geom.clean_block(block.ranges, max_range)), angles)
+            decoded.append((block, ranges, angles, block.stamps.tolist(), max_range.tolist()))
             rows.extend(zip(block.lines.tolist(), [b] * len(block.lines), range(len(block.lines))))
         for _, name, value in params:
             self.params[name] = value
@@ -166,3 +166,21 @@ class _FrameIterator:
         del self.pending[:done]
         oldest = self.pending[0].timestamp if self.pending else (self.last_stamp or (math.inf, 0))[0]
         poses.trim(oldest)
+
+
+def _without_seam(ranges: list[np.ndarray], angles: list[np.ndarray]) -> list[np.ndarray]:
+    """Rows of a block without the repeated last beam of 360-degree scans (``angles`` is edited in place).
+
+    A line with a 360-degree field of view over ``n - 1`` steps measures its
+    first direction twice (:func:`seam_repeat`); the last beam is dropped (the
+    loader says so when it opens the log: :func:`.geometry.first_line_notes`).
+    Rows that share one angle array keep sharing one (read-only) view.
+    """
+    trimmed: dict[int, np.ndarray | None] = {}
+    for i, a in enumerate(angles):
+        if id(a) not in trimmed:
+            trimmed[id(a)] = a[:-1] if seam_repeat(a) else None
+        cut = trimmed[id(a)]
+        if cut is not None:
+            angles[i], ranges[i] = cut, ranges[i][:-1]
+    return ranges

@@ -14,6 +14,10 @@ beams      angle step           beams at
 other n    180/(n-1) deg        -90 ... +90 deg
 =========  ===================  ====================================
 
+A beam count other than 180, 181, 360, 361 without PARAM geometry is
+probably not a SICK LMS 2xx: the default still applies (as in CARMEN) and
+the loader warns when the log's first laser line is such a line (:func:`first_line_notes`).
+
 PARAM lines that override the defaults (front laser; ``rear`` for RLASER):
 ``laser_front_laser_resolution`` / ``laser_frontlaser_resolution`` (degrees),
 ``laser_front_laser_fov`` (degrees, or radians when <= 2*pi as in the CSAIL
@@ -35,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from albot1.data.loaders.beams import seam_note, seam_repeat
 from albot1.geometry.types import FloatArray
 
 #: SICK LMS 2xx maximum (8191 cm is its "no echo" code); used when a log states no maximum.
@@ -50,6 +55,46 @@ class BeamGeometry:
     step: float
     max_range: float
     source: str
+
+
+#: Beam counts of a 180-degree SICK LMS 2xx at 1 and 0.5 deg, which CARMEN's defaults describe. A FLASER line
+#: of another count without PARAM geometry gets the same 180-degree spread, but it is likely another scanner
+#: (a 270-degree Hokuyo's 1081 readings, a 360-degree scanner's 1440), so the loader warns.
+SICK_BEAM_COUNTS = (180, 181, 360, 361)
+
+
+def guessed_geometry_note(source: object, laser: str, beams: int) -> str:
+    """The warning for FLASER/RLASER lines whose beam count CARMEN's defaults do not describe (once per load)."""
+    which = "rear" if laser == "RLASER" else "front"
+    return (
+        f"{source}: {laser} lines of {beams} readings and no PARAM laser_{which}_laser_fov or "
+        f"laser_{which}_laser_resolution before them: their beams are taken to span -90..+90 deg (CARMEN's "
+        f"default, made for a 180-degree SICK LMS 2xx, which gives {', '.join(map(str, SICK_BEAM_COUNTS))} "
+        f"readings); a scanner with another field of view needs those PARAM lines (or ROBOTLASER1 lines)"
+    )
+
+
+def first_line_notes(
+    where: str, laser: str, beams: int, start: float | None, step: float | None, params: dict[str, str]
+) -> list[str]:
+    """The warnings the log's first laser line calls for: a FLASER/RLASER beam count CARMEN's defaults do not
+    describe, a 360-degree scan whose last beam repeats its first (:func:`seam_repeat`).
+
+    Said by the loader when it opens the log (from its head, :mod:`.probe`), not
+    while frames stream: decoded frames are cached (:mod:`albot1.data.decoded`)
+    and a cached read decodes nothing, so a warning logged while streaming
+    would be lost. ``start``/``step``: the line's own geometry (ROBOTLASER1,
+    RAWLASER), None for FLASER/RLASER, whose geometry comes from ``params``.
+    """
+    notes = []
+    if start is None or step is None:
+        geometry = param_geometry(beams, params, rear=laser == "RLASER")
+        start, step = geometry.start, geometry.step
+        if geometry.source.startswith("default") and beams not in SICK_BEAM_COUNTS:
+            notes.append(guessed_geometry_note(where, laser, beams))
+    if seam_repeat(beam_angles(beams, start, step)):
+        notes.append(seam_note(where, laser, beams))
+    return notes
 
 
 def default_geometry(beams: int) -> tuple[float, float]:

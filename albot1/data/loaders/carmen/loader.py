@@ -164,6 +164,14 @@ class CarmenLoader:
         )
         if noteworthy_skips(head):
             log.warning("%s: skipped: %s", path, metadata.extra["skipped_messages"])
+        if head.lasers:
+            first = head.lasers[0]
+            line = int(first.lines[0])
+            start = None if first.start is None else float(first.start[0])
+            step = None if first.step is None else float(first.step[0])
+            before = {name: value for at, name, value in head.params if at < line}
+            for note in geom.first_line_notes(f"{path}:{line}", laser, first.beams, start, step, before):
+                log.warning(note)
         relations = (
             read_relations(given.relations, repeats=given.relations_repeats) if given.relations is not None else None
         )

@@ -33,6 +33,7 @@ import numpy as np
 
 from albot1.data.errors import DataError, ParseError, TopicError
 from albot1.data.loaders.base import COMMON_OPTIONS
+from albot1.data.loaders.beams import seam_note
 from albot1.data.loaders.rosbag.bag1_check import version_problem
 from albot1.data.loaders.rosbag.mounting import bag_mounting
 from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, reading_problem, scan_arrays
@@ -59,6 +60,7 @@ class _BagSource:
 
     def __post_init__(self) -> None:
         self._tracks: tuple[PoseTrack, PoseTrack | None] | None = None
+        self._seam_said = False
 
     def tracks(self) -> tuple[PoseTrack, PoseTrack | None]:
         if self._tracks is None:
@@ -129,6 +131,9 @@ class _BagSource:
         if problem is not None:
             raise ParseError(self.shown, f"topic {self.choice.scan}: LaserScan {problem}", index=index)
         ranges, angles = scan_arrays(raw, *geometry)
+        if ranges.shape[0] < n and not self._seam_said:
+            self._seam_said = True
+            log.warning(seam_note(str(self.shown), f"topic {self.choice.scan} (message #{index})", n))
         return Scan(ranges=ranges, angles=angles, timestamp=t, max_range=geometry[3])
 
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from albot1.data.loaders.beams import seam_repeat
 from albot1.data.model import MAX_COORDINATE_M
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
@@ -169,15 +170,21 @@ def scan_arrays(
     Readings outside ``[range_min, range_max]``, inf and NaN all mean "no
     usable return" (REP-117) and become NaN. Angles are
     ``angle_min + i * angle_increment`` computed in float64 from the
-    message's float32 fields. A negative increment (a clockwise scanner, or
-    one mounted upside down) is reversed so angles ascend as the model
-    requires; ranges are reversed with them.
+    message's float32 fields. A 360-degree scan whose last beam repeats the
+    first's direction (``angle_max = angle_min + 2 pi``,
+    :func:`~albot1.data.loaders.beams.seam_repeat`) loses that last beam, so
+    the caller sees fewer ranges than the message holds and says so. A
+    negative increment (a clockwise scanner, or one mounted upside down) is
+    reversed so angles ascend as the model requires; ranges are reversed with
+    them.
     """
     r = np.asarray(ranges, dtype=np.float64).copy()
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(r) | (r < float(range_min)) | (r > float(range_max))
     r[bad] = np.nan
     angles = float(angle_min) + np.arange(r.shape[0], dtype=np.float64) * float(angle_increment)
+    if seam_repeat(angles):
+        r, angles = r[:-1], angles[:-1]
     if angle_increment < 0:
         return r[::-1].copy(), angles[::-1].copy()
     return r, angles

@@ -13,8 +13,10 @@ import pytest
 
 from albot1.data.loaders.carmen.loader import CarmenLoader
 
-FLASER = "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 {t} host {t}"
-RLASER = "RLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 {t} host {t}"
+# 181 readings: a SICK LMS 2xx's, so the only warning is what the tests are about (not the default geometry's)
+READINGS = " ".join(["2.0"] * 181)
+FLASER = f"FLASER 181 {READINGS} 0 0 0 0 0 0 {{t}} host {{t}}"
+RLASER = f"RLASER 181 {READINGS} 0 0 0 0 0 0 {{t}} host {{t}}"
 SONAR = "SONAR 3 1 2 3 {t} host {t}"
 NEFF = "NEFF 12.5 {t} host {t}"
 
