@@ -42,7 +42,11 @@ WARM_UP ?= 1
 $(STAMP): pyproject.toml
 	@case "$(INSTALLER)" in uv|pip) ;; *) echo "make venv: INSTALLER=$(INSTALLER): expected uv or pip" >&2; exit 2;; esac
 	@case "$(WARM_UP)" in 0|1) ;; *) echo "make venv: WARM_UP=$(WARM_UP): expected 1 (compile the kernels) or 0" >&2; exit 2;; esac
-	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	@# A venv whose creation was interrupted (no pip in it) is made again, not reused half-built.
+	if ! $(BIN)/python -m pip --version >/dev/null 2>&1; then \
+	  if [ -e $(VENV) ]; then echo "make venv: $(VENV) has no working python with pip (an interrupted creation?); making it again" >&2; fi; \
+	  rm -rf $(VENV) && $(PYTHON) -m venv $(VENV); \
+	fi
 	if [ "$(INSTALLER)" = uv ] && $(BIN)/python -m pip install --quiet 'uv==$(UV_VERSION)' \
 	    && $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[dev]'; then :; else \
 	  [ "$(INSTALLER)" = uv ] && echo "make venv: uv could not install the project; installing with pip" >&2; \
