@@ -214,7 +214,8 @@ def test_a_relations_option_replaces_the_catalogs_file_unread(tmp_path: Path, ca
         "tiny.clf": SHA,
         "own.relations": hashlib.sha256(own.read_bytes()).hexdigest(),
     }
-    assert caplog.text == ""
+    # Nothing said of relations (the 3-beam FLASER log's geometry warning comes from the CARMEN loader).
+    assert [r.getMessage() for r in caplog.records if r.name != "albot1.data.loaders.carmen.loader"] == []
     (tmp_path / "data" / "radish" / "tiny.relations").unlink()  # not even looked for
     assert open_sequence(f"tiny?relations={own}", settings=settings).relations is not None
 
