@@ -388,8 +388,12 @@ _LATEX_ESCAPES = {
 
 
 def _latex_escape(text: str) -> str:
-    """``text`` as LaTeX prints it literally (names of datasets, methods, degradations come from users)."""
-    return "".join(_LATEX_ESCAPES.get(ch, ch) for ch in str(text))
+    """``text`` as LaTeX prints it literally (names of datasets, methods, degradations come from users).
+
+    One line: a blank line inside a name was a ``\\par`` in a tabular cell or a caption, an error that
+    stopped the paper's build.
+    """
+    return "".join(_LATEX_ESCAPES.get(ch, ch) for ch in " ".join(str(text).split()))
 
 
 def latex(table: pd.DataFrame, columns: dict[str, Column], title: str, selected: str | None = None) -> str:
