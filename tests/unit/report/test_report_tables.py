@@ -313,3 +313,14 @@ def test_a_blank_line_in_a_name_is_no_paragraph_break_in_the_latex_table(tmp_pat
     tex = written["metrics.tex"].read_text()
     assert "\\caption{Accuracy per dataset, method and degradation: w x}" in tex
     assert "odo metry & none & " in tex
+
+
+def test_a_mean_over_fewer_seeds_than_the_row_counts_says_over_how_many_and_why_in_md_and_tex(tmp_path: Path) -> None:
+    """3 completed seeds, ATE n/a in one: the row read ``3 | 1.50 ± 0.71`` (a mean over 2) with no n/a note."""
+    records = [record("w", "odometry", "none", s, ate) for s, ate in ((0, 1.0), (1, 2.0), (2, None))]
+    written = write_tables(records, tmp_path)
+    md = written["metrics.md"].read_text()
+    assert "| odometry | none | 3 | 1.50 ± 0.71 (1.00–2.00), over 2 of 3 seeds | 0.500 | ok |" in md
+    assert "- n/a: ATE RMSE (m) — not computed in this test" in md
+    tex = written["metrics.tex"].read_text()
+    assert "odometry & none & 1.50 $\\pm$ 0.71 (1.00--2.00), over 2 of 3 seeds & 0.500 & ok \\\\" in tex
