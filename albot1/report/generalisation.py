@@ -31,7 +31,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from statistics import median
 from typing import Any
@@ -44,6 +44,7 @@ from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
 from albot1.metrics.paired import BLOCKS, CONFIDENCE, NOT_APPLICABLE, RESAMPLES, ZERO_ERROR, compare
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
+from albot1.report.markdown import text as md_text
 from albot1.report.provenance import regenerate_command
 from albot1.report.tuning import LEGEND, MARK, held_in, marked
 
@@ -192,7 +193,22 @@ def render_page(
     plan: GridPlan, rows: list[Comparison], failed: list[str] | None = None, *, regenerate: str | None = None
 ) -> str:
     """The Markdown page (see the module docstring); ``regenerate``: the commands that write it again
-    (:func:`albot1.report.provenance.regenerate_command`; None: those of the default folders)."""
+    (:func:`albot1.report.provenance.regenerate_command`; None: those of the default folders).
+
+    Names and reasons come from suite files and runs: they are written as text (:mod:`albot1.report.markdown`),
+    so a ``|`` in a method's name no longer splits its row and ``<b>`` is not HTML.
+    """
+    rows = [
+        replace(
+            r,
+            dataset=md_text(r.dataset),
+            method=md_text(r.method),
+            degradation=md_text(r.degradation),
+            reason=None if r.reason is None else md_text(r.reason),
+        )
+        for r in rows
+    ]
+    failed = None if failed is None else [md_text(f) for f in failed]
     pct = f"{CONFIDENCE:.0%}"
     lines = [
         "# Every method against the odometry it was given",

@@ -4,7 +4,10 @@ Dataset and method names, reasons, descriptions and paths come from files a
 user (or someone who sent them the results folder) wrote. Markdown passes raw
 HTML through, so such text is written as text: HTML-escaped (as ``index.html``
 does, :func:`html.escape`), table pipes and line breaks neutralised, and a
-code span delimited so that no backtick inside it can end it.
+code span delimited so that no backtick inside it can end it. Backslashes and
+the emphasis marks ``* _ ~`` are backslash-escaped too: a name ``a\\|b`` became
+``a\\\\|b`` (an escaped backslash, then a pipe that split the table cell), and
+``a*b*c`` was shown as "a", an italic "b", "c".
 """
 
 from __future__ import annotations
@@ -15,7 +18,10 @@ import re
 
 def text(value: object) -> str:
     """``value`` as Markdown text: no HTML, no table cell break, one line."""
-    escaped = html.escape(" ".join(str(value).split()), quote=True)
+    flat = " ".join(str(value).split()).replace("\\", "\\\\")
+    escaped = html.escape(flat, quote=True)
+    for mark in "*_~":
+        escaped = escaped.replace(mark, "\\" + mark)
     return escaped.replace("|", "\\|").replace("`", "&#96;").replace("[", "\\[").replace("]", "\\]")
 
 

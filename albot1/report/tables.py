@@ -234,13 +234,12 @@ def cell_text(row: pd.Series, column: str) -> str:
         if row["seeds"] == 0:
             return FAILED if row["failed"] else NOT_RUN
         return NOT_APPLICABLE
-    return stats_text(
-        float(mean),
-        float(row[f"{column}_std"]),
-        float(row[f"{column}_min"]),
-        float(row[f"{column}_max"]),
-        int(row[f"{column}_n"]),
+    n, seeds = int(row[f"{column}_n"]), int(row["seeds"])
+    text = stats_text(
+        float(mean), float(row[f"{column}_std"]), float(row[f"{column}_min"]), float(row[f"{column}_max"]), n
     )
+    # a mean over fewer seeds than the seeds column says (the metric is n/a in the others) must say so
+    return text if n >= seeds else f"{text}, over {n} of {seeds} seeds"
 
 
 def columns_present(group: pd.DataFrame, columns: dict[str, Column]) -> tuple[list[str], list[str]]:
@@ -297,7 +296,7 @@ def na_notes(group: pd.DataFrame, columns: dict[str, Column], present: list[str]
     grouped: dict[tuple[str, bool], list[str]] = {}
     for c in present:
         reasons = [str(r) for r in dict.fromkeys(group[f"{c}_na"].dropna())]
-        if reasons and (group[f"{c}_mean"].isna() & (group["seeds"] > 0)).any():
+        if reasons and (group[f"{c}_n"] < group["seeds"]).any():
             grouped.setdefault(("; ".join(reasons), False), []).append(columns[c].header)
     for c in absent:
         reasons = [str(r) for r in dict.fromkeys(group[f"{c}_na"].dropna())]
@@ -325,7 +324,8 @@ def markdown(
         f"# {title}",
         "",
         "Each number: mean ± sample std over the completed seeds, then (min–max); one number when there is one "
-        f"seed or all seeds agree. {SIGNIFICANT} significant digits. `n/a`: the metric does not apply to that run "
+        f"seed or all seeds agree; `over k of n seeds` when the metric does not apply to the others. "
+        f"{SIGNIFICANT} significant digits. `n/a`: the metric does not apply to that run "
         "(the reason is under the table); `failed`: no seed completed (the status column says why).",
         "",
         *([md_text(selected), ""] if selected else []),
@@ -388,8 +388,12 @@ _LATEX_ESCAPES = {
 
 
 def _latex_escape(text: str) -> str:
-    """``text`` as LaTeX prints it literally (names of datasets, methods, degradations come from users)."""
-    return "".join(_LATEX_ESCAPES.get(ch, ch) for ch in str(text))
+    """``text`` as LaTeX prints it literally (names of datasets, methods, degradations come from users).
+
+    One line: a blank line inside a name was a ``\\par`` in a tabular cell or a caption, an error that
+    stopped the paper's build.
+    """
+    return "".join(_LATEX_ESCAPES.get(ch, ch) for ch in " ".join(str(text).split()))
 
 
 def latex(table: pd.DataFrame, columns: dict[str, Column], title: str, selected: str | None = None) -> str:

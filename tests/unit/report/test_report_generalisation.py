@@ -56,6 +56,19 @@ def test_the_page_lists_where_a_method_is_worse_than_its_odometry_with_marks() -
     assert "Nowhere" in render_page(plan, rows[1:])
 
 
+def test_names_with_markdown_and_html_characters_are_written_as_text_on_every_line_of_the_page() -> None:
+    """A ``|`` in a method's name split its row into one more column; ``<b>`` was HTML; ``*x*`` italic."""
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    rows = [_row("a|b <b>*x*", 11.0, 9.0, 13.0, "worse", False)]
+    text = render_page(plan, rows, ["m|n on d<1> (none)"])
+    name = "a\\|b &lt;b&gt;\\*x\\*"
+    assert f"| {name} | fhw-corrected?odometry=laser-pose | none | 1 | 11.000 | 1.000 | 11 | 9–13 |" in text
+    assert f"| {name} | 1 | 0 | 0 | 0 | 1 | 11 | 11 (fhw-corrected?odometry=laser-pose, none) |" in text
+    assert f"| {name} | none | 1 | 11.000 | 1.000 | 11 [9–13] | worse |" in text
+    assert "Every seed failed (reasons: the report's README): m\\|n on d&lt;1&gt; (none)." in text
+    assert "<b>" not in text and "a|b" not in text
+
+
 def test_with_perfect_odometry_the_method_ate_is_shown_without_a_ratio() -> None:
     plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
     row = replace(_row("gtsam-graph", 0.0, 0.0, 0.0, PERFECT, False), ate_m=0.126, odometry_ate_m=0.0)

@@ -294,3 +294,33 @@ def test_write_tables_keeps_cost_out_of_the_accuracy_files(tmp_path: Path) -> No
 def test_a_huge_number_is_scientific_not_hundreds_of_digits(value: float, places: int, text: str) -> None:
     """A diverged run's 1e308 m filled a table cell with 309 digits."""
     assert fmt(value, places) == text
+
+
+def test_a_method_name_with_a_backslash_pipe_or_emphasis_marks_stays_one_literal_markdown_cell(
+    tmp_path: Path,
+) -> None:
+    """``a\\|b`` was written ``a\\\\|b``: an escaped backslash, then a pipe that split the row into one more cell;
+    ``*x*`` and ``_y_`` were shown in italics, ``~~z~~`` struck through."""
+    name = "a\\|b *x* _y_ ~~z~~"
+    written = write_tables([record("w", name, "none", 0, 1.0)], tmp_path)
+    row = next(line for line in written["metrics.md"].read_text().splitlines() if line.startswith("| a"))
+    assert row.startswith("| a\\\\\\|b \\*x\\* \\_y\\_ \\~\\~z\\~\\~ | none | 1 | ")
+
+
+def test_a_blank_line_in_a_name_is_no_paragraph_break_in_the_latex_table(tmp_path: Path) -> None:
+    """A ``\\par`` in a caption or a tabular cell stops LaTeX with an error."""
+    written = write_tables([record("w\n\nx", "odo\n\nmetry", "none", 0, 1.0)], tmp_path)
+    tex = written["metrics.tex"].read_text()
+    assert "\\caption{Accuracy per dataset, method and degradation: w x}" in tex
+    assert "odo metry & none & " in tex
+
+
+def test_a_mean_over_fewer_seeds_than_the_row_counts_says_over_how_many_and_why_in_md_and_tex(tmp_path: Path) -> None:
+    """3 completed seeds, ATE n/a in one: the row read ``3 | 1.50 ± 0.71`` (a mean over 2) with no n/a note."""
+    records = [record("w", "odometry", "none", s, ate) for s, ate in ((0, 1.0), (1, 2.0), (2, None))]
+    written = write_tables(records, tmp_path)
+    md = written["metrics.md"].read_text()
+    assert "| odometry | none | 3 | 1.50 ± 0.71 (1.00–2.00), over 2 of 3 seeds | 0.500 | ok |" in md
+    assert "- n/a: ATE RMSE (m) — not computed in this test" in md
+    tex = written["metrics.tex"].read_text()
+    assert "odometry & none & 1.50 $\\pm$ 0.71 (1.00--2.00), over 2 of 3 seeds & 0.500 & ok \\\\" in tex
