@@ -149,6 +149,11 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
     return out
 
 
+def _listing(lead: str, items: list[str]) -> list[str]:
+    """A paragraph ``lead: a; b; c.`` after a blank line, or nothing when ``items`` is empty."""
+    return ["", f"{lead}: " + "; ".join(items) + "."] if items else []
+
+
 def _num(value: float | None, digits: int = 3) -> str:
     return NA if value is None or not math.isfinite(value) else f"{value:.{digits}f}"
 
@@ -240,13 +245,10 @@ def render_page(
     else:
         lines.append(f"Nowhere at {pct} confidence.")
     above = [r for r in rows if r.verdict == "indistinguishable" and r.ratio > 1.0]
-    if above:
-        lines += [
-            "",
-            "Ratio above 1 but not significantly: "
-            + "; ".join(f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio)}" for r in above)
-            + ".",
-        ]
+    lines += _listing(
+        "Ratio above 1 but not significantly",
+        [f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio)}" for r in above],
+    )
     lines += [
         "",
         "## Per method",
@@ -266,13 +268,10 @@ def render_page(
             f"{_ratio(median(r.ratio for r in mine))} | {_ratio(top.ratio)} ({top.dataset}, {top.degradation}) |"
         )
     uncompared = [r for r in rows if r.verdict == NOT_APPLICABLE]
-    if uncompared:
-        lines += [
-            "",
-            "Not compared (no paired comparison applies): "
-            + "; ".join(f"{r.method} on {r.dataset} ({r.degradation}): {r.reason}" for r in uncompared)
-            + ".",
-        ]
+    lines += _listing(
+        "Not compared (no paired comparison applies)",
+        [f"{r.method} on {r.dataset} ({r.degradation}): {r.reason}" for r in uncompared],
+    )
     perfect = [r for r in rows if r.verdict == PERFECT]
     if perfect:
         # One column per dataset and perturbation: a perturbation of the set-up that leaves the odometry exact
