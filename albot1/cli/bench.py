@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from albot1.cli.interrupt import noting_interrupts
 from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import RESULTS_ROOT, get_settings
@@ -82,22 +83,26 @@ def bench(
     # The bar (cells done of the total, with an ETA) only on a terminal: piped output and CI logs stay clean.
     view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not (progress and enabled()))
     try:
-        plan, summary, store = run_suite(
-            suite,
-            results=results,
-            jobs=jobs,
-            executor=executor,
-            observer=view,
-            settings=get_settings(data_dir=data_dir),
-            preview=render_preview,
-            retry_failed=retry_failed,
-        )
+        with noting_interrupts() as ctrl_c:
+            plan, summary, store = run_suite(
+                suite,
+                results=results,
+                jobs=jobs,
+                executor=executor,
+                observer=view,
+                settings=get_settings(data_dir=data_dir),
+                preview=render_preview,
+                retry_failed=retry_failed,
+            )
+        interrupted = ctrl_c.received  # a KeyboardInterrupt lost in a finalizer still ends the command as Ctrl-C
     except KeyboardInterrupt:
-        # The cells got the same Ctrl-C and were recorded as interrupted; the store is consistent.
-        typer.echo("albot1: interrupted; completed cells are kept, run the same command again to resume", err=True)
-        raise typer.Exit(130) from None
+        interrupted = True
     finally:
         view.close()
+    if interrupted:
+        # The cells got the same Ctrl-C and were recorded as interrupted; the store is consistent.
+        typer.echo("albot1: interrupted; completed cells are kept, run the same command again to resume", err=True)
+        raise typer.Exit(130)
     for skipped in plan.skipped_datasets:
         typer.echo(
             f"skipped dataset {skipped.name}: {skipped.reason}"

@@ -279,7 +279,8 @@ def load_npz(entry: Path) -> dict[str, np.ndarray] | str | None:
     (:mod:`albot1.metrics.reference_map`): whatever a damaged zip raises is a reason to rebuild, never an error.
     """
     try:
-        with np.load(entry, allow_pickle=False) as npz:  # zip CRCs are checked as members are read
+        # Opened here, not by np.load: numpy leaves its own handle open when the zip does not parse.
+        with entry.open("rb") as handle, np.load(handle, allow_pickle=False) as npz:  # CRCs checked as members are read
             return {name: npz[name] for name in npz.files}
     except (FileNotFoundError, NotADirectoryError):
         return None

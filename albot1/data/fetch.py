@@ -137,6 +137,7 @@ def _receive(url: str, out: IO[bytes], dest: Path, limit: int, what: str, timeou
             _write(out, None, dest)
             content_type = headers.get_content_type() if headers and "Content-Type" in headers else ""
     except urllib.error.HTTPError as exc:
+        exc.close()  # the error holds the reply and its socket; left open, it is only freed (with a warning) by gc
         if 300 <= exc.code < 400:
             raise FetchError(
                 f"{url}: HTTP {exc.code}, a redirect loop or too many redirects; expected the dataset file"

@@ -116,5 +116,11 @@ def write_map(run_dir: Path, data: MapData) -> str:
     if data.segments is not None:
         return GEOJSON
     points = _stored_points(data)
-    atomic_write(run_dir / NPZ, lambda p: np.savez_compressed(p.open("wb"), points=points))
+    atomic_write(run_dir / NPZ, lambda p: _write_npz(p, points))
     return NPZ
+
+
+def _write_npz(path: Path, points: np.ndarray) -> None:
+    """``points`` into ``path``, closed here: before :func:`atomic_write` syncs and renames it, not by the collector."""
+    with path.open("wb") as handle:
+        np.savez_compressed(handle, points=points)

@@ -39,6 +39,7 @@ COORDS = st.floats(-1e6, 1e6, allow_nan=False)
 def _read_quietly(path: Path, fmt: str) -> object:
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # a numpy RuntimeWarning leaking is a failure
+        warnings.simplefilter("ignore", ResourceWarning)  # another test's garbage, freed here by chance
         return read_trajectory(path, fmt)
 
 
@@ -70,6 +71,7 @@ def test_the_relations_reader_returns_finite_relations_or_a_data_error(text: str
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error")
+                warnings.simplefilter("ignore", ResourceWarning)  # another test's garbage, freed here by chance
                 relations = read_relations(path)
         except DataError as exc:
             assert "\n" not in str(exc) and str(path) in str(exc)

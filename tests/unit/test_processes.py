@@ -51,6 +51,8 @@ def test_tree_memory_counts_the_process_and_its_children_and_kill_tree_stops_bot
     finally:
         proc.kill()
         proc.wait()
+        assert proc.stdout is not None
+        proc.stdout.close()  # left open, the collector frees it with a ResourceWarning during another test
 
 
 def test_kill_tree_of_a_process_that_is_gone_does_nothing() -> None:

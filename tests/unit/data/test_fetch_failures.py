@@ -14,6 +14,7 @@ import http.server
 import io
 import threading
 import time
+import urllib.error
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -61,6 +62,8 @@ class _Misbehaving(http.server.BaseHTTPRequestHandler):
             self.send_header("Location", self.path)
             self.send_header("Content-Length", "0")
             self.end_headers()
+        elif mode == "missing":
+            self._head(404, 0)
         elif mode == "empty":
             self._head(200, 0)
         elif mode == "silent":
@@ -138,6 +141,18 @@ def test_a_redirect_loop_is_one_line(base: str, tmp_path: Path) -> None:
     assert refusal(url, tmp_path / "dl" / "tiny.clf") == (
         f"{url}: HTTP 302, a redirect loop or too many redirects; expected the dataset file"
     )
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("path", ["loop", "missing"])
+def test_an_http_error_reply_is_closed_not_left_to_the_collector(base: str, tmp_path: Path, path: str) -> None:
+    # An HTTPError carries the server's reply and its socket. Left open, the socket is freed by the garbage collector
+    # with a ResourceWarning, which failed whichever later test happened to run the collection (CI, stop 38).
+    with pytest.raises(FetchError, match="HTTP") as refused:
+        fetch.download_verified(f"{base}/{path}/tiny.clf", tmp_path / "dl" / "tiny.clf", SHA, timeout=10.0)
+    reply = refused.value.__context__  # the refusal is raised `from None`: the HTTPError is kept as its context
+    assert isinstance(reply, urllib.error.HTTPError)
+    assert reply.closed
 
 
 @pytest.mark.timeout(30)

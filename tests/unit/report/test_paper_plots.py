@@ -142,6 +142,7 @@ def test_a_floor_note_naming_many_series_is_counted_and_does_not_collapse_the_la
         value_axis(ax, 0.0023, labels, "m")
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # matplotlib warns when constrained layout collapses an axes
+        warnings.simplefilter("ignore", ResourceWarning)  # another test's garbage, freed here by chance
         save(fig, tmp_path / "f.png")
     svg = (tmp_path / "f.svg").read_text()
     assert "(8 series)" in svg and "method-with-a-long-name-0" not in svg

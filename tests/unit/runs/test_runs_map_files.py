@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import gc
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -140,3 +142,14 @@ def test_segment_map_text_is_the_dictionary_dumped_non_finite_included(
 ) -> None:
     data = MapData(segments=segments, segment_properties=[{"n": float(i)} for i in range(len(segments))], points=points)
     assert map_text(data) == _reference_text(data)
+
+
+def test_the_point_map_file_is_closed_by_the_writer_not_left_to_the_collector(tmp_path: Path) -> None:
+    # The .npz was written through a handle nobody closed: flushed only when the interpreter freed it.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ResourceWarning)
+        assert write_map(tmp_path, MapData(points=np.array([[0.5, 1.5]]))) == "map.npz"
+        gc.collect()
+    assert [str(w.message) for w in caught if issubclass(w.category, ResourceWarning)] == []
+    with np.load(tmp_path / "map.npz") as npz:
+        assert npz["points"].tolist() == [[0.5, 1.5]]

@@ -1,0 +1,65 @@
+"""Ctrl-C whose KeyboardInterrupt a finalizer dropped still ends `albot1 bench` as interrupted (exit 130, one line).
+
+Seen once in the full suite under load: Ctrl-C during a cold compile killed the cell forkserver, the runner's
+KeyboardInterrupt never surfaced, the cell was recorded as "executor error: EOFError" and the command exited 1.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from albot1.cli.app import main
+from albot1.cli.interrupt import noting_interrupts
+
+INTERRUPTED = "albot1: interrupted; completed cells are kept, run the same command again to resume"
+
+
+class _CtrlCInAFinalizer:
+    """Gets Ctrl-C while it is being freed: Python raises the KeyboardInterrupt inside ``__del__``, which drops it."""
+
+    def __del__(self) -> None:
+        os.kill(os.getpid(), signal.SIGINT)
+        sum(range(1000))  # bytecode after the signal: where the KeyboardInterrupt is raised, and dropped
+
+
+def _run_suite_losing_ctrl_c(*args: Any, **kwargs: Any) -> tuple[None, None, None]:
+    _CtrlCInAFinalizer()  # freed at once
+    return None, None, None  # the grid "finished": the command must not go on to print a summary of it
+
+
+def test_a_ctrl_c_dropped_by_a_finalizer_ends_bench_as_interrupted(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import albot1.bench.runner
+
+    monkeypatch.setattr(albot1.bench.runner, "run_suite", _run_suite_losing_ctrl_c)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["albot1", "bench", "quick", "--results", "results", "--no-progress"])
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exited:
+        main()
+    out, err = capsys.readouterr()
+    assert (exited.value.code, out, err.splitlines()) == (130, "", [INTERRUPTED])
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
+
+
+def test_outside_the_command_ctrl_c_and_dropped_exceptions_behave_as_python_says(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    with noting_interrupts() as ctrl_c, pytest.raises(KeyboardInterrupt):
+        os.kill(os.getpid(), signal.SIGINT)
+        sum(range(1000))
+    assert ctrl_c.received
+    with noting_interrupts() as nothing:
+        pass
+    assert not nothing.received
+    hook = sys.unraisablehook
+    with noting_interrupts():
+        assert sys.unraisablehook is not hook
+    assert sys.unraisablehook is hook and signal.getsignal(signal.SIGINT) is signal.default_int_handler
