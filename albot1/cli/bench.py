@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from albot1.cli.interrupt import noting_interrupts
+from albot1.cli.interrupt import Interrupts, noting_interrupts
 from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import RESULTS_ROOT, get_settings
@@ -81,9 +81,15 @@ def bench(
         typer.echo(plan_table(plan))
         return
     # The bar (cells done of the total, with an ETA) only on a terminal: piped output and CI logs stay clean.
-    view = TqdmProgress(lambda line: tqdm.write(line, file=sys.stderr), disable=not (progress and enabled()))
+    # After Ctrl-C a cell may still end, killed by it (its forkserver died: "executor error"); that is the interrupt,
+    # not a failure to report above the "interrupted" line.
+    ctrl_c = Interrupts()
+    view = TqdmProgress(
+        lambda line: None if ctrl_c.received else tqdm.write(line, file=sys.stderr),
+        disable=not (progress and enabled()),
+    )
     try:
-        with noting_interrupts() as ctrl_c:
+        with noting_interrupts(ctrl_c):
             plan, summary, store = run_suite(
                 suite,
                 results=results,

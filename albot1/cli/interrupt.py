@@ -35,7 +35,7 @@ class Interrupts:
 
 
 @contextmanager
-def noting_interrupts() -> Iterator[Interrupts]:
+def noting_interrupts(noted: Interrupts | None = None) -> Iterator[Interrupts]:
     """SIGINT raises KeyboardInterrupt as usual and is also remembered; the previous handler is put back on exit.
 
     A KeyboardInterrupt that a finalizer dropped is not printed ("Exception
@@ -44,8 +44,10 @@ def noting_interrupts() -> Iterator[Interrupts]:
     Outside the main thread, or when SIGINT does not raise KeyboardInterrupt
     today (ignored, or another program's handler), nothing is changed and
     ``received`` stays False: the command then behaves as without this.
+    ``noted`` lets the caller hand the record to code made before the handler
+    (a progress view that stays quiet after Ctrl-C).
     """
-    noted = Interrupts()
+    noted = Interrupts() if noted is None else noted
     if threading.current_thread() is not threading.main_thread():
         yield noted
         return
