@@ -33,6 +33,7 @@ from albot1.report.collect import CellRecord, Column, as_of
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.external_notes import external_html
 from albot1.report.interactive_page import VIEWS_DIR, View, view_html, views_scripts
+from albot1.report.number_text import EXAMPLE, SEEDS_LEGEND
 from albot1.report.paired_tables import PairedRow, html_table
 from albot1.report.plots import vector_of
 from albot1.report.provenance import data_by_dataset, describe_data, rerun_command
@@ -274,7 +275,7 @@ def write_html(
         f"libraries: {_e(libraries)}</li>",
         "</ul>",
         '<h2 id="tables">Tables</h2>',
-        "<p>Each number: mean ± sample std over the completed seeds, then (min–max). "
+        f"<p>Each number: {_e(SEEDS_LEGEND)}, e.g. <code>{_e(EXAMPLE)}</code> for seeds of 1, 2 and 10. "
         "Files: "
         + ", ".join(f'<a href="{_e(rel(p, out))}">{_e(name)}</a>' for name, p in tables.items())
         + ". Cost was measured with the suite's parallelism on a possibly shared machine: compare it within "

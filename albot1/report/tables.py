@@ -1,10 +1,12 @@
 """Tables per dataset x method x degradation, aggregated over seeds: CSV for tools, Markdown and LaTeX for people.
 
 Across seeds each number is the mean +/- the sample standard deviation
-(ddof = 1) with the range (min-max) in brackets, the rpg_trajectory_evaluation
-convention: a mean alone hides one bad seed. All numbers of a table are
-given to :data:`SIGNIFICANT` significant digits, the std and the range with
-the decimals of their mean, so a column reads evenly.
+(ddof = 1), then the median, then the range (min-max) in brackets, the
+rpg_trajectory_evaluation convention plus the project's standard (means as
+well as medians): a mean alone hides one bad seed, and the median shows
+whether it is one seed or all. All numbers of a table are given to
+:data:`SIGNIFICANT` significant digits, the std, median and range with the
+decimals of their mean, so a column reads evenly.
 
 Every planned group is a row, also when no seed completed: its cells say
 ``failed`` and its status column gives the reason (``failed (timeout:
@@ -44,6 +46,7 @@ from albot1.report.collect import (
 )
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.markdown import text as md_text
+from albot1.report.number_text import EXAMPLE, SEEDS_LEGEND, SIGNIFICANT, stats_text
 from albot1.report.paired_tables import PairedRow, intro, markdown_lines, no_pairs, paired_rows, write_paired_csv
 from albot1.report.provenance import data_by_dataset, describe_data
 from albot1.report.tuning import LEGEND, held_in, marked
@@ -52,7 +55,6 @@ if TYPE_CHECKING:
     import pandas as pd
 
 STATS = ("mean", "std", "median", "min", "max")
-SIGNIFICANT = 3
 NOT_APPLICABLE = "n/a"
 FAILED = "failed"
 NOT_RUN = "not run"
@@ -197,36 +199,6 @@ def _short(text: str) -> str:
     return flat if len(flat) <= REASON_CHARS else flat[: REASON_CHARS - 1] + "…"
 
 
-def decimals(value: float, significant: int = SIGNIFICANT) -> int | None:
-    """Decimals that show ``value`` to ``significant`` digits; None: use scientific notation (below 1e-3)."""
-    magnitude = abs(float(f"{value:.{significant - 1}e}"))  # as rounded: 9.9996 shows as 10.0, not 10.00
-    if magnitude == 0:
-        return significant - 1
-    if magnitude < 1e-3:
-        return None
-    return max(0, significant - 1 - math.floor(math.log10(magnitude)))
-
-
-#: From this magnitude on a number is shown in scientific notation whatever its decimals: a diverged run's
-#: 1e308 m would otherwise fill a table cell with 309 digits.
-LARGE = 1e6
-
-
-def fmt(value: float, places: int | None) -> str:
-    """``value`` with ``places`` decimals (None, or a magnitude of :data:`LARGE` or more: scientific)."""
-    if places is None or abs(value) >= LARGE:
-        return f"{value:.{SIGNIFICANT - 1}e}"
-    return f"{value:.{places}f}"
-
-
-def stats_text(mean: float, std: float, low: float, high: float, n: int) -> str:
-    """``mean`` for one seed; ``mean ± std (min–max)`` for several, all with the decimals of the mean."""
-    places = decimals(mean)
-    if n <= 1 or low == high:
-        return fmt(mean, places)
-    return f"{fmt(mean, places)} ± {fmt(std, places)} ({fmt(low, places)}–{fmt(high, places)})"
-
-
 def cell_text(row: pd.Series, column: str) -> str:
     """The table text of ``column`` in aggregated ``row``: numbers, ``n/a``, ``failed`` or ``not run``."""
     mean = row[f"{column}_mean"]
@@ -235,9 +207,8 @@ def cell_text(row: pd.Series, column: str) -> str:
             return FAILED if row["failed"] else NOT_RUN
         return NOT_APPLICABLE
     n, seeds = int(row[f"{column}_n"]), int(row["seeds"])
-    text = stats_text(
-        float(mean), float(row[f"{column}_std"]), float(row[f"{column}_min"]), float(row[f"{column}_max"]), n
-    )
+    stat = {name: float(row[f"{column}_{name}"]) for name in STATS}
+    text = stats_text(stat["mean"], stat["std"], stat["median"], stat["min"], stat["max"], n)
     # a mean over fewer seeds than the seeds column says (the metric is n/a in the others) must say so
     return text if n >= seeds else f"{text}, over {n} of {seeds} seeds"
 
@@ -323,7 +294,7 @@ def markdown(
     lines = [
         f"# {title}",
         "",
-        "Each number: mean ± sample std over the completed seeds, then (min–max); one number when there is one "
+        f"Each number: {SEEDS_LEGEND}, e.g. `{EXAMPLE}` for seeds of 1, 2 and 10; one number when there is one "
         f"seed or all seeds agree; `over k of n seeds` when the metric does not apply to the others. "
         f"{SIGNIFICANT} significant digits. `n/a`: the metric does not apply to that run "
         "(the reason is under the table); `failed`: no seed completed (the status column says why).",
@@ -402,7 +373,7 @@ def latex(table: pd.DataFrame, columns: dict[str, Column], title: str, selected:
     ``columns`` and ``selected`` as for :func:`markdown` (the note becomes a comment line).
     """
     lines = [
-        f"% {title}: mean $\\pm$ sample std over seeds (min--max); {SIGNIFICANT} significant digits.",
+        f"% {title}: mean $\\pm$ sample std over seeds, median (min--max); {SIGNIFICANT} significant digits.",
         "% Needs \\usepackage{booktabs}. n/a: the metric does not apply (see the Markdown table for the reason).",
         *([f"% {' '.join(selected.split())}"] if selected else []),
         "",

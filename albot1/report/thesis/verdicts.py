@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Final, Literal
 
 from albot1.metrics.paired import BETTER, CONFIDENCE, Comparison
-from albot1.report.tables import decimals, fmt
+from albot1.report.number_text import decimals, fmt
 
 HOLDS: Final = "holds"
 FAILS: Final = "does not hold"

@@ -108,6 +108,14 @@ def test_the_readme_links_the_page_and_every_table_format(report: Path) -> None:
 
 
 @pytest.mark.slow
+def test_the_page_says_how_a_number_over_seeds_reads_with_the_formatters_own_example(report: Path) -> None:
+    """The legend above the tables names the median and shows a cell as the tables write it."""
+    page = (report / "index.html").read_text(encoding="utf-8")
+    legend = "Each number: mean ± sample std over the completed seeds, their median, then (min–max), e.g. "
+    assert legend + "<code>4.33 ± 4.93, median 2.00 (1.00–10.00)</code> for seeds of 1, 2 and 10. " in page
+
+
+@pytest.mark.slow
 @pytest.mark.skipif(headless_chromium.browser() is None, reason=headless_chromium.NO_BROWSER)
 def test_a_headless_browser_renders_the_page_with_its_tables(report: Path, tmp_path: Path) -> None:
     browser = headless_chromium.browser()

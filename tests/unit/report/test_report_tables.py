@@ -16,16 +16,16 @@ from albot1.metrics.registry import metric_registry
 from albot1.metrics.updates import update_counts
 from albot1.records import ResultRecord, check_number_path, parse_record
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, SOURCE_MODELS, CellRecord, Column
+from albot1.report.html import table_html
 from albot1.report.markdown import text as md_text
+from albot1.report.number_text import fmt, stats_text
 from albot1.report.tables import (
     Aggregates,
     aggregate,
     cell_text,
     cells_frame,
-    fmt,
     markdown,
     pick,
-    stats_text,
     write_tables,
 )
 
@@ -155,7 +155,7 @@ def test_aggregate_over_seeds_mean_std_median_min_max() -> None:
     stats = [swept[f"ate_rmse_m_{s}"] for s in ("mean", "median", "min", "max")]
     assert stats == [3.0, 2.0, 1.0, 6.0]
     assert swept["ate_rmse_m_std"] == pytest.approx(np.std([1.0, 2.0, 6.0], ddof=1))  # the sample std over seeds
-    assert cell_text(swept, "ate_rmse_m") == "3.00 ± 2.65 (1.00–6.00)"
+    assert cell_text(swept, "ate_rmse_m") == "3.00 ± 2.65, median 2.00 (1.00–6.00)"
     single = table.iloc[0]
     assert (single["seeds"], single["planned"], single["failed"]) == (1, 2, 1)  # the failed seed is not averaged in
     assert single["status"] == "1 of 2 failed (exception: RuntimeError: boom)"
@@ -204,20 +204,43 @@ def test_a_picked_aggregate_is_the_aggregate_of_the_picked_columns(keys: list[st
 
 
 @pytest.mark.parametrize(
-    ("mean", "std", "low", "high", "n", "text"),
+    ("mean", "std", "median", "low", "high", "n", "text"),
     [
-        (0.0456, 0.0012, 0.0441, 0.0467, 3, "0.0456 ± 0.0012 (0.0441–0.0467)"),
-        (36.14, 4.21, 31.5, 40.2, 3, "36.1 ± 4.2 (31.5–40.2)"),
-        (1234.5, 10.0, 1220.0, 1250.0, 2, "1234 ± 10 (1220–1250)"),  # >= 3 digits before the point: no decimals
-        (9.9996, 0.0, 9.9996, 9.9996, 3, "10.0"),  # rounded first: 10.0, not 10.00; equal seeds: one number
-        (2.5e-10, 1e-10, 1e-10, 4e-10, 3, "2.50e-10 ± 1.00e-10 (1.00e-10–4.00e-10)"),  # perfect odometry
-        (0.0, 0.0, 0.0, 0.0, 1, "0.00"),
+        (0.0456, 0.0012, 0.0459, 0.0441, 0.0467, 3, "0.0456 ± 0.0012, median 0.0459 (0.0441–0.0467)"),
+        (36.14, 4.21, 36.7, 31.5, 40.2, 3, "36.1 ± 4.2, median 36.7 (31.5–40.2)"),
+        # >= 3 digits before the point: no decimals
+        (1234.5, 10.0, 1234.5, 1220.0, 1250.0, 2, "1234 ± 10, median 1234 (1220–1250)"),
+        (9.9996, 0.0, 9.9996, 9.9996, 9.9996, 3, "10.0"),  # rounded first: 10.0, not 10.00; equal seeds: one number
+        # perfect odometry
+        (2.5e-10, 1e-10, 2e-10, 1e-10, 4e-10, 3, "2.50e-10 ± 1.00e-10, median 2.00e-10 (1.00e-10–4.00e-10)"),
+        (0.0, 0.0, 0.0, 0.0, 0.0, 1, "0.00"),
     ],
 )
 def test_numbers_have_three_significant_digits_and_the_spread_the_decimals_of_the_mean(
-    mean: float, std: float, low: float, high: float, n: int, text: str
+    mean: float, std: float, median: float, low: float, high: float, n: int, text: str
 ) -> None:
-    assert stats_text(mean, std, low, high, n) == text
+    assert stats_text(mean, std, median, low, high, n) == text
+
+
+def test_a_cell_over_seeds_shows_the_median_beside_the_mean_in_md_tex_and_html(tmp_path: Path) -> None:
+    """Seeds of 1, 2 and 10 m: the mean (4.33) says little of the typical seed, the median (2.00) does.
+
+    The standard asks for means as well as medians; the median was computed but reached only the CSV.
+    """
+    records = [record("w", "odometry", "none", s, ate) for s, ate in ((0, 1.0), (1, 2.0), (2, 10.0))]
+    written = write_tables(records, tmp_path)
+    md = written["metrics.md"].read_text()
+    assert "| odometry | none | 3 | 4.33 ± 4.93, median 2.00 (1.00–10.00) | 0.500 | ok |" in md
+    assert "Each number: mean ± sample std over the completed seeds, their median, then (min–max), e.g. " in md
+    assert "`4.33 ± 4.93, median 2.00 (1.00–10.00)` for seeds of 1, 2 and 10; one number when" in md
+    tex = written["metrics.tex"].read_text()
+    assert "odometry & none & 4.33 $\\pm$ 4.93, median 2.00 (1.00--10.00) & 0.500 & ok \\\\" in tex
+    assert "mean $\\pm$ sample std over seeds, median (min--max); 3 significant digits." in tex
+    csv = written["metrics.csv"].read_text().splitlines()
+    header, row = csv[0].split(","), csv[1].split(",")
+    assert row[header.index("ate_rmse_m_median")] == "2"
+    html = table_html(aggregate(cells_frame(records), METRIC_COLUMNS), METRIC_COLUMNS, {})
+    assert '<td class="num" data-v="4.33333333333">4.33 ± 4.93, median 2.00 (1.00–10.00)</td>' in html
 
 
 def test_a_group_whose_seeds_all_failed_is_a_row_marked_failed_with_the_reason() -> None:
@@ -257,7 +280,7 @@ def test_latex_tables_are_booktabs_with_escaped_labels(tmp_path: Path) -> None:
         and "\\bottomrule" in tex
         and "\\caption{Accuracy per dataset, method and degradation: w\\_1}" in tex
     )
-    assert "odometry & gauss:0.1:1 & 1.50 $\\pm$ 0.71 (1.00--2.00)" in tex
+    assert "odometry & gauss:0.1:1 & 1.50 $\\pm$ 0.71, median 1.50 (1.00--2.00)" in tex
 
 
 def test_latex_escapes_every_character_tex_or_ot1_would_misprint(tmp_path: Path) -> None:
@@ -320,7 +343,7 @@ def test_a_mean_over_fewer_seeds_than_the_row_counts_says_over_how_many_and_why_
     records = [record("w", "odometry", "none", s, ate) for s, ate in ((0, 1.0), (1, 2.0), (2, None))]
     written = write_tables(records, tmp_path)
     md = written["metrics.md"].read_text()
-    assert "| odometry | none | 3 | 1.50 ± 0.71 (1.00–2.00), over 2 of 3 seeds | 0.500 | ok |" in md
+    assert "| odometry | none | 3 | 1.50 ± 0.71, median 1.50 (1.00–2.00), over 2 of 3 seeds | 0.500 | ok |" in md
     assert "- n/a: ATE RMSE (m) — not computed in this test" in md
     tex = written["metrics.tex"].read_text()
-    assert "odometry & none & 1.50 $\\pm$ 0.71 (1.00--2.00), over 2 of 3 seeds & 0.500 & ok \\\\" in tex
+    assert "odometry & none & 1.50 $\\pm$ 0.71, median 1.50 (1.00--2.00), over 2 of 3 seeds & 0.500 & ok \\\\" in tex
