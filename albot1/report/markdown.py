@@ -19,7 +19,9 @@ import re
 def text(value: object) -> str:
     """``value`` as Markdown text: no HTML, no table cell break, one line."""
     flat = " ".join(str(value).split()).replace("\\", "\\\\")
-    escaped = html.escape(flat, quote=True)
+    # Quotes stay as written ("odometry's", not "odometry&#x27;s" in the raw page): with < and > escaped no HTML
+    # element, hence no attribute a quote could end, can start in the text.
+    escaped = html.escape(flat, quote=False)
     for mark in "*_~":
         escaped = escaped.replace(mark, "\\" + mark)
     return escaped.replace("|", "\\|").replace("`", "&#96;").replace("[", "\\[").replace("]", "\\]")

@@ -243,8 +243,8 @@ def render_page(data: ResultsData) -> str:
         *standard_table(data),
         "",
         *(line for text in _other_store_lines(data) for line in (text, "")),
-        "Every measured row (`reports/default/standard-benchmark.md` adds maxima, loop relations and CPU time for "
-        "the default suite's methods):",
+        "Every measured row (`reports/default/standard-benchmark.md` adds medians, maxima, loop relations and CPU "
+        "time for the default suite's methods):",
         "",
         *_detail_lines(data),
         "",

@@ -31,10 +31,10 @@ from albot1.methods.baselines.published import published_systems
 from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.metrics.paired import CONFIDENCE, method_text
 from albot1.report.collect import CellRecord
-from albot1.report.comparisons import Cell, Errors, all_pairs, matrix_lines, relation_errors_of
 from albot1.report.limits import known_limit_of
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import data_lines, regenerate_command
+from albot1.report.standard_paired import PAIRED_TABLE, Paired, compare_by_log, paired_csv, paired_lines
 from albot1.report.tuning import LEGEND, held_in, marked
 
 #: The five logs of the standard benchmark, with the names the published tables use.
@@ -47,7 +47,6 @@ STANDARD_LOGS: dict[str, str] = {
 }
 PAGE = "standard-benchmark.md"
 TABLE = "standard-benchmark.csv"
-PAIRED_TABLE = "standard-benchmark-paired.csv"
 NA = "n/a"
 
 
@@ -61,10 +60,14 @@ class Row:
     status: str = "done"  # done | failed | not measured
     translation_mean_m: float | None = None
     translation_std_m: float | None = None
+    #: the relation errors are heavy-tailed (a few wrong loop closures make the mean): the median says how typical
+    #: relations fare; published tables give mean ± std only, so their rows have none
+    translation_median_m: float | None = None
     translation_max_m: float | None = None
     relations: int | None = None
     rotation_mean_deg: float | None = None
     rotation_std_deg: float | None = None
+    rotation_median_deg: float | None = None
     rotation_max_deg: float | None = None
     loop_translation_mean_m: float | None = None
     loop_translation_std_m: float | None = None
@@ -174,10 +177,12 @@ def _measured(rec: CellRecord) -> Row:
         method,
         translation_mean_m=t.mean,
         translation_std_m=t.std,
+        translation_median_m=t.median,
         translation_max_m=t.max,
         relations=t.n,
         rotation_mean_deg=r.mean,
         rotation_std_deg=r.std,
+        rotation_median_deg=r.median,
         rotation_max_deg=r.max,
         loop_translation_mean_m=loops.translation_m.mean,
         loop_translation_std_m=loops.translation_m.std,
@@ -196,47 +201,9 @@ def _measured(rec: CellRecord) -> Row:
     )
 
 
-@dataclass(frozen=True)
-class Paired:
-    """One log's paired comparisons: every two measured methods on the same relations (translation, rotation)."""
-
-    labels: list[str]
-    found: dict[tuple[str, str], Cell]
-    #: method -> why its run is not compared (its relation errors cannot be read back)
-    left_out: dict[str, str]
-
-
 def paired_by_log(records: list[CellRecord]) -> dict[str, Paired]:
     """Per standard log, the measured runs of the page (first whole-log cell per method) compared pairwise."""
-    first: dict[str, dict[str, CellRecord]] = {}
-    for rec in records:
-        if _full_log_cell(rec):
-            first.setdefault(rec.cell.dataset_label, {}).setdefault(rec.cell.method_label, rec)
-    out: dict[str, Paired] = {}
-    for log, by_method in first.items():
-        errors: dict[str, Errors] = {m: relation_errors_of(r) for m, r in by_method.items() if r.status == "done"}
-        labels = [m for m, e in errors.items() if e.missing is None]
-        left_out = {m: str(e.missing) for m, e in errors.items() if e.missing is not None}
-        found = all_pairs(labels, errors, ("relation translation", "relation rotation"))
-        out[log] = Paired(labels, found, left_out)
-    return out
-
-
-def _paired_lines(paired: Paired | None) -> list[str]:
-    if paired is None or len(paired.labels) + len(paired.left_out) < 2:
-        return []
-    lines = ["Paired comparison (row against column, the same relations; translation / rotation):", ""]
-    if len(paired.labels) >= 2:
-        lines += [*matrix_lines(paired.labels, paired.found, "row vs column"), ""]
-    lines += [f"- {m}: not compared: {why}" for m, why in paired.left_out.items()]
-    why: dict[str, list[str]] = {}  # each n/a reason once, with the comparisons it applies to
-    for i, a in enumerate(paired.labels):
-        for b in paired.labels[i + 1 :]:
-            for kind, found in zip(("translation", "rotation"), paired.found[(a, b)], strict=True):
-                if not found.applies:
-                    why.setdefault(str(found.reason), []).append(f"{a} vs {b} ({kind})")
-    lines += [f"- `–` {reason}: {'; '.join(where)}" for reason, where in why.items()]
-    return [*lines, ""] if paired.left_out or why else lines
+    return compare_by_log(records, _full_log_cell)
 
 
 def published_rows(durations: dict[str, float] | None = None) -> list[Row]:
@@ -284,14 +251,16 @@ def _pm(mean: float | None, std: float | None, digits: int) -> str:
 
 def _cell(row: Row) -> list[str]:
     if row.status != "done":
-        return [marked(row.method, row.held_in), row.kind, f"**{row.status}**: {row.note}", *[""] * 8]
+        return [marked(row.method, row.held_in), row.kind, f"**{row.status}**: {row.note}", *[""] * 10]
     return [
         marked(row.method, row.held_in),
         f"**{row.kind}**" if row.kind == "published" else row.kind,
         _pm(row.translation_mean_m, row.translation_std_m, 4),
+        _num(row.translation_median_m, 4),
         _num(row.translation_max_m, 3),
         NA if row.relations is None else str(row.relations),
         _pm(row.rotation_mean_deg, row.rotation_std_deg, 3),
+        _num(row.rotation_median_deg, 3),
         _num(row.rotation_max_deg, 2),
         _pm(row.loop_translation_mean_m, row.loop_translation_std_m, 4)
         + ("" if row.loop_rotation_mean_deg is None else f", {_num(row.loop_rotation_mean_deg, 3)}°")
@@ -305,7 +274,8 @@ def _cell(row: Row) -> list[str]:
 
 
 _HEAD = (
-    "| method | row | translation (m), mean ± std | max (m) | N | rotation (deg), mean ± std | max (deg) "
+    "| method | row | translation (m), mean ± std | median (m) | max (m) | N | rotation (deg), mean ± std "
+    "| median (deg) | max (deg) "
     "| loop relations (> 30 s): translation (m), rotation | wall time (s) | CPU time (s) "
     "| log duration / time: wall / CPU |"
 )
@@ -344,8 +314,9 @@ def render_page(
         "",
         "Relation metric of Kuemmerle et al. (2009): for every ground-truth relation `(t1, t2, d*)` the error of "
         "the method's relative pose `inv(T(t1)) * T(t2)`, translational (m) and rotational (deg), mean ± sample "
-        "std, max and N over all relations of the log; *loop relations* are those whose two scans are more than "
-        "30 s apart. Every method runs on the **whole raw log with its own odometry** (no prefix, no "
+        "std, median, max and N over all relations of the log (the published tables give mean ± std only: their "
+        "median is n/a); *loop relations* are those whose two scans are more than 30 s apart. Every method runs "
+        "on the **whole raw log with its own odometry** (no prefix, no "
         "degradation). Measured rows come from this results folder; rows marked **published** are figures "
         "printed in the cited papers, read from `albot1/methods/baselines/published.toml`, never measured here.",
         "",
@@ -408,13 +379,13 @@ def render_page(
             lines += [f"Not measured: {skipped[log]}", ""]
         elif not any(r.kind == "measured" for r in log_rows):
             lines += ["Not measured: the suite has no cell on the whole log with its own odometry.", ""]
-        lines += [_HEAD, "|" + "---|" * 11]
+        lines += [_HEAD, "|" + "---|" * 13]
         lines += ["| " + " | ".join(_cell(r)) + " |" for r in log_rows]
         sources = [f"- {r.method}: {r.source}" + (f" ({r.note})" if r.note else "") for r in log_rows if r.source]
         limits = [f"- {r.method} ({r.status}), known limit from its preset file: {r.limit}" for r in log_rows]
         limits = [line for line, r in zip(limits, log_rows, strict=True) if r.limit]
         lines += ["", *sources, *limits, ""]
-        lines += _paired_lines((paired or {}).get(log))
+        lines += paired_lines((paired or {}).get(log))
     lines += [
         "## Reading the figures",
         "",
@@ -468,22 +439,8 @@ def write_standard(
         text = text.rstrip("\n") + "\n\n## Data\n\n" + "".join(f"- {md_text(line)}\n" for line in data)
     atomic_write(page, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     atomic_write(table, lambda tmp: tmp.write_text(_csv(rows), encoding="utf-8"))
-    atomic_write(out / PAIRED_TABLE, lambda tmp: tmp.write_text(_paired_csv(paired), encoding="utf-8"))
+    atomic_write(out / PAIRED_TABLE, lambda tmp: tmp.write_text(paired_csv(paired), encoding="utf-8"))
     return page, table
-
-
-def _paired_csv(paired: dict[str, Paired]) -> str:
-    """Each unordered pair of measured methods per log once (row before column in the page's order)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(["log", "method", "against", "error", "relations", "ratio", "low", "high", "verdict", "reason"])
-    for log, entry in paired.items():
-        for i, a in enumerate(entry.labels):
-            for b in entry.labels[i + 1 :]:
-                for kind, c in zip(("translation", "rotation"), entry.found[(a, b)], strict=True):
-                    numbers = ["" if math.isnan(v) else f"{v:.9g}" for v in (c.ratio, c.low, c.high)]
-                    writer.writerow([log, a, b, kind, c.pairs, *numbers, c.verdict, c.reason or ""])
-    return buffer.getvalue()
 
 
 def _csv(rows: list[Row]) -> str:

@@ -42,7 +42,8 @@ def test_each_dataset_names_its_short_checksums() -> None:
 
 
 def test_markdown_text_and_code_never_carry_html_or_break_out() -> None:
-    assert text('<script>alert("x")</script> | a\nb') == ("&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt; \\| a b")
+    assert text('<script>alert("x")</script> | a\nb') == ('&lt;script&gt;alert("x")&lt;/script&gt; \\| a b')
+    assert text("the odometry's prediction") == "the odometry's prediction"  # not &#x27;: no element can start
     assert text("[link](javascript:x) `c`") == "\\[link\\](javascript:x) &#96;c&#96;"
     assert code("a`b") == "``a`b``"
     assert code("`x") == "`` `x ``"

@@ -122,8 +122,9 @@ def test_the_page_and_csv_keep_measured_and_published_rows_apart(tmp_path: Path)
     assert "Test CPU 3.0 GHz, 2 logical CPUs (1 physical)" in text
     assert "Intel Xeon E5-1650" in text
     assert "Not measured: not found under the data roots (`albot1 datasets fetch fr-clinic`)" in text
-    assert "| odometry | measured | 0.3167 ± 0.4193 |" in text
-    assert "| Cartographer (Hess et al. 2016) | **published** | 0.0375 ± 0.0426 |" in text
+    # errors 0.05, 0.1 and 0.8 m: mean ± std, then the median (the typical relation), max, N; rotation 0
+    assert "| odometry | measured | 0.3167 ± 0.4193 | 0.1000 | 0.800 | 3 | 0.000 ± 0.000 | 0.000 | 0.00 |" in text
+    assert "| Cartographer (Hess et al. 2016) | **published** | 0.0375 ± 0.0426 | n/a | n/a | n/a |" in text
     with table.open() as f:
         rows = list(csv.DictReader(f))
     kinds = {(r["log"], r["kind"]) for r in rows}

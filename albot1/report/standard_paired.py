@@ -1,0 +1,76 @@
+"""The standard-benchmark page's paired comparisons: every two measured methods of a log on the same relations.
+
+Kept apart from :mod:`albot1.report.standard` (the page and its rows) so that each stays a module one can
+read whole; the page calls :func:`compare_by_log` with its own rule of which cell is a whole-log run.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from albot1.report.collect import CellRecord
+from albot1.report.comparisons import Cell, Errors, all_pairs, matrix_lines, relation_errors_of
+
+PAIRED_TABLE = "standard-benchmark-paired.csv"
+
+
+@dataclass(frozen=True)
+class Paired:
+    """One log's paired comparisons: every two measured methods on the same relations (translation, rotation)."""
+
+    labels: list[str]
+    found: dict[tuple[str, str], Cell]
+    #: method -> why its run is not compared (its relation errors cannot be read back)
+    left_out: dict[str, str]
+
+
+def compare_by_log(records: list[CellRecord], whole_log: Callable[[CellRecord], bool]) -> dict[str, Paired]:
+    """Per log, the first ``whole_log`` cell of each method, compared pairwise with the others on the same relations."""
+    first: dict[str, dict[str, CellRecord]] = {}
+    for rec in records:
+        if whole_log(rec):
+            first.setdefault(rec.cell.dataset_label, {}).setdefault(rec.cell.method_label, rec)
+    out: dict[str, Paired] = {}
+    for log, by_method in first.items():
+        errors: dict[str, Errors] = {m: relation_errors_of(r) for m, r in by_method.items() if r.status == "done"}
+        labels = [m for m, e in errors.items() if e.missing is None]
+        left_out = {m: str(e.missing) for m, e in errors.items() if e.missing is not None}
+        found = all_pairs(labels, errors, ("relation translation", "relation rotation"))
+        out[log] = Paired(labels, found, left_out)
+    return out
+
+
+def paired_lines(paired: Paired | None) -> list[str]:
+    """The page's lines under one log: the matrix, the methods left out and each n/a reason once."""
+    if paired is None or len(paired.labels) + len(paired.left_out) < 2:
+        return []
+    lines = ["Paired comparison (row against column, the same relations; translation / rotation):", ""]
+    if len(paired.labels) >= 2:
+        lines += [*matrix_lines(paired.labels, paired.found, "row vs column"), ""]
+    lines += [f"- {m}: not compared: {why}" for m, why in paired.left_out.items()]
+    why: dict[str, list[str]] = {}  # each n/a reason once, with the comparisons it applies to
+    for i, a in enumerate(paired.labels):
+        for b in paired.labels[i + 1 :]:
+            for kind, found in zip(("translation", "rotation"), paired.found[(a, b)], strict=True):
+                if not found.applies:
+                    why.setdefault(str(found.reason), []).append(f"{a} vs {b} ({kind})")
+    lines += [f"- `–` {reason}: {'; '.join(where)}" for reason, where in why.items()]
+    return [*lines, ""] if paired.left_out or why else lines
+
+
+def paired_csv(paired: dict[str, Paired]) -> str:
+    """Each unordered pair of measured methods per log once (row before column in the page's order)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["log", "method", "against", "error", "relations", "ratio", "low", "high", "verdict", "reason"])
+    for log, entry in paired.items():
+        for i, a in enumerate(entry.labels):
+            for b in entry.labels[i + 1 :]:
+                for kind, c in zip(("translation", "rotation"), entry.found[(a, b)], strict=True):
+                    numbers = ["" if math.isnan(v) else f"{v:.9g}" for v in (c.ratio, c.low, c.high)]
+                    writer.writerow([log, a, b, kind, c.pairs, *numbers, c.verdict, c.reason or ""])
+    return buffer.getvalue()
