@@ -5,11 +5,17 @@ formats per figure: 18 of 20 s on the quick suite), and `make bench` rebuilds
 every report after every grid, most often with few or no new cells. Each
 group of figures (one dataset's figures, one figure of the thesis page) is
 stamped with a digest of everything it is drawn from: the code version (so a
-change of the plotting code redraws everything), the drawing options, and the
-bytes of every ``result.json`` and ``metrics.json`` the group reads (a cell
-that ran again rewrites both). A group is drawn again when its digest
-differs, when any file it made is missing, or when the stamp file cannot be
-read; a stamp is never trusted beyond that.
+change of the plotting code redraws everything), the versions of the
+libraries that draw (another matplotlib lays a figure out otherwise), the
+drawing options, and the bytes of every file of every run folder the group
+reads (not only ``result.json`` and ``metrics.json``: a trajectory, map or
+per-scan time file rewritten in place is drawn from as it now is, as a report
+built afresh would). A group is drawn again when its digest differs, when any
+file it made is missing, or when the stamp file cannot be read; a stamp is
+never trusted beyond that. A group found out of date is struck from the stamp
+file before it is drawn again, so a report stopped while drawing it (Ctrl-C,
+a kill) leaves no stamp that could vouch for its half-redrawn files later
+(after the inputs went back to what the old stamp names).
 
 The stamps are one JSON file (:data:`STAMPS`) beside the figures, written
 atomically once the figures are on disk. A group whose drawing could not be
@@ -29,8 +35,8 @@ from typing import Any
 
 from albot1 import versions
 from albot1.atomic import atomic_write
+from albot1.report.build_stamp import LIBRARIES, Source, content_sha256
 from albot1.report.collect import CellRecord
-from albot1.runs.folder import METRICS_FILE, RESULT_FILE
 
 #: The stamp file, in the folder of the figures it describes.
 STAMPS = "figures.json"
@@ -38,28 +44,28 @@ STAMPS = "figures.json"
 STAMPS_VERSION = 1
 
 
-def _file_digest(path: Path) -> str:
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return "absent"
-
-
 def record_digest(record: CellRecord) -> list[str]:
-    """What of a cell a figure can show: its key, status and the bytes of its result and metrics records."""
+    """What of a cell a figure can show: its key, status and the bytes of every file of its run folder.
+
+    Every file, not a list of those the figures read today: a figure that starts reading another file of
+    the run folder cannot be forgotten here. The build stamp has just hashed the same files
+    (:func:`content_sha256` reads each once per process).
+    """
     if record.status != "done":
         return [record.cell.key, record.status]
-    return [
-        record.cell.key,
-        record.status,
-        _file_digest(record.run_dir / RESULT_FILE),
-        _file_digest(record.run_dir / METRICS_FILE),
-    ]
+    folder = Source(record.run_dir)
+    files = [[f.relative_to(folder.root).as_posix(), content_sha256(f)] for f in folder.files()]
+    return [record.cell.key, record.status, json.dumps(files)]
 
 
 def inputs_digest(records: Iterable[CellRecord], *options: object) -> str:
-    """The digest of a group of figures: the code version, ``options`` (JSON-able) and ``records``."""
-    parts = [versions.code_version(), [record_digest(r) for r in records], list(options)]
+    """The digest of a group of figures: the code and drawing libraries' versions, ``options`` and ``records``."""
+    parts = [
+        versions.code_version(),
+        versions.library_versions(LIBRARIES),
+        [record_digest(r) for r in records],
+        list(options),
+    ]
     text = json.dumps(parts, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -118,7 +124,10 @@ class FigureCache:
     def lookup(self, group: str, digest: str) -> Cached | None:
         """The group's files and payload when its digest is ``digest`` and every file it made still exists."""
         entry = self._groups.get(group)
-        if entry is None or entry.get("digest") != digest:
+        if entry is not None and entry.get("digest") != digest:
+            self._strike(group)
+            return None
+        if entry is None:
             return None
         stored = entry.get("files")
         if not isinstance(stored, list) or not all(isinstance(f, str) for f in stored):
@@ -127,6 +136,12 @@ class FigureCache:
         if not all(f.is_file() for f in files):
             return None
         return Cached(files, entry.get("payload"))
+
+    def _strike(self, group: str) -> None:
+        """Forget an out-of-date ``group`` on disk at once: it is about to be drawn again, and may be stopped."""
+        self._groups.pop(group, None)
+        self._changed = True
+        self._write(self._unsettled | self._was_unsettled)  # the stamps' own save still follows
 
     def store(self, group: str, digest: str, files: Iterable[Path], payload: Any = None) -> None:
         """Remember that ``group`` drawn from ``digest`` made ``files`` (and their vector twins where they exist)."""
@@ -148,7 +163,10 @@ class FigureCache:
         """Write the stamps (atomically) when a group was stored or the unsettled groups changed since read."""
         if not self._changed and self._unsettled == self._was_unsettled:
             return
-        document = {"version": STAMPS_VERSION, "groups": self._groups, "unsettled": sorted(self._unsettled)}
-        atomic_write(self.stamps, lambda tmp: tmp.write_text(json.dumps(document, indent=1, sort_keys=True)))
+        self._write(self._unsettled)
         self._changed = False
         self._was_unsettled = set(self._unsettled)
+
+    def _write(self, unsettled: set[str]) -> None:
+        document = {"version": STAMPS_VERSION, "groups": self._groups, "unsettled": sorted(unsettled)}
+        atomic_write(self.stamps, lambda tmp: tmp.write_text(json.dumps(document, indent=1, sort_keys=True)))

@@ -10,6 +10,7 @@ again) gives; a deleted output is written again (albot1.report.rebuild).
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -89,3 +90,28 @@ def test_an_incremental_report_equals_a_full_rebuild(results: Path, tmp_path: Pa
     rebuild.report(results, out)
     assert _contents(out) == incremental
     assert rebuild.current_report(results, out) == out / "README.md"
+
+
+@pytest.mark.slow
+def test_a_run_file_edited_in_place_with_its_time_put_back_is_drawn_again(results: Path, tmp_path: Path) -> None:
+    """A trajectory rewritten with its size and modification time kept: the rebuilt report is a fresh one."""
+    out = tmp_path / "report"
+    rebuild.report(results, out)
+    assert rebuild.current_report(results, out) == out / "README.md"
+    trajectory = sorted(results.rglob("trajectory.tum"))[0]
+    lines = trajectory.read_text().splitlines(keepends=True)
+    fields = lines[2].split(" ")  # the second pose (after the header line)
+    fields[1] = f"{float(fields[1]) + 0.5:.9f}"  # half a metre off in x, written as wide: the same size
+    lines[2] = " ".join(fields)
+    st = trajectory.stat()
+    trajectory.write_text("".join(lines))
+    os.utime(trajectory, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert trajectory.stat().st_size == st.st_size
+    assert rebuild.current_report(results, out) is None  # the store's bytes changed
+    before = _contents(out)
+    rebuild.report(results, out)
+    incremental = _contents(out)
+    changed = {name for name in incremental if incremental[name] != before.get(name)}
+    assert any(name.endswith("-trajectories.png") for name in changed)  # the figure shows the edited poses
+    rebuild.report(results, out, force=True)
+    assert _contents(out) == incremental
