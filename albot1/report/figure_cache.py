@@ -17,6 +17,14 @@ file before it is drawn again, so a report stopped while drawing it (Ctrl-C,
 a kill) leaves no stamp that could vouch for its half-redrawn files later
 (after the inputs went back to what the old stamp names).
 
+A figure that is no longer drawn (its data gone: a robustness figure once a
+degradation's cells are removed, a dataset no longer in the store, another
+store reported into the same folder) would stay in the folder with its old
+numbers, unlinked but there to be copied into a paper. So a build's
+:meth:`FigureCache.save` deletes the files of this folder that the stamps
+named before and no group names now, and forgets the groups the build did
+not look up: the folder holds what a report built afresh holds.
+
 The stamps are one JSON file (:data:`STAMPS`) beside the figures, written
 atomically once the figures are on disk. A group whose drawing could not be
 kept (a figure that failed: its reason is worked out again next time) is
@@ -88,6 +96,9 @@ class FigureCache:
         self._changed = False
         self._unsettled: set[str] = set()
         self._was_unsettled = self._read_unsettled()
+        self._named_before = self._names()
+        self._seen: set[str] = set()  # the groups this build looked up, stored or could not keep
+        self._kept: set[str] = set()  # files of groups it could not keep, drawn this time
 
     def _read(self) -> dict[str, dict[str, Any]]:
         try:
@@ -100,6 +111,10 @@ class FigureCache:
         if not isinstance(groups, dict):
             return {}
         return {k: v for k, v in groups.items() if isinstance(v, dict)}
+
+    def _names(self) -> set[str]:
+        """Every file the stamps name (the groups' files, as stored)."""
+        return {f for entry in self._groups.values() for f in entry.get("files") or [] if isinstance(f, str)}
 
     def _read_unsettled(self) -> set[str]:
         try:
@@ -123,6 +138,7 @@ class FigureCache:
 
     def lookup(self, group: str, digest: str) -> Cached | None:
         """The group's files and payload when its digest is ``digest`` and every file it made still exists."""
+        self._seen.add(group)
         entry = self._groups.get(group)
         if entry is not None and entry.get("digest") != digest:
             self._strike(group)
@@ -145,22 +161,39 @@ class FigureCache:
 
     def store(self, group: str, digest: str, files: Iterable[Path], payload: Any = None) -> None:
         """Remember that ``group`` drawn from ``digest`` made ``files`` (and their vector twins where they exist)."""
-        names: list[str] = []
-        for f in files:
-            for path in (f, f.with_suffix(".svg")):
-                if path.is_file():
-                    names.append(self.name(path))
-        self._groups[group] = {"digest": digest, "files": sorted(set(names)), "payload": payload}
+        self._groups[group] = {"digest": digest, "files": self._stored_names(files), "payload": payload}
+        self._seen.add(group)
         self._unsettled.discard(group)
         self._changed = True
 
-    def unsettled(self, group: str) -> None:
-        """Say that ``group`` was drawn but could not be kept (a failed drawing): the next build must try again."""
+    def _stored_names(self, files: Iterable[Path]) -> list[str]:
+        """The stored names of ``files`` and of their vector twins, those that exist."""
+        names = {self.name(path) for f in files for path in (f, f.with_suffix(".svg")) if path.is_file()}
+        return sorted(names)
+
+    def unsettled(self, group: str, files: Iterable[Path] = ()) -> None:
+        """Say that ``group`` was drawn but could not be kept (a failed drawing): the next build must try again.
+
+        ``files``: what the drawing made all the same (the page links them): they are not deleted as stale.
+        """
+        self._kept.update(self._stored_names(files))
         self._groups.pop(group, None)
+        self._seen.add(group)
         self._unsettled.add(group)
 
     def save(self) -> None:
-        """Write the stamps (atomically) when a group was stored or the unsettled groups changed since read."""
+        """Write the stamps (atomically) when a group was stored or the unsettled groups changed since read.
+
+        Called once a build has looked up every group it draws: the groups it did not are forgotten, and the
+        files of this folder that only earlier drawings named are deleted (see the module docstring).
+        """
+        for group in set(self._groups) - self._seen:
+            del self._groups[group]
+            self._changed = True
+        for stale in self._named_before - self._names() - self._kept:
+            if not Path(stale).is_absolute():  # a file of another folder (a thesis figure's link) is not ours
+                self.path(stale).unlink(missing_ok=True)
+        self._named_before = self._names()
         if not self._changed and self._unsettled == self._was_unsettled:
             return
         self._write(self._unsettled)

@@ -179,3 +179,41 @@ def test_a_group_found_out_of_date_is_struck_before_it_is_drawn(tmp_path: Path) 
     again = FigureCache(tmp_path)
     assert again.lookup("group", "d1") is None
     assert json.loads((tmp_path / STAMPS).read_text())["unsettled"] == ["other"]  # still tried again
+
+
+def test_figures_no_longer_drawn_are_deleted_with_their_groups(tmp_path: Path) -> None:
+    elsewhere = tmp_path / "other-report" / "maps.png"  # a file of another folder that a group links
+    elsewhere.parent.mkdir()
+    elsewhere.write_bytes(b"linked")
+    folder = tmp_path / "plots"
+    folder.mkdir()
+    for name in ("a.png", "a.svg", "b.png", "c.png"):
+        (folder / name).write_bytes(name.encode())
+    cache = FigureCache(folder)
+    cache.store("dataset:one", "d1", [folder / "a.png", folder / "b.png", elsewhere])
+    cache.store("dataset:two", "d1", [folder / "c.png"])
+    cache.save()
+    assert sorted(p.name for p in folder.iterdir()) == ["a.png", "a.svg", "b.png", "c.png", STAMPS]
+    # the next build: "one" changed and no longer makes b.png; "two" left the store (never looked up)
+    again = FigureCache(folder)
+    assert again.lookup("dataset:one", "d2") is None
+    again.store("dataset:one", "d2", [folder / "a.png"])
+    again.save()
+    assert sorted(p.name for p in folder.iterdir()) == ["a.png", "a.svg", STAMPS]  # as a fresh build leaves it
+    assert elsewhere.read_bytes() == b"linked"
+    assert FigureCache(folder).lookup("dataset:two", "d1") is None
+    stamps = json.loads((folder / STAMPS).read_text())
+    assert sorted(stamps["groups"]) == ["dataset:one"]
+
+
+def test_what_a_failed_drawing_made_is_not_deleted(tmp_path: Path) -> None:
+    (tmp_path / "trace.png").write_bytes(b"drawn")
+    cache = FigureCache(tmp_path)
+    cache.store("thesis:trace", "d1", [tmp_path / "trace.png"])
+    cache.save()
+    # drawn again: the first panel is drawn, the second fails (its reason is shown beside the first)
+    again = FigureCache(tmp_path)
+    assert again.lookup("thesis:trace", "d2") is None
+    again.unsettled("thesis:trace", [tmp_path / "trace.png"])
+    again.save()
+    assert (tmp_path / "trace.png").read_bytes() == b"drawn"  # the page links it
