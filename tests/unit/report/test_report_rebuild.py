@@ -115,3 +115,18 @@ def test_a_run_file_edited_in_place_with_its_time_put_back_is_drawn_again(result
     assert any(name.endswith("-trajectories.png") for name in changed)  # the figure shows the edited poses
     rebuild.report(results, out, force=True)
     assert _contents(out) == incremental
+
+
+@pytest.mark.slow
+def test_a_page_the_store_no_longer_makes_is_removed(results: Path, tmp_path: Path) -> None:
+    """Another store's report (or this store's, before cells went) left pages this store does not make."""
+    out = tmp_path / "report"
+    out.mkdir()
+    stale = ["generalisation.md", "generalisation.csv", "standard-benchmark.md", "standard-benchmark.csv"]
+    for name in stale:
+        (out / name).write_text("numbers of an earlier report\n")
+    rebuild.report(results, out)
+    fresh = tmp_path / "fresh"
+    rebuild.report(results, fresh)
+    assert sorted(_contents(out)) == sorted(_contents(fresh))
+    assert not any((out / name).exists() for name in stale)
