@@ -16,14 +16,14 @@ writes) holds
 * the size, modification and change times and inode of every file it wrote.
 
 A build is skipped when the digest is the same and every recorded output is
-still there with the same stat; otherwise it runs in
-full (its figures still come from the figure cache when their own inputs did
-not change). Inputs are judged by content, not by time: `albot1 bench`
-rewrites ``grid.json`` with the same bytes on every run, and a copied store
-holds the same results. A file's sha256 is remembered with its size,
-modification and change times and inode, so a re-run reads only the files
-rewritten since (a rewrite of the same size whose modification time was put
-back still changes the change time). The folders read are the ones recorded by the last build: a changed
+still there with the same stat; otherwise it runs in full (its figures still
+come from the figure cache when their own inputs did not change). Inputs are
+judged by content, not by time: `albot1 bench` rewrites ``grid.json`` with
+the same bytes on every run, and a copied store holds the same results. A
+file's sha256 is remembered with its size, modification and change times and
+inode, so a re-run reads only the files rewritten since (a rewrite of the
+same size whose modification time was put back still changes the change
+time). The folders read are the ones recorded by the last build: a changed
 plan changes ``grid.json``'s digest, and the build that follows records the
 folders anew.
 
