@@ -117,7 +117,7 @@ class Fingerprints:
             for memory in (self.known, _SEEN):
                 entry = memory.get(name)
                 if entry is not None and tuple(entry[:-1]) == stat:
-                    self.known[name] = entry
+                    self.known[name] = _SEEN[name] = entry
                     return str(entry[-1])
         try:
             digest = hashlib.sha256()

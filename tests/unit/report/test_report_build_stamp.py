@@ -295,3 +295,16 @@ def test_every_option_that_changes_a_report_is_in_its_digest_and_jobs_is_not(tmp
         "columns": None,
     }
     assert report_options(tmp_path / "results", tmp_path / "out", plots=True, map_style="grid", columns="a") != base
+
+
+def test_a_file_known_from_a_stamp_is_not_read_again_by_the_figure_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = tmp_path / "trajectory.tum"
+    path.write_bytes(b"0 0 0 0 0 0 0 1\n")
+    known = Fingerprints()
+    first = known.sha256(path)
+    monkeypatch.setattr(build_stamp, "_SEEN", {})  # a new process: only the stamp's memory
+    Fingerprints(known.known).sha256(path)  # the build stamp's check
+    figure_cache = Fingerprints()
+    assert figure_cache.sha256(path) == first and figure_cache.read == 0
