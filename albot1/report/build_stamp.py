@@ -13,16 +13,17 @@ writes) holds
   (:mod:`albot1.resources`, with ``ALBOT1_CONFIG_DIR``'s), the options, and
   the content (sha256) of every file of the folders it reads (the stores,
   with their companions);
-* the size and modification time of every file it wrote.
+* the size, modification and change times and inode of every file it wrote.
 
 A build is skipped when the digest is the same and every recorded output is
-still there with the same size and modification time; otherwise it runs in
-full (its figures still come from the figure cache when their own inputs did
-not change). Inputs are judged by content, not by time: `albot1 bench`
-rewrites ``grid.json`` with the same bytes on every run, and a copied store
-holds the same results. A file's sha256 is remembered with its size and
-modification time, so a re-run reads only the files whose size or time
-changed. The folders read are the ones recorded by the last build: a changed
+still there with the same stat; otherwise it runs in full (its figures still
+come from the figure cache when their own inputs did not change). Inputs are
+judged by content, not by time: `albot1 bench` rewrites ``grid.json`` with
+the same bytes on every run, and a copied store holds the same results. A
+file's sha256 is remembered with its size, modification and change times and
+inode, so a re-run reads only the files rewritten since (a rewrite of the
+same size whose modification time was put back still changes the change
+time). The folders read are the ones recorded by the last build: a changed
 plan changes ``grid.json``'s digest, and the build that follows records the
 folders anew.
 
@@ -48,7 +49,7 @@ from albot1.resources import FOLDERS, resource_dirs
 #: The stamp file, in the folder a build writes.
 STAMP = "build.json"
 #: Bumped when the stamp's layout changes: a stamp of another version is not trusted.
-STAMP_VERSION = 1
+STAMP_VERSION = 2  # 2: a file's stat holds its change time and inode
 #: The libraries whose version can change what a report draws or tabulates.
 LIBRARIES = ("numpy", "pandas", "scipy", "matplotlib", "plotly", "pydantic")
 #: The stamp files of the figure cache (:data:`albot1.report.figure_cache.STAMPS`; not imported: it is heavy).
@@ -77,31 +78,47 @@ class Source:
         return [str(self.root), self.pattern]
 
 
-def _stat(path: Path) -> tuple[int, int] | None:
+def _stat(path: Path) -> tuple[int, ...] | None:
+    """What tells a file's rewrite without reading it: size, modification and change times, inode.
+
+    The size and modification time alone miss a rewrite of the same size whose time was put back
+    (``touch -r``, ``cp -p``, ``rsync -t`` of an edited file): the change time and the inode cannot be
+    set back, so such a file is read again (a copied store is too: new inodes, same bytes, nothing rebuilt).
+    """
     try:
         st = os.stat(path)
     except OSError:
         return None
-    return (st.st_size, st.st_mtime_ns)
+    return (st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino)
+
+
+#: Length of a remembered fingerprint: the :func:`_stat` fields, then the sha256.
+_ENTRY = 5
+#: Every sha256 this process worked out, by absolute path (same entries as :attr:`Fingerprints.known`): a
+#: report's figure cache reads the run files its build stamp has just hashed (:func:`content_sha256`).
+_SEEN: dict[str, list[Any]] = {}
 
 
 class Fingerprints:
-    """The sha256 of files, remembered with the size and modification time they had when read."""
+    """The sha256 of files, remembered with the :func:`_stat` they had when read."""
 
     def __init__(self, known: dict[str, Any] | None = None) -> None:
         self.known: dict[str, list[Any]] = {}
         for name, entry in (known or {}).items():
-            if isinstance(entry, list) and len(entry) == 3:
+            if isinstance(entry, list) and len(entry) == _ENTRY:
                 self.known[name] = entry
         self.read = 0  # files hashed (not found in memory): what a test and a timing can look at
 
     def sha256(self, path: Path) -> str:
-        """``path``'s sha256 ("absent" when it cannot be read); read again only when its size or time changed."""
+        """``path``'s sha256 ("absent" when it cannot be read); read again only when its :func:`_stat` changed."""
         name = os.path.abspath(path)
         stat = _stat(path)
-        entry = self.known.get(name)
-        if stat is not None and entry is not None and (entry[0], entry[1]) == stat:
-            return str(entry[2])
+        if stat is not None:
+            for memory in (self.known, _SEEN):
+                entry = memory.get(name)
+                if entry is not None and tuple(entry[:-1]) == stat:
+                    self.known[name] = _SEEN[name] = entry
+                    return str(entry[-1])
         try:
             digest = hashlib.sha256()
             with open(path, "rb") as handle:
@@ -111,8 +128,13 @@ class Fingerprints:
             return "absent"
         self.read += 1
         if stat is not None:
-            self.known[name] = [stat[0], stat[1], digest.hexdigest()]
+            self.known[name] = _SEEN[name] = [*stat, digest.hexdigest()]
         return digest.hexdigest()
+
+
+def content_sha256(path: Path) -> str:
+    """``path``'s sha256 ("absent" when it cannot be read), read only when this process has not already."""
+    return Fingerprints().sha256(path)
 
 
 def resources_digest() -> list[list[str]]:

@@ -5,11 +5,25 @@ formats per figure: 18 of 20 s on the quick suite), and `make bench` rebuilds
 every report after every grid, most often with few or no new cells. Each
 group of figures (one dataset's figures, one figure of the thesis page) is
 stamped with a digest of everything it is drawn from: the code version (so a
-change of the plotting code redraws everything), the drawing options, and the
-bytes of every ``result.json`` and ``metrics.json`` the group reads (a cell
-that ran again rewrites both). A group is drawn again when its digest
-differs, when any file it made is missing, or when the stamp file cannot be
-read; a stamp is never trusted beyond that.
+change of the plotting code redraws everything), the versions of the
+libraries that draw (another matplotlib lays a figure out otherwise), the
+drawing options, and the bytes of every file of every run folder the group
+reads (not only ``result.json`` and ``metrics.json``: a trajectory, map or
+per-scan time file rewritten in place is drawn from as it now is, as a report
+built afresh would). A group is drawn again when its digest differs, when any
+file it made is missing, or when the stamp file cannot be read; a stamp is
+never trusted beyond that. A group found out of date is struck from the stamp
+file before it is drawn again, so a report stopped while drawing it (Ctrl-C,
+a kill) leaves no stamp that could vouch for its half-redrawn files later
+(after the inputs went back to what the old stamp names).
+
+A figure that is no longer drawn (its data gone: a robustness figure once a
+degradation's cells are removed, a dataset no longer in the store, another
+store reported into the same folder) would stay in the folder with its old
+numbers, unlinked but there to be copied into a paper. So a build's
+:meth:`FigureCache.save` deletes the files of this folder that the stamps
+named before and no group names now, and forgets the groups the build did
+not look up: the folder holds what a report built afresh holds.
 
 The stamps are one JSON file (:data:`STAMPS`) beside the figures, written
 atomically once the figures are on disk. A group whose drawing could not be
@@ -29,8 +43,8 @@ from typing import Any
 
 from albot1 import versions
 from albot1.atomic import atomic_write
+from albot1.report.build_stamp import LIBRARIES, Source, content_sha256
 from albot1.report.collect import CellRecord
-from albot1.runs.folder import METRICS_FILE, RESULT_FILE
 
 #: The stamp file, in the folder of the figures it describes.
 STAMPS = "figures.json"
@@ -38,28 +52,28 @@ STAMPS = "figures.json"
 STAMPS_VERSION = 1
 
 
-def _file_digest(path: Path) -> str:
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return "absent"
-
-
 def record_digest(record: CellRecord) -> list[str]:
-    """What of a cell a figure can show: its key, status and the bytes of its result and metrics records."""
+    """What of a cell a figure can show: its key, status and the bytes of every file of its run folder.
+
+    Every file, not a list of those the figures read today: a figure that starts reading another file of
+    the run folder cannot be forgotten here. The build stamp has just hashed the same files
+    (:func:`content_sha256` reads each once per process).
+    """
     if record.status != "done":
         return [record.cell.key, record.status]
-    return [
-        record.cell.key,
-        record.status,
-        _file_digest(record.run_dir / RESULT_FILE),
-        _file_digest(record.run_dir / METRICS_FILE),
-    ]
+    folder = Source(record.run_dir)
+    files = [[f.relative_to(folder.root).as_posix(), content_sha256(f)] for f in folder.files()]
+    return [record.cell.key, record.status, json.dumps(files)]
 
 
 def inputs_digest(records: Iterable[CellRecord], *options: object) -> str:
-    """The digest of a group of figures: the code version, ``options`` (JSON-able) and ``records``."""
-    parts = [versions.code_version(), [record_digest(r) for r in records], list(options)]
+    """The digest of a group of figures: the code and drawing libraries' versions, ``options`` and ``records``."""
+    parts = [
+        versions.code_version(),
+        versions.library_versions(LIBRARIES),
+        [record_digest(r) for r in records],
+        list(options),
+    ]
     text = json.dumps(parts, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -82,6 +96,9 @@ class FigureCache:
         self._changed = False
         self._unsettled: set[str] = set()
         self._was_unsettled = self._read_unsettled()
+        self._named_before = self._names()
+        self._seen: set[str] = set()  # the groups this build looked up, stored or could not keep
+        self._kept: set[str] = set()  # files of groups it could not keep, drawn this time
 
     def _read(self) -> dict[str, dict[str, Any]]:
         try:
@@ -94,6 +111,10 @@ class FigureCache:
         if not isinstance(groups, dict):
             return {}
         return {k: v for k, v in groups.items() if isinstance(v, dict)}
+
+    def _names(self) -> set[str]:
+        """Every file the stamps name (the groups' files, as stored)."""
+        return {f for entry in self._groups.values() for f in entry.get("files") or [] if isinstance(f, str)}
 
     def _read_unsettled(self) -> set[str]:
         try:
@@ -117,8 +138,12 @@ class FigureCache:
 
     def lookup(self, group: str, digest: str) -> Cached | None:
         """The group's files and payload when its digest is ``digest`` and every file it made still exists."""
+        self._seen.add(group)
         entry = self._groups.get(group)
-        if entry is None or entry.get("digest") != digest:
+        if entry is not None and entry.get("digest") != digest:
+            self._strike(group)
+            return None
+        if entry is None:
             return None
         stored = entry.get("files")
         if not isinstance(stored, list) or not all(isinstance(f, str) for f in stored):
@@ -128,27 +153,53 @@ class FigureCache:
             return None
         return Cached(files, entry.get("payload"))
 
+    def _strike(self, group: str) -> None:
+        """Forget an out-of-date ``group`` on disk at once: it is about to be drawn again, and may be stopped."""
+        self._groups.pop(group, None)
+        self._changed = True
+        self._write(self._unsettled | self._was_unsettled)  # the stamps' own save still follows
+
     def store(self, group: str, digest: str, files: Iterable[Path], payload: Any = None) -> None:
         """Remember that ``group`` drawn from ``digest`` made ``files`` (and their vector twins where they exist)."""
-        names: list[str] = []
-        for f in files:
-            for path in (f, f.with_suffix(".svg")):
-                if path.is_file():
-                    names.append(self.name(path))
-        self._groups[group] = {"digest": digest, "files": sorted(set(names)), "payload": payload}
+        self._groups[group] = {"digest": digest, "files": self._stored_names(files), "payload": payload}
+        self._seen.add(group)
         self._unsettled.discard(group)
         self._changed = True
 
-    def unsettled(self, group: str) -> None:
-        """Say that ``group`` was drawn but could not be kept (a failed drawing): the next build must try again."""
+    def _stored_names(self, files: Iterable[Path]) -> list[str]:
+        """The stored names of ``files`` and of their vector twins, those that exist."""
+        names = {self.name(path) for f in files for path in (f, f.with_suffix(".svg")) if path.is_file()}
+        return sorted(names)
+
+    def unsettled(self, group: str, files: Iterable[Path] = ()) -> None:
+        """Say that ``group`` was drawn but could not be kept (a failed drawing): the next build must try again.
+
+        ``files``: what the drawing made all the same (the page links them): they are not deleted as stale.
+        """
+        self._kept.update(self._stored_names(files))
         self._groups.pop(group, None)
+        self._seen.add(group)
         self._unsettled.add(group)
 
     def save(self) -> None:
-        """Write the stamps (atomically) when a group was stored or the unsettled groups changed since read."""
+        """Write the stamps (atomically) when a group was stored or the unsettled groups changed since read.
+
+        Called once a build has looked up every group it draws: the groups it did not are forgotten, and the
+        files of this folder that only earlier drawings named are deleted (see the module docstring).
+        """
+        for group in set(self._groups) - self._seen:
+            del self._groups[group]
+            self._changed = True
+        for stale in self._named_before - self._names() - self._kept:
+            if not Path(stale).is_absolute():  # a file of another folder (a thesis figure's link) is not ours
+                self.path(stale).unlink(missing_ok=True)
+        self._named_before = self._names()
         if not self._changed and self._unsettled == self._was_unsettled:
             return
-        document = {"version": STAMPS_VERSION, "groups": self._groups, "unsettled": sorted(self._unsettled)}
-        atomic_write(self.stamps, lambda tmp: tmp.write_text(json.dumps(document, indent=1, sort_keys=True)))
+        self._write(self._unsettled)
         self._changed = False
         self._was_unsettled = set(self._unsettled)
+
+    def _write(self, unsettled: set[str]) -> None:
+        document = {"version": STAMPS_VERSION, "groups": self._groups, "unsettled": sorted(unsettled)}
+        atomic_write(self.stamps, lambda tmp: tmp.write_text(json.dumps(document, indent=1, sort_keys=True)))

@@ -207,6 +207,17 @@ def write_index(
     return index
 
 
+def _remove_unwritten(out: Path, *names: str) -> None:
+    """Delete the report's own ``names`` in ``out`` that this build does not write.
+
+    An earlier report into the same folder (of this store before cells were removed, or of another store)
+    may have written them: left there, they would show its numbers beside this report's, unlinked but there
+    to be copied; a report built afresh has none.
+    """
+    for name in names:
+        (out / name).unlink(missing_ok=True)
+
+
 def build_report(
     results_dir: str | Path,
     out: str | Path | None = None,
@@ -246,9 +257,13 @@ def build_report(
         tables = write_tables(records, target, paired, columns, tabled)
         if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
             tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target, results)
+        else:
+            _remove_unwritten(target, STANDARD_PAGE, STANDARD_TABLE)
         generalisation = write_generalisation(plan, records, target, results)
         if generalisation is not None:
             tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation
+        else:
+            _remove_unwritten(target, GENERALISATION_PAGE, GENERALISATION_TABLE)
         views = write_views(pictured, target, colors) if plots else None
         name = "benchmark.md" if thesis else "README.md"
         page = (

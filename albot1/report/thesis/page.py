@@ -243,7 +243,8 @@ def _cached_draw(figures: _Figures, cache: FigureCache, request: FigureRequest) 
             [[d.caption, None if d.path is None else cache.name(d.path), d.reason, d.linked] for d in drawn],
         )
     else:
-        cache.unsettled(group)  # the report is not skipped as a whole until this figure is drawn
+        # the report is not skipped as a whole until this figure is drawn; what was drawn is linked meanwhile
+        cache.unsettled(group, [d.path for d in drawn if d.path and not d.linked])
     return drawn
 
 

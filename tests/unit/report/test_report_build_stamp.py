@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any, cast
@@ -96,6 +97,41 @@ def test_a_changed_added_or_removed_input_invalidates(built: tuple[Path, Path]) 
     assert BuildStamp(out).fresh(OPTIONS) is None
 
 
+def _rewrite_keeping_time(path: Path, text: str) -> None:
+    """Rewrite ``path`` with ``text`` and put its modification time back (``touch -r``, ``cp -p``, ``rsync -t``)."""
+    st = path.stat()
+    assert len(text.encode()) == st.st_size  # the same size: size and time alone cannot tell
+    path.write_text(text)
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+
+
+def test_an_input_rewritten_with_its_size_and_time_kept_invalidates(built: tuple[Path, Path]) -> None:
+    store, out = built
+    _rewrite_keeping_time(store / "runs" / "a" / "metrics.json", '{"ate": 9.0}')
+    stamp = BuildStamp(out)
+    assert stamp.fresh(OPTIONS) is None  # the tables would show the old ATE
+    assert stamp.fingerprints.read == 1
+
+
+def test_an_output_rewritten_with_its_size_and_time_kept_invalidates(built: tuple[Path, Path]) -> None:
+    _, out = built
+    _rewrite_keeping_time(out / "README.md", "REPORT")
+    assert BuildStamp(out).fresh(OPTIONS) is None
+
+
+def test_a_copied_store_is_read_again_and_changes_nothing(built: tuple[Path, Path], tmp_path: Path) -> None:
+    store, out = built
+    stamp = BuildStamp(out)
+    digest = stamp.digest([Source(store)], OPTIONS)
+    copy = tmp_path / "copy"
+    shutil.copytree(store, copy, copy_function=shutil.copy2)  # times kept, new inodes
+    shutil.rmtree(store)
+    copy.rename(store)
+    again = BuildStamp(out)
+    assert again.digest([Source(store)], OPTIONS) == digest
+    assert again.fingerprints.read == 3  # other inodes: every file read again, none trusted by its time
+
+
 def test_hidden_files_are_not_inputs(built: tuple[Path, Path]) -> None:
     store, out = built
     (store / ".lock").write_text("host pid 1\n")  # the runner's lock, rewritten by every `albot1 bench`
@@ -130,7 +166,9 @@ def test_a_changed_project_toml_invalidates(built: tuple[Path, Path], monkeypatc
     assert BuildStamp(out).fresh(OPTIONS) is None
 
 
-@pytest.mark.parametrize("text", ["", "{", "[]", json.dumps({"version": 0}), json.dumps({"version": 1})])
+@pytest.mark.parametrize(
+    "text", ["", "{", "[]", json.dumps({"version": 0}), json.dumps({"version": build_stamp.STAMP_VERSION})]
+)
 def test_a_damaged_or_foreign_stamp_is_not_trusted(built: tuple[Path, Path], text: str) -> None:
     _, out = built
     (out / STAMP).write_text(text)
@@ -257,3 +295,16 @@ def test_every_option_that_changes_a_report_is_in_its_digest_and_jobs_is_not(tmp
         "columns": None,
     }
     assert report_options(tmp_path / "results", tmp_path / "out", plots=True, map_style="grid", columns="a") != base
+
+
+def test_a_file_known_from_a_stamp_is_not_read_again_by_the_figure_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = tmp_path / "trajectory.tum"
+    path.write_bytes(b"0 0 0 0 0 0 0 1\n")
+    known = Fingerprints()
+    first = known.sha256(path)
+    monkeypatch.setattr(build_stamp, "_SEEN", {})  # a new process: only the stamp's memory
+    Fingerprints(known.known).sha256(path)  # the build stamp's check
+    figure_cache = Fingerprints()
+    assert figure_cache.sha256(path) == first and figure_cache.read == 0

@@ -10,15 +10,19 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from types import SimpleNamespace
+from typing import Any, cast
 
 import pytest
 
+from albot1 import versions
 from albot1.bench.cells import execute_cell
+from albot1.bench.grid import Cell
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import ResultsStore
 from albot1.bench.suite import parse_suite
 from albot1.report import figure_pool, tables
+from albot1.report.collect import CellRecord
 from albot1.report.figure_cache import STAMPS, FigureCache, inputs_digest
 from albot1.report.index import build_report
 from albot1.settings import get_settings
@@ -122,3 +126,94 @@ def test_damaged_or_foreign_stamps_are_ignored(tmp_path: Path) -> None:
 def test_the_digest_names_the_options(results: Path) -> None:
     assert inputs_digest([], "a", 1) == inputs_digest([], "a", 1)
     assert inputs_digest([], "a", 1) != inputs_digest([], "a", 2)
+
+
+def _run_folder(root: Path) -> CellRecord:
+    """A completed cell whose run folder holds a result, metrics and a trajectory (what the figures draw)."""
+    root.mkdir()
+    (root / "result.json").write_text('{"scans": 2}')
+    (root / "metrics.json").write_text('{"ate": 1.0}')
+    (root / "trajectory.tum").write_text("0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n")
+    return CellRecord(cast(Cell, SimpleNamespace(key="k")), "done", root, None, None, None)
+
+
+def test_a_run_file_rewritten_in_place_changes_the_digest(tmp_path: Path) -> None:
+    record = _run_folder(tmp_path / "run")
+    before = inputs_digest([record], "dataset")
+    trajectory = tmp_path / "run" / "trajectory.tum"
+    trajectory.write_text(trajectory.read_text().replace("1 1 0", "1 3 0"))  # result and metrics untouched
+    assert inputs_digest([record], "dataset") != before  # the trajectory figures show the new poses
+
+
+def test_a_new_file_in_a_run_folder_changes_the_digest_and_a_hidden_one_does_not(tmp_path: Path) -> None:
+    record = _run_folder(tmp_path / "run")
+    before = inputs_digest([record], "dataset")
+    (tmp_path / "run" / ".tmp-trajectory.tum").write_text("half written")
+    assert inputs_digest([record], "dataset") == before
+    (tmp_path / "run" / "map.geojson").write_text("{}")
+    assert inputs_digest([record], "dataset") != before
+
+
+def test_another_drawing_library_changes_the_digest(monkeypatch: pytest.MonkeyPatch) -> None:
+    before = inputs_digest([], "dataset")
+    real = versions.library_versions
+
+    def other_matplotlib(names: tuple[str, ...]) -> dict[str, str | None]:
+        return {**real(names), "matplotlib": "0.0.1"}
+
+    monkeypatch.setattr(versions, "library_versions", other_matplotlib)
+    assert inputs_digest([], "dataset") != before  # another matplotlib lays the figures out otherwise
+
+
+def test_a_group_found_out_of_date_is_struck_before_it_is_drawn(tmp_path: Path) -> None:
+    figure = tmp_path / "a.png"
+    figure.write_bytes(b"drawn from d1")
+    cache = FigureCache(tmp_path)
+    cache.store("group", "d1", [figure], ["a.png"])
+    cache.unsettled("other")
+    cache.save()
+    # the inputs change to d2: the group is drawn again, and the report is stopped half-way (no save)
+    assert FigureCache(tmp_path).lookup("group", "d2") is None
+    figure.write_bytes(b"half drawn from d2")
+    # the inputs go back to d1: the stamp must not vouch for the files the stopped drawing left
+    again = FigureCache(tmp_path)
+    assert again.lookup("group", "d1") is None
+    assert json.loads((tmp_path / STAMPS).read_text())["unsettled"] == ["other"]  # still tried again
+
+
+def test_figures_no_longer_drawn_are_deleted_with_their_groups(tmp_path: Path) -> None:
+    elsewhere = tmp_path / "other-report" / "maps.png"  # a file of another folder that a group links
+    elsewhere.parent.mkdir()
+    elsewhere.write_bytes(b"linked")
+    folder = tmp_path / "plots"
+    folder.mkdir()
+    for name in ("a.png", "a.svg", "b.png", "c.png"):
+        (folder / name).write_bytes(name.encode())
+    cache = FigureCache(folder)
+    cache.store("dataset:one", "d1", [folder / "a.png", folder / "b.png", elsewhere])
+    cache.store("dataset:two", "d1", [folder / "c.png"])
+    cache.save()
+    assert sorted(p.name for p in folder.iterdir()) == ["a.png", "a.svg", "b.png", "c.png", STAMPS]
+    # the next build: "one" changed and no longer makes b.png; "two" left the store (never looked up)
+    again = FigureCache(folder)
+    assert again.lookup("dataset:one", "d2") is None
+    again.store("dataset:one", "d2", [folder / "a.png"])
+    again.save()
+    assert sorted(p.name for p in folder.iterdir()) == ["a.png", "a.svg", STAMPS]  # as a fresh build leaves it
+    assert elsewhere.read_bytes() == b"linked"
+    assert FigureCache(folder).lookup("dataset:two", "d1") is None
+    stamps = json.loads((folder / STAMPS).read_text())
+    assert sorted(stamps["groups"]) == ["dataset:one"]
+
+
+def test_what_a_failed_drawing_made_is_not_deleted(tmp_path: Path) -> None:
+    (tmp_path / "trace.png").write_bytes(b"drawn")
+    cache = FigureCache(tmp_path)
+    cache.store("thesis:trace", "d1", [tmp_path / "trace.png"])
+    cache.save()
+    # drawn again: the first panel is drawn, the second fails (its reason is shown beside the first)
+    again = FigureCache(tmp_path)
+    assert again.lookup("thesis:trace", "d2") is None
+    again.unsettled("thesis:trace", [tmp_path / "trace.png"])
+    again.save()
+    assert (tmp_path / "trace.png").read_bytes() == b"drawn"  # the page links it

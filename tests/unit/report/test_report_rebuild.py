@@ -10,6 +10,7 @@ again) gives; a deleted output is written again (albot1.report.rebuild).
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -22,7 +23,9 @@ from albot1.bench.suite import parse_suite
 from albot1.cli.app import app
 from albot1.report import rebuild
 from albot1.report.build_stamp import STAMP
+from albot1.report.collect import collect
 from albot1.report.figure_cache import STAMPS
+from albot1.report.plots import representative
 from albot1.settings import get_settings
 
 
@@ -89,3 +92,44 @@ def test_an_incremental_report_equals_a_full_rebuild(results: Path, tmp_path: Pa
     rebuild.report(results, out)
     assert _contents(out) == incremental
     assert rebuild.current_report(results, out) == out / "README.md"
+
+
+@pytest.mark.slow
+def test_a_run_file_edited_in_place_with_its_time_put_back_is_drawn_again(results: Path, tmp_path: Path) -> None:
+    """A trajectory rewritten with its size and modification time kept: the rebuilt report is a fresh one."""
+    out = tmp_path / "report"
+    rebuild.report(results, out)
+    assert rebuild.current_report(results, out) == out / "README.md"
+    pictured = representative(collect(results)[1])["odometry"]  # the run the trajectory figures draw
+    trajectory = pictured.run_dir / "trajectory.tum"
+    lines = trajectory.read_text().splitlines(keepends=True)
+    fields = lines[2].split(" ")  # the second pose (after the header line)
+    fields[1] = f"{float(fields[1]) + 0.5:.9f}"  # half a metre off in x, written as wide: the same size
+    lines[2] = " ".join(fields)
+    st = trajectory.stat()
+    trajectory.write_text("".join(lines))
+    os.utime(trajectory, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert trajectory.stat().st_size == st.st_size
+    assert rebuild.current_report(results, out) is None  # the store's bytes changed
+    before = _contents(out)
+    rebuild.report(results, out)
+    incremental = _contents(out)
+    changed = {name for name in incremental if incremental[name] != before.get(name)}
+    assert any(name.endswith("-trajectories.png") for name in changed)  # the figure shows the edited poses
+    rebuild.report(results, out, force=True)
+    assert _contents(out) == incremental
+
+
+@pytest.mark.slow
+def test_a_page_the_store_no_longer_makes_is_removed(results: Path, tmp_path: Path) -> None:
+    """Another store's report (or this store's, before cells went) left pages this store does not make."""
+    out = tmp_path / "report"
+    out.mkdir()
+    stale = ["generalisation.md", "generalisation.csv", "standard-benchmark.md", "standard-benchmark.csv"]
+    for name in stale:
+        (out / name).write_text("numbers of an earlier report\n")
+    rebuild.report(results, out)
+    fresh = tmp_path / "fresh"
+    rebuild.report(results, fresh)
+    assert sorted(_contents(out)) == sorted(_contents(fresh))
+    assert not any((out / name).exists() for name in stale)
