@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
+from albot1.metrics.unit import NO_REFERENCE
 from albot1.report.thesis.claims import READINGS, THESIS
 from albot1.report.thesis.evidence import Evidence, Lookup, counter_path
 from albot1.report.thesis.verdicts import Number, Verdict, at_most
@@ -158,6 +159,19 @@ def albot1_datasets(ev: Evidence, variants: Iterable[str]) -> list[str]:
     """The datasets on which any of ``variants`` was planned, in plan order."""
     wanted = set(variants)
     return [d for d in ev.datasets() if any(m in wanted for m in ev.methods(d))]
+
+
+def lacks_reference(ev: Evidence, dataset: str, methods: Iterable[str], path: str) -> bool:
+    """Whether the metric at ``path`` does not apply to ``dataset`` because the dataset has no reference poses.
+
+    Why: a claim measured against reference poses is left out on such a dataset (a note says so), but on
+    no other ground. A dataset whose runs failed, did not run yet or lack the number for another reason
+    keeps its claim row, and its verdicts say "not comparable" with that reason; leaving it out would
+    drop the claim from the count and blame the dataset for the runs. True when no run of ``methods``
+    has the number and a run says the dataset has no reference poses (the metric's own words).
+    """
+    numbers = [number(ev, dataset, method, path, method) for method in methods]
+    return not any(n.known for n in numbers) and any(n.missing == NO_REFERENCE for n in numbers)
 
 
 def is_public(dataset: str) -> bool:

@@ -19,6 +19,7 @@ from albot1.report.thesis.experiments.common import (
     albot1_datasets,
     cell,
     is_public,
+    lacks_reference,
     number,
     per_variant,
     shape_cell,
@@ -54,8 +55,8 @@ def section_map(ev: Evidence) -> Section:
         "map-shape number; raw logs without them cannot.",
     )
     datasets = albot1_datasets(ev, VARIANTS)
-    with_shape = [d for d in datasets if any(number(ev, d, m, SHAPE, m).known for m in VARIANTS)]
-    without = [d for d in datasets if d not in with_shape]
+    without = [d for d in datasets if lacks_reference(ev, d, VARIANTS, SHAPE)]
+    with_shape = [d for d in datasets if d not in without]
     for dataset in with_shape:
         section.claims.append(
             ClaimRow(
@@ -138,7 +139,8 @@ def section_map(ev: Evidence) -> Section:
                 ("albot1:thesis",),
             )
         )
-    for dataset in with_shape:
+    measured = [d for d in with_shape if any(number(ev, d, m, SHAPE, m).known for m in VARIANTS)]
+    for dataset in measured:
         if dataset not in drawn and dataset not in (ds.dense, ds.sparse):  # those two: Experiments 4-5's figures
             section.figures.append(
                 FigureRequest("linked-maps", f"exp1-maps-{dataset}", f"maps of `{dataset}` (default suite)", dataset)

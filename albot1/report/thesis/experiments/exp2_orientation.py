@@ -14,6 +14,7 @@ from albot1.report.thesis.experiments.common import (
     Section,
     albot1_datasets,
     cell,
+    lacks_reference,
     number,
     per_variant,
     store_of,
@@ -86,7 +87,7 @@ def section_orientation(ev: Evidence) -> Section:
         "least as far as its nearest, so the largest difference is taken over as many stops as the route has.",
     )
     near = READINGS["orientation_min_distance_m"].value
-    datasets = [d for d in albot1_datasets(ev, VARIANTS) if any(number(ev, d, m, STOPS, "").known for m in VARIANTS)]
+    datasets = [d for d in albot1_datasets(ev, VARIANTS) if not lacks_reference(ev, d, VARIANTS, STOPS)]
     for dataset in datasets:
 
         def test(m: str, d: str = dataset) -> Verdict:
