@@ -78,11 +78,21 @@ def _thesis(text: str | None) -> str:
 
 
 def ratio_at_least(small: Number, large: Number, min_ratio: float, *, thesis: str | None = None) -> Verdict:
-    """Holds when ``large`` is at least ``min_ratio`` times ``small`` (e.g. odometry's loop gap vs Albot1's)."""
+    """Holds when ``large`` is at least ``min_ratio`` times ``small`` (e.g. odometry's loop gap vs Albot1's).
+
+    ``small`` 0 is an infinite ratio; both 0 is none (not comparable: a perfect odometry leaves no error to
+    tolerate, and ``0 >= 2 * 0`` would call that a success).
+    """
     absent = _missing(small, large)
     if absent is not None:
         return absent
     s, big = float(small.value), float(large.value)  # type: ignore[arg-type]
+    if s == 0 and big == 0:  # 0/0: no ratio, and nothing for ``small`` to improve on
+        return Verdict(
+            NOT_COMPARABLE,
+            f"{small.label} {small.text()} vs {large.label} {large.text()}: no ratio of two zeros, nothing to "
+            f"improve on{_thesis(thesis)}",
+        )
     ratio = math.inf if s == 0 else big / s
     shown = "inf" if math.isinf(ratio) else quantity(ratio)
     word: Word = HOLDS if ratio >= min_ratio else FAILS

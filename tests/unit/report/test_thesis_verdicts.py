@@ -164,3 +164,12 @@ def test_a_lower_mean_holds_only_when_the_paired_test_says_better() -> None:
     assert untested.word == HOLDS and untested.reason.endswith("; no paired test (4 pairs, fewer than 10)")
     missing = lower_than(Number("albot1", None, "m", "failed"), Number("odometry", 0.5, "m"))
     assert with_paired_test(missing, compare([(0.8 * base, base)], power=1, resamples=50)) == missing
+
+
+def test_two_zero_loop_gaps_make_no_ratio() -> None:
+    verdict = ratio_at_least(m("albot1 loop gap", 0.0), m("odometry", 0.0), 2.0, thesis="0.4 m vs 4.6 m, 11.5x")
+    assert verdict == Verdict(
+        NOT_COMPARABLE,
+        "albot1 loop gap 0 m vs odometry 0 m: no ratio of two zeros, nothing to improve on; thesis 0.4 m vs 4.6 m, "
+        "11.5x",
+    )
