@@ -57,5 +57,12 @@ METRIC = Metric(
     needs=(REFERENCE,),
     compute=compute,
     headline=headline,
-    columns=(ColumnSpec("orientation_deg", "bearing_abs_error_mean_deg", "bearing error mean (deg)"),),
+    columns=(
+        ColumnSpec(
+            "orientation_deg",
+            "bearing_abs_error_mean_deg",
+            "bearing error mean (deg)",
+            undefined="no stop point where the start's bearing is defined (none 1 m or more from the start)",
+        ),
+    ),
 )

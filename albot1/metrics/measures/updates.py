@@ -33,5 +33,7 @@ METRIC = Metric(
     needs=(COUNTERS,),
     compute=compute,
     headline=headline,
-    columns=(ColumnSpec("updates_per_view", "updates_per_view", "updates/view"),),
+    columns=(
+        ColumnSpec("updates_per_view", "updates_per_view", "updates/view", undefined="the run saw no views (views: 0)"),
+    ),
 )

@@ -302,3 +302,22 @@ def test_exit_errors_without_a_comparison_are_not_applicable_with_the_runs_reaso
     expected = reason or "no exit prediction compared (exits.exit_predictions: [])"
     assert METRIC_COLUMNS["exit_aligned_m"].reason(record) == expected
     assert METRIC_COLUMNS["exit_not_aligned_m"].reason(record) == expected
+
+
+def test_updates_and_orientation_nulls_say_why() -> None:
+    """A null updates/view or bearing mean is n/a with its own reason, not "not defined for this run"."""
+    from albot1.bench.grid import Cell
+    from albot1.metrics.orientation import orientation_table
+    from albot1.metrics.updates import update_counts
+    from albot1.report.collect import CellRecord
+
+    still = np.zeros((3, 3))  # a robot that never moved: its one stop (the last scan) is at the start
+    blocks = {"updates": update_counts({"views": 0, "updates": 0}), "orientation": orientation_table(still, still)}
+    assert blocks["updates"]["updates_per_view"] is None and blocks["orientation"]["bearing_undefined"] == 1
+    metrics = parse_record(MetricsRecord, {"run": RUN, **blocks}, "m")
+    cell = Cell("s", "d", "d", "m", "m", "p", "none", 0, "k", "v", 1, 1)
+    record = CellRecord(cell, "done", Path("/nonexistent"), None, metrics, None)
+    assert METRIC_COLUMNS["updates_per_view"].reason(record) == "the run saw no views (views: 0)"
+    assert METRIC_COLUMNS["orientation_deg"].reason(record) == (
+        "no stop point where the start's bearing is defined (none 1 m or more from the start)"
+    )
