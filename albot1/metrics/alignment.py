@@ -43,16 +43,21 @@ Alignment = Literal["none", "first", "rigid"]
 ALIGNMENTS: tuple[str, ...] = get_args(Alignment)
 
 
+def check_poses(poses: ArrayLike, name: str, what: str) -> FloatArray:
+    """``poses`` as an ``(N, 3)`` float array of finite poses, or MetricsError naming the first bad scan."""
+    arr: FloatArray = np.asarray(poses, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise MetricsError(f"{what}: expected the {name} as (N, 3) poses (x, y, theta), got shape {arr.shape}")
+    if not np.isfinite(arr).all():
+        bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
+        raise MetricsError(f"{what}: the {name} has a non-finite pose at scan {bad}")
+    return arr
+
+
 def check_pair(estimate: ArrayLike, reference: ArrayLike, what: str = "trajectories") -> tuple[FloatArray, FloatArray]:
     """Both as ``(N, 3)`` float arrays of equal length N >= 1, or MetricsError."""
-    est = np.asarray(estimate, dtype=float)
-    ref = np.asarray(reference, dtype=float)
-    for name, arr in (("estimate", est), ("reference", ref)):
-        if arr.ndim != 2 or arr.shape[1] != 3:
-            raise MetricsError(f"{what}: expected the {name} as (N, 3) poses (x, y, theta), got shape {arr.shape}")
-        if not np.isfinite(arr).all():
-            bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
-            raise MetricsError(f"{what}: the {name} has a non-finite pose at scan {bad}")
+    est = check_poses(estimate, "estimate", what)
+    ref = check_poses(reference, "reference", what)
     if len(est) != len(ref):
         raise MetricsError(
             f"{what}: the estimate has {len(est)} poses and the reference {len(ref)}; expected one of each per scan"

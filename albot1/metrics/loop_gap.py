@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from albot1.geometry import se2
-from albot1.metrics.alignment import check_pair
+from albot1.metrics.alignment import check_pair, check_poses
 from albot1.metrics.errors import MetricsError
 from albot1.metrics.rpe import relative_errors
 from albot1.metrics.stats import summarize
@@ -41,8 +41,8 @@ MIN_TRAVEL_M = 10.0
 
 def route_gap(estimate: ArrayLike, reference: ArrayLike | None = None) -> dict[str, Any]:
     """Start-to-end error (m, deg); with ``reference=None`` the route is taken as closed."""
-    est = np.asarray(estimate, dtype=float)
-    if est.ndim != 2 or est.shape[1] != 3 or len(est) < 2:
+    est = check_poses(estimate, "estimate", "loop gap")
+    if len(est) < 2:
         raise MetricsError(f"loop gap: expected at least 2 poses (N, 3), got shape {est.shape}")
     d_est = se2.between(est[0], est[-1])
     if reference is None:
