@@ -79,7 +79,10 @@ def test_one_pose_has_no_loop_gap_nor_stops_nor_drift() -> None:
     table = orientation_table(one, one)
     assert table["stops"] == 0 and table["bearing_abs_error_max_deg"] is None
     block = drift(one, one)
-    assert block["at_10m"] is None and block["at_10m_reason"] == "the route (0.0 m of reference travel) has no 10 m segment"
+    assert (
+        block["at_10m"] is None
+        and block["at_10m_reason"] == "the route (0.0 m of reference travel) has no 10 m segment"
+    )
 
 
 def test_table_3_1_bearing_and_distance_by_hand_across_180_deg() -> None:

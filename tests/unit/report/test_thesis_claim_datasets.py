@@ -82,3 +82,11 @@ def test_the_orientation_claim_is_left_out_only_where_there_are_no_reference_pos
     failed = section.claims[1].verdicts["albot1:plus"]
     assert failed.word == NOT_COMPARABLE
     assert FAILED in failed.reason
+
+
+def test_experiment_2_says_the_thesis_exceeds_its_own_distance_bound() -> None:
+    notes = section_orientation(_evidence()).notes
+    assert notes == [
+        "The thesis's own Table 3.1 does not keep its stated bounds of 7 deg and 3 m at every stop (stop c: "
+        "3.5 deg / 3.2 m); the verdicts test the bounds as the text states them (3.2.2, text below Table 3.1)."
+    ]
