@@ -134,6 +134,9 @@ def _null_reason(metrics: MetricsRecord, path: str, undefined: str | None = None
             return named
         if getattr(node, "pairs", None) == 0:
             return "no pairs to measure on this route (pairs: 0)"
+        unsought = getattr(node, "pairs_reason", None)  # no pairs were sought (a loop gap without reference poses)
+        if isinstance(unsought, str):
+            return unsought
         node = getattr(node, part, None)
     return reason
 

@@ -321,3 +321,23 @@ def test_updates_and_orientation_nulls_say_why() -> None:
     assert METRIC_COLUMNS["orientation_deg"].reason(record) == (
         "no stop point where the start's bearing is defined (none 1 m or more from the start)"
     )
+
+
+def test_a_closed_route_without_reference_says_why_it_has_no_revisit_gap() -> None:
+    from albot1.bench.grid import Cell
+    from albot1.metrics.loop_gap import route_gap
+    from albot1.report.collect import CellRecord
+
+    loop_gap = {
+        "units": {"gap": "m", "heading": "deg"},
+        "alignment": "none (relative poses)",
+        "route": route_gap(np.zeros((3, 3)), None),
+        "pairs": None,
+        "pairs_reason": NO_REFERENCE,
+    }
+    metrics = parse_record(MetricsRecord, {"run": RUN, "loop_gap": loop_gap}, "m")
+    cell = Cell("s", "d", "d", "m", "m", "p", "none", 0, "k", "v", 1, 1)
+    record = CellRecord(cell, "done", Path("/nonexistent"), None, metrics, None)
+    assert METRIC_COLUMNS["loop_gap_m"].value(record) == 0.0
+    assert METRIC_COLUMNS["revisit_gap_m"].value(record) is None
+    assert METRIC_COLUMNS["revisit_gap_m"].reason(record) == NO_REFERENCE
