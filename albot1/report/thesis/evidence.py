@@ -131,11 +131,25 @@ class Evidence:
         if value is None:
             counter = path.removeprefix(COUNTERS)
             if counter != path and lookup.record.metrics is not None and lookup.record.metrics.get(UPDATES) is not None:
-                reason = f"the run reports no counter {counter!r} (its method or version does not count it)"
+                reason = _absent_counter_reason(lookup.record, counter)
             else:
                 reason = column.reason(lookup.record) or "no value"
             return Number(label, None, unit, reason)
         return Number(label, value, unit)
+
+
+def _absent_counter_reason(record: CellRecord, counter: str) -> str:
+    """Why a run's counters lack ``counter``: the places metric's words for an exit-prediction counter, else plain.
+
+    A network of places counts its exit predictions (``exit_predictions_compared``,
+    ``exit_prediction_aligned_mean_m``, ...) only when it compared one; then the places metric says why none was
+    (no place recognised, the run ended first, ...), and "does not count it" would be untrue.
+    """
+    places = record.metrics.get(PLACES) if record.metrics is not None else None
+    exits = places.exits if places is not None else None
+    if counter.startswith("exit_prediction") and exits is not None and exits.exit_predictions_reason:
+        return exits.exit_predictions_reason
+    return f"the run reports no counter {counter!r} (its method or version does not count it)"
 
 
 def metric_column(path: str) -> Column | None:
