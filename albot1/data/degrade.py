@@ -94,13 +94,18 @@ class Degradation:
 
     @property
     def spec(self) -> str:
+        """The canonical SPEC (in the odometry source's label and the dropout's metadata).
+
+        12 significant digits (``:g`` kept 6: ``gauss:0.1234567:1`` read ``gauss:0.123457:1``, a level not run),
+        which hides the degree -> radian -> degree round-off and nothing a SPEC would be written with.
+        """
         if self.kind in ("none", "thesis"):
             return self.kind
         if self.kind == "dropout":
-            return f"dropout:{self.a:g}"
+            return f"dropout:{self.a:.12g}"
         if self.kind == "offset":
-            return f"offset:{self.a:g}:{self.c:g}:{math.degrees(self.b):g}"
-        return f"{self.kind}:{self.a:g}:{math.degrees(self.b):g}"
+            return f"offset:{self.a:.12g}:{self.c:.12g}:{math.degrees(self.b):.12g}"
+        return f"{self.kind}:{self.a:.12g}:{math.degrees(self.b):.12g}"
 
     @property
     def seeded(self) -> bool:
@@ -232,7 +237,9 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
             yield replace(frame, odometry=current)
 
     source = sequence.metadata.odometry_source or "odometry"
-    meta = replace(sequence.metadata, odometry_source=f"{source} degraded {deg.spec} seed {seed}")
+    # A deterministic SPEC names no seed: every seed gives this odometry, and a label naming one would say otherwise.
+    seeded = f" seed {seed}" if deg.seeded else ""
+    meta = replace(sequence.metadata, odometry_source=f"{source} degraded {deg.spec}{seeded}")
     return sequence.with_frames(frames, metadata=meta, scan_count=sequence.known_scan_count)
 
 

@@ -88,6 +88,22 @@ def test_minus_zero_is_zero_in_the_label() -> None:
     assert parse_spec(" gauss: 0.1 : 1 ").spec == "gauss:0.1:1"
 
 
+@pytest.mark.parametrize(
+    "spec", ["gauss:0.1234567:1", "bias:1234567:0.5", "offset:0.2:0.05:2.25", "dropout:0.3333333", "gauss:0.05:2"]
+)
+def test_the_label_names_the_level_that_was_run(spec: str) -> None:
+    assert parse_spec(spec).spec == spec
+    label = degrade(_mounted(np.zeros((2, 3)), (0.0, 0.0, 0.0)), spec, seed=4)
+    named = label.metadata.extra.get("scan_dropout") or label.metadata.odometry_source
+    assert named.endswith(f"{spec} seed 4" if parse_spec(spec).seeded else f"degraded {spec}")
+
+
+@pytest.mark.parametrize("spec", ["thesis", "bias:0.02:0.5", "offset:0.2:0.05:2"])
+def test_a_deterministic_degradation_claims_no_seed(spec: str) -> None:
+    seq = degrade(_mounted(np.zeros((2, 3)), (0.0, 0.0, 0.0)), spec, seed=7)
+    assert seq.metadata.odometry_source == f"odometry degraded {parse_spec(spec).spec}"
+
+
 FINITE = st.floats(-100, 100, allow_nan=False).filter(lambda v: v != 0)
 
 
