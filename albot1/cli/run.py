@@ -64,7 +64,8 @@ def run(
     # Bad arguments fail before the log is opened and the method runs, not after.
     overrides = parse_overrides(set_ or [])
     check_seed(seed)
-    parse_spec(degrade)
+    # Recorded in its one spelling: `GAUSS:0.10:1` and `gauss:0.1:1` are one run key, one table row (as in a suite).
+    degrade = parse_spec(degrade).spec
     if limit is not None and limit < 1:
         raise SliceError(f"--limit {limit}: expected a positive number of scans (at least 1)")
     writable_folder(out, "--out")

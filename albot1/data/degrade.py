@@ -147,12 +147,15 @@ class Degradation:
 _NUMBER = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
 
 
-def parse_spec(spec: str) -> Degradation:
+def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
     """Parse a SPEC string (see module doc); DegradationSpecError says what is expected.
 
     A SPEC that would change nothing (every value 0, or so small it rounds
     to 0) is refused: its runs would be scored and tabled as a degraded level
-    while they repeat the undegraded run (write ``none`` for that).
+    while they repeat the undegraded run (write ``none`` for that). ``stored``:
+    the SPEC of a run already made (``result.json``), read back to reopen or
+    order it; a no-op is accepted there, so runs made before it was refused
+    stay readable.
     """
     text = spec.strip().lower()
     if text in ("", "none"):
@@ -187,7 +190,7 @@ def parse_spec(spec: str) -> Degradation:
         deg = Degradation(kind, values[0], math.radians(values[2]), values[1])
     else:
         deg = Degradation(kind, values[0], math.radians(values[1]) if len(values) > 1 else 0.0)
-    if not (deg.a or deg.b or deg.c):
+    if not (stored or deg.a or deg.b or deg.c):
         raise DegradationSpecError(
             f"degradation {spec!r} changes nothing (every value is 0): its runs would repeat the undegraded run "
             f"under a degraded label; write none"

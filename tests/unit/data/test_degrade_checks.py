@@ -2,19 +2,23 @@
 
 from __future__ import annotations
 
+import json
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from albot1.bench.suite import _check_degradations
 from albot1.cli.app import main
-from albot1.data.degrade import DegradationSpecError, degrade, parse_spec
+from albot1.data.degrade import Degradation, DegradationSpecError, degrade, parse_spec
 from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
 from albot1.data.transforms import sensor_frame
 from albot1.geometry import se2
+from albot1.report.collect import severity_order
 
 ANGLES = np.radians(np.arange(-90.0, 91.0))
 
@@ -137,3 +141,28 @@ def test_albot1_run_refuses_a_bad_degradation_before_opening_the_log(
         "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG, bias:DX_M:DTHETA_DEG, "
         "offset:DX_M:DY_M:DTHETA_DEG or dropout:P"
     ]
+
+
+def test_a_stored_run_of_a_no_op_spec_stays_readable() -> None:
+    assert parse_spec("gauss:0:0", stored=True) == Degradation("gauss")
+    assert severity_order(["dropout:0", "gauss:0.1:1", "none"]) == ["none", "gauss:0.1:1", "dropout:0"]
+
+
+def test_a_spec_written_two_ways_is_one_run_key(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folders = []
+    for spelling in (" GAUSS:0.10:1.0 ", "gauss:0.1:1"):
+        args = ["albot1", "run", "odometry", "synthetic-corridor[:4]", "--degrade", spelling]
+        monkeypatch.setattr(sys, "argv", [*args, "--out", str(tmp_path), "--json"])
+        with pytest.raises(SystemExit) as info:
+            main()
+        assert info.value.code == 0
+        summary = json.loads(capsys.readouterr().out)
+        assert summary["degradation"] == "gauss:0.1:1"
+        folders.append(summary["run_dir"])
+    assert folders[0] == folders[1]
+
+
+def test_a_suite_records_its_degradations_in_their_one_spelling() -> None:
+    assert _check_degradations(("GAUSS:0.10:1.0", "bias:-0:0.5", "thesis")) == ("gauss:0.1:1", "bias:0:0.5", "thesis")
