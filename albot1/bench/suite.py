@@ -391,7 +391,11 @@ _Seeds = TypeVar("_Seeds", tuple[int, ...], tuple[int, ...] | None)
 
 def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
     """Each spec valid, and none twice: a repeated one, or one written two ways (``gauss:0.05:2`` and
-    ``gauss:0.050:2.0``), would plan its cells twice, and a report would weight its seeds twice."""
+    ``gauss:0.050:2.0``), would plan its cells twice, and a report would weight its seeds twice.
+
+    Returned in their canonical spelling (``Degradation.spec``), as ``albot1 run`` records them: ``GAUSS:0.10:1``
+    in a suite and ``gauss:0.1:1`` on the command line are one level, one run key and one table row.
+    """
     seen: dict[object, str] = {}
     for spec in specs:
         try:
@@ -401,7 +405,7 @@ def _check_degradations(specs: tuple[str, ...]) -> tuple[str, ...]:
         if parsed in seen:
             raise ValueError(f"{spec!r} repeats {seen[parsed]!r} (the same perturbation): list each once")
         seen[parsed] = spec
-    return specs
+    return tuple(parse_spec(spec).spec for spec in specs)
 
 
 def _check_seeds(seeds: _Seeds) -> _Seeds:

@@ -52,7 +52,7 @@ def run(
       albot1 run gtsam-graph intel-corrected --degrade gauss:0.1:1 --seed 1
     """
     # The layers that do the work are imported by the command, not by this module: see albot1.cli.app.
-    from albot1.data.degrade import check_seed
+    from albot1.data.degrade import check_seed, parse_spec
     from albot1.data.errors import SliceError
     from albot1.data.open import canonical_reference, open_sequence
     from albot1.methods.registry import parse_overrides
@@ -64,6 +64,8 @@ def run(
     # Bad arguments fail before the log is opened and the method runs, not after.
     overrides = parse_overrides(set_ or [])
     check_seed(seed)
+    # Recorded in its one spelling: `GAUSS:0.10:1` and `gauss:0.1:1` are one run key, one table row (as in a suite).
+    degrade = parse_spec(degrade).spec
     if limit is not None and limit < 1:
         raise SliceError(f"--limit {limit}: expected a positive number of scans (at least 1)")
     writable_folder(out, "--out")

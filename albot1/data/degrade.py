@@ -21,9 +21,13 @@ pose, which is how odometry error arises physically. SPEC strings
 ``offset:DX_M:DY_M:DTHETA_DEG``
     a wrong laser offset: the odometry is reported for a frame displaced by
     (dx, dy, dtheta) from where the scans are taken (a mounting the method
-    does not know). Each step becomes ``inv(D) * step * D``, so a turn in
-    place reads as a small arc and a straight step keeps its length but not
-    its direction when dtheta is not 0. Deterministic.
+    does not know). Each step of the scanner becomes ``inv(D) * step * D``
+    (D in the scanner's frame: on a robot whose scanner sits at a
+    ``sensor_offset`` S, the robot's odometry steps are conjugated by
+    ``S * D * inv(S)``, so the methods, which see the scanner's trajectory,
+    get exactly that), so a turn in place reads as a small arc and a straight
+    step keeps its length but not its direction when dtheta is not 0.
+    Deterministic.
 ``dropout:P``
     scan dropout: every scan after the first is left out with probability
     ``P`` (0 <= P < 1), independently; the kept frames are renumbered from 0
@@ -33,6 +37,13 @@ pose, which is how odometry error arises physically. SPEC strings
 
 ``offset`` and ``dropout`` are the suite's perturbations of the sensor set-up
 rather than of the odometry's noise (issue 21: robustness on held-out logs).
+A slice in the dataset's name (``NAME[::3]``, ``NAME[:N]``) is applied
+first: a degradation acts on the steps between the scans the slice kept
+(``bias:0.02:0.5`` on ``[::3]`` adds 0.02 m per three-scan step). Every
+value is per step, not per metre or per second: ``gauss`` and ``thesis``
+move a robot that stands still. A SPEC whose values are all 0 is refused
+(it would repeat the undegraded run under a degraded label).
+
 Otherwise only the odometry changes; scans, reference poses and relations are
 kept. The random stream is a ``numpy.random.default_rng(seed)`` re-created for
 every iteration, so a re-read of the sequence gives the same result.
@@ -41,6 +52,7 @@ every iteration, so a re-read of the sequence gives the same result.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
@@ -51,12 +63,16 @@ from albot1.data.finite import pose_problem
 from albot1.data.model import Frame, Sequence
 from albot1.geometry import se2
 
-EXPECTED_SPEC = (
-    "expected none, thesis, gauss:SIGMA_XY_M:SIGMA_THETA_DEG, bias:DX_M:DTHETA_DEG, "
-    "offset:DX_M:DY_M:DTHETA_DEG or dropout:P"
-)
+#: kind -> the form of its SPEC (each error names the one it expected)
+_FORM = {
+    "gauss": "gauss:SIGMA_XY_M:SIGMA_THETA_DEG",
+    "bias": "bias:DX_M:DTHETA_DEG",
+    "offset": "offset:DX_M:DY_M:DTHETA_DEG",
+    "dropout": "dropout:P",
+}
+EXPECTED_SPEC = f"expected none, thesis, {', '.join(list(_FORM.values())[:-1])} or {_FORM['dropout']}"
 #: kind -> how many values its SPEC carries after the kind
-_ARITY = {"gauss": 2, "bias": 2, "offset": 3, "dropout": 1}
+_ARITY = {kind: form.count(":") for kind, form in _FORM.items()}
 #: The metadata ``extra`` key a dropout sets ("dropout:P seed S"): the scans are a thinned subset of the source's.
 SCAN_DROPOUT = "scan_dropout"
 #: Seeds are what ``numpy.random.default_rng`` accepts and a suite's TOML integer can hold: 0 .. 2**63 - 1.
@@ -78,21 +94,34 @@ class Degradation:
 
     @property
     def spec(self) -> str:
+        """The canonical SPEC (in the odometry source's label and the dropout's metadata).
+
+        12 significant digits (``:g`` kept 6: ``gauss:0.1234567:1`` read ``gauss:0.123457:1``, a level not run),
+        which hides the degree -> radian -> degree round-off and nothing a SPEC would be written with.
+        """
         if self.kind in ("none", "thesis"):
             return self.kind
         if self.kind == "dropout":
-            return f"dropout:{self.a:g}"
+            return f"dropout:{self.a:.12g}"
         if self.kind == "offset":
-            return f"offset:{self.a:g}:{self.c:g}:{math.degrees(self.b):g}"
-        return f"{self.kind}:{self.a:g}:{math.degrees(self.b):g}"
+            return f"offset:{self.a:.12g}:{self.c:.12g}:{math.degrees(self.b):.12g}"
+        return f"{self.kind}:{self.a:.12g}:{math.degrees(self.b):.12g}"
 
     @property
     def seeded(self) -> bool:
         """Whether the result depends on the seed (otherwise every seed repeats one run)."""
         return (self.kind == "gauss" and not self.a == self.b == 0.0) or (self.kind == "dropout" and self.a > 0)
 
-    def perturb(self, step: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        """One degraded increment ``(dx, dy, dtheta)``."""
+    def perturb(
+        self, step: np.ndarray, rng: np.random.Generator, sensor_offset: np.ndarray | None = None
+    ) -> np.ndarray:
+        """One degraded increment ``(dx, dy, dtheta)`` of the robot's odometry.
+
+        ``sensor_offset``: where the scanner sits on the robot (``metadata.sensor_offset``). ``offset``'s
+        displacement is seen from the scanner, so on the robot it is ``S * D * inv(S)``: the method, which
+        sees the odometry moved onto the scanner (``transforms.sensor_frame``), then gets ``inv(D) * M * D``
+        for the scanner's own step ``M``, whatever the mounting.
+        """
         dx, dy, dth = step
         if self.kind == "thesis":
             dist = math.hypot(dx, dy)
@@ -108,37 +137,65 @@ class Degradation:
             return np.array([dx + self.a, dy, dth + self.b])
         if self.kind == "offset":
             mount = np.array([self.a, self.c, self.b])
+            if sensor_offset is not None and np.any(sensor_offset):
+                mount = se2.compose(se2.compose(sensor_offset, mount), se2.inverse(sensor_offset))
             return se2.compose(se2.compose(se2.inverse(mount), np.asarray(step, dtype=float)), mount)
         return np.asarray(step, dtype=float)
 
 
-def parse_spec(spec: str) -> Degradation:
-    """Parse a SPEC string (see module doc); DegradationSpecError says what is expected."""
+#: A value: a plain ASCII decimal or exponent number (no ``1_000``, unicode minus or digits, ``nan``).
+_NUMBER = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
+
+
+def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
+    """Parse a SPEC string (see module doc); DegradationSpecError says what is expected.
+
+    A SPEC that would change nothing (every value 0, or so small it rounds
+    to 0) is refused: its runs would be scored and tabled as a degraded level
+    while they repeat the undegraded run (write ``none`` for that). ``stored``:
+    the SPEC of a run already made (``result.json``), read back to reopen or
+    order it; a no-op is accepted there, so runs made before it was refused
+    stay readable.
+    """
     text = spec.strip().lower()
     if text in ("", "none"):
         return Degradation("none")
     if text == "thesis":
         return Degradation("thesis", 0.1, math.radians(1.0))
     kind, _, rest = text.partition(":")
-    parts = rest.split(":") if rest else []
-    if kind not in _ARITY or len(parts) != _ARITY[kind]:
-        raise DegradationSpecError(f"degradation {spec!r} not understood; {EXPECTED_SPEC}")
-    try:
-        values = [float(part) for part in parts]
-    except ValueError:
-        raise DegradationSpecError(f"degradation {spec!r}: the values must be numbers; {EXPECTED_SPEC}") from None
-    if not all(math.isfinite(v) for v in values) or (kind == "gauss" and min(values) < 0):
-        raise DegradationSpecError(f"degradation {spec!r}: values must be finite (and sigmas >= 0); {EXPECTED_SPEC}")
-    if kind == "dropout":
-        if not 0.0 <= values[0] < 1.0:
-            raise DegradationSpecError(
-                f"degradation {spec!r}: the dropout probability must be in [0, 1) (the first scan is always kept); "
-                f"{EXPECTED_SPEC}"
-            )
-        return Degradation(kind, values[0])
+    if kind not in _ARITY:
+        raise DegradationSpecError(f"degradation {spec!r} not understood (unknown kind {kind!r}); {EXPECTED_SPEC}")
+    parts = [part.strip() for part in rest.split(":")] if rest else []
+    if len(parts) != _ARITY[kind]:
+        raise DegradationSpecError(
+            f"degradation {spec!r}: {kind} takes {_ARITY[kind]} value(s) ({_FORM[kind]}), got {len(parts)}; "
+            f"{EXPECTED_SPEC}"
+        )
+    bad = next((part for part in parts if not _NUMBER.fullmatch(part)), None)
+    if bad is not None:
+        raise DegradationSpecError(
+            f"degradation {spec!r}: value {bad!r} is not a plain finite number ({_FORM[kind]}); {EXPECTED_SPEC}"
+        )
+    values = [float(part) + 0.0 for part in parts]  # + 0.0: -0 is 0 (one spelling, one key)
+    if not all(math.isfinite(v) for v in values):  # 1e999
+        raise DegradationSpecError(f"degradation {spec!r}: values must be finite ({_FORM[kind]}); {EXPECTED_SPEC}")
+    if kind == "gauss" and min(values) < 0:
+        raise DegradationSpecError(f"degradation {spec!r}: sigmas must be >= 0 ({_FORM[kind]}); {EXPECTED_SPEC}")
+    if kind == "dropout" and not 0.0 <= values[0] < 1.0:
+        raise DegradationSpecError(
+            f"degradation {spec!r}: the dropout probability must be in [0, 1) (the first scan is always kept); "
+            f"{EXPECTED_SPEC}"
+        )
     if kind == "offset":
-        return Degradation(kind, values[0], math.radians(values[2]), values[1])
-    return Degradation(kind, values[0], math.radians(values[1]))
+        deg = Degradation(kind, values[0], math.radians(values[2]), values[1])
+    else:
+        deg = Degradation(kind, values[0], math.radians(values[1]) if len(values) > 1 else 0.0)
+    if not (stored or deg.a or deg.b or deg.c):
+        raise DegradationSpecError(
+            f"degradation {spec!r} changes nothing (every value is 0): its runs would repeat the undegraded run "
+            f"under a degraded label; write none"
+        )
+    return deg
 
 
 def check_seed(seed: object) -> int:
@@ -161,6 +218,8 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
     if deg.kind == "dropout":
         return _dropout(sequence, deg, seed)
 
+    mounting = np.asarray(sequence.metadata.sensor_offset, dtype=float)
+
     def frames(source: Iterator[Frame]) -> Iterator[Frame]:
         rng = np.random.default_rng(seed)
         prev_raw: np.ndarray | None = None
@@ -170,7 +229,7 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
                 current = np.asarray(frame.odometry, dtype=float)
             else:
                 step = se2.between(prev_raw, frame.odometry)
-                current = se2.compose(current, deg.perturb(step, rng))
+                current = se2.compose(current, deg.perturb(step, rng, mounting))
                 problem = pose_problem(current, "the degraded odometry")
                 if problem is not None:  # e.g. gauss:1e300:1 overflows: refused, never mapped
                     raise DegradationSpecError(
@@ -181,7 +240,9 @@ def degrade(sequence: Sequence, spec: str | Degradation, *, seed: int = 0) -> Se
             yield replace(frame, odometry=current)
 
     source = sequence.metadata.odometry_source or "odometry"
-    meta = replace(sequence.metadata, odometry_source=f"{source} degraded {deg.spec} seed {seed}")
+    # A deterministic SPEC names no seed: every seed gives this odometry, and a label naming one would say otherwise.
+    seeded = f" seed {seed}" if deg.seeded else ""
+    meta = replace(sequence.metadata, odometry_source=f"{source} degraded {deg.spec}{seeded}")
     return sequence.with_frames(frames, metadata=meta, scan_count=sequence.known_scan_count)
 
 

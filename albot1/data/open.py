@@ -41,7 +41,7 @@ from albot1.config.keyvalue import KeyValueError, parse_query
 from albot1.config.suggest import did_you_mean
 from albot1.data import catalog
 from albot1.data.attach import REFERENCE_KEYWORDS, with_reference, with_relations
-from albot1.data.degrade import degrade
+from albot1.data.degrade import degrade, parse_spec
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
 from albot1.data.filekind import check_input
 from albot1.data.finite import checked
@@ -136,7 +136,8 @@ def open_as_run(
     the same SPEC and seed, or it compares the run with other scans. A
     source without a seed (an external trajectory) was not degraded.
     """
-    return degrade(open_sequence(ref, settings=settings), degradation, seed=0 if seed is None else seed)
+    spec = parse_spec(degradation, stored=True)
+    return degrade(open_sequence(ref, settings=settings), spec, seed=0 if seed is None else seed)
 
 
 def _checksums(path: Path | None, options: dict[str, Any]) -> dict[str, str]:

@@ -315,7 +315,7 @@ def severity_order(levels: list[str]) -> list[str]:
     rank = {"none": 0, "gauss": 1, "bias": 2, "thesis": 3, "offset": 4, "dropout": 5}
 
     def key(level: str) -> tuple[int, float, float]:
-        spec = parse_spec(level)
+        spec = parse_spec(level, stored=True)
         return rank.get(spec.kind, 6), spec.a, spec.b
 
     return sorted(levels, key=key)

@@ -113,8 +113,8 @@ def write_index(
         "",
         "## Grid",
         "",
-        f"- seeds: {', '.join(map(str, plan.seeds))} (the deterministic degradations `none`, `thesis` and "
-        "`bias:...` run with the first seed only: every seed would repeat the same run)",
+        f"- seeds: {', '.join(map(str, plan.seeds))} (the deterministic degradations `none`, `thesis`, "
+        "`bias:...` and `offset:...` run with the first seed only: every seed would repeat the same run)",
         f"- degradations: {', '.join(code(d) for d in plan.degradations)} "
         "(`none` = the dataset's own odometry; swept ones only on datasets with reference poses)",
         f"- datasets: {', '.join(text(d) for d in dict.fromkeys(r.cell.dataset_label for r in records)) or '(none)'}",

@@ -118,9 +118,11 @@ def test_gauss_noise_is_zero_mean_with_the_given_sigmas() -> None:
     np.testing.assert_allclose(err.std(axis=0), sigma, rtol=0.05)
 
 
-def test_gauss_with_zero_sigmas_changes_nothing() -> None:
+def test_a_parsed_gauss_with_zero_sigmas_changes_nothing() -> None:
+    # As a SPEC it is refused (tests/unit/data/test_degrade_checks.py); built directly it is the identity.
     seq = _sequence(_route())
-    np.testing.assert_allclose(degrade(seq, "gauss:0:0", seed=1).odometry, seq.odometry, atol=1e-12)
+    np.testing.assert_allclose(degrade(seq, Degradation("gauss"), seed=1).odometry, seq.odometry, atol=1e-12)
+    assert not Degradation("gauss").seeded
 
 
 @pytest.mark.parametrize("spec", ["thesis", "gauss:0.1:3", "bias:0.2:5"])
@@ -136,7 +138,8 @@ def test_scans_reference_timestamps_relations_and_name_are_untouched(spec: str) 
         np.testing.assert_array_equal(after.reference, before.reference)
     np.testing.assert_array_equal(out.timestamps, seq.timestamps)
     assert out.metadata.source == "unit"
-    assert "degraded" in out.metadata.odometry_source and "seed 11" in out.metadata.odometry_source
+    seeded = " seed 11" if parse_spec(spec).seeded else ""  # a deterministic SPEC claims no seed
+    assert out.metadata.odometry_source == f"wheels degraded {parse_spec(spec).spec}{seeded}"
     # The input sequence's own odometry is not modified by degrading it.
     np.testing.assert_array_equal(seq.odometry, _sequence(_route()).odometry)
 
@@ -159,7 +162,7 @@ def test_a_parsed_degradation_object_is_accepted() -> None:
         ("  Thesis ", "thesis", 0.1, 1.0),
         ("gauss:0.05:2", "gauss", 0.05, 2.0),
         ("bias:-0.1:-1.5", "bias", -0.1, -1.5),
-        ("BIAS:0:0", "bias", 0.0, 0.0),
+        ("BIAS:0:0.5", "bias", 0.0, 0.5),
     ],
 )
 def test_parse_spec(text: str, kind: str, a: float, b_deg: float) -> None:
@@ -273,5 +276,5 @@ def test_scan_dropout_keeps_the_first_scan_renumbers_and_repeats_with_its_seed()
         np.testing.assert_array_equal(frame.reference, source.reference)
         np.testing.assert_array_equal(frame.scan.ranges, source.scan.ranges)
     assert degrade(seq, "dropout:0.5", seed=3).metadata.extra["scan_dropout"] == "dropout:0.5 seed 3"
-    assert len(list(degrade(seq, "dropout:0", seed=3).frames())) == 41
-    assert parse_spec("dropout:0.25").seeded and not parse_spec("dropout:0").seeded
+    assert len(list(degrade(seq, Degradation("dropout"), seed=3).frames())) == 41
+    assert parse_spec("dropout:0.25").seeded and not Degradation("dropout").seeded

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.suite import find_suite
+from albot1.data.degrade import parse_spec
 from albot1.report import generalisation, standard
 from albot1.report.collect import CellRecord
 from albot1.report.generalisation import Comparison
@@ -73,3 +74,23 @@ def test_the_index_says_how_to_resume_cells_not_run_into_the_same_results_folder
         f"The runner stopped before these cells finished; run `albot1 bench quick --results {tmp_path}/elsewhere` again"
     )
     assert line in index.read_text()
+
+
+def test_the_index_names_every_degradation_that_runs_with_one_seed(tmp_path: Path) -> None:
+    # offset:DX:DY:DTH is as deterministic as bias: the generalisation suite runs it once, and the index said only
+    # `none`, `thesis` and `bias:...` ran with the first seed.
+    plan = _plan("quick", find_suite("quick").resolve())
+    cell = Cell("quick", "drive", "drive", "odometry", "odometry", "default", "none", 0, "k", "v", 1.0, 1.0)
+    tables = {name: tmp_path / name for name in ("metrics.md", "metrics.csv", "metrics.tex", "cost.md", "cost.csv")}
+    tables |= {name: tmp_path / name for name in ("cost.tex", "cells.csv", "cells-cost.csv")}
+    rec = CellRecord(cell, "not run", tmp_path / "runs" / "k", None, None, None)
+    seeds = next(
+        line
+        for line in write_index(plan, [rec], tables, {}, tmp_path, tmp_path).read_text().splitlines()
+        if line.startswith("- seeds: ")
+    )
+    for spec in ("thesis", "bias:0.02:0.5", "offset:0.2:0.05:2"):
+        assert not parse_spec(spec).seeded
+        kind = parse_spec(spec).kind
+        assert f"`{kind}`" in seeds or f"`{kind}:...`" in seeds
+    assert "gauss" not in seeds and "dropout" not in seeds
