@@ -54,7 +54,10 @@ def test_the_scan_limit_is_part_of_the_runs_name_and_folder(
         (["--limit", "-5"], "--limit -5: expected a positive number of scans"),
         (["--seed", "-1"], "seed -1: expected an integer from 0 to 9223372036854775807"),
         (["--seed", str(2**64)], f"seed {2**64}: expected an integer from 0"),
-        (["--degrade", "gauss:1"], "degradation 'gauss:1' not understood"),
+        (
+            ["--degrade", "gauss:1"],
+            "degradation 'gauss:1': gauss takes 2 value(s) (gauss:SIGMA_XY_M:SIGMA_THETA_DEG), got 1",
+        ),
     ],
 )
 def test_bad_arguments_are_one_line_before_anything_is_written(
