@@ -14,6 +14,7 @@ from albot1.bench.errors import SuiteError
 from albot1.bench.plan import plan_suite
 from albot1.bench.suite import load_suite
 from albot1.cli.app import app
+from albot1.config.targets import TargetError
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.methods.errors import PluginError
@@ -143,3 +144,45 @@ def test_a_malformed_entry_point_is_one_line(install_method_plugin: PluginInstal
     install_method_plugin({"broken": "no colon here"})
     with pytest.raises(PluginError, match=r"entry point 'broken' .*expected 'module:Class'"):
         method_registry()
+
+
+class DictConfigMapper(EchoMapper):
+    """A plugin whose config class is no pydantic model."""
+
+    config_model = dict  # type: ignore[assignment]
+
+
+@pytest.mark.parametrize(
+    ("source", "found"),
+    [
+        ("raise RuntimeError('no licence file')\n", "importing it raised RuntimeError: no licence file"),
+        ("import sys\nsys.exit(0)\n", "importing it raised SystemExit(0) (sys.exit)"),
+        ("import sys\nsys.exit('bye')\n", "importing it raised SystemExit('bye') (sys.exit)"),
+        ("undefined_name.attribute\n", "importing it raised NameError: name 'undefined_name' is not defined"),
+    ],
+)
+def test_a_plugin_module_that_fails_as_it_is_imported_is_one_line_naming_it(
+    install_method_plugin: PluginInstaller, source: str, found: str
+) -> None:
+    """A module raising (or calling sys.exit) at import once gave a traceback, or exit 0 with nothing done."""
+    site = install_method_plugin({"rogue": "rogue_plugin_module:Mapper"})
+    (site / "rogue_plugin_module.py").write_text(source)
+    result = CliRunner().invoke(app, ["run", "rogue", f"{WORLD}[:3]", "--out", str(site / "runs")])
+    assert isinstance(result.exception, TargetError), result.output
+    assert str(result.exception) == (
+        "method 'rogue' (plugin of albot1-test-plugin 0.1): rogue_plugin_module:Mapper: the module "
+        f"rogue_plugin_module cannot be imported: {found}"
+    )
+    sys.modules.pop("rogue_plugin_module", None)
+
+
+def test_a_plugin_whose_config_class_is_no_pydantic_model_is_one_line(
+    install_method_plugin: PluginInstaller,
+) -> None:
+    install_method_plugin({"rogue": f"{__name__}:DictConfigMapper"})
+    with pytest.raises(TargetError) as caught:
+        method_registry().get("rogue").load_class()
+    assert str(caught.value) == (
+        f"method 'rogue' (plugin of albot1-test-plugin 0.1): {__name__}:DictConfigMapper: its config_model is "
+        "<class 'dict'>; expected a pydantic BaseModel subclass (see albot1.contract.Mapper)"
+    )
