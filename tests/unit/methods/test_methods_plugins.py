@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 from typing import Any, ClassVar
@@ -186,3 +187,22 @@ def test_a_plugin_whose_config_class_is_no_pydantic_model_is_one_line(
         f"method 'rogue' (plugin of albot1-test-plugin 0.1): {__name__}:DictConfigMapper: its config_model is "
         "<class 'dict'>; expected a pydantic BaseModel subclass (see albot1.contract.Mapper)"
     )
+
+
+class ChattyMapper(EchoMapper):
+    """A plugin that prints its progress to stdout."""
+
+    def process(self, frame: Frame) -> None:
+        print(f"chatty: scan {frame.index}")
+        super().process(frame)
+
+
+def test_what_a_plugin_prints_goes_to_stderr_and_the_json_stays_one_object(
+    install_method_plugin: PluginInstaller, tmp_path: Path
+) -> None:
+    install_method_plugin({"chatty": f"{__name__}:ChattyMapper"})
+    result = CliRunner().invoke(app, ["run", "chatty", f"{WORLD}[:3]", "--out", str(tmp_path), "--json"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)  # stdout is the JSON object alone
+    assert (summary["method"], summary["scans"]) == ("chatty", 3)
+    assert result.stderr == "chatty: scan 0\nchatty: scan 1\nchatty: scan 2\n"
