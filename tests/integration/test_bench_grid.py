@@ -281,18 +281,25 @@ name = "fault"
 label = "fault:os-exit"
 set = {{ mode = "os-exit", at_scan = 2 }}
 
+[[methods]]
+name = "fault"
+label = "fault:interrupt"
+set = {{ mode = "interrupt", at_scan = 2 }}
+
 [[datasets]]
 name = "{WORLD}[:6]"
 """
 
 
 def test_a_method_ending_its_cell_process_is_a_failed_cell_with_its_reason(tmp_path: Path) -> None:
-    """sys.exit(0) in a method once read as 'finished but left no complete run'; the rest of the grid completes."""
+    """sys.exit(0) in a method once read as 'finished but left no complete run', a KeyboardInterrupt it raised as
+    Ctrl-C; the rest of the grid completes."""
     plan, summary, store = run(suite_file(tmp_path, ENDING, name="ending"), tmp_path / "results", jobs=1)
     assert {o.method_label: o.status for o in summary.outcomes} == {
         "odometry": "done",
         "fault:exit": "failed",
         "fault:os-exit": "failed",
+        "fault:interrupt": "failed",
     }
     reasons = {o.method_label: (o.kind, o.reason) for o in summary.failures}
     assert reasons["fault:exit"] == (
@@ -301,6 +308,10 @@ def test_a_method_ending_its_cell_process_is_a_failed_cell_with_its_reason(tmp_p
         "it to return, or to raise an exception for a failure (a method may not end the process)",
     )
     assert reasons["fault:os-exit"][0] == "exception" and "a method calling os._exit(0)?" in reasons["fault:os-exit"][1]
+    assert reasons["fault:interrupt"] == (  # a KeyboardInterrupt the method raised is no Ctrl-C
+        "exception",
+        "KeyboardInterrupt: raised in the cell without a Ctrl-C (no SIGINT reached it): by the method?",
+    )
     for cell in plan.cells:
         failed = store.run_dir(cell.key) / "FAILED.json"
         assert failed.exists() == cell.method_label.startswith("fault"), cell.method_label
