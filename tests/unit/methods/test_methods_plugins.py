@@ -206,3 +206,27 @@ def test_what_a_plugin_prints_goes_to_stderr_and_the_json_stays_one_object(
     summary = json.loads(result.stdout)  # stdout is the JSON object alone
     assert (summary["method"], summary["scans"]) == ("chatty", 3)
     assert result.stderr == "chatty: scan 0\nchatty: scan 1\nchatty: scan 2\n"
+
+
+@pytest.mark.parametrize("name", ["kiss_icp", "KISS-ICP", "Odometry"])
+def test_a_plugin_may_not_take_a_built_in_methods_variables(install_method_plugin: PluginInstaller, name: str) -> None:
+    """A plugin `kiss_icp` read ALBOT1_KISS_ICP_* (the built-in kiss-icp's variables) and ran for a suite's typo."""
+    install_method_plugin({name: f"{__name__}:EchoMapper"})
+    builtin = "odometry" if name == "Odometry" else "kiss-icp"
+    prefix = "ALBOT1_ODOMETRY_" if name == "Odometry" else "ALBOT1_KISS_ICP_"
+    with pytest.raises(PluginError) as caught:
+        method_registry()
+    assert str(caught.value) == (
+        f"entry point {name!r} of albot1-test-plugin 0.1 (group albot1.methods) takes the name {builtin!r} of a "
+        f"built-in method as {prefix}* variables; the plugin must choose another name"
+    )
+
+
+def test_two_plugins_may_not_share_their_variables(install_method_plugin: PluginInstaller) -> None:
+    install_method_plugin({"my-slam": f"{__name__}:EchoMapper", "my_slam": f"{__name__}:EchoMapper"})
+    with pytest.raises(PluginError) as caught:
+        method_registry()
+    assert str(caught.value) == (
+        "methods 'my-slam' (albot1-test-plugin 0.1) and 'my_slam' (albot1-test-plugin 0.1) of group albot1.methods "
+        "would read the same ALBOT1_MY_SLAM_* variables; one must choose another name"
+    )
