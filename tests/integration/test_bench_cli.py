@@ -112,7 +112,8 @@ def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(tmp
     assert done.returncode == 1, done.stderr
     assert done.stderr.strip().splitlines() == [
         f"albot1: error: {suite}: invalid suite: methods.1 ('fault'): invalid config for method 'fault' (preset "
-        "'default'): mode: Input should be 'ok', 'slow', 'raise', 'hang', 'memory' or 'crash', found nonsense "
+        "'default'): mode: Input should be 'ok', 'slow', 'raise', 'hang', 'memory', 'crash', 'exit', 'os-exit' or "
+        "'interrupt', found nonsense "
         "(from set)"
     ]
 
