@@ -230,3 +230,19 @@ def test_two_plugins_may_not_share_their_variables(install_method_plugin: Plugin
         "methods 'my-slam' (albot1-test-plugin 0.1) and 'my_slam' (albot1-test-plugin 0.1) of group albot1.methods "
         "would read the same ALBOT1_MY_SLAM_* variables; one must choose another name"
     )
+
+
+def test_what_a_plugin_module_prints_on_import_stays_out_of_the_bench_plan_table(
+    install_method_plugin: PluginInstaller, tmp_path: Path
+) -> None:
+    site = install_method_plugin({"banner": "banner_plugin_module:Mapper"})
+    (site / "banner_plugin_module.py").write_text(
+        f"print('banner plugin 1.0 loaded')\nfrom {__name__} import EchoMapper as Mapper\n"
+    )
+    suite = tmp_path / "banner.toml"
+    suite.write_text(f'[[methods]]\nname = "banner"\n\n[[datasets]]\nname = "{WORLD}[:3]"\n')
+    result = CliRunner().invoke(app, ["bench", str(suite), "--dry-run"])
+    sys.modules.pop("banner_plugin_module", None)
+    assert result.exit_code == 0, result.output
+    assert "banner plugin" not in result.stdout and result.stdout.startswith("suite banner")
+    assert result.stderr == "banner plugin 1.0 loaded\n"
