@@ -122,9 +122,35 @@ def _write_error(run_dir: Path, kind: str, exc: BaseException) -> None:
     )
 
 
+class _Sigint:
+    """Whether SIGINT reached this cell (``watched``: the cell's handler notes it)."""
+
+    watched = False
+    received = False
+
+
+def _note_sigint() -> None:
+    """Note SIGINT before raising KeyboardInterrupt as Python does, so that Ctrl-C is told from a raised one.
+
+    A method (a third-party plugin) may raise KeyboardInterrupt itself; recorded as "interrupted (Ctrl-C)"
+    that reads as if someone had stopped the grid. Left alone when SIGINT does not raise KeyboardInterrupt
+    today (ignored, or another handler).
+    """
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        return
+
+    def note(signum: int, frame: object) -> None:
+        _Sigint.received = True
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, note)
+    _Sigint.watched = True
+
+
 def child_main(args: dict[str, Any]) -> int:
     """Run one cell; the exit code tells the supervisor how it ended (details in ``.error.json``)."""
     _die_with_parent(args.get("parent_pid"))
+    _note_sigint()
     run_dir = Path(args["runs_root"]) / args["cell"]["key"]
     try:
         _redirect_output(Path(args["log_path"]))
@@ -147,8 +173,12 @@ def _report(run_dir: Path, exc: BaseException) -> int:
         return exc.code
     if storage_error(exc) is not None:
         kind, code = "storage", EXIT_STORAGE
-    elif isinstance(exc, KeyboardInterrupt):
+    elif isinstance(exc, KeyboardInterrupt) and (_Sigint.received or not _Sigint.watched):
         kind, code = "interrupted", EXIT_INTERRUPTED
+    elif isinstance(exc, KeyboardInterrupt):  # raised by code in the cell, no Ctrl-C: that code's failure
+        raised = KeyboardInterrupt("raised in the cell without a Ctrl-C (no SIGINT reached it): by the method?")
+        raised.__cause__ = exc
+        exc, kind, code = raised, "exception", EXIT_EXCEPTION
     elif _caused_by_memory(exc):  # run_method wraps library errors in the method's error class
         kind, code = "memory", EXIT_MEMORY
     else:

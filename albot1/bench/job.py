@@ -87,7 +87,10 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
     if ended.exit_code != EXIT_OK:
         return "crash", f"the cell process exited with code {ended.exit_code} without an error report"
     if not store.is_complete(cell.key):
-        return "exception", "the cell process finished but left no complete run (DONE and metrics.json)"
+        return "exception", (
+            "the cell process exited with code 0 but left no complete run (DONE and metrics.json) and no error "
+            "report: something in it ended the process early (a method calling os._exit(0)?)"
+        )
     return None
 
 

@@ -25,6 +25,7 @@ from albot1.bench.external import external_cell
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
 from albot1.config.suggest import unknown_name_message
+from albot1.config.targets import TargetError
 from albot1.data import catalog
 from albot1.data.degrade import parse_spec
 from albot1.data.errors import DatasetNotFoundError
@@ -78,6 +79,8 @@ def _resolve(suite: Suite, entry: MethodEntry, registry: MethodRegistry) -> tupl
     """
     try:
         registry.get(entry.name).load_class()
+    except TargetError as exc:  # its message names the method (and the plugin declaring it)
+        return None, f"cannot load {exc}"
     except Exception as exc:  # the method's module itself is broken: a cell failure, not a runner crash
         return None, f"cannot load method {entry.name!r}: {type(exc).__name__}: {exc}"
     try:

@@ -18,12 +18,14 @@ of a method left out imports and warms it up itself).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import gc
 import importlib
 import logging
 import os
 import signal
+import sys
 from collections.abc import Callable, Collection, Iterable
 from typing import TYPE_CHECKING
 
@@ -157,7 +159,11 @@ def methods_to_preload() -> frozenset[str] | None:
 
 
 def _warm() -> None:
-    for failure in warm(methods=methods_to_preload()):
+    # The server shares the runner's stdout, which carries the runner's tables: what a module prints as it is
+    # imported here (a plugin's banner) goes to stderr, beside the runner's other lines.
+    with contextlib.redirect_stdout(sys.stderr):
+        failures = warm(methods=methods_to_preload())
+    for failure in failures:
         _log.warning("albot1 bench: preloading %s (each cell that needs it will fail with this reason)", failure)
     _warm_matplotlib()
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 from typing import Annotated
@@ -77,7 +78,8 @@ def bench(
     if scheduler is not None:
         executor = scheduler_executor(scheduler, executor)
     if dry_run:
-        plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
+        with contextlib.redirect_stdout(sys.stderr):  # what a method's module prints as it is imported (below)
+            plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))
         return
     # The bar (cells done of the total, with an ETA) only on a terminal: piped output and CI logs stay clean.
@@ -89,7 +91,9 @@ def bench(
         disable=not (progress and enabled()),
     )
     try:
-        with noting_interrupts(ctrl_c):
+        # What a method's module prints as the planner imports it (a plugin's banner) goes to stderr: stdout is
+        # the tables (the cells' output goes to their logs; the forkserver's preload sends it to stderr too).
+        with noting_interrupts(ctrl_c), contextlib.redirect_stdout(sys.stderr):
             plan, summary, store = run_suite(
                 suite,
                 results=results,

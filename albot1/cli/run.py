@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -76,17 +78,20 @@ def run(
     dataset = canonical_reference(dataset if limit is None else f"{dataset}[:{limit}]")
     sequence = open_sequence(dataset, settings=get_settings(data_dir=data_dir))
     sequence = with_progress(sequence, f"{method} on {dataset}", at_most=slice_bound(dataset))
-    result = run_method(
-        method,
-        sequence,
-        preset=preset,
-        overrides=overrides,
-        degradation=degrade,
-        seed=seed,
-        dataset_name=dataset,
-        # Said once, on a terminal: a method's start-up (e.g. numba compiling on a code version's first run).
-        announce=(lambda line: typer.echo(line, err=True)) if enabled() else None,
-    )
+    # What the method prints (a plugin's progress lines, a library's banner) goes to stderr: stdout carries the
+    # command's result alone, so `--json` is one JSON object a script can parse.
+    with contextlib.redirect_stdout(sys.stderr):
+        result = run_method(
+            method,
+            sequence,
+            preset=preset,
+            overrides=overrides,
+            degradation=degrade,
+            seed=seed,
+            dataset_name=dataset,
+            # Said once, on a terminal: a method's start-up (e.g. numba compiling on a code version's first run).
+            announce=(lambda line: typer.echo(line, err=True)) if enabled() else None,
+        )
     run_dir = write_run(result, out, preview=render_preview)
     mark_latest(out, run_dir)
     record = read_result(run_dir)  # the headline says what result.json says

@@ -11,6 +11,7 @@ naming the target.
 
 from __future__ import annotations
 
+import importlib
 import pkgutil
 import re
 
@@ -36,14 +37,23 @@ def resolve_target(target: str) -> object:
 
     An ImportError of the module (a missing optional dependency, a broken
     plugin) stays chained to the TargetError, so its traceback is kept for
-    whoever logs it.
+    whoever logs it; so does any other exception the module's code raises as
+    it is imported, ``SystemExit`` included (a third-party module must not end
+    the command, or exit 0 from it with nothing done).
     """
     check_target(target)
     module = target.partition(":")[0]
     try:
-        return pkgutil.resolve_name(target)
+        importlib.import_module(module)
     except ImportError as exc:
         raise TargetError(f"{target}: the module {module} cannot be imported: {exc}") from exc
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # a plugin's module that fails or calls sys.exit() as it is imported
+        what = f"SystemExit({exc.code!r}) (sys.exit)" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+        raise TargetError(f"{target}: the module {module} cannot be imported: importing it raised {what}") from exc
+    try:
+        return pkgutil.resolve_name(target)
     except AttributeError:
         raise TargetError(f"{target}: the module {module} has no attribute {target.partition(':')[2]!r}") from None
 

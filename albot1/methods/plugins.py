@@ -21,6 +21,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from importlib.metadata import EntryPoint, entry_points
 
+from albot1.config.env import method_prefix
 from albot1.config.targets import TargetError, check_target
 from albot1.methods.errors import PluginError
 
@@ -58,15 +59,31 @@ def plugin(point: EntryPoint) -> Plugin:
 
 
 def installed_plugins(builtin: Iterable[str]) -> list[Plugin]:
-    """The installed plugins' methods, by name; PluginError when one takes a built-in method's name."""
-    taken = set(builtin)
+    """The installed plugins' methods, by name; PluginError when one takes a built-in method's name.
+
+    A name is taken by its environment prefix too (``ALBOT1_<METHOD>_``, upper case, dashes as underscores,
+    :func:`albot1.config.env.method_prefix`): a plugin ``kiss_icp`` would otherwise read the variables meant
+    for the built-in ``kiss-icp`` (and a suite's typo ``kiss_icp`` would run the plugin instead of a "did you
+    mean").
+    """
+    taken = {method_prefix(name): name for name in builtin}
     seen: dict[str, EntryPoint] = {}
+    prefixes: dict[str, EntryPoint] = {}
     out = []
     for point in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda p: p.name):
-        if point.name in taken:
+        prefix = method_prefix(point.name)
+        if prefix in taken:
+            same = taken[prefix] == point.name
             raise PluginError(
                 f"entry point {point.name!r} of {_distribution(point)} (group {ENTRY_POINT_GROUP}) takes the name "
-                "of a built-in method; the plugin must choose another name"
+                + ("of a built-in method" if same else f"{taken[prefix]!r} of a built-in method as {prefix}* variables")
+                + "; the plugin must choose another name"
+            )
+        other = prefixes.setdefault(prefix, point)
+        if other.name != point.name:
+            raise PluginError(
+                f"methods {other.name!r} ({_distribution(other)}) and {point.name!r} ({_distribution(point)}) of "
+                f"group {ENTRY_POINT_GROUP} would read the same {prefix}* variables; one must choose another name"
             )
         if point.name in seen:
             if seen[point.name].value == point.value:

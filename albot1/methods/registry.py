@@ -56,6 +56,12 @@ def load_mapper_class(target: str) -> type[Mapper]:
     missing = [name for name in MAPPER_ATTRIBUTES if _static_attr(cls, name) is None]
     if missing:
         raise TargetError(f"{target}: not a mapper class, it lacks {', '.join(missing)} (see albot1.contract.Mapper)")
+    model = _static_attr(cls, "config_model")
+    if not (isinstance(model, type) and issubclass(model, BaseModel)):
+        raise TargetError(
+            f"{target}: its config_model is {model!r}; expected a pydantic BaseModel subclass "
+            "(see albot1.contract.Mapper)"
+        )
     return cast("type[Mapper]", cls)
 
 
@@ -133,7 +139,11 @@ class MethodSpec:
             raise UnknownMethodError(
                 f"method {self.name!r} is unavailable: {reason}" + (f" (install: {hint})" if hint else "")
             )
-        return load_mapper_class(self.target)
+        try:
+            return load_mapper_class(self.target)
+        except TargetError as exc:  # say which method (and which plugin's) it is, not only its class
+            origin = f" (plugin of {self.plugin})" if self.plugin is not None else ""
+            raise TargetError(f"method {self.name!r}{origin}: {exc}") from exc
 
     def load_error_class(self) -> type[Exception]:
         cls = resolve_class(self.error_class)

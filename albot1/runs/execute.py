@@ -14,6 +14,7 @@ same span as ``wall_s`` (:func:`cpu_time_s`).
 from __future__ import annotations
 
 import logging
+import numbers
 import resource
 import sys
 import time
@@ -25,9 +26,10 @@ import numpy as np
 from albot1 import versions
 from albot1.contract import MapData, MapperOutput, RunResult
 from albot1.data.degrade import degrade
-from albot1.data.model import MAX_COORDINATE_M, Frame, Sequence
+from albot1.data.model import MAX_COORDINATE_M, Frame, Scan, Sequence
 from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
+from albot1.geometry.types import FloatArray
 from albot1.methods.registry import MethodRegistry, get_method, resolve_config
 from albot1.runs.errors import RunError
 
@@ -80,42 +82,47 @@ def run_method(
     # the recorded odometry/reference are mapped back to the robot below (albot1.data.transforms.sensor_frame).
     offset = seq.metadata.sensor_offset
     seen = sensor_frame(seq)
-    mapper = spec.load_class()(config, seed=seed)
-    # The versions of the libraries the mapper has imported by now are kept from here on (the record below names
-    # what ran, not what another install put in place during the run: albot1.versions.library_versions); read
-    # before the run's clock starts, so the metadata search is not in its timings.
-    versions.library_versions()
-
-    wall_start, cpu_start = time.perf_counter(), cpu_time_s()
-    warm_up = getattr(mapper, "warm_up", None)
-    if callable(warm_up):
-        warm_up(announce)
-    startup_s = time.perf_counter() - wall_start
-    per_scan: list[int] = []
-    blind_scans = 0
-    stamps: list[float] = []
-    odometry: list[np.ndarray] = []
-    reference: list[np.ndarray] | None = []
-    index = -1
+    mapper_class = spec.load_class()
+    where = "while starting"  # where the method was, for the message of a failure
     try:
+        mapper = mapper_class(config, seed=seed)
+        # The versions of the libraries the mapper has imported by now are kept from here on (the record below
+        # names what ran, not what another install put in place during the run: albot1.versions.library_versions);
+        # read before the run's clock starts, so the metadata search is not in its timings.
+        versions.library_versions()
+
+        wall_start, cpu_start = time.perf_counter(), cpu_time_s()
+        warm_up = getattr(mapper, "warm_up", None)
+        if callable(warm_up):
+            warm_up(announce)
+        startup_s = time.perf_counter() - wall_start
+        per_scan: list[int] = []
+        blind_scans = 0
+        stamps: list[float] = []
+        odometry: list[np.ndarray] = []
+        reference: list[np.ndarray] | None = []
         for frame in seen.frames():
-            index = frame.index
-            blind = withhold_ground_truth(frame)
-            start = time.perf_counter_ns()
-            mapper.process(blind)
-            per_scan.append(time.perf_counter_ns() - start)
+            where = f"at scan {frame.index}"
+            # What the runner keeps of the frame is read before the method sees it, and the method is handed
+            # arrays of its own: a method that writes into its input alters neither the run's record (odometry,
+            # the blind-scan count) nor the sequence's frames (an in-memory sequence, the degraded odometry chain).
+            stamps.append(frame.scan.timestamp)
+            odometry.append(np.array(frame.odometry, dtype=float))
             if not frame.scan.valid().any():
                 blind_scans += 1
-            stamps.append(frame.scan.timestamp)
-            odometry.append(frame.odometry)
             if reference is not None:
                 # A reference counts only when every frame has one.
                 if frame.reference is None:
                     reference = None
                 else:
                     reference.append(frame.reference)
+            blind = withhold_ground_truth(frame)
+            start = time.perf_counter_ns()
+            mapper.process(blind)
+            per_scan.append(time.perf_counter_ns() - start)
             if on_frame is not None:
-                on_frame(index)
+                on_frame(frame.index)
+        where = "in finish"
         finish_start = time.perf_counter()
         output = mapper.finish()
         finish_s = time.perf_counter() - finish_start
@@ -127,9 +134,16 @@ def run_method(
         rest = text[len(method) :] if text.startswith(method) else f": {text}"
         raise error_class(f"{method} on {dataset}{rest}") from exc
     except Exception as exc:  # a library failed deep inside: name method, dataset and scan
-        raise error_class(f"{method} on {dataset} failed at scan {index}: {type(exc).__name__}: {exc}") from exc
+        raise error_class(f"{method} on {dataset} failed {where}: {type(exc).__name__}: {exc}") from exc
+    except KeyboardInterrupt:
+        raise  # Ctrl-C: the command stops (a bench cell records it as interrupted)
+    except BaseException as exc:  # sys.exit() or a bare BaseException: a method may not end the run
+        raise error_class(
+            f"{method} on {dataset} failed {where}: it raised {_exit_text(exc)}; expected it to return, or to "
+            "raise an exception for a failure (a method may not end the process)"
+        ) from exc
 
-    _check_output(output, len(per_scan), method, dataset, error_class)
+    output = _check_output(output, len(per_scan), method, dataset, error_class)
     note = blind_note(blind_scans, len(per_scan), method, dataset)
     if note is not None:
         log.warning(note)
@@ -201,8 +215,29 @@ def withhold_ground_truth(frame: Frame) -> Frame:
     never reach them: a mapper is given frames only). The runner keeps the
     reference for evaluation and for the method's judge (``MethodSpec.judge``),
     which run after the mapper has finished.
+
+    The arrays are the method's own: a writeable one is a copy, so a method
+    that writes into its input (a plugin clipping ranges in place) cannot
+    alter the runner's frame or the sequence the frame came from; a read-only
+    one (the beam angles a loader shares between scans) cannot be written and
+    is handed as it is (a copy would cost per scan and change its type for
+    numba's kernels).
     """
-    return frame if frame.reference is None else Frame(frame.index, frame.scan, frame.odometry)
+    scan = frame.scan
+    own = Scan(_own(scan.ranges), _own(scan.angles), scan.timestamp, scan.max_range)
+    return Frame(frame.index, own, _own(frame.odometry))
+
+
+def _own(array: FloatArray) -> FloatArray:
+    """``array`` itself when it is read-only, else a copy."""
+    return array.copy() if array.flags.writeable else array
+
+
+def _exit_text(exc: BaseException) -> str:
+    """How a BaseException that is not an Exception reads in a method's failure (``sys.exit(0)`` -> SystemExit(0))."""
+    if isinstance(exc, SystemExit):
+        return f"SystemExit({exc.code!r}) (sys.exit)"
+    return f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
 
 
 def map_problem(data: MapData) -> str | None:
@@ -224,18 +259,50 @@ def map_problem(data: MapData) -> str | None:
     return None
 
 
-def _check_output(output: MapperOutput, n: int, method: str, dataset: str, error_class: type[Exception]) -> None:
-    poses = np.asarray(output.poses, dtype=float)
-    if poses.shape != (n, 3):
+def _check_output(output: object, n: int, method: str, dataset: str, error_class: type[Exception]) -> MapperOutput:
+    """``output`` when it is what :meth:`Mapper.finish` must return, else the method's error (one line).
+
+    The run boundary checks whatever a method hands back (a third-party
+    plugin's included): a pose that a metric could not score (non-finite,
+    beyond :data:`MAX_COORDINATE_M`, complex or text) fails the run here, naming
+    the method and the scan, rather than later in an evaluation or never.
+    """
+    run = f"{method} on {dataset}"
+    if not isinstance(output, MapperOutput):
         raise error_class(
-            f"{method} on {dataset}: expected {n} poses (one per scan) of (x, y, theta), got shape {poses.shape}"
+            f"{run}: finish() returned {type(output).__name__}; expected a MapperOutput (albot1.contract)"
         )
+    expected = f"expected {n} poses (one per scan) of (x, y, theta) as real numbers"
+    try:
+        poses = np.asarray(output.poses)
+    except (TypeError, ValueError):  # ragged rows
+        raise error_class(f"{run}: the poses do not form an array (rows of unequal length?); {expected}") from None
+    if poses.dtype.kind not in "iuf":
+        raise error_class(f"{run}: the poses are of dtype {poses.dtype}; {expected}")
+    if poses.shape != (n, 3):
+        raise error_class(f"{run}: {expected}, got shape {poses.shape}")
+    poses = poses.astype(float)
     bad = np.flatnonzero(~np.isfinite(poses).all(axis=1))
     if len(bad):
-        raise error_class(f"{method} on {dataset}: {len(bad)} non-finite poses, first at scan {bad[0]} (diverged)")
+        raise error_class(f"{run}: {len(bad)} non-finite poses, first at scan {bad[0]} (diverged)")
+    far = np.flatnonzero(np.abs(poses[:, :2]).max(axis=1) > MAX_COORDINATE_M)
+    if len(far):
+        raise error_class(
+            f"{run}: {len(far)} poses beyond {MAX_COORDINATE_M:g} m, first at scan {far[0]} "
+            f"({poses[far[0]].tolist()}); expected positions of a map in metres (diverged)"
+        )
+    if not isinstance(output.map, MapData):
+        raise error_class(f"{run}: the map is {type(output.map).__name__}; expected a MapData (albot1.contract)")
     problem = map_problem(output.map)
     if problem is not None:
-        raise error_class(f"{method} on {dataset}: {problem}")
+        raise error_class(f"{run}: {problem}")
+    for name in ("counters", "extras", "files"):
+        if not isinstance(getattr(output, name), dict):
+            raise error_class(f"{run}: {name} is {type(getattr(output, name)).__name__}; expected a dict")
     for key in ("views", "updates"):
         if key not in output.counters:
-            raise RunError(f"{method} on {dataset}: counters lack the required key {key!r}")
+            raise RunError(f"{run}: counters lack the required key {key!r}")
+    for key, value in output.counters.items():
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not np.isfinite(float(value)):
+            raise error_class(f"{run}: counter {key!r} is {value!r}; expected a finite number")
+    return output

@@ -24,7 +24,7 @@ from albot1.methods.baselines.odometry import OdometryConfig, OdometryMapper
 class FaultConfig(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    mode: Literal["ok", "slow", "raise", "hang", "memory", "crash"] = "ok"
+    mode: Literal["ok", "slow", "raise", "hang", "memory", "crash", "exit", "os-exit", "interrupt"] = "ok"
     at_scan: int = 5
     sleep_s: float = 0.01
 
@@ -53,6 +53,12 @@ class FaultMapper:
                     self._hoard.append(np.ones(32 * 2**20))
             if mode == "crash":
                 os.kill(os.getpid(), signal.SIGSEGV)
+            if mode == "exit":  # a method must not end the process: the runner turns this into its error
+                raise SystemExit(0)
+            if mode == "interrupt":  # raised, not a Ctrl-C
+                raise KeyboardInterrupt
+            if mode == "os-exit":  # uncatchable: the cell ends with code 0 and no run
+                os._exit(0)
         self._inner.process(frame)
 
     def finish(self) -> MapperOutput:

@@ -14,6 +14,7 @@ import pytest
 from typer.testing import CliRunner
 
 from albot1.cli.app import app, main
+from conftest import PluginInstaller
 
 
 def test_dry_run_lists_the_planned_cells_without_running_them(tmp_path: Path) -> None:
@@ -112,7 +113,8 @@ def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(tmp
     assert done.returncode == 1, done.stderr
     assert done.stderr.strip().splitlines() == [
         f"albot1: error: {suite}: invalid suite: methods.1 ('fault'): invalid config for method 'fault' (preset "
-        "'default'): mode: Input should be 'ok', 'slow', 'raise', 'hang', 'memory' or 'crash', found nonsense "
+        "'default'): mode: Input should be 'ok', 'slow', 'raise', 'hang', 'memory', 'crash', 'exit', 'os-exit' or "
+        "'interrupt', found nonsense "
         "(from set)"
     ]
 
@@ -281,3 +283,21 @@ def test_ctrl_c_during_the_forkservers_cold_warm_up_prints_only_the_interrupted_
     ], stderr
     _, alive = psutil.wait_procs([server, *helpers], timeout=30)
     assert alive == [], f"the forkserver or its compile helpers went on after Ctrl-C: {alive}"
+
+
+def test_what_a_plugin_module_prints_on_import_stays_out_of_the_bench_tables(
+    install_method_plugin: PluginInstaller, tmp_path: Path
+) -> None:
+    """The runner's planner and the cell forkserver's preload both import the plugin; neither may print on stdout."""
+    site = install_method_plugin({"banner": "banner_plugin_module:Mapper"})
+    (site / "banner_plugin_module.py").write_text(
+        "print('banner plugin 1.0 loaded')\nfrom albot1.methods.baselines.odometry import OdometryMapper as Mapper\n"
+    )
+    suite = tmp_path / "banner.toml"
+    suite.write_text('[[methods]]\nname = "banner"\n\n[[datasets]]\nname = "synthetic-office-startstop[:3]"\n')
+    args = [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+    args += ["--results", str(tmp_path / "results"), "--no-progress"]
+    done = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=dict(os.environ))
+    assert done.returncode == 0, done.stderr
+    assert "banner plugin" not in done.stdout and done.stdout.startswith("method ")
+    assert done.stderr.count("banner plugin 1.0 loaded\n") == 2  # the planner's import and the preload's

@@ -265,3 +265,53 @@ name = "aces"
     text = build_report(store.root, tmp_path / "report", plots=False).read_text()
     assert "`aces`: not downloaded" in text and "fetch it with `albot1 datasets fetch aces`" in text
     assert "Cells: 1 planned, 1 complete, 0 failed, 0 not run." in text
+
+
+ENDING = f"""
+[[methods]]
+name = "odometry"
+
+[[methods]]
+name = "fault"
+label = "fault:exit"
+set = {{ mode = "exit", at_scan = 2 }}
+
+[[methods]]
+name = "fault"
+label = "fault:os-exit"
+set = {{ mode = "os-exit", at_scan = 2 }}
+
+[[methods]]
+name = "fault"
+label = "fault:interrupt"
+set = {{ mode = "interrupt", at_scan = 2 }}
+
+[[datasets]]
+name = "{WORLD}[:6]"
+"""
+
+
+def test_a_method_ending_its_cell_process_is_a_failed_cell_with_its_reason(tmp_path: Path) -> None:
+    """sys.exit(0) in a method once read as 'finished but left no complete run', a KeyboardInterrupt it raised as
+    Ctrl-C; the rest of the grid completes."""
+    plan, summary, store = run(suite_file(tmp_path, ENDING, name="ending"), tmp_path / "results", jobs=1)
+    assert {o.method_label: o.status for o in summary.outcomes} == {
+        "odometry": "done",
+        "fault:exit": "failed",
+        "fault:os-exit": "failed",
+        "fault:interrupt": "failed",
+    }
+    reasons = {o.method_label: (o.kind, o.reason) for o in summary.failures}
+    assert reasons["fault:exit"] == (
+        "exception",
+        f"PluginMethodError: fault on {WORLD}[:6] failed at scan 2: it raised SystemExit(0) (sys.exit); expected "
+        "it to return, or to raise an exception for a failure (a method may not end the process)",
+    )
+    assert reasons["fault:os-exit"][0] == "exception" and "a method calling os._exit(0)?" in reasons["fault:os-exit"][1]
+    assert reasons["fault:interrupt"] == (  # a KeyboardInterrupt the method raised is no Ctrl-C
+        "exception",
+        "KeyboardInterrupt: raised in the cell without a Ctrl-C (no SIGINT reached it): by the method?",
+    )
+    for cell in plan.cells:
+        failed = store.run_dir(cell.key) / "FAILED.json"
+        assert failed.exists() == cell.method_label.startswith("fault"), cell.method_label

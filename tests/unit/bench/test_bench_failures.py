@@ -301,3 +301,28 @@ def test_the_file_system_state_names_a_full_or_read_only_results_folder(
     assert job.file_system_state(tmp_path) == "no space left on device (no free inodes)"
     monkeypatch.setattr(os, "statvfs", lambda path: fake(f_flag=os.ST_RDONLY))
     assert job.file_system_state(tmp_path) == "read-only file system"
+
+
+def test_a_cell_tells_ctrl_c_from_a_keyboard_interrupt_raised_in_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A plugin raising KeyboardInterrupt was recorded as 'interrupted (SIGINT, e.g. Ctrl-C)'."""
+    monkeypatch.setattr(cell_main._Sigint, "watched", False)
+    monkeypatch.setattr(cell_main._Sigint, "received", False)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        cell_main._note_sigint()
+        assert cell_main._report(tmp_path, KeyboardInterrupt()) == cell_main.EXIT_EXCEPTION
+        raised = json.loads((tmp_path / cell_main.ERROR_FILE).read_text())
+        assert (raised["kind"], raised["type"], raised["message"]) == (
+            "exception",
+            "KeyboardInterrupt",
+            "raised in the cell without a Ctrl-C (no SIGINT reached it): by the method?",
+        )
+        with pytest.raises(KeyboardInterrupt) as caught:
+            os.kill(os.getpid(), signal.SIGINT)  # what Ctrl-C does
+            time.sleep(5)  # the handler raises at the next bytecode
+        assert cell_main._report(tmp_path, caught.value) == cell_main.EXIT_INTERRUPTED
+        assert json.loads((tmp_path / cell_main.ERROR_FILE).read_text())["kind"] == "interrupted"
+    finally:
+        signal.signal(signal.SIGINT, before)

@@ -150,7 +150,13 @@ def test_read_plan_says_what_the_path_is_when_it_is_no_folder(tmp_path: Path) ->
             "BaselineError: diverged",
         ),
         (ChildExit(1, False, 1.0), None, "crash", "exited with code 1 without an error report"),
-        (ChildExit(0, False, 1.0), None, "exception", "left no complete run"),
+        (
+            ChildExit(0, False, 1.0),
+            None,
+            "exception",
+            "the cell process exited with code 0 but left no complete run (DONE and metrics.json) and no error "
+            "report: something in it ended the process early (a method calling os._exit(0)?)",
+        ),
     ],
 )
 def test_judge_names_every_way_a_cell_can_end(

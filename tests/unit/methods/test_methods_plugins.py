@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 from typing import Any, ClassVar
@@ -14,6 +15,7 @@ from albot1.bench.errors import SuiteError
 from albot1.bench.plan import plan_suite
 from albot1.bench.suite import load_suite
 from albot1.cli.app import app
+from albot1.config.targets import TargetError
 from albot1.contract import MapData, MapperOutput
 from albot1.data.model import Frame
 from albot1.methods.errors import PluginError
@@ -143,3 +145,104 @@ def test_a_malformed_entry_point_is_one_line(install_method_plugin: PluginInstal
     install_method_plugin({"broken": "no colon here"})
     with pytest.raises(PluginError, match=r"entry point 'broken' .*expected 'module:Class'"):
         method_registry()
+
+
+class DictConfigMapper(EchoMapper):
+    """A plugin whose config class is no pydantic model."""
+
+    config_model = dict  # type: ignore[assignment]
+
+
+@pytest.mark.parametrize(
+    ("source", "found"),
+    [
+        ("raise RuntimeError('no licence file')\n", "importing it raised RuntimeError: no licence file"),
+        ("import sys\nsys.exit(0)\n", "importing it raised SystemExit(0) (sys.exit)"),
+        ("import sys\nsys.exit('bye')\n", "importing it raised SystemExit('bye') (sys.exit)"),
+        ("undefined_name.attribute\n", "importing it raised NameError: name 'undefined_name' is not defined"),
+    ],
+)
+def test_a_plugin_module_that_fails_as_it_is_imported_is_one_line_naming_it(
+    install_method_plugin: PluginInstaller, source: str, found: str
+) -> None:
+    """A module raising (or calling sys.exit) at import once gave a traceback, or exit 0 with nothing done."""
+    site = install_method_plugin({"rogue": "rogue_plugin_module:Mapper"})
+    (site / "rogue_plugin_module.py").write_text(source)
+    result = CliRunner().invoke(app, ["run", "rogue", f"{WORLD}[:3]", "--out", str(site / "runs")])
+    assert isinstance(result.exception, TargetError), result.output
+    assert str(result.exception) == (
+        "method 'rogue' (plugin of albot1-test-plugin 0.1): rogue_plugin_module:Mapper: the module "
+        f"rogue_plugin_module cannot be imported: {found}"
+    )
+    sys.modules.pop("rogue_plugin_module", None)
+
+
+def test_a_plugin_whose_config_class_is_no_pydantic_model_is_one_line(
+    install_method_plugin: PluginInstaller,
+) -> None:
+    install_method_plugin({"rogue": f"{__name__}:DictConfigMapper"})
+    with pytest.raises(TargetError) as caught:
+        method_registry().get("rogue").load_class()
+    assert str(caught.value) == (
+        f"method 'rogue' (plugin of albot1-test-plugin 0.1): {__name__}:DictConfigMapper: its config_model is "
+        "<class 'dict'>; expected a pydantic BaseModel subclass (see albot1.contract.Mapper)"
+    )
+
+
+class ChattyMapper(EchoMapper):
+    """A plugin that prints its progress to stdout."""
+
+    def process(self, frame: Frame) -> None:
+        print(f"chatty: scan {frame.index}")
+        super().process(frame)
+
+
+def test_what_a_plugin_prints_goes_to_stderr_and_the_json_stays_one_object(
+    install_method_plugin: PluginInstaller, tmp_path: Path
+) -> None:
+    install_method_plugin({"chatty": f"{__name__}:ChattyMapper"})
+    result = CliRunner().invoke(app, ["run", "chatty", f"{WORLD}[:3]", "--out", str(tmp_path), "--json"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)  # stdout is the JSON object alone
+    assert (summary["method"], summary["scans"]) == ("chatty", 3)
+    assert result.stderr == "chatty: scan 0\nchatty: scan 1\nchatty: scan 2\n"
+
+
+@pytest.mark.parametrize("name", ["kiss_icp", "KISS-ICP", "Odometry"])
+def test_a_plugin_may_not_take_a_built_in_methods_variables(install_method_plugin: PluginInstaller, name: str) -> None:
+    """A plugin `kiss_icp` read ALBOT1_KISS_ICP_* (the built-in kiss-icp's variables) and ran for a suite's typo."""
+    install_method_plugin({name: f"{__name__}:EchoMapper"})
+    builtin = "odometry" if name == "Odometry" else "kiss-icp"
+    prefix = "ALBOT1_ODOMETRY_" if name == "Odometry" else "ALBOT1_KISS_ICP_"
+    with pytest.raises(PluginError) as caught:
+        method_registry()
+    assert str(caught.value) == (
+        f"entry point {name!r} of albot1-test-plugin 0.1 (group albot1.methods) takes the name {builtin!r} of a "
+        f"built-in method as {prefix}* variables; the plugin must choose another name"
+    )
+
+
+def test_two_plugins_may_not_share_their_variables(install_method_plugin: PluginInstaller) -> None:
+    install_method_plugin({"my-slam": f"{__name__}:EchoMapper", "my_slam": f"{__name__}:EchoMapper"})
+    with pytest.raises(PluginError) as caught:
+        method_registry()
+    assert str(caught.value) == (
+        "methods 'my-slam' (albot1-test-plugin 0.1) and 'my_slam' (albot1-test-plugin 0.1) of group albot1.methods "
+        "would read the same ALBOT1_MY_SLAM_* variables; one must choose another name"
+    )
+
+
+def test_what_a_plugin_module_prints_on_import_stays_out_of_the_bench_plan_table(
+    install_method_plugin: PluginInstaller, tmp_path: Path
+) -> None:
+    site = install_method_plugin({"banner": "banner_plugin_module:Mapper"})
+    (site / "banner_plugin_module.py").write_text(
+        f"print('banner plugin 1.0 loaded')\nfrom {__name__} import EchoMapper as Mapper\n"
+    )
+    suite = tmp_path / "banner.toml"
+    suite.write_text(f'[[methods]]\nname = "banner"\n\n[[datasets]]\nname = "{WORLD}[:3]"\n')
+    result = CliRunner().invoke(app, ["bench", str(suite), "--dry-run"])
+    sys.modules.pop("banner_plugin_module", None)
+    assert result.exit_code == 0, result.output
+    assert "banner plugin" not in result.stdout and result.stdout.startswith("suite banner")
+    assert result.stderr == "banner plugin 1.0 loaded\n"
