@@ -48,11 +48,8 @@ def noting_interrupts(noted: Interrupts | None = None) -> Iterator[Interrupts]:
     (a progress view that stays quiet after Ctrl-C).
     """
     noted = Interrupts() if noted is None else noted
-    if threading.current_thread() is not threading.main_thread():
-        yield noted
-        return
     before = signal.getsignal(signal.SIGINT)
-    if before is not signal.default_int_handler:
+    if threading.current_thread() is not threading.main_thread() or before is not signal.default_int_handler:
         yield noted
         return
 
