@@ -135,9 +135,14 @@ def rogue() -> MethodRegistry:
 def test_an_output_no_metric_can_score_fails_the_run_in_one_line(
     rogue: MethodRegistry, mode: str, message: str
 ) -> None:
+    assert _failure(rogue, mode) == message
+
+
+def _failure(rogue: MethodRegistry, mode: str) -> str:
+    """The one line of the PluginMethodError a run of the rogue method in ``mode`` fails with."""
     with pytest.raises(PluginMethodError) as caught:
         run_method("rogue", _sequence(), overrides={"mode": mode}, registry=rogue)
-    assert str(caught.value) == message
+    return str(caught.value)
 
 
 EXPECTED_RETURN = "expected it to return, or to raise an exception for a failure (a method may not end the process)"
@@ -158,9 +163,7 @@ def test_a_method_that_ends_the_process_or_fails_to_start_is_a_failed_run(
     rogue: MethodRegistry, mode: str, message: str
 ) -> None:
     """``sys.exit(0)`` inside a method once ended `albot1 run` with exit 0 and no run; now it is the method's error."""
-    with pytest.raises(PluginMethodError) as caught:
-        run_method("rogue", _sequence(), overrides={"mode": mode}, registry=rogue)
-    assert str(caught.value) == message
+    assert _failure(rogue, mode) == message
 
 
 def test_ctrl_c_still_stops_the_run(rogue: MethodRegistry) -> None:
