@@ -52,12 +52,12 @@ every iteration, so a re-read of the sequence gives the same result.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
 
+from albot1.config.numbers import is_number
 from albot1.data.errors import DataError
 from albot1.data.finite import pose_problem
 from albot1.data.model import Frame, Sequence
@@ -143,8 +143,9 @@ class Degradation:
         return np.asarray(step, dtype=float)
 
 
-#: A value: a plain ASCII decimal or exponent number (no ``1_000``, unicode minus or digits, ``nan``).
-_NUMBER = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
+def _plain_finite(part: str) -> bool:
+    """A value of a SPEC: the project's one test of a number as text (no ``1_000``, unicode minus or digits), finite."""
+    return is_number(part) and math.isfinite(float(part))
 
 
 def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
@@ -171,14 +172,12 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
             f"degradation {spec!r}: {kind} takes {_ARITY[kind]} value(s) ({_FORM[kind]}), got {len(parts)}; "
             f"{EXPECTED_SPEC}"
         )
-    bad = next((part for part in parts if not _NUMBER.fullmatch(part)), None)
+    bad = next((part for part in parts if not _plain_finite(part)), None)
     if bad is not None:
         raise DegradationSpecError(
             f"degradation {spec!r}: value {bad!r} is not a plain finite number ({_FORM[kind]}); {EXPECTED_SPEC}"
         )
     values = [float(part) + 0.0 for part in parts]  # + 0.0: -0 is 0 (one spelling, one key)
-    if not all(math.isfinite(v) for v in values):  # 1e999
-        raise DegradationSpecError(f"degradation {spec!r}: values must be finite ({_FORM[kind]}); {EXPECTED_SPEC}")
     if kind == "gauss" and min(values) < 0:
         raise DegradationSpecError(f"degradation {spec!r}: sigmas must be >= 0 ({_FORM[kind]}); {EXPECTED_SPEC}")
     if kind == "dropout" and not 0.0 <= values[0] < 1.0:
