@@ -37,6 +37,8 @@ EXECUTORS_HELP = "local | dask | dask://HOST:PORT"
 #: may need more, and the test of an unreachable scheduler less: the wait is the whole of that test).
 CONNECT_TIMEOUT_S = 10.0
 CONNECT_TIMEOUT_ENV = "ALBOT1_DASK_CONNECT_TIMEOUT"
+#: Where a local Dask cluster's scheduler serves its HTTP routes: any free port, loopback only.
+LOCAL_HTTP_ADDRESS = "127.0.0.1:0"
 
 
 def connect_timeout_s() -> float:
@@ -111,8 +113,17 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
             finally:
                 client.close()
         return
+    # No dashboard; the scheduler still serves its HTTP routes (health, metrics), by default on port 8787, and
+    # warns on the user's terminal when that port is taken (a second bench, a notebook's cluster): a free port of
+    # the loopback interface instead, never reachable from another machine.
     with dask.config.set({"distributed.worker.daemon": False}):
-        cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=dask_processes, dashboard_address=None)
+        cluster = LocalCluster(
+            n_workers=jobs,
+            threads_per_worker=1,
+            processes=dask_processes,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": LOCAL_HTTP_ADDRESS},
+        )
     try:
         with Client(cluster) as client, _quiet_cancellations():
             yield client.get_executor(pure=False)

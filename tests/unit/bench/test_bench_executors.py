@@ -250,3 +250,16 @@ def test_a_halt_does_not_wait_for_a_running_cell_it_cancelled(tmp_path: Path) ->
     summary = ended[0]
     assert summary.halted == "cannot write the results: no space left"
     assert [c.key for c in summary.not_started] == ["k1", "k2"]
+
+
+def test_two_local_dask_clusters_at_once_warn_of_no_taken_port(tmp_path: Path) -> None:
+    """The scheduler's HTTP routes went to port 8787 and warned on the terminal when a second bench (or a notebook's
+    cluster) held it: each local cluster now takes a free loopback port, so nothing is printed."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with open_executor("dask", 1, dask_processes=False) as first, open_executor("dask", 1, dask_processes=False):
+            assert first.submit(sum, [1, 2]).result(timeout=60) == 3
+    taken = [str(w.message) for w in caught if "already in use" in str(w.message)]
+    assert taken == []
