@@ -77,6 +77,19 @@ def test_a_spec_that_changes_nothing_is_refused_rather_than_scored_as_degraded(s
         ("gauss:nan:1", "value 'nan' is not a plain finite number"),
         ("gauss:0.1:-1", "sigmas must be >= 0 (gauss:SIGMA_XY_M:SIGMA_THETA_DEG)"),
         ("noise:0.1:1", "not understood (unknown kind 'noise')"),
+        # a combination used to read as a miscounted SPEC ("gauss takes 2 value(s), got 4")
+        (
+            "gauss:0.02:0.5,bias:-0.03:-1",
+            "names 2 kinds (gauss, bias): a run takes one degradation, combinations are not supported",
+        ),
+        (
+            "gauss:0.02:0.5 dropout:0.5",
+            "names 2 kinds (gauss, dropout): a run takes one degradation, combinations are not supported",
+        ),
+        ("thesis+bias:0.1:1", "names 2 kinds (thesis, bias): a run takes one degradation"),
+        # a kind without values given one used to read "unknown kind 'thesis'"
+        ("thesis:1", "thesis takes no values"),
+        ("none:0", "none takes no values"),
     ],
 )
 def test_a_bad_spec_names_what_its_kind_expected(spec: str, says: str) -> None:
