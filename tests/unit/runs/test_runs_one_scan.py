@@ -42,6 +42,9 @@ def test_a_one_scan_run_has_no_ate_and_no_map_shape_with_the_reason(tmp_path: Pa
     metrics = evaluate_run(_run(tmp_path, "synthetic-office-startstop[:1]"))
     assert metrics.block("ate") is None and metrics.reason("ate") == ATE_REASON
     assert metrics.block("map_shape") is None and metrics.reason("map_shape") == MAP_REASON
+    assert metrics.reason("loop_gap") == (
+        "loop gap: 1 pose(s), so no route from a start to an end; expected at least 2 poses"
+    )  # was "expected at least 2 poses (N, 3), got shape (1, 3)", an array's shape for a one-scan run
 
 
 def test_a_two_scan_run_is_still_scored(tmp_path: Path) -> None:
