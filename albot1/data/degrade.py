@@ -42,7 +42,8 @@ first: a degradation acts on the steps between the scans the slice kept
 (``bias:0.02:0.5`` on ``[::3]`` adds 0.02 m per three-scan step). Every
 value is per step, not per metre or per second: ``gauss`` and ``thesis``
 move a robot that stands still. A SPEC whose values are all 0 is refused
-(it would repeat the undegraded run under a degraded label).
+(it would repeat the undegraded run under a degraded label), and so is a
+``bias`` or ``offset`` that only turns by whole turns (``bias:0:720``).
 
 Otherwise only the odometry changes; scans, reference poses and relations are
 kept. The random stream is a ``numpy.random.default_rng(seed)`` re-created for
@@ -206,6 +207,13 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
         raise DegradationSpecError(
             f"degradation {spec!r} changes nothing (every value is 0): its runs would repeat the undegraded run "
             f"under a degraded label; write none"
+        )
+    turn = values[-1]  # bias's and offset's rotation (deg) is their last value
+    if not stored and kind in ("bias", "offset") and not (deg.a or deg.c) and math.remainder(turn, 360.0) == 0.0:
+        # `bias:0:720` turns every step by two whole turns: the odometry is the undegraded one (to rounding)
+        raise DegradationSpecError(
+            f"degradation {spec!r} changes nothing (no translation, and {turn:g} deg is a whole number of turns): "
+            f"its runs would repeat the undegraded run under a degraded label; write none"
         )
     return deg
 
