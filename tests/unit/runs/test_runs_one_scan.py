@@ -2,7 +2,7 @@
 
 The rigid alignment puts the one pose exactly on the reference's, so `albot1 evaluate` printed
 "ate rmse 0.000 m" and "map_shape precision 1.000, coverage 1.000": perfect numbers that measure nothing.
-They are now null with that reason; the unaligned ATE (`--align none`) still measures the pose.
+They are now null with that reason; the unaligned ATE (`--trajectory ... --align none`) still measures the pose.
 """
 
 from __future__ import annotations
