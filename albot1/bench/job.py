@@ -57,6 +57,12 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
         except (OSError, json.JSONDecodeError):
             error = None
         error_path.unlink(missing_ok=True)
+    if error is None and _stopped(ended) and store.is_complete(cell.key):
+        # The kill landed after the child had written its whole result (DONE and metrics.json, each by atomic
+        # rename), while it was exiting: the cell is complete, as `albot1 report` and the next `albot1 bench`
+        # read its folder. A timeout recorded beside it made the bench print FAILED for a cell the report
+        # counted complete (a FAILED.json beside a complete result), and the reason said "no result".
+        return None
     if ended.timed_out:
         return "timeout", f"time limit exceeded: no result after {cell.time_s:g} s (killed)"
     if ended.memory_exceeded:
@@ -92,6 +98,12 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
             "report: something in it ended the process early (a method calling os._exit(0)?)"
         )
     return None
+
+
+def _stopped(ended: ChildExit) -> bool:
+    """Whether the child was stopped from outside (a limit, a lost pool, a signal) rather than exiting itself."""
+    signalled = ended.exit_code is not None and ended.exit_code < 0
+    return ended.timed_out or ended.memory_exceeded or ended.pool_lost is not None or signalled
 
 
 def file_system_state(folder: Path) -> str:

@@ -42,7 +42,8 @@ first: a degradation acts on the steps between the scans the slice kept
 (``bias:0.02:0.5`` on ``[::3]`` adds 0.02 m per three-scan step). Every
 value is per step, not per metre or per second: ``gauss`` and ``thesis``
 move a robot that stands still. A SPEC whose values are all 0 is refused
-(it would repeat the undegraded run under a degraded label).
+(it would repeat the undegraded run under a degraded label), and so is a
+``bias`` or ``offset`` that only turns by whole turns (``bias:0:720``).
 
 Otherwise only the odometry changes; scans, reference poses and relations are
 kept. The random stream is a ``numpy.random.default_rng(seed)`` re-created for
@@ -52,6 +53,7 @@ every iteration, so a re-read of the sequence gives the same result.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
@@ -73,6 +75,8 @@ _FORM = {
 EXPECTED_SPEC = f"expected none, thesis, {', '.join(list(_FORM.values())[:-1])} or {_FORM['dropout']}"
 #: kind -> how many values its SPEC carries after the kind
 _ARITY = {kind: form.count(":") for kind, form in _FORM.items()}
+#: every kind a SPEC may name (the two without values first)
+_KINDS = ("none", "thesis", *_FORM)
 #: The metadata ``extra`` key a dropout sets ("dropout:P seed S"): the scans are a thinned subset of the source's.
 SCAN_DROPOUT = "scan_dropout"
 #: Seeds are what ``numpy.random.default_rng`` accepts and a suite's TOML integer can hold: 0 .. 2**63 - 1.
@@ -163,7 +167,17 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
         return Degradation("none")
     if text == "thesis":
         return Degradation("thesis", 0.1, math.radians(1.0))
+    named = [word for word in re.findall(r"[a-z]+", text) if word in _KINDS]
+    if len(named) > 1:
+        # `gauss:0.02:0.5,bias:-0.03:-1` used to read "gauss takes 2 value(s), got 4", as if a value were missing
+        raise DegradationSpecError(
+            f"degradation {spec!r} names {len(named)} kinds ({', '.join(named)}): a run takes one degradation, "
+            f"combinations are not supported; {EXPECTED_SPEC}"
+        )
     kind, _, rest = text.partition(":")
+    if kind in ("none", "thesis"):
+        # `thesis:1` used to read "unknown kind 'thesis'"
+        raise DegradationSpecError(f"degradation {spec!r}: {kind} takes no values; {EXPECTED_SPEC}")
     if kind not in _ARITY:
         raise DegradationSpecError(f"degradation {spec!r} not understood (unknown kind {kind!r}); {EXPECTED_SPEC}")
     parts = [part.strip() for part in rest.split(":")] if rest else []
@@ -193,6 +207,13 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
         raise DegradationSpecError(
             f"degradation {spec!r} changes nothing (every value is 0): its runs would repeat the undegraded run "
             f"under a degraded label; write none"
+        )
+    turn = values[-1]  # bias's and offset's rotation (deg) is their last value
+    if not stored and kind in ("bias", "offset") and not (deg.a or deg.c) and math.remainder(turn, 360.0) == 0.0:
+        # `bias:0:720` turns every step by two whole turns: the odometry is the undegraded one (to rounding)
+        raise DegradationSpecError(
+            f"degradation {spec!r} changes nothing (no translation, and {turn:g} deg is a whole number of turns): "
+            f"its runs would repeat the undegraded run under a degraded label; write none"
         )
     return deg
 

@@ -200,6 +200,10 @@ def _exists(text: str) -> bool:
 
 #: ``REF[BODY]``: a reference followed by a slice (unless the whole text names an existing path).
 _SLICED = re.compile(r"(?P<ref>.+)\[(?P<body>[^\[\]]*)\]")
+#: ``NAME[:400]?odometry=laser-pose``: slices written before the loader options instead of after them
+_SLICED_BEFORE_QUERY = re.compile(
+    r"(?P<name>[^?\[\]]+)(?P<slices>(?:\[[^\[\]?]*\])+)\?(?P<query>[^?\[\]]+)(?P<after>(?:\[[^\[\]?]*\])*)"
+)
 
 
 def split_slice(ref: str) -> tuple[str, int | None, int | None]:
@@ -215,6 +219,14 @@ def split_slice(ref: str) -> tuple[str, int | None, int | None]:
     """
     slices: list[tuple[str, str]] = []  # (body, the reference it ends), outermost first
     text = ref
+    before = _SLICED_BEFORE_QUERY.fullmatch(ref)
+    if before is not None and not _exists(ref):
+        # The same scans as NAME?QUERY[...]: read so, so both spellings are one run key (they were two) and the
+        # canonical spelling puts the slices last. Errors still quote the reference as written.
+        text = f"{before['name']}?{before['query']}{before['slices']}{before['after']}"
+        while (sliced := _SLICED.fullmatch(text)) is not None:
+            slices.append((sliced["body"], ref))
+            text = sliced["ref"]
     while (sliced := _SLICED.fullmatch(text)) is not None and not _exists(text):
         slices.append((sliced["body"], text))
         text = sliced["ref"]

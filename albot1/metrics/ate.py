@@ -49,6 +49,13 @@ def ate(
     pairs (evo's ``--n_to_align``), named in ``alignment_transform``.
     """
     est, ref = check_pair(estimate, reference, "ATE")
+    if len(est) == 1 and alignment != "none":
+        # `NAME[:1]`, a dropout that kept one scan: the alignment puts the one pose on the reference's, so an
+        # error of 0 m and 0 deg would be a made-up perfect score, not a measurement.
+        raise MetricsError(
+            f"ATE: one pose, which the {alignment} alignment puts exactly on the reference's (its error is 0 by "
+            "construction); expected at least 2 poses"
+        )
     aligned, transform = align(est, ref, alignment, n_to_align)
     trans = np.hypot(aligned[:, 0] - ref[:, 0], aligned[:, 1] - ref[:, 1])
     rot = np.degrees(np.abs(se2.wrap(aligned[:, 2] - ref[:, 2])))

@@ -43,7 +43,10 @@ def route_gap(estimate: ArrayLike, reference: ArrayLike | None = None) -> dict[s
     """Start-to-end error (m, deg); with ``reference=None`` the route is taken as closed."""
     est = check_poses(estimate, "estimate", "loop gap")
     if len(est) < 2:
-        raise MetricsError(f"loop gap: expected at least 2 poses (N, 3), got shape {est.shape}")
+        # said "expected at least 2 poses (N, 3), got shape (1, 3)": a one-scan run read as an array of the wrong shape
+        raise MetricsError(
+            f"loop gap: {len(est)} pose(s), so no route from a start to an end; expected at least 2 poses"
+        )
     d_est = se2.between(est[0], est[-1])
     if reference is None:
         d_ref = np.zeros(3)

@@ -54,6 +54,9 @@ BEST = "best"
 NO_ERRORS = "no method has errors that could be read back, so none is the best"
 #: why the method with the lowest pooled error is not called the best: no other method's runs paired with its
 NO_EVIDENCE = "lowest pooled error, but no run of another method could be compared with its runs"
+#: why it is not called the best either when other methods' runs did pair with its, but none of those comparisons
+#: applies (fewer pairs than the test needs, say); the first of their reasons follows in parentheses
+NO_DECISION = "lowest pooled error, but no other method's comparison with its runs applies"
 
 
 @dataclass(frozen=True)
@@ -134,7 +137,7 @@ def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str,
         for method, mine in by_method.items()
     }
     if best is not None and not any(found is not None and found.applies for found in against_best.values()):
-        against_best[best] = not_applicable(NO_EVIDENCE)  # the lowest pooled error, but never paired with another's
+        against_best[best] = _unproven_best(list(against_best.values()))
     rows = []
     for method, mine in by_method.items():
         missing = next((errors[r.cell.key].missing for r in mine if errors[r.cell.key].missing), None)
@@ -153,6 +156,18 @@ def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str,
             )
         )
     return rows
+
+
+def _unproven_best(comparisons: list[Comparison | None]) -> Comparison:
+    """The best's own n/a when no comparison against it applies: never paired, or paired without a verdict.
+
+    Saying "could not be compared" of runs that were paired (3 scans each: "3 pairs, fewer than 10") would
+    give a false reason, so the reason names what the paired comparisons said.
+    """
+    paired = [found for found in comparisons if found is not None and found.pairs > 0]
+    if not paired:
+        return not_applicable(NO_EVIDENCE)
+    return not_applicable(f"{NO_DECISION} ({paired[0].reason})")
 
 
 def _cell(found: Comparison | None, role: str) -> str:
@@ -197,8 +212,8 @@ def intro() -> str:
         "error to the other's "
         f"(< 1: lower) with its {CONFIDENCE:.0%} interval; test: {method_text()}. *pairs (runs)*: the errors "
         f"paired and the pairs of runs they come from. Fewer than {MIN_PAIRS} pairs, or a run whose errors cannot "
-        "be read back, is n/a with the reason; so is the best's own cell when no other method's runs could be "
-        "compared with its. A claim that one method beats another holds only where its row says better or worse."
+        "be read back, is n/a with the reason; so is the best's own cell when no other method's comparison with "
+        "its runs applies. A claim that one method beats another holds only where its row says better or worse."
     )
 
 

@@ -96,6 +96,13 @@ def projected_scans(inputs: MetricInputs, sequence: Sequence, reference: FloatAr
 def compute(inputs: MetricInputs) -> MapShapeBlock:
     reference, load_map = inputs.reference, inputs.load_map
     assert reference is not None and load_map is not None  # REFERENCE and MAP are needs
+    if len(inputs.poses) == 1:
+        # The rigid alignment puts the one pose on the reference's, so the map is the reference map: a precision
+        # and coverage of 1 would be made up.
+        raise MetricsError(
+            "map shape: one scan, whose map the rigid alignment puts exactly on the reference map (agreement 1 by "
+            "construction); expected at least 2 scans"
+        )
     points = reference_points(inputs, reference)
     transform = rigid_transform(inputs.poses, reference)
     map_points = se2.transform_points(transform, load_map().geometry_points())

@@ -43,9 +43,20 @@ def compute(inputs: MetricInputs) -> OrientationBlock:
     return block_of(OrientationBlock, orientation_table(inputs.poses, inputs.reference, inputs.timestamps))
 
 
+#: why the bearing error is null in a computed block (the report's not-applicable note and the headline say it)
+BEARING_UNDEFINED = "no stop point where the start's bearing is defined (none 1 m or more from the start)"
+#: why every mean is null: the first scan is no stop point (the start itself), so a one-scan run has none
+NO_STOPS = "no stop point: the run has no scan after its first"
+
+
 def headline(block: OrientationBlock) -> str:
+    """The means, or n/a with the reason (a bare "n/a deg" gave none)."""
+    if block.stops == 0:
+        return NO_STOPS
+    bearing = block.bearing_abs_error_mean_deg
+    bearing_text = f"{fmt(bearing, '.2f')} deg" if bearing is not None else f"n/a ({BEARING_UNDEFINED})"
     return (
-        f"{block.stops} stops, bearing |err| mean {fmt(block.bearing_abs_error_mean_deg, '.2f')} deg, "
+        f"{block.stops} stops, bearing |err| mean {bearing_text}, "
         f"distance |err| mean {fmt(block.distance_abs_error_mean_m)} m"
     )
 
@@ -62,7 +73,7 @@ METRIC = Metric(
             "orientation_deg",
             "bearing_abs_error_mean_deg",
             "bearing error mean (deg)",
-            undefined="no stop point where the start's bearing is defined (none 1 m or more from the start)",
+            undefined=BEARING_UNDEFINED,
         ),
     ),
 )

@@ -178,3 +178,36 @@ def test_judge_accepts_a_complete_cell(tmp_path: Path) -> None:
     (run_dir / "DONE").write_text("k1\n")
     (run_dir / "metrics.json").write_text("{}")
     assert judge(make_cell(), store, ChildExit(0, False, 1.0)) is None
+
+
+@pytest.mark.parametrize(
+    "ended",
+    [
+        ChildExit(None, True, 1.04),
+        ChildExit(None, False, 1.0, memory_exceeded=True, peak_rss_mb=140.4),
+        ChildExit(-9, False, 1.0),
+        ChildExit(255, False, 1.0, pool_lost="was killed by SIGKILL"),
+    ],
+)
+def test_judge_accepts_a_cell_killed_after_its_result_was_complete(tmp_path: Path, ended: ChildExit) -> None:
+    """A kill that lands while the child exits, after DONE and metrics.json, leaves a complete cell.
+
+    `albot1 bench` used to record it as a timeout (FAILED.json beside the complete result: the bench printed
+    FAILED, "no result after 1 s", while `albot1 report` counted the cell complete).
+    """
+    store = ResultsStore(tmp_path)
+    run_dir = store.prepare(make_cell())
+    (run_dir / "DONE").write_text("k1\n")
+    (run_dir / "metrics.json").write_text("{}")
+    assert judge(make_cell(), store, ended) is None
+
+
+def test_judge_keeps_a_timeout_when_the_result_is_half_written(tmp_path: Path) -> None:
+    """DONE without metrics.json is no result: the timeout stands."""
+    store = ResultsStore(tmp_path)
+    run_dir = store.prepare(make_cell())
+    (run_dir / "DONE").write_text("k1\n")
+    assert judge(make_cell(), store, ChildExit(None, True, 1.04)) == (
+        "timeout",
+        "time limit exceeded: no result after 7 s (killed)",
+    )

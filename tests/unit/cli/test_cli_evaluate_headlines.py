@@ -7,6 +7,9 @@ import numpy as np
 from albot1.cli.evaluate import headlines
 from albot1.metrics.ate import ate
 from albot1.metrics.loop_gap import route_gap
+from albot1.metrics.measures.orientation import METRIC as ORIENTATION
+from albot1.metrics.measures.orientation import OrientationBlock
+from albot1.metrics.orientation import orientation_table
 from albot1.metrics.record import MetricsRecord
 from albot1.metrics.registry import metric_registry
 from albot1.metrics.updates import update_counts
@@ -54,3 +57,15 @@ def test_every_metric_has_a_line_in_file_order_with_its_headline_or_reason() -> 
         "  places       null: no places here",
         "  relation_box null: no relation_box here",
     ]
+
+
+def test_the_orientation_line_gives_the_reason_of_an_undefined_mean() -> None:
+    """Old code printed "0 stops, bearing |err| mean n/a deg, distance |err| mean n/a m": n/a without a reason."""
+    one = parse_record(OrientationBlock, orientation_table(np.zeros((1, 3)), np.zeros((1, 3))), "test")
+    assert ORIENTATION.headline(one) == "no stop point: the run has no scan after its first"
+    short = np.array([[0.0, 0.0, 0.0], [0.05, 0.0, 0.0], [0.1, 0.0, 0.0]])  # 0.1 m: the one stop is near the start
+    near = parse_record(OrientationBlock, orientation_table(short, short), "test")
+    assert ORIENTATION.headline(near) == (
+        "1 stops, bearing |err| mean n/a (no stop point where the start's bearing is defined (none 1 m or more "
+        "from the start)), distance |err| mean 0.000 m"
+    )

@@ -77,6 +77,19 @@ def test_a_spec_that_changes_nothing_is_refused_rather_than_scored_as_degraded(s
         ("gauss:nan:1", "value 'nan' is not a plain finite number"),
         ("gauss:0.1:-1", "sigmas must be >= 0 (gauss:SIGMA_XY_M:SIGMA_THETA_DEG)"),
         ("noise:0.1:1", "not understood (unknown kind 'noise')"),
+        # a combination used to read as a miscounted SPEC ("gauss takes 2 value(s), got 4")
+        (
+            "gauss:0.02:0.5,bias:-0.03:-1",
+            "names 2 kinds (gauss, bias): a run takes one degradation, combinations are not supported",
+        ),
+        (
+            "gauss:0.02:0.5 dropout:0.5",
+            "names 2 kinds (gauss, dropout): a run takes one degradation, combinations are not supported",
+        ),
+        ("thesis+bias:0.1:1", "names 2 kinds (thesis, bias): a run takes one degradation"),
+        # a kind without values given one used to read "unknown kind 'thesis'"
+        ("thesis:1", "thesis takes no values"),
+        ("none:0", "none takes no values"),
     ],
 )
 def test_a_bad_spec_names_what_its_kind_expected(spec: str, says: str) -> None:
@@ -166,3 +179,20 @@ def test_a_spec_written_two_ways_is_one_run_key(
 
 def test_a_suite_records_its_degradations_in_their_one_spelling() -> None:
     assert _check_degradations(("GAUSS:0.10:1.0", "bias:-0:0.5", "thesis")) == ("gauss:0.1:1", "bias:0:0.5", "thesis")
+
+
+@pytest.mark.parametrize(("spec", "turn"), [("bias:0:720", "720"), ("offset:0:0:360", "360"), ("bias:0:-360", "-360")])
+def test_a_whole_number_of_turns_without_translation_is_refused_as_changing_nothing(spec: str, turn: str) -> None:
+    """`bias:0:720` used to run and be tabled as a degraded level while its odometry was the undegraded one."""
+    with pytest.raises(DegradationSpecError) as info:
+        parse_spec(spec)
+    assert str(info.value) == (
+        f"degradation {spec!r} changes nothing (no translation, and {turn} deg is a whole number of turns): its runs "
+        "would repeat the undegraded run under a degraded label; write none"
+    )
+    assert parse_spec(spec, stored=True).kind == spec.split(":")[0]  # a run already made stays readable
+
+
+@pytest.mark.parametrize("spec", ["bias:0.01:720", "offset:0:0.1:360", "bias:0:1", "gauss:0:360"])
+def test_a_whole_turn_with_anything_else_still_degrades(spec: str) -> None:
+    assert parse_spec(spec).kind == spec.split(":")[0]

@@ -157,6 +157,10 @@ def test_nested_slices_open_the_scans_of_the_one_slice_they_make() -> None:
         ("intel[:300:2]", "intel[:300:2]"),
         ("intel[::2][:150]", "intel[:300:2]"),
         ("intel-corrected?odometry=laser-pose[::3]", "intel-corrected?odometry=laser-pose[::3]"),
+        # slices before the loader options select the same scans: one spelling, one run key (they were two)
+        ("intel-corrected[::3]?odometry=laser-pose", "intel-corrected?odometry=laser-pose[::3]"),
+        ("intel-corrected[:400]?odometry=laser-pose[:10]", "intel-corrected?odometry=laser-pose[:10]"),
+        ("intel-corrected[:400][::2]?odometry=laser-pose", "intel-corrected?odometry=laser-pose[:400:2]"),
     ],
 )
 def test_canonical_reference_spells_each_slice_one_way(ref: str, canonical: str) -> None:
@@ -177,3 +181,14 @@ def test_a_stop_or_step_beyond_any_log_is_every_scan_or_the_first_not_a_crash() 
     whole = open_sequence("synthetic-office-startstop").count_scans()
     assert sum(1 for _ in open_sequence("synthetic-office-startstop[:" + "9" * 30 + "]").frames()) == whole
     assert sum(1 for _ in open_sequence("synthetic-office-startstop[::" + "9" * 30 + "]").frames()) == 1
+
+
+def test_slices_before_the_loader_options_open_the_same_scans_and_errors_quote_them_as_written() -> None:
+    before = open_sequence("synthetic-office-startstop[:12:3]?odometry=reference")
+    after = open_sequence("synthetic-office-startstop?odometry=reference[:12:3]")
+    stamps = [[frame.scan.timestamp for frame in sequence.frames()] for sequence in (before, after)]
+    assert len(stamps[0]) == 4 and stamps[0] == stamps[1]
+    assert split_slice("aces[:400]?odometry=laser-pose") == ("aces?odometry=laser-pose", 400, None)
+    with pytest.raises(SliceError) as caught:
+        split_slice("aces[100:400]?odometry=laser-pose")
+    assert str(caught.value).startswith("'aces[100:400]?odometry=laser-pose': slice START is 100, but only prefixes")

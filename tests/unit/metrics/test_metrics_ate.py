@@ -95,6 +95,11 @@ def test_a_robot_turning_on_the_spot_takes_the_rotation_from_the_headings(n: int
     """
     ref = np.column_stack([np.full(n, 3.0), np.full(n, -2.0), se2.wrap(1.0 + 0.4 * np.arange(n))])
     est = se2.compose([5.0, 1.0, -1.0], ref)  # the same motion seen from another frame
+    assert np.degrees(rigid_transform(est, ref)[2]) == pytest.approx(np.degrees(1.0), abs=1e-9)
+    if n == 1:  # one pose: the alignment fits it, so its ATE (0 by construction) is refused (test_runs_one_scan.py)
+        with pytest.raises(MetricsError, match="one pose"):
+            ate(est, ref, "rigid")
+        return
     block = ate(est, ref, "rigid")
     assert block["rmse_m"] == pytest.approx(0.0, abs=1e-12)
     assert block["rotation"]["max_deg"] == pytest.approx(0.0, abs=1e-9)

@@ -17,6 +17,7 @@ from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
 from albot1.report.comparisons import Errors, all_pairs
 from albot1.report.paired_tables import (
+    NO_DECISION,
     NO_ERRORS,
     NO_EVIDENCE,
     TABLE,
@@ -33,22 +34,23 @@ from albot1.runs.folder import write_run
 SCANS = 40
 
 
-def _drive(error: float) -> Sequence:
+def _drive(error: float, scans: int = SCANS) -> Sequence:
     """A straight drive with reference poses; the odometry is ``error`` too long and turns ``error`` deg per step."""
-    t = np.arange(SCANS, dtype=float)
-    truth = np.column_stack([t * 0.5, np.zeros(SCANS), np.zeros(SCANS)])
-    odometry = np.column_stack([t * 0.5 * (1 + error), np.zeros(SCANS), np.radians(error) * t])
+    t = np.arange(scans, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(scans), np.zeros(scans)])
+    odometry = np.column_stack([t * 0.5 * (1 + error), np.zeros(scans), np.radians(error) * t])
     angles = np.radians(np.linspace(-90.0, 90.0, 181))
     frames = [
         Frame(i, Scan(np.full(181, 5.0), angles, 100.0 + t[i], 30.0), odometry[i], reference=truth[i])
-        for i in range(SCANS)
+        for i in range(scans)
     ]
     return Sequence.from_frames("drive", frames)
 
 
-def _record(tmp_path: Path, method: str, error: float, seed: int) -> CellRecord:
+def _record(tmp_path: Path, method: str, error: float, seed: int, scans: int = SCANS) -> CellRecord:
     """An odometry run of the drive filed as ``method``'s cell of seed ``seed`` (its poses: that odometry)."""
-    run_dir = write_run(run_method("odometry", _drive(error), dataset_name="drive"), tmp_path / f"{method}-{seed}")
+    sequence = _drive(error, scans)
+    run_dir = write_run(run_method("odometry", sequence, dataset_name="drive"), tmp_path / f"{method}-{seed}")
     evaluate_run(run_dir)
     key = f"{method}-{seed}"  # unique per cell, as in a suite
     cell = Cell("t", "drive", "drive", method, method, "default", "gauss:0.1:1", seed, key, "v", 1.0, 1.0)
@@ -191,3 +193,16 @@ def test_a_perfect_method_is_better_in_the_matrix_whichever_label_comes_first(or
     ahead, behind = found[("perfect", "noisy")][0], found[("noisy", "perfect")][0]
     assert (ahead.verdict, ahead.ratio, ahead.low, ahead.high, ahead.short()) == (BETTER, 0.0, 0.0, 0.0, "< 0")
     assert (behind.verdict, behind.reason, behind.short()) == ("n/a", PERFECT_REFERENCE, "–")
+
+
+def test_a_best_paired_too_few_times_says_so_not_that_it_was_never_compared(tmp_path: Path) -> None:
+    # Three-scan runs (`NAME[:3]`) pair, but 3 pairs are too few for the test: the best's own n/a used to say
+    # "no run of another method could be compared with its runs", which was false.
+    records = [_record(tmp_path, "odometry", 0.10, 0, scans=3), _record(tmp_path, "kiss-icp", 0.02, 0, scans=3)]
+    rows = {r.method: r for r in paired_rows(records)}
+    assert rows["kiss-icp"].best == "kiss-icp"
+    own = rows["kiss-icp"].against_best
+    assert own is not None and (own.verdict, own.reason) == ("n/a", f"{NO_DECISION} (3 pairs, fewer than 10)")
+    lines = markdown_lines(list(rows.values()), "drive")
+    assert f"- n/a: {NO_DECISION} (3 pairs, fewer than 10): kiss-icp as the best (gauss:0.1:1)" in lines
+    assert all(NO_EVIDENCE not in line for line in lines)
