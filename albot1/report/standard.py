@@ -21,7 +21,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +34,14 @@ from albot1.report.collect import CellRecord
 from albot1.report.limits import known_limit_of
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import data_lines, regenerate_command
-from albot1.report.standard_paired import PAIRED_TABLE, Paired, compare_by_log, paired_csv, paired_lines
+from albot1.report.standard_paired import (
+    PAIRED_TABLE,
+    Paired,
+    compare_by_log,
+    paired_csv,
+    paired_lines,
+    shown_record,
+)
 from albot1.report.tuning import LEGEND, held_in, marked
 
 #: The five logs of the standard benchmark, with the names the published tables use.
@@ -111,33 +118,54 @@ def _full_log_cell(rec: CellRecord) -> bool:
 
 
 def measured_rows(records: list[CellRecord]) -> list[Row]:
-    """A row per (standard log, method label) the results hold on the whole log (first seed of each).
+    """A row per (standard log, method label) the results hold on the whole log: its lowest completed seed.
 
+    A suite may run several seeds on a log: the row shows the lowest seed that completed (the lowest seed when none
+    did), whatever order the records come in, and its note names that seed and what the other seeds gave, so one
+    seed's figure is never shown as if it were the only run, and a failed seed never hides a completed one.
     A method the suite ran on some standard logs but not on another gets a
     "not measured" row there, so a missing figure reads as a choice of the
     suite (an expensive method on the logs that fit its budget), not as a
     gap in the table.
     """
     rows: list[Row] = []
-    seen: set[tuple[str, str]] = set()
+    groups: dict[tuple[str, str], list[CellRecord]] = {}
     methods: dict[str, tuple[str, str]] = {}
     for rec in records:
-        if not _full_log_cell(rec):
-            continue
-        key = (rec.cell.dataset_label, rec.cell.method_label)
-        if key in seen:
-            continue
-        seen.add(key)
-        methods.setdefault(rec.cell.method_label, (rec.cell.method, rec.cell.preset))
-        rows.append(_measured(rec))
-    measured_logs = {log for log, _ in seen}
+        if _full_log_cell(rec):
+            groups.setdefault((rec.cell.dataset_label, rec.cell.method_label), []).append(rec)
+            methods.setdefault(rec.cell.method_label, (rec.cell.method, rec.cell.preset))
+    for group in groups.values():
+        shown = shown_record(group)
+        row = _measured(shown)
+        if len(group) > 1:
+            row = replace(row, note="; ".join(part for part in (row.note, _seeds_note(shown, group)) if part))
+        rows.append(row)
+    measured_logs = {log for log, _ in groups}
     for label, (method, preset) in methods.items():
         for log in STANDARD_LOGS:
-            if log in measured_logs and (log, label) not in seen:
+            if log in measured_logs and (log, label) not in groups:
                 note = "not in this suite's grid for this log (see the suite file)"
                 limit = known_limit_of(method, preset, log) or ""
                 rows.append(Row(log, "measured", label, status="not measured", note=note, limit=limit))
     return rows
+
+
+def _seeds_note(shown: CellRecord, group: list[CellRecord]) -> str:
+    """Which seed a row shows and what the other seeds of the same cell gave (translation mean, or their status)."""
+    others = []
+    for rec in sorted(group, key=lambda rec: rec.cell.seed):
+        if rec is shown:
+            continue
+        block = rec.metrics.get(RELATIONS) if rec.status == "done" and rec.metrics is not None else None
+        what = (
+            f"{block.translation_m.mean:.4f} m"
+            if block is not None and block.translation_m.mean is not None
+            else (rec.status if rec.status != "done" else "no relation metric")
+        )
+        others.append(f"seed {rec.cell.seed} {what}")
+    kind = "the lowest completed" if shown.status == "done" else "none completed"
+    return f"seed {shown.cell.seed} shown ({kind}) of {len(group)} seeds run; " + ", ".join(others)
 
 
 def _measured(rec: CellRecord) -> Row:

@@ -28,12 +28,23 @@ class Paired:
     left_out: dict[str, str]
 
 
+def shown_record(group: list[CellRecord]) -> CellRecord:
+    """The record the page shows of one (log, method)'s seeds: the lowest completed seed, else the lowest seed.
+
+    One rule for the row and its paired comparisons, whatever order the store lists the seeds in: a failed seed
+    never hides a completed one, and the matrix compares the very runs the rows show.
+    """
+    done = [rec for rec in group if rec.status == "done"]
+    return min(done or group, key=lambda rec: rec.cell.seed)
+
+
 def compare_by_log(records: list[CellRecord], whole_log: Callable[[CellRecord], bool]) -> dict[str, Paired]:
-    """Per log, the first ``whole_log`` cell of each method, compared pairwise with the others on the same relations."""
-    first: dict[str, dict[str, CellRecord]] = {}
+    """Per log, each method's shown ``whole_log`` cell (:func:`shown_record`), compared pairwise on like relations."""
+    groups: dict[str, dict[str, list[CellRecord]]] = {}
     for rec in records:
         if whole_log(rec):
-            first.setdefault(rec.cell.dataset_label, {}).setdefault(rec.cell.method_label, rec)
+            groups.setdefault(rec.cell.dataset_label, {}).setdefault(rec.cell.method_label, []).append(rec)
+    first = {log: {m: shown_record(g) for m, g in by.items()} for log, by in groups.items()}
     out: dict[str, Paired] = {}
     for log, by_method in first.items():
         errors: dict[str, Errors] = {m: relation_errors_of(r) for m, r in by_method.items() if r.status == "done"}

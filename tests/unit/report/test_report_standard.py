@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ from albot1.config.presets import load_known_limits
 from albot1.data.model import Frame, Relations, Scan, Sequence
 from albot1.geometry import se2
 from albot1.methods.baselines.published import published_systems
+from albot1.metrics.measures.relations import METRIC as RELATIONS
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
 from albot1.report.collect import CellRecord
@@ -176,3 +178,57 @@ def test_a_failed_or_unrun_row_carries_the_known_limit_its_preset_file_records(t
     line = f"- mrpt-rbpf (failed), known limit from its preset file: {limits['default']['aces']}"
     assert line in text.splitlines()
     assert f"- mrpt-rbpf (not measured), known limit from its preset file: {limits['default']['fr-clinic']}" in text
+
+
+def test_several_seeds_show_the_lowest_completed_one_and_name_the_others(tmp_path: Path) -> None:
+    """With seeds run in any order, the row is the lowest completed seed's, and its note says what the others gave.
+
+    The row used to be whichever record came first: here seed 2's, or the failed seed 0 hiding two completed ones.
+    """
+    one = _replace_seed(_record(tmp_path / "1", "aces"), 1)
+    two = _replace_seed(_record(tmp_path / "2", "aces"), 2)
+    failed = CellRecord(
+        _cell("aces", "odometry", "k-0"), "failed", tmp_path, None, None, Failure("boom", "exception", 1, 9.0, None)
+    )
+    assert one.metrics is not None
+    block = one.metrics.get(RELATIONS)
+    assert block is not None
+    mean = block.translation_m.mean
+    for order in ([two, failed, one], [failed, one, two], [one, two, failed]):
+        (row,) = [r for r in measured_rows(order) if r.log == "aces"]
+        assert row.status == "done" and row.translation_mean_m == mean
+        assert row.note == f"seed 1 shown (the lowest completed) of 3 seeds run; seed 0 failed, seed 2 {mean:.4f} m"
+    (alone,) = [r for r in measured_rows([failed]) if r.log == "aces"]
+    assert alone.status == "failed" and alone.note == "boom"  # one seed: as before, no seeds note
+    (none_done,) = measured_rows([_replace_seed(failed, 3), failed])
+    assert none_done.note == "boom; seed 0 shown (none completed) of 2 seeds run; seed 3 failed"
+
+
+def _replace_seed(rec: CellRecord, seed: int) -> CellRecord:
+    return replace(rec, cell=replace(rec.cell, seed=seed, key=f"k-{seed}"))
+
+
+def test_the_paired_matrix_compares_the_seed_the_row_shows(tmp_path: Path) -> None:
+    """A failed seed 0 listed first left the method out of the matrix although its row showed a completed seed."""
+    from albot1.report.standard_paired import compare_by_log
+
+    odometry = _record(tmp_path / "o", "aces")
+    other = _replace_seed(_record(tmp_path / "x", "aces"), 1)
+    other = CellRecord(
+        replace(other.cell, method="kiss-icp", method_label="kiss-icp"),
+        "done",
+        other.run_dir,
+        other.result,
+        other.metrics,
+        None,
+    )
+    failed = CellRecord(
+        replace(other.cell, seed=0, key="k-f"),
+        "failed",
+        tmp_path,
+        None,
+        None,
+        Failure("boom", "exception", 1, 9.0, None),
+    )
+    paired = compare_by_log([odometry, failed, other], lambda rec: True)["aces"]
+    assert sorted(paired.labels) == ["kiss-icp", "odometry"] and paired.left_out == {}
