@@ -203,3 +203,14 @@ class FigureCache:
     def _write(self, unsettled: set[str]) -> None:
         document = {"version": STAMPS_VERSION, "groups": self._groups, "unsettled": sorted(unsettled)}
         atomic_write(self.stamps, lambda tmp: tmp.write_text(json.dumps(document, indent=1, sort_keys=True)))
+
+
+def clear_figures(folder: Path) -> None:
+    """A build without figures (``--no-plots``) into ``folder``: delete what an earlier build drew and stamped there.
+
+    Left in place, those figures would show an earlier build's numbers beside this build's tables, unlinked but
+    there to be copied into a paper (the same reason :meth:`FigureCache.save` deletes figures no longer drawn).
+    Only files the stamps name are deleted: anything else in the folder is not the report's and stays.
+    """
+    if (folder / STAMPS).is_file():
+        FigureCache(folder).save()  # no group looked up: every stamped group is forgotten and its files deleted

@@ -53,6 +53,9 @@ from albot1.report.rpe_plots import plot_rpe_boxes
 from albot1.report.tables import Aggregates
 from albot1.report.trajectory_plots import plot_ape_map, plot_error_vs_distance, plot_trajectories
 
+#: The folder of a report's figures, in its output folder.
+PLOTS_DIR = "plots"
+
 if TYPE_CHECKING:
     import pandas as pd  # annotations only: importing the report does not import pandas
 
@@ -201,7 +204,7 @@ class PendingPlots:
         self._colors = colors or method_colors(r.cell.method_label for r in records)
         self._aggregates = Aggregates(records) if aggregates is None else aggregates
         self._map_style = map_style
-        self._plots_dir = out / "plots"
+        self._plots_dir = out / PLOTS_DIR
         self._plots_dir.mkdir(parents=True, exist_ok=True)
         self._by_dataset: dict[str, list[CellRecord]] = {}
         for rec in records:

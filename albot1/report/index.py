@@ -18,13 +18,14 @@ from albot1.bench.grid import GridPlan
 from albot1.report.collect import COST_COLUMNS, METRIC_COLUMNS, CellRecord, as_of, collect
 from albot1.report.column_selection import ALL_COLUMNS, ColumnSelection
 from albot1.report.external_notes import external_markdown
-from albot1.report.figure_pool import PlotProgress, start_plots
+from albot1.report.figure_cache import clear_figures
+from albot1.report.figure_pool import PLOTS_DIR, PlotProgress, start_plots
 from albot1.report.folders import default_out
 from albot1.report.generalisation import PAGE as GENERALISATION_PAGE
 from albot1.report.generalisation import TABLE as GENERALISATION_TABLE
 from albot1.report.generalisation import write_generalisation
 from albot1.report.html import INDEX_HTML, rel, write_html
-from albot1.report.interactive_page import write_views
+from albot1.report.interactive_page import VIEWS_DIR, write_views
 from albot1.report.map_plots import MapStyle
 from albot1.report.markdown import code, text
 from albot1.report.paired_tables import paired_rows
@@ -252,6 +253,9 @@ def build_report(
         if plots
         else nullcontext(None)
     )
+    if not plots:  # an earlier build's figures would stay beside this build's tables
+        for folder in (PLOTS_DIR, VIEWS_DIR):
+            clear_figures(target / folder)
     with plotting as pending:
         paired = paired_rows(records)  # the accuracy tables' paired comparisons (metrics.md, paired.csv, index.html)
         tables = write_tables(records, target, paired, columns, tabled)

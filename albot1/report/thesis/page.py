@@ -24,7 +24,7 @@ from albot1.metrics.measures.map_shape import METRIC as MAP_SHAPE
 from albot1.metrics.measures.orientation import METRIC as ORIENTATION
 from albot1.report.collect import CellRecord, as_of
 from albot1.report.errors import ReportError
-from albot1.report.figure_cache import FigureCache, inputs_digest
+from albot1.report.figure_cache import FigureCache, clear_figures, inputs_digest
 from albot1.report.html import rel
 from albot1.report.map_plots import maps_drawn, plot_maps
 from albot1.report.markdown import text as md_text
@@ -431,6 +431,8 @@ def write_thesis_page(
             for request in section.figures:
                 drawn[request.stem] = _cached_draw(figures, cache, request)
         cache.save()
+    else:
+        clear_figures(out / FIGURES)
     lines = [
         "# The thesis's experiments, reproduced",
         "",

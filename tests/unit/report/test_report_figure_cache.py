@@ -217,3 +217,17 @@ def test_what_a_failed_drawing_made_is_not_deleted(tmp_path: Path) -> None:
     again.unsettled("thesis:trace", [tmp_path / "trace.png"])
     again.save()
     assert (tmp_path / "trace.png").read_bytes() == b"drawn"  # the page links it
+
+
+def test_a_report_without_plots_removes_the_figures_an_earlier_report_drew_there(results: Path, tmp_path: Path) -> None:
+    """``--no-plots`` into a folder with an earlier report's figures left them there, with that report's numbers."""
+    out = tmp_path / "report"
+    build_report(results, out)
+    drawn = sorted(p.name for p in (out / "plots").rglob("*.png"))
+    assert drawn  # the earlier report's figures
+    (out / "plots" / "mine.txt").write_text("not the report's")
+    build_report(results, out, plots=False)
+    assert sorted(p.name for p in (out / "plots").rglob("*.png")) == []
+    assert sorted(p.name for p in (out / "plots").rglob("*.svg")) == []
+    assert (out / "plots" / "mine.txt").read_text() == "not the report's"  # a file no stamp names stays
+    assert "plots/" not in (out / "README.md").read_text()
