@@ -219,6 +219,7 @@ def test_what_a_failed_drawing_made_is_not_deleted(tmp_path: Path) -> None:
     assert (tmp_path / "trace.png").read_bytes() == b"drawn"  # the page links it
 
 
+@pytest.mark.slow
 def test_a_report_without_plots_removes_the_figures_an_earlier_report_drew_there(results: Path, tmp_path: Path) -> None:
     """``--no-plots`` into a folder with an earlier report's figures left them there, with that report's numbers."""
     out = tmp_path / "report"
