@@ -83,7 +83,9 @@ def run_method(
     offset = seq.metadata.sensor_offset
     seen = sensor_frame(seq)
     mapper_class = spec.load_class()
-    where = "while starting"  # where the method was, for the message of a failure
+    # where the method was, for the message of its failure; None while the runner reads the next scan or reports
+    # progress: a failure there (a loader's OSError) is not the method's and leaves as raised
+    where: str | None = "while starting"
     try:
         mapper = mapper_class(config, seed=seed)
         # The versions of the libraries the mapper has imported by now are kept from here on (the record below
@@ -96,13 +98,13 @@ def run_method(
         if callable(warm_up):
             warm_up(announce)
         startup_s = time.perf_counter() - wall_start
+        where = None
         per_scan: list[int] = []
         blind_scans = 0
         stamps: list[float] = []
         odometry: list[np.ndarray] = []
         reference: list[np.ndarray] | None = []
         for frame in seen.frames():
-            where = f"at scan {frame.index}"
             # What the runner keeps of the frame is read before the method sees it, and the method is handed
             # arrays of its own: a method that writes into its input alters neither the run's record (odometry,
             # the blind-scan count) nor the sequence's frames (an in-memory sequence, the degraded odometry chain).
@@ -117,9 +119,11 @@ def run_method(
                 else:
                     reference.append(frame.reference)
             blind = withhold_ground_truth(frame)
+            where = f"at scan {frame.index}"
             start = time.perf_counter_ns()
             mapper.process(blind)
             per_scan.append(time.perf_counter_ns() - start)
+            where = None
             if on_frame is not None:
                 on_frame(frame.index)
         where = "in finish"
@@ -134,10 +138,14 @@ def run_method(
         rest = text[len(method) :] if text.startswith(method) else f": {text}"
         raise error_class(f"{method} on {dataset}{rest}") from exc
     except Exception as exc:  # a library failed deep inside: name method, dataset and scan
+        if where is None:
+            raise
         raise error_class(f"{method} on {dataset} failed {where}: {type(exc).__name__}: {exc}") from exc
     except KeyboardInterrupt:
         raise  # Ctrl-C: the command stops (a bench cell records it as interrupted)
     except BaseException as exc:  # sys.exit() or a bare BaseException: a method may not end the run
+        if where is None:
+            raise
         raise error_class(
             f"{method} on {dataset} failed {where}: it raised {_exit_text(exc)}; expected it to return, or to "
             "raise an exception for a failure (a method may not end the process)"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import sys
+from collections.abc import Iterator
 from typing import Any, ClassVar
 
 import numpy as np
@@ -186,3 +187,20 @@ def test_a_method_writing_into_its_frames_alters_neither_the_record_nor_the_sequ
     for frame in sequence.frames():  # the sequence's own frames are as they were
         np.testing.assert_array_equal(frame.scan.ranges, np.full(9, 2.0))
         np.testing.assert_array_equal(frame.odometry, [0.5 * frame.index, 0.1 * frame.index, 0.0])
+
+
+def test_a_failure_reading_the_next_scan_is_not_the_method_s(rogue: MethodRegistry) -> None:
+    """The loader failing on scan 3 read "rogue on toy failed at scan 2: OSError: ...": the method blamed, scan wrong.
+
+    The error is the data's: it leaves the run as raised (the bench records it, `albot1 run` says it in one line).
+    """
+    frames = list(_sequence().frames())
+
+    def reading() -> Iterator[Frame]:
+        yield from frames[:3]
+        raise OSError(5, "Input/output error", "toy.bag")
+
+    with pytest.raises(OSError) as caught:
+        run_method("rogue", Sequence("toy", reading), registry=rogue)
+    assert type(caught.value) is OSError
+    assert (caught.value.errno, caught.value.filename) == (5, "toy.bag")
