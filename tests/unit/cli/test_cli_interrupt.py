@@ -56,7 +56,7 @@ def test_a_ctrl_c_dropped_by_a_finalizer_ends_bench_as_interrupted(
 def test_a_ctrl_c_dropped_by_a_finalizer_stops_the_grid_at_the_next_cell_not_at_its_end(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """The runner never saw the lost KeyboardInterrupt: it went on starting cells (hours of a grid, its lines hidden)."""
+    """The runner never saw the lost KeyboardInterrupt: it went on starting cells (a whole grid, lines hidden)."""
     import albot1.bench.runner
 
     ended_after: list[int] = []
