@@ -249,15 +249,29 @@ def _exit_text(exc: BaseException) -> str:
 
 
 def map_problem(data: MapData) -> str | None:
-    """Why a method's map cannot be kept (non-finite or absurd coordinates), or None.
+    """Why a method's map cannot be kept (rows of another shape, not real numbers, non-finite or absurd), or None.
 
     The run boundary's own check: whatever a method did with its inputs, no
     run ends with a map that a report or a metric cannot draw or measure.
+    Points of three columns were stored as ``(-1, 2)`` rows (three points made
+    of two), complex ones lost their imaginary part, flat or text arrays
+    ended the run in a numpy traceback.
     """
-    for name, array in (("segment", data.segments), ("point", data.points)):
+    for name, array, form in (
+        ("segment", data.segments, "(M, 4) rows (x1, y1, x2, y2)"),
+        ("point", data.points, "(K, 2) rows (x, y)"),
+    ):
         if array is None or not len(array):
             continue
-        values = np.asarray(array, dtype=float)
+        try:
+            given = np.asarray(array)
+        except (TypeError, ValueError):  # ragged rows
+            return f"the map's {name}s do not form an array (rows of unequal length?); expected {form} of real numbers"
+        if given.dtype.kind not in "iuf":
+            return f"the map's {name}s are of dtype {given.dtype}; expected {form} of real numbers"
+        if given.ndim != 2 or given.shape[1] != (4 if name == "segment" else 2):
+            return f"the map's {name}s are of shape {given.shape}; expected {form} of real numbers"
+        values = given.astype(float)
         bad = np.flatnonzero(~(np.isfinite(values).all(axis=1) & (np.abs(values).max(axis=1) <= MAX_COORDINATE_M)))
         if len(bad):
             return (

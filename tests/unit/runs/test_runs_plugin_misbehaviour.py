@@ -93,6 +93,14 @@ class RogueMapper:
             poses = [[0.0, 0.0, 0.0]] * (len(self.poses) - 1) + [[0.0, 0.0]]
         if self.mode == "no-map":
             map_data = None
+        if self.mode == "points-xyz":  # stored as points_text's (-1, 2) rows: three points out of two
+            map_data = MapData(points=np.arange(6.0).reshape(2, 3))
+        if self.mode == "points-flat":
+            map_data = MapData(points=np.zeros(4))
+        if self.mode == "segments-text":
+            map_data = MapData(segments=np.array([["0", "0", "1", "x"]]))
+        if self.mode == "points-complex":
+            map_data = MapData(points=np.zeros((2, 2)) + 1j)
         if self.mode == "nan-counter":
             counters["updates"] = float("nan")
         return MapperOutput(poses=poses, map=map_data, counters=counters)
@@ -130,6 +138,16 @@ def rogue() -> MethodRegistry:
         ),
         ("none", f"{RUN}: finish() returned NoneType; expected a MapperOutput (albot1.contract)"),
         ("no-map", f"{RUN}: the map is NoneType; expected a MapData (albot1.contract)"),
+        ("points-xyz", f"{RUN}: the map's points are of shape (2, 3); expected (K, 2) rows (x, y) of real numbers"),
+        ("points-flat", f"{RUN}: the map's points are of shape (4,); expected (K, 2) rows (x, y) of real numbers"),
+        (
+            "segments-text",
+            f"{RUN}: the map's segments are of dtype <U1; expected (M, 4) rows (x1, y1, x2, y2) of real numbers",
+        ),
+        (
+            "points-complex",
+            f"{RUN}: the map's points are of dtype complex128; expected (K, 2) rows (x, y) of real numbers",
+        ),
         ("nan-counter", f"{RUN}: counter 'updates' is nan; expected a finite number"),
     ],
 )
