@@ -278,6 +278,23 @@ def map_problem(data: MapData) -> str | None:
                 f"the map has {len(bad)} {name}(s) with non-finite or absurd coordinates (first: {name} {bad[0]}, "
                 f"{values[bad[0]].tolist()}); expected finite metres within {MAX_COORDINATE_M:g} m"
             )
+    return _properties_problem(data)
+
+
+def _properties_problem(data: MapData) -> str | None:
+    """Why ``segment_properties`` do not go with the segments, or None (map.geojson pairs them one to one)."""
+    props = data.segment_properties
+    if props is None:
+        return None
+    expected = "expected one dict per segment (or none)"
+    if not isinstance(props, list):
+        return f"the map's segment properties are a {type(props).__name__}; {expected}"
+    odd = next((i for i, p in enumerate(props) if not isinstance(p, dict)), None)
+    if odd is not None:
+        return f"the map's segment property {odd} is a {type(props[odd]).__name__}; {expected}"
+    count = 0 if data.segments is None else len(data.segments)
+    if len(props) != count:
+        return f"the map has {len(props)} segment properties for {count} segments; {expected}"
     return None
 
 

@@ -99,6 +99,8 @@ class RogueMapper:
             map_data = MapData(points=np.zeros(4))
         if self.mode == "segments-text":
             map_data = MapData(segments=np.array([["0", "0", "1", "x"]]))
+        if self.mode == "short-properties":  # map.geojson paired them with zip: the third segment was dropped
+            map_data = MapData(segments=np.zeros((3, 4)), segment_properties=[{"id": 0}, {"id": 1}])
         if self.mode == "points-complex":
             map_data = MapData(points=np.zeros((2, 2)) + 1j)
         if self.mode == "nan-counter":
@@ -143,6 +145,10 @@ def rogue() -> MethodRegistry:
         (
             "segments-text",
             f"{RUN}: the map's segments are of dtype <U1; expected (M, 4) rows (x1, y1, x2, y2) of real numbers",
+        ),
+        (
+            "short-properties",
+            f"{RUN}: the map has 2 segment properties for 3 segments; expected one dict per segment (or none)",
         ),
         (
             "points-complex",
