@@ -5,7 +5,7 @@ from __future__ import annotations
 import contextlib
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -13,6 +13,24 @@ from albot1.cli.interrupt import Interrupts, noting_interrupts
 from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import RESULTS_ROOT, get_settings
+
+
+class _HeedingCtrlC:
+    """The grid's view, and at each cell's end a Ctrl-C whose KeyboardInterrupt went astray stops the runner.
+
+    The runner stops on a KeyboardInterrupt raised where it waits; one that a finalizer dropped never reaches
+    it, and it went on starting the grid's other cells (their lines hidden, the Ctrl-C honoured at the end).
+    """
+
+    def __init__(self, view: Any, ctrl_c: Interrupts) -> None:
+        self.view, self.ctrl_c = view, ctrl_c
+
+    def started(self, total: int, cached: int) -> None:
+        self.view.started(total, cached)
+
+    def finished(self, outcome: Any) -> None:
+        self.view.finished(outcome)
+        self.ctrl_c.heed()
 
 
 def register(app: typer.Typer) -> None:
@@ -99,7 +117,7 @@ def bench(
                 results=results,
                 jobs=jobs,
                 executor=executor,
-                observer=view,
+                observer=_HeedingCtrlC(view, ctrl_c),
                 settings=get_settings(data_dir=data_dir),
                 preview=render_preview,
                 retry_failed=retry_failed,

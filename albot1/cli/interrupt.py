@@ -33,6 +33,15 @@ class Interrupts:
     def __init__(self) -> None:
         self.received = False
 
+    def heed(self) -> None:
+        """Raise KeyboardInterrupt when Ctrl-C was noted: one whose exception went astray stops the work here.
+
+        Called where the command can stop cleanly (the end of a cell): without it the work went on to its
+        end (a whole grid) after a Ctrl-C whose KeyboardInterrupt a finalizer dropped.
+        """
+        if self.received:
+            raise KeyboardInterrupt
+
 
 @contextmanager
 def noting_interrupts(noted: Interrupts | None = None) -> Iterator[Interrupts]:

@@ -34,6 +34,7 @@ from albot1.report.provenance import data_by_dataset, describe_data, rerun_comma
 from albot1.report.standard import PAGE as STANDARD_PAGE
 from albot1.report.standard import TABLE as STANDARD_TABLE
 from albot1.report.standard import on_standard_logs, write_standard
+from albot1.report.standard_paired import PAIRED_TABLE as STANDARD_PAIRED_TABLE
 from albot1.report.tables import Aggregates, write_tables
 from albot1.report.thesis.experiments.datasets import THESIS_SUITE
 from albot1.report.thesis.page import own_records, write_thesis_page
@@ -262,7 +263,7 @@ def build_report(
         if on_standard_logs(plan, records):  # a page of five "not measured" logs says nothing (a user's own bags)
             tables[STANDARD_PAGE], tables[STANDARD_TABLE] = write_standard(plan, records, target, results)
         else:
-            _remove_unwritten(target, STANDARD_PAGE, STANDARD_TABLE)
+            _remove_unwritten(target, STANDARD_PAGE, STANDARD_TABLE, STANDARD_PAIRED_TABLE)
         generalisation = write_generalisation(plan, records, target, results)
         if generalisation is not None:
             tables[GENERALISATION_PAGE], tables[GENERALISATION_TABLE] = generalisation

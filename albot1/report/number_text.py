@@ -29,22 +29,33 @@ LARGE = 1e6
 
 
 def fmt(value: float, places: int | None) -> str:
-    """``value`` with ``places`` decimals (None, or a magnitude of :data:`LARGE` or more: scientific)."""
+    """``value`` with ``places`` decimals (None, or a magnitude of :data:`LARGE` or more: scientific).
+
+    A number that rounds to zero reads without a sign: ``-0.001`` at two decimals is ``0.00``, not ``-0.00``
+    (a negative number where the table has none).
+    """
     if places is None or abs(value) >= LARGE:
-        return f"{value:.{SIGNIFICANT - 1}e}"
-    return f"{value:.{places}f}"
+        text = f"{value:.{SIGNIFICANT - 1}e}"
+    else:
+        text = f"{value:.{places}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0 else text
 
 
 def stats_text(mean: float, std: float, median: float, low: float, high: float, n: int) -> str:
     """``mean`` for one seed; ``mean ± std, median M (min–max)`` for several, all with the decimals of the mean.
 
     The one text of an aggregate over seeds (Markdown, LaTeX, HTML): the median is there because one bad
-    seed moves the mean and the std but not the median.
+    seed moves the mean and the std but not the median. A std that would read zero at the mean's decimals
+    while the seeds differ (``1234 ± 0`` for seeds 0.6 m apart) is shown to its own first significant digit:
+    ``± 0`` is what seeds that agree would give, and those read as one number.
     """
     places = decimals(mean)
     if n <= 1 or low == high:
         return fmt(mean, places)
-    spread = f"{fmt(mean, places)} ± {fmt(std, places)}, median {fmt(median, places)}"
+    deviation = fmt(std, places)
+    if std > 0 and float(deviation) == 0:
+        deviation = fmt(std, decimals(std, 1))
+    spread = f"{fmt(mean, places)} ± {deviation}, median {fmt(median, places)}"
     return f"{spread} ({fmt(low, places)}–{fmt(high, places)})"
 
 

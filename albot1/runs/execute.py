@@ -83,7 +83,9 @@ def run_method(
     offset = seq.metadata.sensor_offset
     seen = sensor_frame(seq)
     mapper_class = spec.load_class()
-    where = "while starting"  # where the method was, for the message of a failure
+    # where the method was, for the message of its failure; None while the runner reads the next scan or reports
+    # progress: a failure there (a loader's OSError) is not the method's and leaves as raised
+    where: str | None = "while starting"
     try:
         mapper = mapper_class(config, seed=seed)
         # The versions of the libraries the mapper has imported by now are kept from here on (the record below
@@ -96,13 +98,13 @@ def run_method(
         if callable(warm_up):
             warm_up(announce)
         startup_s = time.perf_counter() - wall_start
+        where = None
         per_scan: list[int] = []
         blind_scans = 0
         stamps: list[float] = []
         odometry: list[np.ndarray] = []
         reference: list[np.ndarray] | None = []
         for frame in seen.frames():
-            where = f"at scan {frame.index}"
             # What the runner keeps of the frame is read before the method sees it, and the method is handed
             # arrays of its own: a method that writes into its input alters neither the run's record (odometry,
             # the blind-scan count) nor the sequence's frames (an in-memory sequence, the degraded odometry chain).
@@ -117,9 +119,11 @@ def run_method(
                 else:
                     reference.append(frame.reference)
             blind = withhold_ground_truth(frame)
+            where = f"at scan {frame.index}"
             start = time.perf_counter_ns()
             mapper.process(blind)
             per_scan.append(time.perf_counter_ns() - start)
+            where = None
             if on_frame is not None:
                 on_frame(frame.index)
         where = "in finish"
@@ -134,10 +138,14 @@ def run_method(
         rest = text[len(method) :] if text.startswith(method) else f": {text}"
         raise error_class(f"{method} on {dataset}{rest}") from exc
     except Exception as exc:  # a library failed deep inside: name method, dataset and scan
+        if where is None:
+            raise
         raise error_class(f"{method} on {dataset} failed {where}: {type(exc).__name__}: {exc}") from exc
     except KeyboardInterrupt:
         raise  # Ctrl-C: the command stops (a bench cell records it as interrupted)
     except BaseException as exc:  # sys.exit() or a bare BaseException: a method may not end the run
+        if where is None:
+            raise
         raise error_class(
             f"{method} on {dataset} failed {where}: it raised {_exit_text(exc)}; expected it to return, or to "
             "raise an exception for a failure (a method may not end the process)"
@@ -241,21 +249,52 @@ def _exit_text(exc: BaseException) -> str:
 
 
 def map_problem(data: MapData) -> str | None:
-    """Why a method's map cannot be kept (non-finite or absurd coordinates), or None.
+    """Why a method's map cannot be kept (rows of another shape, not real numbers, non-finite or absurd), or None.
 
     The run boundary's own check: whatever a method did with its inputs, no
     run ends with a map that a report or a metric cannot draw or measure.
+    Points of three columns were stored as ``(-1, 2)`` rows (three points made
+    of two), complex ones lost their imaginary part, flat or text arrays
+    ended the run in a numpy traceback.
     """
-    for name, array in (("segment", data.segments), ("point", data.points)):
+    for name, array, form in (
+        ("segment", data.segments, "(M, 4) rows (x1, y1, x2, y2)"),
+        ("point", data.points, "(K, 2) rows (x, y)"),
+    ):
         if array is None or not len(array):
             continue
-        values = np.asarray(array, dtype=float)
+        try:
+            given = np.asarray(array)
+        except (TypeError, ValueError):  # ragged rows
+            return f"the map's {name}s do not form an array (rows of unequal length?); expected {form} of real numbers"
+        if given.dtype.kind not in "iuf":
+            return f"the map's {name}s are of dtype {given.dtype}; expected {form} of real numbers"
+        if given.ndim != 2 or given.shape[1] != (4 if name == "segment" else 2):
+            return f"the map's {name}s are of shape {given.shape}; expected {form} of real numbers"
+        values = given.astype(float)
         bad = np.flatnonzero(~(np.isfinite(values).all(axis=1) & (np.abs(values).max(axis=1) <= MAX_COORDINATE_M)))
         if len(bad):
             return (
                 f"the map has {len(bad)} {name}(s) with non-finite or absurd coordinates (first: {name} {bad[0]}, "
                 f"{values[bad[0]].tolist()}); expected finite metres within {MAX_COORDINATE_M:g} m"
             )
+    return _properties_problem(data)
+
+
+def _properties_problem(data: MapData) -> str | None:
+    """Why ``segment_properties`` do not go with the segments, or None (map.geojson pairs them one to one)."""
+    props = data.segment_properties
+    if props is None:
+        return None
+    expected = "expected one dict per segment (or none)"
+    if not isinstance(props, list):
+        return f"the map's segment properties are a {type(props).__name__}; {expected}"
+    odd = next((i for i, p in enumerate(props) if not isinstance(p, dict)), None)
+    if odd is not None:
+        return f"the map's segment property {odd} is a {type(props[odd]).__name__}; {expected}"
+    count = 0 if data.segments is None else len(data.segments)
+    if len(props) != count:
+        return f"the map has {len(props)} segment properties for {count} segments; {expected}"
     return None
 
 

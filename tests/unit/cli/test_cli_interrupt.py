@@ -53,6 +53,31 @@ def test_a_ctrl_c_dropped_by_a_finalizer_ends_bench_as_interrupted(
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
 
 
+def test_a_ctrl_c_dropped_by_a_finalizer_stops_the_grid_at_the_next_cell_not_at_its_end(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The runner never saw the lost KeyboardInterrupt: it went on starting cells (a whole grid, lines hidden)."""
+    import albot1.bench.runner
+
+    ended_after: list[int] = []
+
+    def run_suite_going_on(*args: Any, observer: Any, **kwargs: Any) -> tuple[None, None, None]:
+        _CtrlCInAFinalizer()
+        for cell in range(3):  # the cells the runner goes on to run and see end
+            observer.finished(SimpleNamespace(status="done", allowed=False, kept=False, description=f"c{cell}"))
+            ended_after.append(cell)
+        return None, None, None
+
+    monkeypatch.setattr(albot1.bench.runner, "run_suite", run_suite_going_on)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["albot1", "bench", "quick", "--results", "results", "--no-progress"])
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exited:
+        main()
+    out, err = capsys.readouterr()
+    assert (exited.value.code, out, err.splitlines(), ended_after) == (130, "", [INTERRUPTED], [])
+
+
 def test_outside_the_command_ctrl_c_and_dropped_exceptions_behave_as_python_says(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

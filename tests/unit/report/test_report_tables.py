@@ -222,6 +222,27 @@ def test_numbers_have_three_significant_digits_and_the_spread_the_decimals_of_th
     assert stats_text(mean, std, median, low, high, n) == text
 
 
+@pytest.mark.parametrize(
+    ("mean", "std", "median", "low", "high", "text"),
+    [
+        # seeds 0.6 m apart around 1234 m: "± 0" said the seeds agreed while (1234–1235) said they did not
+        (1234.5, 0.4243, 1234.5, 1234.2, 1234.8, "1234 ± 0.4, median 1234 (1234–1235)"),
+        (5.0012, 0.0021, 5.0012, 4.9997, 5.0027, "5.00 ± 0.002, median 5.00 (5.00–5.00)"),
+        (5.0, 0.0004, 5.0, 4.9997, 5.0003, "5.00 ± 4.00e-04, median 5.00 (5.00–5.00)"),
+    ],
+)
+def test_a_spread_that_rounds_to_zero_at_the_decimals_of_the_mean_gets_its_own_digits(
+    mean: float, std: float, median: float, low: float, high: float, text: str
+) -> None:
+    assert stats_text(mean, std, median, low, high, 2) == text
+
+
+def test_a_number_that_rounds_to_zero_reads_without_a_minus_sign() -> None:
+    """A seed of -0.001 shown at two decimals read "-0.00": a negative number where none was."""
+    assert stats_text(5.0, 5.0, 5.0, -0.001, 10.0, 3) == "5.00 ± 5.00, median 5.00 (0.00–10.00)"
+    assert (fmt(-0.0, 2), fmt(-0.004, 2), fmt(-0.006, 2), fmt(-1e-5, None)) == ("0.00", "0.00", "-0.01", "-1.00e-05")
+
+
 def test_a_cell_over_seeds_shows_the_median_beside_the_mean_in_md_tex_and_html(tmp_path: Path) -> None:
     """Seeds of 1, 2 and 10 m: the mean (4.33) says little of the typical seed, the median (2.00) does.
 

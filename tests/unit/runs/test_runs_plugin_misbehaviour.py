@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import sys
+from collections.abc import Iterator
 from typing import Any, ClassVar
 
 import numpy as np
@@ -92,6 +93,16 @@ class RogueMapper:
             poses = [[0.0, 0.0, 0.0]] * (len(self.poses) - 1) + [[0.0, 0.0]]
         if self.mode == "no-map":
             map_data = None
+        if self.mode == "points-xyz":  # stored as points_text's (-1, 2) rows: three points out of two
+            map_data = MapData(points=np.arange(6.0).reshape(2, 3))
+        if self.mode == "points-flat":
+            map_data = MapData(points=np.zeros(4))
+        if self.mode == "segments-text":
+            map_data = MapData(segments=np.array([["0", "0", "1", "x"]]))
+        if self.mode == "short-properties":  # map.geojson paired them with zip: the third segment was dropped
+            map_data = MapData(segments=np.zeros((3, 4)), segment_properties=[{"id": 0}, {"id": 1}])
+        if self.mode == "points-complex":
+            map_data = MapData(points=np.zeros((2, 2)) + 1j)
         if self.mode == "nan-counter":
             counters["updates"] = float("nan")
         return MapperOutput(poses=poses, map=map_data, counters=counters)
@@ -129,6 +140,20 @@ def rogue() -> MethodRegistry:
         ),
         ("none", f"{RUN}: finish() returned NoneType; expected a MapperOutput (albot1.contract)"),
         ("no-map", f"{RUN}: the map is NoneType; expected a MapData (albot1.contract)"),
+        ("points-xyz", f"{RUN}: the map's points are of shape (2, 3); expected (K, 2) rows (x, y) of real numbers"),
+        ("points-flat", f"{RUN}: the map's points are of shape (4,); expected (K, 2) rows (x, y) of real numbers"),
+        (
+            "segments-text",
+            f"{RUN}: the map's segments are of dtype <U1; expected (M, 4) rows (x1, y1, x2, y2) of real numbers",
+        ),
+        (
+            "short-properties",
+            f"{RUN}: the map has 2 segment properties for 3 segments; expected one dict per segment (or none)",
+        ),
+        (
+            "points-complex",
+            f"{RUN}: the map's points are of dtype complex128; expected (K, 2) rows (x, y) of real numbers",
+        ),
         ("nan-counter", f"{RUN}: counter 'updates' is nan; expected a finite number"),
     ],
 )
@@ -186,3 +211,20 @@ def test_a_method_writing_into_its_frames_alters_neither_the_record_nor_the_sequ
     for frame in sequence.frames():  # the sequence's own frames are as they were
         np.testing.assert_array_equal(frame.scan.ranges, np.full(9, 2.0))
         np.testing.assert_array_equal(frame.odometry, [0.5 * frame.index, 0.1 * frame.index, 0.0])
+
+
+def test_a_failure_reading_the_next_scan_is_not_the_method_s(rogue: MethodRegistry) -> None:
+    """The loader failing on scan 3 read "rogue on toy failed at scan 2: OSError: ...": the method blamed, scan wrong.
+
+    The error is the data's: it leaves the run as raised (the bench records it, `albot1 run` says it in one line).
+    """
+    frames = list(_sequence().frames())
+
+    def reading() -> Iterator[Frame]:
+        yield from frames[:3]
+        raise OSError(5, "Input/output error", "toy.bag")
+
+    with pytest.raises(OSError) as caught:
+        run_method("rogue", Sequence("toy", reading), registry=rogue)
+    assert type(caught.value) is OSError
+    assert (caught.value.errno, caught.value.filename) == (5, "toy.bag")
