@@ -5,7 +5,7 @@ from __future__ import annotations
 import contextlib
 import sys
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -13,6 +13,10 @@ from albot1.cli.interrupt import Interrupts, noting_interrupts
 from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import RESULTS_ROOT, get_settings
+
+if TYPE_CHECKING:  # the bench's modules are imported when the command runs, not with the CLI
+    from albot1.bench.grid import CellOutcome
+    from albot1.bench.runner import GridObserver
 
 
 class _HeedingCtrlC:
@@ -22,13 +26,13 @@ class _HeedingCtrlC:
     it, and it went on starting the grid's other cells (their lines hidden, the Ctrl-C honoured at the end).
     """
 
-    def __init__(self, view: Any, ctrl_c: Interrupts) -> None:
+    def __init__(self, view: GridObserver, ctrl_c: Interrupts) -> None:
         self.view, self.ctrl_c = view, ctrl_c
 
     def started(self, total: int, cached: int) -> None:
         self.view.started(total, cached)
 
-    def finished(self, outcome: Any) -> None:
+    def finished(self, outcome: CellOutcome) -> None:
         self.view.finished(outcome)
         self.ctrl_c.heed()
 
