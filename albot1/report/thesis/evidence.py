@@ -97,20 +97,40 @@ class Evidence:
         return out
 
     def find(self, dataset: str, method: str, degradation: str = "none") -> Lookup:
-        """The completed cell of ``method`` on ``dataset`` (lowest seed), first store first; else why not."""
+        """The completed cell of ``method`` on ``dataset`` at the compared seed, first store first; else why not.
+
+        Every method on one (store, dataset, degradation) is read at the same seed (:func:`compared_seed`), so
+        two methods' numbers set side by side come from the same randomness: a method whose run on that seed
+        failed is missing with that reason, even when another of its seeds completed (the reason says so),
+        never replaced by that other seed.
+        """
         reasons: list[str] = []
         for s in self.stores:
             matching = [r for r in s.records if _is(r, dataset, method, degradation)]
-            done = sorted((r for r in matching if r.status == "done"), key=lambda r: r.cell.seed)
+            seed = compared_seed(s.records, dataset, degradation)
+            on_seed = [r for r in matching if r.cell.seed == seed]
+            at = f"seed {seed}, " if len(seeds_of(s.records, dataset, degradation)) > 1 else ""
+            done = [r for r in on_seed if r.status == "done"]
             if done:
                 return Lookup(done[0], s)
-            failed = [r for r in matching if r.status == "failed" and r.failure is not None]
+            others = sorted({r.cell.seed for r in matching if r.status == "done" and r.cell.seed != seed})
+            also = (
+                f"; seed {', '.join(map(str, others))} completed but is not compared: every method on {dataset} "
+                f"is read at seed {seed}"
+                if others
+                else ""
+            )
+            failed = [r for r in on_seed if r.status == "failed" and r.failure is not None]
             if failed:
                 f = failed[0].failure
                 assert f is not None
-                reasons.append(f"failed in {s.path} ({f.kind}: {' '.join(f.reason.split())[:160]})")
+                reason = " ".join(f.reason.split())[:160]
+                reasons.append(f"failed in {s.path} ({at}{f.kind}: {reason}){also}")
+            elif on_seed:
+                reasons.append(f"not run yet in {s.path} (the runner stopped first){also}")
             elif matching:
-                reasons.append(f"not run yet in {s.path} (the runner stopped first)")
+                read_at = f": every method on {dataset} is read at seed {seed}"
+                reasons.append(f"no run on seed {seed} in {s.path}{also or read_at}")
             else:
                 skipped = _skip_reason(s.plan, dataset, method)
                 if skipped:
@@ -164,6 +184,20 @@ def metric_column(path: str) -> Column | None:
         return Column("metrics", path, path)
     except KeyError:
         return None
+
+
+def compared_seed(records: list[CellRecord], dataset: str, degradation: str) -> int | None:
+    """The seed every method on ``dataset`` [``degradation``] of one store is read at: the lowest planned there.
+
+    Chosen from the plan, not from what completed, so one method's failure never moves another method to a
+    different seed; with one seed per cell (the suites' default) it is that seed.
+    """
+    return min(seeds_of(records, dataset, degradation), default=None)
+
+
+def seeds_of(records: list[CellRecord], dataset: str, degradation: str) -> set[int]:
+    """The seeds one store planned on ``dataset`` [``degradation``], any method."""
+    return {r.cell.seed for r in records if r.cell.dataset_label == dataset and r.cell.degradation == degradation}
 
 
 def _is(record: CellRecord, dataset: str, method: str, degradation: str) -> bool:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from albot1.metrics.unit import NO_REFERENCE
 from albot1.report.thesis.claims import READINGS, THESIS
-from albot1.report.thesis.evidence import Evidence, Lookup, counter_path
+from albot1.report.thesis.evidence import Evidence, Lookup, counter_path, seeds_of
 from albot1.report.thesis.verdicts import Number, Verdict, at_most
 
 #: The Albot1 variants every claim is tested for: label -> column heading.
@@ -128,13 +128,20 @@ def cell(value: Number) -> str:
 
 
 def store_of(ev: Evidence, dataset: str, methods: Iterable[str], deg: str = "none") -> str:
-    """The stores the runs of ``methods`` on ``dataset`` were read from (every number names its store)."""
+    """The stores the runs of ``methods`` on ``dataset`` were read from (every number names its store).
+
+    A store that ran several seeds there also names the one its numbers are read at (:func:`compared_seed`,
+    the same for every method), so a verdict says which randomness it compared.
+    """
     stores: dict[str, None] = {}
     for method in methods:
         found: Lookup = ev.find(dataset, method, deg)
-        if found.store is not None:
-            stores[str(found.store.path)] = None
-    return ", ".join(f"`{s}`" for s in stores) or "–"
+        if found.store is not None and found.record is not None:
+            seeds = sorted(seeds_of(found.store.records, dataset, deg))
+            planned = ", ".join(map(str, seeds))
+            at = f" (seed {found.record.cell.seed} of seeds {planned})" if len(seeds) > 1 else ""
+            stores[f"`{found.store.path}`{at}"] = None
+    return ", ".join(stores) or "–"
 
 
 def table(header: list[str], rows: list[list[str]]) -> str:
