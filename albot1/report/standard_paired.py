@@ -10,7 +10,7 @@ import csv
 import io
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from albot1.report.collect import CellRecord
 from albot1.report.comparisons import Cell, Errors, all_pairs, matrix_lines, relation_errors_of
@@ -26,6 +26,8 @@ class Paired:
     found: dict[tuple[str, str], Cell]
     #: method -> why its run is not compared (its relation errors cannot be read back)
     left_out: dict[str, str]
+    #: method -> the seed of its compared run, kept only when some method of the log ran several seeds
+    seeds: dict[str, int] = field(default_factory=dict)
 
 
 def shown_record(group: list[CellRecord]) -> CellRecord:
@@ -51,7 +53,9 @@ def compare_by_log(records: list[CellRecord], whole_log: Callable[[CellRecord], 
         labels = [m for m, e in errors.items() if e.missing is None]
         left_out = {m: str(e.missing) for m, e in errors.items() if e.missing is not None}
         found = all_pairs(labels, errors, ("relation translation", "relation rotation"))
-        out[log] = Paired(labels, found, left_out)
+        several = any(len(group) > 1 for group in groups[log].values())
+        seeds = {m: by_method[m].cell.seed for m in labels} if several else {}
+        out[log] = Paired(labels, found, left_out, seeds)
     return out
 
 
@@ -63,6 +67,7 @@ def paired_lines(paired: Paired | None) -> list[str]:
     if len(paired.labels) >= 2:
         lines += [*matrix_lines(paired.labels, paired.found, "row vs column"), ""]
     lines += [f"- {m}: not compared: {why}" for m, why in paired.left_out.items()]
+    lines += _seeds_lines(paired.seeds)
     why: dict[str, list[str]] = {}  # each n/a reason once, with the comparisons it applies to
     for i, a in enumerate(paired.labels):
         for b in paired.labels[i + 1 :]:
@@ -70,7 +75,21 @@ def paired_lines(paired: Paired | None) -> list[str]:
                 if not found.applies:
                     why.setdefault(str(found.reason), []).append(f"{a} vs {b} ({kind})")
     lines += [f"- `–` {reason}: {'; '.join(where)}" for reason, where in why.items()]
-    return [*lines, ""] if paired.left_out or why else lines
+    return [*lines, ""] if paired.left_out or why or paired.seeds else lines
+
+
+def _seeds_lines(seeds: dict[str, int]) -> list[str]:
+    """Which seed each compared run is (the row's), said when a method ran several; a mix of seeds said as such."""
+    if not seeds:
+        return []
+    runs = ", ".join(f"{m} seed {seed}" for m, seed in seeds.items())
+    mixed = (
+        ": not the same seed for every method (a failed seed is replaced by the method's lowest completed one), "
+        "so a ratio also compares the methods' randomness"
+        if len(set(seeds.values())) > 1
+        else ""
+    )
+    return [f"- runs compared: {runs}{mixed}"]
 
 
 def paired_csv(paired: dict[str, Paired]) -> str:

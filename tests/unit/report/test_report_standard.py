@@ -232,3 +232,26 @@ def test_the_paired_matrix_compares_the_seed_the_row_shows(tmp_path: Path) -> No
     )
     paired = compare_by_log([odometry, failed, other], lambda rec: True)["aces"]
     assert sorted(paired.labels) == ["kiss-icp", "odometry"] and paired.left_out == {}
+
+
+def test_the_paired_matrix_names_the_seeds_it_compares_when_a_method_ran_several(tmp_path: Path) -> None:
+    """Each method's row may show a different seed (a failed seed 0): the matrix said nothing of it."""
+    from albot1.report.standard_paired import compare_by_log, paired_lines
+
+    def kiss(rec: CellRecord) -> CellRecord:
+        return replace(rec, cell=replace(rec.cell, method="kiss-icp", method_label="kiss-icp"))
+
+    odometry = _record(tmp_path / "o", "aces")
+    kiss_done = kiss(_replace_seed(_record(tmp_path / "k", "aces"), 1))
+    kiss_failed = replace(kiss_done, cell=replace(kiss_done.cell, seed=0, key="k-f"), status="failed")
+    kiss_failed = replace(kiss_failed, failure=Failure("boom", "exception", 1, 9.0, None), metrics=None, result=None)
+    paired = compare_by_log([kiss_failed, kiss_done, odometry], lambda rec: True)["aces"]
+    assert paired.seeds == {"kiss-icp": 1, "odometry": 0}
+    assert (
+        "- runs compared: kiss-icp seed 1, odometry seed 0: not the same seed for every method (a failed seed is "
+        "replaced by the method's lowest completed one), so a ratio also compares the methods' randomness"
+    ) in paired_lines(paired)
+    same = compare_by_log([odometry, _replace_seed(odometry, 1), kiss(odometry)], lambda rec: True)["aces"]
+    assert "- runs compared: odometry seed 0, kiss-icp seed 0" in paired_lines(same)
+    one_seed = compare_by_log([odometry, kiss(odometry)], lambda rec: True)["aces"]
+    assert one_seed.seeds == {} and not any(line.startswith("- runs compared") for line in paired_lines(one_seed))
