@@ -43,13 +43,7 @@ def test_a_ctrl_c_dropped_by_a_finalizer_ends_bench_as_interrupted(
     import albot1.bench.runner
 
     monkeypatch.setattr(albot1.bench.runner, "run_suite", _run_suite_losing_ctrl_c)
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(sys, "argv", ["albot1", "bench", "quick", "--results", "results", "--no-progress"])
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as exited:
-        main()
-    out, err = capsys.readouterr()
-    assert (exited.value.code, out, err.splitlines()) == (130, "", [INTERRUPTED])
+    assert _bench(tmp_path, monkeypatch, capsys) == (130, "", [INTERRUPTED])
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back
 
 
@@ -69,13 +63,7 @@ def test_a_ctrl_c_dropped_by_a_finalizer_stops_the_grid_at_the_next_cell_not_at_
         return None, None, None
 
     monkeypatch.setattr(albot1.bench.runner, "run_suite", run_suite_going_on)
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(sys, "argv", ["albot1", "bench", "quick", "--results", "results", "--no-progress"])
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as exited:
-        main()
-    out, err = capsys.readouterr()
-    assert (exited.value.code, out, err.splitlines(), ended_after) == (130, "", [INTERRUPTED], [])
+    assert (*_bench(tmp_path, monkeypatch, capsys), ended_after) == (130, "", [INTERRUPTED], [])
 
 
 def test_outside_the_command_ctrl_c_and_dropped_exceptions_behave_as_python_says(
@@ -92,3 +80,16 @@ def test_outside_the_command_ctrl_c_and_dropped_exceptions_behave_as_python_says
     with noting_interrupts():
         assert sys.unraisablehook is not hook
     assert sys.unraisablehook is hook and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def _bench(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> tuple[object, str, list[str]]:
+    """``albot1 bench quick`` in ``tmp_path``: its exit code, stdout and stderr lines."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["albot1", "bench", "quick", "--results", "results", "--no-progress"])
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exited:
+        main()
+    out, err = capsys.readouterr()
+    return exited.value.code, out, err.splitlines()
