@@ -104,6 +104,7 @@ def measurement_costs(
             huber,
             gate,
             overhang,
+            np.inf,
         )
     per_surface = np.empty(ref.shape[0], dtype=np.int64)
     for j in range(ref.shape[0]):  # a loop, not np.zeros: one numpy routine less to compile
@@ -133,6 +134,7 @@ def measurement_costs(
             huber,
             gate,
             overhang,
+            np.inf,
         )
         total = landmarks
         matched = landmarks

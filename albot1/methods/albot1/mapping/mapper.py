@@ -414,7 +414,7 @@ class Albot1Mapper:
             self.on_update(UpdateEvent(trigger, which, view_scan, pose, out, view_map))
         ids = out.view_ids[lms.index]
         # Landmark positions are kept as placed now: later updates may edit the map surfaces (note 12).
-        lm_map = view_map[lms.index]
+        lm_map = view_map.take(lms.index, axis=0)  # (``take``: the rows of ``[lms.index]``, cheaper)
         self._landmark_rows = (ids, lm_map, lms.kinds)  # the compiled localisation reads them (robust_starts)
         self._u_step = view_scan
         c.surfaces_added += len(out.added)

@@ -167,12 +167,19 @@ def pose_cost(
     huber: float,
     gate: float,
     overhang: float,
+    bound: float,
 ) -> float:
     """The robust cost of the measurement terms at pose ``(x, y, phi)`` (residuals in sigmas).
 
     A view point with no reference surface within ``gate`` costs as much as
     one exactly at the gate, so poses that explain fewer points do not look
-    cheaper.
+    cheaper. The sum stops once it reaches ``bound`` and returns what it has
+    (at least ``bound``): every term is at least 0 (Huber's loss with a
+    positive threshold, the config's ``gt=0``) and adding a non-negative
+    float never lowers a sum, so the full cost could only be higher. The
+    choice of the cheapest start (:func:`refine_pose`) passes the lowest
+    cost so far and skips most points of a start that cannot win, with the
+    same choice as the full sums (issue 24); ``np.inf``: the full cost.
     """
     c = math.cos(phi)
     s = math.sin(phi)
@@ -190,6 +197,8 @@ def pose_cost(
             if point_ok[i, e]:
                 total += huber_cost(np.hypot(tx - lm_map[i, 2 * e], ty - lm_map[i, 2 * e + 1]) / point_sigma, huber)
     for p in range(points.shape[0]):
+        if total >= bound:
+            return total
         tx = x + c * points[p, 0] - s * points[p, 1]
         ty = y + s * points[p, 0] + c * points[p, 1]
         best = nearest_surface(tx, ty, ref, boxes, gate, overhang)[1]
@@ -264,6 +273,7 @@ def refine_pose(
             huber,
             gate,
             overhang,
+            lowest,
         )
         if cost < lowest:
             lowest = cost

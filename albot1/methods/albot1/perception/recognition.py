@@ -112,4 +112,7 @@ def recognise(
         max_distance,
         matching == "greedy",
     )
-    return Tracked(surfaces[j], kinds[j], previous.ids[i], side, gap, angle_diff, d_prev, d_prev_cur)
+    # ``take`` rather than fancy indexing for the 2-D rows: the same rows, a third of the cost here (issue 24)
+    return Tracked(
+        surfaces.take(j, axis=0), kinds.take(j, axis=0), previous.ids[i], side, gap, angle_diff, d_prev, d_prev_cur
+    )

@@ -1,4 +1,5 @@
-"""``refine_pose`` skips a start equal to an earlier one: the result is the one costing every start gives."""
+"""``refine_pose`` skips a start equal to an earlier one, and stops costing a start that cannot win: the result is
+the one costing every start in full gives."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 
 from albot1.methods.albot1.compiled import as_written
-from albot1.methods.albot1.mapping.pose_kernels import refine_pose, repeats_earlier
+from albot1.methods.albot1.mapping.pose_kernels import pose_cost, refine_pose, repeats_earlier, surface_boxes
 
 # Two walls at right angles seen from the view, their map copies moved by (0.1, -0.05), and points along them.
 VIEW = np.array([[-2.0, 3.0, 2.0, 3.0], [2.0, 3.0, 2.0, 0.5]])
@@ -38,3 +39,38 @@ def test_repeated_starts_change_no_bit_of_the_pose_or_the_information(compiled: 
         ux, uy, uphi, uinfo = _solve(kernel, unique)
         assert (rx, ry, rphi) == (ux, uy, uphi)
         assert np.array_equal(rinfo, uinfo)
+
+
+def _cost(x: float, y: float, phi: float, bound: float) -> float:
+    ok = np.ones((2, 2), dtype=np.bool_)
+    boxes = surface_boxes(MAP, 0.5)
+    return float(pose_cost(x, y, phi, VIEW, MAP, ok, POINTS, MAP, boxes, 0.05, 0.1, 0.05, 2.0, 0.5, math.inf, bound))
+
+
+def test_a_bounded_cost_is_the_full_cost_below_the_bound_and_at_least_the_bound_from_it() -> None:
+    rng = np.random.default_rng(7)
+    stopped = 0
+    for x, y, phi in rng.uniform([-0.4, -0.4, -0.3], [0.4, 0.4, 0.3], size=(200, 3)):
+        full = _cost(x, y, phi, math.inf)
+        for bound in (0.0, 0.5 * full, full, np.nextafter(full, math.inf), 2.0 * full, math.inf):
+            bounded = _cost(x, y, phi, bound)
+            if full < bound:
+                assert bounded == full  # the same terms in the same order: the same bits
+            else:
+                assert bound <= bounded <= full
+                stopped += bounded < full
+    assert stopped > 100  # the bound does cut sums short
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "as-written"])
+def test_the_start_chosen_with_cut_short_costs_is_the_cheapest_by_full_costs(compiled: bool) -> None:
+    kernel = refine_pose if compiled else as_written(refine_pose)
+    rng = np.random.default_rng(11)
+    for _ in range(30):
+        starts = np.ascontiguousarray(rng.uniform([-0.4, -0.4, -0.3], [0.4, 0.4, 0.3], size=(6, 3)))
+        full = [_cost(*start, math.inf) for start in starts]
+        cheapest = np.ascontiguousarray(starts[[int(np.argmin(full))]])  # argmin: the first lowest, as the kernel
+        x, y, phi, info = _solve(kernel, starts)
+        cx, cy, cphi, cinfo = _solve(kernel, cheapest)
+        assert (x, y, phi) == (cx, cy, cphi)
+        assert np.array_equal(info, cinfo)
