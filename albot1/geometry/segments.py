@@ -36,8 +36,17 @@ def closest_parameter(x: float, y: float, ax: float, ay: float, bx: float, by: f
     ey = by - ay
     l2 = ex * ex + ey * ey
     if l2 > 0.0:
-        return min(1.0, max(0.0, ((x - ax) * ex + (y - ay) * ey) / l2))
+        return clip_parameter((x - ax) * ex + (y - ay) * ey, l2)
     return 0.0
+
+
+def clip_parameter(along: float, l2: float) -> float:
+    """:func:`closest_parameter` from the projection ``along`` (``(p - a) . (b - a)``) and ``l2 = |b - a|^2 > 0``.
+
+    Its own function so that a kernel which has ``along`` already (the overlap rule's test, Albot1+'s nearest
+    surface) clips it with the same arithmetic, and the same bits, without computing it twice.
+    """
+    return min(1.0, max(0.0, along / l2))
 
 
 def point_segment_distance(x: float, y: float, s: FloatArray) -> float:

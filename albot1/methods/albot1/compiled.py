@@ -227,6 +227,7 @@ GEOMETRY_CALLEES: tuple[Callable[..., Any], ...] = tuple(
     for fn in (
         se2.wrap_angle,
         segments.orientation,
+        segments.clip_parameter,
         segments.closest_parameter,
         segments.point_segment_distance,
         segments.line_angle,

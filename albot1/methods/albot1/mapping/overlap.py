@@ -34,13 +34,22 @@ def overhangs(x: float, y: float, ax: float, ay: float, bx: float, by: float, li
     A degenerate segment (a = b) has no line to project on: never excluded (the caller's distance to it is
     the distance to the point, as before). ``limit`` :data:`NO_LIMIT` never excludes.
     """
-    if limit == NO_LIMIT:
-        return False
     ex = bx - ax
     ey = by - ay
     l2 = ex * ex + ey * ey
-    if not l2 > 0.0:
+    return overhangs_along((x - ax) * ex + (y - ay) * ey, l2, math.sqrt(l2), limit)
+
+
+@jitable
+def overhangs_along(along: float, l2: float, length: float, limit: float) -> bool:
+    """:func:`overhangs` from the projection ``along`` (``(p - a) . (b - a)``, the projection times the length),
+    the squared length ``l2`` and the length ``sqrt(l2)``.
+
+    Albot1+'s nearest surface (:func:`~albot1.methods.albot1.mapping.pose_kernels.nearest_surface`) has them
+    already: it clips ``along / l2`` for the distance next, and computes the length once per surface, not once
+    per point and surface.
+    """
+    if limit == NO_LIMIT or not l2 > 0.0:
         return False
-    along = (x - ax) * ex + (y - ay) * ey  # projection times the length
-    reach = limit * math.sqrt(l2)
+    reach = limit * length
     return along < -reach or along > l2 + reach

@@ -33,10 +33,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.se2 import wrap_angle
-from albot1.geometry.segments import closest_parameter
+from albot1.geometry.segments import clip_parameter
 from albot1.geometry.types import FloatArray
 from albot1.methods.albot1.compiled import jitable, kernel
-from albot1.methods.albot1.mapping.overlap import overhangs
+from albot1.methods.albot1.mapping.overlap import overhangs_along
 
 BoolArray = NDArray[np.bool_]
 
@@ -112,15 +112,34 @@ def add_point_to_line(
     )
 
 
+#: A squared distance beyond ``best^2`` times this is certainly not nearer than ``best``: the rounding of the
+#: square sums (a few units of 2^-53) and of ``np.hypot`` (under one unit) are far below 2^-30, so skipping
+#: ``np.hypot`` there leaves every comparison, and every bit, as it was (issue 24: ``hypot`` is libm's slowest
+#: call in the scan terms). Only where ``best^2`` is far from underflow (``best`` above :data:`SQUARE_SAFE`).
+CERTAINLY_FARTHER = 1.0 + 2.0**-30
+SQUARE_SAFE = 2.0**-500
+
+
 @jitable
 def surface_boxes(ref: FloatArray, margin: float) -> FloatArray:
-    """Each surface's bounding box grown by ``margin``: ``(m, 4)`` xmin, ymin, xmax, ymax."""
-    boxes = np.empty((ref.shape[0], 4))
+    """Each surface's bounding box grown by ``margin`` and what every point's test of it repeats: ``(m, 8)``.
+
+    Columns: xmin, ymin, xmax, ymax, then ``ex, ey`` (``b - a``), ``l2 = ex^2 + ey^2`` and ``sqrt(l2)``,
+    computed once per surface instead of once per point and surface (:func:`nearest_surface`).
+    """
+    boxes = np.empty((ref.shape[0], 8))
     for j in range(ref.shape[0]):
         boxes[j, 0] = min(ref[j, 0], ref[j, 2]) - margin
         boxes[j, 1] = min(ref[j, 1], ref[j, 3]) - margin
         boxes[j, 2] = max(ref[j, 0], ref[j, 2]) + margin
         boxes[j, 3] = max(ref[j, 1], ref[j, 3]) + margin
+        ex = ref[j, 2] - ref[j, 0]
+        ey = ref[j, 3] - ref[j, 1]
+        l2 = ex * ex + ey * ey
+        boxes[j, 4] = ex
+        boxes[j, 5] = ey
+        boxes[j, 6] = l2
+        boxes[j, 7] = math.sqrt(l2)
     return boxes
 
 
@@ -134,16 +153,29 @@ def nearest_surface(
     that cannot be within ``gate`` before any distance is computed; a surface
     the point's projection overhangs by more than ``overhang`` m is skipped
     too (:mod:`albot1.methods.albot1.mapping.overlap`; ``NO_LIMIT``: none is).
+    The distance is :func:`~albot1.geometry.segments.point_segment_distance`'s arithmetic, with the
+    projection computed once for the overlap test and the clipping, and ``np.hypot`` only where the
+    squared distance leaves the comparison open (:data:`CERTAINLY_FARTHER`).
     """
     best = gate
     found = -1
     for j in range(ref.shape[0]):
         if x < boxes[j, 0] or x > boxes[j, 2] or y < boxes[j, 1] or y > boxes[j, 3]:
             continue
-        if overhangs(x, y, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3], overhang):
+        ex = boxes[j, 4]
+        ey = boxes[j, 5]
+        l2 = boxes[j, 6]
+        t = 0.0
+        if l2 > 0.0:
+            along = (x - ref[j, 0]) * ex + (y - ref[j, 1]) * ey
+            if overhangs_along(along, l2, boxes[j, 7], overhang):
+                continue
+            t = clip_parameter(along, l2)
+        dx = ref[j, 0] + t * ex - x
+        dy = ref[j, 1] + t * ey - y
+        if best > SQUARE_SAFE and dx * dx + dy * dy > best * best * CERTAINLY_FARTHER:
             continue
-        t = closest_parameter(x, y, ref[j, 0], ref[j, 1], ref[j, 2], ref[j, 3])
-        d = np.hypot(ref[j, 0] + t * (ref[j, 2] - ref[j, 0]) - x, ref[j, 1] + t * (ref[j, 3] - ref[j, 1]) - y)
+        d = np.hypot(dx, dy)
         if d < best:
             best = d
             found = j

@@ -5,10 +5,14 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 import pytest
 
+from albot1.geometry.segments import closest_parameter
 from albot1.methods.albot1.compiled import as_written
+from albot1.methods.albot1.mapping import pose_kernels
+from albot1.methods.albot1.mapping.overlap import NO_LIMIT, overhangs
 from albot1.methods.albot1.mapping.pose_kernels import pose_cost, refine_pose, repeats_earlier, surface_boxes
 
 # Two walls at right angles seen from the view, their map copies moved by (0.1, -0.05), and points along them.
@@ -74,3 +78,43 @@ def test_the_start_chosen_with_cut_short_costs_is_the_cheapest_by_full_costs(com
         cx, cy, cphi, cinfo = _solve(kernel, cheapest)
         assert (x, y, phi) == (cx, cy, cphi)
         assert np.array_equal(info, cinfo)
+
+
+def _nearest_by_the_rule(x: float, y: float, ref: np.ndarray, gate: float, overhang: float) -> tuple[int, float]:
+    """The nearest surface as the rule states it: every surface, the overlap test, then ``hypot`` to the segment."""
+    best, found = gate, -1
+    for j, (ax, ay, bx, by) in enumerate(ref.tolist()):
+        if overhangs(x, y, ax, ay, bx, by, overhang):
+            continue
+        t = closest_parameter(x, y, ax, ay, bx, by)
+        d = float(np.hypot(ax + t * (bx - ax) - x, ay + t * (by - ay) - y))
+        if d < best:
+            best, found = d, j
+    return found, best
+
+
+@numba.njit(cache=False)
+def _nearest_compiled(x: float, y: float, ref: np.ndarray, boxes: np.ndarray, gate: float, overhang: float):  # type: ignore[no-untyped-def]
+    return pose_kernels.nearest_surface(x, y, ref, boxes, gate, overhang)
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "as-written"])
+@pytest.mark.parametrize("overhang", [NO_LIMIT, 0.0, 0.2])
+def test_the_nearest_surface_is_the_one_the_rule_gives_to_the_bit(compiled: bool, overhang: float) -> None:
+    # Per-surface terms computed once and hypot skipped where the squared distance settles the comparison: the
+    # same surface and the same distance as every surface measured in full, including ties (mirrored surfaces
+    # at one distance, a repeated surface), degenerate surfaces and points on a surface.
+    nearest = _nearest_compiled if compiled else pose_kernels.nearest_surface
+    rng = np.random.default_rng(5)
+    walls = rng.uniform(-1.0, 1.0, size=(12, 4))
+    walls[3] = walls[2]  # a repeated surface: the first keeps it
+    walls[4, 2:] = walls[4, :2]  # a degenerate one
+    mirrored = np.array([[-0.5, -0.3, -0.5, 0.3], [0.5, -0.3, 0.5, 0.3]])  # the y axis is equidistant to both
+    ref = np.ascontiguousarray(np.vstack([walls, mirrored]))
+    boxes = pose_kernels.surface_boxes(ref, 0.5)
+    points = np.vstack(
+        [rng.uniform(-1.5, 1.5, size=(400, 2)), np.column_stack([np.zeros(5), np.linspace(-0.2, 0.2, 5)])]
+    )
+    points = np.vstack([points, ref[:, :2], ref[:, 2:]])  # points on surfaces' ends
+    for x, y in points.tolist():
+        assert nearest(x, y, ref, boxes, 0.5, overhang) == _nearest_by_the_rule(x, y, ref, 0.5, overhang)
