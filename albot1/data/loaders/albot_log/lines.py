@@ -98,6 +98,8 @@ class ViewParser:
         self.path = path
         self.sensor: _Sensor | None = None
         self.index = 0
+        #: whether view 0 has a reference pose, and its line: every later view must agree (all or none)
+        self.first_reference: tuple[bool, int] | None = None
 
     def error(self, line: int, message: str) -> ParseError:
         return ParseError(self.path, message, line=line)
@@ -141,6 +143,7 @@ class ViewParser:
             )
         if not _is_count(tokens[1]) or int(tokens[1]) != self.index:
             raise self.error(line, f"expected view index {self.index}, got {tokens[1]!r}")
+        self._check_reference_presence(line, has_ref)
         poses = _numbers(self.path, line, tokens[2:6] + (tokens[6:9] if has_ref else []), "VIEW time/pose")
         if not np.all(np.isfinite(poses)):
             raise self.error(line, "the timestamp and poses must be finite numbers")
@@ -154,6 +157,26 @@ class ViewParser:
         )
         self.index += 1
         return frame
+
+    def _check_reference_presence(self, line: int, has_ref: bool) -> None:
+        """Reference poses for every view or for none, as every other source gives them.
+
+        A run scores reference poses only when every scan has one, so a log with
+        some ``-`` views used to lose all its reference poses without a word
+        ("the dataset has no reference poses").
+        """
+        if self.first_reference is None:
+            self.first_reference = (has_ref, line)
+            return
+        first_has, first_line = self.first_reference
+        if has_ref != first_has:
+            which = ("has a reference pose", "has none ('-')")
+            raise self.error(
+                line,
+                f"view {self.index} {which[0] if has_ref else which[1]}, but view 0 (line {first_line}) "
+                f"{which[0] if first_has else which[1]}; expected a reference pose for every view or for none "
+                f"(scores need one for every scan)",
+            )
 
     def _ranges(self, line: int, points: FloatArray) -> FloatArray:
         assert self.sensor is not None

@@ -49,7 +49,7 @@ from albot1.data.loaders.albot_log.lines import (
     sensor_line,
     view_line,
 )
-from albot1.data.loaders.base import COMMON_OPTIONS
+from albot1.data.loaders.base import COMMON_OPTIONS, reference_presence_problem
 from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.model import Frame, Sequence, SequenceMetadata
@@ -134,7 +134,7 @@ class AlbotLogLoader:
             source=str(path),
             format=self.format_name,
             odometry_source="VIEW odometry poses",
-            reference_source="VIEW reference poses (where a view has one)",
+            reference_source="VIEW reference poses (every view has one, or none does)",
         )
         return Sequence(name or stem, lambda: _frames(path), metadata)
 
@@ -153,11 +153,16 @@ class AlbotLogWriter:
                     fh.write(f"# source: {' '.join(sequence.metadata.source.split())}\n")
                 fh.write(f"UNITS {UNITS}\nFRAME {FRAME}\nNAME {' '.join(sequence.name.split()) or 'unnamed'}\n")
                 geometry: tuple[FloatArray, float] | None = None
+                first: Frame | None = None
                 for i, frame in enumerate(sequence.frames()):
                     if frame.index != i:
                         raise UnwritableError(f"frame {i} has index {frame.index}; expected consecutive indices from 0")
                     scan = frame.scan
                     check_frame(frame)
+                    first = first or frame
+                    gap = reference_presence_problem(first, frame, "an albot log", "its reader refuses the others")
+                    if gap is not None:
+                        raise UnwritableError(gap)
                     if geometry is None or not (
                         scan.max_range == geometry[1] and np.array_equal(scan.angles, geometry[0])
                     ):

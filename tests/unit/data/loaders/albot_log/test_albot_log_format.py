@@ -27,7 +27,7 @@ def synthetic(n: int = 25, seed: int = 3) -> Sequence:
         angles = ANGLES if i < n // 2 else np.sort(rng.uniform(-2.0, 2.0, 90))  # geometry changes mid-log
         ranges = np.round(rng.uniform(0.0, 40.0, angles.shape[0]), 2)
         ranges[rng.random(angles.shape[0]) < 0.2] = np.nan
-        ref = np.array([0.5 * i, 1.0, -3.0]) if i % 3 else None
+        ref = np.array([0.5 * i, 1.0, -3.0])  # every view or none: a log of both is refused
         frames.append(Frame(i, Scan(ranges, angles, 12.5 + 0.1 * i, 40.0), np.array([0.1 * i, 0.2 * i, 7.0 - i]), ref))
     return Sequence.from_frames("office run", frames)
 
@@ -71,12 +71,14 @@ def test_a_hand_written_log_loads(tmp_path: Path) -> None:
         HEADER
         + "# comment\n\nNAME demo\n"
         + SENSOR3
-        + "VIEW 0 0.0 0.0 0.0 0.0 - -2.0 0.0 0.0 3.5 nan nan\n"
+        + "VIEW 0 0.0 0.0 0.0 0.0 0.0 0.0 0.0 -2.0 0.0 0.0 3.5 nan nan\n"
         + "VIEW 1 0.5 0.25 0.0 0.0 1.0 2.0 0.01 -1.75 0.0 0.0 3.25 1.5 0.0\n",
     )
     assert [f.index for f in frames] == [0, 1]
     assert np.allclose(frames[0].scan.ranges, [np.nan, 3.5, 2.0], equal_nan=True)
-    assert frames[0].reference is None and frames[1].reference == pytest.approx([1.0, 2.0, 0.01])
+    assert frames[0].reference == pytest.approx([0.0, 0.0, 0.0]) and frames[1].reference == pytest.approx(
+        [1.0, 2.0, 0.01]
+    )
     assert frames[1].scan.ranges == pytest.approx([1.5, 3.25, 1.75])
 
 
