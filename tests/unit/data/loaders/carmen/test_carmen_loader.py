@@ -336,3 +336,37 @@ def test_small_chunks_give_the_same_frames(
     np.testing.assert_array_equal(chunked.odometry, expected_odom)
     np.testing.assert_array_equal(chunked.reference, expected_ref)
     assert chunked.count_scans() == 300
+
+
+@pytest.mark.parametrize(("offset", "side", "angular"), [(0.3, 0.0, 0.0), (-0.25, 0.05, 0.1)])
+def test_rear_laser_mount_faces_backwards_as_carmen_writes_its_laser_pose(
+    tmp_path: Path, offset: float, side: float, angular: float
+) -> None:
+    """CARMEN's robot module writes an RLASER line's laser pose as theta = odom_theta + pi and
+    x = odom_x + offset * cos(theta) (robot_laser.c): the rear laser looks backwards. Its mount used to be
+    read as (offset, side, angular), facing forwards, so every rear scan was placed mirrored front to back.
+    The mount must be the one the lines' own laser and odometry poses imply."""
+    from albot1.geometry import se2
+
+    params = [
+        f"PARAM robot_rearlaser_offset {offset}",
+        f"PARAM robot_rearlaser_side_offset {side}",
+        f"PARAM robot_rearlaser_angular_offset {angular}",
+    ]
+    mount = np.array([-offset, -side, math.pi + angular])  # the rear PARAMs after a half turn
+    lines = []
+    for k, odom in enumerate([(0.0, 0.0, 0.0), (1.0, 0.5, 0.7), (2.0, -1.0, -2.9)]):
+        laser = [float(v) for v in se2.compose(np.array(odom), mount)]
+        r = " ".join(["2.000"] * 181)
+        lines.append(
+            f"RLASER 181 {r} {laser[0]!r} {laser[1]!r} {laser[2]!r} {odom[0]} {odom[1]} {odom[2]} "
+            f"{k + 1.0:.6f} host {k + 1.0:.6f}"
+        )
+    sequence = CarmenLoader().load(write(tmp_path, params + lines), laser="RLASER", reference="laser-pose")
+    offset = np.array(sequence.metadata.sensor_offset)
+    np.testing.assert_allclose(offset[:2], mount[:2], atol=1e-12)
+    assert abs(se2.wrap(offset[2] - mount[2])) < 1e-12
+    for frame in sequence.frames():
+        implied = se2.between(frame.odometry, frame.reference)  # laser pose fields vs odometry fields
+        np.testing.assert_allclose(implied[:2], offset[:2], atol=1e-9)
+        assert abs(se2.wrap(implied[2] - offset[2])) < 1e-9
