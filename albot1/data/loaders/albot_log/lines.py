@@ -11,6 +11,7 @@ reader refuses.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -210,8 +211,34 @@ class ViewParser:
         return r[::-1].copy()
 
 
-def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | None, list[tuple[int, str]]]:
-    """Checks magic, version, UNITS and FRAME; returns NAME and the lines read past the header."""
+@dataclass(frozen=True)
+class Header:
+    """What the header lines say: the sequence's NAME (None if absent) and the laser's MOUNT on the robot."""
+
+    name: str | None
+    #: ``MOUNT x y theta``: the laser's pose in the robot frame (m, m, rad; the sequence's ``sensor_offset``)
+    mount: tuple[float, float, float]
+
+
+def mount_line(offset: tuple[float, float, float]) -> str:
+    """The MOUNT header line of a laser pose in the robot frame (written only when it is not zero)."""
+    return "MOUNT " + _fmt(offset)
+
+
+def _mount(path: Path, line: int, value: str) -> tuple[float, float, float]:
+    tokens = value.split()
+    if len(tokens) != 3:
+        raise ParseError(
+            path, f"expected 'MOUNT <x> <y> <theta>' (the laser's pose on the robot), got {value!r}", line=line
+        )
+    x, y, theta = (float(v) for v in _numbers(path, line, tokens, "MOUNT"))
+    if not all(np.isfinite((x, y, theta))):
+        raise ParseError(path, f"MOUNT {value}: expected three finite numbers (m, m, rad)", line=line)
+    return x, y, theta
+
+
+def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[Header, list[tuple[int, str]]]:
+    """Checks magic, version, UNITS and FRAME; returns NAME and MOUNT, and the lines read past the header."""
     first = next(lines, None)
     if first is None:
         raise ParseError(path, f"empty file; expected the first line '{MAGIC} {VERSION}'", line=1)
@@ -223,6 +250,7 @@ def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | Non
             path, f"unsupported {MAGIC} version {tokens[1]!r}; this reader knows version {VERSION}", line=1
         )
     seen: dict[str, str] = {}
+    seen_at: dict[str, tuple[int, str]] = {}
     for lineno, text in lines:
         stripped = text.strip()
         if not stripped or stripped.startswith("#"):
@@ -237,11 +265,13 @@ def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | Non
                     f"(expected 'UNITS {UNITS}' and 'FRAME {FRAME}')",
                     line=lineno,
                 )
-            return seen.get("NAME"), [(lineno, text)]
-        if key not in ("UNITS", "FRAME", "NAME"):
+            mount = _mount(path, *seen_at["MOUNT"]) if "MOUNT" in seen_at else (0.0, 0.0, 0.0)
+            return Header(seen.get("NAME"), mount), [(lineno, text)]
+        if key not in ("UNITS", "FRAME", "NAME", "MOUNT"):
             raise ParseError(
-                path, f"unknown header line {key!r}; expected UNITS, FRAME, NAME, SENSOR or VIEW", line=lineno
+                path, f"unknown header line {key!r}; expected UNITS, FRAME, NAME, MOUNT, SENSOR or VIEW", line=lineno
             )
+        seen_at[key] = (lineno, value)
         value = " ".join(value.split())
         if key == "UNITS" and value != UNITS:
             raise ParseError(path, f"expected 'UNITS {UNITS}' (no other units are defined), got {value!r}", line=lineno)
