@@ -34,6 +34,7 @@ def write_bag(
     quaternions: list[tuple[float, float, float, float]] | None = None,
     *,
     odom_offset_s: int = 0,
+    odom_children: list[str] | None = None,
 ) -> Path:
     """A ROS1 bag written with rosbags directly, so any field value can be stored."""
     from rosbags.rosbag1 import Writer
@@ -74,7 +75,7 @@ def write_bag(
             zero = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
             odom = t["nav_msgs/msg/Odometry"](
                 header=header(i + odom_offset_s),
-                child_frame_id="base",
+                child_frame_id=(odom_children or ["base"] * len(scans))[i],
                 pose=t["geometry_msgs/msg/PoseWithCovariance"](
                     pose=t["geometry_msgs/msg/Pose"](
                         position=t["geometry_msgs/msg/Point"](x=0.1 * i, y=0.0, z=0.0),
@@ -285,3 +286,15 @@ def test_scans_of_two_lasers_on_one_topic_are_refused_not_placed_with_one_mount(
     assert (
         len(list(load(write_bag(tmp_path / "one.bag", [{"frame_id": "front"}, {"frame_id": "/front"}])).frames())) == 2
     )
+
+
+def test_odometry_of_two_publishers_on_one_topic_is_refused_not_interleaved(tmp_path: Path) -> None:
+    """Wheel odometry and a filter both publishing on /odom used to be read as one track, jumping between
+    the two estimates at every message."""
+    path = write_bag(tmp_path / "two.bag", [{}, {}, {}], odom_children=["base", "base", "base_filtered"])
+    with pytest.raises(
+        ParseError,
+        match=r"two\.bag\[message #2\]: topic /odom: pose of 'x' -> 'base_filtered', but the topic's "
+        r"first message is 'x' -> 'base'; expected one frame pair per topic",
+    ):
+        list(load(path).frames())
