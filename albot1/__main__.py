@@ -11,4 +11,4 @@ from __future__ import annotations
 from albot1.cli.app import main
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    main()
