@@ -23,7 +23,7 @@ def valid_text() -> list[str]:
             i,
             Scan(np.where(rng.random(7) < 0.2, np.nan, np.round(rng.uniform(0, 20, 7), 2)), ANGLES, 1.0 + i, 20.0),
             np.array([0.1 * i, 0.0, 0.05 * i]),
-            np.array([1.0, 2.0, 0.3]) if i % 2 else None,
+            np.array([1.0, 2.0, 0.3 * i]),  # every view or none: a log of both is refused
         )
         for i in range(4)
     ]

@@ -45,19 +45,22 @@ class SequenceWriter(Protocol):
         ...
 
 
-def reference_presence_problem(first: Frame, frame: Frame, reader: str) -> str | None:
+def reference_presence_problem(
+    first: Frame, frame: Frame, reader: str, why: str = "it interpolates them to each scan's time"
+) -> str | None:
     """Why ``frame`` cannot follow ``first`` in a format that keeps reference poses for all scans or none.
 
     CARMEN (TRUEPOS lines) and bags (a reference topic) interpolate the
     reference poses to every scan's time, so a sequence where only some frames
     have one would come back with invented poses (or be refused): the writers
-    refuse it instead. The albot log stores a reference per view and needs no
-    such rule.
+    refuse it instead. The albot log stores a reference per view, but its reader
+    refuses a log where only some views have one (a run would score none of them),
+    so its writer refuses that too, with ``why`` saying so.
     """
     if (first.reference is None) == (frame.reference is None):
         return None
     has, lacks = (frame, first) if frame.reference is not None else (first, frame)
     return (
         f"frame {has.index} has a reference pose but frame {lacks.index} has none; {reader} holds reference "
-        f"poses for every scan or for none (it interpolates them to each scan's time)"
+        f"poses for every scan or for none ({why})"
     )

@@ -60,3 +60,22 @@ def test_every_spelling_of_one_slice_is_one_run_folder_under_the_canonical_name(
     assert {s["run_dir"] for s in summaries} == {summaries[0]["run_dir"]}
     assert {s["dataset"] for s in summaries} == {"synthetic-corridor[:30]"}
     assert len([p for p in tmp_path.iterdir() if p.name != "latest"]) == 1
+
+
+def test_python_dash_m_albot1_runs_the_command_line(tmp_path: Path) -> None:
+    """A checkout used through PYTHONPATH has no `albot1` script on PATH; `python -m albot1` is the way in, and
+    it used to fail with "albot1 is a package and cannot be directly executed"."""
+    import os
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[3]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    command = [sys.executable, "-m", "albot1"]
+    done = subprocess.run([*command, "--help"], capture_output=True, text=True, timeout=120, cwd=tmp_path, env=env)
+    assert done.returncode == 0 and "Usage: python -m albot1" in done.stdout, done.stderr
+    missing = str(tmp_path / "none.clf")
+    done = subprocess.run(
+        [*command, "datasets", "info", missing], capture_output=True, text=True, timeout=120, cwd=tmp_path, env=env
+    )
+    assert done.returncode == 1 and done.stderr.startswith("albot1: error: ") and "Traceback" not in done.stderr

@@ -11,6 +11,7 @@ reader refuses.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -98,6 +99,8 @@ class ViewParser:
         self.path = path
         self.sensor: _Sensor | None = None
         self.index = 0
+        #: whether view 0 has a reference pose, and its line: every later view must agree (all or none)
+        self.first_reference: tuple[bool, int] | None = None
 
     def error(self, line: int, message: str) -> ParseError:
         return ParseError(self.path, message, line=line)
@@ -141,6 +144,7 @@ class ViewParser:
             )
         if not _is_count(tokens[1]) or int(tokens[1]) != self.index:
             raise self.error(line, f"expected view index {self.index}, got {tokens[1]!r}")
+        self._check_reference_presence(line, has_ref)
         poses = _numbers(self.path, line, tokens[2:6] + (tokens[6:9] if has_ref else []), "VIEW time/pose")
         if not np.all(np.isfinite(poses)):
             raise self.error(line, "the timestamp and poses must be finite numbers")
@@ -154,6 +158,26 @@ class ViewParser:
         )
         self.index += 1
         return frame
+
+    def _check_reference_presence(self, line: int, has_ref: bool) -> None:
+        """Reference poses for every view or for none, as every other source gives them.
+
+        A run scores reference poses only when every scan has one, so a log with
+        some ``-`` views used to lose all its reference poses without a word
+        ("the dataset has no reference poses").
+        """
+        if self.first_reference is None:
+            self.first_reference = (has_ref, line)
+            return
+        first_has, first_line = self.first_reference
+        if has_ref != first_has:
+            which = ("has a reference pose", "has none ('-')")
+            raise self.error(
+                line,
+                f"view {self.index} {which[0] if has_ref else which[1]}, but view 0 (line {first_line}) "
+                f"{which[0] if first_has else which[1]}; expected a reference pose for every view or for none "
+                f"(scores need one for every scan)",
+            )
 
     def _ranges(self, line: int, points: FloatArray) -> FloatArray:
         assert self.sensor is not None
@@ -187,8 +211,34 @@ class ViewParser:
         return r[::-1].copy()
 
 
-def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | None, list[tuple[int, str]]]:
-    """Checks magic, version, UNITS and FRAME; returns NAME and the lines read past the header."""
+@dataclass(frozen=True)
+class Header:
+    """What the header lines say: the sequence's NAME (None if absent) and the laser's MOUNT on the robot."""
+
+    name: str | None
+    #: ``MOUNT x y theta``: the laser's pose in the robot frame (m, m, rad; the sequence's ``sensor_offset``)
+    mount: tuple[float, float, float]
+
+
+def mount_line(offset: tuple[float, float, float]) -> str:
+    """The MOUNT header line of a laser pose in the robot frame (written only when it is not zero)."""
+    return "MOUNT " + _fmt(offset)
+
+
+def _mount(path: Path, line: int, value: str) -> tuple[float, float, float]:
+    tokens = value.split()
+    if len(tokens) != 3:
+        raise ParseError(
+            path, f"expected 'MOUNT <x> <y> <theta>' (the laser's pose on the robot), got {value!r}", line=line
+        )
+    x, y, theta = (float(v) for v in _numbers(path, line, tokens, "MOUNT"))
+    if not all(np.isfinite((x, y, theta))):
+        raise ParseError(path, f"MOUNT {value}: expected three finite numbers (m, m, rad)", line=line)
+    return x, y, theta
+
+
+def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[Header, list[tuple[int, str]]]:
+    """Checks magic, version, UNITS and FRAME; returns NAME and MOUNT, and the lines read past the header."""
     first = next(lines, None)
     if first is None:
         raise ParseError(path, f"empty file; expected the first line '{MAGIC} {VERSION}'", line=1)
@@ -200,6 +250,7 @@ def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | Non
             path, f"unsupported {MAGIC} version {tokens[1]!r}; this reader knows version {VERSION}", line=1
         )
     seen: dict[str, str] = {}
+    seen_at: dict[str, tuple[int, str]] = {}
     for lineno, text in lines:
         stripped = text.strip()
         if not stripped or stripped.startswith("#"):
@@ -214,11 +265,13 @@ def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[str | Non
                     f"(expected 'UNITS {UNITS}' and 'FRAME {FRAME}')",
                     line=lineno,
                 )
-            return seen.get("NAME"), [(lineno, text)]
-        if key not in ("UNITS", "FRAME", "NAME"):
+            mount = _mount(path, *seen_at["MOUNT"]) if "MOUNT" in seen_at else (0.0, 0.0, 0.0)
+            return Header(seen.get("NAME"), mount), [(lineno, text)]
+        if key not in ("UNITS", "FRAME", "NAME", "MOUNT"):
             raise ParseError(
-                path, f"unknown header line {key!r}; expected UNITS, FRAME, NAME, SENSOR or VIEW", line=lineno
+                path, f"unknown header line {key!r}; expected UNITS, FRAME, NAME, MOUNT, SENSOR or VIEW", line=lineno
             )
+        seen_at[key] = (lineno, value)
         value = " ".join(value.split())
         if key == "UNITS" and value != UNITS:
             raise ParseError(path, f"expected 'UNITS {UNITS}' (no other units are defined), got {value!r}", line=lineno)

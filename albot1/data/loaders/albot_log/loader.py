@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import gzip
 import itertools
+import math
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, ClassVar
@@ -45,11 +46,12 @@ from albot1.data.loaders.albot_log.lines import (
     VERSION,
     ViewParser,
     check_frame,
+    mount_line,
     read_header,
     sensor_line,
     view_line,
 )
-from albot1.data.loaders.base import COMMON_OPTIONS
+from albot1.data.loaders.base import COMMON_OPTIONS, reference_presence_problem
 from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.model import Frame, Sequence, SequenceMetadata
@@ -121,7 +123,7 @@ class AlbotLogLoader:
             )
         if not path.is_file():
             raise DataError(f"{path}: no such file")
-        name, _ = read_header(path, _lines(path))
+        header, _ = read_header(path, _lines(path))
         if next(_frames(path), None) is None:  # reads up to the first VIEW only
             last = sum(1 for _ in _lines(path))
             raise ParseError(
@@ -133,10 +135,11 @@ class AlbotLogLoader:
         metadata = SequenceMetadata(
             source=str(path),
             format=self.format_name,
+            sensor_offset=header.mount,
             odometry_source="VIEW odometry poses",
-            reference_source="VIEW reference poses (where a view has one)",
+            reference_source="VIEW reference poses (every view has one, or none does)",
         )
-        return Sequence(name or stem, lambda: _frames(path), metadata)
+        return Sequence(header.name or stem, lambda: _frames(path), metadata)
 
 
 class AlbotLogWriter:
@@ -152,12 +155,22 @@ class AlbotLogWriter:
                 if sequence.metadata.source:
                     fh.write(f"# source: {' '.join(sequence.metadata.source.split())}\n")
                 fh.write(f"UNITS {UNITS}\nFRAME {FRAME}\nNAME {' '.join(sequence.name.split()) or 'unnamed'}\n")
+                offset = tuple(float(v) for v in sequence.metadata.sensor_offset)
+                if any(offset):  # the laser's mount: without it the scans would be read as taken at the robot's centre
+                    if not all(map(math.isfinite, offset)):
+                        raise UnwritableError(f"the laser mount {offset} is not three finite numbers")
+                    fh.write(mount_line((offset[0], offset[1], offset[2])) + "\n")
                 geometry: tuple[FloatArray, float] | None = None
+                first: Frame | None = None
                 for i, frame in enumerate(sequence.frames()):
                     if frame.index != i:
                         raise UnwritableError(f"frame {i} has index {frame.index}; expected consecutive indices from 0")
                     scan = frame.scan
                     check_frame(frame)
+                    first = first or frame
+                    gap = reference_presence_problem(first, frame, "an albot log", "its reader refuses the others")
+                    if gap is not None:
+                        raise UnwritableError(gap)
                     if geometry is None or not (
                         scan.max_range == geometry[1] and np.array_equal(scan.angles, geometry[0])
                     ):

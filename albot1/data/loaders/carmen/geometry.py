@@ -165,17 +165,28 @@ def param_geometry(beams: int, params: dict[str, str], rear: bool = False) -> Be
 
 
 def sensor_offset(params: dict[str, str], rear: bool = False) -> tuple[float, float, float]:
-    """Laser pose in the robot frame from PARAM ``robot_frontlaser_offset`` (and side/angular, if logged)."""
+    """Laser pose in the robot frame from PARAM ``robot_frontlaser_offset`` (and side/angular, if logged).
+
+    CARMEN's rear laser looks backwards: its robot module writes an RLASER line's laser pose as
+    ``theta = odom_theta + pi``, ``x = odom_x + offset * cos(theta)`` (``robot_laser.c``,
+    ``construct_laser_message``), so ``robot_rearlaser_offset`` is measured along the rear laser's own
+    heading. Its mount is therefore the rear PARAMs composed after a half turn, ``(-offset, -side, pi +
+    angular)``; taken as ``(offset, side, angular)`` every rear scan was placed facing forwards (a map
+    mirrored front to back).
+    """
     which = "rear" if rear else "front"
 
     def get(name: str) -> float:
         return float(params.get(name, "0"))  # checked by param_problem when parsed
 
-    return (
+    x, y, theta = (
         get(f"robot_{which}laser_offset"),
         get(f"robot_{which}laser_side_offset"),
         get(f"robot_{which}laser_angular_offset"),
     )
+    if not rear:
+        return x, y, theta
+    return 0.0 - x, 0.0 - y, math.remainder(math.pi + theta, 2 * math.pi)
 
 
 _ANGLE_CACHE: dict[tuple[int, float, float], FloatArray] = {}

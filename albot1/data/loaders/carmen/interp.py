@@ -14,6 +14,13 @@ scan's time is taken as is (no interpolation), paired by file order when
 several share the stamp: this is what makes logs written by
 :class:`~albot1.data.loaders.carmen.writer.CarmenWriter` round-trip even when
 their scans share timestamps.
+
+A scan outside the poses' time span gets the nearest end pose held, but only
+within ``tolerance`` of it (a scan logged a moment before the first ODOM line,
+as fr079's first is by 0.01 s); farther out the pose would be invented, not
+measured (a log whose ODOM or TRUEPOS stream stops long before its scans do),
+so it is a ParseError naming the scan's line, as the bag loader refuses to
+extrapolate. ``time_tolerance=inf`` holds the end poses at any distance.
 """
 
 from __future__ import annotations
@@ -39,6 +46,7 @@ class PoseBuffer:
         self.poses = np.zeros((0, 3))
         self.lines = np.zeros(0, dtype=np.int64)
         self.max_time = -np.inf
+        self.min_time = np.inf
         self.max_line = 0
         self.seen = 0
 
@@ -68,11 +76,21 @@ class PoseBuffer:
         order = np.argsort(times, kind="stable")
         self.times, self.poses, self.lines = times[order], poses[order], lines[order]
         self.max_time = float(running[-1])
+        self.min_time = min(self.min_time, float(records.timestamps.min()))
         self.max_line = int(records.lines[-1])
         self.seen += len(records.lines)
 
     def ready(self, t: float) -> bool:
-        return self.max_time > t + self.tolerance
+        """Whether no later line can change the pose at ``t``.
+
+        Later stamps lie above ``max_time - tolerance``; beyond ``t + tolerance``
+        they cannot land before ``t``. A scan before every pose seen so far waits one
+        tolerance longer, until they cannot land within ``tolerance`` after it either,
+        so whether it is too far before the first pose (:meth:`at`) does not depend on
+        where the log's chunks end.
+        """
+        wait = 2 * self.tolerance if t < self.min_time else self.tolerance
+        return self.max_time > t + wait
 
     def at(self, t: float, line: int) -> NDArray[np.float64]:
         if len(self.times) == 0:
@@ -82,6 +100,7 @@ class PoseBuffer:
                 f"expected {self.kind} lines (or choose another pose source)",
                 line=line,
             )
+        self._check_span(t, line)
         exact = np.flatnonzero(self.times == t)
         if len(exact):
             # a pose stamped exactly at the scan time is used as is; among several (logs whose stamps
@@ -93,6 +112,23 @@ class PoseBuffer:
             return stored
         blended: NDArray[np.float64] = se2.interpolate(self.times, self.poses, np.array([t]))[0]
         return blended
+
+    def _check_span(self, t: float, line: int) -> None:
+        """A ParseError for a scan farther than ``tolerance`` outside the poses' time span (its pose would be held)."""
+        if t < self.min_time - self.tolerance:
+            where, gap, end = "before the first", self.min_time - t, self.min_time
+        elif t > self.max_time + self.tolerance:
+            where, gap, end = "after the last", t - self.max_time, self.max_time
+        else:
+            return
+        raise ParseError(
+            self.path,
+            f"scan at t = {t:.6f} s lies {gap:.3f} s {where} {self.kind} line (t = {end:.6f} s); its pose would "
+            f"be invented (the end pose held), not measured; expected "
+            f"scans within the {self.kind} lines' time span, to within time_tolerance {self.tolerance} s "
+            f"(time_tolerance=inf holds the end poses)",
+            line=line,
+        )
 
     def trim(self, oldest_needed: float) -> None:
         """Drop poses older than the bracket of ``oldest_needed - tolerance``."""

@@ -18,7 +18,8 @@ Odometry sources (option ``odometry``):
     does, by up to 0.9 s); they are sorted, and a scan is only emitted once
     an ODOM stamp later than ``scan time + time_tolerance`` has been read, so
     the result does not depend on chunking. Scans before the first (after
-    the last) ODOM line take the first (last) ODOM pose.
+    the last) ODOM line take the first (last) ODOM pose, within
+    ``time_tolerance`` of it; farther out they are refused (:mod:`.interp`).
 ``"odom-segments"``
     the GMapping-corrected logs of ``radish-corrected/``: after every FLASER
     the ODOM stream is *re-anchored* at the scan's corrected pose and then

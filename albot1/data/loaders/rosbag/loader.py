@@ -87,9 +87,22 @@ class _BagSource:
         odom, ref = self.tracks()
         topic = self.choice.scan
         out, dropped, last = 0, 0, -math.inf
+        first_frame: str | None = None
         with opened_bag(self.bag, self.shown) as reader:
             for i, msg in topic_messages(reader, topic, self.shown):
                 t = header_stamp(msg)
+                frame_id = str(msg.header.frame_id).lstrip("/")
+                if first_frame is None:
+                    first_frame = frame_id
+                elif frame_id != first_frame:
+                    # two lasers publishing on one topic: one mount (the first scan's frame's) would place both
+                    raise ParseError(
+                        self.shown,
+                        f"topic {topic}: scan in frame {frame_id!r}, but the topic's first scan is in frame "
+                        f"{first_frame!r}; expected one laser per topic (the laser's mount is read for one frame; "
+                        f"two lasers publishing on one topic cannot be told apart by time)",
+                        index=i,
+                    )
                 if t < last:
                     raise ParseError(
                         self.shown,

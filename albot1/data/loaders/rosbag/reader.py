@@ -116,8 +116,25 @@ def _planar_pose(shown: Path, topic: str, index: int, p: Any, q: Any) -> tuple[f
 
 
 def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
+    """The poses of a ``nav_msgs/Odometry`` topic as a track; all in one ``frame_id -> child_frame_id`` pair.
+
+    Two publishers on one topic (wheel odometry and a filter's both on ``/odom``) would otherwise be
+    interleaved into one track that jumps between two estimates at every message.
+    """
     times, poses = [], []
+    frames: tuple[str, str] | None = None
     for i, msg in topic_messages(reader, topic, shown):
+        pair = (str(msg.header.frame_id).lstrip("/"), str(msg.child_frame_id).lstrip("/"))
+        if frames is None:
+            frames = pair
+        elif pair != frames:
+            raise ParseError(
+                shown,
+                f"topic {topic}: pose of {pair[0]!r} -> {pair[1]!r}, but the topic's first message is "
+                f"{frames[0]!r} -> {frames[1]!r}; expected one frame pair per topic (two publishers' poses "
+                f"interleaved would make one track jump between them)",
+                index=i,
+            )
         pose = _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation)
         times.append(header_stamp(msg))
         poses.append(pose)

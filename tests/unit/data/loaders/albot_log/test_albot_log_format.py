@@ -13,7 +13,7 @@ import pytest
 from albot1.data.errors import DataError, ParseError
 from albot1.data.loaders.albot_log.loader import AlbotLogLoader, AlbotLogWriter, view_line
 from albot1.data.loaders.registry import loader_for
-from albot1.data.model import Frame, Scan, Sequence
+from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
 
 ANGLES = np.deg2rad(np.arange(-90.0, 90.5, 0.5))
 HEADER = "ALBOT1-LOG 1\nUNITS length=m angle=rad time=s\nFRAME thesis\n"
@@ -27,7 +27,7 @@ def synthetic(n: int = 25, seed: int = 3) -> Sequence:
         angles = ANGLES if i < n // 2 else np.sort(rng.uniform(-2.0, 2.0, 90))  # geometry changes mid-log
         ranges = np.round(rng.uniform(0.0, 40.0, angles.shape[0]), 2)
         ranges[rng.random(angles.shape[0]) < 0.2] = np.nan
-        ref = np.array([0.5 * i, 1.0, -3.0]) if i % 3 else None
+        ref = np.array([0.5 * i, 1.0, -3.0])  # every view or none: a log of both is refused
         frames.append(Frame(i, Scan(ranges, angles, 12.5 + 0.1 * i, 40.0), np.array([0.1 * i, 0.2 * i, 7.0 - i]), ref))
     return Sequence.from_frames("office run", frames)
 
@@ -71,12 +71,14 @@ def test_a_hand_written_log_loads(tmp_path: Path) -> None:
         HEADER
         + "# comment\n\nNAME demo\n"
         + SENSOR3
-        + "VIEW 0 0.0 0.0 0.0 0.0 - -2.0 0.0 0.0 3.5 nan nan\n"
+        + "VIEW 0 0.0 0.0 0.0 0.0 0.0 0.0 0.0 -2.0 0.0 0.0 3.5 nan nan\n"
         + "VIEW 1 0.5 0.25 0.0 0.0 1.0 2.0 0.01 -1.75 0.0 0.0 3.25 1.5 0.0\n",
     )
     assert [f.index for f in frames] == [0, 1]
     assert np.allclose(frames[0].scan.ranges, [np.nan, 3.5, 2.0], equal_nan=True)
-    assert frames[0].reference is None and frames[1].reference == pytest.approx([1.0, 2.0, 0.01])
+    assert frames[0].reference == pytest.approx([0.0, 0.0, 0.0]) and frames[1].reference == pytest.approx(
+        [1.0, 2.0, 0.01]
+    )
     assert frames[1].scan.ranges == pytest.approx([1.5, 3.25, 1.75])
 
 
@@ -195,3 +197,22 @@ def test_writer_checks(tmp_path: Path) -> None:
     with pytest.raises(DataError, match="takes no loading options"):
         AlbotLogWriter().write(synthetic(2), tmp_path / "ok.albotlog")
         AlbotLogLoader().load(tmp_path / "ok.albotlog", scan_topic="/scan")
+
+
+def test_the_laser_mount_survives_a_round_trip_and_a_bad_mount_line_is_refused(tmp_path: Path) -> None:
+    """A source whose laser sits off the robot's centre (a bag's /tf_static, fr-clinic's 0.22 m, a rear laser's
+    half turn) used to lose its mount in an albot log without a word: read back, every scan was placed at the
+    robot's centre, facing forwards (converting fr-clinic moved each scan 0.22 m). The log's MOUNT line keeps it."""
+    frames = [Frame(i, Scan(np.ones(3), np.array([-0.5, 0.0, 0.5]), float(i), 10.0), np.zeros(3)) for i in range(2)]
+    mount = (0.22, -0.05, math.pi)
+    seq = Sequence.from_frames("m", frames, SequenceMetadata(sensor_offset=mount))
+    AlbotLogWriter().write(seq, tmp_path / "m.albotlog")
+    assert AlbotLogLoader().load(tmp_path / "m.albotlog").metadata.sensor_offset == mount
+    AlbotLogWriter().write(Sequence.from_frames("z", frames), tmp_path / "z.albotlog")  # no mount: no MOUNT line
+    assert "MOUNT" not in (tmp_path / "z.albotlog").read_text()
+    assert AlbotLogLoader().load(tmp_path / "z.albotlog").metadata.sensor_offset == (0.0, 0.0, 0.0)
+    for bad, message in (("MOUNT 0.2 0.1", r"expected 'MOUNT <x> <y> <theta>'"), ("MOUNT 0.2 nan 0", "finite")):
+        path = tmp_path / "bad.albotlog"
+        path.write_text(HEADER + bad + "\n" + SENSOR3 + "VIEW 0 0.0 0.0 0.0 0.0 - -2.0 0.0 0.0 3.5 nan nan\n")
+        with pytest.raises(ParseError, match=rf"bad\.albotlog:4: .*{message}"):
+            AlbotLogLoader().load(path)

@@ -74,3 +74,31 @@ def test_a_number_in_python_s_digit_grouping_is_refused_at_its_line_not_read(tmp
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(ParseError, match=rf"g\.albotlog:{view + 1}: .*'1_0' is not a number"):
         AlbotLogLoader().load(path).frames().__next__()
+
+
+@pytest.mark.parametrize("first_has", [False, True])
+def test_a_log_where_only_some_views_have_a_reference_is_refused_not_read_without_any(
+    tmp_path: Path, first_has: bool
+) -> None:
+    """A run scores reference poses only when every scan has one: a log with some '-' views used to load and
+    lose every reference pose it held ("the dataset has no reference poses"), without a word."""
+    views = [
+        "VIEW 0 0.0 0.0 0.0 0.0 " + ("1.0 2.0 0.0" if first_has else "-") + " 0.0 1.0 0.0 1.0 0.0 1.0",
+        "VIEW 1 0.5 0.1 0.0 0.0 1.1 2.0 0.0 0.0 1.0 0.0 1.0 0.0 1.0",
+        "VIEW 2 1.0 0.2 0.0 0.0 - 0.0 1.0 0.0 1.0 0.0 1.0",
+    ]
+    path = tmp_path / "part.albotlog"
+    path.write_text(HEADER + "SENSOR-ANGLES 3 10.0 -0.001 0.0 0.001\n" + "\n".join(views) + "\n")
+    line, has, lacks = (
+        (7, "view 2 has none \\('-'\\)", "has a reference pose")
+        if first_has
+        else (6, "view 1 has a reference pose", "has none")
+    )
+    with pytest.raises(ParseError, match=rf"part\.albotlog:{line}: {has}, but view 0 \(line 5\) {lacks}"):
+        list(AlbotLogLoader().load(path).frames())
+    frames = [
+        Frame(i, Scan(np.ones(3), ANGLES, float(i), 10.0), np.zeros(3), np.zeros(3) if i == 1 else None)
+        for i in range(2)
+    ]
+    with pytest.raises(UnwritableError, match=r"frame 1 has a reference pose but frame 0 has none; an albot log"):
+        AlbotLogWriter().write(Sequence.from_frames("p", frames), tmp_path / "out.albotlog")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import bz2
 import gzip
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -111,10 +112,57 @@ def test_odom_interpolation_holds_end_poses_and_sorts_jitter(tmp_path: Path) -> 
         odom_line((3.0, 0.0, 0.0), 3.0),
         odom_line((2.0, 0.0, 0.0), 2.0),
         flaser([1.0] * 180, 2.5),
-        flaser([1.0] * 180, 9.0),
+        flaser([1.0] * 180, 3.9),
     ]
     frames = load(write(tmp_path, lines), odometry="odom")
     np.testing.assert_allclose([f.odometry[0] for f in frames], [1.0, 2.5, 3.0])
+
+
+@pytest.mark.parametrize("kind", ["ODOM", "TRUEPOS"])
+@pytest.mark.parametrize(
+    ("layout", "line", "found"),
+    [
+        (
+            "S10 P14.5 S14.6 P15 S15 P15.5",
+            1,
+            "10.000000 s lies 4.500 s before the first {kind} line (t = 14.500000 s)",
+        ),
+        (
+            "S14.6 P14.5 S15 P15 P15.5 S30",
+            6,
+            "30.000000 s lies 14.500 s after the last {kind} line (t = 15.500000 s)",
+        ),
+    ],
+)
+def test_scans_far_outside_the_pose_lines_are_refused_not_given_a_held_pose(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str, layout: str, line: int, found: str
+) -> None:
+    """A log whose ODOM (or TRUEPOS) stream covers only part of its scans used to give the others the end
+    pose, silently: a robot standing still in the odometry, or reference poses that were never measured.
+    Farther than time_tolerance outside the poses' span that is refused, at the scan's line, in every chunking.
+    ``layout``: the log's lines, S = a scan and P = a pose line at that time."""
+    import functools
+
+    from albot1.data.loaders.carmen import frames as frames_module
+    from albot1.data.loaders.carmen.source import iter_line_chunks
+
+    def pose(t: float) -> str:
+        if kind == "ODOM":
+            return odom_line((t, 0.0, 0.0), t)
+        return f"TRUEPOS {t} 0 0 {t} 0 0 {t:.6f} host {t:.6f}"
+
+    lines = [flaser([1.0] * 180, float(w[1:])) if w[0] == "S" else pose(float(w[1:])) for w in layout.split()]
+    path = write(tmp_path, lines)
+    options = {"odometry": "odom"} if kind == "ODOM" else {"reference": "truepos"}
+    message = (
+        rf"log\.clf:{line}: scan at t = {re.escape(found.format(kind=kind))}.*time_tolerance=inf holds the end poses"
+    )
+    with pytest.raises(ParseError, match=message):
+        load(path, **options)
+    monkeypatch.setattr(frames_module, "iter_line_chunks", functools.partial(iter_line_chunks, chunk_bytes=200))
+    with pytest.raises(ParseError, match=message):
+        load(path, **options)
+    assert len(load(path, time_tolerance=math.inf, **options)) == 3
 
 
 def test_odom_going_back_beyond_tolerance_names_the_line(tmp_path: Path) -> None:
@@ -288,3 +336,37 @@ def test_small_chunks_give_the_same_frames(
     np.testing.assert_array_equal(chunked.odometry, expected_odom)
     np.testing.assert_array_equal(chunked.reference, expected_ref)
     assert chunked.count_scans() == 300
+
+
+@pytest.mark.parametrize(("offset", "side", "angular"), [(0.3, 0.0, 0.0), (-0.25, 0.05, 0.1)])
+def test_rear_laser_mount_faces_backwards_as_carmen_writes_its_laser_pose(
+    tmp_path: Path, offset: float, side: float, angular: float
+) -> None:
+    """CARMEN's robot module writes an RLASER line's laser pose as theta = odom_theta + pi and
+    x = odom_x + offset * cos(theta) (robot_laser.c): the rear laser looks backwards. Its mount used to be
+    read as (offset, side, angular), facing forwards, so every rear scan was placed mirrored front to back.
+    The mount must be the one the lines' own laser and odometry poses imply."""
+    from albot1.geometry import se2
+
+    params = [
+        f"PARAM robot_rearlaser_offset {offset}",
+        f"PARAM robot_rearlaser_side_offset {side}",
+        f"PARAM robot_rearlaser_angular_offset {angular}",
+    ]
+    mount = np.array([-offset, -side, math.pi + angular])  # the rear PARAMs after a half turn
+    lines = []
+    for k, odom in enumerate([(0.0, 0.0, 0.0), (1.0, 0.5, 0.7), (2.0, -1.0, -2.9)]):
+        laser = [float(v) for v in se2.compose(np.array(odom), mount)]
+        r = " ".join(["2.000"] * 181)
+        lines.append(
+            f"RLASER 181 {r} {laser[0]!r} {laser[1]!r} {laser[2]!r} {odom[0]} {odom[1]} {odom[2]} "
+            f"{k + 1.0:.6f} host {k + 1.0:.6f}"
+        )
+    sequence = CarmenLoader().load(write(tmp_path, params + lines), laser="RLASER", reference="laser-pose")
+    offset = np.array(sequence.metadata.sensor_offset)
+    np.testing.assert_allclose(offset[:2], mount[:2], atol=1e-12)
+    assert abs(se2.wrap(offset[2] - mount[2])) < 1e-12
+    for frame in sequence.frames():
+        implied = se2.between(frame.odometry, frame.reference)  # laser pose fields vs odometry fields
+        np.testing.assert_allclose(implied[:2], offset[:2], atol=1e-9)
+        assert abs(se2.wrap(implied[2] - offset[2])) < 1e-9

@@ -34,6 +34,7 @@ def write_bag(
     quaternions: list[tuple[float, float, float, float]] | None = None,
     *,
     odom_offset_s: int = 0,
+    odom_children: list[str] | None = None,
 ) -> Path:
     """A ROS1 bag written with rosbags directly, so any field value can be stored."""
     from rosbags.rosbag1 import Writer
@@ -42,15 +43,17 @@ def write_bag(
     ts = get_typestore(Stores.ROS1_NOETIC)
     t = ts.types
 
-    def header(i: int) -> Any:
+    def header(i: int, frame_id: str = "x") -> Any:
         return t["std_msgs/msg/Header"](
-            seq=i, stamp=t["builtin_interfaces/msg/Time"](sec=10 + i, nanosec=0), frame_id="x"
+            seq=i, stamp=t["builtin_interfaces/msg/Time"](sec=10 + i, nanosec=0), frame_id=frame_id
         )
 
     with Writer(path) as bag:
         scan_conn = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
         odom_conn = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
-        for i, fields in enumerate(scans):
+        for i, given in enumerate(scans):
+            fields = dict(given)
+            frame_id = str(fields.pop("frame_id", "x"))  # the scan's header frame (the laser), not a message field
             values = {
                 "angle_min": -math.pi / 2,
                 "angle_max": -math.pi / 2 + 179 * STEP,
@@ -61,14 +64,18 @@ def write_bag(
                 **fields,
             }
             msg = t["sensor_msgs/msg/LaserScan"](
-                header=header(i), time_increment=0.0, scan_time=0.0, intensities=np.zeros(0, np.float32), **values
+                header=header(i, frame_id),
+                time_increment=0.0,
+                scan_time=0.0,
+                intensities=np.zeros(0, np.float32),
+                **values,
             )
             bag.write(scan_conn, (10 + i) * 10**9, ts.serialize_ros1(msg, "sensor_msgs/msg/LaserScan"))
             qx, qy, qz, qw = (quaternions or [(0.0, 0.0, 0.0, 1.0)] * len(scans))[i]
             zero = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
             odom = t["nav_msgs/msg/Odometry"](
                 header=header(i + odom_offset_s),
-                child_frame_id="base",
+                child_frame_id=(odom_children or ["base"] * len(scans))[i],
                 pose=t["geometry_msgs/msg/PoseWithCovariance"](
                     pose=t["geometry_msgs/msg/Pose"](
                         position=t["geometry_msgs/msg/Point"](x=0.1 * i, y=0.0, z=0.0),
@@ -264,3 +271,30 @@ def test_the_bag_writer_refuses_what_the_reader_refuses(tmp_path: Path) -> None:
     with pytest.raises(UnwritableError, match=r"e\.bag: the sequence has no scans"):
         Ros1BagWriter().write(Sequence.from_frames("e", []), tmp_path / "e.bag")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_scans_of_two_lasers_on_one_topic_are_refused_not_placed_with_one_mount(tmp_path: Path) -> None:
+    """Two lasers publishing on one topic (a front and a rear scanner both on /scan) used to load as one laser:
+    every scan got the mount of the first scan's frame, the rear laser's placed where the front one sits."""
+    path = write_bag(tmp_path / "two.bag", [{"frame_id": "front"}, {"frame_id": "/front"}, {"frame_id": "rear"}])
+    with pytest.raises(
+        ParseError,
+        match=r"two\.bag\[message #2\]: topic /scan: scan in frame 'rear', but the topic's first scan is "
+        r"in frame 'front'; expected one laser per topic",
+    ):
+        list(load(path).frames())
+    assert (
+        len(list(load(write_bag(tmp_path / "one.bag", [{"frame_id": "front"}, {"frame_id": "/front"}])).frames())) == 2
+    )
+
+
+def test_odometry_of_two_publishers_on_one_topic_is_refused_not_interleaved(tmp_path: Path) -> None:
+    """Wheel odometry and a filter both publishing on /odom used to be read as one track, jumping between
+    the two estimates at every message."""
+    path = write_bag(tmp_path / "two.bag", [{}, {}, {}], odom_children=["base", "base", "base_filtered"])
+    with pytest.raises(
+        ParseError,
+        match=r"two\.bag\[message #2\]: topic /odom: pose of 'x' -> 'base_filtered', but the topic's "
+        r"first message is 'x' -> 'base'; expected one frame pair per topic",
+    ):
+        list(load(path).frames())
