@@ -16,10 +16,17 @@ def test_plain_listing_is_one_line_per_method() -> None:
     result = runner.invoke(app, ["methods"])
     assert result.exit_code == 0, result.output
     lines = result.output.splitlines()
-    assert [line.split()[0] for line in lines] == method_registry().names()
-    assert lines[1] == "albot1         available  the Albot1 perceptual mapper (thesis chapter 3)"
-    # every row's columns start at the same place, the longest name included
-    assert {line.index(" available") for line in lines} == {len("albot1-places") + 1}
+    # one row per method; an unavailable one (MRPT's apps not installed here) has its reason on an indented line
+    rows = [line for line in lines if not line.startswith(" ")]
+    assert [row.split()[0] for row in rows] == method_registry().names()
+    assert rows[1].split(None, 2) == ["albot1", "available", "the Albot1 perceptual mapper (thesis chapter 3)"]
+    # every row's columns start at the same place, the longest name and the longest status included
+    assert {row.index(row.split()[1]) for row in rows} == {len("albot1-places") + 2}
+    status_width = max(len(row.split()[1]) for row in rows)
+    assert {row.index(row.split(None, 2)[2]) for row in rows} == {len("albot1-places") + 2 + status_width + 2}
+    for before, line in zip(lines, lines[1:], strict=False):
+        if line.startswith(" "):
+            assert line.strip().startswith("-> ") and before.split()[1] == "unavailable"
 
 
 def test_presets_table_of_one_method() -> None:
