@@ -167,7 +167,7 @@ class AlbotLogWriter:
                         raise UnwritableError(f"frame {i} has index {frame.index}; expected consecutive indices from 0")
                     scan = frame.scan
                     check_frame(frame)
-                    first = first or frame
+                    first = frame if first is None else first
                     gap = reference_presence_problem(first, frame, "an albot log", "its reader refuses the others")
                     if gap is not None:
                         raise UnwritableError(gap)
