@@ -20,9 +20,10 @@ Two kinds of errors, one per table that needs them:
 
 The errors are recomputed from the run folder, not stored: each is checked
 against the run's own ``metrics.json`` (ATE RMSE, or relation mean and N),
-and a run whose folder does not reproduce it (an external trajectory, whose
-relations are looked up in every pose of its file, not only in the poses
-matched to scans) is not compared, with that reason.
+and a run whose folder does not reproduce it (metrics written by another
+version of the code) is not compared, with that reason. An external
+trajectory's folder keeps the poses matched to scans, stamped with their
+scans' stamps, which are the poses its metrics were scored on.
 """
 
 from __future__ import annotations
@@ -54,9 +55,8 @@ FIGURE: Final[dict[Kind, str]] = {
 #: relative tolerance of the check that the recomputed errors reproduce the run's metrics.json
 REPRODUCE_RTOL: Final = 1e-6
 NOT_REPRODUCED: Final = (
-    "its run folder does not reproduce its metrics.json (an external file is scored on every pose of the file, "
-    "the folder keeps the poses matched to scans; or the metrics were written by another version of the code: "
-    "albot1 evaluate the run again)"
+    "its run folder does not reproduce its metrics.json (the metrics were written by another version of the code, "
+    "e.g. an external file's relations looked up at the file's own stamps: albot1 evaluate the run again)"
 )
 
 

@@ -23,8 +23,11 @@ against:
   ``NAME[:100]`` both stamp 0), so any other file whose timestamps repeat
   is refused, suggesting ``albot1 evaluate RUN_DIR``.
 
-The relation metric needs only times, so it looks relations up in every
-pose of the file (matched or not). Map shape, update counts and cost need
+Every metric, the relation metric included, scores the matched poses
+stamped with their scans' stamps: a relation names two scans by their
+stamps, so a pose printed with fewer decimals, or a little late, is still
+its scan's pose (looked up at the file's own stamps, such relations were
+left out as if the file had no pose for them). Map shape, update counts and cost need
 a map, counters and timings that a trajectory file does not hold: those
 metrics are null with that reason.
 """
@@ -195,11 +198,10 @@ def load_external(
     scan_times, reference = arrays.timestamps, arrays.reference
     if reference is not None:
         reference = as_stored(scan_times, reference)  # as a run folder's reference.tum holds it
-    stamps = file.timestamps
-    if stamps is not None and paired_by_line(stamps, stamps_as_stored(scan_times), (file.path,), dataset=dataset):
+    stamps, stored_times = file.timestamps, stamps_as_stored(scan_times)
+    if stamps is not None and paired_by_line(stamps, stored_times, (file.path,), dataset=dataset):
         dt = None
         matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
-        pose_times = stamps
     elif file.timestamps is None:
         if len(file.poses) != len(scan_times):
             raise RunError(
@@ -208,23 +210,25 @@ def load_external(
             )
         dt = None
         matching = Matching(np.arange(len(scan_times)), np.arange(len(scan_times)), 0, 0)
-        pose_times = scan_times
     else:
         refuse_repeated_stamps_by_time(file, len(scan_times), f"scans of {dataset!r}")
         dt = MAX_DT_S if max_dt_s is None else max_dt_s
         matching = match_by_time(file.timestamps, scan_times, dt)
-        pose_times = file.timestamps
         if not len(matching.pose_index):
             raise RunError(
-                f"{file.path}: none of its {len(file.poses)} poses (times {pose_times.min():.3f}-"
-                f"{pose_times.max():.3f} s) lies within {dt:g} s of a scan of {dataset!r} (times "
+                f"{file.path}: none of its {len(file.poses)} poses (times {file.timestamps.min():.3f}-"
+                f"{file.timestamps.max():.3f} s) lies within {dt:g} s of a scan of {dataset!r} (times "
                 f"{scan_times.min():.3f}-{scan_times.max():.3f} s); expected the log's own timestamps"
             )
     poses = file.poses[matching.pose_index]
     scans = matching.scan_index
+    # A matched pose is its scan's pose, stamped as the run folder stamps that scan: a relation names scans by
+    # their stamps, so looking relations up at the file's own stamps left out every relation whose pose was
+    # printed with fewer decimals or a little late (0.5 ms: within --max-dt, beyond the 0.1 ms relation
+    # tolerance), as if the trajectory had no pose for that scan, and scored the rest.
+    times = stored_times[scans]
     key, digest = _key(file, dataset)
     name = label or file.path.stem
-    order = np.argsort(pose_times, kind="stable")
     return Scored(
         header={
             "key": key,
@@ -237,13 +241,13 @@ def load_external(
             "has_reference": reference is not None,
         },
         dataset=dataset,
-        timestamps=pose_times[matching.pose_index],
+        timestamps=times,
         poses=poses,
         reference=reference[scans] if reference is not None else None,
         relations=_as_stored(sequence.relations),
         relations_source=f"the relations of {dataset}",
-        relation_timestamps=pose_times[order],
-        relation_poses=file.poses[order],
+        relation_timestamps=times,
+        relation_poses=poses,
         absent={"map_shape": NO_MAP, "updates": NO_COUNTERS, "cost": NO_TIMING},
         extra={
             "trajectory": {

@@ -33,9 +33,9 @@ class Scored:
 
     ``timestamps``/``poses``/``reference`` are aligned row by row (one row
     per scan scored). ``relation_timestamps``/``relation_poses`` are the
-    poses the relation metric looks relations up in (the same rows for a
-    run; every pose of an external file, matched to a scan or not, since a
-    relation needs only times). ``load_map``, ``counters`` and
+    poses the relation metric looks relations up in (the same rows, for a
+    run and for an external file alike: its poses matched to scans, at
+    their scans' stamps). ``load_map``, ``counters`` and
     ``per_scan_ns``/``timing`` are None when the source has none, and
     ``absent`` says why for the metrics that need them.
     """
