@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -128,6 +128,8 @@ def evaluate(
     from albot1.runs.scored import scored_run
 
     settings = get_settings(data_dir=data_dir)
+    if plot_also and plot is None:
+        raise typer.BadParameter("--plot-also adds files to the figures of --plot DIR; give --plot DIR too")
     if (run_dir is None) == (trajectory is None):
         raise typer.BadParameter("give either RUN_DIR or --trajectory FILE (with --dataset NAME), not both")
     if trajectory is None:
@@ -165,6 +167,8 @@ def evaluate(
             reference,
             out=out,
             evo=evo,
+            plot=plot,
+            plot_also=plot_also or [],
             as_json=as_json,
             format_name=format_name,
             reference_format=reference_format,
@@ -204,16 +208,32 @@ def evaluate(
 
 
 def _evaluate_pair(
-    trajectory: Path, reference: Path, *, out: Path | None, evo: Path | None, as_json: bool, **options: object
+    trajectory: Path,
+    reference: Path,
+    *,
+    out: Path | None,
+    evo: Path | None,
+    plot: Path | None,
+    plot_also: list[Path],
+    as_json: bool,
+    **options: Any,
 ) -> None:
-    """``--trajectory EST --reference REF``: two files scored like evo_ape/evo_rpe (see albot1.runs.pair)."""
+    """``--trajectory EST --reference REF``: two files scored like evo_ape/evo_rpe (see albot1.runs.pair).
+
+    ``--plot`` draws the same figures as with a dataset (it used to be ignored here without a word), the
+    ``--plot-also`` files matched to the same reference file with the same options.
+    """
     from albot1.records import dump_record
     from albot1.runs.evaluate import evaluate_pair
+    from albot1.runs.pair import load_pair
 
     metrics, scored = evaluate_pair(trajectory, reference, out=out, **options)
     _note_left_out(metrics)
     if evo is not None:
         _evo(scored, evo, _file_name(metrics.run.method))
+    if plot is not None:
+        also = {key: value for key, value in options.items() if key != "label"}  # each file its own name
+        _draw([scored] + [load_pair(path, reference, **also) for path in plot_also], plot)
     if as_json:
         typer.echo(json.dumps(dump_record(metrics)))
         return
@@ -283,11 +303,16 @@ def _evo(scored: Scored, folder: Path, name: str) -> None:
 def _plot(
     first: Scored, dataset: str, folder: Path, also: list[Path], max_dt: float | None, settings: Settings
 ) -> None:
-    """``--plot``: the figures of :mod:`albot1.report.evaluate_plots`, listed on stderr."""
-    from albot1.report.evaluate_plots import plot_scored
+    """``--plot``: ``first`` and the ``also`` files scored against ``dataset``, drawn (:func:`_draw`)."""
     from albot1.runs.external import load_external
 
-    items = [first] + [load_external(p, dataset, max_dt_s=max_dt, settings=settings) for p in also]
+    _draw([first] + [load_external(p, dataset, max_dt_s=max_dt, settings=settings) for p in also], folder)
+
+
+def _draw(items: list[Scored], folder: Path) -> None:
+    """The figures of :mod:`albot1.report.evaluate_plots` for ``items`` (the first the main one), listed on stderr."""
+    from albot1.report.evaluate_plots import plot_scored
+
     drawn = plot_scored(items, folder)
     typer.echo(f"plots: {', '.join(str(p) for p in drawn.files)}", err=True)
     if drawn.missing is not None:
