@@ -48,3 +48,15 @@ def test_plot_also_without_plot_is_refused_not_ignored(tmp_path: Path) -> None:
     assert result.exit_code == 2
     said = " ".join(result.output.replace("│", " ").split())  # the message as typer boxes it, unwrapped
     assert "--plot-also adds files to the figures of --plot DIR; give --plot DIR too" in said
+
+
+def test_evo_files_for_one_matched_pose_say_so_not_that_the_reference_has_none(tmp_path: Path) -> None:
+    gt, big, _ = _files(tmp_path)
+    one = tmp_path / "one.tum"
+    one.write_text(big.read_text(encoding="utf-8").splitlines()[1] + "\n", encoding="utf-8")  # line 0: header
+    result = runner.invoke(
+        app, ["evaluate", "--trajectory", str(one), "--reference", str(gt), "--evo", str(tmp_path / "evo")]
+    )
+    assert result.exit_code == 0, result.output
+    assert "need at least 2 poses scored against reference poses; 1 was" in result.stderr
+    assert "the dataset has none" not in result.stderr
