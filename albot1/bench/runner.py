@@ -34,6 +34,7 @@ from albot1.bench.order import longest_first, past_costs
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import LOG, UNREADABLE_FAILURE, ResultsStore
 from albot1.bench.suite import find_suite, load_suite
+from albot1.methods.registry import method_registry
 from albot1.runs.folder import PreviewRenderer
 from albot1.runs.output import writable_folder
 from albot1.settings import Settings, get_settings
@@ -340,8 +341,13 @@ def run_suite(
     suite_file = find_suite(suite_ref)
     suite = load_suite(suite_file)
     if kind == "local":
+        # Only registered names: the server warns about any other as a typo in ALBOT1_PRELOAD_METHODS, a variable
+        # the user never set, beside the planner's own "unknown method" error (which follows).
+        registered = method_registry()
         start_forkserver(
-            None if suite.registered_methods else {m.name for m in suite.methods if m.trajectories is None}
+            None
+            if suite.registered_methods
+            else {m.name for m in suite.methods if m.trajectories is None and m.name in registered}
         )
     plan = plan_suite(suite, settings or get_settings())
     writable_folder(results, "--results")  # after the suite and its plan: a bad suite makes no folder
