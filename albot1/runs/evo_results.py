@@ -65,9 +65,7 @@ def write_evo_results(scored: Scored, folder: Path, prefix: str = "") -> list[Pa
         raise RunError("evo result files need reference poses (at least 2); the dataset has none")
     if len(reference) < 2:
         # said "the dataset has none" also when the reference had poses but only one was matched to the file
-        raise RunError(
-            f"evo result files need at least 2 poses scored against reference poses; {len(reference)} was"
-        )
+        raise RunError(f"evo result files need at least 2 poses scored against reference poses; {len(reference)} was")
     folder.mkdir(parents=True, exist_ok=True)
     label = str(scored.header["method"])
     ref_name = f"{scored.dataset} reference"
