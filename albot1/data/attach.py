@@ -9,7 +9,8 @@ the same everywhere (``docs/formats.md``, "Options of every source"):
     a relations file (:mod:`albot1.data.relations`) replaces the source's own
     relations (if any); the relation metric then scores against it. A file
     none of whose relation stamps lies within the log's time span (another
-    log's relations) is refused on the first full pass over the scans.
+    log's relations), or one with a relation end within that span that is no
+    scan's stamp, is refused on the first full pass over the scans.
     ``relations_repeats=drop|keep`` says how its identically repeated lines
     count: once (drop, the default) or as listed (keep, the published
     evaluator's reading).
@@ -39,13 +40,15 @@ import numpy as np
 
 from albot1.data.errors import DataError, ReferenceOptionError
 from albot1.data.model import Frame, Relations, Sequence
-from albot1.data.relations import STAMP_TOLERANCE_S, read_relations, repeat_policy
+from albot1.data.relations import STAMP_TOLERANCE_S, match_stamps, read_relations, repeat_policy
 from albot1.data.trajectory import read_trajectory
 
 #: Largest gap (s) between a scan and the reference pose it takes (evo's default ``t_max_diff``).
 REFERENCE_MAX_DT_S = 0.01
 #: Values of ``reference`` that a CARMEN log reads as a keyword, not as a file name.
 REFERENCE_KEYWORDS = ("none", "laser-pose", "truepos", "auto")
+#: How many relations an error about relation ends between scans names.
+_NAMED = 3
 
 
 def with_relations(sequence: Sequence, value: object, ref: str, repeats: object = None) -> Sequence:
@@ -66,7 +69,8 @@ def with_relations(sequence: Sequence, value: object, ref: str, repeats: object 
 
 
 def _of_this_log(frames: Iterator[Frame], relations: Relations, path: Path, ref: str) -> Iterator[Frame]:
-    """``frames`` unchanged; once they are all seen, ReferenceOptionError if no relation stamp lies in their time.
+    """``frames`` unchanged; once they are all seen, ReferenceOptionError if no relation stamp lies in their time,
+    or if one within their time names no scan.
 
     Relations of another log would otherwise be counted (``datasets info``)
     and then all left out by the relation metric as naming scans the run did
@@ -76,21 +80,42 @@ def _of_this_log(frames: Iterator[Frame], relations: Relations, path: Path, ref:
     outside the slice). Any overlap, within :data:`STAMP_TOLERANCE_S` (the
     relation metric's matching tolerance), passes: partial overlap is
     counted and reported by the metric.
+
+    A relation end *within* the log's time that is no scan's stamp (between two
+    scans: a file rounded to milliseconds, another clock, a typo) is refused
+    too, naming the first such relations: the relation metric matches ends to
+    scans within 0.1 ms and would leave such a relation out as naming "a scan
+    the run did not see", scoring the rest as if the file were complete.
     """
-    first = last = math.nan
+    seen: list[float] = []
     for frame in frames:
         t = frame.scan.timestamp
         if math.isfinite(t):
-            first, last = (t, t) if math.isnan(first) else (min(first, t), max(last, t))
+            seen.append(t)
         yield frame
-    if not len(relations) or math.isnan(first):
+    if not len(relations) or not seen:
         return
+    scans = np.asarray(seen, dtype=float)
+    first, last = float(scans.min()), float(scans.max())
     stamps = np.concatenate([relations.t1, relations.t2])
-    if not np.any((stamps >= first - STAMP_TOLERANCE_S) & (stamps <= last + STAMP_TOLERANCE_S)):
+    inside = (stamps >= first - STAMP_TOLERANCE_S) & (stamps <= last + STAMP_TOLERANCE_S)
+    if not np.any(inside):
         raise ReferenceOptionError(
             f"{path}: its {len(relations)} relations span {stamps.min():.3f}-{stamps.max():.3f} s, but the scans "
             f"of {ref!r} span {first:.3f}-{last:.3f} s: no relation lies within the log's time; expected the "
             "relations of this log"
+        )
+    _, gap = match_stamps(scans, stamps)
+    between = np.flatnonzero(inside & (gap > STAMP_TOLERANCE_S)) % len(relations)
+    if len(between):
+        bad = np.unique(between)
+        named = ", ".join(f"{k + 1} ({relations.t1[k]:.6f} -> {relations.t2[k]:.6f})" for k in bad[:_NAMED]) + (
+            ", ..." if len(bad) > _NAMED else ""
+        )
+        raise ReferenceOptionError(
+            f"{path}: {len(bad)} of its {len(relations)} relations have an end within the time of {ref!r} "
+            f"({first:.3f}-{last:.3f} s) that is no scan's stamp (none within {STAMP_TOLERANCE_S:g} s): relation "
+            f"{named}; expected every relation end to be the stamp of a scan of this log"
         )
 
 

@@ -150,3 +150,26 @@ def test_relations_of_another_log_are_refused_on_the_first_full_pass(sources: di
     assert len(open_sequence(f"{sources['carmen']}?relations={partial}").arrays.timestamps) == len(stamps)
     # a slice stops before the end of the log: its relations may lie beyond it, so it is not refused here
     assert len(open_sequence(f"{sources['carmen']}?relations={foreign}[:10]").arrays.timestamps) == 10
+
+
+def test_a_relation_end_between_two_scans_is_refused_on_the_first_full_pass(
+    sources: dict[str, Path], tmp_path: Path
+) -> None:
+    """An end within the log's time that is no scan's stamp: refused, never left out as "outside the run".
+
+    Before, the relation metric matched it to no scan (0.1 ms) and left it out as naming a scan the run did not
+    see: a file whose stamps were rounded to milliseconds scored a subset of its relations without an error.
+    """
+    stamps = open_sequence(sources["carmen"]).arrays.timestamps
+    good = f"{float(stamps[1])!r} {float(stamps[4])!r} 1 0 0 0 0 0\n"
+    mid = (float(stamps[5]) + float(stamps[6])) / 2
+    between = tmp_path / "between.relations"
+    between.write_text(good + f"{float(stamps[2])!r} {mid!r} 1 0 0 0 0 0\n")
+    for path in sources.values():
+        with pytest.raises(DataError, match=r"1 of its 2 relations have an end within the time of .* that is no "):
+            open_sequence(f"{path}?relations={between}").arrays  # noqa: B018 - the one full pass over the scans
+        with pytest.raises(DataError, match=rf"relation 2 \({float(stamps[2]):.6f} -> {mid:.6f}\)"):
+            open_sequence(f"{path}?relations={between}[::2]").arrays  # noqa: B018 - a stride reads every scan
+    exact = tmp_path / "exact.relations"
+    exact.write_text(good)
+    assert len(open_sequence(f"{sources['carmen']}?relations={exact}").arrays.timestamps) == len(stamps)
