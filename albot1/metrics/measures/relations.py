@@ -29,7 +29,7 @@ class RelationsBlock(Record):
     """``relations``: the Kuemmerle et al. (2009) metric (sample std), with how many relations the run covered.
 
     ``relations_total`` counts the dataset's relations, ``relations_used`` those scored and
-    ``relations_outside_run`` those left out because an end names a scan the run did not see (a slice of
+    ``relations_outside_run`` those left out because an end names a scan without a pose (a slice of
     the log; :func:`albot1.data.relations.relations_in_run`), so a slice never drops relations silently.
     ``relations_repeated_lines`` counts the lines of the relations file that repeat an earlier line
     identically, and ``relations_repeats_counted`` says whether they were counted as listed (the
@@ -68,7 +68,11 @@ def compute(inputs: MetricInputs) -> RelationsBlock:
 def headline(block: RelationsBlock) -> str:
     t, r = block.translation_m, block.rotation_deg
     outside, total = block.relations_outside_run, block.relations_total
-    left_out = f" ({outside} of {total} relations left out: they name scans the run did not see)" if outside else ""
+    left_out = (
+        f" ({outside} of {total} relations left out: they name scans without a pose in this trajectory)"
+        if outside
+        else ""
+    )
     repeats = block.relations_repeated_lines
     if repeats:
         reading = "counted as listed, the published reading" if block.relations_repeats_counted else "counted once"

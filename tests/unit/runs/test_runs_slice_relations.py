@@ -127,7 +127,8 @@ def test_run_evaluate_and_a_bench_cell_score_the_same_relations_of_a_slice_and_c
     assert block["translation_m"]["max"] == pytest.approx(max(errors_m), abs=1e-9)
     if dropped:
         assert line.endswith(
-            f"N = {used} ({dropped} of {len(PAIRS)} relations left out: they name scans the run did not see)"
+            f"N = {used} ({dropped} of {len(PAIRS)} relations left out: "
+            "they name scans without a pose in this trajectory)"
         )
     else:
         assert line.endswith(f"N = {used}")
