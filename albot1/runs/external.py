@@ -285,4 +285,5 @@ def _as_stored(relations: Relations | None) -> Relations | None:
     with tempfile.TemporaryDirectory(prefix="albot1-relations-") as folder:
         path = Path(folder) / "relations.txt"
         write_relations(path, relations)
-        return read_relations(path, empty_ok=True)
+        # the dataset's own file already warned about its repeated lines; this copy repeated it naming a temporary file
+        return read_relations(path, empty_ok=True, warn_repeats=False)

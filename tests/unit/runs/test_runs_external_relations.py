@@ -9,6 +9,7 @@ no pose for their scans (which scored a subset of the relations under the reason
 from __future__ import annotations
 
 import hashlib
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -103,3 +104,26 @@ def test_a_suites_external_run_folder_reproduces_its_relation_metric(
     assert stored.relations is not None and stored.relations.relations_used == 4
     again = evaluate_run(run_dir)
     assert again.relations == stored.relations
+
+
+def test_repeated_relation_lines_are_not_warned_about_again_for_a_temporary_copy(
+    tmp_path: Path, walk: Sequence, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """The warning names the dataset's file; the copy scoring reads back was named too, a path the user never saw."""
+    relations = walk.relations
+    assert relations is not None
+    twice = Relations(
+        np.r_[relations.t1, relations.t1[:1]],
+        np.r_[relations.t2, relations.t2[:1]],
+        np.r_[relations.poses, relations.poses[:1]],
+        repeats=1,
+        repeats_counted=True,
+    )
+    walk.relations = twice
+    truth = walk.arrays.reference
+    assert truth is not None
+    write_tum(tmp_path / "t.tum", walk.timestamps, truth)
+    with caplog.at_level(logging.WARNING):
+        record, _ = evaluate_trajectory(tmp_path / "t.tum", "walk")
+    assert record.relations is not None and record.relations.relations_used == 5
+    assert not [r.getMessage() for r in caplog.records if "albot1-relations-" in r.getMessage()]
