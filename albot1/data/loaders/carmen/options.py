@@ -112,5 +112,5 @@ def describe_reference(mode: str, laser: str) -> str:
         return ""
     if mode == "truepos":
         return "TRUEPOS lines, SE(2)-interpolated at the scan ipc timestamp"
-    fields = "x y theta" if laser in OLD_LASERS else "robot_x robot_y robot_theta"
-    return f"{laser} {fields} fields"
+    fields = "x y theta" if laser in OLD_LASERS else "laser_x laser_y laser_theta"
+    return f"{laser} {fields} fields (the laser's pose) composed with the inverse laser mount: the robot's pose"
