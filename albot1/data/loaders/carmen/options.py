@@ -18,7 +18,7 @@ from typing import Any
 
 from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
-from albot1.data.loaders.base import COMMON_OPTIONS
+from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, max_pose_gap
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 from albot1.data.relations import RepeatPolicy, repeat_policy
 
@@ -35,6 +35,8 @@ class CarmenOptions:
     laser: str | None = None
     max_range: float | None = None
     time_tolerance: float = 1.0
+    #: largest gap (s) between the ODOM/TRUEPOS lines a scan's pose is interpolated between (loaders/base.py)
+    max_pose_gap: float = DEFAULT_MAX_POSE_GAP_S
     name: str | None = None
     parallel_bz2: bool = True
 
@@ -53,6 +55,7 @@ class CarmenOptions:
                     options[key] = float(options[key])
                 except (TypeError, ValueError):
                     raise DataError(f"{path}: {key}={options[key]!r}; expected a number") from None
+        options["max_pose_gap"] = max_pose_gap(options.get("max_pose_gap"), path)
         opts = CarmenOptions(**options)
         if opts.odometry not in ODOMETRY_SOURCES:
             raise DataError(  # "reference" is taken by albot1.data.open before the loader runs

@@ -64,8 +64,9 @@ class PoseSources:
         self.laser = laser
         self.reference_mode = reference
         tol = opts.time_tolerance
-        self.odom = PoseBuffer(path, "ODOM", tol) if opts.odometry == "odom" else None
-        self.truth = PoseBuffer(path, "TRUEPOS", tol) if reference == "truepos" else None
+        gap = opts.max_pose_gap
+        self.odom = PoseBuffer(path, "ODOM", tol, gap) if opts.odometry == "odom" else None
+        self.truth = PoseBuffer(path, "TRUEPOS", tol, gap) if reference == "truepos" else None
         #: pose messages no source reads: the parser need not decode them
         self.skip = frozenset(
             name

@@ -230,6 +230,14 @@ class PoseTrack:
     def __len__(self) -> int:
         return int(self.times.shape[0])
 
+    def bracket(self, t: float) -> tuple[float, float]:
+        """The stamps of the two samples a pose at ``t`` (inside the span) is interpolated between;
+        ``(t, t)`` at a stored stamp, where nothing is interpolated."""
+        i = int(np.searchsorted(self.times, t, side="left"))
+        if i < len(self.times) and self.times[i] == t:
+            return t, t
+        return float(self.times[max(i - 1, 0)]), float(self.times[min(i, len(self.times) - 1)])
+
     def at(self, t: float) -> FloatArray | None:
         """The pose at time ``t`` (exactly a stored pose at a stored stamp), or None outside the span."""
         if not self.start <= t <= self.end:
