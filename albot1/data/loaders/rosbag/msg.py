@@ -168,7 +168,10 @@ def scan_arrays(
     """``(ranges, angles)`` of a LaserScan in the data model's conventions.
 
     Readings outside ``[range_min, range_max]``, inf and NaN all mean "no
-    usable return" (REP-117) and become NaN. Angles are
+    usable return" (REP-117) and become NaN; so does a reading of exactly 0
+    m, which a driver writes for "no echo" (a return at the laser's own window
+    is impossible) and which ``range_min = 0`` (as ``albot1 convert`` writes,
+    and many drivers do) used to keep as a point at the laser. Angles are
     ``angle_min + i * angle_increment`` computed in float64 from the
     message's float32 fields. A 360-degree scan whose last beam repeats the
     first's direction (``angle_max = angle_min + 2 pi``,
@@ -180,7 +183,7 @@ def scan_arrays(
     """
     r = np.asarray(ranges, dtype=np.float64).copy()
     with np.errstate(invalid="ignore"):
-        bad = ~np.isfinite(r) | (r < float(range_min)) | (r > float(range_max))
+        bad = ~np.isfinite(r) | (r < float(range_min)) | (r > float(range_max)) | (r == 0.0)
     r[bad] = np.nan
     angles = float(angle_min) + np.arange(r.shape[0], dtype=np.float64) * float(angle_increment)
     if seam_repeat(angles):

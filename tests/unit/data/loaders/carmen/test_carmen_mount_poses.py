@@ -124,3 +124,14 @@ def test_robotlaser1_mount_printed_with_six_decimals_is_accepted(tmp_path: Path)
         fields = " ".join(f"{v:.6f}" for v in (*laser, *odom))
         lines.append(f"ROBOTLASER1 0 -1.0 1.0 0.5 30.0 0.01 0 3 1.0 2.0 3.0 0 {fields} 0 0 0 0 0 {k}.5 host {k}.5")
     assert CarmenLoader().load(_write(tmp_path, lines)).count_scans() == len(ODOMETRY)
+
+
+def test_a_corrected_carmen_trajectory_file_reads_as_robot_poses(tmp_path: Path) -> None:
+    """``albot1 evaluate --trajectory run.clf`` (GMapping's output) is scored against robot poses: its laser-pose
+    fields are read through the loader's reference, so they come back moved onto the robot as well."""
+    from albot1.data.trajectory import read_carmen_poses
+
+    mount = np.array([-0.04, 0.0, 0.0])
+    lines = ["PARAM robot_frontlaser_offset -0.04 0 host 0", *_old_laser_log("FLASER", mount)]
+    _, poses = read_carmen_poses(_write(tmp_path, lines))
+    np.testing.assert_allclose(poses[:, :2], np.array(ODOMETRY)[:, :2], atol=1e-12)
