@@ -97,13 +97,16 @@ _warned_folders: set[Path] = set()
 
 @cache
 def decoder_version(loader_module: str) -> str:
-    """Digest of the loader package's source files, this module's and :data:`LAYOUT` (16 hex digits)."""
+    """Digest of the loader package's source files, the loaders' shared ``base.py`` (its pose-gap rule decides
+    what a CARMEN load refuses), this module's and :data:`LAYOUT` (16 hex digits)."""
     import importlib
 
     digest = hashlib.sha256(f"layout {LAYOUT}\n".encode())
     module = importlib.import_module(loader_module)
     folder = Path(inspect.getfile(module)).parent
-    sources = sorted(folder.glob("*.py")) + [Path(__file__), Path(inspect.getfile(Frame))]
+    # data/loaders/base.py found by path: importing the loaders here would make a cycle between siblings
+    shared = [base] if (base := folder.parent / "base.py").is_file() else []
+    sources = sorted(folder.glob("*.py")) + shared + [Path(__file__), Path(inspect.getfile(Frame))]
     for source in sources:
         digest.update(source.name.encode() + b"\0" + source.read_bytes())
     return digest.hexdigest()[:16]

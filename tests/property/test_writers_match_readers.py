@@ -85,3 +85,50 @@ def test_written_files_load_in_full_or_nothing_is_written(fmt: str, seq: Sequenc
         assert len(loaded) == len(list(seq.frames()))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+@st.composite
+def near_max_scans(draw: st.DrawFn, zeros: bool) -> Sequence:
+    """One to three scans whose readings crowd the max range: exactly at it, within the CARMEN reader's 5 mm
+    no-return margin below it, ordinary, no return (NaN) and, with ``zeros``, 0 m (no return as well)."""
+    max_range = draw(st.sampled_from([30.0, 5.6, 80.99, 0.5]))
+    reading = st.one_of(
+        st.just(max_range),
+        st.floats(max_range - 0.006, max_range),
+        st.floats(1e-3, max_range),
+        st.just(math.nan),
+        *([st.just(0.0)] if zeros else []),
+    )
+    angles = np.linspace(-1.5, 1.5, 7)
+    frames = [
+        Frame(
+            i,
+            Scan(np.array(draw(st.lists(reading, min_size=7, max_size=7))), angles, 1.0 + i, max_range),
+            np.array([0.1 * i, 0.0, 0.0]),
+            None,
+        )
+        for i in range(draw(st.integers(1, 3)))
+    ]
+    return Sequence.from_frames("near-max", frames)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fmt", list(NAMES))
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_round_trips_keep_every_return_and_every_no_return(fmt: str, data: st.DataObject) -> None:
+    """A return at (or just below) the max range used to come back from a CARMEN log as no return, and a bag's
+    0 m reading as a point at the laser. Written and read back, every return is a return at the same range (to
+    the format's precision: 6 decimals, float32) and every no-return (NaN; 0 m in CARMEN and bags, where 0 is
+    the "no echo" value) is NaN. The albot log keeps a 0 m point as written, so it gets no zeros here."""
+    seq = data.draw(near_max_scans(zeros=fmt != "albot-log"))
+    folder = Path(tempfile.mkdtemp(prefix="albot1-roundtrip-"))
+    try:
+        out = folder / NAMES[fmt]
+        writer_for(fmt).write(seq, out)
+        for before, after in zip(seq.frames(), load(out).frames(), strict=True):
+            returns = np.isfinite(before.scan.ranges) & (before.scan.ranges != 0.0)
+            np.testing.assert_array_equal(np.isfinite(after.scan.ranges), returns)
+            np.testing.assert_allclose(after.scan.ranges[returns], before.scan.ranges[returns], rtol=1e-6, atol=1e-6)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)

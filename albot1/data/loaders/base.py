@@ -8,9 +8,11 @@ signature) instead of probing attributes; ``load`` returns a streamed
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
+from albot1.data.errors import DataError
 from albot1.data.model import Frame, Sequence
 
 #: The options every source takes besides its loader's own (applied by :mod:`albot1.data.open` and
@@ -63,4 +65,37 @@ def reference_presence_problem(
     return (
         f"frame {has.index} has a reference pose but frame {lacks.index} has none; {reader} holds reference "
         f"poses for every scan or for none ({why})"
+    )
+
+
+#: Largest time (s) between the two pose samples (odometry or reference) a scan's pose is interpolated between,
+#: the loaders' option ``max_pose_gap``. Across a longer gap the robot may have moved any way while nothing was
+#: recorded, so the interpolated pose would be invented, not measured. Chosen above the largest such gap of
+#: every registered log read with interpolated odometry (``odometry=odom``: intel 3.11 s, aces 2.95 s, fr079
+#: 0.24 s; docs/formats.md); bags written by ``albot1 convert`` stamp a pose at every scan, so never interpolate.
+DEFAULT_MAX_POSE_GAP_S = 5.0
+
+
+def max_pose_gap(value: Any, source: object) -> float:
+    """The ``max_pose_gap`` option as seconds > 0 (``inf``: no limit); None means the default."""
+    if value is None:
+        return DEFAULT_MAX_POSE_GAP_S
+    try:
+        seconds = float(value)
+    except (TypeError, ValueError):
+        seconds = math.nan
+    if not seconds > 0:
+        raise DataError(f"{source}: max_pose_gap={value!r}; expected seconds > 0 (or inf for no limit)")
+    return seconds
+
+
+def pose_gap_problem(t: float, before: float, after: float, limit: float, what: str) -> str | None:
+    """Why a pose at ``t`` interpolated between samples at ``before`` and ``after`` would be invented, or None."""
+    gap = after - before
+    if gap <= limit:
+        return None
+    return (
+        f"scan at t = {t:.6f} s falls in a {gap:.3f} s gap of the {what} (samples at {before:.6f} and "
+        f"{after:.6f} s); its pose would be interpolated across it, not measured; expected samples at most "
+        f"max_pose_gap {limit:g} s apart around every scan (max_pose_gap=inf interpolates across any gap)"
     )

@@ -22,7 +22,7 @@ from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.checks import span_problem, time_problem
 from albot1.data.loaders.carmen.options import CarmenOptions
 from albot1.data.loaders.carmen.parse import LaserBlock, ParsedChunk, parse_chunk
-from albot1.data.loaders.carmen.poses import PendingScan, PoseSources
+from albot1.data.loaders.carmen.poses import PendingScan, PoseSources, mount_problem
 from albot1.data.loaders.carmen.probe import refuse_mixed
 from albot1.data.loaders.carmen.source import iter_line_chunks
 from albot1.data.model import Frame, Scan
@@ -31,11 +31,15 @@ from albot1.data.model import Frame, Scan
 class FrameStream:
     """Turns parsed chunks into frames; one instance serves every iteration (it holds no state)."""
 
-    def __init__(self, path: Path, opts: CarmenOptions, laser: str, reference: str) -> None:
+    def __init__(
+        self, path: Path, opts: CarmenOptions, laser: str, reference: str, mount: tuple[float, float, float]
+    ) -> None:
         self.path = path
         self.opts = opts
         self.laser = laser
         self.reference = reference
+        #: the laser's pose on the robot (``metadata.sensor_offset``)
+        self.mount = mount
 
     def frames(self) -> Iterator[Frame]:
         return _FrameIterator(self).run()
@@ -53,7 +57,7 @@ class _FrameIterator:
         self.pending: list[PendingScan] = []
         self.index = 0
         self.last_stamp: tuple[float, int] | None = None
-        self.poses = PoseSources(stream.path, stream.opts, stream.laser, stream.reference)
+        self.poses = PoseSources(stream.path, stream.opts, stream.laser, stream.reference, stream.mount)
         self.last_line = 0
 
     def run(self) -> Iterator[Frame]:
@@ -104,6 +108,10 @@ class _FrameIterator:
         rows: list[tuple[int, int, int]] = []  # (line, block, row) in file order
         decoded = []
         for b, block in enumerate(parsed.lasers):
+            if self.s.laser == "ROBOTLASER1" and block.robot is not None and block.sensor is not None:
+                found = mount_problem(block.robot, block.sensor, self.s.mount)
+                if found is not None:
+                    raise ParseError(self.path, found[1], line=int(block.lines[found[0]]))
             if block.start is None or block.step is None or block.max_range is None:
                 start, step, max_range = self._old_geometry(block, params)
             else:

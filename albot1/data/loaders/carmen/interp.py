@@ -21,6 +21,11 @@ as fr079's first is by 0.01 s); farther out the pose would be invented, not
 measured (a log whose ODOM or TRUEPOS stream stops long before its scans do),
 so it is a ParseError naming the scan's line, as the bag loader refuses to
 extrapolate. ``time_tolerance=inf`` holds the end poses at any distance.
+
+Between the lines the same holds for a gap: a scan whose two bracketing poses
+lie more than ``max_gap`` seconds apart (the loader option ``max_pose_gap``,
+:data:`~albot1.data.loaders.base.DEFAULT_MAX_POSE_GAP_S`) is a ParseError
+naming its line, not a pose interpolated across a stretch nothing recorded.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.data.errors import ParseError
+from albot1.data.loaders.base import DEFAULT_MAX_POSE_GAP_S, pose_gap_problem
 from albot1.data.loaders.carmen.parse import PoseRecords
 from albot1.geometry import se2
 
@@ -38,10 +44,11 @@ from albot1.geometry import se2
 class PoseBuffer:
     """Poses of one message kind, sorted by time, trimmed as scans are emitted."""
 
-    def __init__(self, path: Path, kind: str, tolerance: float) -> None:
+    def __init__(self, path: Path, kind: str, tolerance: float, max_gap: float = DEFAULT_MAX_POSE_GAP_S) -> None:
         self.path = path
         self.kind = kind
         self.tolerance = tolerance
+        self.max_gap = max_gap
         self.times = np.zeros(0)
         self.poses = np.zeros((0, 3))
         self.lines = np.zeros(0, dtype=np.int64)
@@ -110,6 +117,11 @@ class PoseBuffer:
             pick = exact[np.argmax(np.where(before, lines, -1))] if before.any() else exact[np.argmin(lines)]
             stored: NDArray[np.float64] = self.poses[pick].copy()
             return stored
+        after = int(np.searchsorted(self.times, t, side="right"))
+        if 0 < after < len(self.times):  # beyond the ends the end pose is held, within tolerance (_check_span)
+            problem = pose_gap_problem(t, self.times[after - 1], self.times[after], self.max_gap, f"{self.kind} lines")
+            if problem is not None:
+                raise ParseError(self.path, problem, line=line)
         blended: NDArray[np.float64] = se2.interpolate(self.times, self.poses, np.array([t]))[0]
         return blended
 

@@ -30,10 +30,16 @@ Odometry sources (option ``odometry``):
     all 13 logs).
 
 Reference sources (option ``reference``): ``"none"``; ``"laser-pose"`` (the
-FLASER ``x y theta`` / ROBOTLASER1 robot pose fields: the corrected pose in
-the SLAM-corrected logs); ``"truepos"`` (TRUEPOS lines interpolated at scan
+FLASER/RLASER ``x y theta`` / ROBOTLASER1 ``laser_x laser_y laser_theta``
+fields, the corrected pose in the SLAM-corrected logs: in CARMEN these are the
+*laser's* pose, so each is composed with the inverse mount to give the robot's,
+:mod:`.poses`); ``"truepos"`` (TRUEPOS lines interpolated at scan
 time); ``"auto"`` (TRUEPOS when the first chunk of the log has TRUEPOS lines,
 else none).
+
+ROBOTLASER1 lines carry the mount on every line (laser pose vs robot pose);
+the loader applies the first line's to every scan and refuses a later line
+whose own mount differs by more than :data:`.poses.MOUNT_TOLERANCE`.
 
 ODOM and TRUEPOS lines are only decoded when a pose source uses them.
 
@@ -177,7 +183,7 @@ class CarmenLoader:
             read_relations(given.relations, repeats=given.relations_repeats) if given.relations is not None else None
         )
         name = opts.name or _stem(path)
-        stream = FrameStream(path, opts, laser, reference)
+        stream = FrameStream(path, opts, laser, reference, offset)
         return Sequence(name, stream.frames, metadata, relations)
 
 

@@ -18,7 +18,7 @@ from typing import Any
 
 from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
-from albot1.data.loaders.base import COMMON_OPTIONS
+from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, max_pose_gap
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 from albot1.data.relations import RepeatPolicy, repeat_policy
 
@@ -35,6 +35,8 @@ class CarmenOptions:
     laser: str | None = None
     max_range: float | None = None
     time_tolerance: float = 1.0
+    #: largest gap (s) between the ODOM/TRUEPOS lines a scan's pose is interpolated between (loaders/base.py)
+    max_pose_gap: float = DEFAULT_MAX_POSE_GAP_S
     name: str | None = None
     parallel_bz2: bool = True
 
@@ -53,6 +55,7 @@ class CarmenOptions:
                     options[key] = float(options[key])
                 except (TypeError, ValueError):
                     raise DataError(f"{path}: {key}={options[key]!r}; expected a number") from None
+        options["max_pose_gap"] = max_pose_gap(options.get("max_pose_gap"), path)
         opts = CarmenOptions(**options)
         if opts.odometry not in ODOMETRY_SOURCES:
             raise DataError(  # "reference" is taken by albot1.data.open before the loader runs
@@ -112,5 +115,5 @@ def describe_reference(mode: str, laser: str) -> str:
         return ""
     if mode == "truepos":
         return "TRUEPOS lines, SE(2)-interpolated at the scan ipc timestamp"
-    fields = "x y theta" if laser in OLD_LASERS else "robot_x robot_y robot_theta"
-    return f"{laser} {fields} fields"
+    fields = "x y theta" if laser in OLD_LASERS else "laser_x laser_y laser_theta"
+    return f"{laser} {fields} fields (the laser's pose) composed with the inverse laser mount: the robot's pose"

@@ -5,6 +5,16 @@ lines interpolated at its time (``odom``), or, in the GMapping-corrected logs
 of ``radish-corrected/``, from the ODOM increments since the previous scan
 re-anchored at each corrected scan pose (``odom-segments``); its reference
 from TRUEPOS lines (``truepos``) or its line's pose fields (``laser-pose``).
+
+Robot, not laser: in CARMEN a laser line's ``x y theta`` (FLASER/RLASER) and
+``laser_x laser_y laser_theta`` (ROBOTLASER1) are the *laser's* pose, the
+robot pose composed with the laser's mount (CARMEN's ``robot_laser.c`` writes
+``x = odom_x + offset cos(theta)``, ``theta = odom_theta (+ pi for the rear
+laser)``; its scan matcher ``vasco`` corrects that field, not the robot pose).
+The reference is the robot's, so those fields are composed with the inverse
+mount; so is the ``odom-segments`` chain, which starts at the FLASER pose
+field. The odometry fields (``odom_x ...``, ``robot_x ...``) are robot poses
+already and are taken as logged.
 :class:`PoseSources` holds the look-ahead buffers these need across chunks
 (:mod:`.interp`) and says when a waiting scan can be given its poses.
 """
@@ -25,6 +35,9 @@ from albot1.geometry import se2
 
 #: The corrected logs print anchors with the same digits as the scan pose; this only absorbs float noise.
 ANCHOR_TOLERANCE = 1e-5
+#: Largest accepted disagreement of a ROBOTLASER1 line's mount with the first line's (m and rad): CARMEN prints
+#: poses with 6 decimals, which moves ``between(robot pose, laser pose)`` by ~1e-6 (fr-clinic: 1.3e-6 m, 0 rad).
+MOUNT_TOLERANCE = 1e-4
 
 
 @dataclass(slots=True)
@@ -41,14 +54,19 @@ class PendingScan:
 class PoseSources:
     """The odometry and reference of each scan, from the sources the options chose (state of one pass)."""
 
-    def __init__(self, path: Path, opts: CarmenOptions, laser: str, reference: str) -> None:
+    def __init__(
+        self, path: Path, opts: CarmenOptions, laser: str, reference: str, mount: tuple[float, float, float]
+    ) -> None:
         self.path = path
+        #: the laser's pose on the robot (``metadata.sensor_offset``); None when zero (poses kept bit for bit)
+        self.unmount = se2.inverse(np.asarray(mount, dtype=np.float64)) if any(mount) else None
         self.mode = opts.odometry
         self.laser = laser
         self.reference_mode = reference
         tol = opts.time_tolerance
-        self.odom = PoseBuffer(path, "ODOM", tol) if opts.odometry == "odom" else None
-        self.truth = PoseBuffer(path, "TRUEPOS", tol) if reference == "truepos" else None
+        gap = opts.max_pose_gap
+        self.odom = PoseBuffer(path, "ODOM", tol, gap) if opts.odometry == "odom" else None
+        self.truth = PoseBuffer(path, "TRUEPOS", tol, gap) if reference == "truepos" else None
         #: pose messages no source reads: the parser need not decode them
         self.skip = frozenset(
             name
@@ -103,9 +121,15 @@ class PoseSources:
         if self.reference_mode == "truepos":
             assert self.truth is not None
             return self.truth.at(rec.timestamp, rec.line)
-        pose = rec.sensor if self.laser in OLD_LASERS else rec.robot
-        assert pose is not None
-        return pose.copy()
+        assert rec.sensor is not None  # RAWLASER + laser-pose is rejected in load()
+        return self._robot(rec.sensor)
+
+    def _robot(self, laser_pose: np.ndarray) -> np.ndarray:
+        """The robot's pose from the laser's: ``laser_pose * inv(mount)``."""
+        if self.unmount is None:
+            return np.array(laser_pose, dtype=np.float64)
+        robot: np.ndarray = se2.compose(laser_pose, self.unmount)
+        return robot
 
     def _segment_odometry(self, rec: PendingScan) -> np.ndarray:
         logged = rec.sensor if self.laser in OLD_LASERS else rec.robot
@@ -140,4 +164,29 @@ class PoseSources:
         keep = self.seg_lines > rec.line
         self.seg_lines, self.seg_poses = self.seg_lines[keep], self.seg_poses[keep]
         self.prev_scan = (rec.line, np.array(logged, dtype=np.float64), odometry)
-        return odometry
+        # the chain lives in the frame of the logged pose, the laser's for FLASER/RLASER (see the module docstring)
+        return self._robot(odometry) if self.laser in OLD_LASERS else odometry
+
+
+def mount_problem(robot: np.ndarray, laser: np.ndarray, mount: tuple[float, float, float]) -> tuple[int, str] | None:
+    """The first ROBOTLASER1 row whose own mount (``between(robot pose, laser pose)``) is not ``mount``, and why.
+
+    The loader takes the mount from the log's first line and applies it to every scan; a later line whose
+    laser sits elsewhere on the robot would be placed wrongly without a word (a second laser's lines under
+    one name, a changed mount, or laser poses corrected by a scan matcher apart from the robot poses).
+    """
+    found = se2.between(robot, laser)
+    gap = np.abs(found - np.asarray(mount, dtype=np.float64))
+    gap[:, 2] = np.abs(se2.wrap(gap[:, 2]))
+    bad = np.flatnonzero((gap > MOUNT_TOLERANCE).any(axis=1))
+    if not len(bad):
+        return None
+    row = int(bad[0])
+    shown = ", ".join(f"{v:.6g}" for v in found[row])
+    expected = ", ".join(f"{v:.6g}" for v in mount)
+    return row, (
+        f"ROBOTLASER1 laser pose vs robot pose puts the laser at ({shown}) (x m, y m, yaw rad) on the robot, but the "
+        f"log's first ROBOTLASER1 line puts it at ({expected}); expected one mount for every line (to within "
+        f"{MOUNT_TOLERANCE:g}): the loader applies one mount to every scan, so lines of another laser or whose laser "
+        f"poses were corrected apart from the robot poses cannot be read as this log's scans"
+    )

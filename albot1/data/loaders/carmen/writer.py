@@ -9,7 +9,12 @@ field of view round-trip without guessing. Per frame the writer emits::
     ROBOTLASER1 ... laser pose = odometry * sensor_offset, robot pose = odometry ...
 
 all stamped with the scan's timestamp. A no-return beam (NaN) is written as
-the max range, which the loader's no-return rule turns back into NaN. Ranges
+the max range (a 0 m reading as 0, CARMEN's "no reading"), which the loader's no-return
+rule turns back into NaN. A return
+within the rule's 5 mm of the max range (a bag reading equal to ``range_max``)
+would come back as no return too, so the line then declares a max range raised
+just above its longest return (by at most 6 mm, :func:`_declared_max_range`);
+a positive return that prints as 0 is refused. Ranges
 are written with 6 decimals (1 um), poses with 9, timestamps with 6, the beam
 geometry with 17 significant digits (so angles come back to 1e-15 rad).
 
@@ -38,8 +43,9 @@ from albot1.atomic import atomic_write
 from albot1.data.errors import UnwritableError
 from albot1.data.loaders.base import reference_presence_problem
 from albot1.data.loaders.carmen.checks import beam_count_problem, geometry_problem, ranges_problem, time_problem
+from albot1.data.loaders.carmen.geometry import NO_RETURN_MARGIN
 from albot1.data.loaders.output import prepare_output, writing
-from albot1.data.model import Frame, Sequence
+from albot1.data.model import Frame, Scan, Sequence
 from albot1.geometry import se2
 
 HOST = "albot1"
@@ -90,21 +96,58 @@ def _frame_problem(frame: Frame, step: float) -> str | None:
         return f"max_range {max_range!r}; expected a positive number of metres"
     if float(f"{max_range:.6f}") <= 0:
         return f"max_range {max_range!r} rounds to 0 in the log's 6 decimals (which means 'not stated')"
-    found = geometry_problem(n, *(np.array([float(v)]) for v in (scan.angles[0], step * (n - 1), step, max_range)))
-    if found is None:  # the ranges as written: 6 decimals, no return as the max range
-        written: np.ndarray = np.round(np.where(np.isnan(scan.ranges), max_range, scan.ranges), 6)
+    returns = _returns(scan.ranges)
+    declared = _declared_max_range(scan)
+    found = geometry_problem(n, *(np.array([float(v)]) for v in (scan.angles[0], step * (n - 1), step, declared)))
+    if found is None:  # the ranges as written: 6 decimals, no return as the declared max range
+        written: np.ndarray = np.round(np.where(returns, scan.ranges, declared), 6)
         found = ranges_problem(written[None, :])
     if found is not None:
         return found[1]
     longest = float(np.nanmax(scan.ranges)) if not np.isnan(scan.ranges).all() else 0.0
     if longest > max_range:
         return f"a range of {longest!r} m exceeds max_range {max_range!r} m (it would come back as no return)"
+    vanishing = (scan.ranges > 0) & (written <= 0)
+    if vanishing.any():
+        k = int(np.argmax(vanishing))
+        return (
+            f"range {k + 1} of {n} is {float(scan.ranges[k])!r} m, which prints as 0 in the log's 6 decimals and "
+            f"would come back as no return (a return at 0 m is impossible; NaN means no return)"
+        )
     values = [scan.timestamp, *np.asarray(frame.odometry, dtype=np.float64).tolist()]
     if frame.reference is not None:
         values += np.asarray(frame.reference, dtype=np.float64).tolist()
     if not all(math.isfinite(v) for v in values):
         return f"the timestamp and poses must be finite numbers, got {values}"
     return None
+
+
+def _returns(ranges: np.ndarray) -> np.ndarray:
+    """Which beams are written as they are: all but NaN (no return), written as the max range. A 0 m reading
+    is written as 0, CARMEN's "no reading", which the reader takes as no return too (and refuses a line of
+    nothing else: a dead laser); an infinite or negative range is written for the checks to refuse."""
+    returns: np.ndarray = ~np.isnan(ranges)
+    return returns
+
+
+def _declared_max_range(scan: Scan) -> float:
+    """The max range the line declares: the scan's, or raised just enough that every return stays a return.
+
+    The reader takes ``r >= max_range - NO_RETURN_MARGIN`` as no return (a logged maximum printed with
+    CARMEN's 1 cm resolution), so a return within 5 mm of the max range (one equal to a bag's
+    ``range_max``, say) would come back as no return. The declared max range is then raised to the longest
+    printed return plus 6 mm, rounded up to the printed micrometre: every return reads back below it, and
+    the no-returns written at it read back as no return. It moves by at most 6 mm.
+    """
+    max_range = float(scan.max_range)
+    ranges = scan.ranges[_returns(scan.ranges)]
+    returns = ranges[(ranges > 0) & (ranges <= max_range)]  # others are refused by the checks
+    if not returns.size:
+        return max_range
+    longest = float(np.round(returns.max(), 6))
+    if longest < max_range - NO_RETURN_MARGIN - 1e-6:
+        return max_range
+    return max(max_range, math.ceil((longest + NO_RETURN_MARGIN + 0.001) * 1e6) / 1e6)
 
 
 def _laser_line(frame: Frame, offset: np.ndarray) -> str:
@@ -115,8 +158,8 @@ def _laser_line(frame: Frame, offset: np.ndarray) -> str:
     problem = _frame_problem(frame, step)
     if problem is not None:
         raise UnwritableError(f"frame {frame.index}: {problem}; the CARMEN reader would refuse it")
-    max_range = float(scan.max_range)
-    ranges = np.where(np.isfinite(scan.ranges), scan.ranges, max_range)
+    max_range = _declared_max_range(scan)
+    ranges = np.where(_returns(scan.ranges), scan.ranges, max_range)
     robot = np.asarray(frame.odometry, dtype=np.float64)
     laser = se2.compose(robot, offset)
     stamp = f"{scan.timestamp:.6f}"

@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from albot1.data.errors import DataError, ParseError, TopicError
-from albot1.data.loaders.base import COMMON_OPTIONS
+from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, max_pose_gap, pose_gap_problem
 from albot1.data.loaders.beams import seam_note
 from albot1.data.loaders.rosbag.bag1_check import version_problem
 from albot1.data.loaders.rosbag.mounting import bag_mounting
@@ -43,7 +43,15 @@ from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
 
 log = logging.getLogger(__name__)
 
-_OPTIONS = ("scan_topic", "odom_topic", "reference_topic", "odom_frame", "base_frame", "outside_odometry")
+_OPTIONS = (
+    "scan_topic",
+    "odom_topic",
+    "reference_topic",
+    "odom_frame",
+    "base_frame",
+    "outside_odometry",
+    "max_pose_gap",
+)
 _OUTSIDE = ("error", "drop")
 
 
@@ -57,6 +65,8 @@ class _BagSource:
     odom_frame: str
     base_frame: str | None
     outside: str
+    #: largest gap (s) between the two pose messages a scan's pose is interpolated between (loaders/base.py)
+    max_gap: float = DEFAULT_MAX_POSE_GAP_S
 
     def __post_init__(self) -> None:
         self._tracks: tuple[PoseTrack, PoseTrack | None] | None = None
@@ -82,6 +92,11 @@ class _BagSource:
                 f"(load with outside_odometry='drop' to skip such scans)",
                 index=index,
             )
+
+    def _check_gap(self, index: int, t: float, track: PoseTrack, topic: str) -> None:
+        problem = pose_gap_problem(t, *track.bracket(t), self.max_gap, f"messages of {topic}")
+        if problem is not None:
+            raise ParseError(self.shown, f"topic {self.choice.scan}: {problem}", index=index)
 
     def frames(self) -> Iterator[Frame]:
         odom, ref = self.tracks()
@@ -116,6 +131,7 @@ class _BagSource:
                     self._outside(i, t, odom, self.choice.odom)
                     dropped += 1
                     continue
+                self._check_gap(i, t, odom, self.choice.odom)
                 reference = None
                 if ref is not None:
                     reference = ref.at(t)
@@ -123,6 +139,7 @@ class _BagSource:
                         self._outside(i, t, ref, str(self.choice.reference))
                         dropped += 1
                         continue
+                    self._check_gap(i, t, ref, str(self.choice.reference))
                 yield Frame(out, self._scan(msg, t, i), pose, reference)
                 out += 1
         if dropped:
@@ -161,6 +178,7 @@ def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
     if opts["outside_odometry"] not in _OUTSIDE:
         raise DataError(f"outside_odometry={opts['outside_odometry']!r}; expected one of {', '.join(_OUTSIDE)}")
     opts["odom_frame"] = opts["odom_frame"] or "odom"
+    opts["max_pose_gap"] = max_pose_gap(opts["max_pose_gap"], shown)
     return opts
 
 
@@ -175,7 +193,9 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
     for topic, role in ((choice.scan, "scans"), (choice.odom, "odometry"), (choice.reference, "reference poses")):
         if topic is not None and topics[topic].count == 0:
             raise TopicError(f"{shown}: topic {topic} ({role}) has no messages; expected at least one")
-    source = _BagSource(bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"])
+    source = _BagSource(
+        bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"], opts["max_pose_gap"]
+    )
     mounting = bag_mounting(bag, shown, topics, choice, opts["base_frame"], opts["odom_frame"])
     odom_desc = (
         f"{choice.odom} transforms {opts['odom_frame']} -> {opts['base_frame'] or '(its only child)'}"

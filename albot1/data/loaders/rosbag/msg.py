@@ -168,7 +168,10 @@ def scan_arrays(
     """``(ranges, angles)`` of a LaserScan in the data model's conventions.
 
     Readings outside ``[range_min, range_max]``, inf and NaN all mean "no
-    usable return" (REP-117) and become NaN. Angles are
+    usable return" (REP-117) and become NaN; so does a reading of exactly 0
+    m, which a driver writes for "no echo" (a return at the laser's own window
+    is impossible) and which ``range_min = 0`` (as ``albot1 convert`` writes,
+    and many drivers do) used to keep as a point at the laser. Angles are
     ``angle_min + i * angle_increment`` computed in float64 from the
     message's float32 fields. A 360-degree scan whose last beam repeats the
     first's direction (``angle_max = angle_min + 2 pi``,
@@ -180,7 +183,7 @@ def scan_arrays(
     """
     r = np.asarray(ranges, dtype=np.float64).copy()
     with np.errstate(invalid="ignore"):
-        bad = ~np.isfinite(r) | (r < float(range_min)) | (r > float(range_max))
+        bad = ~np.isfinite(r) | (r < float(range_min)) | (r > float(range_max)) | (r == 0.0)
     r[bad] = np.nan
     angles = float(angle_min) + np.arange(r.shape[0], dtype=np.float64) * float(angle_increment)
     if seam_repeat(angles):
@@ -229,6 +232,14 @@ class PoseTrack:
 
     def __len__(self) -> int:
         return int(self.times.shape[0])
+
+    def bracket(self, t: float) -> tuple[float, float]:
+        """The stamps of the two samples a pose at ``t`` (inside the span) is interpolated between;
+        ``(t, t)`` at a stored stamp, where nothing is interpolated."""
+        i = int(np.searchsorted(self.times, t, side="left"))
+        if i < len(self.times) and self.times[i] == t:
+            return t, t
+        return float(self.times[max(i - 1, 0)]), float(self.times[min(i, len(self.times) - 1)])
 
     def at(self, t: float) -> FloatArray | None:
         """The pose at time ``t`` (exactly a stored pose at a stored stamp), or None outside the span."""

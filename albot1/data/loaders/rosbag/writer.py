@@ -4,7 +4,7 @@ Every frame becomes, all stamped with the scan's timestamp (header stamp and
 bag time alike):
 
 * ``/scan`` ``sensor_msgs/LaserScan`` (frame ``laser``): ranges as float32,
-  no-return (NaN) as ``+inf`` (REP-117: "no object detected in range"),
+  no-return (NaN, or a range of 0 m) as ``+inf`` (REP-117: "no object detected in range"),
   ``range_min = 0``, ``range_max`` = the scan's max range, ``angle_min`` and
   ``angle_increment`` from the beam angles, which must be evenly spaced;
 * ``/odom`` ``nav_msgs/Odometry`` (``odom -> base_link``): the odometry pose
@@ -116,7 +116,18 @@ class RosMessages:
                 f"[{finite.min()}, {finite.max()}]; they would be read back as no-return"
             )
         with np.errstate(over="ignore"):  # beyond float32: inf, refused below or read as no return
-            ranges = np.where(np.isfinite(scan.ranges), scan.ranges, np.inf).astype(np.float32)
+            # no return (NaN, or 0 m: no laser measures its own window) as +inf, never 0: with range_min = 0
+            # a 0 would be a valid reading, a point at the laser, for other tools replaying the bag
+            returns = np.isfinite(scan.ranges) & (scan.ranges != 0.0)
+            ranges = np.where(returns, scan.ranges, np.inf).astype(np.float32)
+        lost = returns & (ranges == 0.0)
+        if lost.any():
+            k = int(np.argmax(lost))
+            raise UnwritableError(
+                f"scan #{frame.index}: range {k + 1} of {scan.beams} is {float(scan.ranges[k])!r} m, which is 0 as "
+                f"float32 and would be read back as no return; expected a return of at least float32's smallest step"
+            )
+        with np.errstate(over="ignore"):
             angle_min, step = spacing
             fields = [float(np.float32(v)) for v in (angle_min, scan.angles[-1], step, 0.0, scan.max_range)]
         problem = laserscan_problem(scan.beams, *fields) or reading_problem(ranges, fields[3], fields[4])

@@ -47,4 +47,6 @@ def test_the_metadata_says_which_fields_a_source_reads() -> None:
     assert describe_odometry("laser-pose", "FLASER") == "FLASER odom_x odom_y odom_theta fields"
     assert describe_odometry("laser-pose", "ROBOTLASER1") == "ROBOTLASER1 robot_x robot_y robot_theta fields"
     assert describe_reference("none", "FLASER") == ""
-    assert describe_reference("laser-pose", "FLASER") == "FLASER x y theta fields"
+    assert describe_reference("laser-pose", "FLASER") == (
+        "FLASER x y theta fields (the laser's pose) composed with the inverse laser mount: the robot's pose"
+    )

@@ -95,3 +95,25 @@ def test_stamps_may_jitter_back_within_the_readers_tolerance(tmp_path: Path) -> 
     frames = [frame(0, np.ones(5), t=5.0), frame(1, np.ones(5), t=4.5), frame(2, np.ones(5), t=6.0)]
     CarmenWriter().write(Sequence.from_frames("jitter", frames), tmp_path / "j.clf")
     assert [f.scan.timestamp for f in CarmenLoader().load(tmp_path / "j.clf").frames()] == [5.0, 4.5, 6.0]
+
+
+def test_returns_at_the_max_range_stay_returns(tmp_path: Path) -> None:
+    """A reading equal to a bag's range_max (or within the reader's 5 mm no-return margin below the max range)
+    used to be written as a reading the reader takes for no return. The line now declares a max range raised
+    just above the longest return; no-returns (NaN) still come back as no return."""
+    ranges = [10.0, 9.997, np.nan, 0.0, 4.0]
+    path = tmp_path / "max.clf"
+    CarmenWriter().write(Sequence.from_frames("m", [frame(0, ranges, max_range=10.0)]), path)
+    scan = next(iter(CarmenLoader().load(path))).scan
+    np.testing.assert_array_equal(np.isnan(scan.ranges), [False, False, True, True, False])
+    np.testing.assert_allclose(scan.ranges[[0, 1, 4]], [10.0, 9.997, 4.0], atol=1e-6)
+    assert 10.0 < scan.max_range <= 10.006
+    unchanged = tmp_path / "far.clf"
+    CarmenWriter().write(Sequence.from_frames("m", [frame(0, [9.99, 1.0, 2.0, 3.0, 4.0], max_range=10.0)]), unchanged)
+    assert next(iter(CarmenLoader().load(unchanged))).scan.max_range == 10.0
+
+
+def test_a_return_that_prints_as_zero_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(DataError, match=r"range 2 of 5 is 1e-07 m, which prints as 0 in the log's 6 decimals"):
+        CarmenWriter().write(Sequence.from_frames("z", [frame(0, [1.0, 1e-7, 1.0, 1.0, 1.0])]), tmp_path / "z.clf")
+    assert list(tmp_path.iterdir()) == []

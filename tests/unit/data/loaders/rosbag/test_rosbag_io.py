@@ -235,6 +235,30 @@ def test_scans_outside_the_odometry_span_are_an_error_or_dropped_on_request(tmp_
         Ros2BagLoader().load(tmp_path / "short_odom", scan_topics="/scan")
 
 
+def test_a_scan_in_a_long_odometry_gap_is_refused_unless_max_pose_gap_allows_it(tmp_path: Path) -> None:
+    """Odometry messages 10 s apart around a scan: its pose used to be interpolated across the gap silently."""
+    frames = scan_frames(3)
+    odom_at = {0: frames[0].scan.timestamp - 5.0, 2: frames[2].scan.timestamp + 5.0}
+
+    def build(bag: Any, ts: Any, msgs: RosMessages) -> None:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        odom = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
+        for index, t in odom_at.items():
+            ns = seconds_to_ns(t)
+            message = msgs.odometry(frames[index].odometry, ns, "odom", index)
+            bag.write(odom, ns, ts.serialize_cdr(message, "nav_msgs/msg/Odometry"))
+        for f in frames:
+            ns = seconds_to_ns(f.scan.timestamp)
+            bag.write(scan, ns, ts.serialize_cdr(msgs.scan(f, ns), "sensor_msgs/msg/LaserScan"))
+
+    write_ros2(tmp_path / "gap", build)
+    with pytest.raises(ParseError, match=r"gap\[message #0\]: topic /scan: scan at t = .* falls in a 10\.4.. s gap"):
+        list(Ros2BagLoader().load(tmp_path / "gap").frames())
+    assert len(list(Ros2BagLoader().load(tmp_path / "gap", max_pose_gap=11.0).frames())) == 3
+    with pytest.raises(DataError, match=r"max_pose_gap='never'; expected seconds > 0"):
+        Ros2BagLoader().load(tmp_path / "gap", max_pose_gap="never")
+
+
 def test_undecodable_message_and_backwards_stamps_name_the_message_index(tmp_path: Path) -> None:
     frames = scan_frames(4)
 

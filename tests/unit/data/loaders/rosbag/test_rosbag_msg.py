@@ -31,6 +31,15 @@ def test_scan_arrays_marks_out_of_range_inf_and_nan_as_no_return() -> None:
     assert np.allclose(angles, [-0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 1.0], atol=0, rtol=0)
 
 
+def test_a_zero_reading_is_no_return_even_when_range_min_is_zero() -> None:
+    """range_min = 0 (as albot1 convert writes, and many drivers) used to keep a 0.0 reading as a point at the
+    laser; 0 is a driver's "no echo", a return at the laser's own window is impossible."""
+    ranges, _ = scan_arrays(
+        np.array([0.0, 1.0, 0.0], dtype=np.float32), angle_min=0.0, angle_increment=0.1, range_min=0.0, range_max=5.0
+    )
+    assert np.isnan(ranges).tolist() == [True, False, True]
+
+
 def test_a_clockwise_scan_is_reversed_so_angles_ascend() -> None:
     ranges, angles = scan_arrays(
         np.array([1.0, 2.0, 3.0]), angle_min=0.5, angle_increment=-0.5, range_min=0.0, range_max=10.0
