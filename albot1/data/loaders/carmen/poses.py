@@ -14,7 +14,9 @@ laser)``; its scan matcher ``vasco`` corrects that field, not the robot pose).
 The reference is the robot's, so those fields are composed with the inverse
 mount; so is the ``odom-segments`` chain, which starts at the FLASER pose
 field. The odometry fields (``odom_x ...``, ``robot_x ...``) are robot poses
-already and are taken as logged.
+already and are taken as logged, except where a FLASER/RLASER line holds the
+same numbers in both field sets (the corrected logs write their one corrected
+pose twice): those are the laser's pose, like the reference.
 :class:`PoseSources` holds the look-ahead buffers these need across chunks
 (:mod:`.interp`) and says when a waiting scan can be given its poses.
 """
@@ -108,6 +110,11 @@ class PoseSources:
         mode = self.mode
         if mode == "laser-pose":
             assert rec.robot is not None  # RAWLASER + laser-pose is rejected in load()
+            if self.laser in OLD_LASERS and rec.sensor is not None and np.array_equal(rec.sensor, rec.robot):
+                # A corrected log writes its one corrected pose in both field sets (raw CARMEN lines differ by
+                # the mount): that is the laser's pose, read as the reference is, so perfect odometry stays the
+                # reference to the bit instead of sitting one mount away from it.
+                return self._robot(rec.robot)
             return rec.robot.copy()
         if mode == "odom":
             assert self.odom is not None

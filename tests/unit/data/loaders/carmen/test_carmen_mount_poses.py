@@ -89,6 +89,30 @@ def test_corrected_log_reference_and_odometry_segments_move_back_onto_the_robot(
     np.testing.assert_allclose(se2.compose(np.array([f.odometry for f in frames]), mount), chain, atol=1e-12)
 
 
+def test_corrected_log_perfect_odometry_is_the_reference_to_the_bit(tmp_path: Path) -> None:
+    """``odometry=laser-pose`` on a corrected log (both field sets one corrected pose) is the generalisation
+    suite's perfect odometry: it must be read as the reference is (moved onto the robot), not one mount away."""
+    mount = np.array([-0.04, 0.0, 0.0])
+    corrected = [(0.0, 0.0, 0.0), (1.1, 0.1, 0.05), (2.0, 0.3, 1.6), (2.1, 1.3, -3.0)]
+    lines = ["PARAM robot_frontlaser_offset -0.04 0 host 0"]
+    for k, pose in enumerate(corrected):
+        lines.append(f"FLASER 180 {' '.join(['1.000'] * 180)} {_fmt(pose)} {_fmt(pose)} {k}.0 host {k}.0")
+    sequence = CarmenLoader().load(_write(tmp_path, lines), odometry="laser-pose", reference="laser-pose")
+    frames = list(sequence.frames())
+    for frame, pose in zip(frames, corrected, strict=True):
+        np.testing.assert_array_equal(frame.odometry, frame.reference)
+        np.testing.assert_allclose(se2.compose(frame.odometry, mount), pose, atol=1e-12)
+
+
+def test_raw_log_odometry_fields_stay_the_robot_odometry(tmp_path: Path) -> None:
+    """On a raw log the two field sets differ by the mount: the odometry fields are the robot's, taken as logged."""
+    mount = np.array([-0.04, 0.0, 0.0])
+    lines = ["PARAM robot_frontlaser_offset -0.04 0 host 0", *_old_laser_log("FLASER", mount)]
+    frames = list(CarmenLoader().load(_write(tmp_path, lines), odometry="laser-pose").frames())
+    for frame, odom in zip(frames, ODOMETRY, strict=True):
+        np.testing.assert_array_equal(frame.odometry, np.array(odom))
+
+
 def _robotlaser(robot: tuple[float, float, float], mount: tuple[float, float, float], stamp: float) -> str:
     laser = se2.compose(np.array(robot), np.array(mount))
     return (
