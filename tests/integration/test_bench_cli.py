@@ -68,7 +68,9 @@ def test_bench_exits_1_after_the_whole_grid_when_a_cell_failed(tmp_path: Path) -
 
 
 @pytest.mark.usefixtures("fault_plugin")
-def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(tmp_path: Path) -> None:
+def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     fault = ""  # the plugin method `fault` (fault_plugin fixture)
     suite = tmp_path / "allowed.toml"
     suite.write_text(
@@ -107,9 +109,10 @@ def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(tmp
     assert "FAILED (allowed by the suite) fault on" in retried.stderr and "kept from" not in retried.stderr
     assert failed.stat().st_mtime_ns != stamp
     # A bad config is not the method's failure: allow_failure does not cover it, the suite is refused before any
-    # cell runs (one line naming the entry and the key).
+    # cell runs (one line naming the entry and the key). A refusal before planning: main() in this process
+    # (_albot1_in_process says why), with the plugin installed here by fault_plugin.
     suite.write_text(suite.read_text().replace('mode = "raise"', 'mode = "nonsense"'))
-    done = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=env)
+    done = _albot1_in_process(tmp_path, monkeypatch, capsys, *args[3:])
     assert done.returncode == 1, done.stderr
     assert done.stderr.strip().splitlines() == [
         f"albot1: error: {suite}: invalid suite: methods.1 ('fault'): invalid config for method 'fault' (preset "
