@@ -84,6 +84,7 @@ from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, fiel
 from pydantic_core import PydanticCustomError
 
 from albot1.bench.errors import SuiteError
+from albot1.config.toml_lines import key_lines, line_of
 from albot1.config.validation import describe_errors
 from albot1.data.degrade import MAX_SEED, DegradationSpecError, parse_spec
 from albot1.data.errors import SliceError
@@ -417,21 +418,39 @@ def _check_seeds(seeds: _Seeds) -> _Seeds:
     return seeds
 
 
-def parse_suite(data: dict[str, Any], *, name: str, source: str, path: Path | None = None) -> Suite:
-    """Validate suite data (a parsed TOML table); SuiteError names ``source`` and the offending key."""
+def parse_suite(
+    data: dict[str, Any], *, name: str, source: str, path: Path | None = None, text: str | None = None
+) -> Suite:
+    """Validate suite data (a parsed TOML table); SuiteError names ``source`` and the offending key.
+
+    ``text``: the file's TOML text, so the error also names the line of the first key it can place
+    (``s.toml:12: invalid suite: datasets.3.colour: ...``): in a suite of many ``[[datasets]]`` entries an
+    index alone left the user counting headers.
+    """
+    lines = key_lines(text) if text is not None else {}
     if "path" in data:  # set from where the file was found, never by the file
-        raise SuiteError(f"{source}: invalid suite: path: unknown key (the suite's path is where its file is)")
+        at = _at(source, lines, ("path",))
+        raise SuiteError(f"{at}: invalid suite: path: unknown key (the suite's path is where its file is)")
     try:
         return Suite.model_validate({"name": name, **data, "path": path})
     except ValidationError as exc:
-        raise SuiteError(f"{source}: invalid suite: {describe_errors(exc, found=True)}") from None
+        located = (error["loc"] for error in exc.errors() if error["loc"])
+        at = _at(source, lines, next(located, ()))
+        raise SuiteError(f"{at}: invalid suite: {describe_errors(exc, found=True)}") from None
+
+
+def _at(source: str, lines: dict[tuple[str | int, ...], int], location: tuple[str | int, ...]) -> str:
+    """``source:LINE`` when ``location`` (or a prefix of it) has a known line, else ``source``."""
+    line = line_of(lines, location) if location else None
+    return source if line is None else f"{source}:{line}"
 
 
 def load_suite(path: str | Path) -> Suite:
     """Read and validate a suite file."""
     file = Path(path)
     try:
-        data = tomllib.loads(file.read_text(encoding="utf-8"))
+        text = file.read_text(encoding="utf-8")
+        data = tomllib.loads(text)
     except OSError as exc:
         raise SuiteError(f"{file}: cannot read the suite file: {exc.strerror or exc}") from None
     except UnicodeDecodeError as exc:
@@ -439,7 +458,7 @@ def load_suite(path: str | Path) -> Suite:
     except tomllib.TOMLDecodeError as exc:
         raise SuiteError(f"{file}: not valid TOML: {exc}") from None
     name = data.pop("name", file.stem)
-    return parse_suite(data, name=name, source=str(file), path=file.resolve())
+    return parse_suite(data, name=name, source=str(file), path=file.resolve(), text=text)
 
 
 def find_suite(ref: str) -> Path:

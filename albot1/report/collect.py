@@ -239,11 +239,21 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
     such a cell too, not "not run": that would blame a stopped runner for a
     damaged file. Only a DONE run with no ``metrics.json`` at all was stopped
     between its run and its evaluation.
+
+    A cell planned twice under the same labels (two spellings of one slice in a suite, ``NAME[:5]`` and
+    ``NAME[0:5]``: one key, one run folder) is one record: each copy was a row of its table group, so the
+    std, the median and the ``planned`` count were taken over the run counted twice (seeds 0 and 1 twice each:
+    std 0.018 where the two seeds give 0.023).
     """
     store = ResultsStore(results_dir)
     plan = store.read_plan()
     records: list[CellRecord] = []
+    seen: set[tuple[str, str, str]] = set()
     for cell in plan.cells:
+        identity = (cell.key, cell.dataset_label, cell.method_label)
+        if identity in seen:
+            continue
+        seen.add(identity)
         run_dir = store.run_dir(cell.key)
         if store.is_complete(cell.key) or (run_is_complete(run_dir) and (run_dir / METRICS).exists()):
             attempt = run_dir / ATTEMPT  # absent when the runner stopped right after the evaluation

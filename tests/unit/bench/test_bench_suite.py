@@ -72,7 +72,7 @@ def test_method_labels_include_non_default_presets_and_must_be_unique() -> None:
 @pytest.mark.parametrize(
     ("text", "expected"),
     [
-        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", strde = 2}]\n', r"s\.toml: .*datasets\.0\.strde"),
+        ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", strde = 2}]\n', r"s\.toml:2: .*datasets\.0\.strde"),
         ('methods = [{name = "odometry"}]\ndatasets = [{name = "*", limit = 0}]\n', r"datasets\.0\.limit"),
         ('methods = []\ndatasets = [{name = "*"}]\n', r"methods"),
         (
@@ -280,7 +280,8 @@ def test_a_value_of_the_wrong_type_is_one_problem_naming_what_was_found(
 ) -> None:
     with pytest.raises(SuiteError) as caught:
         load_suite(write(tmp_path, text + '[[methods]]\nname = "odometry"\n[[datasets]]\nname = "*"\n'))
-    assert str(caught.value) == f"{tmp_path / 's.toml'}: invalid suite: {expected}"
+    line = 2 if text.startswith("[") else 1  # the key's line, after its table header
+    assert str(caught.value) == f"{tmp_path / 's.toml'}:{line}: invalid suite: {expected}"
 
 
 @pytest.mark.parametrize(
@@ -309,7 +310,7 @@ def test_a_value_of_the_wrong_type_is_one_problem_naming_what_was_found(
 def test_a_dataset_entry_value_of_the_wrong_type_is_refused(tmp_path: Path, entry: str, expected: str) -> None:
     with pytest.raises(SuiteError) as caught:
         load_suite(write(tmp_path, f'methods = [{{name = "odometry"}}]\ndatasets = [{entry}]\n'))
-    assert str(caught.value) == f"{tmp_path / 's.toml'}: invalid suite: {expected}"
+    assert str(caught.value) == f"{tmp_path / 's.toml'}:2: invalid suite: {expected}"
 
 
 @pytest.mark.parametrize(
@@ -331,7 +332,7 @@ def test_a_method_entry_value_of_the_wrong_type_is_refused(tmp_path: Path, entry
     with pytest.raises(SuiteError) as caught:
         load_suite(write(tmp_path, f'methods = [{entry}]\ndatasets = [{{name = "*"}}]\n'))
     message = str(caught.value)
-    assert message.startswith(f"{tmp_path / 's.toml'}: invalid suite: {expected}") and "; " not in message, message
+    assert message.startswith(f"{tmp_path / 's.toml'}:1: invalid suite: {expected}") and "; " not in message, message
 
 
 def test_integers_stand_for_floats_and_arrays_for_lists(tmp_path: Path) -> None:
@@ -370,3 +371,21 @@ def test_every_spelling_of_a_slice_is_labelled_one_way(tmp_path: Path, entry: st
     suite = load_suite(write(tmp_path, f'[[methods]]\nname = "odometry"\n[[datasets]]\n{entry}\n'))
     options = suite.options_for(suite.datasets[0].name)
     assert options is not None and options.label == label
+
+
+def test_an_invalid_suite_names_the_line_of_the_key(tmp_path: Path) -> None:
+    """``file:LINE``: in a suite of many ``[[datasets]]`` entries an index alone left the user counting headers."""
+    text = (
+        '# a comment\n[grid]\ndegradations = [\n  "thesis",\n]\nseeds = [0]\n\n[[methods]]\nname = "odometry"\n'
+        'set = { x = 1 }\n[[datasets]]\nname = "a"\n[[datasets]]\nname = "b"\ndescription = """\ncolour = 1\n"""\n'
+        "colour = 3\n"
+    )
+    with pytest.raises(SuiteError) as caught:
+        load_suite(write(tmp_path, text))
+    assert str(caught.value) == (
+        f"{tmp_path / 's.toml'}:15: invalid suite: datasets.1.description: Extra inputs are not permitted; "
+        "datasets.1.colour: Extra inputs are not permitted"
+    )
+    bad_seed = text.replace("seeds = [0]", "seeds = [-1]")
+    with pytest.raises(SuiteError, match=r"s\.toml:6: invalid suite: grid\.seeds\.0: "):
+        load_suite(write(tmp_path, bad_seed))
