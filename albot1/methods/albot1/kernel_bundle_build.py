@@ -33,7 +33,10 @@ class KernelBundleError(Albot1Error):
 
 def _kernel_files(name: str, kernel: Any) -> list[Path]:
     """Numba's cache files of ``kernel`` (its index, then its data files), read from where numba wrote them."""
-    cached = Path(kernel._cache.cache_path)
+    where = getattr(kernel._cache, "cache_path", None)
+    if where is None:  # numba's NullCache: the kernel was decorated without cache=True
+        raise KernelBundleError(f"kernel bundle: {name} is compiled without numba's cache; expected cache=True")
+    cached = Path(where)
     base = kernel._cache._impl.filename_base
     index = cached / f"{base}.nbi"
     if not index.is_file():

@@ -290,6 +290,17 @@ def _fake_kernel(cache_path: Path) -> Any:
     return SimpleNamespace(_cache=SimpleNamespace(cache_path=str(cache_path), _impl=impl))
 
 
+def test_the_build_refuses_a_kernel_compiled_without_the_cache() -> None:
+    """Decorated without ``cache=True`` a kernel has numba's NullCache: one line, not a TypeError from ``Path``."""
+    import numba
+
+    from albot1.methods.albot1.kernel_bundle_build import KernelBundleError, _kernel_files
+
+    uncached = numba.njit(lambda x: x + 1)
+    with pytest.raises(KernelBundleError, match=r"^kernel bundle: plain is compiled without numba's cache"):
+        _kernel_files("plain", uncached)
+
+
 def test_the_build_refuses_a_kernel_whose_cache_files_are_missing(tmp_path: Path) -> None:
     """A wheel whose bundle silently lacked a kernel would compile it at the first run while claiming it ships it."""
     from albot1.methods.albot1.kernel_bundle_build import KernelBundleError, _kernel_files
