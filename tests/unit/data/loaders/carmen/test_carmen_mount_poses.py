@@ -122,8 +122,10 @@ def _robotlaser(robot: tuple[float, float, float], mount: tuple[float, float, fl
 
 
 def test_robotlaser1_reference_is_the_laser_pose_fields_moved_onto_the_robot(tmp_path: Path) -> None:
-    """CARMEN's scan matcher (vasco) corrects a ROBOTLASER1 line's laser_pose and leaves robot_pose as the
-    odometry: reference=laser-pose reads the laser_pose fields, composed with the inverse mount."""
+    """reference=laser-pose reads a ROBOTLASER1 line's laser_pose fields composed with the inverse mount. On any
+    log the loader accepts (one mount for every line) that equals the robot_pose fields, so this pins the reading
+    down rather than guarding an old defect: a vasco-corrected log (laser_pose corrected apart from robot_pose),
+    where the two would differ, is refused by the one-mount check (next test), not read."""
     mount = (0.22, 0.0, 0.0)
     path = _write(tmp_path, [_robotlaser(odom, mount, k + 1.0) for k, odom in enumerate(ODOMETRY)])
     frames = list(CarmenLoader().load(path, reference="laser-pose").frames())
