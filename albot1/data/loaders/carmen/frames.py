@@ -32,7 +32,14 @@ class FrameStream:
     """Turns parsed chunks into frames; one instance serves every iteration (it holds no state)."""
 
     def __init__(
-        self, path: Path, opts: CarmenOptions, laser: str, reference: str, mount: tuple[float, float, float]
+        self,
+        path: Path,
+        opts: CarmenOptions,
+        laser: str,
+        reference: str,
+        mount: tuple[float, float, float],
+        *,
+        check_mount: bool = False,
     ) -> None:
         self.path = path
         self.opts = opts
@@ -40,6 +47,8 @@ class FrameStream:
         self.reference = reference
         #: the laser's pose on the robot (``metadata.sensor_offset``)
         self.mount = mount
+        #: the mount came from the first ROBOTLASER1 line (no PARAM states it): every line must restate it
+        self.check_mount = check_mount
 
     def frames(self) -> Iterator[Frame]:
         return _FrameIterator(self).run()
@@ -108,7 +117,7 @@ class _FrameIterator:
         rows: list[tuple[int, int, int]] = []  # (line, block, row) in file order
         decoded = []
         for b, block in enumerate(parsed.lasers):
-            if self.s.laser == "ROBOTLASER1" and block.robot is not None and block.sensor is not None:
+            if self.s.check_mount and block.robot is not None and block.sensor is not None:
                 found = mount_problem(block.robot, block.sensor, self.s.mount)
                 if found is not None:
                     raise ParseError(self.path, found[1], line=int(block.lines[found[0]]))

@@ -164,6 +164,11 @@ def param_geometry(beams: int, params: dict[str, str], rear: bool = False) -> Be
     return BeamGeometry(start, step, max_range if max_range is not None else DEFAULT_MAX_RANGE, source)
 
 
+def states_front_mount(params: dict[str, str]) -> bool:
+    """Whether the log's PARAM lines state the front laser's mount (any of its offset, side or angular parts)."""
+    return any(f"robot_frontlaser_{part}" in params for part in ("offset", "side_offset", "angular_offset"))
+
+
 def sensor_offset(params: dict[str, str], rear: bool = False) -> tuple[float, float, float]:
     """Laser pose in the robot frame from PARAM ``robot_frontlaser_offset`` (and side/angular, if logged).
 

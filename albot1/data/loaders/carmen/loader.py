@@ -37,9 +37,15 @@ fields, the corrected pose in the SLAM-corrected logs: in CARMEN these are the
 time); ``"auto"`` (TRUEPOS when the first chunk of the log has TRUEPOS lines,
 else none).
 
-ROBOTLASER1 lines carry the mount on every line (laser pose vs robot pose);
-the loader applies the first line's to every scan and refuses a later line
-whose own mount differs by more than :data:`.poses.MOUNT_TOLERANCE`.
+ROBOTLASER1 lines carry the mount on every line (laser pose vs robot pose).
+Where the log states it (PARAM ``robot_frontlaser_offset`` and its side and
+angular parts, what CARMEN's robot module composed the laser poses with), the
+PARAM mount is used, and a line whose laser pose is not the robot pose composed
+with it is a corrected one (``vasco`` corrects the laser pose only), read as
+such. Without those PARAMs the loader applies the first line's mount to every
+scan and refuses a later line whose own mount differs by more than
+:data:`.poses.MOUNT_TOLERANCE`: nothing else could tell a corrected line from
+a second laser's.
 
 ODOM and TRUEPOS lines are only decoded when a pose source uses them.
 
@@ -147,7 +153,8 @@ class CarmenLoader:
             reference = "truepos" if len(head.truepos.lines) else "none"
         params = {name: value for _, name, value in head.params}
         offset = geom.sensor_offset(params, rear=laser in ("RLASER", "RAWLASER2"))
-        if laser == "ROBOTLASER1" and head.lasers:
+        lines_state_mount = laser == "ROBOTLASER1" and not geom.states_front_mount(params)
+        if lines_state_mount and head.lasers:
             first = head.lasers[0]
             assert first.robot is not None and first.sensor is not None
             rel = se2.between(first.robot[0], first.sensor[0])
@@ -183,7 +190,7 @@ class CarmenLoader:
             read_relations(given.relations, repeats=given.relations_repeats) if given.relations is not None else None
         )
         name = opts.name or _stem(path)
-        stream = FrameStream(path, opts, laser, reference, offset)
+        stream = FrameStream(path, opts, laser, reference, offset, check_mount=lines_state_mount)
         return Sequence(name, stream.frames, metadata, relations)
 
 

@@ -195,5 +195,6 @@ def mount_problem(robot: np.ndarray, laser: np.ndarray, mount: tuple[float, floa
         f"ROBOTLASER1 laser pose vs robot pose puts the laser at ({shown}) (x m, y m, yaw rad) on the robot, but the "
         f"log's first ROBOTLASER1 line puts it at ({expected}); expected one mount for every line (to within "
         f"{MOUNT_TOLERANCE:g}): the loader applies one mount to every scan, so lines of another laser or whose laser "
-        f"poses were corrected apart from the robot poses cannot be read as this log's scans"
+        f"poses were corrected apart from the robot poses cannot be read as this log's scans (a corrected log "
+        f"reads when its PARAM robot_frontlaser_offset states the mount)"
     )

@@ -142,6 +142,30 @@ def test_robotlaser1_line_with_another_mount_is_refused(tmp_path: Path) -> None:
         CarmenLoader().load(_write(tmp_path, lines)).count_scans()
 
 
+def test_robotlaser1_log_corrected_by_vasco_reads_with_the_param_mount(tmp_path: Path) -> None:
+    """vasco corrects each line's laser pose and leaves the robot pose as the odometry, so the lines' own mounts
+    differ. With the mount stated by PARAM (what the robot module composed the laser poses with) such a log is
+    read: the odometry is the robot pose fields, the reference the corrected laser poses moved onto the robot.
+    Without the PARAM lines it is refused (test above): nothing else tells a corrected line from another laser's."""
+    mount = np.array([0.22, 0.0, 0.0])
+    corrected = [(0.0, 0.0, 0.0), (1.05, 0.45, 0.72), (2.1, -0.9, -2.85), (2.4, -1.6, 3.12)]
+    lines = [
+        f"PARAM robot_frontlaser_offset {mount[0]} host 0",
+        *(
+            f"ROBOTLASER1 0 -1.0 1.0 0.5 30.0 0.01 0 3 1.000 2.000 3.000 0 {_fmt(se2.compose(np.array(fixed), mount))} "
+            f"{_fmt(odom)} 0 0 0 0 0 {k + 1.0} host {k + 1.0}"
+            for k, (odom, fixed) in enumerate(zip(ODOMETRY, corrected, strict=True))
+        ),
+    ]
+    sequence = CarmenLoader().load(_write(tmp_path, lines), reference="laser-pose")
+    assert sequence.metadata.sensor_offset == (0.22, 0.0, 0.0)
+    frames = list(sequence.frames())
+    for frame, odom, fixed in zip(frames, ODOMETRY, corrected, strict=True):
+        np.testing.assert_array_equal(frame.odometry, np.array(odom))
+        np.testing.assert_allclose(frame.reference[:2], fixed[:2], atol=1e-12)
+        assert abs(se2.wrap(frame.reference[2] - fixed[2])) < 1e-12
+
+
 def test_robotlaser1_mount_printed_with_six_decimals_is_accepted(tmp_path: Path) -> None:
     """CARMEN prints poses with %f (6 decimals): fr-clinic's per-line mounts scatter by 1.3e-6 m."""
     lines = []
