@@ -125,7 +125,8 @@ def test_robotlaser1_reference_is_the_laser_pose_fields_moved_onto_the_robot(tmp
     """reference=laser-pose reads a ROBOTLASER1 line's laser_pose fields composed with the inverse mount. On any
     log the loader accepts (one mount for every line) that equals the robot_pose fields, so this pins the reading
     down rather than guarding an old defect: a vasco-corrected log (laser_pose corrected apart from robot_pose),
-    where the two would differ, is refused by the one-mount check (next test), not read."""
+    where the two differ, is refused by the one-mount check without PARAM lines, and read with the PARAM mount
+    (the tests below)."""
     mount = (0.22, 0.0, 0.0)
     path = _write(tmp_path, [_robotlaser(odom, mount, k + 1.0) for k, odom in enumerate(ODOMETRY)])
     frames = list(CarmenLoader().load(path, reference="laser-pose").frames())
