@@ -42,7 +42,17 @@ from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
-from albot1.metrics.paired import BLOCKS, CONFIDENCE, NOT_APPLICABLE, RESAMPLES, ZERO_ERROR, compare
+from albot1.metrics.paired import (
+    BLOCKS,
+    CONFIDENCE,
+    DIGITS,
+    NOT_APPLICABLE,
+    RESAMPLES,
+    ZERO_ERROR,
+    compare,
+    ratio_digits,
+    ratio_text,
+)
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import regenerate_command
@@ -158,14 +168,15 @@ def _num(value: float | None, digits: int = 3) -> str:
     return NA if value is None or not math.isfinite(value) else f"{value:.{digits}f}"
 
 
-def _ratio(value: float) -> str:
-    return NA if not math.isfinite(value) else f"{value:.3g}"
+def _ratio(value: float, digits: int = DIGITS) -> str:
+    return NA if not math.isfinite(value) else ratio_text(value, digits)
 
 
 def _interval(row: Comparison) -> str:
     if row.verdict in (PERFECT, NOT_APPLICABLE):
         return NA
-    return f"{_ratio(row.ratio)} [{_ratio(row.ratio_low)}–{_ratio(row.ratio_high)}]"
+    digits = ratio_digits(row.ratio_low, row.ratio_high)  # enough to show the interval's side of 1
+    return f"{_ratio(row.ratio, digits)} [{_ratio(row.ratio_low, digits)}–{_ratio(row.ratio_high, digits)}]"
 
 
 def _verdict(row: Comparison) -> str:
@@ -239,8 +250,9 @@ def render_page(
         lines += ["|---|---|---|---:|---:|---:|---:|---|"]
         lines += [
             f"| {marked(r.method, r.held_in)} | {r.dataset} | {r.degradation} | {_seeds(r)} | {_num(r.ate_m)} | "
-            f"{_num(r.odometry_ate_m)} | {_ratio(r.ratio)} | {_ratio(r.ratio_low)}–{_ratio(r.ratio_high)} |"
+            f"{_num(r.odometry_ate_m)} | {_ratio(r.ratio, d)} | {_ratio(r.ratio_low, d)}–{_ratio(r.ratio_high, d)} |"
             for r in worse
+            for d in (ratio_digits(r.ratio_low, r.ratio_high),)
         ]
     else:
         lines.append(f"Nowhere at {pct} confidence.")

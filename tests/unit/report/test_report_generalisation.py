@@ -56,6 +56,15 @@ def test_the_page_lists_where_a_method_is_worse_than_its_odometry_with_marks() -
     assert "Nowhere" in render_page(plan, rows[1:])
 
 
+def test_a_worse_ratio_close_to_one_is_printed_with_the_digits_that_show_it_above_one() -> None:
+    """At 3 digits the row read ``1 [1–1]`` beside "worse" (and ``1 | 1–1`` in the worse table): no evidence shown."""
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    text = render_page(plan, [_row("kiss-icp", 1.0004, 1.0003, 1.0005, "worse", False)])
+    assert "| 1.0004 [1.0003–1.0005] | worse |" in text
+    assert "| 1.000 | 1.0004 | 1.0003–1.0005 |" in text
+    assert "| 0.2 [0.1–0.3] |" in render_page(plan, [_row("m", 0.2, 0.1, 0.3, "better", False)])
+
+
 def test_names_with_markdown_and_html_characters_are_written_as_text_on_every_line_of_the_page() -> None:
     """A ``|`` in a method's name split its row into one more column; ``<b>`` was HTML; ``*x*`` italic."""
     plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
