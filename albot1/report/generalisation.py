@@ -23,7 +23,11 @@ comparison does not apply (fewer than :data:`~albot1.metrics.paired.MIN_PAIRS`
 scans, an unbounded interval) the cell says ``n/a`` and why, and a ratio to
 perfect odometry is never formed (``perfect odometry``). RPE@10 m and
 the loop gap are shown beside the odometry method's own cell of the same
-dataset, degradation and seed (when the suite ran it).
+dataset, degradation and seed (when the suite ran it): both as means over
+the seeds where both have the number, so the ratio beside them compares the
+same seeds (a seed whose odometry cell failed used to stay in the method's
+mean and out of the odometry's); without an odometry number on any seed,
+the method's mean over its own seeds and ``n/a``.
 """
 
 from __future__ import annotations
@@ -113,6 +117,16 @@ def _mean(values: list[float | None]) -> float | None:
     return sum(present) / len(present) if present else None
 
 
+def _paired_means(mine: list[float | None], theirs: list[float | None]) -> tuple[float | None, float | None]:
+    """The method's and the odometry's means over the seeds where both have a number (``mine[k]`` and
+    ``theirs[k]``: seed k), so that their ratio compares the same seeds; where no seed has both, the method's
+    mean over its own seeds and None."""
+    both = [(m, o) for m, o in zip(mine, theirs, strict=True) if m is not None and o is not None]
+    if not both:
+        return _mean(mine), None
+    return _mean([m for m, _ in both]), _mean([o for _, o in both])
+
+
 def comparisons(records: list[CellRecord]) -> list[Comparison]:
     """A :class:`Comparison` per (dataset, method, degradation) with at least one scored run, in plan order."""
     rpe, gap = METRIC_COLUMNS["drift_10m_m"], METRIC_COLUMNS["loop_gap_m"]
@@ -135,6 +149,10 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
         # perfect odometry first: its table shows the method's ATE whatever the number of scans
         paired = compare(pairs) if odometry_ate >= PERFECT_M else None
         odo = [odometry_cells.get((dataset, degradation, rec.cell.seed)) for rec, _ in scored]
+        rpe10 = _paired_means([rpe.value(rec) for rec, _ in scored], [None if o is None else rpe.value(o) for o in odo])
+        loop_gap = _paired_means(
+            [gap.value(rec) for rec, _ in scored], [None if o is None else gap.value(o) for o in odo]
+        )
         out.append(
             Comparison(
                 dataset=dataset,
@@ -148,10 +166,10 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
                 ratio_low=math.nan if paired is None else paired.low,
                 ratio_high=math.nan if paired is None else paired.high,
                 verdict=PERFECT if paired is None else paired.verdict,
-                rpe10_m=_mean([rpe.value(rec) for rec, _ in scored]),
-                odometry_rpe10_m=_mean([rpe.value(o) for o in odo if o is not None]),
-                loop_gap_m=_mean([gap.value(rec) for rec, _ in scored]),
-                odometry_loop_gap_m=_mean([gap.value(o) for o in odo if o is not None]),
+                rpe10_m=rpe10[0],
+                odometry_rpe10_m=rpe10[1],
+                loop_gap_m=loop_gap[0],
+                odometry_loop_gap_m=loop_gap[1],
                 held_in=held_in(scored[0][0].cell),
                 reason=None if paired is None else paired.reason,
             )
@@ -234,7 +252,8 @@ def render_page(
         f"ratio (< 1: the method improved on its odometry) with a {pct} paired moving-block bootstrap interval over "
         f"scans ({RESAMPLES} resamples, blocks of 1/{BLOCKS} of a run, the same scans for both); **worse** / "
         f"**better** when the whole interval is above / below 1, else *indistinguishable*. RPE@10 m and loop gap: "
-        "the method's / the odometry method's cell of the same data and seeds (ratio in brackets). Method: "
+        "the method's / the odometry method's cell of the same data, means over the seeds both have (ratio in "
+        "brackets). Method: "
         "`albot1/report/generalisation.py`.",
         "",
         LEGEND,

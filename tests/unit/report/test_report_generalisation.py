@@ -157,3 +157,35 @@ def test_the_csv_leaves_a_missing_ratio_empty_and_says_why(tmp_path: Path) -> No
     assert lines[1] == (
         "fhw-corrected?odometry=laser-pose,gtsam-graph,none,1,0,0.126,0,,,,perfect odometry,0.2,0.1,,2,False,"
     )
+
+
+def _seed_run(tmp_path: Path, method_label: str, seed: int, scale: float) -> CellRecord:
+    """An odometry run on a 20 m straight drive whose odometry is ``scale`` times long, filed as ``method_label``'s
+    cell of ``seed``."""
+    t = np.arange(41, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(41), np.zeros(41)])
+    odometry = np.column_stack([t * 0.5 * scale, np.zeros(41), np.radians(0.5) * t])
+    angles = np.radians(np.linspace(-90.0, 90.0, 181))
+    frames = [
+        Frame(i, Scan(np.full(181, 5.0), angles, 100.0 + t[i], 30.0), odometry[i], reference=truth[i])
+        for i in range(41)
+    ]
+    run_dir = write_run(run_method("odometry", Sequence.from_frames("drive", frames), dataset_name="drive"), tmp_path)
+    evaluate_run(run_dir)
+    cell = Cell("t", "drive", "drive", method_label, method_label, "default", "none", seed, run_dir.name, "v", 1, 1)
+    metrics = read_record(MetricsRecord, run_dir / "metrics.json")
+    return CellRecord(cell, "done", run_dir, read_record(ResultRecord, run_dir / "result.json"), metrics, None)
+
+
+def test_rpe_beside_the_odometry_is_a_mean_over_the_same_seeds(tmp_path: Path) -> None:
+    """The odometry cell of seed 1 failed: its mean was over seed 0 alone and the method's over seeds 0 and 1, so
+    the ratio beside them compared a good seed with a bad one (3.69x here, where the seed both ran gives 1.00x).
+    The loop gap beside its odometry's is paired the same way (one helper)."""
+    method = [_seed_run(tmp_path / f"m{seed}", "kiss-icp", seed, scale) for seed, scale in ((0, 1.1), (1, 1.9))]
+    odometry = _seed_run(tmp_path / "o0", "odometry", 0, 1.1)  # the same drive as the method's seed 0
+    failed = replace(odometry, cell=replace(odometry.cell, seed=1), status="failed", metrics=None)
+    (row,) = comparisons([*method, odometry, failed])
+    assert row.seeds == 2
+    assert row.rpe10_m is not None and row.rpe10_m == pytest.approx(row.odometry_rpe10_m)
+    (alone,) = comparisons(method)  # no odometry cell: the method's mean over its own seeds, the odometry's n/a
+    assert alone.odometry_rpe10_m is None and alone.rpe10_m is not None and alone.rpe10_m > row.rpe10_m
