@@ -51,6 +51,7 @@ from albot1.metrics.paired import (
     CONFIDENCE,
     DIGITS,
     NOT_APPLICABLE,
+    RATIO_TIE,
     RESAMPLES,
     ZERO_ERROR,
     compare,
@@ -275,10 +276,14 @@ def render_page(
         ]
     else:
         lines.append(f"Nowhere at {pct} confidence.")
-    above = [r for r in rows if r.verdict == "indistinguishable" and r.ratio > 1.0]
+    # above 1 by more than rounding, each with the digits that show it above 1 (1.0004 read "1" at 3 digits)
+    above = [r for r in rows if r.verdict == "indistinguishable" and r.ratio > 1.0 + RATIO_TIE]
     lines += _listing(
         "Ratio above 1 but not significantly",
-        [f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio)}" for r in above],
+        [
+            f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio, ratio_digits(r.ratio, r.ratio))}"
+            for r in above
+        ],
     )
     lines += [
         "",

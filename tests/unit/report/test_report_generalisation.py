@@ -63,6 +63,11 @@ def test_a_worse_ratio_close_to_one_is_printed_with_the_digits_that_show_it_abov
     assert "| 1.0004 [1.0003–1.0005] | worse |" in text
     assert "| 1.000 | 1.0004 | 1.0003–1.0005 |" in text
     assert "| 0.2 [0.1–0.3] |" in render_page(plan, [_row("m", 0.2, 0.1, 0.3, "better", False)])
+    # not significantly above 1: listed as such with the digits that show it above 1 (was "kiss-icp ... 1")
+    same = render_page(plan, [_row("kiss-icp", 1.0004, 0.9, 1.1, "indistinguishable", False)])
+    assert "Ratio above 1 but not significantly: kiss-icp on fhw-corrected?odometry=laser-pose (none) 1.0004." in same
+    tie = render_page(plan, [_row("kiss-icp", 1.0000001, 0.9, 1.1, "indistinguishable", False)])
+    assert "Ratio above 1 but not significantly" not in tie  # above 1 by rounding only
 
 
 def test_names_with_markdown_and_html_characters_are_written_as_text_on_every_line_of_the_page() -> None:
