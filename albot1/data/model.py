@@ -138,9 +138,9 @@ class Relations:
     t1: FloatArray
     t2: FloatArray
     poses: FloatArray  # (M, 3): x, y, yaw of the relation
-    #: How many lines of the file this was read from repeat an earlier line identically: left out (each
-    #: relation counted once) unless ``repeats_counted`` (read with ``repeats="keep"``, as the published
-    #: evaluator counts lines); see :mod:`albot1.data.relations`.
+    #: How many lines of the file this was read from repeat an earlier line (identically, or in the other
+    #: direction as its inverse): left out (each relation counted once) unless ``repeats_counted`` (read with
+    #: ``repeats="keep"``, as the published evaluator counts lines); see :mod:`albot1.data.relations`.
     repeats: int = 0
     repeats_counted: bool = False
 

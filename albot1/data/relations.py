@@ -42,6 +42,17 @@ lines repeat (a warning naming them, :attr:`Relations.repeats`) and the
 relation metric's block records the count and the reading. The same pair
 with two *different* motions is an error: which one is the measurement
 cannot be decided.
+
+A line that gives an earlier relation **in the other direction** (``t2 t1``
+and the inverse motion, to the rounding of printed decimals:
+:data:`REVERSE_TOLERANCE`) is the same measurement too, and is counted the
+same way (once by default, as listed with ``keep``, said in the warning as
+``line 7 (= 3 reversed)``): counted twice it weighted that relation double,
+and its two errors differ (the translation error of ``inv(d)`` against
+``inv(d*)`` is not that of ``d`` against ``d*``), so the metric depended on
+how often the file's author wrote a pair. A reversed line whose motion is
+not the inverse is the same pair with two different motions: an error. No
+published file has such a line.
 """
 
 from __future__ import annotations
@@ -76,6 +87,10 @@ MAX_MOTION_M = 1e8
 MAX_YAW_RAD = math.pi + 1e-5
 #: Largest accepted |t1|, |t2| (s): Unix seconds until year 5138; nanosecond stamps are refused, not misread.
 MAX_TIMESTAMP_S = 1e11
+#: How far (m per metre of the relation's length, plus this much; and rad) a line giving an earlier relation in the
+#: other direction may be from that relation's inverse and still be the same measurement: the inverse of a motion
+#: printed to 5 decimals misses the printed inverse by about 1e-5 of that, so this is a tenfold margin.
+REVERSE_TOLERANCE = 1e-4
 #: How identical repeated lines are read: ``drop`` counts each relation once (the default), ``keep`` as listed.
 RepeatPolicy = Literal["drop", "keep"]
 REPEAT_POLICIES: tuple[RepeatPolicy, ...] = ("drop", "keep")
@@ -109,6 +124,7 @@ def read_relations(
     rows: list[list[float]] = []
     seen: dict[tuple[float, float], tuple[int, list[float]]] = {}
     repeated: list[str] = []
+    reversed_lines = 0
     for number, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("#"):
@@ -135,6 +151,14 @@ def read_relations(
             repeated.append(f"{number} (= {first})")
             if repeats == "drop":
                 continue
+        elif (values[1], values[0]) in seen:
+            first, kept = seen[(values[1], values[0])]
+            _check_reverse(p, number, first, kept, values)
+            seen[pair] = (number, values)
+            repeated.append(f"{number} (= {first} reversed)")
+            reversed_lines += 1
+            if repeats == "drop":
+                continue
         else:
             seen[pair] = (number, values)
         rows.append(values)
@@ -144,9 +168,10 @@ def read_relations(
         raise ParseError(p, f"no relation: {found}; expected one relation per line ({_FIELDS})")
     if repeated and warn_repeats:
         log.warning(
-            "%s: %d relation line(s) repeat an earlier line identically; %s: line %s",
+            "%s: %d relation line(s) repeat an earlier line %s; %s: line %s",
             p,
             len(repeated),
+            "identically or in the other direction" if reversed_lines else "identically",
             "each relation is counted once"
             if repeats == "drop"
             else "each is counted as listed (relations_repeats=keep)",
@@ -179,6 +204,27 @@ def _noted_repeats(path: Path, line: str) -> tuple[RepeatPolicy, int]:
     if set(fields) != {"relations_repeats", "repeated_lines"} or not count.isdigit():
         raise ParseError(path, f"{line!r}; expected '{_REPEATS_NOTE}drop|keep repeated_lines=N'", line=1)
     return repeat_policy(fields["relations_repeats"], f"{path}:1"), int(count)
+
+
+def _check_reverse(path: Path, number: int, first: int, kept: list[float], values: list[float]) -> None:
+    """ParseError unless line ``number`` (``values``) is the inverse of line ``first``'s relation (``kept``).
+
+    Both motions composed must give no motion, to :data:`REVERSE_TOLERANCE` (the rounding of printed decimals).
+    """
+    x, y, yaw = kept[2], kept[3], kept[7]
+    c, s = math.cos(yaw), math.sin(yaw)
+    # kept * values: the pose of t1 (of line `first`) seen from itself after going to t2 and back
+    dx, dy = x + c * values[2] - s * values[3], y + s * values[2] + c * values[3]
+    turn = math.remainder(yaw + values[7], math.tau)
+    if math.hypot(dx, dy) <= REVERSE_TOLERANCE * (1.0 + math.hypot(x, y)) and abs(turn) <= REVERSE_TOLERANCE:
+        return
+    raise ParseError(
+        path,
+        f"the relation t1={kept[0]!r} t2={kept[1]!r} of line {first} is listed again in the other direction with "
+        f"a motion that is not its inverse (composed they move {math.hypot(dx, dy):.6g} m and "
+        f"{math.degrees(turn):.6g} deg); expected each relation once, or its exact inverse",
+        line=number,
+    )
 
 
 def _check_row(path: Path, number: int, values: list[float]) -> None:

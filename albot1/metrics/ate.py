@@ -91,8 +91,14 @@ def windowed_ate(
     50 m of the map sees, and is far less sensitive to one event. Window
     ``k`` holds the scans from the first at or beyond ``k * window_m`` of
     reference travel up to the first at or beyond ``(k + 1) * window_m``;
-    the tail shorter than a window is left out (``uncovered_m``). At least
-    two windows are needed (a MetricsError otherwise).
+    the tail shorter than a window is left out (``uncovered_m``). A window
+    that no scan falls in (one reference step longer than the window jumps
+    over it: a gap in a sparse reference file) is left out and counted
+    (``windows_without_scan``): it used to be scored on the one scan that
+    ends it, which its own alignment puts on the reference exactly, an
+    RMSE of 0 by construction pulling the mean down. At least two windows
+    holding scans are needed (a MetricsError otherwise); ``windows`` counts
+    those scored.
     """
     est, ref = check_pair(estimate, reference, "windowed ATE")
     if not window_m > 0:
@@ -108,13 +114,21 @@ def windowed_ate(
     windows: list[dict[str, Any]] = []
     for k in range(count):
         first, last = int(bounds[k]), int(bounds[k + 1])
+        if first == last:  # no scan in this window: its "error" would be one pose aligned onto itself
+            continue
         s = summarize(position_errors(est[first : last + 1], ref[first : last + 1], alignment), ddof=0)
         windows.append({"first_scan": first, "last_scan": last, "rmse_m": s["rmse"], "max_m": s["max"]})
+    if len(windows) < 2:
+        raise MetricsError(
+            f"windowed ATE: {len(windows)} of the route's {count} {window_m:g} m windows hold a scan (the reference "
+            "steps over the others); expected at least two"
+        )
     rmse = [w["rmse_m"] for w in windows]
     return {
         "alignment": f"{alignment}, each window on its own",
         "window_m": window_m,
-        "windows": count,
+        "windows": len(windows),
+        "windows_without_scan": count - len(windows),
         "uncovered_m": total - count * window_m,
         "units": {"translation": "m"},
         "mean_rmse_m": float(np.mean(rmse)),

@@ -16,7 +16,14 @@ Two forms, both alignment-free (they compare relative poses):
     :data:`RADIUS_M` of each other although more than :data:`MIN_DT_S`
     seconds and :data:`MIN_TRAVEL_M` metres of reference path apart (the
     travel bound keeps a robot standing still from counting as a loop; the
-    time bound matches the relation metric's loop relations). For each later
+    time bound matches the relation metric's loop relations). Two scans
+    that share a stamp are not held to the time bound: the log gives them no
+    time to judge by (the corrected Radish logs belgioioso, freiburg-campus
+    and orebro stamp every scan 0, csail and infinite-corridor nearly all one
+    value), so the travel bound alone decides, and the block counts them
+    (``pairs_same_stamp``). They used to fail it (a difference of 0 s), and
+    those logs read "pairs: 0" though their routes revisit places (belgioioso
+    12 pairs, orebro 11, csail 59 instead of 12). For each later
     scan only its nearest qualifying earlier scan is kept, so a revisited
     corridor contributes one pair per scan, not a quadratic number.
 """
@@ -86,7 +93,8 @@ def loop_pairs(
         return np.empty((0, 2), dtype=np.int64)
     pairs = np.sort(pairs, axis=1)
     i, j = pairs[:, 0], pairs[:, 1]
-    keep = (np.abs(t[j] - t[i]) > min_dt_s) & (travel[j] - travel[i] > min_travel_m)
+    # a shared stamp says nothing of the time between two scans metres apart: only the travel bound applies
+    keep = ((np.abs(t[j] - t[i]) > min_dt_s) | (t[j] == t[i])) & (travel[j] - travel[i] > min_travel_m)
     i, j = i[keep], j[keep]
     if len(i) == 0:
         return np.empty((0, 2), dtype=np.int64)
@@ -101,12 +109,14 @@ def loop_pairs(
 def pair_gaps(timestamps: ArrayLike, estimate: ArrayLike, reference: ArrayLike, **rule: float) -> dict[str, Any]:
     """Errors of the estimated relative pose over every revisit pair (m, deg)."""
     est, ref = check_pair(estimate, reference, "loop pairs")
-    pairs = loop_pairs(timestamps, ref, **rule)
+    t = np.asarray(timestamps, dtype=float)
+    pairs = loop_pairs(t, ref, **rule)
     block: dict[str, Any] = {
         "radius_m": rule.get("radius_m", RADIUS_M),
         "min_dt_s": rule.get("min_dt_s", MIN_DT_S),
         "min_travel_m": rule.get("min_travel_m", MIN_TRAVEL_M),
         "pairs": int(len(pairs)),
+        "pairs_same_stamp": int(np.count_nonzero(t[pairs[:, 0]] == t[pairs[:, 1]])),
     }
     if len(pairs) == 0:
         block.update({"translation_m": None, "rotation_deg": None, "worst_pair": None})

@@ -16,10 +16,16 @@ Its interval is a paired **moving-block bootstrap**: errors along a route are
 correlated (one bad stretch spoils many consecutive scans or relations), so
 each group (a run: one seed) is resampled as blocks of ``1/BLOCKS`` of its
 length, with the same indices for A and B, within the group (the groups are
-strata; their number is kept). :data:`RESAMPLES` resamples from a fixed seed
-make the interval reproducible: the same errors give the same page. A is
-**better** when the whole ``CONFIDENCE`` interval is below 1, **worse** when
-it is above 1, else **indistinguishable**. A comparison with fewer than
+strata; their number is kept), except that runs of a single pair are
+resampled together as one stratum (a run of one pair resampled within itself
+draws that pair every time, so runs of one pair each would give an interval
+of zero width: a certainty the data do not hold). :data:`RESAMPLES`
+resamples from a fixed seed make the interval reproducible: the same errors
+give the same page. A is **better** when the whole ``CONFIDENCE`` interval is
+below 1, **worse** when it is above 1, else **indistinguishable**; an
+interval within :data:`RATIO_TIE` of 1 is a tie (rounding, not a difference),
+and a ratio is printed with the digits that show which side of 1 its
+interval lies on (``1.0004 [1.0003–1.0005]``, never ``worse 1 [1–1]``). A comparison with fewer than
 :data:`MIN_PAIRS` pairs, or where B's error is zero, does not apply and says
 why (a bootstrap over a handful of values claims more than it knows). Nor
 does one whose interval is unbounded: when B's errors are zero on nearly
@@ -50,6 +56,12 @@ MIN_PAIRS: Final = 10
 #: a pooled error below this (m or deg) is zero: a perfect reference (e.g. the reference poses given as odometry),
 #: to which a ratio is numerical noise
 ZERO_ERROR: Final = 1e-6
+#: an interval within this relative distance of 1 is a tie (indistinguishable): the float rounding of the errors
+#: (a 1 mm error computed from poses 1e6 m from the origin is rounded by ~1e-7 of itself) moves a ratio of two
+#: methods with the same poses this far; the report's check that errors reproduce uses the same 1e-6
+RATIO_TIE: Final = 1e-6
+#: significant digits of a ratio on the pages (more where they are needed to show the interval's side of 1)
+DIGITS: Final = 3
 #: resamples whose indices are built at once (memory: CHUNK x the longest group's length)
 CHUNK: Final = 250
 
@@ -118,14 +130,17 @@ class Comparison:
         )
 
     def text(self) -> str:
-        """``0.42 [0.38–0.47]`` (3 significant digits), or ``n/a`` with the reason."""
+        """``0.42 [0.38–0.47]`` (3 significant digits, more where :func:`ratio_digits` needs them), or ``n/a``."""
         if not self.applies:
             return f"n/a ({self.reason})"
-        return f"{_g(self.ratio)} [{_g(self.low)}–{_g(self.high)}]"
+        digits = ratio_digits(self.low, self.high)
+        return f"{ratio_text(self.ratio, digits)} [{ratio_text(self.low, digits)}–{ratio_text(self.high, digits)}]"
 
     def short(self) -> str:
         """``< 0.42``: the verdict's symbol and the ratio (a matrix cell); ``–`` when it does not apply."""
-        return SYMBOL[NOT_APPLICABLE] if not self.applies else f"{SYMBOL[self.verdict]} {_g(self.ratio)}"
+        if not self.applies:
+            return SYMBOL[NOT_APPLICABLE]
+        return f"{SYMBOL[self.verdict]} {ratio_text(self.ratio, ratio_digits(self.low, self.high))}"
 
 
 def _reciprocal(value: float) -> float:
@@ -133,9 +148,31 @@ def _reciprocal(value: float) -> float:
     return value if math.isnan(value) else 1.0 / value
 
 
-def _g(value: float) -> str:
-    """3 significant digits; ``n/a`` for a value that is not a number (never printed as ``nan`` or ``inf``)."""
-    return f"{value:.3g}" if math.isfinite(value) else "n/a"
+def ratio_text(value: float, digits: int = DIGITS) -> str:
+    """``digits`` significant digits; ``n/a`` for a value that is not a number (never printed as ``nan`` or ``inf``)."""
+    return f"{value:.{digits}g}" if math.isfinite(value) else "n/a"
+
+
+def ratio_digits(low: float, high: float) -> int:
+    """The significant digits (:data:`DIGITS` or more) with which an interval's printed ends keep its side of 1.
+
+    Why: at 3 digits an interval of 1.0003 to 1.0005 prints as ``1 [1–1]`` beside the verdict "worse", which
+    reads as a contradiction (or as a tie called a difference). An interval that is entirely above or below 1
+    (beyond :data:`RATIO_TIE`, as :func:`verdict` reads it) gets the digits that print its nearer end on its
+    side of 1; any other keeps :data:`DIGITS`.
+    """
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return DIGITS
+    if low > 1.0 + RATIO_TIE:
+        end, side = low, 1.0
+    elif high < 1.0 - RATIO_TIE:
+        end, side = high, -1.0
+    else:
+        return DIGITS
+    digits = DIGITS
+    while digits < 17 and (float(f"{end:.{digits}g}") - 1.0) * side <= 0:
+        digits += 1
+    return digits
 
 
 def method_text(resamples: int = RESAMPLES) -> str:
@@ -196,9 +233,10 @@ def bootstrap_ratio(
 ) -> tuple[float, float, float]:
     """``(ratio, low, high)``: the pooled error ratio of A to B and its paired moving-block bootstrap interval.
 
-    ``pairs``: per group (a run), A's and B's errors at the same scans or relations, in route order.
+    ``pairs``: per group (a run), A's and B's errors at the same scans or relations, in route order. The
+    groups are resampled as :func:`strata` makes them.
     """
-    powered = [(np.asarray(a, dtype=float) ** power, np.asarray(b, dtype=float) ** power) for a, b in pairs]
+    powered = [(np.asarray(a, dtype=float) ** power, np.asarray(b, dtype=float) ** power) for a, b in strata(pairs)]
     ratio = _pooled(sum(float(np.sum(a)) for a, _ in powered), sum(float(np.sum(b)) for _, b in powered), power)
     shapes = tuple(_shape(len(a)) for a, _ in powered)
     starts = _block_starts(shapes, resamples, seed)
@@ -222,11 +260,32 @@ def bootstrap_ratio(
     return ratio, float(low), float(high)
 
 
+def strata(pairs: Sequence[Pair]) -> list[Pair]:
+    """The groups the bootstrap resamples within: each run on its own, the runs of a single pair pooled into one.
+
+    A run of one pair resampled within itself draws that pair in every resample, so runs of one pair each
+    (a short slice covering one relation per seed) would leave every resample the same and the interval of
+    zero width: ``worse 1.17 [1.17–1.17]`` from a dozen noisy pairs. The runs are independent of each other,
+    so their single pairs are one stratum, resampled together, in the place of the first of them. With fewer
+    than two such runs nothing changes: the same strata, the same draws, the same numbers.
+    """
+    single = [k for k, (a, _) in enumerate(pairs) if np.asarray(a).size == 1]
+    if len(single) < 2:
+        return list(pairs)
+    pooled: Pair = (
+        np.concatenate([np.asarray(pairs[k][0], dtype=float).ravel() for k in single]),
+        np.concatenate([np.asarray(pairs[k][1], dtype=float).ravel() for k in single]),
+    )
+    others = set(single[1:])
+    return [pooled if k == single[0] else pair for k, pair in enumerate(pairs) if k not in others]
+
+
 def verdict(low: float, high: float) -> str:
-    """better / worse / indistinguishable from the interval of A's error ratio to B's."""
-    if low > 1.0:
+    """better / worse / indistinguishable from the interval of A's error ratio to B's (within :data:`RATIO_TIE`
+    of 1 on either side: a tie, since rounding alone moves the ratio of two equal methods that far)."""
+    if low > 1.0 + RATIO_TIE:
         return WORSE
-    if high < 1.0:
+    if high < 1.0 - RATIO_TIE:
         return BETTER
     return SAME
 

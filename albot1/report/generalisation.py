@@ -23,7 +23,11 @@ comparison does not apply (fewer than :data:`~albot1.metrics.paired.MIN_PAIRS`
 scans, an unbounded interval) the cell says ``n/a`` and why, and a ratio to
 perfect odometry is never formed (``perfect odometry``). RPE@10 m and
 the loop gap are shown beside the odometry method's own cell of the same
-dataset, degradation and seed (when the suite ran it).
+dataset, degradation and seed (when the suite ran it): both as means over
+the seeds where both have the number, so the ratio beside them compares the
+same seeds (a seed whose odometry cell failed used to stay in the method's
+mean and out of the odometry's); without an odometry number on any seed,
+the method's mean over its own seeds and ``n/a``.
 """
 
 from __future__ import annotations
@@ -42,7 +46,18 @@ from albot1.atomic import atomic_write
 from albot1.bench.grid import GridPlan
 from albot1.metrics.ate import position_errors
 from albot1.metrics.measures.ate import METRIC as ATE
-from albot1.metrics.paired import BLOCKS, CONFIDENCE, NOT_APPLICABLE, RESAMPLES, ZERO_ERROR, compare
+from albot1.metrics.paired import (
+    BLOCKS,
+    CONFIDENCE,
+    DIGITS,
+    NOT_APPLICABLE,
+    RATIO_TIE,
+    RESAMPLES,
+    ZERO_ERROR,
+    compare,
+    ratio_digits,
+    ratio_text,
+)
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import regenerate_command
@@ -103,6 +118,16 @@ def _mean(values: list[float | None]) -> float | None:
     return sum(present) / len(present) if present else None
 
 
+def _paired_means(mine: list[float | None], theirs: list[float | None]) -> tuple[float | None, float | None]:
+    """The method's and the odometry's means over the seeds where both have a number (``mine[k]`` and
+    ``theirs[k]``: seed k), so that their ratio compares the same seeds; where no seed has both, the method's
+    mean over its own seeds and None."""
+    both = [(m, o) for m, o in zip(mine, theirs, strict=True) if m is not None and o is not None]
+    if not both:
+        return _mean(mine), None
+    return _mean([m for m, _ in both]), _mean([o for _, o in both])
+
+
 def comparisons(records: list[CellRecord]) -> list[Comparison]:
     """A :class:`Comparison` per (dataset, method, degradation) with at least one scored run, in plan order."""
     rpe, gap = METRIC_COLUMNS["drift_10m_m"], METRIC_COLUMNS["loop_gap_m"]
@@ -125,6 +150,10 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
         # perfect odometry first: its table shows the method's ATE whatever the number of scans
         paired = compare(pairs) if odometry_ate >= PERFECT_M else None
         odo = [odometry_cells.get((dataset, degradation, rec.cell.seed)) for rec, _ in scored]
+        rpe10 = _paired_means([rpe.value(rec) for rec, _ in scored], [None if o is None else rpe.value(o) for o in odo])
+        loop_gap = _paired_means(
+            [gap.value(rec) for rec, _ in scored], [None if o is None else gap.value(o) for o in odo]
+        )
         out.append(
             Comparison(
                 dataset=dataset,
@@ -138,10 +167,10 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
                 ratio_low=math.nan if paired is None else paired.low,
                 ratio_high=math.nan if paired is None else paired.high,
                 verdict=PERFECT if paired is None else paired.verdict,
-                rpe10_m=_mean([rpe.value(rec) for rec, _ in scored]),
-                odometry_rpe10_m=_mean([rpe.value(o) for o in odo if o is not None]),
-                loop_gap_m=_mean([gap.value(rec) for rec, _ in scored]),
-                odometry_loop_gap_m=_mean([gap.value(o) for o in odo if o is not None]),
+                rpe10_m=rpe10[0],
+                odometry_rpe10_m=rpe10[1],
+                loop_gap_m=loop_gap[0],
+                odometry_loop_gap_m=loop_gap[1],
                 held_in=held_in(scored[0][0].cell),
                 reason=None if paired is None else paired.reason,
             )
@@ -158,14 +187,15 @@ def _num(value: float | None, digits: int = 3) -> str:
     return NA if value is None or not math.isfinite(value) else f"{value:.{digits}f}"
 
 
-def _ratio(value: float) -> str:
-    return NA if not math.isfinite(value) else f"{value:.3g}"
+def _ratio(value: float, digits: int = DIGITS) -> str:
+    return NA if not math.isfinite(value) else ratio_text(value, digits)
 
 
 def _interval(row: Comparison) -> str:
     if row.verdict in (PERFECT, NOT_APPLICABLE):
         return NA
-    return f"{_ratio(row.ratio)} [{_ratio(row.ratio_low)}–{_ratio(row.ratio_high)}]"
+    digits = ratio_digits(row.ratio_low, row.ratio_high)  # enough to show the interval's side of 1
+    return f"{_ratio(row.ratio, digits)} [{_ratio(row.ratio_low, digits)}–{_ratio(row.ratio_high, digits)}]"
 
 
 def _verdict(row: Comparison) -> str:
@@ -223,7 +253,8 @@ def render_page(
         f"ratio (< 1: the method improved on its odometry) with a {pct} paired moving-block bootstrap interval over "
         f"scans ({RESAMPLES} resamples, blocks of 1/{BLOCKS} of a run, the same scans for both); **worse** / "
         f"**better** when the whole interval is above / below 1, else *indistinguishable*. RPE@10 m and loop gap: "
-        "the method's / the odometry method's cell of the same data and seeds (ratio in brackets). Method: "
+        "the method's / the odometry method's cell of the same data, means over the seeds both have (ratio in "
+        "brackets). Method: "
         "`albot1/report/generalisation.py`.",
         "",
         LEGEND,
@@ -239,15 +270,20 @@ def render_page(
         lines += ["|---|---|---|---:|---:|---:|---:|---|"]
         lines += [
             f"| {marked(r.method, r.held_in)} | {r.dataset} | {r.degradation} | {_seeds(r)} | {_num(r.ate_m)} | "
-            f"{_num(r.odometry_ate_m)} | {_ratio(r.ratio)} | {_ratio(r.ratio_low)}–{_ratio(r.ratio_high)} |"
+            f"{_num(r.odometry_ate_m)} | {_ratio(r.ratio, d)} | {_ratio(r.ratio_low, d)}–{_ratio(r.ratio_high, d)} |"
             for r in worse
+            for d in (ratio_digits(r.ratio_low, r.ratio_high),)
         ]
     else:
         lines.append(f"Nowhere at {pct} confidence.")
-    above = [r for r in rows if r.verdict == "indistinguishable" and r.ratio > 1.0]
+    # above 1 by more than rounding, each with the digits that show it above 1 (1.0004 read "1" at 3 digits)
+    above = [r for r in rows if r.verdict == "indistinguishable" and r.ratio > 1.0 + RATIO_TIE]
     lines += _listing(
         "Ratio above 1 but not significantly",
-        [f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio)}" for r in above],
+        [
+            f"{r.method} on {r.dataset} ({r.degradation}) {_ratio(r.ratio, ratio_digits(r.ratio, r.ratio))}"
+            for r in above
+        ],
     )
     lines += [
         "",

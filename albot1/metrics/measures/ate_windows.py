@@ -31,11 +31,16 @@ class AteWindow(Record):
 
 
 class AteWindowsBlock(Record):
-    """``ate_windows``: ATE of consecutive windows of ``window_m`` reference travel, each aligned on its own."""
+    """``ate_windows``: ATE of consecutive windows of ``window_m`` reference travel, each aligned on its own.
+
+    ``windows``: the windows scored; ``windows_without_scan``: those no scan falls in, left out (absent from
+    files written before they were).
+    """
 
     alignment: str
     window_m: NonNegative
     windows: Count
+    windows_without_scan: Count | None = None
     uncovered_m: float  # may be -1e-9 m: the window count tolerates rounding (albot1.metrics.ate.windowed_ate)
     units: dict[str, str]
     mean_rmse_m: NonNegative

@@ -39,7 +39,8 @@ class WorstPair(Record):
 class LoopGapBlock(Record):
     """``loop_gap`` with reference poses: the route gap and every revisit pair.
 
-    With ``pairs: 0`` the pair statistics and ``worst_pair`` are null.
+    With ``pairs: 0`` the pair statistics and ``worst_pair`` are null. ``pairs_same_stamp``: the pairs whose two
+    scans share a stamp, held to the travel bound alone (absent from files written before it was counted).
     """
 
     units: dict[str, str]
@@ -52,6 +53,7 @@ class LoopGapBlock(Record):
     translation_m: Stats | None
     rotation_deg: Stats | None
     worst_pair: WorstPair | None
+    pairs_same_stamp: Count | None = None
 
 
 class ClosedRouteGapBlock(Record):

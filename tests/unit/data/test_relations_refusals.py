@@ -128,3 +128,37 @@ def test_a_yaw_of_pi_as_printed_is_read(tmp_path: Path, yaw: str) -> None:
     path = tmp_path / "r.relations"
     path.write_text(f"0 0.2 1 0 0 0 0 {yaw}\n")
     assert read_relations(path).poses[0, 2] == float(yaw)
+
+
+# line 3 gives line 1's relation (a 90 deg left turn ending 2 m ahead, 1 m left) from t2 back to t1: its inverse
+_BOTH_WAYS = "0 0.2 2 1 0 0 0 1.5707963\n0.2 0.4 1 0 0 0 0 0\n0.2 0 -1 2 0 0 0 -1.5707963\n"
+
+
+def test_a_relation_given_in_both_directions_is_one_relation_counted_as_repeats_are(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Both directions were read as two relations: that pair weighted double, with two different translation errors
+    (the error of inv(d) against inv(d*) is not that of d against d*), whichever way the file's author wrote it."""
+    path = tmp_path / "r.relations"
+    path.write_text(_BOTH_WAYS)
+    with caplog.at_level(logging.WARNING):
+        relations = read_relations(path)
+    assert len(relations) == 2 and relations.repeats == 1 and not relations.repeats_counted
+    assert relations.t1.tolist() == [0.0, 0.2] and relations.t2.tolist() == [0.2, 0.4]
+    assert "1 relation line(s) repeat an earlier line identically or in the other direction" in caplog.text
+    assert "line 3 (= 1 reversed)" in caplog.text
+    kept = read_relations(path, repeats="keep", warn_repeats=False)  # the published evaluator's reading: as listed
+    assert len(kept) == 3 and kept.repeats == 1 and kept.repeats_counted
+
+
+def test_a_relation_given_in_both_directions_with_motions_that_disagree_is_refused_with_the_line(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "r.relations"
+    path.write_text(_BOTH_WAYS.replace("0.2 0 -1 2", "0.2 0 -1 2.5"))
+    with pytest.raises(DataError) as caught:
+        read_relations(path)
+    assert str(caught.value).startswith(
+        f"{path}:3: the relation t1=0.0 t2=0.2 of line 1 is listed again in the other direction with a motion that "
+        "is not its inverse (composed they move 0.5 m"
+    )

@@ -109,3 +109,21 @@ def test_fewer_than_two_windows_is_an_error() -> None:
     ref = straight(79, 1.0)
     with pytest.raises(MetricsError, match=r"route \(79.0 m of reference travel\) is shorter than two 50 m windows"):
         windowed_ate(ref, ref)
+
+
+def test_a_window_no_scan_falls_in_is_left_out_not_scored_zero() -> None:
+    """A reference with a 100 m gap (a sparse reference file): the two windows inside the gap held one scan each,
+    which its own alignment put on the reference exactly, an RMSE of 0 by construction: the mean fell from 0.70 m
+    (the one window that holds scans) to 0.23 m."""
+    travel = np.r_[np.arange(50.0), 149.0 + np.arange(1.0, 40.0)]  # 0..49 m, then a jump to 150 m, on to 188 m
+    ref = np.column_stack([travel, np.zeros(len(travel)), np.zeros(len(travel))])
+    est = ref + np.column_stack([np.zeros(len(travel)), np.sin(np.arange(len(travel))), np.zeros(len(travel))])
+    with pytest.raises(MetricsError, match=r"1 of the route's 3 50 m windows hold a scan .*; expected at least two"):
+        windowed_ate(est, ref)
+    longer = np.r_[travel, 188.0 + np.arange(1.0, 60.0)]  # on to 247 m: windows 0-50 and 150-200 hold scans
+    ref = np.column_stack([longer, np.zeros(len(longer)), np.zeros(len(longer))])
+    est = ref + np.column_stack([np.zeros(len(longer)), np.sin(np.arange(len(longer))), np.zeros(len(longer))])
+    block = windowed_ate(est, ref)
+    assert (block["windows"], block["windows_without_scan"]) == (2, 2)
+    assert [(w["first_scan"], w["last_scan"]) for w in block["per_window"]] == [(0, 50), (50, 100)]
+    assert all(w["rmse_m"] > 0.5 for w in block["per_window"]) and block["window_rmse"]["min_m"] > 0.5

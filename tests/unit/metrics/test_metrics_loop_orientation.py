@@ -86,6 +86,25 @@ def test_revisits_need_time_and_travel() -> None:
     assert len(loop_pairs(np.arange(len(ref)) * 0.5, ref)) == 0  # 20 s round trip: not > 30 s
     parked = np.zeros((50, 3))
     assert len(loop_pairs(np.arange(50) * 10.0, parked)) == 0  # standing still is not a loop
+    assert len(loop_pairs(np.zeros(50), parked)) == 0  # nor without a clock
+
+
+def test_a_log_that_stamps_every_scan_alike_has_its_revisits_judged_by_travel_alone() -> None:
+    """belgioioso-, freiburg-campus- and orebro-corrected stamp every scan 0: the time bound (0 s apart, not > 30 s)
+    dropped every revisit, and the block said "pairs: 0" on routes that return (belgioioso 12 pairs, orebro 11)."""
+    ref = square()
+    est = ref.copy()
+    est[-1, :2] += [0.3, -0.4]
+    clocked = pair_gaps(np.arange(len(ref)) * 5.0, est, ref)
+    unclocked = pair_gaps(np.zeros(len(ref)), est, ref)
+    assert unclocked["pairs"] == 1 and unclocked["translation_m"] is not None
+    assert (clocked["pairs"], clocked["pairs_same_stamp"]) == (1, 0)
+    assert (unclocked["pairs"], unclocked["pairs_same_stamp"]) == (1, 1)
+    assert unclocked["worst_pair"] == clocked["worst_pair"] == {"scans": [0, 40], "gap_m": pytest.approx(0.5)}
+    # a clock on part of the log (csail: two stamps for 406 scans): a pair across two stamps keeps the time bound
+    two = np.where(np.arange(len(ref)) < 20, 0.0, 10.0)
+    assert loop_pairs(two, ref).tolist() == []  # 10 s apart: not > 30 s
+    assert loop_pairs(np.where(np.arange(len(ref)) < 20, 0.0, 100.0), ref).tolist() == [[0, 40]]
 
 
 def test_table_3_1_rows_for_a_wrong_first_turn() -> None:

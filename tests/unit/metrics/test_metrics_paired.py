@@ -12,12 +12,15 @@ from albot1.metrics.paired import (
     MIN_PAIRS,
     NOT_APPLICABLE,
     PERFECT_REFERENCE,
+    RATIO_TIE,
     SAME,
     UNBOUNDED,
     WORSE,
     bootstrap_ratio,
     compare,
     method_text,
+    ratio_digits,
+    strata,
     verdict,
 )
 
@@ -176,3 +179,42 @@ def test_a_mirror_swaps_the_pooled_errors_and_keeps_the_evidence() -> None:
     assert (found.error_a, found.error_b) == (math.sqrt(np.mean(a * a)), math.sqrt(np.mean(b * b)))
     assert (back.error_a, back.error_b) == (found.error_b, found.error_a)
     assert (back.ratio, back.low, back.high, back.verdict) == (1 / found.ratio, 1 / found.high, 1 / found.low, WORSE)
+
+
+def test_runs_of_one_pair_each_are_resampled_together_not_given_an_interval_of_zero_width() -> None:
+    """A dozen seeds of one relation each (a short slice): each run resampled within itself drew its one pair in
+    every resample, so the interval had zero width and noise was called a difference (``worse 1.17 [1.17–1.17]``).
+    The runs are independent: their pairs are one stratum, and the interval is that of the twelve pairs pooled."""
+    rng = np.random.default_rng(0)
+    a, b = rng.uniform(0.0, 1.0, 12), rng.uniform(0.0, 1.0, 12)
+    runs = compare([(a[k : k + 1], b[k : k + 1]) for k in range(12)], power=1)
+    pooled = compare([(a, b)], power=1)
+    assert runs.low < runs.ratio < runs.high and runs.verdict == SAME
+    assert (runs.ratio, runs.low, runs.high, runs.verdict) == (pooled.ratio, pooled.low, pooled.high, SAME)
+    assert (runs.pairs, runs.groups) == (12, 12)  # the page still counts the runs the pairs come from
+    # runs of several pairs keep their strata: with one run of one pair beside them, the same numbers as before
+    long = [(rng.gamma(2.0, 0.3, 40), rng.gamma(2.0, 0.3, 40)) for _ in range(2)]
+    one = (np.array([0.3]), np.array([0.4]))
+    assert strata([*long, one]) == [*long, one]
+    merged = strata([long[0], one, long[1], one])
+    assert len(merged) == 3 and merged[0] is long[0] and merged[2] is long[1]
+    assert merged[1][0].tolist() == [0.3, 0.3] and merged[1][1].tolist() == [0.4, 0.4]
+
+
+def test_a_ratio_within_rounding_of_one_is_a_tie_and_a_verdict_prints_the_side_of_one_it_is_on() -> None:
+    """``worse 1 [1–1]``: a 0.04 % difference printed at 3 digits read as a tie called worse, and errors equal
+    but for float rounding (1e-12 apart) were called worse: a verdict from the last bit."""
+    b = np.random.default_rng(0).uniform(0.1, 1.0, 200)
+    noise = compare([(b + 1e-12, b)])
+    assert noise.verdict == SAME and noise.text() == "1 [1–1]"
+    assert verdict(1.0 + RATIO_TIE / 2, 1.0 + RATIO_TIE) == SAME
+    assert verdict(1.0 - 2 * RATIO_TIE, 1.0 - 1.5 * RATIO_TIE) == BETTER
+    slightly = compare([(b * 1.0004, b)])
+    assert slightly.verdict == WORSE
+    assert slightly.text() == "1.0004 [1.0004–1.0004]" and slightly.short() == "> 1.0004"
+    back = slightly.mirrored()
+    assert back.verdict == BETTER and back.text() == "0.9996 [0.9996–0.9996]"
+    close = compare([(b * (1 - 3e-6), b)])
+    assert close.verdict == BETTER and close.text().startswith("0.999997 [")
+    assert ratio_digits(0.8, 1.2) == 3 and ratio_digits(1.2, 1.5) == 3  # an interval that reads well stays at 3
+    assert ratio_digits(0.9, 0.99999) == 5  # 0.99999 at 3 digits rounds up to 1

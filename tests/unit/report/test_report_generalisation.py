@@ -56,6 +56,20 @@ def test_the_page_lists_where_a_method_is_worse_than_its_odometry_with_marks() -
     assert "Nowhere" in render_page(plan, rows[1:])
 
 
+def test_a_worse_ratio_close_to_one_is_printed_with_the_digits_that_show_it_above_one() -> None:
+    """At 3 digits the row read ``1 [1–1]`` beside "worse" (and ``1 | 1–1`` in the worse table): no evidence shown."""
+    plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
+    text = render_page(plan, [_row("kiss-icp", 1.0004, 1.0003, 1.0005, "worse", False)])
+    assert "| 1.0004 [1.0003–1.0005] | worse |" in text
+    assert "| 1.000 | 1.0004 | 1.0003–1.0005 |" in text
+    assert "| 0.2 [0.1–0.3] |" in render_page(plan, [_row("m", 0.2, 0.1, 0.3, "better", False)])
+    # not significantly above 1: listed as such with the digits that show it above 1 (was "kiss-icp ... 1")
+    same = render_page(plan, [_row("kiss-icp", 1.0004, 0.9, 1.1, "indistinguishable", False)])
+    assert "Ratio above 1 but not significantly: kiss-icp on fhw-corrected?odometry=laser-pose (none) 1.0004." in same
+    tie = render_page(plan, [_row("kiss-icp", 1.0000001, 0.9, 1.1, "indistinguishable", False)])
+    assert "Ratio above 1 but not significantly" not in tie  # above 1 by rounding only
+
+
 def test_names_with_markdown_and_html_characters_are_written_as_text_on_every_line_of_the_page() -> None:
     """A ``|`` in a method's name split its row into one more column; ``<b>`` was HTML; ``*x*`` italic."""
     plan = GridPlan("generalisation", None, "", [], [], [], {}, [0], ["none"], {})
@@ -148,3 +162,35 @@ def test_the_csv_leaves_a_missing_ratio_empty_and_says_why(tmp_path: Path) -> No
     assert lines[1] == (
         "fhw-corrected?odometry=laser-pose,gtsam-graph,none,1,0,0.126,0,,,,perfect odometry,0.2,0.1,,2,False,"
     )
+
+
+def _seed_run(tmp_path: Path, method_label: str, seed: int, scale: float) -> CellRecord:
+    """An odometry run on a 20 m straight drive whose odometry is ``scale`` times long, filed as ``method_label``'s
+    cell of ``seed``."""
+    t = np.arange(41, dtype=float)
+    truth = np.column_stack([t * 0.5, np.zeros(41), np.zeros(41)])
+    odometry = np.column_stack([t * 0.5 * scale, np.zeros(41), np.radians(0.5) * t])
+    angles = np.radians(np.linspace(-90.0, 90.0, 181))
+    frames = [
+        Frame(i, Scan(np.full(181, 5.0), angles, 100.0 + t[i], 30.0), odometry[i], reference=truth[i])
+        for i in range(41)
+    ]
+    run_dir = write_run(run_method("odometry", Sequence.from_frames("drive", frames), dataset_name="drive"), tmp_path)
+    evaluate_run(run_dir)
+    cell = Cell("t", "drive", "drive", method_label, method_label, "default", "none", seed, run_dir.name, "v", 1, 1)
+    metrics = read_record(MetricsRecord, run_dir / "metrics.json")
+    return CellRecord(cell, "done", run_dir, read_record(ResultRecord, run_dir / "result.json"), metrics, None)
+
+
+def test_rpe_beside_the_odometry_is_a_mean_over_the_same_seeds(tmp_path: Path) -> None:
+    """The odometry cell of seed 1 failed: its mean was over seed 0 alone and the method's over seeds 0 and 1, so
+    the ratio beside them compared a good seed with a bad one (3.69x here, where the seed both ran gives 1.00x).
+    The loop gap beside its odometry's is paired the same way (one helper)."""
+    method = [_seed_run(tmp_path / f"m{seed}", "kiss-icp", seed, scale) for seed, scale in ((0, 1.1), (1, 1.9))]
+    odometry = _seed_run(tmp_path / "o0", "odometry", 0, 1.1)  # the same drive as the method's seed 0
+    failed = replace(odometry, cell=replace(odometry.cell, seed=1), status="failed", metrics=None)
+    (row,) = comparisons([*method, odometry, failed])
+    assert row.seeds == 2
+    assert row.rpe10_m is not None and row.rpe10_m == pytest.approx(row.odometry_rpe10_m)
+    (alone,) = comparisons(method)  # no odometry cell: the method's mean over its own seeds, the odometry's n/a
+    assert alone.odometry_rpe10_m is None and alone.rpe10_m is not None and alone.rpe10_m > row.rpe10_m
