@@ -98,6 +98,10 @@ class GtsamGraphConfig(MethodConfig):
         "once the variance can be learnt, the first ones too (odometry_trust.OdometryFactors)"
     )
     odometry_trust_translation: bool = Field(description="... in translation too (else: the heading alone)")
+    odometry_trust_translation_follows_heading: bool = Field(
+        description="... the translation trusted wherever the heading is, at its earned variance, and each step gated "
+        "on its heading alone (odometry_trust.OdometryTrust._estimate; needs odometry_trust_translation)"
+    )
     odometry_trust_window: int = Field(ge=2, description="... learnt from this many recent matched node steps")
     odometry_trust_bias_z: float = Field(
         gt=0, description="... a component whose median disagreement is this many standard errors from 0 is not fused"
@@ -328,6 +332,11 @@ class GtsamGraphConfig(MethodConfig):
             raise ValueError(
                 "odometry_trust_run_nodes needs odometry_trust = true and odometry_trust_factors = true: without them "
                 "it does nothing"
+            )
+        if self.odometry_trust_translation_follows_heading and not self.odometry_trust_translation:
+            raise ValueError(
+                "odometry_trust_translation_follows_heading needs odometry_trust_translation = true: without it it "
+                "does nothing"
             )
         if self.odometry_trust_run_nodes == 1:
             raise ValueError("odometry_trust_run_nodes = 1 would repeat the per-step factors: use 0 (off) or 2 or more")

@@ -86,6 +86,7 @@ class FrontEnd:
             config.odometry_trust_kind_min_steps,
             math.radians(config.odometry_trust_floor_turn_deg),
             config.odometry_trust_turn_scale,
+            config.odometry_trust_translation_follows_heading,
         )
         self._odometry_factors = (
             EarnedFactors(self._odometry_trust, config.odometry_trust_earned_level, counters)

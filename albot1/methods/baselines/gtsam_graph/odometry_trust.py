@@ -60,6 +60,18 @@ fusion is gated: when the odometry step and the match disagree by more than
 their joint covariance allows (Mahalanobis distance squared above
 ``gate_chi2``), one of them is an outlier and the match stands, as before.
 
+Also optional (``translation_follows_heading``, off in the default preset): the
+translation trusted wherever the heading is, at the variance its innovations
+earn (never below the floor), without comparing it with the match's claim, and
+each step gated on its heading alone. The match's claimed translation variance
+is the floor (``match_sigma_floor_xy_m``, ICP's own is far smaller), and with
+perfect odometry its real errors are 1.5-2.3x that in variance on
+edmonton-corrected and infinite-corridor-corrected (the heading's claim holds:
+0.56-0.68), so covariance matching blames the odometry for the match's excess
+and a perfect odometry's translation is never, or only now and then, trusted;
+the heading, whose claim is calibrated, decides instead (docs/baselines.md,
+gtsam-graph, "where the error with perfect odometry comes from").
+
 Optionally (``turn_rad``, off in the default preset) turns and straight
 steps are learnt apart (:meth:`OdometryTrust.kind`): a step is then judged
 with the larger of the pooled variance and its own kind's, without the
@@ -121,6 +133,7 @@ class OdometryTrust:
         kind_min_steps: int = 10,
         floor_turn_rad: float = 0.0,
         turn_scale: bool = False,
+        translation_follows_heading: bool = False,
     ) -> None:
         """``components``: which of x (0), y (1), heading (2) may be fused at all; ``bias_horizon``: the number of
         steps over which a median disagreement too small for the bias test is counted as accumulating (0: not);
@@ -128,7 +141,10 @@ class OdometryTrust:
         steps whose odometry turns more than this are learnt and judged apart from the others (:meth:`kind`;
         ``inf``: one population); ``floor_turn_rad``: the floor holds only for steps whose odometry turns at least
         this much (0: every step; :meth:`floor_ratio`); ``turn_scale``: a heading scale error learnt from every
-        step (:class:`.odometry_scale.TurnScale`) adds to each step's heading variance in proportion to its turn."""
+        step (:class:`.odometry_scale.TurnScale`) adds to each step's heading variance in proportion to its turn;
+        ``translation_follows_heading``: x and y are trusted wherever the heading is (:meth:`_estimate`) and a step is
+        gated on its heading alone (:meth:`gated_variances`)."""
+        self.translation_follows_heading = translation_follows_heading
         self.scale = TurnScale(bias_z, bias_horizon) if turn_scale else None
         self.floor_turn_rad = floor_turn_rad
         self._pooled: deque[FloatArray] = deque(maxlen=window)
@@ -218,9 +234,12 @@ class OdometryTrust:
             variance += self.bias_horizon * squared_bias(float(centre[k]), float(spread[k]), n)
             if k == 2:
                 variance += scale
-            if variance < float(match_variances[k]):
-                # the odometry is the better of the two here (else: the match alone, as tuned)
+            if variance < float(match_variances[k]) or (k < 2 and self.translation_follows_heading):
+                # the odometry is the better of the two here (else: the match alone, as tuned); or a translation
+                # judged by the heading's verdict below, at the variance it earned (never below the floor)
                 out[k] = max(variance, floor * float(match_variances[k]))
+        if self.translation_follows_heading and not math.isfinite(out[2]):
+            out[:2] = np.inf
         return out
 
     def fuse(
@@ -258,6 +277,8 @@ class OdometryTrust:
         if variances is None or not np.isfinite(variances).any():
             return None
         trusted = np.isfinite(variances)
+        if self.translation_follows_heading:
+            trusted = np.array([False, False, True])  # the translation's match claim is not to be judged against
         d = innovation(match_step, odometry_step)[trusted]
         joint = np.asarray(match_covariance, dtype=float)[np.ix_(trusted, trusted)] + np.diag(variances[trusted])
         if float(d @ np.linalg.solve(joint, d)) > self.gate_chi2:
