@@ -219,6 +219,24 @@ def test_robustness_puts_degradations_on_categories_with_the_spread_of_seeds(tmp
     assert "drawn at" in svg and "(clean)" in svg
 
 
+def test_robustness_says_perturbation_not_odometry_degradation_when_a_level_leaves_the_odometry_alone(
+    tmp_path: Path,
+) -> None:
+    """A scan dropout thins the scans and keeps their odometry: the generalisation suite's figures put
+    ``dropout:0.5`` and ``offset:...`` on an axis "odometry degradation (applied to the dataset's odometry ...)"."""
+    records = _records(tmp_path, _world(40.0, 6.0), "loop")
+    table = aggregate(cells_frame(records), METRIC_COLUMNS)
+    colors = method_colors(r.cell.method_label for r in records)
+    plot_robustness(table, "loop", "ate_rmse_m", "ATE RMSE (m)", tmp_path / "odometry.png", colors)
+    svg = (tmp_path / "odometry.svg").read_text()
+    assert "per odometry degradation" in svg and "(applied to the dataset's odometry before" in svg
+    table.loc[table["degradation"] == "bias:0.01:0.5", "degradation"] = "dropout:0.5"
+    plot_robustness(table, "loop", "ate_rmse_m", "ATE RMSE (m)", tmp_path / "dropout.png", colors)
+    svg = (tmp_path / "dropout.svg").read_text()
+    assert ">dropout:0.5<" in svg and "odometry degradation" not in svg
+    assert "per perturbation" in svg and "perturbation (odometry noise, scan dropout; applied to the data" in svg
+
+
 def test_trajectory_error_plots_need_a_reference(tmp_path: Path) -> None:
     sequence = _world(10.0, 0.0, n=12)
     frames = [Frame(f.index, f.scan, f.odometry, None) for f in sequence.frames()]
