@@ -14,6 +14,7 @@ from albot1.geometry import se2
 from albot1.metrics.record import MetricsRecord
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, severity_order
 from albot1.report.cost_plots import plot_scan_time
+from albot1.report.html import CAPTIONS
 from albot1.report.map_plots import occupancy, plot_maps
 from albot1.report.plots import (
     FIXED_COLORS,
@@ -235,6 +236,8 @@ def test_robustness_says_perturbation_not_odometry_degradation_when_a_level_leav
     svg = (tmp_path / "dropout.svg").read_text()
     assert ">dropout:0.5<" in svg and "odometry degradation" not in svg
     assert "per perturbation" in svg and "perturbation (odometry noise, scan dropout; applied to the data" in svg
+    # the page's caption of these figures says so too
+    assert all("scan dropout" in CAPTIONS[f"robustness-{kind}"] for kind in ("ate", "drift", "loop-gap"))
 
 
 def test_trajectory_error_plots_need_a_reference(tmp_path: Path) -> None:
