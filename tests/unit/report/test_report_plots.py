@@ -44,6 +44,16 @@ def test_severity_order_puts_none_first_then_gaussian_by_sigma_then_thesis() -> 
     assert severity_order(levels) == ["none", "gauss:0.05:0.5", "gauss:0.1:1", "gauss:0.2:3", "bias:0.01:0.1", "thesis"]
 
 
+def test_severity_order_ranks_biases_by_size_whatever_their_sign() -> None:
+    """A signed order put ``bias:-0.05:-1`` before ``bias:0.01:0.1``, as if it were the milder one."""
+    assert severity_order(["bias:-0.05:-1", "bias:0.01:0.1", "none", "bias:0.05:1"]) == [
+        "none",
+        "bias:0.01:0.1",
+        "bias:-0.05:-1",
+        "bias:0.05:1",
+    ]
+
+
 def test_slug_makes_dataset_labels_file_safe() -> None:
     assert slug("aces") == "aces" and slug("synthetic-office-loop") == "synthetic-office-loop"
     assert re.fullmatch(r"aces_2500_2-h[0-9a-f]{10}", slug("aces[:2500:2]"))
