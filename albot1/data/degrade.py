@@ -44,6 +44,9 @@ value is per step, not per metre or per second: ``gauss`` and ``thesis``
 move a robot that stands still. A SPEC whose values are all 0 is refused
 (it would repeat the undegraded run under a degraded label), and so is a
 ``bias`` or ``offset`` that only turns by whole turns (``bias:0:720``).
+Each value is taken to the 12 significant digits of the SPEC's one spelling
+(:attr:`Degradation.spec`, what ``albot1 run`` and suites run and key), and
+checked there: ``dropout:0.9999999999999`` is ``dropout:1``, refused.
 
 Otherwise only the odometry changes; scans, reference poses and relations are
 kept. The random stream is a ``numpy.random.default_rng(seed)`` re-created for
@@ -106,10 +109,10 @@ class Degradation:
         if self.kind in ("none", "thesis"):
             return self.kind
         if self.kind == "dropout":
-            return f"dropout:{self.a:.12g}"
+            return f"dropout:{_label(self.a)}"
         if self.kind == "offset":
-            return f"offset:{self.a:.12g}:{self.c:.12g}:{math.degrees(self.b):.12g}"
-        return f"{self.kind}:{self.a:.12g}:{math.degrees(self.b):.12g}"
+            return f"offset:{_label(self.a)}:{_label(self.c)}:{_label(math.degrees(self.b))}"
+        return f"{self.kind}:{_label(self.a)}:{_label(math.degrees(self.b))}"
 
     @property
     def seeded(self) -> bool:
@@ -145,6 +148,11 @@ class Degradation:
                 mount = se2.compose(se2.compose(sensor_offset, mount), se2.inverse(sensor_offset))
             return se2.compose(se2.compose(se2.inverse(mount), np.asarray(step, dtype=float)), mount)
         return np.asarray(step, dtype=float)
+
+
+def _label(value: float) -> str:
+    """A SPEC value as :attr:`Degradation.spec` spells it: 12 significant digits."""
+    return f"{value:.12g}"
 
 
 def _plain_finite(part: str) -> bool:
@@ -191,13 +199,19 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
         raise DegradationSpecError(
             f"degradation {spec!r}: value {bad!r} is not a plain finite number ({_FORM[kind]}); {EXPECTED_SPEC}"
         )
-    values = [float(part) + 0.0 for part in parts]  # + 0.0: -0 is 0 (one spelling, one key)
+    # Each value as the label spells it (+ 0.0: -0 is 0; one spelling, one key): `albot1 run` and suites run, key
+    # and table the label, so the checks below judge the level that runs. `dropout:0.9999999999999` (label
+    # dropout:1) passed here and was refused as 'dropout:1', a SPEC nobody wrote, when the run started.
+    values = [float(_label(float(part))) + 0.0 for part in parts]
+    rounded = any(float(part) != value for part, value in zip(parts, values, strict=True))
+    written, run = ":".join(parts), ":".join(map(_label, values))
+    digits = f", {written} being {run} to the 12 significant digits a level is run with" if rounded else ""
     if kind == "gauss" and min(values) < 0:
         raise DegradationSpecError(f"degradation {spec!r}: sigmas must be >= 0 ({_FORM[kind]}); {EXPECTED_SPEC}")
     if kind == "dropout" and not 0.0 <= values[0] < 1.0:
         raise DegradationSpecError(
-            f"degradation {spec!r}: the dropout probability must be in [0, 1) (the first scan is always kept); "
-            f"{EXPECTED_SPEC}"
+            f"degradation {spec!r}: the dropout probability must be in [0, 1) (the first scan is always kept)"
+            f"{digits}; {EXPECTED_SPEC}"
         )
     if kind == "offset":
         deg = Degradation(kind, values[0], math.radians(values[2]), values[1])
@@ -212,8 +226,8 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
     if not stored and kind in ("bias", "offset") and not (deg.a or deg.c) and math.remainder(turn, 360.0) == 0.0:
         # `bias:0:720` turns every step by two whole turns: the odometry is the undegraded one (to rounding)
         raise DegradationSpecError(
-            f"degradation {spec!r} changes nothing (no translation, and {turn:g} deg is a whole number of turns): "
-            f"its runs would repeat the undegraded run under a degraded label; write none"
+            f"degradation {spec!r} changes nothing (no translation, and {turn:g} deg is a whole number of "
+            f"turns{digits}): its runs would repeat the undegraded run under a degraded label; write none"
         )
     return deg
 

@@ -255,8 +255,29 @@ def slice_reference(ref: str, stop: int | None, step: int | None) -> str:
 
 
 def canonical_reference(ref: str) -> str:
-    """``ref`` with its trailing slices in their one spelling (:func:`split_slice`, :func:`slice_reference`)."""
-    return slice_reference(*split_slice(ref))
+    """``ref`` with its loader options and trailing slices in their one spelling (:func:`canonical_query`,
+    :func:`split_slice`, :func:`slice_reference`)."""
+    text, stop, step = split_slice(ref)
+    return slice_reference(canonical_query(text), stop, step)
+
+
+def canonical_query(text: str) -> str:
+    """``NAME?b=2&a=1`` -> ``NAME?a=1&b=2``: the loader options of a reference (no slice) in their one spelling.
+
+    The options are a set (:func:`open_sequence` applies them in its own order, whatever order they are
+    written in), so ``?odometry=reference&views=1:10`` and ``?views=1:10&odometry=reference``, ``NAME?`` and
+    ``NAME``, ``a = 1`` and ``a=1`` open the same scans and are one run key and one table row: keys sorted,
+    spaces around keys and values and empty items dropped, values otherwise as written. A text naming an
+    existing path, or whose options do not parse (opening it says why), is returned as it is.
+    """
+    name, has_query, query = text.partition("?")
+    if not has_query or _exists(text):
+        return text
+    try:
+        pairs = parse_query(query, what="loader option")
+    except KeyValueError:
+        return text
+    return name + ("?" + "&".join(f"{key}={pairs[key]}" for key in sorted(pairs)) if pairs else "")
 
 
 def parse_slice(body: str, ref: str) -> tuple[int | None, int | None]:

@@ -321,11 +321,15 @@ def cell_rows(records: list[CellRecord]) -> list[dict[str, Any]]:
 
 
 def severity_order(levels: list[str]) -> list[str]:
-    """none, Gaussian levels by sigma, biases, the thesis's degradation, then the set-up ones (offset, dropout)."""
+    """none, Gaussian levels by sigma, biases, the thesis's degradation, then the set-up ones (offset, dropout).
+
+    Within a kind by size, whatever the sign (``bias:0.01:0.1`` before ``bias:-0.05:-1``; a signed order put
+    every negative bias first, however large), then by sign, so the order is one.
+    """
     rank = {"none": 0, "gauss": 1, "bias": 2, "thesis": 3, "offset": 4, "dropout": 5}
 
-    def key(level: str) -> tuple[int, float, float]:
+    def key(level: str) -> tuple[int, float, float, float, float, float]:
         spec = parse_spec(level, stored=True)
-        return rank.get(spec.kind, 6), spec.a, spec.b
+        return rank.get(spec.kind, 6), abs(spec.a), abs(spec.b), abs(spec.c), spec.a, spec.b
 
     return sorted(levels, key=key)

@@ -248,7 +248,8 @@ def render_page(
     lines = [
         "# Every method against the odometry it was given",
         "",
-        "For each dataset, method and odometry degradation (seeds pooled): the method's ATE and that of the "
+        "For each dataset, method and perturbation (odometry degradation, wrong laser offset or scan dropout; seeds "
+        "pooled): the method's ATE and that of the "
         "odometry the same runs were given, both after their own rigid SE(2) alignment to the reference; their "
         f"ratio (< 1: the method improved on its odometry) with a {pct} paired moving-block bootstrap interval over "
         f"scans ({RESAMPLES} resamples, blocks of 1/{BLOCKS} of a run, the same scans for both); **worse** / "

@@ -105,6 +105,8 @@ document.querySelectorAll("details.colpick").forEach(function (pick) {
 });
 """
 
+#: What a robustness figure's x axis holds (a suite may sweep a wrong laser offset and scan dropout too).
+_PER_LEVEL = "per degradation (of the odometry, or a wrong laser offset or scan dropout): mean over seeds"
 #: Captions of the per-dataset figures, by the suffix of their file names.
 CAPTIONS = {
     "trajectories": "Trajectories over the reference (rigid alignment, as for the ATE).",
@@ -112,9 +114,9 @@ CAPTIONS = {
     "error-distance": "Position error along the route, against distance travelled on the reference.",
     "rpe-boxes": "Relative error per segment length (boxes: quartiles; whiskers: 1.5 IQR; outliers not drawn).",
     "maps": "Maps in the reference's frame, one panel per method, with the reference and each trajectory.",
-    "robustness-ate": "ATE RMSE per odometry degradation: mean over seeds, ± std, min and max.",
-    "robustness-drift": "RPE per 10 m per odometry degradation: mean over seeds, ± std, min and max.",
-    "robustness-loop-gap": "Loop gap per odometry degradation: mean over seeds, ± std, min and max.",
+    "robustness-ate": f"ATE RMSE {_PER_LEVEL}, ± std, min and max.",
+    "robustness-drift": f"RPE per 10 m {_PER_LEVEL}, ± std, min and max.",
+    "robustness-loop-gap": f"Loop gap {_PER_LEVEL}, ± std, min and max.",
     "scan-time": "Per-scan processing time along the sequence (running median).",
     "runtime": "Median per-scan time per dataset and method on the dataset's own odometry (whisker: p95).",
 }

@@ -1,7 +1,7 @@
-"""Robustness: a metric per odometry degradation, per method, across seeds.
+"""Robustness: a metric per odometry degradation (or other perturbation), per method, across seeds.
 
 Degradations are categories (``none``, Gaussian levels by sigma, biases,
-``thesis``), not points on a numeric axis, so each is a slot on the x axis
+``thesis``, then a wrong laser offset and scan dropout), not points on a numeric axis, so each is a slot on the x axis
 and no line joins unrelated settings. Each method is a marker at the mean
 over seeds with a bar of +/- one sample standard deviation and small ticks
 at the minimum and maximum; a deterministic degradation has one seed and
@@ -9,6 +9,12 @@ no bar. A log axis is used only when the values span more than two
 decades, starting at 1e-4 of the largest value: a perfect-odometry error of
 1e-10 m is drawn at that floor with a downward triangle (and said so)
 instead of stretching the axis over ten empty decades.
+
+The axis names what its levels change: "odometry degradation" only when
+every level is one (``gauss``, ``bias``, ``thesis``); a suite that also
+sweeps ``offset`` or ``dropout`` (the generalisation suite) gets
+"perturbation" with the kinds it holds, since a dropout leaves the odometry
+as it is and thins the scans.
 """
 
 from __future__ import annotations
@@ -17,6 +23,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from albot1.data.degrade import parse_spec
 from albot1.report.collect import severity_order
 from albot1.report.plots import log_floor, pyplot, save, value_axis
 
@@ -65,11 +72,12 @@ def plot_robustness(
     for k in range(1, len(levels)):
         ax.axvline(k - 0.5, color="0.85", lw=0.8, zorder=0)
     ax.set_xlim(-0.5, len(levels) - 0.5)
-    ax.set_xlabel("odometry degradation (applied to the dataset's odometry before any method sees it)", fontsize=8)
+    what, axis = axis_words(levels)
+    ax.set_xlabel(axis, fontsize=8)
     ax.set_ylabel(label)
     ax.grid(alpha=0.3, axis="y", which="both", lw=0.5)
     seeds = int(rows["seeds"].max())
-    fig.suptitle(f"{dataset}: {label} per odometry degradation", fontsize=10)
+    fig.suptitle(f"{dataset}: {label} per {what}", fontsize=10)
     ax.set_title(
         f"marker: mean over the seeds (up to {seeds}); thick bar: ± 1 sample std; ticks: min and max",
         fontsize=8,
@@ -77,3 +85,30 @@ def plot_robustness(
     )
     fig.legend(loc="outside lower center", ncols=min(len(methods), 6), fontsize=8, frameon=False)
     return save(fig, path)
+
+
+#: What each kind of level changes, in the axis label's words (``albot1/data/degrade.py``).
+_CHANGES = {
+    "gauss": "odometry noise",
+    "bias": "odometry bias",
+    "thesis": "the thesis's odometry error",
+    "offset": "a wrong laser offset",
+    "dropout": "scan dropout",
+}
+
+
+def axis_words(levels: list[str]) -> tuple[str, str]:
+    """(what a level is, the x axis label) for these levels: an odometry degradation unless one is not.
+
+    ``offset`` reports the odometry of a displaced frame and ``dropout`` leaves scans out (their odometry
+    untouched): a figure with them was labelled "odometry degradation (applied to the dataset's odometry
+    ...)" all the same.
+    """
+    kinds = [parse_spec(level, stored=True).kind for level in levels]
+    if all(kind in ("none", "gauss", "bias", "thesis") for kind in kinds):
+        return (
+            "odometry degradation",
+            "odometry degradation (applied to the dataset's odometry before any method sees it)",
+        )
+    held = ", ".join(dict.fromkeys(_CHANGES[kind] for kind in kinds if kind in _CHANGES))
+    return "perturbation", f"perturbation ({held}; applied to the data before any method sees it)"

@@ -196,3 +196,37 @@ def test_a_whole_number_of_turns_without_translation_is_refused_as_changing_noth
 @pytest.mark.parametrize("spec", ["bias:0.01:720", "offset:0:0.1:360", "bias:0:1", "gauss:0:360"])
 def test_a_whole_turn_with_anything_else_still_degrades(spec: str) -> None:
     assert parse_spec(spec).kind == spec.split(":")[0]
+
+
+@pytest.mark.parametrize(
+    ("spec", "says"),
+    [
+        ("dropout:0.9999999999999", "0.9999999999999 being 1 to the 12 significant digits"),
+        ("bias:0:359.9999999999", "0:359.9999999999 being 0:360 to the 12 significant digits"),
+        ("offset:0:0:-720.0000000000001", "0:0:-720.0000000000001 being 0:0:-720 to the 12 significant digits"),
+    ],
+)
+def test_a_spec_whose_label_rounds_to_a_refused_level_is_refused_as_written(spec: str, says: str) -> None:
+    """`albot1 run` and suites run the label (12 significant digits): its level is the one checked.
+
+    ``dropout:0.9999999999999`` was accepted, labelled ``dropout:1`` and then refused when the run
+    started, quoting ``'dropout:1'``, a SPEC nobody wrote.
+    """
+    with pytest.raises(DegradationSpecError) as info:
+        parse_spec(spec)
+    assert str(info.value).startswith(f"degradation {spec!r}") and says in str(info.value)
+
+
+@given(
+    st.sampled_from(["gauss", "bias", "offset", "dropout"]),
+    st.lists(st.floats(-1e6, 1e6, allow_nan=False).map(repr), min_size=3, max_size=3),
+)
+def test_every_accepted_spec_runs_the_level_its_label_names(kind: str, values: list[str]) -> None:
+    """The label parses back to the same level, so the run (which parses the label) is the level checked here."""
+    arity = {"gauss": 2, "bias": 2, "offset": 3, "dropout": 1}[kind]
+    spec = ":".join([kind, *values[:arity]])
+    try:
+        parsed = parse_spec(spec)
+    except DegradationSpecError:
+        return
+    assert parse_spec(parsed.spec) == parsed

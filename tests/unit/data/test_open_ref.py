@@ -192,3 +192,26 @@ def test_slices_before_the_loader_options_open_the_same_scans_and_errors_quote_t
     with pytest.raises(SliceError) as caught:
         split_slice("aces[100:400]?odometry=laser-pose")
     assert str(caught.value).startswith("'aces[100:400]?odometry=laser-pose': slice START is 100, but only prefixes")
+
+
+@pytest.mark.parametrize(
+    "spelling",
+    [
+        "synthetic-office-startstop?views=2:30&odometry=reference[:6]",
+        "synthetic-office-startstop? odometry = reference &&views=2:30&[:6]",
+        "synthetic-office-startstop[:6]?views=2:30&odometry=reference",
+    ],
+)
+def test_loader_options_in_another_order_or_spacing_are_one_spelling_of_the_same_scans(spelling: str) -> None:
+    """The options are applied in one order whatever order they are written in: one run key, not one per spelling.
+
+    ``albot1 run`` and a suite's label key a run by this spelling; ``?views=..&odometry=reference`` and
+    ``?odometry=reference&views=..`` (or a trailing ``?``) were two run folders and two table rows of one run.
+    """
+    canonical = "synthetic-office-startstop?odometry=reference&views=2:30[:6]"
+    assert canonical_reference(spelling) == canonical
+    assert canonical_reference(canonical) == canonical
+    stamps = [[f.scan.timestamp for f in open_sequence(ref).frames()] for ref in (spelling, canonical)]
+    assert len(stamps[0]) == 6 and stamps[0] == stamps[1]
+    assert canonical_reference("synthetic-office-startstop?") == "synthetic-office-startstop"
+    assert canonical_reference("synthetic-office-startstop[:6]?") == "synthetic-office-startstop[:6]"

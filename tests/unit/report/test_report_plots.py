@@ -14,6 +14,7 @@ from albot1.geometry import se2
 from albot1.metrics.record import MetricsRecord
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, severity_order
 from albot1.report.cost_plots import plot_scan_time
+from albot1.report.html import CAPTIONS
 from albot1.report.map_plots import occupancy, plot_maps
 from albot1.report.plots import (
     FIXED_COLORS,
@@ -41,6 +42,16 @@ ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 9)
 def test_severity_order_puts_none_first_then_gaussian_by_sigma_then_thesis() -> None:
     levels = ["thesis", "gauss:0.2:3", "none", "bias:0.01:0.1", "gauss:0.05:0.5", "gauss:0.1:1"]
     assert severity_order(levels) == ["none", "gauss:0.05:0.5", "gauss:0.1:1", "gauss:0.2:3", "bias:0.01:0.1", "thesis"]
+
+
+def test_severity_order_ranks_biases_by_size_whatever_their_sign() -> None:
+    """A signed order put ``bias:-0.05:-1`` before ``bias:0.01:0.1``, as if it were the milder one."""
+    assert severity_order(["bias:-0.05:-1", "bias:0.01:0.1", "none", "bias:0.05:1"]) == [
+        "none",
+        "bias:0.01:0.1",
+        "bias:-0.05:-1",
+        "bias:0.05:1",
+    ]
 
 
 def test_slug_makes_dataset_labels_file_safe() -> None:
@@ -217,6 +228,26 @@ def test_robustness_puts_degradations_on_categories_with_the_spread_of_seeds(tmp
     plot_robustness(table, "loop", "ate_rmse_m", "ATE RMSE (m)", tmp_path / "log.png", colors)
     svg = (tmp_path / "log.svg").read_text()
     assert "drawn at" in svg and "(clean)" in svg
+
+
+def test_robustness_says_perturbation_not_odometry_degradation_when_a_level_leaves_the_odometry_alone(
+    tmp_path: Path,
+) -> None:
+    """A scan dropout thins the scans and keeps their odometry: the generalisation suite's figures put
+    ``dropout:0.5`` and ``offset:...`` on an axis "odometry degradation (applied to the dataset's odometry ...)"."""
+    records = _records(tmp_path, _world(40.0, 6.0), "loop")
+    table = aggregate(cells_frame(records), METRIC_COLUMNS)
+    colors = method_colors(r.cell.method_label for r in records)
+    plot_robustness(table, "loop", "ate_rmse_m", "ATE RMSE (m)", tmp_path / "odometry.png", colors)
+    svg = (tmp_path / "odometry.svg").read_text()
+    assert "per odometry degradation" in svg and "(applied to the dataset's odometry before" in svg
+    table.loc[table["degradation"] == "bias:0.01:0.5", "degradation"] = "dropout:0.5"
+    plot_robustness(table, "loop", "ate_rmse_m", "ATE RMSE (m)", tmp_path / "dropout.png", colors)
+    svg = (tmp_path / "dropout.svg").read_text()
+    assert ">dropout:0.5<" in svg and "odometry degradation" not in svg
+    assert "per perturbation" in svg and "perturbation (odometry noise, scan dropout; applied to the data" in svg
+    # the page's caption of these figures says so too
+    assert all("scan dropout" in CAPTIONS[f"robustness-{kind}"] for kind in ("ate", "drift", "loop-gap"))
 
 
 def test_trajectory_error_plots_need_a_reference(tmp_path: Path) -> None:
