@@ -1,7 +1,7 @@
 """Every method's numba kernels that a wheel carries: the list the build step compiles (``setup.py``, issue 24).
 
 Why a module here: Albot1's kernel sets live in :mod:`albot1.methods.albot1`
-and gtsam-graph's grid search in :mod:`albot1.methods.baselines.gtsam_graph`,
+and gtsam-graph's grid search and block sums in :mod:`albot1.methods.baselines.gtsam_graph`,
 which imports Albot1's compile path (``compiled``, ``kernel_bundle``); the
 list that names both can only sit above both, or the two packages would
 import each other. The bundle itself is one mechanism for every method:
@@ -19,10 +19,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from albot1.methods.albot1 import kernel_bundle_build
-from albot1.methods.baselines.gtsam_graph import nearest
+from albot1.methods.baselines.gtsam_graph import block_sums, nearest
 
 #: the kernels of methods other than Albot1 (whose kernel sets the build knows): (warm-up, sample calls) each
-OTHERS: tuple[kernel_bundle_build.KernelSource, ...] = ((nearest.warm_up, nearest.sample_calls),)
+OTHERS: tuple[kernel_bundle_build.KernelSource, ...] = (
+    (nearest.warm_up, nearest.sample_calls),
+    (block_sums.warm_up, block_sums.sample_calls),
+)
 
 
 def calls() -> list[kernel_bundle_build.Call]:

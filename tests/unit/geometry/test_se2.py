@@ -85,3 +85,27 @@ def test_path_length() -> None:
 def test_bad_shape_is_rejected() -> None:
     with pytest.raises(ValueError, match="last axis of length 3"):
         se2.compose(np.zeros(2), np.zeros(3))
+
+
+def test_single_poses_take_the_fast_path_with_the_batch_s_bits(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``compose`` / ``between`` of two (3,) float64 poses: no ``np.stack`` (the fast path), the batch's bits.
+
+    Headings cover the wrap's edges (pi, -pi, 2 pi, signed zeros, tiny and huge angles), where a different
+    operation order or modulo would show.
+    """
+    rng = np.random.default_rng(12)
+    n = 20_000
+    a, b = rng.normal(0.0, 40.0, (n, 3)), rng.normal(0.0, 40.0, (n, 3))
+    a[:, 2], b[:, 2] = rng.uniform(-8.0, 8.0, n), rng.uniform(-8.0, 8.0, n)
+    edges = np.array([math.pi, -math.pi, 2 * math.pi, 0.0, -0.0, 1e-300, -1e-300, 1e10, math.nextafter(math.pi, 0.0)])
+    a[: len(edges) ** 2, 2], b[: len(edges) ** 2, 2] = np.repeat(edges, len(edges)), np.tile(edges, len(edges))
+    batch = {"compose": se2.compose(a, b), "between": se2.between(a, b)}
+
+    def no_stack(*args: object, **kwargs: object) -> None:
+        raise AssertionError("np.stack called for single poses: the fast path was not taken")
+
+    monkeypatch.setattr(se2.np, "stack", no_stack)
+    for name, fn in (("compose", se2.compose), ("between", se2.between)):
+        single = np.array([fn(p, q) for p, q in zip(a, b, strict=True)])
+        assert single.dtype == np.float64 and single.shape == (n, 3)
+        assert single.tobytes() == batch[name].tobytes(), name

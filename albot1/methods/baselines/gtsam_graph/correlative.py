@@ -7,7 +7,8 @@ scan matching"), the target is rasterised into a likelihood field
 every pose of a translation x rotation grid around the guess is scored by
 summing the field at the moved source points; the best pose seeds ICP, which
 then does the precise work and the acceptance tests judge the result.
-Pure numpy/scipy, no I/O.
+numpy/scipy, and one compiled kernel for the place search's block sums
+(:mod:`.block_sums`); no I/O.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
+from albot1.methods.baselines.gtsam_graph.block_sums import block_sums
 
 
 @dataclass(frozen=True)
@@ -170,56 +172,25 @@ def _pooled_fields(field: FloatArray, levels: int) -> list[FloatArray]:
     return out
 
 
-#: Nodes per block of lookups: 128 x 200 points of int64 indices and float64 values stay in a core's L2 cache
-#: (fr-clinic's place searches, with the zero border: 128 nodes cost 0.71-0.73 of the clipped 512-node version's
-#: time, 64 0.73, 256 0.74, 512 0.78, 1024 0.82; one loaded run each).
-_CHUNK = 128
-
-
 def _sum_at(
     table: FloatArray, base: NDArray[np.int64], rot: NDArray[np.int64], origin: NDArray[np.int64]
 ) -> FloatArray:
     """For each node ``k``: the sum over source points of ``table[base[rot[k]] + origin[k]]`` (clipped lookups).
 
-    Read through the flat table (``take``), :data:`_CHUNK` nodes at a time (their
-    lookups stay in the processor's cache). A node whose points all land
-    inside the table (most of a place-recognition search's) needs no
-    clipping: its flat lookups are its rotation's flat points plus one
-    shift, so the nodes of one rotation are taken together and their lookups
-    are one broadcast sum (no per-node copy of the rotated points). The
-    others are clipped in place. Either way the same indices, values and
-    row sums as ``np.clip`` and 2-D fancy indexing (a unit test compares the
-    bits), in about a quarter of the time; this is most of a search.
-    :func:`branch_and_bound_search` widens its tables (:func:`_zero_border`)
-    so that no node needs the clipping: with that, the grouping and
-    :data:`_CHUNK`, fr-clinic's 57 place searches cost 0.72 of what they
-    did with 512-node chunks and clipping.
+    Most of a search; one compiled pass (:func:`.block_sums.block_sums`) that
+    gathers each node's values into one buffer and sums them as numpy sums a
+    row, so the same indices, values and row sums as ``np.clip``, 2-D fancy
+    indexing and ``sum(axis=1)`` (a unit test compares the bits), without the
+    nodes x points temporaries (docs/baselines.md, "Cost (issue 24), third round").
     """
     out = np.empty(len(rot))
-    n0, n1 = table.shape
-    flat = table.ravel()
-    inside = ((base.min(axis=1)[rot] + origin >= 0) & (base.max(axis=1)[rot] + origin < (n0, n1))).all(axis=1)
-    flat_points = base[..., 0] * n1 + base[..., 1]
-    shift = origin[:, 0] * n1 + origin[:, 1]
-    # The unclipped nodes, rotation by rotation (a stable sort keeps each rotation's nodes in their order).
-    nodes = np.flatnonzero(inside)
-    nodes = nodes[np.argsort(rot[nodes], kind="stable")]
-    bounds = np.flatnonzero(np.diff(rot[nodes])) + 1
-    for group in np.split(nodes, bounds) if len(nodes) else ():
-        points = flat_points[rot[group[0]]]
-        for start in range(0, len(group), _CHUNK):  # bounded memory: nodes x points indices per chunk
-            chunk = group[start : start + _CHUNK]
-            out[chunk] = flat.take(points + shift[chunk, None]).sum(axis=1)
-    clipped = np.flatnonzero(~inside)
-    for start in range(0, len(clipped), _CHUNK):
-        chunk = clipped[start : start + _CHUNK]
-        idx = base[rot[chunk]]  # a copy (fancy indexing): the in-place steps leave ``base`` as it is
-        idx += origin[chunk, None, :]
-        np.maximum(idx, 0, out=idx)
-        lookup = np.minimum(idx[..., 0], n0 - 1)
-        lookup *= n1
-        lookup += np.minimum(idx[..., 1], n1 - 1)
-        out[chunk] = flat.take(lookup).sum(axis=1)
+    block_sums(
+        np.ascontiguousarray(table, dtype=np.float64),
+        np.ascontiguousarray(base, dtype=np.int64),
+        np.ascontiguousarray(rot, dtype=np.int64),
+        np.ascontiguousarray(origin, dtype=np.int64),
+        out,
+    )
     return out
 
 

@@ -1,0 +1,180 @@
+"""Place recognition's block sums in one compiled pass: numpy's own summation, so the same bits.
+
+Why: a branch-and-bound place search (:func:`.correlative.branch_and_bound_search`)
+scores hundreds of thousands of blocks, each the sum of a pooled table at its
+source points, and that was over a third of gtsam-graph's CPU on fr-clinic
+(docs/baselines.md, "Cost (issue 24), third round"), most of it numpy
+gathering every block's lookups into a temporary array and reducing it.
+Here each block's values are gathered into one small buffer and summed as
+``ndarray.sum(axis=1)`` sums a row: numpy's pairwise summation
+(``pairwise_sum`` of its ``add`` loops: eight running sums for rows of up to
+128 values, their fixed combination, the rest added in order, longer rows
+split in halves rounded down to a multiple of eight), from an initial 0.0.
+IEEE additions in that order, no fast-math: the same bits as the numpy
+formulation every recorded result came from (a unit test compares them on
+rows of every length up to 300 and longer ones).
+
+Lookups are clipped to the table, as ``np.clip`` and a 2-D lookup did.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from albot1.geometry.types import FloatArray
+from albot1.methods.albot1 import compiled, kernel_bundle
+from albot1.methods.albot1.compiled import jitable, kernel
+
+IntArray = NDArray[np.int64]
+
+#: numpy's ``PW_BLOCKSIZE``: rows up to this long are summed with eight running sums, longer ones split in two
+_BLOCK = 128
+#: frames of the explicit recursion: rows up to 2**60 values
+_DEPTH = 64
+
+
+@jitable
+def _leaf(buf: FloatArray, lo: int, n: int) -> float:
+    """numpy's pairwise sum of ``buf[lo:lo + n]`` for ``n <= 128``: eight running sums, then the rest in order."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += buf[i]
+        return res
+    r0, r1, r2, r3 = buf[lo], buf[lo + 1], buf[lo + 2], buf[lo + 3]
+    r4, r5, r6, r7 = buf[lo + 4], buf[lo + 5], buf[lo + 6], buf[lo + 7]
+    i = lo + 8
+    end = lo + n - n % 8
+    while i < end:
+        r0 += buf[i]
+        r1 += buf[i + 1]
+        r2 += buf[i + 2]
+        r3 += buf[i + 3]
+        r4 += buf[i + 4]
+        r5 += buf[i + 5]
+        r6 += buf[i + 6]
+        r7 += buf[i + 7]
+        i += 8
+    total: float = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < lo + n:
+        total += buf[i]
+        i += 1
+    return total
+
+
+@jitable
+def pairwise_sum(buf: FloatArray, n: int, stack: IntArray, partial: FloatArray) -> float:
+    """``buf[:n].sum()`` as numpy computes it: :func:`_leaf` on blocks, halves added as its recursion adds them.
+
+    numba compiles no recursion here, so the recursion is an explicit stack
+    (``stack``: rows of lo, n, stage; ``partial``: each frame's left half).
+    """
+    if n <= _BLOCK:
+        return _leaf(buf, 0, n)
+    top = 0
+    stack[0, 0], stack[0, 1], stack[0, 2] = 0, n, 0
+    ret = 0.0
+    while top >= 0:
+        lo, m = stack[top, 0], stack[top, 1]
+        if m <= _BLOCK:
+            ret = _leaf(buf, lo, m)
+            top -= 1
+            continue
+        half = m // 2
+        half -= half % 8
+        stage = stack[top, 2]
+        if stage == 0:  # the left half first
+            stack[top, 2] = 1
+            top += 1
+            stack[top, 0], stack[top, 1], stack[top, 2] = lo, half, 0
+        elif stage == 1:  # the left half is ``ret``: now the right one
+            partial[top] = ret
+            stack[top, 2] = 2
+            top += 1
+            stack[top, 0], stack[top, 1], stack[top, 2] = lo + half, m - half, 0
+        else:
+            ret = partial[top] + ret
+            top -= 1
+    return ret
+
+
+@kernel
+def block_sums(table: FloatArray, base: IntArray, rot: IntArray, origin: IntArray, out: FloatArray) -> None:
+    """``out[k]``: the sum over source points ``p`` of ``table[clip(base[rot[k], p] + origin[k])]``, numpy's bits.
+
+    The cell of each lookup is clipped to the table on each axis; the values
+    are summed in the source points' order as ``ndarray.sum(axis=1)`` sums a
+    row (:func:`pairwise_sum`). A node whose lookups all fall inside the table
+    (every node of a search on its zero border) reads its rotation's flat
+    cell indices plus one shift: one load per lookup instead of two, a clip
+    and a product (the same cells, so the same values).
+    """
+    n0, n1 = table.shape
+    rotations, points = base.shape[0], base.shape[1]
+    if points == 0:  # numpy's sum of an empty row
+        out[:] = 0.0
+        return
+    flat = table.ravel()
+    cells = np.empty((rotations, points), dtype=np.int64)
+    low = np.empty((rotations, 2), dtype=np.int64)
+    high = np.empty((rotations, 2), dtype=np.int64)
+    for r in range(rotations):
+        low[r, 0], low[r, 1] = base[r, 0, 0], base[r, 0, 1]
+        high[r, 0], high[r, 1] = base[r, 0, 0], base[r, 0, 1]
+        for p in range(points):
+            i, j = base[r, p, 0], base[r, p, 1]
+            cells[r, p] = i * n1 + j
+            low[r, 0], high[r, 0] = min(low[r, 0], i), max(high[r, 0], i)
+            low[r, 1], high[r, 1] = min(low[r, 1], j), max(high[r, 1], j)
+    buf = np.empty(points)
+    stack = np.empty((_DEPTH, 3), dtype=np.int64)
+    partial = np.empty(_DEPTH)
+    for k in range(rot.shape[0]):
+        r = rot[k]
+        o0, o1 = origin[k, 0], origin[k, 1]
+        if low[r, 0] + o0 >= 0 and high[r, 0] + o0 < n0 and low[r, 1] + o1 >= 0 and high[r, 1] + o1 < n1:
+            shift = o0 * n1 + o1
+            for p in range(points):
+                buf[p] = flat[cells[r, p] + shift]
+        else:
+            for p in range(points):
+                i = min(max(base[r, p, 0] + o0, 0), n0 - 1)
+                j = min(max(base[r, p, 1] + o1, 0), n1 - 1)
+                buf[p] = table[i, j]
+        out[k] = 0.0 + pairwise_sum(buf, points, stack, partial)
+
+
+def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
+    """``(kernel name, kernel, arguments)`` typed as :func:`.correlative._sum_at` calls it (bundle, warm-up).
+
+    numba keys a cached kernel by its argument types, so these are a run's:
+    C-ordered float64 table and int64 index arrays.
+    """
+    table = np.arange(12.0).reshape(3, 4)
+    base = np.array([[[0, 0], [2, 3], [-1, 5]]], dtype=np.int64)
+    rot = np.zeros(2, dtype=np.int64)
+    origin = np.array([[0, 0], [1, -1]], dtype=np.int64)
+    return [("gtsam_graph.block_sums", block_sums, (table, base, rot, origin, np.empty(2)))]
+
+
+def warm_up(announce: Callable[[str], None] | None = None) -> None:
+    """Compile :func:`block_sums` (or load numba's cache) before a run's first scan, as :func:`.nearest.warm_up`.
+
+    The wheel's kernel bundle is tried first (:func:`kernel_bundle.seed`);
+    ``announce`` hears of a real compilation only.
+    """
+    if compiled.needs_compile(block_sums):
+        kernel_bundle.seed(sample_calls(), compiled.needs_compile)
+    cold = compiled.needs_compile(block_sums)
+    if cold and announce is not None:
+        announce(f"gtsam-graph: compiling its block sums once for this code version (cache: {compiled.CACHE_DIR})")
+    start = time.perf_counter()
+    for _, fn, args in sample_calls():
+        fn(*args)
+    if cold and announce is not None:
+        announce(f"gtsam-graph: block sums compiled in {time.perf_counter() - start:.1f} s")
