@@ -242,6 +242,9 @@ class DatasetInfo(Record):
     #: sha256 of every file the sequence was read from, by file name (albot1.data.identity); empty for a
     #: synthetic world (its code version names it) and in results written before it was recorded
     data_sha256: dict[str, Sha256] = {}
+    #: the ``[loader]`` table of a registered dataset's manifest (albot1.data.model.SequenceMetadata); empty for
+    #: other sources and in results written before it was recorded
+    manifest_loader: dict[str, Any] = {}
 
 
 class ResultRecord(Record):
@@ -249,10 +252,11 @@ class ResultRecord(Record):
 
     ``key`` names the run folder; ``dataset`` is the reference the run was
     opened with (so ``albot1 evaluate`` can reopen it); ``config`` is the
-    method's resolved config; ``versions`` holds ``code``, ``git`` and the
-    library versions (null when absent); ``counters`` holds at least
-    ``views`` and ``updates``; ``relations`` is the number of ground-truth
-    relations stored beside it (0 when none).
+    method's resolved config; ``versions`` holds ``code``, ``git``, the
+    library versions (null when absent) and, for a plugin method, ``plugin``
+    (its distribution and version); ``counters`` holds at least ``views`` and
+    ``updates``; ``relations`` is the number of ground-truth relations stored
+    beside it (0 when none).
     """
 
     key: str

@@ -29,6 +29,7 @@ from albot1.config.targets import TargetError
 from albot1.data import catalog
 from albot1.data.degrade import parse_spec
 from albot1.data.errors import DatasetNotFoundError
+from albot1.data.model import SequenceMetadata
 from albot1.data.open import open_sequence, split_slice
 from albot1.data.synthetic import worlds
 from albot1.errors import Albot1Error, ConfigError
@@ -154,10 +155,11 @@ def _candidate_datasets(suite: Suite) -> list[str]:
     return out
 
 
-def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None, bool, dict[str, str]]:
-    """(has reference poses, None, True, data checksums) when the dataset opens, else (None, why skipped, known, {}).
+def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped | None, bool, SequenceMetadata]:
+    """(has reference poses, None, True, metadata) when the dataset opens, else (None, why skipped, known, empty).
 
-    The checksums (``SequenceMetadata.checksums``, cached) go into the cells' keys.
+    The metadata's checksums (``SequenceMetadata.checksums``, cached) and manifest loader options go into the
+    cells' keys.
 
     ``known`` is False when ``name`` names nothing that exists (no world, no
     registered dataset, no file, or options its loader rejects): for a
@@ -173,15 +175,15 @@ def _availability(name: str, settings: Settings) -> tuple[bool | None, Skipped |
             manifest = catalog.get(base)
             fetchable = not manifest.local_only and bool(manifest.log.urls)
             hint = f"albot1 datasets fetch {base}" if fetchable else ""
-            return None, Skipped(name, f"not downloaded: {exc}", hint), True, {}
+            return None, Skipped(name, f"not downloaded: {exc}", hint), True, SequenceMetadata()
     try:
         sequence = open_sequence(name, settings=settings)
         first = next(iter(sequence.frames()), None)
     except DatasetNotFoundError as exc:
-        return None, Skipped(name, str(exc)), False, {}
+        return None, Skipped(name, str(exc)), False, SequenceMetadata()
     if first is None:
-        return None, Skipped(name, "the dataset holds no scans"), True, {}
-    return first.reference is not None, None, True, dict(sequence.metadata.checksums)
+        return None, Skipped(name, "the dataset holds no scans"), True, SequenceMetadata()
+    return first.reference is not None, None, True, sequence.metadata
 
 
 def _deterministic(degradation: str) -> bool:
@@ -254,7 +256,7 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
         opts = suite.options_for(name)
         assert opts is not None  # _candidate_datasets keeps selected names only
         try:
-            has_reference, skipped, known, checksums = _availability(name, settings)
+            has_reference, skipped, known, metadata = _availability(name, settings)
         except Albot1Error as exc:  # a bad slice or loader option, a log that does not parse
             raise SuiteError(f"{suite.path or suite.name}: dataset {name!r}: {exc}") from None
         if skipped is not None and not known and name in literals and not opts.optional:
@@ -283,7 +285,17 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
                     if config is not None
                     else {"unresolved": True, "preset": entry.preset, "set": dict(entry.set)}
                 )
-                key = run_key(opts.label, entry.name, key_config, degradation, seed, code, checksums)
+                key = run_key(
+                    opts.label,
+                    entry.name,
+                    key_config,
+                    degradation,
+                    seed,
+                    code,
+                    metadata.checksums,
+                    metadata.manifest_loader,
+                    registry.get(entry.name).plugin,
+                )
                 if problem is not None:
                     config_failures[key] = problem
                 cells.append(

@@ -151,7 +151,12 @@ def open_dataset(name: str, settings: Settings, *, manifest_relations: bool = Tr
         merged.setdefault("license", manifest.license)
         merged.setdefault("citation", manifest.citation)
     sequence = load(path, manifest.format, **merged)
-    return sequence.with_metadata(replace(sequence.metadata, checksums={**sequence.metadata.checksums, **checksums}))
+    metadata = replace(
+        sequence.metadata,
+        checksums={**sequence.metadata.checksums, **checksums},
+        manifest_loader=dict(manifest.loader),
+    )
+    return sequence.with_metadata(metadata)
 
 
 def fetch(name: str, settings: Settings, *, base_url: str | None = None) -> Path:

@@ -163,6 +163,10 @@ class SequenceMetadata:
     #: sha256 of every file the sequence was read from, by file name (:mod:`albot1.data.identity`); empty for a
     #: sequence made in memory (a synthetic world is named by the code version)
     checksums: dict[str, str] = field(default_factory=dict)
+    #: the ``[loader]`` table of a registered dataset's manifest, as written (``datasets/<name>.toml``): options that
+    #: shape what the loader reads (``max_range``, the odometry source) without appearing in the dataset's name, so
+    #: a run key and ``result.json`` carry them (an edited or replaced manifest must not reuse an older result)
+    manifest_loader: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

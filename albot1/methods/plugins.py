@@ -17,6 +17,7 @@ declares (docs/benchmarking.md).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from importlib.metadata import EntryPoint, entry_points
@@ -30,6 +31,12 @@ ENTRY_POINT_GROUP = "albot1.methods"
 
 #: The error class a plugin's failures are reported as (the runner wraps any other exception in it).
 PLUGIN_ERROR_CLASS = "albot1.methods.errors:PluginMethodError"
+
+
+#: What a method's name may be: it is typed on command lines, makes the ``ALBOT1_<NAME>_`` variables' prefix and a
+#: suite's ``name:preset`` column. A plugin ``my slam`` could set no variable, and ``odometry:fast`` read in every
+#: report as the built-in ``odometry`` under a preset ``fast``.
+METHOD_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
 
 
 def _distribution(point: EntryPoint) -> str:
@@ -47,7 +54,14 @@ class Plugin:
 
 
 def plugin(point: EntryPoint) -> Plugin:
-    """The method an entry point declares; PluginError (one line) when its value is not ``module:Class``."""
+    """The method an entry point declares; PluginError (one line) when its name is no method name
+    (:data:`METHOD_NAME`) or its value is not ``module:Class``."""
+    if not METHOD_NAME.fullmatch(point.name):
+        raise PluginError(
+            f"entry point {point.name!r} of {_distribution(point)} (group {ENTRY_POINT_GROUP}): a method name is "
+            "letters, digits, '-' and '_', starting with a letter or digit (it is typed on command lines, names "
+            "ALBOT1_<METHOD>_ variables and a suite's name:preset columns); the plugin must choose another name"
+        )
     try:
         check_target(point.value)
     except TargetError:

@@ -31,6 +31,7 @@ import json
 from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -57,8 +58,13 @@ def entry_key(
     sensor_offset: FloatArray,
     voxel_m: float,
     max_points: int,
+    manifest_loader: Mapping[str, Any] | None = None,
 ) -> str:
-    """The sha256 (hex) naming the reference map of these inputs; any change gives another key."""
+    """The sha256 (hex) naming the reference map of these inputs; any change gives another key.
+
+    ``manifest_loader``: the dataset manifest's loader options (``SequenceMetadata.manifest_loader``): another
+    ``max_range`` reads other points from the same files.
+    """
     digest = hashlib.sha256()
     described = {
         "layout": LAYOUT,
@@ -69,6 +75,7 @@ def entry_key(
         "count": int(count),
         "voxel_m": float(voxel_m).hex(),
         "max_points": int(max_points),
+        "loader": dict(manifest_loader or {}),
     }
     digest.update(json.dumps(described, sort_keys=True).encode())
     for array in (reference[:count], timestamps[:count], sensor_offset):

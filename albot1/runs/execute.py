@@ -184,7 +184,13 @@ def run_method(
         wall_s=time.perf_counter() - wall_start,
         cpu_s=cpu_time_s() - cpu_start,
         peak_mb=peak_rss_mb(),
-        versions={"code": versions.code_version(), "git": versions.git_commit(), **versions.library_versions()},
+        versions={
+            "code": versions.code_version(),
+            "git": versions.git_commit(),
+            **versions.library_versions(),
+            # a plugin's own code is not in the code version (this package's digest): its distribution and version
+            **({"plugin": spec.plugin} if spec.plugin is not None else {}),
+        },
         dataset_info={
             "source": seq.metadata.source,
             "format": seq.metadata.format,
@@ -192,6 +198,7 @@ def run_method(
             "reference_source": seq.metadata.reference_source,
             "sensor_offset": [float(v) for v in offset],
             "data_sha256": dict(seq.metadata.checksums),
+            "manifest_loader": dict(seq.metadata.manifest_loader),
         },
     )
 

@@ -101,6 +101,8 @@ def run_key(
     seed: int,
     code_version: str,
     data: Mapping[str, str] | None = None,
+    loader: Mapping[str, Any] | None = None,
+    plugin: str | None = None,
 ) -> str:
     """Content hash naming a run folder (16 hex digits).
 
@@ -108,7 +110,14 @@ def run_key(
     (``SequenceMetadata.checksums``): a log edited after its run gets a new
     key, so its old result is never taken for the new data's. A sequence read
     from no file (a synthetic world: its code version names it) keeps the key
-    it had before checksums were recorded.
+    it had before checksums were recorded. ``loader`` is the ``[loader]``
+    table of a registered dataset's manifest (``SequenceMetadata.manifest_loader``):
+    a manifest edited or replaced (``ALBOT1_CONFIG_DIR``) with another
+    ``max_range`` or odometry source reads other scans from the same files,
+    and its name does not say so. ``plugin`` is the distribution and version
+    of a plugin method (``MethodSpec.plugin``, ``versions.plugin`` in
+    ``result.json``): the code version digests this package only, so without
+    it a plugin upgraded since its run would keep the older version's result.
     """
     fields: dict[str, Any] = {
         "dataset": dataset,
@@ -120,6 +129,10 @@ def run_key(
     }
     if data:
         fields["data"] = dict(data)
+    if loader:
+        fields["loader"] = dict(loader)
+    if plugin:
+        fields["plugin"] = plugin
     payload = json.dumps(fields, sort_keys=True, default=str)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
@@ -151,6 +164,8 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
         result.seed,
         str(result.versions.get("code")),
         result.dataset_info.get("data_sha256"),
+        result.dataset_info.get("manifest_loader"),
+        result.versions.get("plugin"),
     )
     run_dir = root / key
     run_dir.mkdir(parents=True, exist_ok=True)

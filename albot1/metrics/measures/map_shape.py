@@ -61,6 +61,7 @@ def reference_points(inputs: MetricInputs, reference: FloatArray) -> FloatArray:
     key = entry_key(
         dataset=dataset,
         checksums=sequence.metadata.checksums,
+        manifest_loader=sequence.metadata.manifest_loader,
         count=n,
         reference=reference,
         timestamps=np.asarray(inputs.timestamps, dtype=float),
