@@ -29,7 +29,8 @@ PUBLISHED_RBPF_MIT_CSAIL_M = 0.049
 
 
 def test_same_seed_same_poses_other_seed_other_poses(data_file: Callable[[str], Path]) -> None:
-    sequence = head(load(data_file("radish/mit-csail.clf.bz2")), 150)
+    # 100 scans: 15 filter updates, and seeds 1 and 2 already part by 0.15 m (measured); 150 cost half as much again
+    sequence = head(load(data_file("radish/mit-csail.clf.bz2")), 100)
     a = run_method("mrpt-rbpf", sequence, seed=1)
     b = run_method("mrpt-rbpf", sequence, seed=1)
     c = run_method("mrpt-rbpf", sequence, seed=2)
