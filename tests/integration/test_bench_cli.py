@@ -16,6 +16,9 @@ from typer.testing import CliRunner
 from albot1.cli.app import app, main
 from conftest import PluginInstaller
 
+# `albot1 bench` end to end (its grid in worker processes): the end-to-end lane (Makefile, `make test-end-to-end`)
+pytestmark = pytest.mark.end_to_end
+
 
 def test_dry_run_lists_the_planned_cells_without_running_them(tmp_path: Path) -> None:
     result = CliRunner().invoke(app, ["bench", "quick", "--dry-run", "--results", str(tmp_path)])

@@ -20,6 +20,9 @@ import pytest
 
 from albot1.bench.store import ResultsStore
 
+# `albot1 bench` end to end (its grid in worker processes): the end-to-end lane (Makefile, `make test-end-to-end`)
+pytestmark = pytest.mark.end_to_end
+
 WORLD = "synthetic-office-startstop"
 SUITE = f"""
 [grid]

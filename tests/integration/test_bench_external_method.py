@@ -19,6 +19,9 @@ from albot1.bench.suite import load_suite
 from albot1.report.collect import cell_rows, collect
 from albot1.settings import get_settings
 
+# `albot1 bench` end to end (its grid in worker processes): the end-to-end lane (Makefile, `make test-end-to-end`)
+pytestmark = pytest.mark.end_to_end
+
 DATASET = "synthetic-office-startstop"
 
 

@@ -26,7 +26,7 @@ from albot1.bench.suite import load_suite
 from albot1.report.index import build_report
 from albot1.settings import Settings, get_settings
 
-pytestmark = pytest.mark.usefixtures("fault_plugin")
+pytestmark = [pytest.mark.end_to_end, pytest.mark.usefixtures("fault_plugin")]
 
 WORLD = "synthetic-office-startstop"
 FAULT = ""  # the method `fault` is a plugin (the fault_plugin fixture installs its entry point)

@@ -24,7 +24,7 @@ from albot1.bench.store import ResultsStore
 from albot1.bench.suite import load_suite
 from albot1.settings import get_settings
 
-pytestmark = pytest.mark.usefixtures("fault_plugin")
+pytestmark = [pytest.mark.end_to_end, pytest.mark.usefixtures("fault_plugin")]
 
 WORLD = "synthetic-office-startstop"
 METHODS = ("odometry", "albot1", "kiss-icp", "gtsam-graph")

@@ -14,7 +14,7 @@ from albot1.report.collect import collect
 from albot1.report.results_data import THESIS_SPEED_NOTE, load_data
 from albot1.report.results_page import readme_block, render_readme_block
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.end_to_end, pytest.mark.slow]
 
 SUITE = """
 [grid]
