@@ -50,7 +50,12 @@ name = "{WORLD}"
 """
 
 # `fault`: the test-only mapper, installed as a plugin (conftest's fault_plugin) before the cluster starts.
-pytestmark = [pytest.mark.end_to_end, pytest.mark.slow, pytest.mark.timeout(600), pytest.mark.usefixtures("fault_plugin")]
+pytestmark = [
+    pytest.mark.end_to_end,
+    pytest.mark.slow,
+    pytest.mark.timeout(600),
+    pytest.mark.usefixtures("fault_plugin"),
+]
 
 
 @pytest.fixture
