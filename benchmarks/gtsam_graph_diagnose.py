@@ -37,6 +37,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+from unittest.mock import patch
 
 import numpy as np
 import scipy.sparse as sp
@@ -50,7 +51,7 @@ from albot1.runs.execute import run_method
 
 # the held-out script's `--set` reading and its fallback threshold: one definition of each (run from benchmarks/)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from gtsam_graph_held_out import FALLBACK_SIGMA_DEG, _value  # noqa: E402
+from gtsam_graph_held_out import FALLBACK_SIGMA_DEG, _value, parse_cell  # noqa: E402
 
 #: A closure this far off the reference (m, deg) counts as wrong in the ``offline`` re-solve.
 WRONG_M, WRONG_DEG = 0.2, 1.0
@@ -91,17 +92,13 @@ def recorded_factors() -> Iterator[dict[str, Any]]:
         finally:
             place[0] = False
 
-    graph.PoseGraph.add_edge = edge  # type: ignore[method-assign]
-    backend.BackEnd.add_node = node  # type: ignore[method-assign,assignment]
-    backend.BackEnd.add_loops = loops  # type: ignore[method-assign]
-    place_recognition.PlaceRecognition.recognise = recognising  # type: ignore[method-assign]
-    try:
+    with (
+        patch.object(graph.PoseGraph, "add_edge", edge),
+        patch.object(backend.BackEnd, "add_node", node),
+        patch.object(backend.BackEnd, "add_loops", loops),
+        patch.object(place_recognition.PlaceRecognition, "recognise", recognising),
+    ):
         yield seen
-    finally:
-        graph.PoseGraph.add_edge = add_edge  # type: ignore[method-assign]
-        backend.BackEnd.add_node = add_node  # type: ignore[method-assign]
-        backend.BackEnd.add_loops = add_loops  # type: ignore[method-assign]
-        place_recognition.PlaceRecognition.recognise = recognise  # type: ignore[method-assign]
 
 
 def _factor_graph(
@@ -218,17 +215,11 @@ def _displaced(truth: np.ndarray, delta: np.ndarray) -> np.ndarray:
 
 def diagnose(cell: str, overrides: dict[str, Any], parts: int, worst: int) -> dict[str, Any]:
     """Run one cell with every factor recorded and compare them with the reference (module docstring)."""
-    dataset, _, rest = cell.partition("|")
-    degradation, _, seed = rest.partition("|")
+    dataset, degradation, seed = parse_cell(cell)
     seq = open_sequence(dataset).materialize()
     with recorded_factors() as seen:
         result = run_method(
-            "gtsam-graph",
-            seq,
-            overrides=overrides,
-            degradation=degradation or "none",
-            seed=int(seed or 0),
-            dataset_name=dataset,
+            "gtsam-graph", seq, overrides=overrides, degradation=degradation, seed=seed, dataset_name=dataset
         )
     config = {
         "loop_kernel": overrides.get("loop_kernel", "cauchy"),

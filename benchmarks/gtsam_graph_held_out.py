@@ -63,6 +63,13 @@ def _value(text: str) -> Any:
     return text
 
 
+def parse_cell(cell: str) -> tuple[str, str, int]:
+    """``DATASET[|DEGRADATION[|SEED]]`` -> (dataset, degradation, seed): the cell form of these scripts' arguments."""
+    dataset, _, rest = cell.partition("|")
+    degradation, _, seed = rest.partition("|")
+    return dataset, degradation or "none", int(seed or 0)
+
+
 @contextmanager
 def recorded_innovations() -> Iterator[list[tuple[float, float]]]:
     """Every matched node step's (odometry heading step, heading innovation) in rad, while the block runs."""
@@ -212,18 +219,12 @@ def measure(
     """Run gtsam-graph on one cell and score it (with ``innovations``: the odometry trust's heading innovations too;
     with ``edges``: the edges' errors against the reference, :func:`edge_table`; with ``moves``: the tracked scans
     whose match moved the odometry guess far, :func:`recorded_moves`)."""
-    dataset, _, rest = cell.partition("|")
-    degradation, _, seed = rest.partition("|")
+    dataset, degradation, seed = parse_cell(cell)
     seq = open_sequence(dataset).materialize()
     wall, cpu = time.perf_counter(), time.process_time()
     with recorded_innovations() as seen, recorded_edges() as graph_edges, recorded_moves() as moved:
         result = run_method(
-            "gtsam-graph",
-            seq,
-            overrides=overrides,
-            degradation=degradation or "none",
-            seed=int(seed or 0),
-            dataset_name=dataset,
+            "gtsam-graph", seq, overrides=overrides, degradation=degradation, seed=seed, dataset_name=dataset
         )
     row: dict[str, Any] = {
         "cell": cell,
