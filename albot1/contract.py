@@ -129,18 +129,26 @@ class RunResult:
     cpu_s: float | None = None
     #: seconds of the mapper's ``warm_up`` before the first scan (0 for a mapper without one)
     startup_s: float = 0.0
+    #: why the per-scan times are not the method's cost (a batch method working in ``finish``), else None
+    per_scan_reason: str | None = None
 
     def timing(self) -> Timing:
-        """The ``timing`` block of ``result.json`` (per-scan statistics are None for a run of no scans)."""
+        """The ``timing`` block of ``result.json``.
+
+        Per-scan statistics are None for a run of no scans, and with ``per_scan_reason`` (the times are not the
+        method's cost) beside them.
+        """
         ms = self.per_scan_ns.astype(float) / 1e6
+        timed = len(ms) > 0 and self.per_scan_reason is None
         return Timing(
-            per_scan_ms_median=float(np.median(ms)) if len(ms) else None,
-            per_scan_ms_p95=float(np.percentile(ms, 95)) if len(ms) else None,
-            per_scan_ms_mean=float(np.mean(ms)) if len(ms) else None,
+            per_scan_ms_median=float(np.median(ms)) if timed else None,
+            per_scan_ms_p95=float(np.percentile(ms, 95)) if timed else None,
+            per_scan_ms_mean=float(np.mean(ms)) if timed else None,
             finish_s=self.finish_s,
             startup_s=self.startup_s,
             total_s=self.total_s,
             wall_s=self.wall_s,
             peak_mb=self.peak_mb,
             cpu_s=self.cpu_s,
+            per_scan_reason=self.per_scan_reason,
         )

@@ -211,8 +211,13 @@ def dump_record(record: Record) -> dict[str, Any]:
 # --------------------------------------------------------------------------- result.json
 
 
-class Timing(Record):
-    """``result.json`` ``timing``: per-scan time of ``process`` (ms; null for a run of no scans), seconds, MiB."""
+class Timing(OmitsAbsentReasons):
+    """``result.json`` ``timing``: per-scan time of ``process`` (ms), seconds, MiB.
+
+    The per-scan statistics are null for a run of no scans, and for a method that does its work in ``finish``
+    (a batch program: ``process`` only keeps the frame), where ``per_scan_reason`` says so: its microseconds of
+    bookkeeping read as the fastest method of a cost table. ``per_scan_reason`` is written only when set.
+    """
 
     per_scan_ms_median: OptNonNegative
     per_scan_ms_p95: OptNonNegative
@@ -227,6 +232,8 @@ class Timing(Record):
     #: seconds before the first scan (the method's warm-up, e.g. compiling kernels), outside the per-scan figures;
     #: absent in results written before it was recorded
     startup_s: OptNonNegative = None
+    #: why the per-scan statistics are null although the run has scans (absent otherwise)
+    per_scan_reason: str | None = None
 
 
 class DatasetInfo(Record):

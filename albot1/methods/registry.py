@@ -95,6 +95,10 @@ class MethodSpec:
     #: True when the method's output depends on its seed even on undegraded odometry (a particle filter):
     #: the bench then runs every seed under a deterministic degradation too, instead of the first only.
     stochastic: bool = False
+    #: True when the method does its work in ``finish`` (a batch program given the whole log): each ``process``
+    #: call only keeps its frame, so the per-scan times are that bookkeeping, not the method's cost, and the run
+    #: records its per-scan statistics as not applicable (``timing.per_scan_reason``; its cost is ``total_s``).
+    batch: bool = False
     #: The distribution that declares the method (an installed plugin), None for a method of this package,
     #: whose presets are the file ``baselines/<name>.toml`` (:func:`albot1.config.presets.preset_names`).
     plugin: str | None = None
@@ -193,6 +197,7 @@ BUILTIN_METHODS: tuple[MethodSpec, ...] = (
         "mrpt-icp",
         "albot1.methods.baselines.mrpt:MrptIcpMapper",
         executables=("icp-slam",),
+        batch=True,
         install_hint="apt-get install mrpt-apps (or: make mrpt)",
         auto_include=False,
         description="MRPT icp-slam: incremental ICP scan matching against a point map, no loop closing",
@@ -201,6 +206,7 @@ BUILTIN_METHODS: tuple[MethodSpec, ...] = (
         "mrpt-rbpf",
         "albot1.methods.baselines.mrpt:MrptRbpfMapper",
         executables=("rbpf-slam",),
+        batch=True,
         stochastic=True,
         install_hint="apt-get install mrpt-apps (or: make mrpt)",
         auto_include=False,

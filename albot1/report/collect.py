@@ -107,6 +107,10 @@ class Column:
             missing = record.metrics.reason(self.metric)
             if missing is not None:
                 return missing
+        if self.source == "result" and record.result is not None and self.path.startswith("timing.per_scan_"):
+            why = record.result.timing.per_scan_reason  # a batch method: its per-scan times are not its cost
+            if why is not None:
+                return why
         if self.source != "metrics" or record.metrics is None:
             return f"no {self.source}.json value"
         return _null_reason(record.metrics, self.path, self.undefined)

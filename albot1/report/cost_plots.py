@@ -50,8 +50,8 @@ def plot_scan_time(records: list[CellRecord], dataset: str, path: Path, colors: 
     drawn = 0
     for label, rec in runs.items():
         ns_file = rec.run_dir / PER_SCAN_FILE
-        if not ns_file.is_file():
-            continue
+        if not ns_file.is_file() or (rec.result is not None and rec.result.timing.per_scan_reason is not None):
+            continue  # no times, or a batch method's bookkeeping (not its cost)
         ms = np.load(ns_file).astype(float) / 1e6
         if not len(ms):
             continue

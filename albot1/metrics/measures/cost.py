@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from albot1.metrics.blocks import block_of, fmt
 from albot1.metrics.cost import cost
+from albot1.metrics.errors import MetricsError
 from albot1.metrics.unit import TIMING, Metric, MetricInputs
 from albot1.records import Count, NonNegative, OptFloat, OptNonNegative, Record, dump_record
 
@@ -41,6 +42,9 @@ class CostBlock(Record):
 
 def compute(inputs: MetricInputs) -> CostBlock:
     assert inputs.per_scan_ns is not None  # TIMING is a need
+    if inputs.timing is not None and inputs.timing.per_scan_reason is not None:
+        # a batch method: per-scan statistics and their growth would describe its bookkeeping, not its cost
+        raise MetricsError(f"cost: {inputs.timing.per_scan_reason}")
     timing = dump_record(inputs.timing) if inputs.timing is not None else {}
     return block_of(CostBlock, cost(inputs.per_scan_ns, timing))
 
