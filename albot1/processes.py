@@ -70,6 +70,25 @@ class TreeMemory:
         return total
 
 
+def high_water_mb(pid: int | str = "self") -> float | None:
+    """The resident high-water mark (MiB) of the program now running as ``pid`` (``VmHWM``); None where unknown.
+
+    Why not ``ru_maxrss``: the kernel carries the high-water mark of a process's image before ``exec`` into the
+    program it becomes, and that image is a fork of its parent, so a program started by a 400 MB process
+    reports at least 400 MB (``/bin/sleep`` 432 MB; ``python -m albot1.bench.cell_main`` under a Dask worker, or
+    ``albot1 run`` started by a large test process, the parent's peak as its own). ``VmHWM`` belongs to the
+    program's own address space. None off Linux (no ``/proc``) or once the process is gone.
+    """
+    try:
+        with open(f"/proc/{pid}/status", "rb") as status:
+            for line in status:
+                if line.startswith(b"VmHWM:"):
+                    return int(line.split()[1]) * 1024 / MIB  # kB
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
 def kill_tree(process: psutil.Process) -> None:
     """SIGKILL ``process``'s descendants, then ``process`` itself (its parent reaps it); gone ones are skipped.
 

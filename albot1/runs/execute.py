@@ -6,8 +6,8 @@ to ``total_s``. A method's start-up before the first scan (``Mapper.warm_up``,
 e.g. numba compiling or loading its kernels) is ``startup_s``, outside the
 per-scan times and ``total_s`` and inside ``wall_s``, so the per-scan
 statistics describe the steady state. ``peak_mb`` is the process's resident-set high-water mark
-(``ru_maxrss``) at the end of the run: the benchmark runs each cell in a fresh
-process, so there it is the cell's peak. ``cpu_s`` is the CPU time of the
+(its own ``VmHWM``, not the ``ru_maxrss`` it inherits across ``exec``) at the end of the run: the
+benchmark runs each cell in a fresh process, so there it is the cell's peak. ``cpu_s`` is the CPU time of the
 same span as ``wall_s`` (:func:`cpu_time_s`).
 """
 
@@ -31,13 +31,22 @@ from albot1.data.transforms import robot_frame, sensor_frame
 from albot1.errors import Albot1Error
 from albot1.geometry.types import FloatArray
 from albot1.methods.registry import MethodRegistry, get_method, resolve_config
+from albot1.processes import high_water_mb
 from albot1.runs.errors import RunError
 
 log = logging.getLogger(__name__)
 
 
 def peak_rss_mb() -> float:
-    """Resident-set high-water mark of this process, MiB."""
+    """Resident-set high-water mark of this process, MiB: its own ``VmHWM``, ``ru_maxrss`` where there is none.
+
+    ``ru_maxrss`` alone is at least the peak of the process that started this one (the kernel keeps it across
+    ``exec``): a cell run as ``python -m albot1.bench.cell_main`` by a 400 MB process recorded 400 MB whatever its
+    method used (:func:`albot1.processes.high_water_mb`).
+    """
+    own = high_water_mb()
+    if own is not None:
+        return own
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return peak / (1024.0 * 1024.0) if sys.platform == "darwin" else peak / 1024.0
 

@@ -39,7 +39,7 @@ from pathlib import Path
 
 import psutil
 
-from albot1.processes import MIB, Stop, supervise
+from albot1.processes import Stop, high_water_mb, supervise
 
 #: How often the child's memory and the clock are checked (s).
 POLL_S = 0.1
@@ -66,18 +66,6 @@ def _die_with_parent() -> None:
     if sys.platform.startswith("linux"):
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-
-
-def _high_water_mb(pid: int) -> float:
-    """The resident high-water mark of the program running as ``pid`` (``VmHWM``, Linux; 0 where unknown)."""
-    try:
-        with open(f"/proc/{pid}/status", "rb") as status:
-            for line in status:
-                if line.startswith(b"VmHWM:"):
-                    return int(line.split()[1]) * 1024 / MIB  # kB
-    except (OSError, ValueError, IndexError):
-        pass
-    return 0.0
 
 
 def _reap(pid: int) -> tuple[int, resource.struct_rusage] | None:
@@ -110,12 +98,12 @@ def run_limited(
             preexec_fn=_die_with_parent,
         )
     reaped: tuple[int, resource.struct_rusage] | None = None
-    high_water_mb = 0.0
+    high_water = 0.0
 
     def ended(timeout: float) -> bool:
         """Reap the child if it has exited, else after ``timeout`` s (``wait4`` has no timeout of its own)."""
-        nonlocal reaped, high_water_mb
-        high_water_mb = max(high_water_mb, _high_water_mb(proc.pid))  # before the reap: /proc/PID goes with it
+        nonlocal reaped, high_water
+        high_water = max(high_water, high_water_mb(proc.pid) or 0.0)  # before the reap: /proc/PID goes with it
         reaped = _reap(proc.pid)
         if reaped is None:
             time.sleep(timeout)
@@ -139,7 +127,7 @@ def run_limited(
     wall_s = time.perf_counter() - start
     code = os.waitstatus_to_exitcode(status)
     proc.returncode = code  # reaped here: keep Popen from waiting on a pid that is gone
-    peak_mb = max(polled_peak_mb, high_water_mb) or None  # not ru_maxrss: see the module docstring
+    peak_mb = max(polled_peak_mb, high_water) or None  # not ru_maxrss: see the module docstring
     return ProcessOutcome(
         returncode=None if stopped is not None else code,
         stopped=stopped,
