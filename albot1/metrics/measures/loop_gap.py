@@ -8,7 +8,7 @@ closed, only the route gap is (:class:`ClosedRouteGapBlock`).
 from __future__ import annotations
 
 from albot1.metrics.blocks import Stats, block_of, fmt
-from albot1.metrics.loop_gap import pair_gaps, route_gap
+from albot1.metrics.loop_gap import MIN_TRAVEL_M, pair_gaps, route_gap
 from albot1.metrics.measures.drift import METRIC as DRIFT
 from albot1.metrics.unit import NO_REFERENCE, RETURNING_ROUTE, BlockLookup, ColumnSpec, Metric, MetricInputs
 from albot1.records import Count, NonNegative, Record
@@ -107,10 +107,20 @@ def headline(block: Block) -> str:
 
 
 def route_returns(block: Block, others: BlockLookup) -> str | None:
-    """None when the route returns to its start (a loop gap means something), else why it does not apply."""
+    """None when the route goes out and returns to its start (a loop gap means something), else why it does not apply.
+
+    A route that never leaves its start (a robot parked or turning on the spot, the first metres of a log) ends
+    within the return bound too, but closes no loop: it must travel at least :data:`MIN_TRAVEL_M` of reference
+    path, the bound a revisit pair is held to. Its "loop gap" was the drift over a few centimetres.
+    """
     offset = block.route.reference_offset_m
     drift = others.get(DRIFT)
     route = drift.route_m if drift is not None else 0.0
+    if drift is not None and route < MIN_TRAVEL_M:
+        return (
+            f"the route never leaves its start to return to it (it travels {route:.1f} m; a loop needs at least "
+            f"{MIN_TRAVEL_M:g} m)"
+        )
     allowed = max(ROUTE_RETURN_M, ROUTE_RETURN_FRACTION * route)
     if offset <= allowed:
         return None
