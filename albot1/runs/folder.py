@@ -283,9 +283,9 @@ def read_run(run_dir: str | Path) -> StoredRun:
     """
     path = Path(run_dir)
     info = read_result(path)
-    stamps, poses = read_tum(_required(path, "trajectory.tum"))
-    _, odom = read_tum(_required(path, "odometry.tum"))
-    reference = read_tum(_required(path, "reference.tum"))[1] if info.has_reference else None
+    stamps, poses = _scan_poses(path, "trajectory.tum", info.scans, None)
+    odom = _scan_poses(path, "odometry.tum", info.scans, stamps)[1]
+    reference = _scan_poses(path, "reference.tum", info.scans, stamps)[1] if info.has_reference else None
     # The copy holds the relations as they were scored: a repeated line in it is one its source counted (this
     # code writes a note saying how it read its source, which wins; copies written before the note counted every
     # line as listed), so "keep" reads every copy back as scored.
@@ -295,6 +295,32 @@ def read_run(run_dir: str | Path) -> StoredRun:
     # another system's trajectory (albot1.runs.external_run) has no per-scan times: an empty array
     per_scan = _read_per_scan(_required(path, PER_SCAN_FILE), 0 if info.preset == EXTERNAL_PRESET else info.scans)
     return StoredRun(path, info, stamps, poses, odom, reference, relations, per_scan)
+
+
+def _scan_poses(
+    run_dir: Path, name: str, scans: int, stamps: NDArray[np.float64] | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """One of the run's TUM files: one pose per scan at the scans' stamps, or a RunError naming the file.
+
+    :func:`write_run` writes the three files from one array of stamps, with ``scans`` rows each. A file cut
+    short (a copy or sync that stopped early) or edited parses as a valid shorter trajectory; scored as it
+    was, every metric would read "does not apply" (or, cut at both ends alike, score fewer scans) with exit 0,
+    so the damage is said here, once, as the damage it is.
+    """
+    file = _required(run_dir, name)
+    found_stamps, poses = read_tum(file)
+    damaged = "the folder was damaged or edited by hand; run it again"
+    if len(poses) != scans:
+        raise RunError(
+            f"{file}: {len(poses)} poses, expected {scans} (one per scan, as {RESULT_FILE} 'scans' says); {damaged}"
+        )
+    if stamps is not None and not np.array_equal(found_stamps, stamps):
+        row = int(np.flatnonzero(found_stamps != stamps)[0])
+        raise RunError(
+            f"{file}: pose {row + 1} has stamp {found_stamps[row]:.9f}, expected {stamps[row]:.9f} (that scan's "
+            f"stamp in trajectory.tum: the run's files are written from one array of stamps); {damaged}"
+        )
+    return found_stamps, poses
 
 
 def _required(run_dir: Path, name: str) -> Path:

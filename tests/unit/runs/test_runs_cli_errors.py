@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import json
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -106,3 +107,44 @@ def test_evaluate_on_a_damaged_run_folder_is_one_line_naming_the_file(
         damage()
         code, _, err = albot1(monkeypatch, capsys, "evaluate", str(run_dir))
         assert code == 1 and words in one_line(err)
+
+
+def _keep_lines(file: Path, keep: slice) -> None:
+    lines = file.read_text(encoding="utf-8").splitlines(keepends=True)
+    file.write_text(lines[0] + "".join(lines[1:][keep]), encoding="utf-8")  # the header kept, poses sliced
+
+
+def _shift_stamp(file: Path, pose: int) -> None:
+    lines = file.read_text(encoding="utf-8").splitlines(keepends=True)
+    fields = lines[pose].split(" ")
+    fields[0] = f"{float(fields[0]) + 0.5:.9f}"
+    lines[pose] = " ".join(fields)
+    file.write_text("".join(lines), encoding="utf-8")
+
+
+@pytest.mark.parametrize(
+    ("name", "damage", "words"),
+    [
+        # a copy cut short at a line boundary parses as a valid shorter trajectory
+        ("trajectory.tum", lambda f: _keep_lines(f, slice(0, 12)), "trajectory.tum: 12 poses, expected 20"),
+        ("odometry.tum", lambda f: _keep_lines(f, slice(0, 19)), "odometry.tum: 19 poses, expected 20"),
+        ("reference.tum", lambda f: _keep_lines(f, slice(3, None)), "reference.tum: 17 poses, expected 20"),
+        ("odometry.tum", lambda f: _shift_stamp(f, 5), "odometry.tum: pose 5 has stamp"),
+    ],
+)
+def test_evaluate_refuses_a_run_file_that_lost_or_moved_scans(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    name: str,
+    damage: Callable[[Path], None],
+    words: str,
+) -> None:
+    """Scored as found, a truncated trajectory made every metric "does not apply" with exit 0: damage, not a result."""
+    code, out, _ = albot1(monkeypatch, capsys, "run", "odometry", WORLD, "--limit", "20", "--out", str(tmp_path))
+    assert code == 0
+    run_dir = Path(out.strip().rsplit(" -> ", 1)[1])
+    damage(run_dir / name)
+    code, _, err = albot1(monkeypatch, capsys, "evaluate", str(run_dir))
+    line = one_line(err)
+    assert code == 1 and words in line and "damaged or edited by hand" in line, line
