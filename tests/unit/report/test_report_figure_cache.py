@@ -1,17 +1,19 @@
 """A report drawn again draws only the figures whose inputs changed (albot1.report.figure_cache).
 
 A tiny store made by the real planner and cell executor (dead reckoning on two small synthetic worlds) is
-reported three times into one folder: the second report draws nothing; after one cell's metrics change, only
-its dataset's figures (and the cross-dataset runtime figure) are drawn again; a deleted figure is drawn again.
+reported: the first report is built once for the module (:func:`first_report`) and each slow test goes on
+from a copy of it; the second report draws nothing; after one cell's metrics change, only its dataset's figures
+(and the cross-dataset runtime figure) are drawn again; a deleted figure is drawn again.
 """
 
 from __future__ import annotations
 
 import json
+import shutil
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Any, cast
+from typing import Any, NamedTuple, cast
 
 import pytest
 
@@ -48,6 +50,36 @@ def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return root
 
 
+class FirstReport(NamedTuple):
+    """The store's first report and what building it did (recorded by the spies below)."""
+
+    folder: Path
+    drawn: list[str]
+    aggregated: int
+
+
+@pytest.fixture(scope="module")
+def first_report(results: Path, tmp_path_factory: pytest.TempPathFactory) -> FirstReport:
+    """The store's report built once, before any test edits the store: the slow tests go on from a copy of it.
+
+    A copy with its file times kept is what a second build into the same folder finds (the figure cache names
+    its files relative to the folder), so the module draws the two datasets' figures once instead of once per
+    test; the second build's claims are checked on the copy.
+    """
+    folder = tmp_path_factory.mktemp("first") / "report"
+    with pytest.MonkeyPatch.context() as patch:
+        drawn = _counting(patch)
+        aggregated = _aggregating(patch)
+        build_report(results, folder)
+    return FirstReport(folder, drawn, len(aggregated))
+
+
+def _copy(report: FirstReport, out: Path) -> Path:
+    """A copy of the first report to build into (file times kept, as the folder the first build left)."""
+    shutil.copytree(report.folder, out)
+    return out
+
+
 def _counting(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     drawn: list[str] = []
     original: Callable[..., list[Path]] = figure_pool._dataset_plots
@@ -74,21 +106,19 @@ def _aggregating(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
 @pytest.mark.slow
 def test_a_second_report_draws_nothing_and_a_changed_cell_redraws_its_dataset_only(
-    results: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    results: Path, first_report: FirstReport, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    out = tmp_path / "report"
-    drawn = _counting(monkeypatch)
-    aggregated = _aggregating(monkeypatch)
-    build_report(results, out)
-    assert sorted(drawn) == sorted(DATASETS)
-    assert len(aggregated) == 2  # accuracy and cost, once each: the tables, figures and index.html share them
+    assert sorted(first_report.drawn) == sorted(DATASETS)
+    assert first_report.aggregated == 2  # accuracy and cost, once each: the tables, figures and index.html share them
+    out = _copy(first_report, tmp_path / "report")
     first = {p.name: p.read_bytes() for p in (out / "plots").glob("*.png")}
     readme = (out / "README.md").read_text(encoding="utf-8")
 
-    drawn.clear()
+    drawn = _counting(monkeypatch)
+    aggregated = _aggregating(monkeypatch)
     build_report(results, out)
     assert drawn == []
-    assert len(aggregated) == 4  # the tables are written again; the figures, all kept, need no aggregate
+    assert len(aggregated) == 2  # the tables are written again; the figures, all kept, need no aggregate
     assert {p.name: p.read_bytes() for p in (out / "plots").glob("*.png")} == first
     assert (out / "README.md").read_text(encoding="utf-8") == readme  # the same figures are linked
 
@@ -220,10 +250,11 @@ def test_what_a_failed_drawing_made_is_not_deleted(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
-def test_a_report_without_plots_removes_the_figures_an_earlier_report_drew_there(results: Path, tmp_path: Path) -> None:
+def test_a_report_without_plots_removes_the_figures_an_earlier_report_drew_there(
+    results: Path, first_report: FirstReport, tmp_path: Path
+) -> None:
     """``--no-plots`` into a folder with an earlier report's figures left them there, with that report's numbers."""
-    out = tmp_path / "report"
-    build_report(results, out)
+    out = _copy(first_report, tmp_path / "report")
     drawn = sorted(p.name for p in (out / "plots").rglob("*.png"))
     assert drawn  # the earlier report's figures
     (out / "plots" / "mine.txt").write_text("not the report's")
