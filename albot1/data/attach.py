@@ -25,7 +25,7 @@ the same everywhere (``docs/formats.md``, "Options of every source"):
     reference is all or nothing (a metric scored on part of the scans would
     not say which part).
 
-CARMEN logs have their own ``reference`` keyword (:data:`REFERENCE_KEYWORDS`:
+CARMEN logs have their own ``reference`` keyword (:data:`~albot1.data.loaders.base.REFERENCE_KEYWORDS`:
 which lines hold the reference); any other value of ``reference`` names a file.
 """
 
@@ -45,8 +45,6 @@ from albot1.data.trajectory import read_trajectory
 
 #: Largest gap (s) between a scan and the reference pose it takes (evo's default ``t_max_diff``).
 REFERENCE_MAX_DT_S = 0.01
-#: Values of ``reference`` that a CARMEN log reads as a keyword, not as a file name.
-REFERENCE_KEYWORDS = ("none", "laser-pose", "truepos", "auto")
 #: How many relations an error about relation ends between scans names.
 _NAMED = 3
 

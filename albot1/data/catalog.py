@@ -21,7 +21,7 @@ from typing import Any
 from urllib.parse import quote
 
 from albot1.config.suggest import unknown_name_message
-from albot1.data.errors import ChecksumError, DatasetNotFoundError
+from albot1.data.errors import ChecksumError, DataError, DatasetNotFoundError
 from albot1.data.fetch import ensure_file
 from albot1.data.identity import content_sha256
 from albot1.data.loaders.registry import load
@@ -70,6 +70,28 @@ def _missing(manifest: DatasetManifest, data_file: DataFile, settings: Settings)
     return DatasetNotFoundError(f"dataset {manifest.name!r}: {data_file.path} not found under {roots}; {hint}")
 
 
+def _folder_refusal(manifest: DatasetManifest, data_file: DataFile, found: Path) -> str:
+    """Why a manifest's file that is a folder is refused, and which file inside to name instead.
+
+    A ROS2 bag is a folder, but a manifest's sha256 is ``sha256sum`` of one
+    file: the entry names the bag's storage file, and the loader reads the
+    ``metadata.yaml`` beside it. This used to be "a folder, not a regular
+    file; expected a data file", naming neither the manifest nor the fix.
+    """
+    where = f" ({manifest.manifest_path})" if manifest.manifest_path else ""
+    storage = sorted(p.name for p in found.iterdir() if p.suffix in (".mcap", ".db3") and p.is_file())
+    hint = (
+        f'; for a ROS2 bag name its storage file: path = "{data_file.path}/{storage[0]}" with sha256 of '
+        f"`sha256sum {found / storage[0]}`"
+        if storage
+        else ""
+    )
+    return (
+        f"{found}: a folder, but the manifest of dataset {manifest.name!r}{where} names it as its "
+        f"{data_file.role} file; expected a file (sha256 is the checksum of one file){hint}"
+    )
+
+
 def verified_file(manifest: DatasetManifest, data_file: DataFile, settings: Settings) -> Path:
     """The first copy of ``data_file`` under the search roots, checked against the manifest's sha256.
 
@@ -83,6 +105,8 @@ def verified_file(manifest: DatasetManifest, data_file: DataFile, settings: Sett
     if not copies:
         raise _missing(manifest, data_file, settings)
     found = copies[0]
+    if found.is_dir():
+        raise DataError(_folder_refusal(manifest, data_file, found))
     got = content_sha256(found, folder_ok=False)
     if got == data_file.sha256:
         return found

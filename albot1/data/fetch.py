@@ -40,6 +40,9 @@ from albot1.data.manifest import DataFile
 from albot1.settings import Settings
 
 _BLOCK = 1 << 20
+#: How many first bytes of a reply are kept to tell an HTML page (:data:`_HTML_STARTS`) from a dataset file.
+_HEAD_BYTES = 64
+_HTML_STARTS = (b"<!doctype html", b"<html")
 TIMEOUT_S = 60.0
 #: The most a download may write when its manifest entry gives no ``size`` (the largest public log of the
 #: catalog is about 60 MB): a URL that never ends (``file:///dev/zero``) stops here, not at a full disk.
@@ -53,6 +56,8 @@ class _Received(NamedTuple):
     sha256: str
     announced: int | None
     content_type: str
+    #: the first bytes of the reply (an HTML page served as application/octet-stream is told by them)
+    head: bytes = b""
 
 
 def sha256_of(path: Path) -> str:
@@ -121,6 +126,7 @@ def _receive(url: str, out: IO[bytes], dest: Path, limit: int, what: str, timeou
     """Stream ``url`` into ``out`` (at most ``limit`` bytes); FetchError for every network or HTTP failure."""
     digest = hashlib.sha256()
     written = 0
+    head = b""
     try:
         with urllib.request.urlopen(url, timeout=timeout) as response:
             headers = response.headers
@@ -133,6 +139,7 @@ def _receive(url: str, out: IO[bytes], dest: Path, limit: int, what: str, timeou
                 if written > limit:
                     raise FetchError(f"{url}: more than {what}; download stopped and discarded")
                 digest.update(block)
+                head = head or block[:_HEAD_BYTES]
                 _write(out, block, dest)
             _write(out, None, dest)
             content_type = headers.get_content_type() if headers and "Content-Type" in headers else ""
@@ -163,7 +170,7 @@ def _receive(url: str, out: IO[bytes], dest: Path, limit: int, what: str, timeou
         ) from None
     except (OSError, ValueError) as exc:
         raise FetchError(f"{url}: download failed after {written} bytes ({_reason(exc)})") from None
-    return _Received(written, digest.hexdigest(), length, content_type)
+    return _Received(written, digest.hexdigest(), length, content_type, head)
 
 
 def _refusal(url: str, got: _Received, sha256: str, size: int | None) -> str:
@@ -175,11 +182,17 @@ def _refusal(url: str, got: _Received, sha256: str, size: int | None) -> str:
         )
     if got.written == 0:
         return f"{url}: the server sent an empty reply (0 bytes), not the dataset file; nothing kept"
-    if got.content_type == "text/html" and not url.lower().endswith((".html", ".htm")):
-        return (
-            f"{url}: the server sent an HTML page ({got.written} bytes, Content-Type text/html), not the dataset "
-            "file (a proxy's login or error page?); file discarded"
-        )
+    if not url.lower().endswith((".html", ".htm")):
+        # by its Content-Type, or by its first bytes when a server labels every reply application/octet-stream
+        # (that used to be only "sha256 ... does not match", not saying a web page had arrived)
+        label = f"Content-Type {got.content_type}" if got.content_type == "text/html" else None
+        if label is None and got.head.lstrip().lower().startswith(_HTML_STARTS):
+            label = f"Content-Type {got.content_type or 'not given'}, but it starts {got.head.lstrip()[:15]!r}"
+        if label is not None:
+            return (
+                f"{url}: the server sent an HTML page ({got.written} bytes, {label}), not the dataset "
+                "file (a proxy's login or error page?); file discarded"
+            )
     if size is not None and got.written != size:
         return f"{url}: {got.written} bytes, but the manifest's size is {size}; file discarded"
     return f"{url}: sha256 {got.sha256} does not match the manifest's {sha256}; file discarded"

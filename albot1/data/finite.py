@@ -9,7 +9,9 @@ with its source, index and timestamp:
 
 * odometry and reference poses: every component finite, and ``|x|, |y|``
   at most :data:`~albot1.data.model.MAX_COORDINATE_M` (the bound of trajectory files);
-* the scan's timestamp finite, its beam angles finite. Ranges may be NaN or
+* the scan's timestamp finite and at most :data:`~albot1.data.model.MAX_TIMESTAMP_S`
+  (the bound of trajectory files: a log stamped 1e300 s used to load and run, and
+  then its own ``trajectory.tum`` was refused by ``albot1 evaluate``); its beam angles finite. Ranges may be NaN or
   infinite: loaders use those for "no return" (``docs/formats.md``); a
   kept reading is at most ``MAX_COORDINATE_M`` (a max range of 1e31 m lets 1e30 m through).
 """
@@ -22,7 +24,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from albot1.data.errors import ParseError
-from albot1.data.model import MAX_COORDINATE_M, Frame, Sequence
+from albot1.data.model import MAX_COORDINATE_M, MAX_TIMESTAMP_S, Frame, Sequence
 
 
 def pose_problem(pose: object, what: str) -> str | None:
@@ -41,6 +43,11 @@ def frame_problem(frame: Frame) -> str | None:
     """Why ``frame`` holds a value no method or metric can use, or None."""
     if not math.isfinite(frame.scan.timestamp):
         return f"timestamp {frame.scan.timestamp} is not finite"
+    if abs(frame.scan.timestamp) > MAX_TIMESTAMP_S:
+        return (
+            f"timestamp {frame.scan.timestamp:.6g} is beyond {MAX_TIMESTAMP_S:g}; expected seconds "
+            "(a stamp in micro- or nanoseconds must be divided first)"
+        )
     problem = pose_problem(frame.odometry, "odometry")
     if problem is None and frame.reference is not None:
         problem = pose_problem(frame.reference, "reference pose")

@@ -18,7 +18,9 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
+from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
+from albot1.data.loaders.registry import FORMATS
 from albot1.data.relations import RepeatPolicy, repeat_policy
 
 #: The roles a file of a dataset may have.
@@ -65,6 +67,49 @@ class DatasetManifest:
         found = self.file("log")
         assert found is not None  # parse_manifest guarantees one log file
         return found
+
+
+#: The keys of a manifest and of one of its ``[[files]]`` tables (``datasets/README.md``, "Schema").
+TOP_KEYS = (
+    "name",
+    "description",
+    "format",
+    "license",
+    "citation",
+    "source",
+    "local_only",
+    "reference",
+    "notes",
+    "files",
+    "loader",
+)
+FILE_KEYS = ("role", "path", "sha256", "size", "urls", "repeats")
+
+
+def _unknown_keys(data: dict[str, Any], known: tuple[str, ...], where: Path) -> None:
+    """A DataError for the first key the schema does not have.
+
+    An unknown key used to be ignored without a word, so a typo lost what it
+    said: ``[loaders]`` for ``[loader]`` loaded a CARMEN log with the default
+    odometry instead of the one asked for, ``url =`` for ``urls =`` left a
+    dataset that "has no download URL".
+    """
+    for key in data:
+        if key not in known:
+            raise DataError(
+                f"{where}: unknown key {key!r}{did_you_mean(key, known)}; expected only {', '.join(known)} "
+                "(see datasets/README.md)"
+            )
+
+
+def _format(value: str, where: Path) -> str:
+    """The manifest's ``format``: a readable format (it used to fail only when the dataset was opened, unnamed)."""
+    if value not in FORMATS:
+        raise DataError(
+            f"{where}: format {value!r}{did_you_mean(value, list(FORMATS))} is no format the datasets are read in; "
+            f"expected one of {', '.join(FORMATS)}"
+        )
+    return value
 
 
 #: TOML's names of the Python types a manifest value may have (for error messages).
@@ -126,6 +171,7 @@ def parse_manifest(path: Path) -> DatasetManifest:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise DataError(f"{path}: not a readable TOML manifest ({exc})") from None
+    _unknown_keys(data, TOP_KEYS, path)
     name = _require(data, "name", str, path)
     if name != path.stem:
         raise DataError(f"{path}: name {name!r} must equal the file name {path.stem!r}")
@@ -134,6 +180,7 @@ def parse_manifest(path: Path) -> DatasetManifest:
         where = Path(f"{path} files[{i}]")
         if not isinstance(entry, dict):
             raise DataError(f"{where}: expected a [[files]] table, got {type(entry).__name__}")
+        _unknown_keys(entry, FILE_KEYS, where)
         role = _require(entry, "role", str, where)
         if role not in ROLES:
             raise DataError(f"{where}: role {role!r}; expected one of {', '.join(ROLES)}")
@@ -160,7 +207,7 @@ def parse_manifest(path: Path) -> DatasetManifest:
     return DatasetManifest(
         name=name,
         description=_optional(data, "description", str, path, ""),
-        format=_optional(data, "format", str, path, "carmen"),
+        format=_format(_optional(data, "format", str, path, "carmen"), path),
         files=tuple(files),
         license=_optional(data, "license", str, path, ""),
         citation=_optional(data, "citation", str, path, ""),

@@ -34,6 +34,10 @@ from albot1.geometry.types import FloatArray
 #: files (:mod:`albot1.data.trajectory`), every loaded frame (:mod:`albot1.data.finite`), the bag reader's ranges
 #: and a method's map (:mod:`albot1.runs.execute`) are held to it.
 MAX_COORDINATE_M = 1e8
+#: Largest accepted |timestamp| (s): year 5138 in Unix time; nanosecond stamps (1.7e18) are refused, not misread.
+#: Trajectory and relations files and every loaded frame (:mod:`albot1.data.finite`) are held to it, so a log
+#: whose stamps a run's own ``trajectory.tum`` could not be read back with is refused when it is loaded.
+MAX_TIMESTAMP_S = 1e11
 
 
 class _BeamDirections:

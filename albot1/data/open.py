@@ -40,12 +40,13 @@ from typing import Any
 from albot1.config.keyvalue import KeyValueError, parse_query
 from albot1.config.suggest import did_you_mean
 from albot1.data import catalog
-from albot1.data.attach import REFERENCE_KEYWORDS, with_reference, with_relations
+from albot1.data.attach import with_reference, with_relations
 from albot1.data.degrade import degrade, parse_spec
 from albot1.data.errors import DatasetNotFoundError, ReferenceOptionError, SliceError
 from albot1.data.filekind import check_input
 from albot1.data.finite import checked
 from albot1.data.identity import content_sha256
+from albot1.data.loaders.base import REFERENCE_KEYWORDS
 from albot1.data.loaders.registry import load
 from albot1.data.model import Sequence
 from albot1.data.synthetic import worlds

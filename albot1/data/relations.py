@@ -67,7 +67,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from albot1.atomic import atomic_write
 from albot1.data.errors import DataError, ParseError
-from albot1.data.model import Relations
+from albot1.data.model import MAX_TIMESTAMP_S, Relations
 from albot1.data.text import TEXT_ENCODING
 from albot1.data.tokens import parse_floats
 
@@ -85,8 +85,6 @@ STAMP_TOLERANCE_S = 1e-4
 MAX_MOTION_M = 1e8
 #: Largest accepted |yaw| (rad) of a relation's motion: pi, with room for pi printed rounded up (3.1416, 3.141593).
 MAX_YAW_RAD = math.pi + 1e-5
-#: Largest accepted |t1|, |t2| (s): Unix seconds until year 5138; nanosecond stamps are refused, not misread.
-MAX_TIMESTAMP_S = 1e11
 #: How far (m per metre of the relation's length, plus this much; and rad) a line giving an earlier relation in the
 #: other direction may be from that relation's inverse and still be the same measurement: the inverse of a motion
 #: printed to 5 decimals misses the printed inverse by about 1e-5 of that, so this is a tenfold margin.

@@ -52,7 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.data.errors import DataError, ParseError
-from albot1.data.model import MAX_COORDINATE_M
+from albot1.data.model import MAX_COORDINATE_M, MAX_TIMESTAMP_S
 from albot1.data.text import TEXT_ENCODING
 from albot1.data.tokens import is_number
 
@@ -61,8 +61,6 @@ TRAJECTORY_FORMATS: tuple[TrajectoryFormat, ...] = get_args(TrajectoryFormat)
 TUM_COLUMNS = "t x y z qx qy qz qw"
 #: Suffixes of CARMEN logs (plain or compressed) for :func:`guess_format`.
 CARMEN_SUFFIXES = (".clf", ".log", ".gfs", ".carmen")
-#: Largest accepted |timestamp| (s): year 5138 in Unix time; nanosecond stamps (1.7e18) are refused, not misread.
-MAX_TIMESTAMP_S = 1e11
 #: Largest accepted | |q| - 1 | of a TUM quaternion; within it the quaternion is normalised.
 QUATERNION_TOLERANCE = 1e-2
 #: Largest accepted entry of ``R R^T - I`` of a KITTI rotation.

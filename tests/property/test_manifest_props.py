@@ -12,6 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from albot1.data.errors import DataError
+from albot1.data.loaders.registry import FORMATS
 from albot1.data.manifest import parse_manifest
 
 
@@ -95,7 +96,13 @@ def test_any_bytes_parse_or_raise_data_error(raw: bytes) -> None:
 @given(
     GOOD_FILE.map(lambda f: {**f, "role": "log"}),
     st.lists(GOOD_FILE.map(lambda f: {**f, "role": "relations"}), max_size=1),
-    st.fixed_dictionaries({}, optional={k: TEXT for k in KEYS if k not in ("local_only", "loader")}),
+    st.fixed_dictionaries(
+        {},
+        optional={
+            **{k: TEXT for k in KEYS if k not in ("local_only", "loader", "format")},
+            "format": st.sampled_from(list(FORMATS)),  # any other format is refused (test_manifest.py)
+        },
+    ),
     st.booleans(),
     st.dictionaries(TEXT, SCALAR, max_size=3),
 )

@@ -19,6 +19,27 @@ from albot1.data.model import Frame, Sequence
 #: :mod:`albot1.data.attach`, not by a loader): loaders name them in their unknown-option errors.
 COMMON_OPTIONS = ("relations", "reference", "reference_max_dt", "odometry=reference", "views")
 
+#: Values of ``reference`` that a CARMEN log reads as a keyword (which lines hold the reference), not as a file
+#: name (:mod:`albot1.data.attach` attaches every other value as a trajectory file).
+REFERENCE_KEYWORDS = ("none", "laser-pose", "truepos", "auto")
+
+
+def reference_keyword_problem(options: dict[str, Any], what: str) -> str | None:
+    """Why ``reference=<word>`` cannot apply to ``what`` (a source that is not a CARMEN log), or None.
+
+    Every source takes ``reference=FILE``; only a CARMEN log reads a word
+    there (which of its lines hold the reference poses). Such a word used to
+    reach the other loaders and be refused as an unknown option by a message
+    that listed ``reference`` among the options every source takes.
+    """
+    value = options.get("reference")
+    if value is None or str(value) not in REFERENCE_KEYWORDS:
+        return None
+    return (
+        f"reference={value} is a CARMEN log's keyword ({', '.join(REFERENCE_KEYWORDS)}: which of its lines hold "
+        f"the reference poses); for {what} reference= names a trajectory file (TUM, KITTI or a corrected CARMEN log)"
+    )
+
 
 @runtime_checkable
 class SequenceLoader(Protocol):

@@ -23,7 +23,7 @@ import functools
 import math
 from typing import Any
 
-from albot1.data.loaders.base import COMMON_OPTIONS
+from albot1.data.loaders.base import COMMON_OPTIONS, reference_keyword_problem
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
 from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError
@@ -183,6 +183,9 @@ def variant(name: str, options: dict[str, Any]) -> WorldSpec:
     ``DatasetNotFoundError``: that world-with-options does not exist).
     """
     spec = spec_for(name)
+    keyword = reference_keyword_problem(options, "a synthetic world")
+    if keyword is not None:
+        raise WorldOptionError(f"synthetic world {name!r}: {keyword}")
     unknown = sorted(set(options) - set(WORLD_OPTIONS))
     if unknown:
         raise WorldOptionError(

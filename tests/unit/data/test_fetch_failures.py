@@ -26,6 +26,7 @@ from albot1.data.errors import FetchError
 PAYLOAD = b"FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\n" * 200
 SHA = hashlib.sha256(PAYLOAD).hexdigest()
 HTML = b"<html><body>Please log in to the guest network</body></html>"
+HTML_AS_BINARY = b"\n  <!DOCTYPE html>\n<html><body>503 Service Unavailable</body></html>"
 
 
 class _Misbehaving(http.server.BaseHTTPRequestHandler):
@@ -55,6 +56,14 @@ class _Misbehaving(http.server.BaseHTTPRequestHandler):
         elif mode == "html":
             self._head(200, len(HTML), "text/html; charset=utf-8")
             self.wfile.write(HTML)
+        elif mode == "html-as-binary":  # a server that labels every reply application/octet-stream
+            self._head(200, len(HTML_AS_BINARY))
+            self.wfile.write(HTML_AS_BINARY)
+        elif mode == "redirect-to-html":  # a captive portal: a redirect to its login page
+            self.send_response(302)
+            self.send_header("Location", "/html/login")
+            self.send_header("Content-Length", "0")
+            self.end_headers()
         elif mode == "not-http":
             self.wfile.write(b"SSH-2.0-OpenSSH_9.6\r\n\r\n")
         elif mode == "loop":
@@ -124,6 +133,26 @@ def test_an_html_page_served_with_200_is_named(base: str, tmp_path: Path, size: 
         f"{url}: the server sent an HTML page ({len(HTML)} bytes, Content-Type text/html), not the dataset file "
         "(a proxy's login or error page?); file discarded"
     )
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("size", [None, len(PAYLOAD)])
+def test_an_html_page_labelled_as_binary_is_named_by_its_first_bytes(
+    base: str, tmp_path: Path, size: int | None
+) -> None:
+    """It used to be "sha256 ... does not match" (or "64 bytes, but the manifest's size is ..."), not saying a
+    web page had arrived."""
+    url = f"{base}/html-as-binary/tiny.clf"
+    assert refusal(url, tmp_path / "dl" / "tiny.clf", size=size) == (
+        f"{url}: the server sent an HTML page ({len(HTML_AS_BINARY)} bytes, Content-Type application/octet-stream, "
+        "but it starts b'<!DOCTYPE html>'), not the dataset file (a proxy's login or error page?); file discarded"
+    )
+
+
+@pytest.mark.timeout(30)
+def test_a_redirect_to_a_login_page_is_named_as_an_html_page(base: str, tmp_path: Path) -> None:
+    url = f"{base}/redirect-to-html/tiny.clf"
+    assert "the server sent an HTML page" in refusal(url, tmp_path / "dl" / "tiny.clf", size=len(PAYLOAD))
 
 
 @pytest.mark.timeout(30)

@@ -70,6 +70,32 @@ def test_a_log_with_an_absurd_odometry_is_refused_at_that_scan(tmp_path: Path, f
         open_sequence(f"{out}{options}").arrays  # noqa: B018
 
 
+@pytest.mark.parametrize("stamp", [1e300, 1.7e18, -2e11])
+def test_a_log_stamped_beyond_the_trajectory_files_bound_is_refused_when_loaded(tmp_path: Path, stamp: float) -> None:
+    """A stamp in nanoseconds (or 1e300) used to load and run; the run's own trajectory.tum was then refused
+    by ``albot1 evaluate`` ("timestamp ... is beyond 1e+11"): the log is refused at that scan instead."""
+    sequence = open_sequence(WORLD)
+    bad = sequence.with_frames(
+        lambda frames: (
+            Frame(f.index, Scan(f.scan.ranges, f.scan.angles, stamp, f.scan.max_range), f.odometry, f.reference)
+            if f.index == 4
+            else f
+            for f in frames
+        )
+    )
+    out = tmp_path / "w.albotlog"
+    convert(bad, out, "albot-log")
+    with pytest.raises(
+        DataError, match=r"w\.albotlog: scan 4 \(t = .* s\): timestamp .* is beyond 1e\+11; expected seconds"
+    ):
+        open_sequence(str(out)).arrays  # noqa: B018
+
+
+def test_stamps_of_todays_unix_time_and_negative_ones_pass() -> None:
+    assert frame_problem(_frame([0, 0, 0], t=1.8e9)) is None
+    assert frame_problem(_frame([0, 0, 0], t=-5.0)) is None
+
+
 @pytest.mark.parametrize("spec", ["gauss:1e300:1", "bias:1e200:0"])
 def test_a_degradation_that_overflows_names_the_step(spec: str) -> None:
     with pytest.raises(DataError, match=r"degradation .* seed 3, step to scan 1 \(t = .*\): the degraded odometry"):

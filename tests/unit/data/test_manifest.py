@@ -54,6 +54,17 @@ def test_minimal_manifest_gets_the_documented_defaults(tmp_path: Path) -> None:
         ("description = 3\n" + GOOD, r"lab.toml: key 'description' must be a string, found a integer"),
         (GOOD + 'repeats = "keep"\n', r"files\[0\]: repeats goes with role = \"relations\", not 'log'"),
         (GOOD + RELATIONS + 'repeats = "twice"\n', r"files\[1\]: relations_repeats='twice'; expected drop"),
+        # an unknown key used to be ignored: [loaders] lost the loader options, url = ... the download URL
+        (
+            GOOD + '[loaders]\nodometry = "odom"\n',
+            r"lab.toml: unknown key 'loaders' \(did you mean 'loader'\?\); expected only name, description",
+        ),
+        ('fromat = "carmen"\n' + GOOD, r"lab.toml: unknown key 'fromat' \(did you mean 'format'\?\)"),
+        (GOOD + 'url = "https://x/lab.clf"\n', r"lab.toml files\[0\]: unknown key 'url' \(did you mean 'urls'\?\)"),
+        (GOOD + 'sha = "x"\n', r"lab.toml files\[0\]: unknown key 'sha'.*expected only role, path, sha256"),
+        # a format no loader reads used to fail only when the dataset was opened, without naming the manifest
+        (GOOD.replace('"carmen"', '"albotlog"'), r"lab.toml: format 'albotlog' \(did you mean 'albot-log'\?\) is no"),
+        (GOOD.replace('"carmen"', '"rawlog"'), r"lab.toml: format 'rawlog' is no format the datasets are read in"),
     ],
 )
 def test_bad_manifests_name_file_entry_and_key(tmp_path: Path, text: str, message: str) -> None:

@@ -8,8 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from albot1.data.convert import convert
 from albot1.data.degrade import degrade
-from albot1.data.errors import ReferenceOptionError
+from albot1.data.errors import DataError, ReferenceOptionError
 from albot1.data.model import Frame, Scan, Sequence
 from albot1.data.open import open_sequence, parse_views
 from albot1.data.transforms import reference_odometry, view_spacing
@@ -117,3 +118,25 @@ def test_odometry_reference_on_a_log_without_reference_is_one_clear_error(tmp_pa
     with pytest.raises(ReferenceOptionError, match="plain.clf'?: odometry=reference, but the dataset has no reference"):
         open_sequence(f"{log}?odometry=reference")
     assert open_sequence(f"{log}?views=1:10").count_scans() == 1  # it never moves: only the first scan is a view
+
+
+@pytest.mark.parametrize(
+    ("fmt", "what"), [("albot-log", "an albot log"), ("ros2-mcap", "a bag"), (None, "a synthetic world")]
+)
+@pytest.mark.parametrize("word", ["none", "truepos"])
+def test_a_carmen_reference_keyword_on_another_source_says_what_reference_takes_there(
+    tmp_path: Path, fmt: str | None, what: str, word: str
+) -> None:
+    """``reference=none`` on an albot log, a bag or a world used to be refused as an unknown option by a
+    message that listed ``reference`` among the options every source takes."""
+    ref = "synthetic-corridor"
+    if fmt is not None:
+        out = tmp_path / ("w.albotlog" if fmt == "albot-log" else "w")
+        convert(open_sequence("synthetic-corridor[:3]"), out, fmt)
+        ref = str(out)
+    with pytest.raises(DataError) as caught:
+        open_sequence(f"{ref}?reference={word}")
+    assert str(caught.value).endswith(
+        f"reference={word} is a CARMEN log's keyword (none, laser-pose, truepos, auto: which of its lines hold the "
+        f"reference poses); for {what} reference= names a trajectory file (TUM, KITTI or a corrected CARMEN log)"
+    )

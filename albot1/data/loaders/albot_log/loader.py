@@ -51,7 +51,7 @@ from albot1.data.loaders.albot_log.lines import (
     sensor_line,
     view_line,
 )
-from albot1.data.loaders.base import COMMON_OPTIONS, reference_presence_problem
+from albot1.data.loaders.base import COMMON_OPTIONS, reference_keyword_problem, reference_presence_problem
 from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
 from albot1.data.loaders.output import prepare_output, writing
 from albot1.data.model import Frame, Sequence, SequenceMetadata
@@ -115,6 +115,9 @@ class AlbotLogLoader:
 
     def load(self, path: Path, **options: Any) -> Sequence:
         path = Path(path)
+        keyword = reference_keyword_problem(options, "an albot log")
+        if keyword is not None:
+            raise DataError(f"{path}: {keyword}")
         unknown = sorted(k for k, v in options.items() if v is not None)
         if unknown:
             raise DataError(

@@ -32,7 +32,13 @@ from typing import Any, ClassVar
 import numpy as np
 
 from albot1.data.errors import DataError, ParseError, TopicError
-from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, max_pose_gap, pose_gap_problem
+from albot1.data.loaders.base import (
+    COMMON_OPTIONS,
+    DEFAULT_MAX_POSE_GAP_S,
+    max_pose_gap,
+    pose_gap_problem,
+    reference_keyword_problem,
+)
 from albot1.data.loaders.beams import seam_note
 from albot1.data.loaders.rosbag.bag1_check import version_problem
 from albot1.data.loaders.rosbag.mounting import bag_mounting
@@ -168,6 +174,9 @@ class _BagSource:
 
 
 def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
+    keyword = reference_keyword_problem(options, "a bag")
+    if keyword is not None:
+        raise DataError(f"{shown}: {keyword}")
     unknown = sorted(k for k, v in options.items() if k not in _OPTIONS and v is not None)
     if unknown:
         raise DataError(
