@@ -29,7 +29,7 @@ from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.earned_choice import EarnedFactors
 from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
-from albot1.methods.baselines.gtsam_graph.match_covariance import floor_covariance, in_child_frame, shaped_covariance
+from albot1.methods.baselines.gtsam_graph.match_covariance import floor_covariance, shaped_covariance
 from albot1.methods.baselines.gtsam_graph.odometry_runs import OdometryRuns
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, OdometryFactors, OdometryTrust
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
@@ -320,15 +320,6 @@ class FrontEnd:
         corr = se2.between(guess, reg.pose)
         return math.hypot(corr[0], corr[1]) <= max_m and abs(corr[2]) <= math.radians(max_deg)
 
-    def _edge_frame(self, relative: FloatArray, covariance: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """An edge whose covariance was judged in the parent's frame, stated in the child's (:mod:`.match_covariance`).
-
-        Only a shaped covariance needs it: the floor's is isotropic in translation, the same in both frames.
-        """
-        if self.config.match_covariance_shaped:
-            return relative, in_child_frame(covariance, float(relative[2]))
-        return relative, covariance
-
     def span_edges(self, relative: FloatArray, points: FloatArray) -> list[SpanEdge]:
         """The new node's edge spanning ``span_nodes`` steps (:mod:`.span_edges`), or none (off, too early, or failed).
 
@@ -422,8 +413,8 @@ class FrontEnd:
                 self._odometry_trust.add(odometry_step, reg.pose)
                 if fused is not None:
                     self.counters["odometry_fused"] += 1
-                    return self._edge_frame(*fused)
-            return self._edge_frame(reg.pose, covariance)
+                    return fused
+            return reg.pose, covariance
         self.counters["odometry_fallbacks"] += 1
         if self._odometry_runs is not None:
             self._odometry_runs.reset()

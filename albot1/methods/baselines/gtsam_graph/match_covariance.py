@@ -1,16 +1,17 @@
 """A sequential match's covariance estimated from the match's own geometry (``match_covariance_shaped``, off).
 
 Why: ICP's Gauss-Newton covariance (``inv(J' W J / point_sigma**2)``) is
-millimetres for a scan of hundreds of points, because it treats every
-point-to-line residual as independent, which points on one wall are not
-(they share the wall's fitted line; Censi 2007). So every match states about
-the constant floor (``match_sigma_floor_xy_m``, 0.02 m), isotropic, and the
-floor decides. With perfect odometry on edmonton-corrected and
-infinite-corridor-corrected the matches' real translation errors are 1.5-2.3x
-that floor in variance, and largest along the match's weak axis (whitened
-RMS 1.6 weak / 0.9 strong: docs/baselines.md, gtsam-graph, "where the error
-with perfect odometry comes from"): the floor is about right where the scan
-constrains the match best and too small along a corridor.
+smaller than the floor (on edmonton-corrected with perfect odometry 7 / 12 mm
+along the strong / weak axis, median), because it treats every point-to-line
+residual as independent, which points on one wall are not (they share the
+wall's fitted line; Censi 2007). So every match states about the constant
+floor (``match_sigma_floor_xy_m``, 0.02 m), isotropic, and the floor decides.
+With perfect odometry on edmonton-corrected and infinite-corridor-corrected
+the matches' real translation errors are 1.5-2.3x that floor in variance, and
+largest along the match's weak axis (whitened RMS 1.6 weak / 0.9 strong:
+docs/baselines.md, gtsam-graph, "where the error with perfect odometry comes
+from"): the floor is about right where the scan constrains the match best and
+too small along a corridor.
 
 The estimate here keeps the information's *shape* and the floor's *scale*:
 the translation information (the Schur complement of the heading, so a
@@ -23,12 +24,11 @@ information, as in the floor's formula, so a fully degenerate axis (a bare
 corridor) states the prior's variance rather than infinity. The heading keeps
 the floor's formula (its claim holds: chi-square 0.56-0.68 per dof).
 
-Covariances come out in two frames. ICP's translation is that of the parent
-node's frame; :mod:`.odometry_trust` compares innovations in that frame, while
-GTSAM's ``BetweenFactorPose2`` states its noise in the tangent space of the
-measured relative pose, whose translation is in the child's frame (rotated by
-the match's heading). With an isotropic translation block the two coincide,
-which is why the floor's formula never needed it.
+The covariance is that of additive (x, y, theta) errors with the translation
+in the parent node's frame, as ICP's information and :mod:`.odometry_trust`'s
+innovations are; :func:`.graph.body_frame_covariance` re-expresses it in GTSAM's
+tangent frame when the edge joins the graph (with the floor's isotropic
+translation that rotation changed nothing; with a shaped one it matters).
 """
 
 from __future__ import annotations
@@ -69,12 +69,3 @@ def shaped_covariance(information: FloatArray, prior: FloatArray, floor: FloatAr
     out[:2, :2] = 0.5 * (block + block.T)
     out[2, 2] = base[2, 2]
     return out
-
-
-def in_child_frame(covariance: FloatArray, heading: float) -> FloatArray:
-    """``covariance`` (parent-frame translation, heading) as GTSAM's between factor states it: translation rotated
-    into the frame of the child pose, whose heading relative to the parent is ``heading`` rad."""
-    c, s = np.cos(heading), np.sin(heading)
-    rot = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # R(heading)^T, heading untouched
-    out = rot @ np.asarray(covariance, dtype=float) @ rot.T
-    return np.asarray(0.5 * (out + out.T), dtype=np.float64)
