@@ -186,6 +186,10 @@ class GtsamGraphConfig(MethodConfig):
         gt=0, description="added to every match's std dev (x, y): matches are never perfect"
     )
     match_sigma_floor_theta_deg: float = Field(gt=0, description="added to every match's std dev (theta)")
+    match_covariance_shaped: bool = Field(
+        description="a sequential match's translation covariance shaped by ICP's information: the floor on its "
+        "best-constrained axis, larger along weaker ones by the eigenvalue ratio (match_covariance.py)"
+    )
     fallback_sigma_xy_m: float = Field(
         gt=0, description="std dev (x, y) of an odometry edge used when the match is poor"
     )

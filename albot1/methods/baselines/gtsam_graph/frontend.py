@@ -29,6 +29,7 @@ from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.earned_choice import EarnedFactors
 from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
+from albot1.methods.baselines.gtsam_graph.match_covariance import floor_covariance, shaped_covariance
 from albot1.methods.baselines.gtsam_graph.odometry_runs import OdometryRuns
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, OdometryFactors, OdometryTrust
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
@@ -390,7 +391,9 @@ class FrontEnd:
         if good and reg is not None:
             self.counters["sequential_matches"] += 1
             self._consecutive_fallbacks = 0
-            covariance = np.asarray(np.linalg.inv(reg.information + self._seq_prior) + self._floor, dtype=np.float64)
+            covariance = (shaped_covariance if cfg.match_covariance_shaped else floor_covariance)(
+                reg.information, self._seq_prior, self._floor
+            )
             if cfg.odometry_trust and cfg.odometry_trust_factors and odometry_step is not None:
                 # the new node's key is the number of nodes so far
                 self.odometry_factors = self._odometry_factors.add(
