@@ -12,8 +12,11 @@ reference-point-to-robot distance from the map's reference point: that is
 the rigid motion aligning the view landmark's reference point and direction
 with the map's, so :func:`landmark_pose` computes that motion in closed form
 and :func:`algorithm2_pose` (the literal two-point construction) is kept to
-prove the equivalence in the tests. Eqs 3.6-3.7 use P1 as reference point;
-when only P2 is stable the same construction is anchored at P2 (note 11).
+prove the equivalence in the tests. Eqs 3.6-3.7 use P1 as reference point
+(the thesis's worked case); here the reference is the endpoint the recognition
+matched (the one eq. 3.5's gap and distance measure) when it is stable in the
+map record too, else the other end, P1 first for a list without match data
+(note 11, docs/albot1-mapper.md item 16).
 """
 
 from __future__ import annotations

@@ -88,6 +88,41 @@ def test_a_lower_update_threshold_changes_the_branches(monkeypatch: pytest.Monke
     assert [t["scan"] for t in out.extras["update_trace"]] == [0]
 
 
+def update_trace(out) -> list[tuple[int, str, int]]:
+    return [(t["scan"], t["view"], t["view_scan"]) for t in out.extras["update_trace"]]
+
+
+def test_the_update_rule_counts_the_recognised_landmarks_not_those_in_view(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Section 3.1 defines the limiting point as "a view that contains less than three landmark surfaces"; Algorithm 4
+    # line 12 tests "(RL_n).size < 3", the landmarks recognised from the tracked list: the code reads line 12. View 1
+    # holds four landmarks but only A and B were tracked: an update (one step after the last: the current view).
+    out = run_views(monkeypatch, ["ABC", "ABDE"]).finish()
+    assert out.extras["landmarks_recognised"] == [0, 2]
+    assert update_trace(out) == [(0, "initial", 0), (1, "current", 1)]
+    # Exactly three recognised (of five in view): no update.
+    out = run_views(monkeypatch, ["ABC", "ABCDE"]).finish()
+    assert out.extras["landmarks_recognised"] == [0, 3]
+    assert update_trace(out) == [(0, "initial", 0)]
+
+
+def test_after_a_previous_view_update_three_recognised_again_need_no_second_update(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Scan 1 recognises A, B, C (exactly 3: no update) and is left tracking them, though it saw D and E too. Scan 2
+    # sees C, D, E: one recognised, two steps after the last update, so lines 18-22 update the map with view 1 and
+    # reset the list to view 1's landmarks (A-E); line 23 ("Go back to step 11") recognises C, D, E from it: three,
+    # not fewer, so line 12 asks for no second update.
+    out = run_views(monkeypatch, ["ABC", "ABCDE", "CDE"]).finish()
+    assert out.extras["landmarks_recognised"] == [0, 3, 1]
+    assert update_trace(out) == [(0, "initial", 0), (2, "previous", 1)]
+    c = out.counters
+    assert (c["updates"], c["updates_previous_view"], c["updates_current_view"], c["double_updates"]) == (1, 1, 0, 0)
+    # The same with D missing from scan 2: two recognised after the reset, so the current view is added too.
+    out = run_views(monkeypatch, ["ABC", "ABCDE", "CE"]).finish()
+    assert update_trace(out) == [(0, "initial", 0), (2, "previous", 1), (2, "current", 2)]
+    assert out.counters["double_updates"] == 1
+
+
 def room_frames(poses: np.ndarray, walls: np.ndarray = ROOM) -> list[Frame]:
     return [
         Frame(i, Scan(cast(walls, p, ANGLES, 30.0), ANGLES, float(i), 30.0), np.asarray(p, dtype=float))

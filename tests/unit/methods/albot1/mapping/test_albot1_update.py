@@ -84,6 +84,22 @@ def test_a_wall_running_on_behind_the_field_of_view_edge(margin_from: MarginFrom
         assert pmap.segments().min(axis=0)[1] == 0.0
 
 
+@pytest.mark.parametrize("margin_from", ["surfaces", "boundary"])
+def test_an_end_outside_the_polygon_but_within_the_margin_counts_as_inside_for_lines_11_12(
+    margin_from: MarginFrom,
+) -> None:
+    # Algorithm 3 line 11, "one edge point of S_i is inside the polygon and the other is outside", read with line 9's
+    # region (inside or within 40 cm; docs/albot1-mapper.md item 21). This wall runs 20 cm behind the view's first
+    # surface (y = 3.2 against 3): its right end is outside the polygon but within the margin, its left end far out.
+    # Literally neither line 9 nor line 11 would touch it; read so, it corresponds to the view surface 20 cm away and
+    # is extended onto it: from its outside end to that surface's far end.
+    pmap = PerceptualMap()
+    sid = int(pmap.add(np.array([[-5.0, 3.2, -1.5, 3.2]]), scan=0)[0])
+    out = update_map(pmap, VIEW, (0.0, 0.0), scan=4, params=UpdateParams(margin_from=margin_from))
+    assert out.extended.tolist() == [sid] and out.deleted.tolist() == [] and out.view_ids.tolist()[0] == sid
+    np.testing.assert_array_equal(pmap.segments(np.array([sid]))[0], [-5.0, 3.2, 0.0, 3.0])
+
+
 def test_update_keeps_partial_surfaces_whole_when_asked_and_adds_unmatched_view_surfaces() -> None:
     pmap, ids = build_map()
     params = UpdateParams(partial_without_match="keep", correspond_distance=0.01, correspond_angle=1e-6)

@@ -190,3 +190,30 @@ def test_empty_inputs_recognise_nothing() -> None:
 
 def test_thesis_frame_pose_conversion() -> None:
     assert rep_to_thesis_pose(np.array([1.0, 2.0, 0.3])) == (-2.0, 1.0, 0.3)
+
+
+@pytest.mark.parametrize("accelerate", [True, False])
+def test_both_recognition_thresholds_are_strict(accelerate: bool) -> None:
+    # Algorithm 1 lines 6-7: "angle (S'_i, S_j) < 5 deg" and "occluding/corner point distance (S'_i, S_j) < 40 cm".
+    # A pair exactly at either bound is not the same landmark; the next float inside it is.
+    kernels = PerceptionKernels(accelerate)
+    kinds = np.array([[OCCLUDING, UNSTABLE]])
+    prev = Tracked.fresh(np.array([[0.0, 2.0, 1.0, 2.0]]), kinds, np.array([7]))
+
+    def ids(cur: np.ndarray, max_angle: float, max_distance: float) -> list[int]:
+        got = recognise(
+            prev, cur, kinds, (0.0, 0.0, 0.0), max_angle=max_angle, max_distance=max_distance, kernels=kernels
+        )
+        return got.ids.tolist()
+
+    moved = np.array([[0.4, 2.0, 1.4, 2.0]])  # P1 exactly 0.4 m from its prediction, same direction
+    assert ids(moved, MAX_ANGLE, 0.4) == []
+    assert ids(moved, MAX_ANGLE, np.nextafter(0.4, 1.0)) == [7]
+    five = math.radians(5.0)
+    turned = np.array([[0.0, 2.0, math.cos(five), 2.0 + math.sin(five)]])  # same P1, turned by 5 degrees
+    # The angle to the last bit as the kernel measures it (directions P1 -> P2, the difference wrapped): 5 degrees
+    # up to rounding, so the bound is set to it rather than to radians(5).
+    angle = abs(se2.wrap_angle(math.atan2(math.sin(five) + 2.0 - 2.0, math.cos(five)) - math.atan2(0.0, 1.0)))
+    assert angle == pytest.approx(five, rel=1e-12)
+    assert ids(turned, angle, MAX_DISTANCE) == []
+    assert ids(turned, np.nextafter(angle, 1.0), MAX_DISTANCE) == [7]

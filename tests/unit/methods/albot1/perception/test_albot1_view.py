@@ -9,6 +9,7 @@ import pytest
 
 from albot1.data.synthetic.lidar import cast
 from albot1.methods.albot1.perception.endpoints import is_stable
+from albot1.methods.albot1.perception.kernels import PerceptionKernels
 from albot1.methods.albot1.perception.landmarks import (
     CORNER,
     OCCLUDED,
@@ -17,7 +18,7 @@ from albot1.methods.albot1.perception.landmarks import (
     find_landmarks,
     stable,
 )
-from albot1.methods.albot1.perception.view import ViewParams, construct_view
+from albot1.methods.albot1.perception.view import View, ViewParams, construct_view
 
 ANGLES = np.radians(np.arange(-90.0, 91.0, 1.0))
 
@@ -208,3 +209,28 @@ def test_total_least_squares_is_exact_on_exact_points() -> None:
     chord = construct_view(ranges, ANGLES, ViewParams())
     fitted = construct_view(ranges, ANGLES, ViewParams(fit_lines=True))
     np.testing.assert_allclose(fitted.surfaces, chord.surfaces, atol=1e-9)
+
+
+@pytest.mark.parametrize("accelerate", [True, False])
+def test_a_landmark_is_at_least_40_cm_long_with_an_occluding_or_corner_end(accelerate: bool) -> None:
+    # Thesis 3.1.4: "surfaces with a minimum length of 40cm and which has at least one occluding or corner edge are
+    # considered as landmark surfaces". Exactly 40 cm is a landmark, the next float below is not; a corner end alone
+    # suffices (3.1.4 names corners; Algorithm 4 line 4 and section 3.1 name occluding edges only: the code reads
+    # 3.1.4, docs/albot1-mapper.md item 9); occluded and unstable ends do not.
+    surfaces = np.array(
+        [
+            [0.0, 2.0, 0.4, 2.0],  # exactly 0.4 m, occluding P1
+            [0.0, 3.0, np.nextafter(0.4, 0.0), 3.0],  # just under 0.4 m, occluding P1
+            [0.0, 4.0, 1.0, 4.0],  # corner P2 only
+            [0.0, 5.0, 1.0, 5.0],  # occluded and unstable ends
+            [0.0, 6.0, 2.0, 6.0],  # occluding P2
+        ]
+    )
+    kinds = np.array(
+        [[OCCLUDING, UNSTABLE], [OCCLUDING, UNSTABLE], [UNSTABLE, CORNER], [OCCLUDED, UNSTABLE], [UNSTABLE, OCCLUDING]]
+    )
+    view = View(surfaces, kinds, np.zeros((5, 2), dtype=np.int64), np.arange(5, dtype=np.int64))
+    got = find_landmarks(view, 0.4, PerceptionKernels(accelerate))
+    assert got.index.tolist() == [0, 2, 4]
+    np.testing.assert_array_equal(got.surfaces, surfaces[[0, 2, 4]])
+    np.testing.assert_array_equal(got.kinds, kinds[[0, 2, 4]])
