@@ -39,6 +39,7 @@ from albot1.metrics.alignment import align, rigid_transform
 from albot1.metrics.errors import MetricsError
 from albot1.report.collect import CellRecord
 from albot1.report.mathtext_memo import share_parsed_math
+from albot1.report.tick_memo import share_tick_updates
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -112,7 +113,9 @@ def pyplot() -> Any:
     """matplotlib.pyplot on the headless Agg backend (imported on first use: it is slow to import).
 
     Every figure of the reports is made through here, so this is also where the process's math-text
-    parses start being shared across figures (:func:`~albot1.report.mathtext_memo.share_parsed_math`).
+    parses start being shared across figures (:func:`~albot1.report.mathtext_memo.share_parsed_math`) and
+    an axes' ticks start being worked out once per layout pass and per draw
+    (:func:`~albot1.report.tick_memo.share_tick_updates`).
     """
     import matplotlib
 
@@ -120,6 +123,7 @@ def pyplot() -> Any:
     import matplotlib.pyplot as plt
 
     share_parsed_math()
+    share_tick_updates()
     return plt
 
 
