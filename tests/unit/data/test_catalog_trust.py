@@ -7,7 +7,6 @@ import http.server
 import os
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -24,14 +23,8 @@ WRONG = b"FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\n" * 20
 SHA = hashlib.sha256(PAYLOAD).hexdigest()
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    monkeypatch.setenv("ALBOT1_CACHE_DIR", str(tmp_path / "checksum-cache"))
-    (tmp_path / "project" / "datasets").mkdir(parents=True)
-    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path / "project"))
-    catalog._manifests.cache_clear()
-    yield
-    catalog._manifests.cache_clear()
+#: every test here in its own config folder and checksum cache (conftest.own_project)
+pytestmark = pytest.mark.usefixtures("own_project")
 
 
 def manifest(

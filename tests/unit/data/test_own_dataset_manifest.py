@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -19,18 +18,12 @@ from albot1.settings import Settings
 WORLD = "synthetic-corridor[:5]"
 
 
-@pytest.fixture(autouse=True)
-def own_config(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    monkeypatch.setenv("ALBOT1_CACHE_DIR", str(tmp_path / "checksum-cache"))
-    (tmp_path / "config" / "datasets").mkdir(parents=True)
-    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path / "config"))
-    catalog._manifests.cache_clear()
-    yield
-    catalog._manifests.cache_clear()
+#: every test here in its own config folder and checksum cache (conftest.own_project)
+pytestmark = pytest.mark.usefixtures("own_project")
 
 
 def register(tmp_path: Path, name: str, fmt: str, path: str, sha256: str) -> Path:
-    toml = tmp_path / "config" / "datasets" / f"{name}.toml"
+    toml = tmp_path / "project" / "datasets" / f"{name}.toml"
     toml.write_text(
         f'name = "{name}"\nformat = "{fmt}"\nlocal_only = true\n\n'
         f'[[files]]\nrole = "log"\npath = "{path}"\nsha256 = "{sha256}"\n'
