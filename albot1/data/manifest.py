@@ -57,6 +57,10 @@ class DatasetManifest:
     notes: str = ""
     loader: dict[str, Any] = field(default_factory=dict)
     manifest_path: Path | None = None
+    #: the catalog name of the dataset whose recording this one is another version of (a corrected or thinned
+    #: copy of the same drive: same place, route and scans); "" = its own recording. Held-in marks treat the two
+    #: as one (albot1.report.tuning): values tuned on one log were tuned on the other's data.
+    recording: str = ""
 
     def file(self, role: str) -> DataFile | None:
         """The first file with ``role`` (``"log"`` or ``"relations"``)."""
@@ -82,6 +86,7 @@ TOP_KEYS = (
     "notes",
     "files",
     "loader",
+    "recording",
 )
 FILE_KEYS = ("role", "path", "sha256", "size", "urls", "repeats")
 
@@ -204,6 +209,9 @@ def parse_manifest(path: Path) -> DatasetManifest:
         )
     if sum(f.role == "log" for f in files) != 1:
         raise DataError(f'{path}: expected exactly one file with role = "log"')
+    recording = _optional(data, "recording", str, path, "")
+    if recording == name:
+        raise DataError(f"{path}: recording names the dataset itself; leave it out for a recording of its own")
     return DatasetManifest(
         name=name,
         description=_optional(data, "description", str, path, ""),
@@ -217,4 +225,5 @@ def parse_manifest(path: Path) -> DatasetManifest:
         notes=_optional(data, "notes", str, path, ""),
         loader=dict(_optional(data, "loader", dict, path, {})),
         manifest_path=path,
+        recording=recording,
     )

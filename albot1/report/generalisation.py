@@ -61,7 +61,7 @@ from albot1.metrics.paired import (
 from albot1.report.collect import METRIC_COLUMNS, CellRecord
 from albot1.report.markdown import text as md_text
 from albot1.report.provenance import regenerate_command
-from albot1.report.tuning import LEGEND, MARK, held_in, marked
+from albot1.report.tuning import LEGEND, MARK, marked, record_held_in
 
 PAGE = "generalisation.md"
 TABLE = "generalisation.csv"
@@ -171,7 +171,7 @@ def comparisons(records: list[CellRecord]) -> list[Comparison]:
                 odometry_rpe10_m=rpe10[1],
                 loop_gap_m=loop_gap[0],
                 odometry_loop_gap_m=loop_gap[1],
-                held_in=held_in(scored[0][0].cell),
+                held_in=record_held_in(scored[0][0]),
                 reason=None if paired is None else paired.reason,
             )
         )

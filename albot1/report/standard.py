@@ -42,7 +42,7 @@ from albot1.report.standard_paired import (
     paired_lines,
     shown_record,
 )
-from albot1.report.tuning import LEGEND, held_in, marked
+from albot1.report.tuning import LEGEND, marked, record_held_in
 
 #: The five logs of the standard benchmark, with the names the published tables use.
 STANDARD_LOGS: dict[str, str] = {
@@ -170,7 +170,7 @@ def _seeds_note(shown: CellRecord, group: list[CellRecord]) -> str:
 
 def _measured(rec: CellRecord) -> Row:
     log, method = rec.cell.dataset_label, rec.cell.method_label
-    tuned = held_in(rec.cell)
+    tuned = record_held_in(rec)
     if rec.status != "done" or rec.metrics is None or rec.result is None:
         reason = rec.failure.reason if rec.failure is not None else "the runner did not reach this cell"
         limit = known_limit_of(rec.cell.method, rec.cell.preset, rec.cell.dataset) or ""

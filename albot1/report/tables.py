@@ -49,7 +49,7 @@ from albot1.report.markdown import text as md_text
 from albot1.report.number_text import EXAMPLE, SEEDS_LEGEND, SIGNIFICANT, stats_text
 from albot1.report.paired_tables import PairedRow, intro, markdown_lines, no_pairs, paired_rows, write_paired_csv
 from albot1.report.provenance import data_by_dataset, describe_data
-from albot1.report.tuning import LEGEND, held_in, marked
+from albot1.report.tuning import LEGEND, MARK, marked, record_held_in
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -101,7 +101,7 @@ class Aggregates:
     def cells(self) -> pd.DataFrame:
         """:func:`cells_frame` with each cell's held-in mark (:func:`albot1.report.tuning.held_in`)."""
         cells = cells_frame(self.records)
-        cells["held_in"] = [held_in(rec.cell) for rec in self.records]
+        cells["held_in"] = [record_held_in(rec) for rec in self.records]
         return cells
 
     @cached_property
@@ -152,7 +152,7 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
             "failed": int(len(failed)),
             "not_run": int((group["status"] == "not run").sum()),
             "status": _status(group, failed),
-            "held_in": bool(group["held_in"].eq(True).any()) if "held_in" in group else False,
+            "held_in": _held_in(group),
         }
         for column in columns:
             values: NDArray[np.float64] = numbers[column][rows]
@@ -168,6 +168,20 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
     rank = {"dataset": order, "method": methods, "degradation": degradations}
     table = table.sort_values(by=list(KEY_COLUMNS), key=lambda s: s.map(rank[str(s.name)]), kind="stable")
     return table.reset_index(drop=True)
+
+
+def _held_in(group: pd.DataFrame) -> bool | None:
+    """A row's held-in mark: True when a cell of it is held-in, None (empty in CSV) when a cell's tuning is unknown.
+
+    Unknown is not "not tuned": a plugin or external system without a ``[tuned_on]`` table read False here,
+    which a CSV reader takes for a held-out number.
+    """
+    if "held_in" not in group:
+        return None
+    values = list(group["held_in"])
+    if any(v is True for v in values):
+        return True
+    return None if any(v is None or v != v for v in values) else False
 
 
 def _stat(values: NDArray[np.float64], stat: str) -> float:
@@ -376,6 +390,7 @@ def latex(table: pd.DataFrame, columns: dict[str, Column], title: str, selected:
         f"% {title}: mean $\\pm$ sample std over seeds, median (min--max); {SIGNIFICANT} significant digits.",
         "% Needs \\usepackage{booktabs}. n/a: the metric does not apply (see the Markdown table for the reason).",
         *([f"% {' '.join(selected.split())}"] if selected else []),
+        *([f"% $^\\dagger$: {LEGEND.removeprefix(MARK).strip()}"] if any_held_in(table) else []),
         "",
     ]
     for dataset, group in table.groupby("dataset", sort=False):
@@ -393,7 +408,8 @@ def latex(table: pd.DataFrame, columns: dict[str, Column], title: str, selected:
         ]
         for _, row in group.iterrows():
             cells = [
-                _latex_escape(row["method"]),
+                # the mark travels with the row: a row pasted into a paper keeps saying it was tuned on this log
+                _latex_escape(row["method"]) + (" $^\\dagger$" if row.get("held_in") is True else ""),
                 _latex_escape(row["degradation"]),
                 *[cell_text(row, c).replace("±", "$\\pm$").replace("–", "--") for c in present],
                 _latex_escape(row["status"]),
@@ -448,7 +464,7 @@ def write_tables(
         paths["tex"].write_text(latex(table, columns, title, selected), encoding="utf-8")
         written.update({f"{name}.{ext}": path for ext, path in paths.items()})
     cost_cells = out / "cells-cost.csv"
-    cells[["dataset", "method", "degradation", "seed", "status", *COST_COLUMNS]].to_csv(
+    cells[["dataset", "method", "degradation", "seed", "status", "held_in", *COST_COLUMNS]].to_csv(
         cost_cells, index=False, float_format="%.9g"
     )
     written["cells-cost.csv"] = cost_cells

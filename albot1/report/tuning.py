@@ -5,11 +5,16 @@ values were chosen on by looking at their scores
 (:func:`albot1.config.presets.tuned_on`). A number measured on one of them
 says how well the method fits data it was fitted to, not how it generalises,
 so every page that shows per-dataset numbers marks it with :data:`MARK` and
-prints :data:`LEGEND`. The dataset of a cell is its catalog name: loader
-options and a slice (``seattle-corrected?odometry=laser-pose[::3]``) do not
-make another dataset, and a tuned-on list names the datasets as the catalog
-does (``intel`` and ``intel-corrected`` are two entries there, and a list
-names each one it used).
+prints :data:`LEGEND`. What a cell was measured on is its data, not its
+spelling: loader options and a slice (``seattle-corrected?odometry=laser-pose[::3]``)
+do not make another dataset, a manifest whose log has the sha256 of a tuned-on
+dataset's log (a user's ``my-aces.toml``, a bag or log given by path whose
+run read that file) is that dataset, and a corrected or thinned copy of a
+drive (a manifest's ``recording``: ``aces-corrected`` is the ``aces`` drive)
+is held-in wherever the drive is. Names alone let a tuned number go unmarked
+on each of these (``my-aces``, ``aces-corrected`` for a method tuned on ``aces``).
+A tuned-on list must name catalog datasets or synthetic worlds: a typo would
+otherwise never mark anything, so it is a :class:`~albot1.errors.ConfigError`.
 
 The lists are read from the preset files when the report is built (they
 describe the values, which every run's ``result.json`` holds): a method or
@@ -21,12 +26,17 @@ unmarked silently.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from functools import cache
 
 from albot1.bench.grid import Cell
-from albot1.config.presets import tuned_on
-from albot1.errors import Albot1Error
+from albot1.config.presets import preset_file, tuned_on
+from albot1.config.suggest import unknown_name_message
+from albot1.data import catalog
+from albot1.data.synthetic.worlds import WORLDS
+from albot1.errors import Albot1Error, ConfigError
 from albot1.methods.registry import load_mapper_class, method_registry
+from albot1.report.collect import CellRecord
 
 #: The mark beside a number measured on a dataset its method was tuned on.
 MARK = "†"
@@ -45,7 +55,11 @@ def dataset_name(reference: str) -> str:
 
 @cache
 def tuned_datasets(method: str, preset: str, target: str | None = None) -> tuple[str, ...] | None:
-    """The datasets ``method``'s ``preset`` was tuned on; None when unknown (not recorded, class not loadable)."""
+    """The datasets ``method``'s ``preset`` was tuned on; None when unknown (not recorded, class not loadable).
+
+    A name that is neither a catalog dataset nor a synthetic world is a ConfigError naming the preset file:
+    it would match no cell, leaving every number of the dataset meant unmarked.
+    """
     registry = method_registry()
     where = target or (registry.get(method).target if method in registry else None)
     if where is None:
@@ -54,15 +68,52 @@ def tuned_datasets(method: str, preset: str, target: str | None = None) -> tuple
         cls = load_mapper_class(where)
     except (Albot1Error, ImportError):
         return None
-    return tuned_on(cls, preset)
+    names = tuned_on(cls, preset)
+    known = {*catalog.names(), *WORLDS}
+    for name in names or ():
+        if name not in known:
+            raise ConfigError(
+                f"{preset_file(cls.name)}: [tuned_on] of preset {preset!r}: "
+                + unknown_name_message("dataset", name, sorted(known), listing="albot1 datasets list")
+            )
+    return names
 
 
-def held_in(cell: Cell) -> bool | None:
-    """Whether ``cell``'s dataset is one its method was tuned on (None: the method records no tuning)."""
+@cache
+def _identities(name: str) -> frozenset[str]:
+    """What a dataset name stands for: itself, its log's sha256 and its drive (``recording``), followed through."""
+    if name not in catalog.names():
+        return frozenset({name})
+    manifest = catalog.get(name)
+    own = {name, manifest.log.sha256}
+    return frozenset(own | (_identities(manifest.recording) if manifest.recording else set()))
+
+
+@cache
+def _held_in_identities(names: tuple[str, ...]) -> frozenset[str]:
+    """Every identity of the tuned-on datasets, and of each catalog dataset of the same log or drive."""
+    tuned = frozenset().union(*(_identities(n) for n in names))
+    same = [n for n in catalog.names() if _identities(n) & tuned]
+    return tuned.union(*(_identities(n) for n in same))
+
+
+def held_in(cell: Cell, data_sha256: Iterable[str] = ()) -> bool | None:
+    """Whether ``cell``'s data is a dataset its method was tuned on (None: the method records no tuning).
+
+    ``data_sha256``: the checksums of the files the cell's run read (``result.json``), which identify a log
+    given by path or under another manifest's name.
+    """
     names = tuned_datasets(cell.method, cell.preset)
     if names is None:
         return None
-    return dataset_name(cell.dataset) in names
+    tuned = _held_in_identities(names)
+    return bool((_identities(dataset_name(cell.dataset)) | set(data_sha256)) & tuned)
+
+
+def record_held_in(rec: CellRecord) -> bool | None:
+    """:func:`held_in` of a stored cell, with the checksums of the files its run read when it has a result."""
+    files = rec.result.dataset_info.data_sha256.values() if rec.result is not None else ()
+    return held_in(rec.cell, files)
 
 
 def marked(text: str, tuned: bool | None) -> str:
