@@ -127,3 +127,22 @@ def test_every_cost_cell_row_says_whether_it_is_held_in(tmp_path: Path) -> None:
     write_tables([], tmp_path)
     header = (tmp_path / "cells-cost.csv").read_text().splitlines()[0].split(",")
     assert "held_in" in header
+
+
+def test_every_recording_a_manifest_names_is_a_catalog_dataset_and_not_itself(tmp_path: Path) -> None:
+    """A typo in ``recording`` would link nothing, leaving the corrected copy's tuned numbers unmarked."""
+    from albot1.data.errors import DataError
+    from albot1.data.manifest import parse_manifest
+
+    linked = {name: catalog.get(name).recording for name in catalog.names() if catalog.get(name).recording}
+    assert linked == {
+        "aces-corrected": "aces",
+        "intel-corrected": "intel",
+        "freiburg-079-corrected": "fr079",
+        "csail-corrected": "mit-csail",
+    }
+    assert set(linked.values()) <= set(catalog.names())
+    own = tmp_path / "loop.toml"
+    own.write_text(f'name = "loop"\nrecording = "loop"\n[[files]]\nrole = "log"\npath = "a/b"\nsha256 = "{"0" * 64}"\n')
+    with pytest.raises(DataError, match=r"loop\.toml: recording names the dataset itself"):
+        parse_manifest(own)
