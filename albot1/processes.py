@@ -1,4 +1,4 @@
-"""Resident memory of a process tree, and stopping one: what a resident-memory limit needs.
+"""Resident memory and CPU time of a process tree, and stopping one: what a memory and a CPU limit need.
 
 Why resident memory and not an address-space limit (``RLIMIT_AS``): the
 compiled libraries the methods use reserve large virtual ranges long before
@@ -14,6 +14,14 @@ The bench's cell processes (``albot1.bench.limits``) and the external
 programs of wrapped baselines (``albot1.methods.baselines.mrpt.process``)
 are both watched by :func:`supervise`; they differ only in how they wait for
 their child and how they stop it.
+
+Why a CPU limit beside the wall clock: a wall-clock limit measures the
+machine's load as much as the program. A single-threaded program that needs
+61 s idle took 303 s of wall on a machine at load 10-16 (two cores), so
+which runs passed a wall limit depended on what else ran. The CPU time the
+tree has used (polled, :meth:`TreeUsage.cpu_seconds`) is the program's own
+cost; the wall clock is then kept only as a backstop for a program that
+hangs without burning CPU.
 """
 
 from __future__ import annotations
@@ -26,12 +34,13 @@ import psutil
 
 MIB = 1024.0 * 1024.0
 
-#: The limit that made :func:`supervise` stop a process tree.
-Stop = Literal["timeout", "memory"]
+#: The limit that made :func:`supervise` stop a process tree: ``timeout`` the wall clock, ``cpu`` the
+#: tree's CPU time, ``memory`` its resident memory.
+Stop = Literal["timeout", "memory", "cpu"]
 
 
-class TreeMemory:
-    """Samples the resident memory (bytes) of ``process`` and its descendants.
+class TreeUsage:
+    """Samples the resident memory (bytes) and the CPU time (s) of ``process`` and its descendants.
 
     Listing the descendants walks every process of the machine (~10 ms with a
     hundred processes), so the list is refreshed every ``refresh_s`` seconds
@@ -46,6 +55,7 @@ class TreeMemory:
         self._members: list[psutil.Process] = [process]
         self._listed_at = -float("inf")
         self.peak_bytes = 0
+        self.cpu_s = 0.0
 
     def _refresh(self) -> None:
         now = time.monotonic()
@@ -68,6 +78,27 @@ class TreeMemory:
                 continue
         self.peak_bytes = max(self.peak_bytes, total)
         return total
+
+    def cpu_seconds(self) -> float:
+        """User and system CPU seconds the tree has used so far (``cpu_s`` keeps the largest reading).
+
+        Each member counts its own time and that of its children it has
+        reaped (``children_user``, ``children_system``): a helper that ended
+        and was waited for by a member stays counted through that member. A
+        member that exits between two listings drops out of the sum until its
+        parent reaps it, so the reading is kept monotonic: CPU time spent is
+        never taken back.
+        """
+        self._refresh()
+        total = 0.0
+        for member in self._members:
+            try:
+                times = member.cpu_times()
+            except psutil.Error:  # exited since the last listing
+                continue
+            total += times.user + times.system + times.children_user + times.children_system
+        self.cpu_s = max(self.cpu_s, total)
+        return self.cpu_s
 
 
 def high_water_mb(pid: int | str = "self") -> float | None:
@@ -116,14 +147,20 @@ def supervise(
     memory_mb: float,
     poll_s: float,
     stop: Callable[[], None] | None = None,
+    cpu_s: float | None = None,
 ) -> tuple[Stop | None, float]:
     """Wait for ``process`` to end, stopping its tree when it passes ``time_s`` seconds or ``memory_mb`` resident.
+
+    ``time_s`` is wall-clock time; ``cpu_s`` (None: none) the user plus
+    system CPU time of the whole tree (polled, so it may be passed by up to
+    ``poll_s`` per busy core). A caller holding a program to its CPU time
+    passes a generous ``time_s`` as the backstop for a hang that burns none.
 
     ``ended(timeout)`` waits up to ``timeout`` s (at most ``poll_s``) and says
     whether the process has exited; the caller owns waiting because only it
     knows how to reap its child (``Popen.wait``, ``os.wait4`` for the child's
     own resource usage, a multiprocessing ``join``). Between two waits the
-    tree's resident memory is sampled (:class:`TreeMemory`). ``stop`` kills
+    tree's resident memory (and, with ``cpu_s``, its CPU time) is sampled (:class:`TreeUsage`). ``stop`` kills
     the tree when a limit is passed (default :func:`kill_tree`; a child in a
     session of its own may rather be stopped by its process group). With
     ``process`` None (it exited before it could be watched) only the clock is
@@ -132,7 +169,7 @@ def supervise(
     """
     deadline = time.monotonic() + time_s
     limit = memory_mb * MIB
-    memory = TreeMemory(process) if process is not None else None
+    usage = TreeUsage(process) if process is not None else None
     stopped: Stop | None = None
     while True:
         remaining = deadline - time.monotonic()
@@ -140,13 +177,15 @@ def supervise(
             stopped = "timeout"
         elif ended(min(poll_s, remaining)):
             break
-        elif memory is not None and memory.sample() > limit:
+        elif usage is not None and usage.sample() > limit:
             stopped = "memory"
+        elif usage is not None and cpu_s is not None and usage.cpu_seconds() > cpu_s:
+            stopped = "cpu"
         if stopped is not None:
             if process is not None and stop is not None:
                 stop()
             elif process is not None:
                 kill_tree(process)
             break
-    peak = memory.peak_bytes / MIB if memory is not None else 0.0
+    peak = usage.peak_bytes / MIB if usage is not None else 0.0
     return stopped, peak

@@ -9,7 +9,7 @@ from collections.abc import Callable
 
 import psutil
 
-from albot1.processes import MIB, TreeMemory, kill_tree, supervise
+from albot1.processes import MIB, TreeUsage, kill_tree, supervise
 
 #: A child that starts a grandchild, then holds ~64 MiB of touched memory until killed.
 PARENT = """
@@ -36,7 +36,7 @@ def test_tree_memory_counts_the_process_and_its_children_and_kill_tree_stops_bot
     proc, grandchild = _start()
     try:
         root = psutil.Process(proc.pid)
-        memory = TreeMemory(root, refresh_s=0.0)
+        memory = TreeUsage(root, refresh_s=0.0)
         total = memory.sample()
         own = root.memory_info().rss
         assert total > own >= 64 * MIB  # the grandchild's resident set is added to the child's
@@ -126,3 +126,53 @@ def test_supervise_of_a_process_that_could_not_be_watched_checks_only_the_clock(
     assert supervise(None, ended, time_s=60, memory_mb=0, poll_s=0.01) == (None, 0.0)
     assert waits == [0.01, 0.01, 0.01]
     assert supervise(None, lambda timeout: False, time_s=0.05, memory_mb=0, poll_s=0.01) == ("timeout", 0.0)
+
+
+#: Starts a helper that burns CPU until killed, and sleeps itself.
+BURNING_HELPER = """
+import subprocess, sys, time
+subprocess.Popen([sys.executable, "-c", "while True: pass"])
+time.sleep(600)
+"""
+
+
+def test_supervise_stops_a_tree_over_its_cpu_limit_counting_the_helpers_cpu() -> None:
+    """The limit is the tree's CPU seconds, so a sleeping parent whose helper burns CPU is stopped as "cpu"."""
+    proc = subprocess.Popen([sys.executable, "-c", BURNING_HELPER])
+    root = psutil.Process(proc.pid)
+    try:
+        start = time.monotonic()
+        stopped, _ = supervise(root, _ended(proc), time_s=60, memory_mb=1024, poll_s=0.05, cpu_s=0.8)
+        assert stopped == "cpu" and time.monotonic() - start < 30  # not the 60 s wall limit
+        assert proc.wait(timeout=10) == -9  # kill_tree
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_tree_usage_cpu_seconds_counts_the_children_and_never_goes_back() -> None:
+    proc = subprocess.Popen([sys.executable, "-c", BURNING_HELPER])
+    try:
+        usage = TreeUsage(psutil.Process(proc.pid), refresh_s=0.0)
+        time.sleep(0.8)
+        first = usage.cpu_seconds()
+        assert first > 0.3  # the sleeping parent alone has used a few hundredths of a second
+        kill_tree(psutil.Process(proc.pid))
+        proc.wait(timeout=10)
+        assert usage.cpu_seconds() == usage.cpu_s >= first  # the killed tree's time is not taken back
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_supervise_without_a_cpu_limit_lets_a_busy_tree_run() -> None:
+    """``cpu_s`` None (the bench's cells): only the wall clock and memory stop the tree."""
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "import time\nt = time.monotonic()\nwhile time.monotonic() - t < 1: pass"]
+    )
+    try:
+        stopped, _ = supervise(psutil.Process(proc.pid), _ended(proc), time_s=30, memory_mb=1024, poll_s=0.05)
+        assert stopped is None and proc.wait(timeout=10) == 0
+    finally:
+        proc.kill()
+        proc.wait()

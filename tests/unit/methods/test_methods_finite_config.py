@@ -25,8 +25,8 @@ FLOAT_FIELD = {
     "albot1-places": "exit_min_width_m",
     "kiss-icp": "voxel_size_m",
     "gtsam-graph": "max_range_m",
-    "mrpt-icp": "timeout_s",
-    "mrpt-rbpf": "timeout_s",
+    "mrpt-icp": "cpu_limit_s",
+    "mrpt-rbpf": "cpu_limit_s",
 }
 
 

@@ -61,7 +61,7 @@ from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.mrpt import outputs
-from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig, MrptRunConfig
+from albot1.methods.baselines.mrpt.config import WALL_BACKSTOP_FACTOR, MrptIcpConfig, MrptRbpfConfig, MrptRunConfig
 from albot1.methods.baselines.mrpt.process import ProcessOutcome, run_limited
 from albot1.methods.baselines.mrpt.templates import render
 
@@ -182,7 +182,8 @@ class _MrptMapper:
             outcome = run_limited(
                 [executable, INI_NAME, RAWLOG_NAME],
                 cwd=work,
-                timeout_s=self.config.timeout_s,
+                timeout_s=self.config.wall_limit_s,  # the backstop for a hang; the limit is cpu_limit_s
+                cpu_limit_s=self.config.cpu_limit_s,
                 memory_limit_mb=self.config.memory_limit_mb,
                 stdout_path=work / "stdout.txt",
                 stderr_path=work / "stderr.txt",
@@ -207,6 +208,8 @@ class _MrptMapper:
             "rawlog_first_replaced_stamp": rawlog.first_replaced_stamp,
             "seed": self.seed,
             "threads": 1,
+            # The limits it ran under: cpu_limit_s is in the config; the wall backstop is derived from it.
+            "wall_backstop_s": self.config.wall_limit_s,
             **extras,
         }
         files = {CONFIG_FILE: ini, **files}
@@ -233,10 +236,16 @@ class _MrptMapper:
     ) -> None:
         """A BaselineError saying why the application did not finish (limits, crash, exit status)."""
         progress = self._progress(out_dir, scans)
+        if outcome.stopped == "cpu":
+            raise BaselineError(
+                f"{self.name}: {self.app} stopped by its CPU limit (cpu_limit_s = {self.config.cpu_limit_s:g}) after "
+                f"{outcome.cpu_s:.1f} CPU-s, {outcome.wall_s:.1f} s wall, {progress}"
+            )
         if outcome.stopped == "timeout":
             raise BaselineError(
-                f"{self.name}: {self.app} stopped by its time limit (timeout_s = {self.config.timeout_s:g}) after "
-                f"{outcome.wall_s:.1f} s, {progress}"
+                f"{self.name}: {self.app} stopped by its wall-clock backstop ({WALL_BACKSTOP_FACTOR:g} x cpu_limit_s "
+                f"= {self.config.wall_limit_s:g} s) after {outcome.wall_s:.1f} s wall, {outcome.cpu_s:.1f} CPU-s "
+                f"(hung?), {progress}"
             )
         if outcome.stopped == "memory":
             raise BaselineError(

@@ -23,7 +23,7 @@ from albot1.methods.baselines.errors import BaselineError
 #: Config fields the wrapper uses itself (never written into an INI file).
 WRAPPER_FIELDS = frozenset(
     {
-        "timeout_s",
+        "cpu_limit_s",
         "memory_limit_mb",
         "min_path_ratio",
         "max_path_ratio",

@@ -5,7 +5,8 @@ output files the real applications write, for ``FAKE_MRPT_SCANS`` scans on
 a straight line 0.5 m per scan (the tests' odometry), or misbehaves as
 ``FAKE_MRPT_MODE`` says: ``short`` (a scan missing), ``frozen`` (the path
 never moves), ``jump`` (a 5 m teleport at scan 3), ``crash`` (an MRPT exception, status 255), ``signal`` (killed
-by SIGSEGV), ``sleep`` (never ends), ``hog`` (grows its memory).
+by SIGSEGV), ``sleep`` (never ends, burning no CPU), ``burn`` (never ends, burning CPU), ``hog`` (grows its
+memory).
 """
 
 from __future__ import annotations
@@ -34,6 +35,9 @@ def main() -> None:
         os.kill(os.getpid(), signal.SIGSEGV)
     if mode == "sleep":
         time.sleep(60)
+    if mode == "burn":
+        while True:
+            pass
     if mode == "hog":
         blocks = []
         while True:

@@ -17,6 +17,7 @@ import pytest
 
 from albot1.contract import MapperOutput
 from albot1.data.model import Frame, Scan
+from albot1.errors import ConfigError
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.mrpt import MrptIcpMapper, MrptRbpfMapper
 from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig
@@ -131,9 +132,19 @@ def test_rbpf_short_log_is_a_failure(fake_apps: Path, monkeypatch: pytest.Monkey
 
 @pytest.mark.slow
 def test_limits_stop_the_application_and_say_which(fake_apps: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("FAKE_MRPT_MODE", "sleep")
-    with pytest.raises(BaselineError, match=r"stopped by its time limit \(timeout_s = 1\.5\)"):
-        _run(_icp(timeout_s=1.5))
+    monkeypatch.setenv("FAKE_MRPT_MODE", "burn")
+    with pytest.raises(
+        BaselineError,
+        match=r"stopped by its CPU limit \(cpu_limit_s = 0\.5\) after (0\.[5-9]|1\.\d) CPU-s, \d+\.\d s wall",
+    ):
+        _run(_icp(cpu_limit_s=0.5))
+    monkeypatch.setenv("FAKE_MRPT_MODE", "sleep")  # burns no CPU: only the wall-clock backstop (10 x) stops it
+    with pytest.raises(
+        BaselineError,
+        match=r"stopped by its wall-clock backstop \(10 x cpu_limit_s = 3 s\) after 3\.\d s wall, 0\.\d CPU-s "
+        r"\(hung\?\)",
+    ):
+        _run(_icp(cpu_limit_s=0.3))
     monkeypatch.setenv("FAKE_MRPT_MODE", "hog")
     with pytest.raises(BaselineError, match=r"stopped by its memory limit \(memory_limit_mb = 150;"):
         _run(_rbpf(memory_limit_mb=150))
@@ -186,3 +197,14 @@ def test_unusable_scan_stamps_are_filled_and_counted(fake_apps: Path) -> None:
         mrpt = mapper.finish().extras["mrpt"]
         assert mrpt["rawlog_replaced_stamps"] == SCANS - 1
         assert mrpt["rawlog_first_replaced_stamp"] == "scan 1: timestamp 5.0 s is not after the previous scan's"
+
+
+@pytest.mark.parametrize("method", ["mrpt-icp", "mrpt-rbpf"])
+def test_the_old_wall_clock_field_is_refused_with_what_replaced_it(method: str) -> None:
+    """``timeout_s`` (wall seconds) became ``cpu_limit_s`` (CPU seconds): taking the old value silently would
+    change its meaning, so a suite or --set that still uses it fails with one line naming the new field."""
+    with pytest.raises(ConfigError) as info:
+        resolve_config(method, "default", {"timeout_s": 300})
+    message = str(info.value)
+    assert "\n" not in message and "timeout_s (wall-clock seconds) was replaced by cpu_limit_s (CPU seconds" in message
+    assert resolve_config(method, "default", {"cpu_limit_s": 300}).model_dump()["cpu_limit_s"] == 300.0

@@ -1,8 +1,9 @@
-"""A child process under a wall-clock and a resident-memory limit."""
+"""A child process under a CPU-time limit, a wall-clock limit and a resident-memory limit."""
 
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +44,68 @@ def test_timeout_kills_the_whole_process_group(tmp_path: Path) -> None:
     outcome = _run(tmp_path, code, timeout_s=0.5)
     assert outcome.stopped == "timeout" and outcome.returncode is None
     assert outcome.wall_s < 10
+
+
+#: Burns CPU for ``{cpu}`` CPU-s in slices, sleeping ``{pause}`` s after each slice: a program the machine's
+#: load slows down (descheduled between slices) uses the same CPU and more wall time.
+SLOWED = """
+import time
+used = 0.0
+while used < {cpu}:
+    start = time.process_time()
+    while time.process_time() - start < 0.05:
+        pass
+    used += time.process_time() - start
+    time.sleep({pause})
+"""
+
+
+def test_a_program_slowed_by_load_passes_its_cpu_limit_where_a_wall_limit_would_stop_it(tmp_path: Path) -> None:
+    """0.4 CPU-s spread over ~2 s of wall: under a 1 CPU-s limit it completes, whatever the wall clock says."""
+    outcome = run_limited(
+        [sys.executable, "-c", SLOWED.format(cpu=0.4, pause=0.25)],
+        cwd=tmp_path,
+        timeout_s=60.0,
+        cpu_limit_s=1.0,
+        memory_limit_mb=2000.0,
+        stdout_path=tmp_path / "out.txt",
+        stderr_path=tmp_path / "err.txt",
+    )
+    assert outcome.stopped is None and outcome.returncode == 0, (tmp_path / "err.txt").read_text()
+    assert outcome.wall_s > 1.5 and outcome.cpu_s < 1.0
+
+
+def test_cpu_limit_stops_a_cpu_burning_grandchild_and_the_group(tmp_path: Path) -> None:
+    """The CPU a helper burns counts (the tree's, not only the program's), and passing it names the CPU limit."""
+    code = "import subprocess, sys, time\nsubprocess.Popen([sys.executable, '-c', 'while True: pass'])\ntime.sleep(60)"
+    start = time.monotonic()
+    outcome = run_limited(
+        [sys.executable, "-c", code],
+        cwd=tmp_path,
+        timeout_s=60.0,
+        cpu_limit_s=1.0,
+        memory_limit_mb=2000.0,
+        stdout_path=tmp_path / "out.txt",
+        stderr_path=tmp_path / "err.txt",
+    )
+    assert outcome.stopped == "cpu" and outcome.returncode is None
+    assert time.monotonic() - start < 30  # not the 60 s wall limit
+    # The sleeping program itself used little: the CPU was its helper's (killed with the group, never reaped by it).
+    assert outcome.cpu_s < 1.0
+
+
+def test_a_sleeping_program_is_stopped_by_the_wall_clock_not_the_cpu_limit(tmp_path: Path) -> None:
+    outcome = run_limited(
+        [sys.executable, "-c", "import time; time.sleep(60)"],
+        cwd=tmp_path,
+        timeout_s=1.0,
+        cpu_limit_s=30.0,
+        memory_limit_mb=2000.0,
+        stdout_path=tmp_path / "out.txt",
+        stderr_path=tmp_path / "err.txt",
+    )
+    assert outcome.stopped == "timeout" and outcome.returncode is None
+    assert 1.0 <= outcome.wall_s < 10 and outcome.cpu_s < 1.0
 
 
 def test_resident_memory_limit(tmp_path: Path) -> None:

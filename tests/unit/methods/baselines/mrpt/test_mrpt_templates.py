@@ -27,7 +27,7 @@ def test_icp_ini_carries_the_config_and_is_headless() -> None:
     assert ini["insertionAngDistance"] == "45.0" and ini["onlyUniqueRobust"] == "1"
     assert ini["logOutput_dir"] == "out" and ini["rawlog_file"] == "in.rawlog"
     assert ini["SHOW_PROGRESS_3D_REAL_TIME"] == "0" and ini["SAVE_3D_SCENE"] == "0" and ini["LOG_FREQUENCY"] == "0"
-    assert "timeout_s" not in ini and "${" not in render("icp-slam", config, rawlog_file="a", output_dir="b")
+    assert "cpu_limit_s" not in ini and "${" not in render("icp-slam", config, rawlog_file="a", output_dir="b")
 
 
 def test_rbpf_ini_has_one_update_threshold_and_the_seed() -> None:
