@@ -79,6 +79,22 @@ PluginInstaller = Callable[[dict[str, str]], Path]
 
 
 @pytest.fixture
+def own_project(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """A user's own config folder (``ALBOT1_CONFIG_DIR``, its ``datasets/`` made) and checksum cache.
+
+    Manifests are read once per process (``catalog._manifests``): the cache is cleared on the way in and out, so
+    no test sees another's datasets. (Here, not in a conftest.py of a test folder: a second module named
+    ``conftest`` would shadow this one for the tests that import helpers from it.)
+    """
+    monkeypatch.setenv("ALBOT1_CACHE_DIR", str(tmp_path / "checksum-cache"))
+    (tmp_path / "project" / "datasets").mkdir(parents=True)
+    monkeypatch.setenv("ALBOT1_CONFIG_DIR", str(tmp_path / "project"))
+    catalog._manifests.cache_clear()
+    yield tmp_path / "project"
+    catalog._manifests.cache_clear()
+
+
+@pytest.fixture
 def install_method_plugin(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[PluginInstaller]:
     """Install a real plugin distribution (a ``*.dist-info`` with ``entry_points.txt``) for one test.
 

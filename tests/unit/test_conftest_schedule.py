@@ -90,3 +90,12 @@ def _files(root: Path) -> set[str]:
 def test_the_garbage_collector_paused_for_collection_is_on_again_for_the_tests() -> None:
     """``conftest.pytest_collection`` pauses the cyclic collector while collecting and must resume it."""
     assert gc.isenabled()
+
+
+def test_the_root_conftest_is_the_only_one() -> None:
+    """Tests import helpers with ``from conftest import ...``: a second conftest.py (tests/unit/data/conftest.py did,
+    for one fixture) can be the module named ``conftest`` when they are collected, and they fail to import."""
+    root = Path(__file__).resolve().parents[2]
+    found = sorted(str(p.relative_to(root)) for p in (root / "tests").rglob("conftest.py"))
+    found += sorted(str(p.relative_to(root)) for p in (root / "benchmarks").rglob("conftest.py"))
+    assert found == [], found

@@ -23,7 +23,7 @@ WRONG = b"FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\n" * 20
 SHA = hashlib.sha256(PAYLOAD).hexdigest()
 
 
-#: every test here in its own config folder and checksum cache (conftest.own_project)
+#: every test here in its own config folder and checksum cache (the root conftest.py's own_project)
 pytestmark = pytest.mark.usefixtures("own_project")
 
 

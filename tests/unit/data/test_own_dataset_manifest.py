@@ -18,7 +18,7 @@ from albot1.settings import Settings
 WORLD = "synthetic-corridor[:5]"
 
 
-#: every test here in its own config folder and checksum cache (conftest.own_project)
+#: every test here in its own config folder and checksum cache (the root conftest.py's own_project)
 pytestmark = pytest.mark.usefixtures("own_project")
 
 
