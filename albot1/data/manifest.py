@@ -19,6 +19,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
 from albot1.config.suggest import did_you_mean
+from albot1.config.toml_lines import Location, key_lines, line_of
 from albot1.data.errors import DataError
 from albot1.data.loaders.registry import FORMATS
 from albot1.data.relations import RepeatPolicy, repeat_policy
@@ -91,7 +92,28 @@ TOP_KEYS = (
 FILE_KEYS = ("role", "path", "sha256", "size", "urls", "repeats")
 
 
-def _unknown_keys(data: dict[str, Any], known: tuple[str, ...], where: Path) -> None:
+@dataclass(frozen=True)
+class _Where:
+    """Where in a manifest a value sits: the file, its ``[[files]]`` entry, and the line of a key.
+
+    Why: a manifest's errors named the file and the entry but no line, so a user with several ``[[files]]``
+    tables counted them by hand (the project's rule for bad input is file and line).
+    """
+
+    path: Path
+    lines: dict[Location, int]
+    #: ``()`` for the top level, ``("files", i)`` inside the i-th ``[[files]]`` table
+    table: Location = ()
+
+    def at(self, key: str | None = None) -> str:
+        """``FILE:LINE`` of ``key`` (or of its table, or no line when neither is written), then the entry."""
+        location = (*self.table, key) if key is not None else self.table
+        line = line_of(self.lines, location) if location else None
+        entry = f" files[{self.table[1]}]" if self.table else ""
+        return f"{self.path}{f':{line}' if line is not None else ''}{entry}"
+
+
+def _unknown_keys(data: dict[str, Any], known: tuple[str, ...], where: _Where) -> None:
     """A DataError for the first key the schema does not have.
 
     An unknown key used to be ignored without a word, so a typo lost what it
@@ -102,17 +124,17 @@ def _unknown_keys(data: dict[str, Any], known: tuple[str, ...], where: Path) -> 
     for key in data:
         if key not in known:
             raise DataError(
-                f"{where}: unknown key {key!r}{did_you_mean(key, known)}; expected only {', '.join(known)} "
+                f"{where.at(key)}: unknown key {key!r}{did_you_mean(key, known)}; expected only {', '.join(known)} "
                 "(see datasets/README.md)"
             )
 
 
-def _format(value: str, where: Path) -> str:
+def _format(value: str, where: _Where) -> str:
     """The manifest's ``format``: a readable format (it used to fail only when the dataset was opened, unnamed)."""
     if value not in FORMATS:
         raise DataError(
-            f"{where}: format {value!r}{did_you_mean(value, list(FORMATS))} is no format the datasets are read in; "
-            f"expected one of {', '.join(FORMATS)}"
+            f"{where.at('format')}: format {value!r}{did_you_mean(value, list(FORMATS))} is no format the datasets "
+            f"are read in; expected one of {', '.join(FORMATS)}"
         )
     return value
 
@@ -121,33 +143,35 @@ def _format(value: str, where: Path) -> str:
 _TOML_TYPES = {str: "string", int: "integer", bool: "boolean", list: "array", dict: "table"}
 
 
-def _require(data: dict[str, Any], key: str, kind: type, where: Path) -> Any:
+def _require(data: dict[str, Any], key: str, kind: type, where: _Where) -> Any:
     value = data.get(key)
     if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
         found = "nothing" if key not in data else f"a {_TOML_TYPES.get(type(value), type(value).__name__)}"
-        raise DataError(f"{where}: key {key!r} must be a {_TOML_TYPES[kind]}, found {found} (see datasets/README.md)")
+        raise DataError(
+            f"{where.at(key)}: key {key!r} must be a {_TOML_TYPES[kind]}, found {found} (see datasets/README.md)"
+        )
     return value
 
 
-def _optional(data: dict[str, Any], key: str, kind: type, where: Path, default: Any) -> Any:
+def _optional(data: dict[str, Any], key: str, kind: type, where: _Where, default: Any) -> Any:
     """``data[key]`` checked against ``kind`` when present, else ``default``."""
     return _require(data, key, kind, where) if key in data else default
 
 
-def _strings(data: dict[str, Any], key: str, where: Path) -> tuple[str, ...]:
+def _strings(data: dict[str, Any], key: str, where: _Where) -> tuple[str, ...]:
     values = _optional(data, key, list, where, [])
     if not all(isinstance(v, str) for v in values):
-        raise DataError(f"{where}: key {key!r} must be a list of strings (see datasets/README.md)")
+        raise DataError(f"{where.at(key)}: key {key!r} must be a list of strings (see datasets/README.md)")
     return tuple(values)
 
 
-def _size(value: int | None, where: Path) -> int | None:
+def _size(value: int | None, where: _Where) -> int | None:
     if value is not None and value < 0:
-        raise DataError(f"{where}: size {value} must be a number of bytes >= 0")
+        raise DataError(f"{where.at('size')}: size {value} must be a number of bytes >= 0")
     return value
 
 
-def _relative_path(value: str, where: Path) -> str:
+def _relative_path(value: str, where: _Where) -> str:
     """A file's ``path``: relative, inside its data root (no ``..``, not absolute); DataError otherwise.
 
     The path is joined to the data folder and to the download cache, where a
@@ -164,39 +188,41 @@ def _relative_path(value: str, where: Path) -> str:
         or any(part in ("", ".", "..") for part in value.split("/"))
     ):
         raise DataError(
-            f"{where}: path {value!r} must be a relative path inside the data folder, like 'radish/aces.clf.bz2' "
-            "(no leading '/' or '~', no '..' or '.' parts, '/' as separator)"
+            f"{where.at('path')}: path {value!r} must be a relative path inside the data folder, like "
+            "'radish/aces.clf.bz2' (no leading '/' or '~', no '..' or '.' parts, '/' as separator)"
         )
     return value
 
 
 def parse_manifest(path: Path) -> DatasetManifest:
-    """Read and check one manifest; DataError naming the file (and file entry) on bad input."""
+    """Read and check one manifest; DataError naming the file, the line (and file entry) on bad input."""
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        data = tomllib.loads(text)
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise DataError(f"{path}: not a readable TOML manifest ({exc})") from None
-    _unknown_keys(data, TOP_KEYS, path)
-    name = _require(data, "name", str, path)
+    top = _Where(path, key_lines(text))
+    _unknown_keys(data, TOP_KEYS, top)
+    name = _require(data, "name", str, top)
     if name != path.stem:
-        raise DataError(f"{path}: name {name!r} must equal the file name {path.stem!r}")
+        raise DataError(f"{top.at('name')}: name {name!r} must equal the file name {path.stem!r}")
     files = []
-    for i, entry in enumerate(_require(data, "files", list, path)):
-        where = Path(f"{path} files[{i}]")
+    for i, entry in enumerate(_require(data, "files", list, top)):
+        where = _Where(path, top.lines, ("files", i))
         if not isinstance(entry, dict):
-            raise DataError(f"{where}: expected a [[files]] table, got {type(entry).__name__}")
+            raise DataError(f"{where.at()}: expected a [[files]] table, got {type(entry).__name__}")
         _unknown_keys(entry, FILE_KEYS, where)
         role = _require(entry, "role", str, where)
         if role not in ROLES:
-            raise DataError(f"{where}: role {role!r}; expected one of {', '.join(ROLES)}")
+            raise DataError(f"{where.at('role')}: role {role!r}; expected one of {', '.join(ROLES)}")
         sha = _require(entry, "sha256", str, where).lower()
         if len(sha) != 64 or any(c not in "0123456789abcdef" for c in sha):
-            raise DataError(f"{where}: sha256 must be 64 hex digits")
+            raise DataError(f"{where.at('sha256')}: sha256 must be 64 hex digits")
         repeats = _optional(entry, "repeats", str, where, None)
         if repeats is not None:
             if role != "relations":
-                raise DataError(f'{where}: repeats goes with role = "relations", not {role!r}')
-            repeats = repeat_policy(repeats, str(where))
+                raise DataError(f'{where.at("repeats")}: repeats goes with role = "relations", not {role!r}')
+            repeats = repeat_policy(repeats, where.at("repeats"))
         files.append(
             DataFile(
                 role=role,
@@ -208,22 +234,24 @@ def parse_manifest(path: Path) -> DatasetManifest:
             )
         )
     if sum(f.role == "log" for f in files) != 1:
-        raise DataError(f'{path}: expected exactly one file with role = "log"')
-    recording = _optional(data, "recording", str, path, "")
+        raise DataError(f'{top.at("files")}: expected exactly one file with role = "log"')
+    recording = _optional(data, "recording", str, top, "")
     if recording == name:
-        raise DataError(f"{path}: recording names the dataset itself; leave it out for a recording of its own")
+        raise DataError(
+            f"{top.at('recording')}: recording names the dataset itself; leave it out for a recording of its own"
+        )
     return DatasetManifest(
         name=name,
-        description=_optional(data, "description", str, path, ""),
-        format=_format(_optional(data, "format", str, path, "carmen"), path),
+        description=_optional(data, "description", str, top, ""),
+        format=_format(_optional(data, "format", str, top, "carmen"), top),
         files=tuple(files),
-        license=_optional(data, "license", str, path, ""),
-        citation=_optional(data, "citation", str, path, ""),
-        source=_optional(data, "source", str, path, ""),
-        local_only=_optional(data, "local_only", bool, path, False),
-        reference=_optional(data, "reference", str, path, ""),
-        notes=_optional(data, "notes", str, path, ""),
-        loader=dict(_optional(data, "loader", dict, path, {})),
+        license=_optional(data, "license", str, top, ""),
+        citation=_optional(data, "citation", str, top, ""),
+        source=_optional(data, "source", str, top, ""),
+        local_only=_optional(data, "local_only", bool, top, False),
+        reference=_optional(data, "reference", str, top, ""),
+        notes=_optional(data, "notes", str, top, ""),
+        loader=dict(_optional(data, "loader", dict, top, {})),
         manifest_path=path,
         recording=recording,
     )

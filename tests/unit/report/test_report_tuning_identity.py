@@ -144,5 +144,5 @@ def test_every_recording_a_manifest_names_is_a_catalog_dataset_and_not_itself(tm
     assert set(linked.values()) <= set(catalog.names())
     own = tmp_path / "loop.toml"
     own.write_text(f'name = "loop"\nrecording = "loop"\n[[files]]\nrole = "log"\npath = "a/b"\nsha256 = "{"0" * 64}"\n')
-    with pytest.raises(DataError, match=r"loop\.toml: recording names the dataset itself"):
+    with pytest.raises(DataError, match=r"loop\.toml:2: recording names the dataset itself"):
         parse_manifest(own)
