@@ -66,6 +66,15 @@ class StandardRow:
     note: str
     #: The results folder of a measured row taken from another store than the default suite's ("": the default's).
     store: str = ""
+    #: Written since the page shows every published figure with its spread and every measured row with its
+    #: medians (a record written before reads them as None): the rotational std, and the medians of a measured row
+    #: (the relation errors are heavy-tailed: the median says how typical relations fare)
+    rotation_std_deg: float | None = None
+    translation_median_m: float | None = None
+    rotation_median_deg: float | None = None
+    #: A published row: the decimals its source printed its figures with (``standard.Row``); None: measured
+    translation_decimals: int | None = None
+    rotation_decimals: int | None = None
 
 
 @dataclass(frozen=True)
@@ -149,6 +158,11 @@ def _standard_row(row: Row) -> StandardRow:
         held_in=row.held_in,
         source=row.source,
         note=row.note,
+        rotation_std_deg=_finite(row.rotation_std_deg),
+        translation_median_m=_finite(row.translation_median_m),
+        rotation_median_deg=_finite(row.rotation_median_deg),
+        translation_decimals=row.translation_decimals,
+        rotation_decimals=row.rotation_decimals,
     )
 
 

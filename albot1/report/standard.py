@@ -89,6 +89,10 @@ class Row:
     held_in: bool | None = None
     #: a failed or unmeasured row: what the method's preset file records about this log (``[known_limits]``)
     limit: str = ""
+    #: a published row: the decimals its source printed each figure with (``PublishedFigure.decimals``), so
+    #: 0.044 is not shown as 0.0440; None: a measured row, shown with the page's own decimals
+    translation_decimals: int | None = None
+    rotation_decimals: int | None = None
 
     @property
     def speed(self) -> float | None:
@@ -260,6 +264,8 @@ def published_rows(durations: dict[str, float] | None = None) -> list[Row]:
                     duration_s=(durations or {}).get(log) if wall else None,
                     source="; ".join(sources),
                     note="; ".join(notes),
+                    translation_decimals=trans.decimals if trans else None,
+                    rotation_decimals=rot.decimals if rot else None,
                 )
             )
     return rows
@@ -277,17 +283,22 @@ def _pm(mean: float | None, std: float | None, digits: int) -> str:
     return _num(mean, digits) + ("" if std is None else f" ± {_num(std, digits)}")
 
 
+def _places(printed: int | None, ours: int) -> int:
+    """A published figure's own decimals (``printed``), else the page's (``ours``) for a measured one."""
+    return ours if printed is None else printed
+
+
 def _cell(row: Row) -> list[str]:
     if row.status != "done":
         return [marked(row.method, row.held_in), row.kind, f"**{row.status}**: {row.note}", *[""] * 10]
     return [
         marked(row.method, row.held_in),
         f"**{row.kind}**" if row.kind == "published" else row.kind,
-        _pm(row.translation_mean_m, row.translation_std_m, 4),
+        _pm(row.translation_mean_m, row.translation_std_m, _places(row.translation_decimals, 4)),
         _num(row.translation_median_m, 4),
         _num(row.translation_max_m, 3),
         NA if row.relations is None else str(row.relations),
-        _pm(row.rotation_mean_deg, row.rotation_std_deg, 3),
+        _pm(row.rotation_mean_deg, row.rotation_std_deg, _places(row.rotation_decimals, 3)),
         _num(row.rotation_median_deg, 3),
         _num(row.rotation_max_deg, 2),
         _pm(row.loop_translation_mean_m, row.loop_translation_std_m, 4)
@@ -383,7 +394,8 @@ def render_page(
             elif entry.status != "done":
                 values.append(entry.status)
             else:
-                values.append(marked(_num(entry.translation_mean_m, 4), entry.held_in))
+                places = _places(entry.translation_decimals, 4)
+                values.append(marked(_num(entry.translation_mean_m, places), entry.held_in))
         lines.append(f"| {name} | " + " | ".join(values) + " |")
     lines += ["", "`–`: no figure (not run here / not published for that log).", "", LEGEND, ""]
     unrecorded = sorted(

@@ -11,6 +11,7 @@ The report reads :func:`published_systems` and labels every figure
 from __future__ import annotations
 
 import tomllib
+from decimal import Decimal
 from functools import lru_cache
 from importlib.resources import files
 from typing import Literal
@@ -32,10 +33,34 @@ class PublishedFigure(BaseModel):
     #: relation error (Kuemmerle et al. 2009: mean +/- std over all relations), or the whole-log processing time
     #: on the authors' machine (``wall_clock_s``; ``note`` names the machine)
     metric: Literal["relation_translation_m", "relation_rotation_deg", "wall_clock_s"]
-    mean: float
-    std: float | None = None
+    mean: float = Field(ge=0, allow_inf_nan=False)
+    std: float | None = Field(default=None, ge=0, allow_inf_nan=False)
     source: str = Field(min_length=1, description="table / page of the cited work")
     note: str = ""
+
+    @property
+    def decimals(self) -> int:
+        """The decimals the source printed: the most that ``mean`` and ``std`` are written with in the file.
+
+        Why: a published 0.044 is not 0.0440, and 0.4 deg is not 0.400 deg; padding a figure to a table's
+        own decimals claims a precision its authors did not give. TOML keeps a number's digits but a
+        float drops trailing zeros (0.220 reads 0.22), which the other number of the pair restores
+        (0.220 +/- 0.296: three decimals), as it does for every figure of ``published.toml``.
+        """
+        return max(printed_decimals(v) for v in (self.mean, self.std) if v is not None)
+
+    def text(self) -> str:
+        """``mean ± std`` (``mean`` without a std) with the decimals the source printed (:attr:`decimals`)."""
+        std = "" if self.std is None else f" ± {self.std:.{self.decimals}f}"
+        return f"{self.mean:.{self.decimals}f}{std}"
+
+
+def printed_decimals(value: float) -> int:
+    """Decimals of ``value``'s shortest text (0.0375 -> 4, 0.4 -> 1, 41.0 -> 0, 1e-05 -> 5)."""
+    exponent = Decimal(repr(value)).normalize().as_tuple().exponent
+    if not isinstance(exponent, int):  # NaN or infinity: the figures refuse them (``allow_inf_nan=False``)
+        raise ValueError(f"{value!r} is not a finite number")
+    return max(0, -exponent)
 
 
 class PublishedSystem(BaseModel):

@@ -255,3 +255,21 @@ def test_the_paired_matrix_names_the_seeds_it_compares_when_a_method_ran_several
     assert "- runs compared: odometry seed 0, kiss-icp seed 0" in paired_lines(same)
     one_seed = compare_by_log([odometry, kiss(odometry)], lambda rec: True)["aces"]
     assert one_seed.seeds == {} and not any(line.startswith("- runs compared") for line in paired_lines(one_seed))
+
+
+def test_published_figures_read_as_their_sources_print_them_not_padded_to_the_page_decimals(tmp_path: Path) -> None:
+    """Hess et al. print GM on ACES as 0.044 ± 0.044 m and 0.4 ± 0.4 deg: 0.0440 ± 0.0440 and 0.400 ± 0.400 deg
+    claimed a precision the source does not give. Measured rows keep the page's decimals."""
+    rec = _record(tmp_path / "runs", "aces")
+    out = tmp_path / "report"
+    out.mkdir()
+    page, _ = write_standard(_plan([]), [rec], out)
+    lines = page.read_text().splitlines()
+    gm = "| GM (Kuemmerle et al. 2009) | **published** | 0.044 ± 0.044 | n/a | n/a | n/a | 0.4 ± 0.4 | n/a | n/a |"
+    assert any(line.startswith(gm) for line in lines)
+    assert any(
+        line.startswith("| SM (Kuemmerle et al. 2009) | **published** | 0.220 ± 0.296 | n/a |") for line in lines
+    )
+    summary = next(line for line in lines if line.startswith("| GM (Kuemmerle et al. 2009) (**published**) |"))
+    assert summary == "| GM (Kuemmerle et al. 2009) (**published**) | 0.044 | 0.031 | 0.004 | 0.056 | 0.143 |"
+    assert any(line.startswith("| odometry | measured | 0.3167 ± 0.4193 |") for line in lines)

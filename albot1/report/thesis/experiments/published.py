@@ -17,7 +17,7 @@ def published_notes(systems: Iterable[str]) -> list[str]:
     lines = []
     for system in published_systems():
         if system.name in systems:
-            figures = "; ".join(f"{f.log} {f.metric} {f.mean:g} ({f.source})" for f in system.figures)
+            figures = "; ".join(f"{f.log} {f.metric} {f.text()} ({f.source})" for f in system.figures)
             lines.append(
                 f"{system.label} is not run here: {system.implementation} Published figures: "
                 f"{figures or 'none verifiable on these logs'}."
@@ -26,7 +26,11 @@ def published_notes(systems: Iterable[str]) -> list[str]:
 
 
 def published_relations(logs: Iterable[str]) -> str | None:
-    """A table of the published relation errors on ``logs`` (whole logs), labelled published; None if none."""
+    """A table of the published relation errors on ``logs`` (whole logs), labelled published; None if none.
+
+    Each figure reads as its source prints it, mean ± std with the source's decimals (``PublishedFigure.text``):
+    ``:g`` would turn the published 0.220 m into 0.22 and leave out the spread.
+    """
     rows = []
     wanted = list(logs)
     for system in published_systems():
@@ -39,8 +43,8 @@ def published_relations(logs: Iterable[str]) -> str | None:
                 [
                     f"`{log}`",
                     system.label,
-                    f"{trans.mean:g} m" if trans else "–",
-                    f"{rot.mean:g} deg" if rot else "–",
+                    f"{trans.text()} m" if trans else "–",
+                    f"{rot.text()} deg" if rot else "–",
                     "; ".join(dict.fromkeys(f.source for f in (trans, rot) if f is not None)),
                 ]
             )
@@ -49,5 +53,14 @@ def published_relations(logs: Iterable[str]) -> str | None:
     return (
         "Published relation errors on the same whole logs (published, not measured here; "
         "`albot1/methods/baselines/published.toml`):\n\n"
-        + table(["log", "published system", "published: translation", "published: rotation", "source"], rows)
+        + table(
+            [
+                "log",
+                "published system",
+                "published: translation, mean ± std",
+                "published: rotation, mean ± std",
+                "source",
+            ],
+            rows,
+        )
     )
