@@ -37,16 +37,21 @@ class PublishedFigure(BaseModel):
     std: float | None = Field(default=None, ge=0, allow_inf_nan=False)
     source: str = Field(min_length=1, description="table / page of the cited work")
     note: str = ""
+    #: the decimals the source printed the figure with, where the numbers cannot say it (0.10 ± 0.20: a float
+    #: keeps 0.1 and 0.2); None: worked out from the numbers (:attr:`decimals`)
+    printed_decimals: int | None = Field(default=None, ge=0, le=12)
 
     @property
     def decimals(self) -> int:
-        """The decimals the source printed: the most that ``mean`` and ``std`` are written with in the file.
+        """The decimals the source printed: ``printed_decimals``, else the most ``mean`` and ``std`` are written with.
 
         Why: a published 0.044 is not 0.0440, and 0.4 deg is not 0.400 deg; padding a figure to a table's
         own decimals claims a precision its authors did not give. TOML keeps a number's digits but a
         float drops trailing zeros (0.220 reads 0.22), which the other number of the pair restores
         (0.220 +/- 0.296: three decimals), as it does for every figure of ``published.toml``.
         """
+        if self.printed_decimals is not None:
+            return self.printed_decimals
         return max(printed_decimals(v) for v in (self.mean, self.std) if v is not None)
 
     def text(self) -> str:

@@ -51,3 +51,12 @@ def test_a_figure_refuses_a_negative_or_infinite_value() -> None:
     for bad in ({"mean": -0.1}, {"mean": float("inf")}, {"mean": 0.1, "std": float("nan")}, {"mean": 0.1, "std": -1}):
         with pytest.raises(ValidationError):
             PublishedFigure(log="intel", metric="relation_translation_m", source="x", **bad)  # type: ignore[arg-type]
+
+
+def test_a_figure_whose_numbers_both_end_in_a_printed_zero_says_its_decimals() -> None:
+    """0.10 ± 0.20 reads back from TOML as 0.1 and 0.2: only ``printed_decimals`` can keep the printed text."""
+    fields = {"log": "intel", "metric": "relation_translation_m", "source": "x", "mean": 0.1, "std": 0.2}
+    assert PublishedFigure(**fields).text() == "0.1 ± 0.2"  # type: ignore[arg-type]
+    assert PublishedFigure(**fields, printed_decimals=2).text() == "0.10 ± 0.20"  # type: ignore[arg-type]
+    with pytest.raises(ValidationError):
+        PublishedFigure(**fields, printed_decimals=-1)  # type: ignore[arg-type]
