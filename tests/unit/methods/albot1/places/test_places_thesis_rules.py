@@ -14,13 +14,14 @@ non-strict one, or the other way round, fails a test. docs/places.md,
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
 
 from albot1.geometry.se2 import wrap_angle
 from albot1.methods.albot1.places import match_kernels
-from albot1.methods.albot1.places.config import Albot1PlacesConfig
+from albot1.methods.albot1.places.config import Albot1PlacesConfig, PlacesFields
 from albot1.methods.albot1.places.kernels import PlacesKernels
 from albot1.methods.albot1.places.mapper import Albot1PlacesMapper
 from albot1.methods.albot1.places.matcher import centre, robot_sides, structural, trigger_threshold
@@ -161,3 +162,21 @@ def test_more_than_n_co_locating_surfaces_trigger_a_check() -> None:
     mapper._evidence = {0: set(range(n + 1))}
     mapper._recognise((1.0, 1.0, 0.0), 30)
     assert mapper._counts.match_attempts == 1
+
+
+#: Chapter 4's words the config's field descriptions quote, from albot1-thesis.md without its math marks (4.1.1,
+#: Algorithms 6-7, 4.2.3). A description that quotes anything else quotes words the thesis does not have.
+THESIS_WORDS = (
+    "an office-like environment with well-defined exits (i.e. doorway, a gap whose typical size is about 1 meter",
+    "Matched_Surfaces > 4 and they are located on both sides of the robot's current position",
+    "Transform S_k onto the metric map of P_c centering on S_j",
+    "the robot should find an exit in its perceptual map that co-locates with the physical exit encountered",
+)
+
+
+def test_the_field_descriptions_quote_only_words_the_thesis_has() -> None:
+    """``albot1 methods --presets`` shows these descriptions: a quotation in them must be the thesis's own."""
+    quoted = re.compile(r"(?<![A-Za-z])'([^']+?)'(?![A-Za-z])")
+    for name, field in PlacesFields.model_fields.items():
+        for words in quoted.findall(field.description or ""):
+            assert any(words in text for text in THESIS_WORDS), f"{name}: {words!r} is not the thesis's"
