@@ -20,6 +20,8 @@ import numpy as np
 import pytest
 
 from albot1.geometry.se2 import wrap_angle
+from albot1.methods.albot1.mapping.mapper import UpdateEvent
+from albot1.methods.albot1.mapping.update import UpdateOutcome
 from albot1.methods.albot1.places import match_kernels
 from albot1.methods.albot1.places.config import Albot1PlacesConfig, PlacesFields
 from albot1.methods.albot1.places.kernels import PlacesKernels
@@ -162,6 +164,27 @@ def test_more_than_n_co_locating_surfaces_trigger_a_check() -> None:
     mapper._evidence = {0: set(range(n + 1))}
     mapper._recognise((1.0, 1.0, 0.0), 30)
     assert mapper._counts.match_attempts == 1
+
+
+def test_the_literal_trigger_counts_only_surfaces_longer_than_40_cm() -> None:
+    """4.1.2 "it is considered surfaces with a length > 40cm" holds for the co-locating surfaces too.
+
+    ``revisit_evidence = "perceptual_map"`` (the literal preset) counts the map surfaces an update deletes or
+    edits by the places they were marked with; a piece 40 cm long or shorter is no evidence. (On
+    synthetic-places-loop 15 of the 101 surfaces it used to count were such pieces.)
+    """
+    mapper = Albot1PlacesMapper(Albot1PlacesConfig(revisit_evidence="perceptual_map", accelerate=False))
+    network = mapper.network
+    for scan in (0, 10):
+        visit = network.start_visit(scan, (0.0, 0.0, 0.0))
+        network.close(visit, np.empty((0, 4)), np.array([5.0, 1.0, 5.0, 2.0]), scan + 10)
+    network.start_visit(20, (0.0, 0.0, 0.0))
+    ids = mapper.inner.map.add(np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.4, 1.0], [0.0, 2.0, 0.3, 2.0]]), 5)
+    mapper._labels = [{0} for _ in ids]  # marked by visit 0, now place 0
+    none = np.empty(0, dtype=np.int64)
+    outcome = UpdateOutcome(view_ids=none, deleted=ids[:2], extended=ids[2:], trimmed=none, added=none)
+    mapper._map_evidence(UpdateEvent(30, "current", 30, (3.0, 3.0, 0.0), outcome, np.empty((0, 4))))
+    assert mapper._evidence == {0: {int(ids[0])}}
 
 
 #: Chapter 4's words the config's field descriptions quote, from albot1-thesis.md without its math marks (4.1.1,
