@@ -75,8 +75,8 @@ class PlacesFields(MethodConfig):
     exit_endpoints: Literal["occluding", "one_occluding"] = Field(
         "occluding",
         description=(
-            "both gap ends occluding (thesis: 'typically between occluding endpoints'), or one occluding and "
-            "the other a corner"
+            "both gap ends occluding (our reading: 4.1.1 names only 'a gap whose typical size is about 1 meter', "
+            "not its ends), or one occluding and the other a corner"
         ),
     )
     exit_track_distance_m: float = Field(

@@ -176,7 +176,10 @@ class Albot1PlacesMapper:
         it into the map, and a surface an update adds in place of one it
         deleted (the same within 5 degrees and 40 cm: the same wall seen
         again) inherits that one's visits, since the perceptual map replaces
-        surfaces rather than editing them.
+        surfaces rather than editing them. Only surfaces longer than
+        ``place_surface_min_m`` count: "in the implementation, it is
+        considered surfaces with a length > 40cm" (4.1.2), and n is counted
+        in such surfaces too (:func:`trigger_threshold` of the structure).
         """
         out = event.outcome
         network = self.network
@@ -187,6 +190,9 @@ class Albot1PlacesMapper:
         touched = np.concatenate([out.deleted, out.extended, out.trimmed])
         if len(touched):
             seg = self.inner.map.segments(touched)
+            # 4.1.2 "it is considered surfaces with a length > 40cm": shorter pieces are no evidence
+            longer = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]) > self._match.min_surface
+            touched, seg = touched[longer], seg[longer]
             through = self.exits.beyond((event.pose[0], event.pose[1]), 0.5 * (seg[:, :2] + seg[:, 2:]), event.scan)
             excluded = self._excluded()
             for sid, exit_id in zip(touched.tolist(), through.tolist()):
