@@ -45,7 +45,7 @@ from albot1.report.comparisons import (
     seeds_paired,
 )
 from albot1.report.markdown import text as md_text
-from albot1.report.tuning import LEGEND, combined, marked, record_held_in
+from albot1.report.tuning import LEGEND, combined, csv_flag, marked, record_held_in
 
 TABLE = "paired.csv"
 ODOMETRY = "odometry"
@@ -279,7 +279,8 @@ def html_table(rows: list[PairedRow], dataset: str) -> str:
         ref = _cell(r.against_reference, REFERENCE) + _against(r, r.reference)
         best = _cell(r.against_best, BEST) + _against(r, r.best)
         body.append(
-            f"<tr><td>{escape(marked(r.method, r.held(r.method)))}</td><td>{escape(r.degradation)}</td><td>{escape(_counts(r))}</td>"
+            f"<tr><td>{escape(marked(r.method, r.held(r.method)))}</td><td>{escape(r.degradation)}</td>"
+            f"<td>{escape(_counts(r))}</td>"
             f"<td>{escape(ref)}</td><td>{escape(best)}</td></tr>"
         )
     notes = "".join(f"<li>{escape(note)}</li>" for note in _notes(mine))
@@ -291,11 +292,6 @@ def html_table(rows: list[PairedRow], dataset: str) -> str:
         + "</tbody></table></div>"
         + (f'<ul class="notes">{notes}</ul>' if notes else "")
     )
-
-
-def _flag(held: bool | None) -> str:
-    """A held-in column's cell as ``cells.csv`` writes it: ``True``, ``False``, empty when unknown."""
-    return "" if held is None else str(held)
 
 
 def write_paired_csv(rows: list[PairedRow], out: Path) -> Path:
@@ -319,8 +315,8 @@ def write_paired_csv(rows: list[PairedRow], out: Path) -> Path:
             writer.writerow(
                 [r.dataset, r.degradation, r.method, "" if other in (None, r.method) else other, role, r.kind]
                 + [found.pairs, found.groups, *numbers]
-                + [found.verdict, found.reason or "", _flag(r.held(r.method))]
-                + ["" if other in (None, r.method) else _flag(r.held(other))]
+                + [found.verdict, found.reason or "", csv_flag(r.held(r.method))]
+                + ["" if other in (None, r.method) else csv_flag(r.held(other))]
             )
     path = out / TABLE
     text = buffer.getvalue()

@@ -88,6 +88,8 @@ class VerdictRow:
     claim: str
     thesis: str
     tallies: dict[str, dict[str, int]]
+    #: label -> how many of its verdicts rest on a held-in number (albot1.report.thesis.verdicts.held); none: 0
+    held_in: dict[str, int] = field(default_factory=dict)
 
 
 @dataclass
@@ -207,14 +209,16 @@ def _verdicts(thesis_dir: Path) -> tuple[dict[str, str], list[VerdictRow], list[
     for section in all_sections(ev):
         for text, group in section.claim_groups():
             if all("" in row.verdicts for row in group):
-                tallies = {"": _tally([row.verdicts[""] for row in group])}
+                shown = {"": [row.verdicts[""] for row in group]}
             else:
-                tallies = {
-                    label: _tally([row.verdicts[key] for row in group if key in row.verdicts])
+                shown = {
+                    label: [row.verdicts[key] for row in group if key in row.verdicts]
                     for key, label in section.columns.items()
                 }
                 columns.update({label: label for label in section.columns.values()})
-            rows.append(VerdictRow(section.title.split(":")[0], text, group[0].thesis, tallies))
+            tallies = {label: _tally(verdicts) for label, verdicts in shown.items()}
+            held = {label: n for label, verdicts in shown.items() if (n := sum(v.held_in for v in verdicts))}
+            rows.append(VerdictRow(section.title.split(":")[0], text, group[0].thesis, tallies, held))
     return columns, rows, list(ev.notes)
 
 

@@ -140,6 +140,17 @@ def held_in_line(method: str, preset: str, dataset: str, data_sha256: Iterable[s
     )
 
 
+def held_in_share(count: int, total: int) -> str:
+    """How many of ``total`` verdicts or numbers pooled in one cell are held-in: ``, 20 held-in †`` (or nothing).
+
+    A count (of a thesis claim over datasets, say) pools held-in and held-out data, so the mark alone would
+    not say how much of it shows fit; the thesis page and the results page word it the same way.
+    """
+    if not count:
+        return ""
+    return f", {'all' if count == total else count} held-in {MARK}"
+
+
 def combined(values: Iterable[bool | None]) -> bool | None:
     """The mark of numbers pooled from several cells: True when one is held-in, None when one's tuning is unknown.
 
@@ -155,6 +166,12 @@ def record_held_in(rec: CellRecord) -> bool | None:
     """:func:`held_in` of a stored cell, with the checksums of the files its run read when it has a result."""
     files = rec.result.dataset_info.data_sha256.values() if rec.result is not None else ()
     return held_in(rec.cell, files)
+
+
+def csv_flag(held: bool | None) -> str:
+    """A ``held_in`` cell of a CSV written by hand, as pandas writes ``cells.csv``'s: ``True``, ``False``, empty
+    when the tuning is unknown (never ``False`` for it)."""
+    return "" if held is None else str(held)
 
 
 def marked(text: str, tuned: bool | None) -> str:

@@ -8,7 +8,10 @@ interactive view of ``index.html`` named a held-in run's trajectory and map with
 from __future__ import annotations
 
 import csv
+from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -22,7 +25,13 @@ from albot1.report.collect import CellRecord
 from albot1.report.interactive import dataset_figure
 from albot1.report.interactive_page import write_views
 from albot1.report.paired_tables import html_table, markdown_lines, paired_rows
+from albot1.report.results_data import ResultsData, VerdictRow
+from albot1.report.results_page import _verdict_lines, tally_text
 from albot1.report.tables import write_tables
+from albot1.report.thesis.evidence import Evidence, Store
+from albot1.report.thesis.experiments.common import ATE, cell, number, tagged
+from albot1.report.thesis.page import _tally, _verdict_cell
+from albot1.report.thesis.verdicts import all_of, at_most, lower_than
 from albot1.report.tuning import LEGEND, MARK
 from albot1.runs.evaluate import evaluate_run
 from albot1.runs.execute import run_method
@@ -123,3 +132,56 @@ def test_a_changed_tuned_on_list_draws_the_view_again(
 def _marked_in_script(text: str) -> bool:
     """Whether a view's script names gtsam-graph with the mark (plotly's JSON may escape it as ``\\u2020``)."""
     return any(f"gtsam-graph {mark}" in text for mark in (MARK, MARK.encode("ascii", "backslashreplace").decode()))
+
+
+# --------------------------------------------------------------------------- the thesis page
+
+
+def _thesis_evidence(records: list[CellRecord]) -> Evidence:
+    """The paired fixture's runs filed as the thesis preset (held-in on WORLD) and odometry, in one store."""
+    thesis = [
+        replace(r, cell=replace(r.cell, method="albot1", method_label="albot1:thesis", preset="thesis"))
+        for r in records
+        if r.cell.method == "gtsam-graph"
+    ]
+    odometry = [r for r in records if r.cell.method == "odometry"]
+    return Evidence(
+        [Store("thesis", Path("results/thesis"), cast(Any, SimpleNamespace(machine={})), thesis + odometry)]
+    )
+
+
+def test_a_thesis_verdict_and_number_on_a_tuned_dataset_carry_the_mark(records: list[CellRecord]) -> None:
+    ev = _thesis_evidence(records)
+    mine = number(ev, WORLD, "albot1:thesis", ATE, "albot1:thesis ATE", "m")
+    odometry = number(ev, WORLD, "odometry", ATE, "odometry ATE", "m")
+    assert mine.known and mine.held_in is True and odometry.held_in is False
+    assert tagged(cell(mine), mine).endswith(f" {MARK}") and MARK not in tagged(cell(odometry), odometry)
+    assert tagged(f"{cell(mine)} / {cell(mine)}", mine, mine).count(MARK) == 1  # once per table cell
+    assert lower_than(mine, odometry).held_in and at_most(mine, 10.0).held_in and not at_most(odometry, 10.0).held_in
+    assert all_of([at_most(odometry, 10.0), at_most(mine, 10.0)]).held_in
+    assert _verdict_cell(at_most(mine, 10.0)).startswith(f"**holds** {MARK}: ")
+    assert _verdict_cell(at_most(odometry, 10.0)).startswith("**holds**: ")
+    mixed = [at_most(mine, 10.0), at_most(odometry, 10.0), at_most(mine, 10.0)]
+    assert _tally(mixed) == f"holds 3 (of 3 datasets, 2 held-in {MARK})"
+    assert _tally([at_most(odometry, 10.0)] * 2) == "holds 2 (of 2 datasets)"
+
+
+def test_the_results_page_counts_held_in_thesis_verdicts() -> None:
+    assert (
+        tally_text({"holds": 2, "does not hold": 1}, 3)
+        == f"holds 2, does not hold 1 (of 3 datasets, all held-in {MARK})"
+    )
+    assert tally_text({"holds": 1}, 1) == f"**holds** {MARK}"
+    assert tally_text({"holds": 2}) == "holds 2 (of 2 datasets)"
+    row = VerdictRow("Experiment 1", "shape kept", "3.2.1", {"thesis preset": {"holds": 2}}, {"thesis preset": 1})
+    data = ResultsData("c", [], {}, "m", [], verdict_columns={"thesis preset": "thesis preset"}, verdicts=[row])
+    assert f"holds 2 (of 2 datasets, 1 held-in {MARK})" in "\n".join(_verdict_lines(data))
+    assert ResultsData.from_json(data.to_json(), "x").verdicts[0].held_in == {"thesis preset": 1}
+
+
+def test_an_external_cell_is_unknown_whatever_its_label(records: list[CellRecord]) -> None:
+    """A suite's external cell (another system's trajectory file) labelled like a registered method read that
+    method's tuning; the file's maker records none here."""
+    cell = next(r.cell for r in records if r.cell.method == "gtsam-graph")
+    assert tuning.held_in(cell) is True
+    assert tuning.held_in(replace(cell, trajectory="their.tum")) is None
