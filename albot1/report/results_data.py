@@ -19,6 +19,7 @@ from typing import Any
 from albot1.report.collect import collect
 from albot1.report.errors import ReportError
 from albot1.report.standard import Row, measured_rows, published_rows
+from albot1.report.tuning import record_held_in
 
 #: Layout of ``results.json``; a record of another version is not read.
 FORMAT = 1
@@ -78,6 +79,8 @@ class AteCell:
     seed: int
     rmse_m: float | None
     note: str
+    #: the cell's held-in mark (albot1.report.tuning.record_held_in; None: unknown, or a record before it)
+    held_in: bool | None = None
 
 
 @dataclass(frozen=True)
@@ -194,7 +197,10 @@ def ate_cells(records: list[Any]) -> list[AteCell]:
             else:
                 note = (rec.metrics.reason(ATE.name) if rec.metrics is not None else None) or "no ATE"
             rmse = _finite(block.rmse_m) if block is not None else None
-            cells.append(AteCell(dataset, degradation, cell.method_label, cell.seed, rmse, " ".join(note.split())))
+            held = record_held_in(rec)
+            cells.append(
+                AteCell(dataset, degradation, cell.method_label, cell.seed, rmse, " ".join(note.split()), held)
+            )
     return sorted(cells, key=lambda c: (KEY_ATE.index((c.dataset, c.degradation)), c.seed))
 
 

@@ -20,16 +20,16 @@ from albot1.bench.grid import Cell
 from albot1.data.model import Frame, Scan, Sequence
 from albot1.metrics.record import MetricsRecord
 from albot1.records import ResultRecord, read_record
-from albot1.report import tuning
+from albot1.report import results_data, tuning
 from albot1.report.collect import CellRecord
 from albot1.report.interactive import dataset_figure
 from albot1.report.interactive_page import write_views
 from albot1.report.paired_tables import html_table, markdown_lines, paired_rows
-from albot1.report.results_data import ResultsData, VerdictRow
-from albot1.report.results_page import _verdict_lines, tally_text
+from albot1.report.results_data import AteCell, ResultsData, VerdictRow
+from albot1.report.results_page import _verdict_lines, ate_table, tally_text
 from albot1.report.tables import write_tables
 from albot1.report.thesis.evidence import Evidence, Store
-from albot1.report.thesis.experiments.common import ATE, cell, number, tagged
+from albot1.report.thesis.experiments.common import ATE, cell, number
 from albot1.report.thesis.page import _tally, _verdict_cell
 from albot1.report.thesis.verdicts import all_of, at_most, lower_than
 from albot1.report.tuning import LEGEND, MARK
@@ -151,6 +151,8 @@ def _thesis_evidence(records: list[CellRecord]) -> Evidence:
 
 
 def test_a_thesis_verdict_and_number_on_a_tuned_dataset_carry_the_mark(records: list[CellRecord]) -> None:
+    from albot1.report.thesis.experiments.common import tagged  # new here: the module's other tests run without it
+
     ev = _thesis_evidence(records)
     mine = number(ev, WORLD, "albot1:thesis", ATE, "albot1:thesis ATE", "m")
     odometry = number(ev, WORLD, "odometry", ATE, "odometry ATE", "m")
@@ -185,3 +187,22 @@ def test_an_external_cell_is_unknown_whatever_its_label(records: list[CellRecord
     cell = next(r.cell for r in records if r.cell.method == "gtsam-graph")
     assert tuning.held_in(cell) is True
     assert tuning.held_in(replace(cell, trajectory="their.tum")) is None
+
+
+def test_the_results_pages_key_ate_cells_carry_the_mark() -> None:
+    """docs/results.md's "ATE on the key degraded cells" showed gtsam-graph on intel-corrected (held-in) bare."""
+    where = ("intel-corrected?odometry=laser-pose", "gauss:0.1:1")
+    cells = [AteCell(*where, "gtsam-graph", seed, 0.07, "", True) for seed in (0, 1)]
+    cells += [AteCell(*where, "odometry", seed, 3.5, "", False) for seed in (0, 1)]
+    cells += [AteCell(*where, "my-plugin", 0, 0.1, "", None)]
+    data = ResultsData("c", [], {}, "m", [], ate=cells)
+    row = next(line for line in ate_table(data) if line.startswith("| `intel-corrected"))
+    assert f"| 0.0700 / 0.0700 {MARK} | 3.5000 / 3.5000 | 0.1000 / – |" in row
+
+
+def test_the_key_ate_cells_are_read_with_their_marks(
+    records: list[CellRecord], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(results_data, "KEY_ATE", ((WORLD, "none"),))
+    marks = {(c.method, c.seed): c.held_in for c in results_data.ate_cells(records)}
+    assert marks[("gtsam-graph", 0)] is True and marks[("odometry", 1)] is False and marks[("my-plugin", 0)] is None
