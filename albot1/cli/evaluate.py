@@ -158,6 +158,7 @@ def evaluate(
             return
         typer.echo(str(written))
         _print_headlines(metrics)
+        _print_held_in(metrics)
         return
     if reference is not None or reference_format is not None:
         if dataset is not None or reference is None:
@@ -262,6 +263,20 @@ def _print_reference_coverage(metrics: MetricsRecord) -> None:
 def _print_headlines(metrics: MetricsRecord) -> None:
     for line in headlines(metrics):
         typer.echo(line)
+
+
+def _print_held_in(metrics: MetricsRecord) -> None:
+    """One line when the run's method was tuned on its dataset (the pages' mark, albot1.report.tuning).
+
+    A trajectory file's scores print none: the system that made it records no tuning here (unknown, not "not
+    tuned"), and the mark is about a method's preset, which a file has not.
+    """
+    from albot1.report.tuning import held_in_line
+
+    run = metrics.run
+    line = held_in_line(run.method, run.preset, run.dataset, run.data_sha256.values())
+    if line is not None:
+        typer.echo(f"  {line}")
 
 
 def headlines(metrics: MetricsRecord) -> list[str]:

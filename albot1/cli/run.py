@@ -60,6 +60,7 @@ def run(
     from albot1.methods.registry import parse_overrides
     from albot1.records import dump_record
     from albot1.report.preview import render_preview
+    from albot1.report.tuning import held_in_line, run_held_in
     from albot1.runs.execute import run_method
     from albot1.runs.folder import mark_latest, read_result, write_run
 
@@ -95,6 +96,8 @@ def run(
     run_dir = write_run(result, out, preview=render_preview)
     mark_latest(out, run_dir)
     record = read_result(run_dir)  # the headline says what result.json says
+    # its counts and timings were measured on a dataset the preset may have been tuned on: say so, as the pages do
+    files = record.dataset_info.data_sha256.values()
     if as_json:
         summary = {
             "run_dir": str(run_dir),
@@ -107,6 +110,7 @@ def run(
             "status": "done",
             "counters": record.counters,
             "timing": dump_record(record.timing),
+            "held_in": run_held_in(record.method, record.preset, record.dataset, files),
         }
         typer.echo(json.dumps(summary))
     else:
@@ -115,3 +119,6 @@ def run(
             f"{record.method} on {record.dataset}: {record.scans} scans, {record.counters.get('updates')} updates, "
             f"{'n/a' if median is None else format(median, '.3f')} ms/scan median -> {run_dir}"
         )
+        line = held_in_line(record.method, record.preset, record.dataset, files)
+        if line is not None:
+            typer.echo(line)

@@ -175,10 +175,17 @@ def all_pairs(labels: Sequence[str], errors: dict[str, Errors], kinds: Sequence[
     return found
 
 
-def matrix_lines(labels: Sequence[str], found: dict[tuple[str, str], Cell], corner: str) -> list[str]:
-    """A Markdown matrix: row method against column method, each cell its comparisons' ``short()`` joined by /."""
-    lines = ["| " + corner + " | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
+def matrix_lines(
+    labels: Sequence[str], found: dict[tuple[str, str], Cell], corner: str, shown: dict[str, str] | None = None
+) -> list[str]:
+    """A Markdown matrix: row method against column method, each cell its comparisons' ``short()`` joined by /.
+
+    ``shown``: a label's heading where it differs from the label (a held-in method's mark, say).
+    """
+    name = shown or {}
+    heads = [name.get(label, label) for label in labels]
+    lines = ["| " + corner + " | " + " | ".join(heads) + " |", "|---|" + "---|" * len(labels)]
     for a in labels:
         cells = ["·" if a == b else " / ".join(c.short() for c in found[(a, b)]) for b in labels]
-        lines.append(f"| {a} | " + " | ".join(cells) + " |")
+        lines.append(f"| {name.get(a, a)} | " + " | ".join(cells) + " |")
     return lines

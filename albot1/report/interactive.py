@@ -56,6 +56,7 @@ from albot1.metrics.stats import summarize
 from albot1.report.collect import CellRecord
 from albot1.report.map_plots import occupancy
 from albot1.report.plots import REFERENCE_COLOR, Extent, has_reference, representative, robust_points
+from albot1.report.tuning import LEGEND, marked, record_held_in
 
 #: The most poses of one trajectory drawn (and hoverable); longer ones are thinned (module doc).
 MAX_POSES = 2000
@@ -77,6 +78,13 @@ class RunView:
     transform: NDArray[np.float64] | None  # the alignment applied (pose), None when drawn in its own frame
     errors: NDArray[np.float64] | None
     note: str | None  # why no errors are shown, or None
+    #: the run's held-in mark (:func:`albot1.report.tuning.record_held_in`; None: tuning unknown)
+    held_in: bool | None = None
+
+    @property
+    def name(self) -> str:
+        """The method's label as its traces are named: with the held-in mark when its values were tuned here."""
+        return marked(self.label, self.held_in)
 
 
 def shown_indices(count: int, errors: NDArray[np.float64] | None, limit: int = MAX_POSES) -> NDArray[np.int64]:
@@ -117,12 +125,13 @@ def run_view(label: str, rec: CellRecord) -> RunView:
     run = rec.stored_run()
     errors, note = stored_errors(rec)
     tag = f"[{rec.cell.degradation}, seed {rec.cell.seed}]"
+    held = record_held_in(rec)
     if errors is None or run.reference is None:
-        return RunView(label, tag, run.timestamps, run.poses[:, :2], None, None, note)
+        return RunView(label, tag, run.timestamps, run.poses[:, :2], None, None, note, held)
     block = rec.metrics.get(ATE) if rec.metrics is not None else None
     assert block is not None  # stored_errors returned errors
     aligned, transform = align(run.poses, run.reference, block.alignment, block.alignment_transform.n_to_align)
-    return RunView(label, tag, run.timestamps, np.asarray(aligned)[:, :2], np.asarray(transform), errors, None)
+    return RunView(label, tag, run.timestamps, np.asarray(aligned)[:, :2], np.asarray(transform), errors, None, held)
 
 
 def _map_traces(
@@ -149,7 +158,7 @@ def _map_traces(
                 "mode": "lines",
                 "x": xs,
                 "y": ys,
-                "name": f"{view.label} map ({len(ends)} lines)",
+                "name": f"{view.name} map ({len(ends)} lines)",
                 "line": {"color": LINE_MAP_COLOR, "width": 1},
                 **common,
             }
@@ -173,7 +182,7 @@ def _map_traces(
                 "showscale": False,
                 "showlegend": True,
                 "opacity": 0.7,
-                "name": f"{view.label} map (occupied {cell:.2g} m cells)",
+                "name": f"{view.name} map (occupied {cell:.2g} m cells)",
                 **common,
             }
         )
@@ -241,6 +250,8 @@ def dataset_figure(records: list[CellRecord], dataset: str, colors: dict[str, st
             notes.append(f"{view.label}: {view.note}")
         if len(view.xy) > MAX_POSES:
             notes.append(f"{view.label}: {len(shown_indices(len(view.xy), view.errors))} of {len(view.xy)} poses drawn")
+    if any(v.held_in for v in views):
+        notes.append(LEGEND)
     framed = any(v.transform is not None for v in views)
     frame = "aligned to the reference as for the ATE" if framed else "each in its own frame (no reference)"
     layout = {
@@ -280,14 +291,14 @@ def _trajectory_trace(view: RunView, color: str) -> dict[str, Any]:
         custom = np.column_stack([idx.astype(float), view.timestamps[idx]])
         marker = {"size": 4, "color": color}
         template = "pose %{customdata[0]}, t = %{customdata[1]:.3f} s<br>no error (no reference)"
-    name = html.escape(view.label)  # plotly reads the template as HTML
+    name = html.escape(view.name)  # plotly reads the template as HTML
     return {
         "type": "scatter",
         "mode": "lines+markers",
         "x": view.xy[idx, 0],
         "y": view.xy[idx, 1],
         "customdata": custom,
-        "name": f"{view.label} {view.tag}",
+        "name": f"{view.name} {view.tag}",
         "legendgroup": view.label,
         "line": {"color": color, "width": 1.5},
         "marker": marker,

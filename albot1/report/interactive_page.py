@@ -28,6 +28,7 @@ from albot1.report.collect import CellRecord
 from albot1.report.figure_cache import FigureCache, inputs_digest
 from albot1.report.interactive import MAX_POSES, dataset_figure, figure_json, write_plotly_js
 from albot1.report.plots import slug
+from albot1.report.tuning import record_held_in
 
 VIEWS_DIR = "interactive"
 #: Plotly's options for every view: wheel zoom, pan by dragging, no logo, fits its column.
@@ -88,7 +89,9 @@ def write_views(records: list[CellRecord], out: Path, colors: dict[str, str]) ->
     for dataset, recs in by_dataset.items():
         name = slug(dataset)
         used = {label: c for label, c in colors.items() if any(r.cell.method_label == label for r in recs)}
-        digest = inputs_digest(recs, "view", dataset, MAX_POSES, sorted(used.items()))
+        # the held-in marks come from the preset files, not the runs: a changed [tuned_on] draws the view again
+        held = [(r.cell.key, record_held_in(r)) for r in recs]
+        digest = inputs_digest(recs, "view", dataset, MAX_POSES, sorted(used.items()), held)
         cached = cache.lookup(f"view:{dataset}", digest)
         if cached is not None and isinstance(cached.payload, list):
             views[dataset] = View(dataset, name, folder / f"{name}.js", [str(n) for n in cached.payload])

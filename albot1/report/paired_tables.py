@@ -23,7 +23,7 @@ import csv
 import io
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from html import escape
 from pathlib import Path
 
@@ -45,6 +45,7 @@ from albot1.report.comparisons import (
     seeds_paired,
 )
 from albot1.report.markdown import text as md_text
+from albot1.report.tuning import LEGEND, combined, csv_flag, marked, record_held_in
 
 TABLE = "paired.csv"
 ODOMETRY = "odometry"
@@ -76,6 +77,13 @@ class PairedRow:
     against_best: Comparison | None
     #: why the method's runs give no errors to compare (every comparison of the row is then n/a)
     missing: str | None = None
+    #: each method of the group -> whether its runs here are held-in (:func:`albot1.report.tuning.combined`;
+    #: None: its tuning is unknown), so a claim "A beats B" says when A or B was tuned on this data
+    held_in: dict[str, bool | None] = field(default_factory=dict)
+
+    def held(self, method: str | None) -> bool | None:
+        """Whether ``method``'s runs in this comparison are held-in (None: unknown or no such method)."""
+        return None if method is None else self.held_in.get(method)
 
 
 def error_kind(records: list[CellRecord]) -> Kind | None:
@@ -138,6 +146,7 @@ def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str,
     }
     if best is not None and not any(found is not None and found.applies for found in against_best.values()):
         against_best[best] = _unproven_best(list(against_best.values()))
+    held = {method: combined(record_held_in(r) for r in mine) for method, mine in by_method.items()}
     rows = []
     for method, mine in by_method.items():
         missing = next((errors[r.cell.key].missing for r in mine if errors[r.cell.key].missing), None)
@@ -153,6 +162,7 @@ def _group_rows(dataset: str, degradation: str, kind: Kind, by_method: dict[str,
                 None if method == reference else compare_runs(seeds_paired(mine, by_method[reference], errors), kind),
                 against_best[method],
                 missing,
+                held,
             )
         )
     return rows
@@ -177,9 +187,14 @@ def _cell(found: Comparison | None, role: str) -> str:
     return f"{found.verdict} {found.text()}" if found.applies else "n/a"
 
 
-def _against(other: str | None, method: str, quote: Callable[[str], str] = str) -> str:
-    """`` (other)``: the method a cell compares with; nothing for the row's own role or when there is none."""
-    return "" if other is None or other == method else f" ({quote(other)})"
+def _against(row: PairedRow, other: str | None, quote: Callable[[str], str] = str) -> str:
+    """`` (other)``: the method a cell compares with, held-in marked; nothing for the row's own role or none."""
+    return "" if other is None or other == row.method else f" ({quote(marked(other, row.held(other)))})"
+
+
+def _any_held_in(rows: list[PairedRow]) -> bool:
+    """Whether a comparison of ``rows`` involves a held-in side (then the table states the mark's legend)."""
+    return any(v is True for r in rows for v in r.held_in.values())
 
 
 def _notes(rows: list[PairedRow]) -> list[str]:
@@ -213,7 +228,9 @@ def intro() -> str:
         f"(< 1: lower) with its {CONFIDENCE:.0%} interval; test: {method_text()}. *pairs (runs)*: the errors "
         f"paired and the pairs of runs they come from. Fewer than {MIN_PAIRS} pairs, or a run whose errors cannot "
         "be read back, is n/a with the reason; so is the best's own cell when no other method's comparison with "
-        "its runs applies. A claim that one method beats another holds only where its row says better or worse."
+        "its runs applies. A claim that one method beats another holds only where its row says better or worse; "
+        "a method marked held-in (the mark after its name, either side) was tuned on that data, so the claim "
+        "shows fit there, not generalisation."
     )
 
 
@@ -242,10 +259,10 @@ def markdown_lines(rows: list[PairedRow], dataset: str) -> list[str]:
         ref = _cell(r.against_reference, REFERENCE)
         best = _cell(r.against_best, BEST)
         lines.append(
-            f"| {md_text(r.method)} | {md_text(r.degradation)} | {_counts(r)} | "
-            f"{ref}{_against(r.reference, r.method, md_text)} | {best}{_against(r.best, r.method, md_text)} |"
+            f"| {md_text(marked(r.method, r.held(r.method)))} | {md_text(r.degradation)} | {_counts(r)} | "
+            f"{ref}{_against(r, r.reference, md_text)} | {best}{_against(r, r.best, md_text)} |"
         )
-    notes = [f"- {md_text(note)}" for note in _notes(mine)]
+    notes = [f"- {md_text(note)}" for note in _notes(mine)] + ([f"- {LEGEND}"] if _any_held_in(mine) else [])
     return [*lines, "", *notes, *([""] if notes else [])]
 
 
@@ -259,13 +276,15 @@ def html_table(rows: list[PairedRow], dataset: str) -> str:
     )
     body = []
     for r in mine:
-        ref = _cell(r.against_reference, REFERENCE) + _against(r.reference, r.method)
-        best = _cell(r.against_best, BEST) + _against(r.best, r.method)
+        ref = _cell(r.against_reference, REFERENCE) + _against(r, r.reference)
+        best = _cell(r.against_best, BEST) + _against(r, r.best)
         body.append(
-            f"<tr><td>{escape(r.method)}</td><td>{escape(r.degradation)}</td><td>{escape(_counts(r))}</td>"
+            f"<tr><td>{escape(marked(r.method, r.held(r.method)))}</td><td>{escape(r.degradation)}</td>"
+            f"<td>{escape(_counts(r))}</td>"
             f"<td>{escape(ref)}</td><td>{escape(best)}</td></tr>"
         )
     notes = "".join(f"<li>{escape(note)}</li>" for note in _notes(mine))
+    notes += f"<li>{escape(LEGEND)}</li>" if _any_held_in(mine) else ""
     return (
         f'<p class="notes">Paired comparison, {escape(FIGURE[mine[0].kind])}: {escape(method_text())}.</p>'
         f'<div class="scroll"><table class="sortable"><thead><tr>{head}</tr></thead><tbody>'
@@ -276,12 +295,17 @@ def html_table(rows: list[PairedRow], dataset: str) -> str:
 
 
 def write_paired_csv(rows: list[PairedRow], out: Path) -> Path:
-    """``paired.csv``: one line per comparison (method against the reference, against the best)."""
+    """``paired.csv``: one line per comparison (method against the reference, against the best).
+
+    ``held_in`` / ``against_held_in``: whether the method's / the other method's runs there are held-in (its
+    values were tuned on that data), empty when unknown; on the best's own line (no other method) the latter
+    is empty.
+    """
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(
         ["dataset", "degradation", "method", "against", "role", "error", "pairs", "runs", "ratio", "low", "high"]
-        + ["verdict", "reason"]
+        + ["verdict", "reason", "held_in", "against_held_in"]
     )
     for r in rows:
         for role, other, found in ((REFERENCE, r.reference, r.against_reference), (BEST, r.best, r.against_best)):
@@ -291,7 +315,8 @@ def write_paired_csv(rows: list[PairedRow], out: Path) -> Path:
             writer.writerow(
                 [r.dataset, r.degradation, r.method, "" if other in (None, r.method) else other, role, r.kind]
                 + [found.pairs, found.groups, *numbers]
-                + [found.verdict, found.reason or ""]
+                + [found.verdict, found.reason or "", csv_flag(r.held(r.method))]
+                + ["" if other in (None, r.method) else csv_flag(r.held(other))]
             )
     path = out / TABLE
     text = buffer.getvalue()

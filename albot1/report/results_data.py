@@ -19,6 +19,7 @@ from typing import Any
 from albot1.report.collect import collect
 from albot1.report.errors import ReportError
 from albot1.report.standard import Row, measured_rows, published_rows
+from albot1.report.tuning import record_held_in
 
 #: Layout of ``results.json``; a record of another version is not read.
 FORMAT = 1
@@ -87,6 +88,8 @@ class AteCell:
     seed: int
     rmse_m: float | None
     note: str
+    #: the cell's held-in mark (albot1.report.tuning.record_held_in; None: unknown, or a record before it)
+    held_in: bool | None = None
 
 
 @dataclass(frozen=True)
@@ -97,6 +100,8 @@ class VerdictRow:
     claim: str
     thesis: str
     tallies: dict[str, dict[str, int]]
+    #: label -> how many of its verdicts rest on a held-in number (albot1.report.thesis.verdicts.held); none: 0
+    held_in: dict[str, int] = field(default_factory=dict)
 
 
 @dataclass
@@ -206,7 +211,10 @@ def ate_cells(records: list[Any]) -> list[AteCell]:
             else:
                 note = (rec.metrics.reason(ATE.name) if rec.metrics is not None else None) or "no ATE"
             rmse = _finite(block.rmse_m) if block is not None else None
-            cells.append(AteCell(dataset, degradation, cell.method_label, cell.seed, rmse, " ".join(note.split())))
+            held = record_held_in(rec)
+            cells.append(
+                AteCell(dataset, degradation, cell.method_label, cell.seed, rmse, " ".join(note.split()), held)
+            )
     return sorted(cells, key=lambda c: (KEY_ATE.index((c.dataset, c.degradation)), c.seed))
 
 
@@ -221,14 +229,16 @@ def _verdicts(thesis_dir: Path) -> tuple[dict[str, str], list[VerdictRow], list[
     for section in all_sections(ev):
         for text, group in section.claim_groups():
             if all("" in row.verdicts for row in group):
-                tallies = {"": _tally([row.verdicts[""] for row in group])}
+                shown = {"": [row.verdicts[""] for row in group]}
             else:
-                tallies = {
-                    label: _tally([row.verdicts[key] for row in group if key in row.verdicts])
+                shown = {
+                    label: [row.verdicts[key] for row in group if key in row.verdicts]
                     for key, label in section.columns.items()
                 }
                 columns.update({label: label for label in section.columns.values()})
-            rows.append(VerdictRow(section.title.split(":")[0], text, group[0].thesis, tallies))
+            tallies = {label: _tally(verdicts) for label, verdicts in shown.items()}
+            held = {label: n for label, verdicts in shown.items() if (n := sum(v.held_in for v in verdicts))}
+            rows.append(VerdictRow(section.title.split(":")[0], text, group[0].thesis, tallies, held))
     return columns, rows, list(ev.notes)
 
 

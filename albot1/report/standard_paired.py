@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 from albot1.report.collect import CellRecord
 from albot1.report.comparisons import Cell, Errors, all_pairs, matrix_lines, relation_errors_of
+from albot1.report.tuning import csv_flag, marked, record_held_in
 
 PAIRED_TABLE = "standard-benchmark-paired.csv"
 
@@ -28,6 +29,8 @@ class Paired:
     left_out: dict[str, str]
     #: method -> the seed of its compared run, kept only when some method of the log ran several seeds
     seeds: dict[str, int] = field(default_factory=dict)
+    #: method -> whether its compared run is held-in (:func:`albot1.report.tuning.record_held_in`; None: unknown)
+    held_in: dict[str, bool | None] = field(default_factory=dict)
 
 
 def shown_record(group: list[CellRecord]) -> CellRecord:
@@ -55,7 +58,8 @@ def compare_by_log(records: list[CellRecord], whole_log: Callable[[CellRecord], 
         found = all_pairs(labels, errors, ("relation translation", "relation rotation"))
         several = any(len(group) > 1 for group in groups[log].values())
         seeds = {m: by_method[m].cell.seed for m in labels} if several else {}
-        out[log] = Paired(labels, found, left_out, seeds)
+        held = {m: record_held_in(by_method[m]) for m in labels}
+        out[log] = Paired(labels, found, left_out, seeds, held)
     return out
 
 
@@ -65,7 +69,8 @@ def paired_lines(paired: Paired | None) -> list[str]:
         return []
     lines = ["Paired comparison (row against column, the same relations; translation / rotation):", ""]
     if len(paired.labels) >= 2:
-        lines += [*matrix_lines(paired.labels, paired.found, "row vs column"), ""]
+        shown = {m: marked(m, paired.held_in.get(m)) for m in paired.labels}
+        lines += [*matrix_lines(paired.labels, paired.found, "row vs column", shown), ""]
     lines += [f"- {m}: not compared: {why}" for m, why in paired.left_out.items()]
     lines += _seeds_lines(paired.seeds)
     why: dict[str, list[str]] = {}  # each n/a reason once, with the comparisons it applies to
@@ -93,14 +98,20 @@ def _seeds_lines(seeds: dict[str, int]) -> list[str]:
 
 
 def paired_csv(paired: dict[str, Paired]) -> str:
-    """Each unordered pair of measured methods per log once (row before column in the page's order)."""
+    """Each unordered pair of measured methods per log once (row before column in the page's order).
+
+    ``held_in`` / ``against_held_in``: whether the method's / the other's run was tuned on the log (empty:
+    unknown), so a row "A beats B" says when either side's values were chosen there.
+    """
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(["log", "method", "against", "error", "relations", "ratio", "low", "high", "verdict", "reason"])
+    header = ["log", "method", "against", "error", "relations", "ratio", "low", "high", "verdict", "reason"]
+    writer.writerow([*header, "held_in", "against_held_in"])
     for log, entry in paired.items():
         for i, a in enumerate(entry.labels):
             for b in entry.labels[i + 1 :]:
                 for kind, c in zip(("translation", "rotation"), entry.found[(a, b)], strict=True):
                     numbers = ["" if math.isnan(v) else f"{v:.9g}" for v in (c.ratio, c.low, c.high)]
-                    writer.writerow([log, a, b, kind, c.pairs, *numbers, c.verdict, c.reason or ""])
+                    held = [csv_flag(entry.held_in.get(m)) for m in (a, b)]
+                    writer.writerow([log, a, b, kind, c.pairs, *numbers, c.verdict, c.reason or "", *held])
     return buffer.getvalue()

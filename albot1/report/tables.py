@@ -49,7 +49,7 @@ from albot1.report.markdown import text as md_text
 from albot1.report.number_text import EXAMPLE, SEEDS_LEGEND, SIGNIFICANT, stats_text
 from albot1.report.paired_tables import PairedRow, intro, markdown_lines, no_pairs, paired_rows, write_paired_csv
 from albot1.report.provenance import data_by_dataset, describe_data
-from albot1.report.tuning import LEGEND, MARK, marked, record_held_in
+from albot1.report.tuning import LEGEND, MARK, combined, marked, record_held_in
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -171,17 +171,8 @@ def aggregate(cells: pd.DataFrame, columns: dict[str, Column]) -> pd.DataFrame:
 
 
 def _held_in(group: pd.DataFrame) -> bool | None:
-    """A row's held-in mark: True when a cell of it is held-in, None (empty in CSV) when a cell's tuning is unknown.
-
-    Unknown is not "not tuned": a plugin or external system without a ``[tuned_on]`` table read False here,
-    which a CSV reader takes for a held-out number.
-    """
-    if "held_in" not in group:
-        return None
-    values = list(group["held_in"])
-    if any(v is True for v in values):
-        return True
-    return None if any(v is None or v != v for v in values) else False
+    """A row's held-in mark (:func:`albot1.report.tuning.combined` of its cells'; None, empty in CSV: unknown)."""
+    return combined(group["held_in"]) if "held_in" in group else None
 
 
 def _stat(values: NDArray[np.float64], stat: str) -> float:

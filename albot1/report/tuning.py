@@ -37,6 +37,7 @@ from albot1.data.synthetic.worlds import WORLDS
 from albot1.errors import Albot1Error, ConfigError
 from albot1.methods.registry import load_mapper_class, method_registry
 from albot1.report.collect import CellRecord
+from albot1.runs.folder import EXTERNAL_PRESET
 
 #: The mark beside a number measured on a dataset its method was tuned on.
 MARK = "†"
@@ -101,19 +102,76 @@ def held_in(cell: Cell, data_sha256: Iterable[str] = ()) -> bool | None:
     """Whether ``cell``'s data is a dataset its method was tuned on (None: the method records no tuning).
 
     ``data_sha256``: the checksums of the files the cell's run read (``result.json``), which identify a log
-    given by path or under another manifest's name.
+    given by path or under another manifest's name. A cell that scores another system's trajectory file is
+    None: that system's tuning is not known, whatever label the suite gives it.
     """
-    names = tuned_datasets(cell.method, cell.preset)
+    if cell.trajectory is not None:
+        return None
+    return run_held_in(cell.method, cell.preset, cell.dataset, data_sha256)
+
+
+def run_held_in(method: str, preset: str, dataset: str, data_sha256: Iterable[str] = ()) -> bool | None:
+    """The one decision: is ``dataset`` (a reference, maybe sliced or with options) held-in for ``method:preset``?
+
+    The run's own words (``result.json``, ``metrics.json`` ``run``) and a grid cell both come here, so a
+    number reads held-in on a command's output exactly where it does on the pages. None: not recorded.
+    """
+    if preset == EXTERNAL_PRESET:
+        return None
+    names = tuned_datasets(method, preset)
     if names is None:
         return None
     tuned = _held_in_identities(names)
-    return bool((_identities(dataset_name(cell.dataset)) | set(data_sha256)) & tuned)
+    return bool((_identities(dataset_name(dataset)) | set(data_sha256)) & tuned)
+
+
+def held_in_line(method: str, preset: str, dataset: str, data_sha256: Iterable[str] = ()) -> str | None:
+    """One line for a command's output when its numbers are held-in (:func:`run_held_in`), naming the preset file.
+
+    None when they are not, or when the tuning is unknown (a plugin, an external trajectory: nothing is said,
+    as "not tuned" would be a claim nobody recorded).
+    """
+    if not run_held_in(method, preset, dataset, data_sha256):
+        return None
+    owner = load_mapper_class(method_registry().get(method).target).name
+    return (
+        f"{MARK} held-in: {method}:{preset} was tuned on this data ({dataset_name(dataset)}; the [tuned_on] table "
+        f"of {preset_file(owner)}): these numbers show fit, not generalisation"
+    )
+
+
+def held_in_share(count: int, total: int) -> str:
+    """How many of ``total`` verdicts or numbers pooled in one cell are held-in: ``, 20 held-in †`` (or nothing).
+
+    A count (of a thesis claim over datasets, say) pools held-in and held-out data, so the mark alone would
+    not say how much of it shows fit; the thesis page and the results page word it the same way.
+    """
+    if not count:
+        return ""
+    return f", {'all' if count == total else count} held-in {MARK}"
+
+
+def combined(values: Iterable[bool | None]) -> bool | None:
+    """The mark of numbers pooled from several cells: True when one is held-in, None when one's tuning is unknown.
+
+    Unknown is not "not tuned": a row or comparison pooling a plugin's cells with others must not read False.
+    """
+    seen = list(values)
+    if any(v is True for v in seen):
+        return True
+    return None if any(v is None or v != v for v in seen) else False
 
 
 def record_held_in(rec: CellRecord) -> bool | None:
     """:func:`held_in` of a stored cell, with the checksums of the files its run read when it has a result."""
     files = rec.result.dataset_info.data_sha256.values() if rec.result is not None else ()
     return held_in(rec.cell, files)
+
+
+def csv_flag(held: bool | None) -> str:
+    """A ``held_in`` cell of a CSV written by hand, as pandas writes ``cells.csv``'s: ``True``, ``False``, empty
+    when the tuning is unknown (never ``False`` for it)."""
+    return "" if held is None else str(held)
 
 
 def marked(text: str, tuned: bool | None) -> str:

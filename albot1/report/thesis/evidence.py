@@ -23,6 +23,7 @@ from albot1.metrics.measures.updates import METRIC as UPDATES
 from albot1.report.collect import METRIC_COLUMNS, CellRecord, Column, collect
 from albot1.report.provenance import bench_command
 from albot1.report.thesis.verdicts import Number
+from albot1.report.tuning import record_held_in
 
 #: The stores read beside ``results/thesis``, as sibling folders of it (``results/<name>``), in search order.
 COMPANION_SUITES = ("default",)
@@ -141,7 +142,11 @@ class Evidence:
         return Lookup(None, None, "; ".join(dict.fromkeys(reasons)))
 
     def number(self, lookup: Lookup, path: str, label: str, unit: str = "") -> Number:
-        """The number at ``path`` of the found cell's ``metrics.json``, or missing with the reason."""
+        """The number at ``path`` of the found cell's ``metrics.json``, or missing with the reason.
+
+        A number carries its cell's held-in mark (:func:`albot1.report.tuning.record_held_in`), which every
+        verdict made from it and every table cell showing it keeps.
+        """
         if lookup.record is None:
             return Number(label, None, unit, lookup.missing)
         column = metric_column(path)
@@ -155,7 +160,7 @@ class Evidence:
             else:
                 reason = column.reason(lookup.record) or "no value"
             return Number(label, None, unit, reason)
-        return Number(label, value, unit)
+        return Number(label, value, unit, held_in=record_held_in(lookup.record))
 
 
 def _absent_counter_reason(record: CellRecord, counter: str) -> str:

@@ -34,6 +34,9 @@ class Number:
     value: float | None
     unit: str = ""
     missing: str | None = None
+    #: measured by a method on a dataset its preset was tuned on (:func:`albot1.report.tuning.run_held_in`);
+    #: None: that method's tuning is unknown; False also for a number no run measured (a count, a threshold)
+    held_in: bool | None = False
 
     @property
     def known(self) -> bool:
@@ -51,10 +54,11 @@ class Number:
 
 @dataclass(frozen=True)
 class Verdict:
-    """A word and the numbers that decided it."""
+    """A word and the numbers that decided it; ``held_in`` when one of them is held-in (:func:`held`)."""
 
     word: Word
     reason: str
+    held_in: bool = False
 
     def line(self) -> str:
         return f"{self.word}: {self.reason}"
@@ -64,6 +68,11 @@ def quantity(value: float, unit: str = "") -> str:
     """``value`` to 3 significant digits with its unit (``4.61 m``, ``0.350``, ``12.0 deg``); counts as integers."""
     text = str(int(value)) if value.is_integer() and abs(value) < 1e15 else fmt(value, decimals(value))
     return f"{text} {unit}" if unit else text
+
+
+def held(*numbers: Number) -> bool:
+    """Whether a verdict from ``numbers`` rests on a held-in one: a claim tested on data its method was tuned on."""
+    return any(n.held_in is True for n in numbers)
 
 
 def _missing(*numbers: Number) -> Verdict | None:
@@ -92,6 +101,7 @@ def ratio_at_least(small: Number, large: Number, min_ratio: float, *, thesis: st
             NOT_COMPARABLE,
             f"{small.label} {small.text()} vs {large.label} {large.text()}: no ratio of two zeros, nothing to "
             f"improve on{_thesis(thesis)}",
+            held(small, large),
         )
     ratio = math.inf if s == 0 else big / s
     shown = "inf" if math.isinf(ratio) else quantity(ratio)
@@ -101,6 +111,7 @@ def ratio_at_least(small: Number, large: Number, min_ratio: float, *, thesis: st
         word,
         f"{small.label} {small.text()} vs {large.label} {large.text()} ({shown}x, {sense} {min_ratio:g}x"
         f"{_thesis(thesis)})",
+        held(small, large),
     )
 
 
@@ -115,6 +126,7 @@ def at_most(value: Number, bound: float, *, strict: bool = False, thesis: str | 
     return Verdict(
         HOLDS if ok else FAILS,
         f"{value.label} {value.text()} {relation} {quantity(bound, value.unit)}{_thesis(thesis)}",
+        held(value),
     )
 
 
@@ -129,6 +141,7 @@ def at_least(value: Number, bound: float, *, strict: bool = False, thesis: str |
     return Verdict(
         HOLDS if ok else FAILS,
         f"{value.label} {value.text()} {relation} {quantity(bound, value.unit)}{_thesis(thesis)}",
+        held(value),
     )
 
 
@@ -141,6 +154,7 @@ def equals(value: Number, expected: float, *, thesis: str | None = None) -> Verd
     return Verdict(
         HOLDS if ok else FAILS,
         f"{value.label} {value.text()} {'=' if ok else '!='} {quantity(expected, value.unit)}{_thesis(thesis)}",
+        held(value),
     )
 
 
@@ -156,6 +170,7 @@ def close_to(value: Number, target: float, tolerance: float, *, thesis: str | No
         HOLDS if ok else FAILS,
         f"{value.label} {value.text()} is {quantity(100 * off)} % from {quantity(target, value.unit)} "
         f"({'within' if ok else 'beyond'} {100 * tolerance:g} %{_thesis(thesis)})",
+        held(value),
     )
 
 
@@ -169,6 +184,7 @@ def lower_than(ours: Number, theirs: Number, *, thesis: str | None = None) -> Ve
     return Verdict(
         HOLDS if ok else FAILS,
         f"{ours.label} {ours.text()} {'<' if ok else '>='} {theirs.label} {theirs.text()}{_thesis(thesis)}",
+        held(ours, theirs),
     )
 
 
@@ -185,10 +201,10 @@ def with_paired_test(point: Verdict, paired: Comparison) -> Verdict:
     if point.word == NOT_COMPARABLE:
         return point
     if not paired.applies:
-        return Verdict(point.word, f"{point.reason}; no paired test ({paired.reason})")
+        return Verdict(point.word, f"{point.reason}; no paired test ({paired.reason})", point.held_in)
     evidence = f"paired ratio {paired.text()} over {paired.pairs} pairs: {paired.verdict} at {CONFIDENCE:.0%}"
     word: Word = HOLDS if point.word == HOLDS and paired.verdict == BETTER else FAILS
-    return Verdict(word, f"{point.reason}; {evidence}")
+    return Verdict(word, f"{point.reason}; {evidence}", point.held_in)
 
 
 def all_of(verdicts: Sequence[Verdict]) -> Verdict:
@@ -201,8 +217,9 @@ def all_of(verdicts: Sequence[Verdict]) -> Verdict:
     """
     if not verdicts:
         return Verdict(NOT_COMPARABLE, "no part of the claim could be tested")
+    tuned = any(v.held_in for v in verdicts)  # every part was tested, so every part's data is the claim's
     for word in (FAILS, NOT_COMPARABLE):
         deciding = [v for v in verdicts if v.word == word]
         if deciding:
-            return Verdict(word, "; ".join(v.reason for v in deciding))
-    return Verdict(HOLDS, "; ".join(v.reason for v in verdicts))
+            return Verdict(word, "; ".join(v.reason for v in deciding), tuned)
+    return Verdict(HOLDS, "; ".join(v.reason for v in verdicts), tuned)

@@ -52,6 +52,7 @@ def test_run_json_summary_is_what_result_json_says(tmp_path: Path) -> None:
         "status": "done",
         "counters": record.counters,
         "timing": json.loads(record.timing.model_dump_json()),
+        "held_in": False,  # odometry is tuned on nothing (tests/unit/cli/test_cli_held_in.py)
     }
     parse_record(Timing, summary["timing"], "stdout")
     line = invoke("run", "odometry", "synthetic-corridor", "--limit", "30", "--out", str(tmp_path)).strip()

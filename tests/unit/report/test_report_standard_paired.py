@@ -91,3 +91,23 @@ def test_a_run_folder_that_does_not_reproduce_its_metric_is_left_out_with_the_re
     assert paired.labels == ["kiss-icp"] and paired.left_out == {"odometry": NOT_REPRODUCED}
     failed = CellRecord(other.cell, "failed", tmp_path, None, None, None)
     assert paired_by_log([failed])["aces"].labels == []
+
+
+def test_the_matrix_and_its_csv_mark_a_method_tuned_on_the_log(tmp_path: Path) -> None:
+    """gtsam-graph's [tuned_on] lists aces: "gtsam-graph < odometry" there is a fit, and the page says so."""
+    records = [_record(tmp_path, "odometry", 0.10), _record(tmp_path, "gtsam-graph", 0.05)]
+    records.append(_record(tmp_path, "my-plugin", 0.05))  # no [tuned_on]: unknown, not held-out
+    out = tmp_path / "report"
+    out.mkdir()
+    plan = GridPlan("t", None, "", [], [], [], {}, [0], ["none"], {})
+    text = write_standard(plan, records, out)[0].read_text()
+    assert "| row vs column | odometry | gtsam-graph † | my-plugin |" in text
+    assert "| gtsam-graph † | < 0.5 / – | · |" in text
+    with (out / PAIRED_TABLE).open() as f:
+        rows = [r for r in csv.DictReader(f) if r["error"] == "translation"]
+    held = {(r["method"], r["against"]): (r["held_in"], r["against_held_in"]) for r in rows}
+    assert held == {
+        ("odometry", "gtsam-graph"): ("False", "True"),
+        ("odometry", "my-plugin"): ("False", ""),
+        ("gtsam-graph", "my-plugin"): ("True", ""),
+    }

@@ -17,6 +17,7 @@ from albot1.report.thesis.experiments.common import (
     per_variant,
     store_of,
     table,
+    tagged,
 )
 from albot1.report.thesis.experiments.datasets import thesis_datasets
 from albot1.report.thesis.verdicts import (
@@ -113,8 +114,8 @@ def section_places(ev: Evidence) -> Section:
     for dataset in (*ds.places_starts, ds.double_loop, ds.two_laps):
         row = [f"`{dataset}`", store_of(ev, dataset, PLACES_VARIANTS)]
         for m in PLACES_VARIANTS:
-            c = {
-                name: cell(number(ev, dataset, m, counter(name), ""))
+            read = {
+                name: number(ev, dataset, m, counter(name), "")
                 for name in (
                     "places",
                     "places_created",
@@ -126,11 +127,13 @@ def section_places(ev: Evidence) -> Section:
                     "revisit_recall",
                 )
             }
-            row.append(
+            c = {name: cell(value) for name, value in read.items()}
+            text = (
                 f"{c['places']} places ({c['places_created']} created); re-visits {c['revisits_actual']}: "
                 f"{c['revisits_true']} true / {c['revisits_false']} false / {c['revisits_missed']} missed; "
                 f"P {c['revisit_precision']}, R {c['revisit_recall']}"
             )
+            row.append(tagged(text, *read.values()))
         rows.append(row)
     section.tables.append(
         "Places and re-visits (thesis: 6 places on the single loop, 4.2.1):\n\n"
@@ -138,8 +141,8 @@ def section_places(ev: Evidence) -> Section:
     )
     rows = []
     for m in PLACES_VARIANTS:
-        values = [
-            cell(number(ev, ds.two_laps, m, counter(name), "", unit))
+        read_back = [
+            number(ev, ds.two_laps, m, counter(name), "", unit)
             for name, unit in (
                 ("exit_predictions_compared", ""),
                 ("exit_prediction_aligned_mean_m", "m"),
@@ -148,7 +151,7 @@ def section_places(ev: Evidence) -> Section:
                 ("exit_prediction_not_aligned_true_mean_m", "m"),
             )
         ]
-        rows.append([f"`{m}`", *values])
+        rows.append([f"`{m}`", *(tagged(cell(value), value) for value in read_back)])
     section.tables.append(
         f"Exit predictions on `{ds.two_laps}` (mean midpoint distance; thesis: Figure 4.8, no numbers in the text):\n\n"
         + table(

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 from albot1.metrics.unit import NO_REFERENCE
 from albot1.report.thesis.claims import READINGS, THESIS
 from albot1.report.thesis.evidence import Evidence, Lookup, counter_path, seeds_of
-from albot1.report.thesis.verdicts import Number, Verdict, at_most
+from albot1.report.thesis.verdicts import Number, Verdict, at_most, held
+from albot1.report.tuning import marked
 
 #: The Albot1 variants every claim is tested for: label -> column heading.
 VARIANTS: dict[str, str] = {
@@ -123,8 +124,17 @@ def number(ev: Evidence, dataset: str, method: str, path: str, label: str, unit:
 
 
 def cell(value: Number) -> str:
-    """A table cell: the number with its unit, or ``n/a``."""
+    """A table cell: the number with its unit, or ``n/a`` (a cell of a run's numbers: :func:`tagged`)."""
     return value.text()
+
+
+def tagged(text: str, *numbers: Number) -> str:
+    """A table cell ``text`` showing ``numbers`` of one run, with the held-in mark once when they are held-in.
+
+    Once per cell, not per number: ``0.227 m / 0.566 †`` reads as one run's pair, and counts of the same run
+    (views, stops) need no mark of their own.
+    """
+    return marked(text, held(*(n for n in numbers if n.known)))
 
 
 def store_of(ev: Evidence, dataset: str, methods: Iterable[str], deg: str = "none") -> str:
@@ -196,5 +206,6 @@ def shape_kept(ev: Evidence, dataset: str, method: str) -> Verdict:
 
 
 def shape_cell(ev: Evidence, dataset: str, method: str) -> str:
-    """``median / precision`` of a run's map."""
-    return f"{cell(number(ev, dataset, method, SHAPE, '', 'm'))} / {cell(number(ev, dataset, method, PRECISION, ''))}"
+    """``median / precision`` of a run's map (held-in marked, :func:`tagged`)."""
+    median, precision = number(ev, dataset, method, SHAPE, "", "m"), number(ev, dataset, method, PRECISION, "")
+    return tagged(f"{cell(median)} / {cell(precision)}", median, precision)

@@ -26,6 +26,7 @@ from albot1.report.thesis.experiments.common import (
     shape_kept,
     store_of,
     table,
+    tagged,
 )
 from albot1.report.thesis.experiments.datasets import thesis_datasets
 from albot1.report.thesis.verdicts import (
@@ -87,10 +88,8 @@ def section_map(ev: Evidence) -> Section:
         )
         row = [f"`{dataset}`", store_of(ev, dataset, [*VARIANTS, ODOMETRY]), views.text()]
         for method in VARIANTS:
-            row += [
-                f"{cell(number(ev, dataset, method, UPDATES, ''))} ({cell(number(ev, dataset, method, PER_VIEW, ''))})",
-                shape_cell(ev, dataset, method),
-            ]
+            updates, per_view = number(ev, dataset, method, UPDATES, ""), number(ev, dataset, method, PER_VIEW, "")
+            row += [tagged(f"{cell(updates)} ({cell(per_view)})", updates, per_view), shape_cell(ev, dataset, method)]
         row.append(shape_cell(ev, dataset, ODOMETRY))
         rows.append(row)
     header = ["dataset", "store", "views"]

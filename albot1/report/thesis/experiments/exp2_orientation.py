@@ -19,6 +19,7 @@ from albot1.report.thesis.experiments.common import (
     per_variant,
     store_of,
     table,
+    tagged,
 )
 from albot1.report.thesis.verdicts import (
     Number,
@@ -62,14 +63,17 @@ def far_stops(ev: Evidence, dataset: str, method: str, min_distance_m: float) ->
     bearing = [abs(r.bearing_error_deg) for r in rows if r.bearing_error_deg is not None]
     distance = [abs(r.distance_error_m) for r in rows]
     no_bearing = "no stop with a defined bearing"
+    tuned = stops.held_in  # every number here is of the run ``stops`` was read from
     return FarStops(
-        Number(labels[0], float(len(rows))),
-        Number(labels[1], max(bearing), "deg") if bearing else Number(labels[1], None, "deg", no_bearing),
-        Number(labels[2], max(distance), "m"),
-        Number(labels[3], sum(bearing) / len(bearing), "deg")
+        Number(labels[0], float(len(rows)), held_in=tuned),
+        Number(labels[1], max(bearing), "deg", held_in=tuned)
+        if bearing
+        else Number(labels[1], None, "deg", no_bearing),
+        Number(labels[2], max(distance), "m", held_in=tuned),
+        Number(labels[3], sum(bearing) / len(bearing), "deg", held_in=tuned)
         if bearing
         else Number(labels[3], None, "deg", no_bearing),
-        Number(labels[4], sum(distance) / len(distance), "m"),
+        Number(labels[4], sum(distance) / len(distance), "m", held_in=tuned),
     )
 
 
@@ -134,11 +138,12 @@ def section_orientation(ev: Evidence) -> Section:
         row = [f"`{dataset}`", store_of(ev, dataset, VARIANTS)]
         for method in VARIANTS:
             far = far_stops(ev, dataset, method, near)
-            row.append(
+            text = (
                 f"{cell(far.stops)} of {cell(number(ev, dataset, method, STOPS, ''))} stops: max "
                 f"{cell(far.bearing)} / {cell(far.distance)}; mean {cell(far.bearing_mean)} / "
                 f"{cell(far.distance_mean)}"
             )
+            row.append(tagged(text, far.stops, far.bearing, far.distance))
         rows.append(row)
     section.tables.append(
         f"Measured at the stops {near:g} m or more from the start (absolute differences of the start's bearing / "

@@ -20,6 +20,7 @@ from albot1.report.thesis.experiments.common import (
     per_variant,
     store_of,
     table,
+    tagged,
     thesis_text,
 )
 from albot1.report.thesis.experiments.datasets import thesis_datasets
@@ -105,7 +106,8 @@ def section_error_tolerance(ev: Evidence) -> Section:
     rows = []
     for deg, odo, alb in (("none", odo_clean, alb_clean), (ds.induced, odo_induced, alb_induced)):
         row = [f"`{deg}`", cell(number(ev, ds.square, ODOMETRY, LOOP_GAP, "", "m", deg)), odo.text()]
-        row += [cell(number(ev, ds.square, m, LOOP_GAP, "", "m", deg)) for m in VARIANTS]
+        gaps = [number(ev, ds.square, m, LOOP_GAP, "", "m", deg) for m in VARIANTS]
+        row += [tagged(cell(gap), gap) for gap in gaps]
         row.append(alb.text())
         rows.append(row)
     section.tables.append(

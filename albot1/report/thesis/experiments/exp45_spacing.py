@@ -29,6 +29,7 @@ from albot1.report.thesis.experiments.common import (
     shape_kept,
     store_of,
     table,
+    tagged,
 )
 from albot1.report.thesis.experiments.datasets import thesis_datasets
 from albot1.report.thesis.experiments.published import published_notes
@@ -115,10 +116,9 @@ def section_spacing(ev: Evidence) -> Section:
     rows = []
     for dataset, views, updates in ((ds.dense, d_views, d_upd), (ds.sparse, s_views, s_upd)):
         row = [f"`{dataset}`", cell(number(ev, dataset, "albot1:thesis", VIEWS, "")), views.text()]
-        row += [
-            f"{cell(number(ev, dataset, m, UPDATES, ''))} ({cell(number(ev, dataset, m, PER_VIEW, ''))})"
-            for m in VARIANTS
-        ]
+        for m in VARIANTS:
+            updates_m, per_view = number(ev, dataset, m, UPDATES, ""), number(ev, dataset, m, PER_VIEW, "")
+            row.append(tagged(f"{cell(updates_m)} ({cell(per_view)})", updates_m, per_view))
         row.append(f"{updates.value:g} ({quantity(updates.value / views.value)})")
         rows.append(row)
     section.tables.append(
@@ -130,13 +130,14 @@ def section_spacing(ev: Evidence) -> Section:
     for method in methods:
         row = [f"`{method}`"]
         for dataset in (ds.dense, ds.sparse):
-            row += [
-                cell(number(ev, dataset, method, SHAPE, "", "m")),
-                cell(number(ev, dataset, method, PRECISION, "")),
-                cell(number(ev, dataset, method, COVERAGE, "")),
-                cell(number(ev, dataset, method, ATE, "", "m")),
-                cell(number(ev, dataset, method, LOOP_GAP, "", "m")),
+            shown = [
+                number(ev, dataset, method, SHAPE, "", "m"),
+                number(ev, dataset, method, PRECISION, ""),
+                number(ev, dataset, method, COVERAGE, ""),
+                number(ev, dataset, method, ATE, "", "m"),
+                number(ev, dataset, method, LOOP_GAP, "", "m"),
             ]
+            row += [tagged(cell(value), value) for value in shown]
         rows.append(row)
     header = ["method"]
     for what in ("0.1 m / 1 deg", "1 m / 10 deg"):

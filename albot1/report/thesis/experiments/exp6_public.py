@@ -29,6 +29,7 @@ from albot1.report.thesis.experiments.common import (
     per_variant,
     store_of,
     table,
+    tagged,
 )
 from albot1.report.thesis.experiments.published import published_relations
 from albot1.report.thesis.verdicts import (
@@ -124,7 +125,8 @@ def section_public(ev: Evidence, scoring: Scoring = RELATIONS, candidates: Itera
         row = [f"`{dataset}`", store_of(ev, dataset, methods, deg), used.text()]
         for m in methods:
             metres = number(ev, dataset, m, scoring.metres, "", "m", deg)
-            row.append(f"{cell(metres)} / {cell(number(ev, dataset, m, scoring.degrees, '', 'deg', deg))}")
+            degrees = number(ev, dataset, m, scoring.degrees, "", "deg", deg)
+            row.append(tagged(f"{cell(metres)} / {cell(degrees)}", metres, degrees))
             if not metres.known:
                 missing.append(f"`{m}` on `{dataset}`: {metres.missing or 'no value'}")
         rows.append(row)
