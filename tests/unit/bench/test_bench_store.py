@@ -127,6 +127,7 @@ def test_read_plan_says_what_the_path_is_when_it_is_no_folder(tmp_path: Path) ->
         ),
         (ChildExit(-11, False, 1.0), None, "crash", "killed by SIGSEGV (a native library crashed)"),
         (ChildExit(-9, False, 1.0), None, "crash", "out-of-memory killer"),
+        (ChildExit(-9, False, 1.0, abandoned=True), None, "interrupted", "the runner gave the cell up while it ran"),
         (ChildExit(-15, False, 1.0), None, "crash", "killed by SIGTERM (stopped from outside: the cell pool"),
         (
             ChildExit(255, False, 1.0, pool_lost="was killed by SIGKILL"),
