@@ -127,6 +127,39 @@ def fault_plugin(install_method_plugin: PluginInstaller) -> None:
     install_method_plugin({"fault": "bench_fault_mappers:FaultMapper"})
 
 
+def write_complete_run(run_dir: Path, key: str) -> None:
+    """Make ``run_dir`` a complete run folder of cell ``key`` as the bench reads it: DONE, metrics.json, result.json.
+
+    The smallest files that pass the store's completeness check
+    (``ResultsStore.is_complete``: a ``result.json`` of that very key), for
+    tests of the runner's bookkeeping that run no method.
+    """
+    result = {
+        "key": key,
+        "method": "odometry",
+        "dataset": "w",
+        "preset": "default",
+        "degradation": "none",
+        "seed": 0,
+        "scans": 1,
+        "config": {},
+        "versions": {"code": "v"},
+        "dataset_info": {"source": "w", "format": "synthetic", "odometry_source": "", "reference_source": ""},
+        "counters": {"views": 1, "updates": 1},
+        "timing": {
+            **dict.fromkeys(("per_scan_ms_median", "per_scan_ms_p95", "per_scan_ms_mean")),
+            **dict.fromkeys(("finish_s", "total_s", "wall_s", "peak_mb"), 0.0),
+        },
+        "map_file": "map.npz",
+        "has_reference": False,
+        "relations": 0,
+    }
+    run_dir.mkdir(parents=True, exist_ok=True)
+    (run_dir / "result.json").write_text(json.dumps(result))
+    (run_dir / "metrics.json").write_text("{}")
+    (run_dir / "DONE").write_text(f"{key}\n")
+
+
 # -- collection without the cyclic garbage collector ---------------------------------------------------------
 
 

@@ -25,7 +25,9 @@ import concurrent.futures as cf
 import logging
 import math
 import os
+import signal
 import sys
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -116,12 +118,15 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
     # No dashboard; the scheduler still serves its HTTP routes (health, metrics), by default on port 8787, and
     # warns on the user's terminal when that port is taken (a second bench, a notebook's cluster): a free port of
     # the loopback interface instead, never reachable from another machine.
-    with dask.config.set({"distributed.worker.daemon": False}):
+    with dask.config.set({"distributed.worker.daemon": False}), _children_ignore_ctrl_c():
         cluster = LocalCluster(
             n_workers=jobs,
             threads_per_worker=1,
             processes=dask_processes,
             dashboard_address=None,
+            # the workers' and scheduler's warnings (a task cancelled as the cluster closes after Ctrl-C or a
+            # halt) are distributed's own bookkeeping, not the grid's: the runner says what happened in one line
+            silence_logs=logging.ERROR,
             scheduler_kwargs={"dashboard_address": LOCAL_HTTP_ADDRESS},
         )
     try:
@@ -129,6 +134,29 @@ def open_executor(spec: str, jobs: int, *, dask_processes: bool = True) -> Itera
             yield client.get_executor(pure=False)
     finally:
         cluster.close()
+
+
+@contextmanager
+def _children_ignore_ctrl_c() -> Iterator[None]:
+    """SIGINT ignored while the local cluster spawns its worker processes, which keep that disposition.
+
+    Ctrl-C reaches the whole process group: the runner stops the grid (``albot1: interrupted``, exit 130) and
+    closes the cluster, which ends the workers and their cells. The workers, Python processes started by
+    ``exec`` with SIGINT at its default, raised KeyboardInterrupt in their event loops as well, and
+    multiprocessing printed two tracebacks per worker above the runner's one line. A disposition of
+    SIG_IGN survives ``exec`` (Python then installs no handler), and the cells' forkserver, which sets
+    SIGINT's default action for its preload, puts the inherited one back after it. Only the main thread
+    may set a handler; elsewhere nothing changes. A Ctrl-C during the start itself (a second or two) is
+    ignored; a worker the nanny restarts later is spawned with the runner's handler (as before).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 @contextmanager

@@ -16,6 +16,7 @@ import socket
 import sys
 import time
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 
 from albot1 import versions
@@ -63,6 +64,11 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
         # read its folder. A timeout recorded beside it made the bench print FAILED for a cell the report
         # counted complete (a FAILED.json beside a complete result), and the reason said "no result".
         return None
+    if ended.abandoned:
+        return "interrupted", (
+            "the runner gave the cell up while it ran (its Dask client closed, e.g. on Ctrl-C, or cancelled the "
+            "cell after a halt), so the cell was stopped; run `albot1 bench` again to retry it"
+        )
     if ended.timed_out:
         return "timeout", f"time limit exceeded: no result after {cell.time_s:g} s (killed)"
     if ended.memory_exceeded:
@@ -143,7 +149,7 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
         return CellOutcome.of(cell, "failed", 0.0, reason, "executor", halts_grid=True)
     try:
         run_dir = store.prepare(cell)
-        ended = run_limited(cell, store.runs, run_dir / LOG, preview=preview)
+        ended = run_limited(cell, store.runs, run_dir / LOG, preview=preview, abandoned=_given_up_by_dask())
     except OSError as exc:
         return _storage_failure(store, cell, exc, 0.0)
     verdict = judge(cell, store, ended)
@@ -169,6 +175,31 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
         reason = f"{reason} [not recorded: {problem}]"
     halts = kind == "storage" or ended.pool_lost is not None
     return CellOutcome.of(cell, "failed", ended.elapsed_s, reason, kind, halts_grid=halts)
+
+
+def _given_up_by_dask() -> Callable[[], bool] | None:
+    """On a Dask worker: whether the scheduler has given this task up since (None elsewhere).
+
+    A runner's client that closes (Ctrl-C, a SIGTERM) or cancels a running cell (after a halt) makes the
+    scheduler cancel its task, but the worker's thread cannot be stopped: the cell ran on and wrote its
+    folder after the runner had released the results folder's lock, and a re-run started then (as the
+    runner's last line invites) ran the same cell into the same folder at the same time.
+    """
+    if "distributed" not in sys.modules:
+        return None
+    from distributed import get_worker
+
+    try:
+        worker = get_worker()
+    except ValueError:  # not inside a Dask task
+        return None
+    key = worker.get_current_task()
+
+    def given_up() -> bool:
+        task = worker.state.tasks.get(key)
+        return task is None or task.state in ("cancelled", "released", "forgotten")
+
+    return given_up
 
 
 def _worker_code_mismatch(cell: Cell) -> str | None:

@@ -70,6 +70,8 @@ class ChildExit:
     supervisor saw (the child and its own children). ``pool_lost``: how the
     forkserver that started the child ended, when it died under the running
     cell (the child was then stopped and its exit status is unknown).
+    ``abandoned``: the supervisor stopped the child because the runner gave
+    the cell up (a Dask client that closed or cancelled it: ``run_limited``'s ``abandoned``).
 
     ``elapsed_s`` is the cell's wall time from the moment its process existed
     (the moment its time limit starts counting) to its end; ``launch_s`` the
@@ -86,6 +88,7 @@ class ChildExit:
     peak_rss_mb: float | None = None
     pool_lost: str | None = None
     launch_s: float | None = None
+    abandoned: bool = False
 
 
 class ForkserverChild:
@@ -249,13 +252,37 @@ def _parent_of(process: psutil.Process | None) -> psutil.Process | None:
         return None
 
 
+def _unless_abandoned(
+    ended: Callable[[float], bool], process: psutil.Process | None, abandoned: Callable[[], bool] | None
+) -> tuple[Callable[[float], bool], list[bool]]:
+    """``ended`` that first kills the child's tree once ``abandoned()`` says so; the list says whether it did."""
+    gave_up: list[bool] = []
+
+    def check(timeout: float) -> bool:
+        if abandoned is not None and not gave_up and abandoned():
+            gave_up.append(True)
+            if process is not None:
+                kill_tree(process)
+        return ended(timeout)
+
+    return check, gave_up
+
+
 def run_limited(
-    cell: Cell, runs_root: Path, log_path: Path, *, how: str | None = None, preview: str | None = None
+    cell: Cell,
+    runs_root: Path,
+    log_path: Path,
+    *,
+    how: str | None = None,
+    preview: str | None = None,
+    abandoned: Callable[[], bool] | None = None,
 ) -> ChildExit:
     """Run ``cell`` in a child; kill it when it passes ``cell.time_s`` seconds or ``cell.memory_mb`` resident.
 
     ``preview`` is the ``module:function`` of the run preview renderer (``bench.cells.renderer_target``).
     The child's wall time is counted from the moment it exists (:class:`ChildExit`: ``elapsed_s``, ``launch_s``).
+    ``abandoned`` (None: never) is asked at every poll whether the runner gave the cell up; the child is
+    then killed (:attr:`ChildExit.abandoned`), so that no cell of a runner gone writes into its results.
     """
     args = child_args(cell, runs_root, log_path, preview)
     start = time.monotonic()
@@ -268,7 +295,8 @@ def run_limited(
         launched = time.monotonic()
         process = watch(forked.pid)
         server = _parent_of(process)
-        stop, peak = supervise(process, forked.ended, cell.time_s, cell.memory_mb)
+        ended, gave_up = _unless_abandoned(forked.ended, process, abandoned)
+        stop, peak = supervise(process, ended, cell.time_s, cell.memory_mb)
         if stop is not None and process is None:
             forked.kill()
         while not forked.ended(POLL_S):
@@ -278,7 +306,14 @@ def run_limited(
         if lost is not None and process is not None:
             kill_tree(process)  # the cell may outlive its server: stop it before it writes anything more
         return ChildExit(
-            code, stop == "timeout", time.monotonic() - launched, stop == "memory", peak, lost, launched - start
+            code,
+            stop == "timeout",
+            time.monotonic() - launched,
+            stop == "memory",
+            peak,
+            lost,
+            launched - start,
+            abandoned=bool(gave_up),
         )
     args_file = runs_root / cell.key / ".child-args.json"
     write_json(args_file, args)
@@ -300,7 +335,8 @@ def run_limited(
             return True
 
         process = watch(child.pid)
-        stop, peak = supervise(process, child_ended, cell.time_s, cell.memory_mb)
+        ended, gave_up = _unless_abandoned(child_ended, process, abandoned)
+        stop, peak = supervise(process, ended, cell.time_s, cell.memory_mb)
         if stop is not None and process is None:
             child.kill()
         code = child.wait()
@@ -312,4 +348,5 @@ def run_limited(
         stop == "memory",
         peak,
         launch_s=launched - start,
+        abandoned=bool(gave_up),
     )

@@ -53,13 +53,16 @@ class GridSummary:
     """Counts and outcomes of one runner invocation.
 
     ``halted``: why the runner stopped starting cells (None: it ran the whole
-    grid); ``not_started``: the cells it then left for a later run.
+    grid); ``not_started``: the cells it then left for a later run;
+    ``damaged``: for each run folder marked DONE that was no readable run of
+    its cell (:meth:`ResultsStore.damage`), what was wrong; those cells ran again.
     """
 
     outcomes: list[CellOutcome] = field(default_factory=list)
     wall_s: float = 0.0
     halted: str | None = None
     not_started: list[Cell] = field(default_factory=list)
+    damaged: list[str] = field(default_factory=list)
 
     @property
     def counts(self) -> Counter[str]:
@@ -143,11 +146,13 @@ def run_grid(
             summary.outcomes.append(outcome)
             if outcome.halts_grid:
                 summary.halted = outcome.reason
-        elif store.is_complete(cell.key):
+        elif (damage := store.damage(cell.key)) is None and store.is_complete(cell.key):
             summary.outcomes.append(CellOutcome.of(cell, "cached"))
         elif keep_allowed_failures and (kept := kept_failure(store, cell)) is not None:
             summary.outcomes.append(kept)
         else:
+            if damage is not None:  # said, not kept as a result nor dropped in silence: the cell runs again
+                summary.damaged.append(damage)
             pending.append(cell)
     if summary.halted is not None:
         summary.not_started += pending

@@ -13,11 +13,12 @@ Layout::
             attempt.json       wall time of the successful attempt (run + store + evaluation)
             FAILED.json        only after a failure: reason, kind, exit code, elapsed
 
-A cell is complete when its run folder has ``DONE`` and a ``metrics.json``
-that parses: both are written by atomic rename, so a runner killed at any
-instant leaves cells that are either complete or recomputed on the next run,
-never half-read. ``FAILED.json`` is removed before a retry and never
-coexists with a completed result after one.
+A cell is complete when its run folder has ``DONE``, a ``metrics.json``
+that parses and a ``result.json`` of that very cell (its key): all are
+written by atomic rename, so a runner killed at any instant leaves cells
+that are either complete or recomputed on the next run, never half-read.
+``FAILED.json`` is removed before a retry and never coexists with a
+completed result after one.
 
 A full or read-only file system is a failure of the grid, not of one cell:
 the cell that met it is recorded as failed (kind ``storage``) after the
@@ -44,9 +45,9 @@ from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell, FailureKind, GridPlan
 from albot1.bench.store_records import parse_failure, parse_plan, read_json_file
 from albot1.filetypes import not_regular
-from albot1.records import RecordError
+from albot1.records import RecordError, ResultRecord, read_record
+from albot1.runs.folder import DONE, RESULT_FILE, write_json
 from albot1.runs.folder import is_complete as run_is_complete
-from albot1.runs.folder import write_json
 
 FAILED = "FAILED.json"
 CELL = "cell.json"
@@ -134,24 +135,68 @@ class ResultsStore:
         return self.runs / key
 
     def is_complete(self, key: str) -> bool:
-        """DONE marker plus a metrics.json that parses."""
+        """DONE marker, a metrics.json that parses and a result.json of this very cell (:meth:`damage`)."""
         run_dir = self.run_dir(key)
-        if not run_is_complete(run_dir) or not_regular(run_dir / METRICS) is not None:
+        metrics = run_dir / METRICS
+        if not run_is_complete(run_dir) or not_regular(metrics) is not None or not metrics.is_file():
             return False  # a FIFO or device in place of metrics.json is no result (and reading it would hang)
+        return self.damage(key) is None
+
+    def read_result(self, key: str) -> ResultRecord:
+        """The ``result.json`` of ``runs/<key>``; RecordError (one line naming the file) when it is no run of ``key``.
+
+        A run folder is named by the hash of what it ran, so a ``result.json``
+        naming another key is a folder copied or renamed by hand: its numbers
+        belong to another cell and must not be read as this one's.
+        """
+        path = self.run_dir(key) / RESULT_FILE
+        result = read_record(ResultRecord, path)
+        if result.key != key:
+            raise RecordError(
+                f"{path}: holds the run of cell {result.key[:40]!r}, not of {key}, the folder's name "
+                "(a run folder copied or renamed?)"
+            )
+        return result
+
+    def damage(self, key: str) -> str | None:
+        """Why the run folder of ``key``, marked DONE, is no readable run of that cell (one line naming the file).
+
+        None when it is one, and for a folder without DONE or without
+        ``metrics.json`` (a run stopped before it ended or before its
+        evaluation: the next attempt completes it). A damaged folder (a
+        truncated or edited ``result.json`` or ``metrics.json``, another
+        cell's files) used to be kept by the bench as complete when only its
+        ``result.json`` was damaged, and the report then failed on it at every
+        build, or read another cell's numbers under this cell's name.
+        """
+        run_dir = self.run_dir(key)
+        if not run_is_complete(run_dir):
+            return None
         try:
-            json.loads((run_dir / METRICS).read_text())
-        except (OSError, json.JSONDecodeError):
-            return False
-        return True
+            self.read_result(key)
+            metrics = run_dir / METRICS
+            if metrics.exists() or metrics.is_symlink():
+                read_json_file(metrics, "metrics record written by `albot1 evaluate`")
+        except RecordError as exc:
+            return str(exc)
+        return None
 
     def prepare(self, cell: Cell) -> Path:
         """Make the cell's folder ready for an attempt: cell.json written, old failure, log and temporaries removed.
 
         Temporary files of writers killed in an earlier attempt (a timeout, a
-        SIGKILLed runner) would otherwise stay in the completed folder.
+        SIGKILLed runner) would otherwise stay in the completed folder. A
+        folder marked DONE whose ``result.json`` is no run of this cell
+        (:meth:`read_result`) loses its DONE, so the cell runs again rather
+        than only being evaluated again.
         """
         run_dir = self.run_dir(cell.key)
         run_dir.mkdir(parents=True, exist_ok=True)
+        if run_is_complete(run_dir):
+            try:
+                self.read_result(cell.key)
+            except RecordError:  # DONE over no run of this cell: run it again, not only evaluate what is there
+                (run_dir / DONE).unlink(missing_ok=True)
         (run_dir / FAILED).unlink(missing_ok=True)
         (run_dir / ERROR_FILE).unlink(missing_ok=True)
         remove_temporaries(run_dir)

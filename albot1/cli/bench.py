@@ -143,6 +143,8 @@ def bench(
         )
     for skipped in plan.skipped_methods:
         typer.echo(f"skipped method {skipped.name}: {skipped.reason}", err=True)
+    for damage in summary.damaged:
+        typer.echo(f"damaged run folder, computed again: {damage}", err=True)
     typer.echo(summary_table(summary))
     typer.echo(f"results: {store.root}  (report: albot1 report {store.root})")
     failed = summary.counts["failed"]

@@ -40,7 +40,7 @@ from albot1.records import (
     number_at,
     read_record,
 )
-from albot1.runs.folder import RESULT_FILE, StoredRun, read_run
+from albot1.runs.folder import StoredRun, read_run
 from albot1.runs.folder import is_complete as run_is_complete
 
 Source = Literal["metrics", "result", "attempt"]
@@ -266,7 +266,7 @@ def collect(results_dir: str | Path) -> tuple[GridPlan, list[CellRecord]]:
                     cell,
                     "done",
                     run_dir,
-                    read_record(ResultRecord, run_dir / RESULT_FILE),
+                    store.read_result(cell.key),
                     read_record(MetricsRecord, run_dir / METRICS),
                     None,
                     read_record(AttemptRecord, attempt) if attempt.is_file() else None,

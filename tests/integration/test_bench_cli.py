@@ -307,3 +307,47 @@ def test_what_a_plugin_module_prints_on_import_stays_out_of_the_bench_tables(
     assert done.returncode == 0, done.stderr
     assert "banner plugin" not in done.stdout and done.stdout.startswith("method ")
     assert done.stderr.count("banner plugin 1.0 loaded\n") == 2  # the planner's import and the preload's
+
+
+@pytest.mark.usefixtures("fault_plugin")
+def test_ctrl_c_on_a_local_dask_cluster_prints_only_the_interrupted_line(tmp_path: Path) -> None:
+    """The cluster's worker processes get the same Ctrl-C; they used to print two tracebacks each above the line.
+
+    And distributed's warnings about the tasks cancelled as the cluster closed. The workers and their cells end.
+    """
+    suite = tmp_path / "hangs.toml"
+    suite.write_text(
+        "[grid]\ndegradations = []\nseeds = [0]\n\n"
+        '[[methods]]\nname = "fault"\nset = { mode = "hang", at_scan = 2 }\n\n'
+        '[[datasets]]\nname = "synthetic-office-startstop[:5]"\n'
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent), *sys.path]))
+    runner = subprocess.Popen(
+        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+        + ["--executor", "dask", "--results", str(tmp_path / "results"), "--no-progress"],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # a process group of its own, as a terminal's foreground job
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while not list((tmp_path / "results").glob("hangs/runs/*/cell.log")) and time.monotonic() < deadline:
+            assert runner.poll() is None, runner.communicate()
+            time.sleep(0.1)
+        time.sleep(2.0)  # the cell process has started and hangs in its method
+        descendants = psutil.Process(runner.pid).children(recursive=True)
+        os.killpg(runner.pid, signal.SIGINT)  # what Ctrl-C does
+        _, stderr = runner.communicate(timeout=120)
+    finally:
+        if runner.poll() is None:
+            os.killpg(runner.pid, signal.SIGKILL)
+            runner.wait()
+    assert runner.returncode == 130, stderr
+    assert stderr.splitlines() == [
+        "albot1: interrupted; completed cells are kept, run the same command again to resume"
+    ], stderr
+    _, alive = psutil.wait_procs(descendants, timeout=30)
+    assert alive == [], f"the Dask workers or their cells went on after Ctrl-C: {alive}"

@@ -291,3 +291,35 @@ def test_a_scheduler_that_does_not_answer_is_one_line(suite: Path, tmp_path: Pat
     lines = [line for line in done.stderr.splitlines() if "Dask scheduler" in line]
     assert len(lines) == 1, done.stderr
     assert lines[0].startswith(f"albot1: error: cannot reach the Dask scheduler at tcp://127.0.0.1:{port}: "), lines
+
+
+def test_a_runner_interrupted_stops_its_running_cells_on_the_workers(cluster: Cluster, tmp_path: Path) -> None:
+    """Ctrl-C closes the runner's client; its cells ran on in the workers' threads after it had exited.
+
+    They wrote their folders after the results folder's lock was released, so a re-run started then (as the
+    runner's last line invites) ran the same cells into the same folders at the same time. Now each worker stops
+    the cell the scheduler gave up and records it as interrupted, as the local pool does.
+    """
+    suite = tmp_path / "hang.toml"
+    suite.write_text(SLOW.replace('label = "slow"\nset = { mode = "slow", sleep_s = 0.15 }', 'set = { mode = "hang" }'))
+    cluster.start_scheduler()
+    for _ in range(2):
+        cluster.start_worker()
+    cluster.wait_for_workers(2)
+    results = tmp_path / "results"
+    runner = start_bench(bench_command(suite, results, "--scheduler", cluster.address), tmp_path)
+    try:
+        wait_for_running_cells(results / "hang" / "runs", 2, runner)
+        runner.send_signal(signal.SIGINT)  # the runner alone: the workers are no children of it
+        _, err = runner.communicate(timeout=120)
+    finally:
+        runner.kill()
+    assert runner.returncode == 130, err
+    store = ResultsStore(results / "hang")
+    started = [c for c in store.read_plan().cells if (store.run_dir(c.key) / LOG).exists()]
+    deadline = time.monotonic() + 30
+    while any(store.failure(c.key) is None for c in started) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    failures = [store.failure(c.key) for c in started]
+    assert len(started) >= 2 and all(f is not None and f.kind == "interrupted" for f in failures), failures
+    assert all("the runner gave the cell up" in f.reason for f in failures if f is not None)

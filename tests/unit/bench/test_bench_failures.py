@@ -28,6 +28,7 @@ from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.limits import ChildExit, _server_fate, supervise, watch
 from albot1.bench.runner import bench_results_root, run_grid
 from albot1.bench.store import ATTEMPT, FAILED, ResultsStore
+from conftest import write_complete_run
 
 ENOSPC = OSError(errno.ENOSPC, "No space left on device")
 
@@ -79,10 +80,10 @@ def test_a_storage_failure_frees_the_attempts_files_but_never_a_complete_cell(tm
     assert sorted(p.name for p in failed_dir.iterdir()) == ["FAILED.json", "cell.json", "cell.log"]
 
     done_dir = store.prepare(make_cell("good"))
-    for name in ("DONE", "metrics.json", "trajectory.tum"):
-        (done_dir / name).write_text("{}")
+    write_complete_run(done_dir, "good")
+    (done_dir / "trajectory.tum").write_text("{}")
     assert store.record_failure(make_cell("good"), "no space", "storage") is None
-    assert {"DONE", "metrics.json", "trajectory.tum"} <= {p.name for p in done_dir.iterdir()}
+    assert {"DONE", "metrics.json", "result.json", "trajectory.tum"} <= {p.name for p in done_dir.iterdir()}
 
 
 def test_prepare_removes_what_a_killed_attempt_left(tmp_path: Path) -> None:
@@ -126,8 +127,7 @@ def test_a_completed_cell_whose_attempt_record_does_not_fit_stays_done_and_halts
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     def completes(cell: Cell, runs_root: Path, log_path: Path, **_: object) -> ChildExit:
-        for name, text in (("DONE", "k1\n"), ("metrics.json", "{}")):
-            (runs_root / cell.key / name).write_text(text)
+        write_complete_run(runs_root / cell.key, cell.key)
         return ChildExit(0, False, 1.0)
 
     def full(path: Path, record: object) -> None:
@@ -326,3 +326,24 @@ def test_a_cell_tells_ctrl_c_from_a_keyboard_interrupt_raised_in_it(
         assert json.loads((tmp_path / cell_main.ERROR_FILE).read_text())["kind"] == "interrupted"
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_a_damaged_done_folder_is_said_and_its_cell_run_again_while_a_sound_one_is_kept(tmp_path: Path) -> None:
+    """The runner used to count a DONE folder with a torn result.json as kept; the report then failed on it forever."""
+    store = ResultsStore(tmp_path)
+    for key in ("k0", "k1"):
+        write_complete_run(store.runs / key, key)
+    torn = store.runs / "k1" / "result.json"
+    torn.write_text(torn.read_text()[:30])
+    ran: list[str] = []
+
+    def job(cell: Cell, root: str) -> CellOutcome:
+        ran.append(cell.key)
+        write_complete_run(store.runs / cell.key, cell.key)
+        return CellOutcome.of(cell, "done", 1.0)
+
+    with cf.ThreadPoolExecutor(max_workers=1) as pool:
+        summary = run_grid(plan_of([make_cell("k0"), make_cell("k1")]), store, pool, job=job)
+    assert ran == ["k1"] and [o.status for o in summary.outcomes] == ["cached", "done"]
+    assert len(summary.damaged) == 1 and summary.damaged[0].startswith(f"{torn}: cannot read a ResultRecord: ")
+    assert store.is_complete("k1")

@@ -21,6 +21,7 @@ from albot1.bench.grid import Cell
 from albot1.bench.limits import ChildExit, run_limited
 from albot1.bench.store import ATTEMPT, FAILED, ResultsStore
 from albot1.records import AttemptRecord, dump_record, parse_record, read_record
+from conftest import write_complete_run
 
 PRELOAD_S = 46.0
 CELL_S = 0.25
@@ -95,8 +96,7 @@ def test_the_preload_a_cell_waited_for_is_its_launch_time_not_its_wall(
 
 
 def completes_after_a_preload(cell: Cell, runs_root: Path, log_path: Path, **_: object) -> ChildExit:
-    for name, text in (("DONE", "k1\n"), ("metrics.json", "{}")):
-        (runs_root / cell.key / name).write_text(text)
+    write_complete_run(runs_root / cell.key, cell.key)
     return ChildExit(0, False, CELL_S, launch_s=PRELOAD_S)
 
 

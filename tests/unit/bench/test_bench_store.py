@@ -13,6 +13,7 @@ from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.job import judge
 from albot1.bench.limits import ChildExit
 from albot1.bench.store import ResultsStore
+from conftest import write_complete_run
 
 
 def make_cell(**changes: object) -> Cell:
@@ -67,6 +68,9 @@ def test_complete_needs_done_and_parseable_metrics(tmp_path: Path) -> None:
     assert not store.is_complete("k1")  # evaluation missing: the cell is re-evaluated, not kept
     (run_dir / "metrics.json").write_text('{"ate": ')
     assert not store.is_complete("k1")  # a torn file never counts
+    (run_dir / "metrics.json").write_text('{"ate": null}')
+    assert not store.is_complete("k1")  # no result.json: nothing the report could read
+    write_complete_run(run_dir, "k1")
     (run_dir / "metrics.json").write_text('{"ate": null}')
     assert store.is_complete("k1")
 
@@ -123,6 +127,7 @@ def test_read_plan_says_what_the_path_is_when_it_is_no_folder(tmp_path: Path) ->
         ),
         (ChildExit(-11, False, 1.0), None, "crash", "killed by SIGSEGV (a native library crashed)"),
         (ChildExit(-9, False, 1.0), None, "crash", "out-of-memory killer"),
+        (ChildExit(-9, False, 1.0, abandoned=True), None, "interrupted", "the runner gave the cell up while it ran"),
         (ChildExit(-15, False, 1.0), None, "crash", "killed by SIGTERM (stopped from outside: the cell pool"),
         (
             ChildExit(255, False, 1.0, pool_lost="was killed by SIGKILL"),
@@ -175,8 +180,7 @@ def test_judge_names_every_way_a_cell_can_end(
 def test_judge_accepts_a_complete_cell(tmp_path: Path) -> None:
     store = ResultsStore(tmp_path)
     run_dir = store.prepare(make_cell())
-    (run_dir / "DONE").write_text("k1\n")
-    (run_dir / "metrics.json").write_text("{}")
+    write_complete_run(run_dir, "k1")
     assert judge(make_cell(), store, ChildExit(0, False, 1.0)) is None
 
 
@@ -197,8 +201,7 @@ def test_judge_accepts_a_cell_killed_after_its_result_was_complete(tmp_path: Pat
     """
     store = ResultsStore(tmp_path)
     run_dir = store.prepare(make_cell())
-    (run_dir / "DONE").write_text("k1\n")
-    (run_dir / "metrics.json").write_text("{}")
+    write_complete_run(run_dir, "k1")
     assert judge(make_cell(), store, ended) is None
 
 
@@ -211,3 +214,37 @@ def test_judge_keeps_a_timeout_when_the_result_is_half_written(tmp_path: Path) -
         "timeout",
         "time limit exceeded: no result after 7 s (killed)",
     )
+
+
+def test_a_done_folder_holding_no_run_of_its_cell_is_named_and_run_again(tmp_path: Path) -> None:
+    """A truncated result.json or another cell's files under DONE: neither kept as a result nor dropped in silence.
+
+    The bench used to keep such a folder as complete (it read only DONE and metrics.json): the report then
+    failed on its result.json at every build, or showed another cell's numbers under this cell's name.
+    """
+    store = ResultsStore(tmp_path)
+    run_dir = store.prepare(make_cell())
+    write_complete_run(run_dir, "k1")
+    (run_dir / "result.json").write_text((run_dir / "result.json").read_text()[:40])
+    assert not store.is_complete("k1")
+    assert (store.damage("k1") or "").startswith(f"{run_dir / 'result.json'}: cannot read a ResultRecord: ")
+    write_complete_run(run_dir, "0123456789abcdef")  # a folder copied from another cell's
+    assert not store.is_complete("k1")
+    assert store.damage("k1") == (
+        f"{run_dir / 'result.json'}: holds the run of cell '0123456789abcdef', not of k1, the folder's name "
+        "(a run folder copied or renamed?)"
+    )
+    store.prepare(make_cell())  # its next attempt runs the method again instead of only evaluating those files
+    assert not (run_dir / "DONE").exists() and store.damage("k1") is None
+
+
+def test_a_done_folder_with_a_torn_metrics_json_is_named_and_only_evaluated_again(tmp_path: Path) -> None:
+    store = ResultsStore(tmp_path)
+    run_dir = store.prepare(make_cell())
+    write_complete_run(run_dir, "k1")
+    (run_dir / "metrics.json").write_text('{"ate": ')
+    assert (store.damage("k1") or "").startswith(f"{run_dir / 'metrics.json'}: not a metrics record written by")
+    store.prepare(make_cell())
+    assert (run_dir / "DONE").exists()  # the run itself is sound: its next attempt evaluates it
+    (run_dir / "metrics.json").unlink()
+    assert store.damage("k1") is None and not store.is_complete("k1")  # stopped before its evaluation: no damage

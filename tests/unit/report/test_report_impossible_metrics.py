@@ -149,6 +149,17 @@ def test_a_truncated_metrics_json_of_a_done_run_is_named_not_reported_as_not_run
     assert str(err.value).startswith(f"{path}: cannot read a MetricsRecord: ")
 
 
+def test_a_run_folder_holding_another_cells_run_is_named_not_read_as_this_cells(pristine: Path) -> None:
+    """A folder copied or renamed by hand: its numbers were shown under the planned cell's name."""
+    path = _edited(pristine, RESULT_FILE, "key", '"0123456789abcdef"')
+    with pytest.raises(RecordError) as err:
+        collect(pristine)
+    assert str(err.value) == (
+        f"{path}: holds the run of cell '0123456789abcdef', not of {path.parent.name}, the folder's name "
+        "(a run folder copied or renamed?)"
+    )
+
+
 def test_a_done_run_without_metrics_json_is_not_run(pristine: Path) -> None:
     """Stopped between the run and its evaluation: the bench evaluates it on its next pass."""
     path = next((pristine / "runs").iterdir()) / METRICS_FILE
