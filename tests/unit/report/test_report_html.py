@@ -35,26 +35,31 @@ def _loop() -> Sequence:
     return Sequence.from_frames("loop", frames)
 
 
-def _cell(key: str, label: str, degradation: str, seed: int) -> Cell:
-    return Cell("tiny", "loop", "loop", "odometry", label, "default", degradation, seed, key, "v", 60.0, 100.0)
+def _cell(key: str, label: str, degradation: str, seed: int, dataset: str = "loop") -> Cell:
+    return Cell("tiny", dataset, dataset, "odometry", label, "default", degradation, seed, key, "v", 60.0, 100.0)
 
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A results folder of 4 completed cells and 1 failed one, and its report (plots included)."""
+    """A results folder of 5 completed cells on two datasets and 1 failed one, and its report (plots included).
+
+    Built serially (``jobs=1``): the worker-process test draws the same store's figures in worker processes and
+    compares them with these, so the module draws the serial figures once for both claims.
+    """
     root = tmp_path_factory.mktemp("results") / "tiny"
     store = ResultsStore(root)
     store.runs.mkdir(parents=True)
     cells = []
-    for label, degradation, seed in (
-        ("odometry", "none", 0),
-        ("odometry", "gauss:0.05:1", 0),
-        ("odometry", "gauss:0.05:1", 1),
-        ("biased", "bias:0.01:0.5", 0),
+    for label, degradation, seed, dataset in (
+        ("odometry", "none", 0, "loop"),
+        ("odometry", "gauss:0.05:1", 0, "loop"),
+        ("odometry", "gauss:0.05:1", 1, "loop"),
+        ("biased", "bias:0.01:0.5", 0, "loop"),
+        ("odometry", "gauss:0.05:1", 1, "loop-b"),
     ):
         run_dir = write_run(run_method("odometry", _loop(), degradation=degradation, seed=seed), store.runs)
         evaluate_run(run_dir)
-        cells.append(_cell(run_dir.name, label, degradation, seed))
+        cells.append(_cell(run_dir.name, label, degradation, seed, dataset))
     failed = _cell("f" * 16, "broken", "none", 0)
     store.prepare(failed)
     store.record_failure(failed, "RuntimeError: injected", "exception", traceback_text="Traceback ...")
@@ -151,45 +156,20 @@ def test_a_results_folder_whose_grid_planned_no_cell_still_gets_a_report(tmp_pat
 
 
 @pytest.mark.slow
-def test_plots_drawn_by_worker_processes_are_the_same_files(tmp_path: Path) -> None:
-    root = tmp_path / "two"
-    store = ResultsStore(root)
-    store.runs.mkdir(parents=True)
-    cells = []
-    for dataset, seed in (("loop-a", 0), ("loop-b", 1)):
-        run_dir = write_run(run_method("odometry", _loop(), degradation="gauss:0.05:1", seed=seed), store.runs)
-        evaluate_run(run_dir)
-        cells.append(
-            Cell(
-                "two",
-                dataset,
-                dataset,
-                "odometry",
-                "odometry",
-                "default",
-                "gauss:0.05:1",
-                seed,
-                run_dir.name,
-                "v",
-                60.0,
-                100.0,
-            )
-        )
-    store.write_plan(GridPlan("two", None, "", cells, [], [], {}, [0, 1], ["gauss:0.05:1"], {}))
-    build_report(root, tmp_path / "serial")
-    build_report(root, tmp_path / "parallel", jobs=2)
-    serial = sorted(p.name for p in (tmp_path / "serial" / "plots").glob("*.png"))
-    parallel = sorted(p.name for p in (tmp_path / "parallel" / "plots").glob("*.png"))
-    assert (
-        serial == parallel
-        and any(n.startswith("loop-a-") for n in serial)
-        and any(n.startswith("loop-b-") for n in serial)
+def test_plots_drawn_by_worker_processes_are_the_same_files(report: Path, tmp_path: Path) -> None:
+    """The module's report (drawn in this process) built again by 2 worker processes: the same files and links."""
+    parallel = build_report(report.parent / "tiny", tmp_path / "parallel", jobs=2).parent
+    serial = sorted(p.name for p in (report / "plots").glob("*.png"))
+    drawn = sorted(p.name for p in (parallel / "plots").glob("*.png"))
+    assert serial == drawn
+    assert any(n.startswith("loop-b-") for n in serial) and any(
+        n.startswith("loop-") and "-b-" not in n for n in serial
     )
     from matplotlib.image import imread
 
     for name in serial:
-        a = imread(tmp_path / "serial" / "plots" / name)
-        b = imread(tmp_path / "parallel" / "plots" / name)
+        a = imread(report / "plots" / name)
+        b = imread(parallel / "plots" / name)
         assert np.array_equal(a, b), name
-    links = [line for line in (tmp_path / "serial" / "README.md").read_text().splitlines() if "plots/" in line]
-    assert links and all(line in (tmp_path / "parallel" / "README.md").read_text() for line in links)
+    links = [line for line in (report / "README.md").read_text().splitlines() if "plots/" in line]
+    assert links and all(line in (parallel / "README.md").read_text() for line in links)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -45,6 +46,32 @@ def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
     for cell in plan.cells:
         execute_cell(cell, store.runs)
     return root
+
+
+#: Makes a folder holding a fresh report of the store as it stands (a copy, file times kept).
+FreshReport = Callable[[Path], Path]
+
+
+@pytest.fixture(scope="module")
+def fresh_report(results: Path, tmp_path_factory: pytest.TempPathFactory) -> FreshReport:
+    """``fresh_report(out)``: ``out`` holds the store's report, built there from a copy of one built from nothing.
+
+    The figures are drawn once and copied (file times kept: the figure cache names its files relative to the
+    folder, so the build in the copy draws none) to every test that starts from a fresh report; they are drawn
+    again only when the store changed since (a test edited it), so each copy is the store's current report.
+    """
+    built = tmp_path_factory.mktemp("fresh") / "report"
+
+    def copy(out: Path) -> Path:
+        if rebuild.current_report(results, built) is None:
+            shutil.rmtree(built, ignore_errors=True)
+            rebuild.report(results, built)
+        shutil.copytree(built, out)
+        rebuild.report(results, out)  # stamped for this folder (a stamp names its folder); the figures are cached
+        assert rebuild.current_report(results, out) == out / "README.md"
+        return out
+
+    return copy
 
 
 def _contents(folder: Path) -> dict[str, bytes]:
@@ -96,11 +123,38 @@ def test_an_incremental_report_equals_a_full_rebuild(results: Path, tmp_path: Pa
 
 
 @pytest.mark.slow
-def test_a_run_file_edited_in_place_with_its_time_put_back_is_drawn_again(results: Path, tmp_path: Path) -> None:
-    """A trajectory rewritten with its size and modification time kept: the rebuilt report is a fresh one."""
+def test_a_page_the_store_no_longer_makes_is_removed(results: Path, fresh_report: FreshReport, tmp_path: Path) -> None:
+    """Another store's report (or this store's, before cells went) left pages this store does not make.
+
+    The folder holds this store's own report besides (a copy of a fresh build, file times kept): its figures come
+    from the figure cache, so the test draws none; the pages are written and removed as before.
+    """
+    fresh = fresh_report(tmp_path / "fresh")
     out = tmp_path / "report"
+    shutil.copytree(fresh, out)
+    stale = [
+        "generalisation.md",
+        "generalisation.csv",
+        "standard-benchmark.md",
+        "standard-benchmark.csv",
+        "standard-benchmark-paired.csv",  # the page's paired comparisons stayed (their verdicts, old numbers)
+    ]
+    for name in stale:
+        (out / name).write_text("numbers of an earlier report\n")
     rebuild.report(results, out)
-    assert rebuild.current_report(results, out) == out / "README.md"
+    assert sorted(_contents(out)) == sorted(_contents(fresh))
+    assert not any((out / name).exists() for name in stale)
+
+
+@pytest.mark.slow
+def test_a_run_file_edited_in_place_with_its_time_put_back_is_drawn_again(
+    results: Path, fresh_report: FreshReport, tmp_path: Path
+) -> None:
+    """A trajectory rewritten with its size and modification time kept: the rebuilt report is a fresh one.
+
+    Runs after the stale-page test (it edits the store, which would make that test's shared fresh report stale).
+    """
+    out = fresh_report(tmp_path / "report")
     pictured = representative(collect(results)[1])["odometry"]  # the run the trajectory figures draw
     trajectory = pictured.run_dir / "trajectory.tum"
     lines = trajectory.read_text().splitlines(keepends=True)
@@ -119,28 +173,3 @@ def test_a_run_file_edited_in_place_with_its_time_put_back_is_drawn_again(result
     assert any(name.endswith("-trajectories.png") for name in changed)  # the figure shows the edited poses
     rebuild.report(results, out, force=True)
     assert _contents(out) == incremental
-
-
-@pytest.mark.slow
-def test_a_page_the_store_no_longer_makes_is_removed(results: Path, tmp_path: Path) -> None:
-    """Another store's report (or this store's, before cells went) left pages this store does not make.
-
-    The folder holds this store's own report besides (a copy of a fresh build, file times kept): its figures come
-    from the figure cache, so the test draws them once, not twice; the pages are written and removed as before.
-    """
-    fresh = tmp_path / "fresh"
-    rebuild.report(results, fresh)
-    out = tmp_path / "report"
-    shutil.copytree(fresh, out)
-    stale = [
-        "generalisation.md",
-        "generalisation.csv",
-        "standard-benchmark.md",
-        "standard-benchmark.csv",
-        "standard-benchmark-paired.csv",  # the page's paired comparisons stayed (their verdicts, old numbers)
-    ]
-    for name in stale:
-        (out / name).write_text("numbers of an earlier report\n")
-    rebuild.report(results, out)
-    assert sorted(_contents(out)) == sorted(_contents(fresh))
-    assert not any((out / name).exists() for name in stale)
