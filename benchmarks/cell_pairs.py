@@ -38,17 +38,40 @@ from pathlib import Path
 from typing import Any
 
 
+def _plan(suite: str) -> list[dict[str, Any]]:
+    """The suite's cells as JSON, planned by this checkout's code."""
+    from albot1.bench.plan import plan_suite
+    from albot1.bench.suite import load_suite
+    from albot1.settings import get_settings
+
+    return [cell.to_json() for cell in plan_suite(load_suite(suite), get_settings()).cells]
+
+
+def _in_fork(task: Any) -> Any:
+    """``task()``'s JSON result, computed in a fork: planning imports what a cell would, and the worker must not
+    hold it (a cell of the old code would then find imported what the new code moved into the preload)."""
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        os.close(read)
+        os.write(write, json.dumps(task()).encode())
+        os._exit(0)
+    os.close(write)
+    with os.fdopen(read, "rb") as pipe:
+        data = pipe.read()
+    os.waitpid(pid, 0)
+    return json.loads(data)
+
+
 def worker(suite: str, out: Path) -> int:
     """One checkout's cells on request (stdin: a cell name per line; stdout: its CPU-s as JSON)."""
     import albot1.bench.preload  # noqa: F401 -- the forkserver's state: imports, kernels, fonts
     from albot1.bench.cell_main import freeze_inherited_heap
     from albot1.bench.cells import execute_cell
-    from albot1.bench.plan import plan_suite
-    from albot1.bench.suite import load_suite
+    from albot1.bench.grid import Cell
     from albot1.report.preview import render_preview
-    from albot1.settings import get_settings
 
-    planned = plan_suite(load_suite(suite), get_settings()).cells
+    planned = [Cell.from_json(c) for c in _in_fork(lambda: _plan(suite))]
     cells = {f"{c.method}|{c.preset}|{c.dataset_label}|{c.degradation}|{c.seed}": c for c in planned}
     out.mkdir(parents=True, exist_ok=True)
     print(json.dumps(sorted(cells)), flush=True)
