@@ -92,6 +92,9 @@ class Mapper(Protocol):
     # Optional, not part of the protocol's check: ``warm_up(self, announce: Callable[[str], None] | None) -> None``
     # does once what would otherwise land on the first timed scan (e.g. compiling kernels); the runner calls it
     # before the timed loop and records its time as ``startup_s``; ``announce`` takes a line for the user.
+    # Optional too: ``preload_modules: ClassVar[tuple[str, ...]]``, the modules of its library the mapper imports
+    # only when it is built; the bench's forkserver imports them once, before it forks any cell
+    # (:mod:`albot1.bench.preload`), instead of each cell importing them again.
 
 
 @dataclass

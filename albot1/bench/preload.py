@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 from albot1 import versions
 
 if TYPE_CHECKING:
-    from albot1.methods.registry import MethodRegistry
+    from albot1.methods.registry import MethodRegistry, MethodSpec
 
 # Ctrl-C reaches the whole process group, this server too, and its preload (a cold numba compile takes tens of
 # seconds) is what it interrupts. Python's KeyboardInterrupt escaped ``multiprocessing.forkserver.main``, which
@@ -84,6 +84,12 @@ MODULES = (
     "albot1.metrics.map_shape",
     "albot1.metrics.updates",
     "albot1.metrics.cost",
+    # Imported by every cell on first use, not by the modules above (issue 24, docs/benchmarking.md, "Session 22"):
+    # each import costs a forked cell 2-9 ms of CPU, again in every cell, where here it is paid once.
+    "platformdirs",  # albot1.settings: the decoded-log and reference-map caches' folder
+    "shapely.ops",  # the synthetic worlds' free space (albot1.data.synthetic.floorplan)
+    "encodings.cp437",  # zipfile reads the member names of every .npz (decoded logs, reference maps) with it
+    "encodings.utf_8_sig",  # albot1.data.text: every text file is read with a byte-order mark dropped
 )
 
 
@@ -119,7 +125,7 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
     warmed: list[str] = []
     for spec in registry or ():
         if (methods is None or spec.name in methods) and spec.available():
-            _attempt(f"method {spec.name} ({spec.target})", spec.load_class, failures)
+            _attempt(f"method {spec.name} ({spec.target})", functools.partial(_load_method, spec), failures)
             warmed.append(spec.name)
     # The versions of the libraries just imported, read here, right after the imports, for every cell (a search of
     # the installed metadata, ~2 ms per library) and kept while this server lives: they name the modules its cells
@@ -131,6 +137,12 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
     # filled).
     failures.extend(warm_up_methods(warmed, registry).lines())
     return failures
+
+
+def _load_method(spec: MethodSpec) -> None:
+    """Import ``spec``'s mapper class and the library modules it names in ``preload_modules`` (``Mapper``)."""
+    for name in getattr(spec.load_class(), "preload_modules", ()):
+        importlib.import_module(name)
 
 
 def _say_unknown(methods: Collection[str], registered: list[str]) -> None:

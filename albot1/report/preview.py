@@ -15,13 +15,25 @@ from albot1.atomic import atomic_write
 from albot1.contract import RunResult
 from albot1.metrics.alignment import align
 from albot1.report.places_plot import render_places
+from albot1.report.tick_memo import share_tick_updates
 from albot1.report.tight_png import save_tight_png
 
 
 def render_preview(result: RunResult, path: Path, max_points: int = 200_000) -> None:
+    """Draw ``result``'s map and trajectory into ``path`` (and ``places.png`` beside it for a network of places).
+
+    Every ``albot1 bench`` cell draws one, in a process forked for that cell,
+    so the preview is a fixed cost per cell (issue 24). Its axes' ticks are
+    worked out once per draw (:func:`~albot1.report.tick_memo.share_tick_updates`,
+    as in the reports): matplotlib otherwise updates each axis's ticks and
+    measures their labels again for the title's place, the axis label's and
+    each spine's, with the same result each time, so the pixels are the same
+    (``docs/benchmarking.md``, "Session 22").
+    """
     from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
 
+    share_tick_updates()
     fig = Figure(figsize=(7, 7), dpi=110)  # no pyplot: nothing to register or close, Agg is the canvas
     ax = fig.add_subplot()
     data = result.map

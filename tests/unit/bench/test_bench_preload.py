@@ -276,3 +276,54 @@ def test_a_cell_inherits_the_commit_and_library_versions_its_run_records() -> No
     assert out.returncode == 0, out.stderr
     versions.git_commit.cache_clear()
     assert json.loads(out.stdout) == [versions.git_commit(), versions.library_versions()]
+
+
+_CELL_IMPORTS = """
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import albot1.bench.preload  # what the forkserver imports before it forks any cell
+from albot1.bench.cells import execute_cell
+from albot1.bench.grid import Cell
+from albot1.bench.plan import plan_suite
+from albot1.bench.suite import load_suite
+from albot1.settings import get_settings
+from albot1.report.preview import render_preview  # the renderer the runner names; imported by the server's cells
+
+suite = Path(tempfile.mkdtemp()) / "s.toml"
+suite.write_text('''
+description = "cheap cells"
+[limits]
+time_s = 60
+memory_mb = 2048
+[grid]
+degradations = ["gauss:0.1:1"]
+seeds = [0]
+[[methods]]
+name = "odometry"
+[[methods]]
+name = "kiss-icp"
+[[datasets]]
+name = "synthetic-office-startstop[:12]"
+sweep = true
+''')
+before = set(sys.modules)
+for cell in plan_suite(load_suite(suite), get_settings()).cells:
+    execute_cell(Cell.from_json(cell.to_json()), Path(tempfile.mkdtemp()), preview=render_preview)
+print(json.dumps(sorted(set(sys.modules) - before)))
+"""
+
+
+def test_cheap_cells_import_nothing_the_server_could_have_imported(tmp_path: Path) -> None:
+    """Odometry and KISS-ICP cells on a world, run after the server's preload, import no module of their own.
+
+    Each module a cell imports is imported again in every cell (2-14 ms of CPU each in a fork: platformdirs,
+    shapely.ops, the cp437 codec zipfile reads .npz member names with, KISS-ICP's modules); imported by the
+    server, never (issue 24).
+    """
+    env = dict(os.environ, **{ENV: "odometry,kiss-icp", "ALBOT1_DECODED_CACHE": str(tmp_path / "decoded")})
+    out = subprocess.run([sys.executable, "-c", _CELL_IMPORTS], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout.splitlines()[-1]) == []
