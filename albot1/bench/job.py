@@ -18,6 +18,7 @@ import time
 import traceback
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from albot1 import versions
 from albot1.bench.cell_main import ERROR_FILE, EXIT_OK, EXIT_STORAGE, STORAGE_ERRNOS, storage_error
@@ -177,6 +178,18 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
     return CellOutcome.of(cell, "failed", ended.elapsed_s, reason, kind, halts_grid=halts)
 
 
+def _dask_worker() -> Any | None:
+    """The Dask worker running this task, or None outside one (distributed not imported, or not in a task)."""
+    if "distributed" not in sys.modules:
+        return None
+    from distributed import get_worker
+
+    try:
+        return get_worker()
+    except ValueError:  # not inside a Dask task
+        return None
+
+
 def _given_up_by_dask() -> Callable[[], bool] | None:
     """On a Dask worker: whether the scheduler has given this task up since (None elsewhere).
 
@@ -185,13 +198,8 @@ def _given_up_by_dask() -> Callable[[], bool] | None:
     folder after the runner had released the results folder's lock, and a re-run started then (as the
     runner's last line invites) ran the same cell into the same folder at the same time.
     """
-    if "distributed" not in sys.modules:
-        return None
-    from distributed import get_worker
-
-    try:
-        worker = get_worker()
-    except ValueError:  # not inside a Dask task
+    worker = _dask_worker()
+    if worker is None:
         return None
     key = worker.get_current_task()
 
@@ -210,13 +218,8 @@ def _worker_code_mismatch(cell: Cell) -> str | None:
     Checked on Dask workers only: the local executor runs jobs in the
     runner's own process, whose code planned the keys.
     """
-    if "distributed" not in sys.modules:
-        return None
-    from distributed import get_worker
-
-    try:
-        worker = get_worker()
-    except ValueError:  # not inside a Dask task
+    worker = _dask_worker()
+    if worker is None:
         return None
     version = versions.code_version()
     if version == cell.code_version:
