@@ -17,6 +17,7 @@ import importlib
 import json
 import os
 import shutil
+import signal
 import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -332,8 +333,10 @@ def pytest_configure(config: pytest.Config) -> None:
 
     Each worker would otherwise decode the public logs it opens into a folder of its own
     (:func:`_decoded_cache_of_the_session`); the workers inherit the controller's environment.
+    Ctrl-C is given back its Python meaning (:func:`_ctrl_c_as_python_has_it`) in the controller and each worker.
     """
     global _recorded
+    _ctrl_c_as_python_has_it()
     if config.getoption("record_durations", None) and not hasattr(config, "workerinput"):
         _recorded = {}
     workers = getattr(config.option, "numprocesses", None) or 0
@@ -343,6 +346,18 @@ def pytest_configure(config: pytest.Config) -> None:
     config.stash[_SESSION_FOLDER] = folder
     if not os.environ.get(DECODED_CACHE_ENV):
         os.environ[DECODED_CACHE_ENV] = str(folder / "decoded")
+
+
+def _ctrl_c_as_python_has_it() -> None:
+    """SIGINT raising KeyboardInterrupt, when the run was started with it ignored (``cmd &`` in a script, nohup).
+
+    A shell without job control starts a background command with SIGINT ignored, and Python then leaves it
+    ignored, as do the processes the tests start: the tests of Ctrl-C handling (the bench's interrupt line, a
+    cell's "interrupted" record) failed under such a run, for what the terminal did, not the code. A handler
+    set here is reset to the default at ``exec``, so the tests' subprocesses get Python's own as well.
+    """
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
