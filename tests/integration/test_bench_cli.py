@@ -19,6 +19,9 @@ from conftest import PluginInstaller
 # `albot1 bench` end to end (its grid in worker processes): the end-to-end lane (Makefile, `make test-end-to-end`)
 pytestmark = pytest.mark.end_to_end
 
+#: the console entry point in a fresh interpreter, as a user runs it
+ALBOT1 = [sys.executable, "-c", "from albot1.cli.app import main; main()"]
+
 
 def test_dry_run_lists_the_planned_cells_without_running_them(tmp_path: Path) -> None:
     result = CliRunner().invoke(app, ["bench", "quick", "--dry-run", "--results", str(tmp_path)])
@@ -34,7 +37,7 @@ def test_errors_are_one_line_on_stderr_with_exit_1(tmp_path: Path) -> None:
         (["bench", "quick", "--executor", "ray"], "executor 'ray' not understood"),
     ):
         done = subprocess.run(
-            [sys.executable, "-c", "from albot1.cli.app import main; main()", *args],
+            [*ALBOT1, *args],
             capture_output=True,
             text=True,
             cwd=tmp_path,
@@ -55,8 +58,7 @@ def test_bench_exits_1_after_the_whole_grid_when_a_cell_failed(tmp_path: Path) -
     )
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent), *sys.path]))
     done = subprocess.run(
-        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
-        + ["--results", str(tmp_path / "results"), "--no-progress"],
+        [*ALBOT1, "bench", str(suite), "-j", "1"] + ["--results", str(tmp_path / "results"), "--no-progress"],
         capture_output=True,
         text=True,
         cwd=tmp_path,
@@ -82,7 +84,7 @@ def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(
         '[[datasets]]\nname = "synthetic-office-startstop"\n'
     )
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent), *sys.path]))
-    args = [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+    args = [*ALBOT1, "bench", str(suite), "-j", "1"]
     args += ["--results", str(tmp_path / "results"), "--no-progress"]
     done = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=env)
     assert done.returncode == 0, done.stderr
@@ -127,7 +129,7 @@ def test_a_method_failure_the_suite_allows_is_reported_but_the_exit_is_clean(
 
 def _albot1(tmp_path: Path, *args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-c", "from albot1.cli.app import main; main()", *args],
+        [*ALBOT1, *args],
         capture_output=True,
         text=True,
         cwd=tmp_path,
@@ -205,8 +207,7 @@ def test_a_suite_with_no_cell_to_run_exits_1_and_its_report_says_so(tmp_path: Pa
     suite = tmp_path / "nodata.toml"
     suite.write_text('[[methods]]\nname = "odometry"\n[[datasets]]\nname = "aces"\n')
     done = subprocess.run(
-        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite)]
-        + ["--results", "results", "--no-progress"],
+        [*ALBOT1, "bench", str(suite)] + ["--results", "results", "--no-progress"],
         capture_output=True,
         text=True,
         cwd=tmp_path,
@@ -260,8 +261,7 @@ def test_ctrl_c_during_the_forkservers_cold_warm_up_prints_only_the_interrupted_
     env = dict(os.environ, XDG_CACHE_HOME=str(cache), ALBOT1_COMPILE_PROCESSES="2")
     env.pop("NUMBA_DISABLE_JIT", None)
     runner = subprocess.Popen(
-        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
-        + ["--results", str(tmp_path / "results"), "--no-progress"],
+        [*ALBOT1, "bench", str(suite), "-j", "1"] + ["--results", str(tmp_path / "results"), "--no-progress"],
         env=env,
         cwd=tmp_path,
         stdout=subprocess.PIPE,
@@ -301,7 +301,7 @@ def test_what_a_plugin_module_prints_on_import_stays_out_of_the_bench_tables(
     )
     suite = tmp_path / "banner.toml"
     suite.write_text('[[methods]]\nname = "banner"\n\n[[datasets]]\nname = "synthetic-office-startstop[:3]"\n')
-    args = [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+    args = [*ALBOT1, "bench", str(suite), "-j", "1"]
     args += ["--results", str(tmp_path / "results"), "--no-progress"]
     done = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300, env=dict(os.environ))
     assert done.returncode == 0, done.stderr
@@ -323,7 +323,7 @@ def test_ctrl_c_on_a_local_dask_cluster_prints_only_the_interrupted_line(tmp_pat
     )
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent), *sys.path]))
     runner = subprocess.Popen(
-        [sys.executable, "-c", "from albot1.cli.app import main; main()", "bench", str(suite), "-j", "1"]
+        [*ALBOT1, "bench", str(suite), "-j", "1"]
         + ["--executor", "dask", "--results", str(tmp_path / "results"), "--no-progress"],
         env=env,
         cwd=tmp_path,
