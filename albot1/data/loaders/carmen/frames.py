@@ -21,7 +21,7 @@ from albot1.data.loaders.beams import seam_repeat
 from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.checks import span_problem, time_problem
 from albot1.data.loaders.carmen.options import CarmenOptions
-from albot1.data.loaders.carmen.parse import LaserBlock, ParsedChunk, parse_chunk
+from albot1.data.loaders.carmen.parse import REAR_LASERS, LaserBlock, ParsedChunk, parse_chunk
 from albot1.data.loaders.carmen.poses import PendingScan, PoseSources, mount_problem
 from albot1.data.loaders.carmen.probe import refuse_mixed
 from albot1.data.loaders.carmen.source import iter_line_chunks
@@ -118,7 +118,7 @@ class _FrameIterator:
         decoded = []
         for b, block in enumerate(parsed.lasers):
             if self.s.check_mount and block.robot is not None and block.sensor is not None:
-                found = mount_problem(block.robot, block.sensor, self.s.mount)
+                found = mount_problem(block.robot, block.sensor, self.s.mount, self.s.laser)
                 if found is not None:
                     raise ParseError(self.path, found[1], line=int(block.lines[found[0]]))
             if block.start is None or block.step is None or block.max_range is None:
@@ -136,7 +136,11 @@ class _FrameIterator:
             ranges = _without_seam(list(geom.clean_block(block.ranges, max_range)), angles)
             decoded.append((block, ranges, angles, block.stamps.tolist(), max_range.tolist()))
             rows.extend(zip(block.lines.tolist(), [b] * len(block.lines), range(len(block.lines))))
-        for _, name, value in params:
+        rear = self.s.laser in REAR_LASERS
+        for line, name, value in params:
+            problem = geom.mount_change_problem(self.params, name, value, rear=rear)
+            if problem is not None:
+                raise ParseError(self.path, problem, line=line)
             self.params[name] = value
         if params:
             self.geometry.clear()
