@@ -68,6 +68,8 @@ class _FrameIterator:
         self.last_stamp: tuple[float, int] | None = None
         self.poses = PoseSources(stream.path, stream.opts, stream.laser, stream.reference, stream.mount)
         self.last_line = 0
+        #: the line of the log's first scan of the chosen laser, once seen
+        self.first_scan_line: int | None = None
 
     def run(self) -> Iterator[Frame]:
         for chunk in iter_line_chunks(self.path, parallel_bz2=self.opts.parallel_bz2):
@@ -137,10 +139,15 @@ class _FrameIterator:
             decoded.append((block, ranges, angles, block.stamps.tolist(), max_range.tolist()))
             rows.extend(zip(block.lines.tolist(), [b] * len(block.lines), range(len(block.lines))))
         rear = self.s.laser in REAR_LASERS
+        if self.first_scan_line is None and rows:
+            self.first_scan_line = min(line for line, _, _ in rows)
         for line, name, value in params:
-            problem = geom.mount_change_problem(self.params, name, value, rear=rear)
-            if problem is not None:
-                raise ParseError(self.path, problem, line=line)
+            # before the first scan a PARAM block may restate a value (the last one counts); after it, the mount
+            # the scans were placed with must not change
+            if self.first_scan_line is not None and line > self.first_scan_line:
+                problem = geom.mount_change_problem(self.params, name, value, rear=rear)
+                if problem is not None:
+                    raise ParseError(self.path, problem, line=line)
             self.params[name] = value
         if params:
             self.geometry.clear()

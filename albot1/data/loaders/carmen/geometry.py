@@ -182,7 +182,10 @@ def mount_change_problem(params: dict[str, str], name: str, value: str, rear: bo
     way (two recordings joined, a parameter changed while logging) would have
     every scan on one side of the change placed with the other side's mount.
     ``params`` holds the values in effect before this line; a value equal to
-    the one in effect (a logger repeating its parameters) is no change.
+    the one in effect (a logger repeating its parameters) is no change. The
+    caller asks only for PARAM lines after the first scan: a PARAM block before
+    it may restate a name (belgioioso-corrected: 0.0, then -0.04), the last
+    value counting.
     """
     if name not in mount_params(rear) or name not in params or float(params[name]) == float(value):
         return None

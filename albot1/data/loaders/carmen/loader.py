@@ -156,8 +156,11 @@ class CarmenLoader:
         reference = opts.reference
         if reference == "auto":
             reference = "truepos" if len(head.truepos.lines) else "none"
-        params: dict[str, str] = {}
-        for _, name, value in head.params:  # the first value: a later, different mount is refused (frames.py)
+        # The values in effect at the first scan (a PARAM block may restate a name, the last value counts), then
+        # those first stated after it; a mount PARAM changing after the first scan is refused (frames.py).
+        first_scan = int(head.lasers[0].lines[0]) if head.lasers else None
+        params = {name: value for at, name, value in head.params if first_scan is None or at < first_scan}
+        for _, name, value in head.params:
             params.setdefault(name, value)
         rear = laser in REAR_LASERS
         offset = geom.sensor_offset(params, rear=rear)

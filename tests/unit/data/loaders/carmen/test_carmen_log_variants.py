@@ -99,3 +99,11 @@ def test_a_repeated_mount_param_and_the_other_lasers_mount_param_are_no_change(t
     lines += ["PARAM robot_rearlaser_offset -0.3 0 host 0", _flaser(1), "PARAM robot_rearlaser_offset -0.2 0 host 0"]
     seq = load(str(_write(tmp_path, [*lines, _flaser(2)])))
     assert len(list(seq.frames())) == 3 and seq.metadata.sensor_offset == (0.1, 0.0, 0.0)
+
+
+def test_a_mount_param_restated_before_the_first_scan_takes_its_last_value(tmp_path: Path) -> None:
+    """belgioioso-corrected's PARAM block states robot_frontlaser_offset 0.0 (line 3), then -0.04 (line 17), all
+    before its first FLASER line: the last value is the mount, as before, and nothing is refused."""
+    lines = ["PARAM robot_frontlaser_offset 0.0 nohost 0", "PARAM robot_frontlaser_offset -0.04 nohost 0"]
+    seq = load(str(_write(tmp_path, [*lines, _flaser(0), _flaser(1)])))
+    assert len(list(seq.frames())) == 2 and seq.metadata.sensor_offset == (-0.04, 0.0, 0.0)
