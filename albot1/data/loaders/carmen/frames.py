@@ -21,7 +21,7 @@ from albot1.data.loaders.beams import seam_repeat
 from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.checks import span_problem, time_problem
 from albot1.data.loaders.carmen.options import CarmenOptions
-from albot1.data.loaders.carmen.parse import LaserBlock, ParsedChunk, parse_chunk
+from albot1.data.loaders.carmen.parse import REAR_LASERS, LaserBlock, ParsedChunk, parse_chunk
 from albot1.data.loaders.carmen.poses import PendingScan, PoseSources, mount_problem
 from albot1.data.loaders.carmen.probe import refuse_mixed
 from albot1.data.loaders.carmen.source import iter_line_chunks
@@ -68,6 +68,8 @@ class _FrameIterator:
         self.last_stamp: tuple[float, int] | None = None
         self.poses = PoseSources(stream.path, stream.opts, stream.laser, stream.reference, stream.mount)
         self.last_line = 0
+        #: the line of the log's first scan of the chosen laser, once seen
+        self.first_scan_line: int | None = None
 
     def run(self) -> Iterator[Frame]:
         for chunk in iter_line_chunks(self.path, parallel_bz2=self.opts.parallel_bz2):
@@ -118,7 +120,7 @@ class _FrameIterator:
         decoded = []
         for b, block in enumerate(parsed.lasers):
             if self.s.check_mount and block.robot is not None and block.sensor is not None:
-                found = mount_problem(block.robot, block.sensor, self.s.mount)
+                found = mount_problem(block.robot, block.sensor, self.s.mount, self.s.laser)
                 if found is not None:
                     raise ParseError(self.path, found[1], line=int(block.lines[found[0]]))
             if block.start is None or block.step is None or block.max_range is None:
@@ -136,7 +138,16 @@ class _FrameIterator:
             ranges = _without_seam(list(geom.clean_block(block.ranges, max_range)), angles)
             decoded.append((block, ranges, angles, block.stamps.tolist(), max_range.tolist()))
             rows.extend(zip(block.lines.tolist(), [b] * len(block.lines), range(len(block.lines))))
-        for _, name, value in params:
+        rear = self.s.laser in REAR_LASERS
+        if self.first_scan_line is None and rows:
+            self.first_scan_line = min(line for line, _, _ in rows)
+        for line, name, value in params:
+            # before the first scan a PARAM block may restate a value (the last one counts); after it, the mount
+            # the scans were placed with must not change
+            if self.first_scan_line is not None and line > self.first_scan_line:
+                problem = geom.mount_change_problem(self.params, name, value, rear=rear)
+                if problem is not None:
+                    raise ParseError(self.path, problem, line=line)
             self.params[name] = value
         if params:
             self.geometry.clear()

@@ -164,9 +164,36 @@ def param_geometry(beams: int, params: dict[str, str], rear: bool = False) -> Be
     return BeamGeometry(start, step, max_range if max_range is not None else DEFAULT_MAX_RANGE, source)
 
 
-def states_front_mount(params: dict[str, str]) -> bool:
-    """Whether the log's PARAM lines state the front laser's mount (any of its offset, side or angular parts)."""
-    return any(f"robot_frontlaser_{part}" in params for part in ("offset", "side_offset", "angular_offset"))
+def mount_params(rear: bool = False) -> tuple[str, str, str]:
+    """The PARAM names that state the front (or rear) laser's mount: its offset, side and angular parts."""
+    which = "rear" if rear else "front"
+    return f"robot_{which}laser_offset", f"robot_{which}laser_side_offset", f"robot_{which}laser_angular_offset"
+
+
+def states_mount(params: dict[str, str], rear: bool = False) -> bool:
+    """Whether the log's PARAM lines state the front (or rear) laser's mount (any of its parts)."""
+    return any(name in params for name in mount_params(rear))
+
+
+def mount_change_problem(params: dict[str, str], name: str, value: str, rear: bool = False) -> str | None:
+    """Why a PARAM line restating the laser's mount with another value cannot be read (None if it can).
+
+    A sequence has one ``sensor_offset``; a log whose mount PARAM changes part
+    way (two recordings joined, a parameter changed while logging) would have
+    every scan on one side of the change placed with the other side's mount.
+    ``params`` holds the values in effect before this line; a value equal to
+    the one in effect (a logger repeating its parameters) is no change. The
+    caller asks only for PARAM lines after the first scan: a PARAM block before
+    it may restate a name (belgioioso-corrected: 0.0, then -0.04), the last
+    value counting.
+    """
+    if name not in mount_params(rear) or name not in params or float(params[name]) == float(value):
+        return None
+    return (
+        f"PARAM {name} changes from {params[name]} to {value}; expected one laser mount for the whole log (a "
+        f"sequence has one sensor_offset, so the scans on one side of this line would be placed with the other "
+        f"side's mount): split the log at this line and load each part"
+    )
 
 
 def sensor_offset(params: dict[str, str], rear: bool = False) -> tuple[float, float, float]:

@@ -85,7 +85,7 @@ from albot1.data.errors import DataError, ParseError
 from albot1.data.loaders.carmen import geometry as geom
 from albot1.data.loaders.carmen.frames import FrameStream
 from albot1.data.loaders.carmen.options import describe_odometry, describe_reference, parse_options
-from albot1.data.loaders.carmen.parse import LASER_MESSAGES
+from albot1.data.loaders.carmen.parse import LASER_MESSAGES, REAR_LASERS, ROBOT_LASERS, UNREAD_LASERS
 from albot1.data.loaders.carmen.probe import noteworthy_skips, probe, refuse_mixed, skipped_note
 from albot1.data.loaders.carmen.source import read_head
 from albot1.data.model import Sequence, SequenceMetadata
@@ -97,8 +97,7 @@ log = logging.getLogger(__name__)
 #: A file is taken for a CARMEN log if a line of its first 64 KiB starts with one of these messages
 #: (or the "# CARMEN" comment the logger writes first).
 _SNIFF_NAMES = frozenset(
-    (b"FLASER", b"RLASER", b"ROBOTLASER1", b"RAWLASER1", b"RAWLASER2", b"RAWLASER3", b"RAWLASER4")
-    + (b"ODOM", b"PARAM", b"TRUEPOS", b"SYNC")
+    name.encode() for name in LASER_MESSAGES + UNREAD_LASERS + ("ODOM", "PARAM", "TRUEPOS", "SYNC")
 )
 _SNIFF_BYTES = 1 << 16
 
@@ -130,12 +129,18 @@ class CarmenLoader:
         laser = opts.laser or head.first_laser
         if laser is None:
             others = sorted(name for name in head.ignored if name in LASER_MESSAGES)
+            unread = sorted(name for name in head.ignored if name in UNREAD_LASERS)
             hint = (
                 f"; the log has {', '.join(f'{head.ignored[n]} {n}' for n in others)} lines: read them with "
                 f"the loader option laser={others[0]} (e.g. 'FILE?laser={others[0]}')"
                 if others
                 else ""
             )
+            if unread:
+                hint += (
+                    f"; it has {', '.join(f'{head.ignored[n]} {n}' for n in unread)} lines, a laser this loader "
+                    f"does not read (laser= takes {', '.join(LASER_MESSAGES)})"
+                )
             raise ParseError(
                 path,
                 f"no front-laser scans in the first 2 MiB of the log; expected FLASER, ROBOTLASER1 or "
@@ -151,9 +156,15 @@ class CarmenLoader:
         reference = opts.reference
         if reference == "auto":
             reference = "truepos" if len(head.truepos.lines) else "none"
-        params = {name: value for _, name, value in head.params}
-        offset = geom.sensor_offset(params, rear=laser in ("RLASER", "RAWLASER2"))
-        lines_state_mount = laser == "ROBOTLASER1" and not geom.states_front_mount(params)
+        # The values in effect at the first scan (a PARAM block may restate a name, the last value counts), then
+        # those first stated after it; a mount PARAM changing after the first scan is refused (frames.py).
+        first_scan = int(head.lasers[0].lines[0]) if head.lasers else None
+        params = {name: value for at, name, value in head.params if first_scan is None or at < first_scan}
+        for _, name, value in head.params:
+            params.setdefault(name, value)
+        rear = laser in REAR_LASERS
+        offset = geom.sensor_offset(params, rear=rear)
+        lines_state_mount = laser in ROBOT_LASERS and not geom.states_mount(params, rear=rear)
         if lines_state_mount and head.lasers:
             first = head.lasers[0]
             assert first.robot is not None and first.sensor is not None

@@ -12,7 +12,7 @@ Message layouts (after the name; every message ends with
 ``ipc_timestamp ipc_hostname logger_timestamp``)::
 
     FLASER|RLASER  n r1..rn x y theta odom_x odom_y odom_theta
-    ROBOTLASER1    type start_angle fov resolution max_range accuracy remission_mode
+    ROBOTLASER1|2  type start_angle fov resolution max_range accuracy remission_mode
                    n r1..rn m e1..em laser_x laser_y laser_theta robot_x robot_y robot_theta
                    tv rv forward_safety side_safety turn_axis
     RAWLASER1..4   type start_angle fov resolution max_range accuracy remission_mode
@@ -46,8 +46,15 @@ from albot1.data.tokens import is_number
 from albot1.geometry.types import FloatArray
 
 OLD_LASERS = ("FLASER", "RLASER")
-NEW_LASERS = ("ROBOTLASER1", "RAWLASER1", "RAWLASER2", "RAWLASER3", "RAWLASER4")
+NEW_LASERS = ("ROBOTLASER1", "ROBOTLASER2", "RAWLASER1", "RAWLASER2", "RAWLASER3", "RAWLASER4")
 LASER_MESSAGES = OLD_LASERS + NEW_LASERS
+#: The messages that carry the laser's and the robot's pose with every scan (CARMEN's robot module, front and rear).
+ROBOT_LASERS = ("ROBOTLASER1", "ROBOTLASER2")
+#: The *rear* laser's messages: their mount is the ``robot_rearlaser_*`` PARAMs' (a laser looking backwards).
+REAR_LASERS = ("RLASER", "ROBOTLASER2", "RAWLASER2")
+#: Laser messages CARMEN's playback defines that this loader does not read (a third to fifth laser, and
+#: LASER3..5, the old form of RAWLASER3..5): named when a log holds no laser the loader reads.
+UNREAD_LASERS = ("LASER3", "LASER4", "LASER5", "RAWLASER5", "ROBOTLASER3", "ROBOTLASER4", "ROBOTLASER5")
 #: The message kinds of the *front* laser, old and new; a log mixing them is refused unless one is chosen.
 FRONT_LASERS = ("FLASER", "ROBOTLASER1", "RAWLASER1")
 POSE_MESSAGES = ("ODOM", "TRUEPOS")
@@ -58,6 +65,11 @@ _LAYOUT = {
     "FLASER": "n r1..rn x y theta odom_x odom_y odom_theta " + _TRAILER,
     "RLASER": "n r1..rn x y theta odom_x odom_y odom_theta " + _TRAILER,
     "ROBOTLASER1": (
+        "laser_type start_angle fov resolution max_range accuracy remission_mode n r1..rn m e1..em "
+        "laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv forward_safety side_safety "
+        "turn_axis " + _TRAILER
+    ),
+    "ROBOTLASER2": (
         "laser_type start_angle fov resolution max_range accuracy remission_mode n r1..rn m e1..em "
         "laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv forward_safety side_safety "
         "turn_axis " + _TRAILER
@@ -314,8 +326,8 @@ def parse_old_lasers(path: Path, name: str, rows: list[tuple[int, bytes]]) -> li
 
 
 def parse_new_lasers(path: Path, name: str, rows: list[tuple[int, bytes]]) -> list[LaserBlock]:
-    """ROBOTLASER1/RAWLASERn lines -> one block per (beams, remissions) layout."""
-    with_pose = name == "ROBOTLASER1"
+    """ROBOTLASER1/2 and RAWLASERn lines -> one block per (beams, remissions) layout."""
+    with_pose = name in ROBOT_LASERS
     extra = 11 if with_pose else 0
     by_shape: dict[tuple[int, int], list[tuple[int, bytes]]] = {}
     for line, rest in rows:

@@ -175,8 +175,12 @@ class PoseSources:
         return self._robot(odometry) if self.laser in OLD_LASERS else odometry
 
 
-def mount_problem(robot: np.ndarray, laser: np.ndarray, mount: tuple[float, float, float]) -> tuple[int, str] | None:
-    """The first ROBOTLASER1 row whose own mount (``between(robot pose, laser pose)``) is not ``mount``, and why.
+def mount_problem(
+    robot: np.ndarray, laser: np.ndarray, mount: tuple[float, float, float], message: str = "ROBOTLASER1"
+) -> tuple[int, str] | None:
+    """The first ROBOTLASER1 (or ``message``: ROBOTLASER2) row whose own mount is not ``mount``, and why.
+
+    A row's own mount is ``between(robot pose, laser pose)``.
 
     The loader takes the mount from the log's first line and applies it to every scan; a later line whose
     laser sits elsewhere on the robot would be placed wrongly without a word (a second laser's lines under
@@ -192,9 +196,9 @@ def mount_problem(robot: np.ndarray, laser: np.ndarray, mount: tuple[float, floa
     shown = ", ".join(f"{v:.6g}" for v in found[row])
     expected = ", ".join(f"{v:.6g}" for v in mount)
     return row, (
-        f"ROBOTLASER1 laser pose vs robot pose puts the laser at ({shown}) (x m, y m, yaw rad) on the robot, but the "
-        f"log's first ROBOTLASER1 line puts it at ({expected}); expected one mount for every line (to within "
+        f"{message} laser pose vs robot pose puts the laser at ({shown}) (x m, y m, yaw rad) on the robot, but the "
+        f"log's first {message} line puts it at ({expected}); expected one mount for every line (to within "
         f"{MOUNT_TOLERANCE:g}): the loader applies one mount to every scan, so lines of another laser or whose laser "
         f"poses were corrected apart from the robot poses cannot be read as this log's scans (a corrected log "
-        f"reads when its PARAM robot_frontlaser_offset states the mount)"
+        f"reads when its PARAM robot_{'rear' if message == 'ROBOTLASER2' else 'front'}laser_offset states the mount)"
     )

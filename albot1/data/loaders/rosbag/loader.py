@@ -314,5 +314,7 @@ class Ros2BagLoader:
                 f"{where / 'metadata.yaml'}: missing; a ROS2 bag folder holds metadata.yaml beside its storage "
                 f"files (found: {found}); ROS 2's `ros2 bag reindex FOLDER` can recreate it"
             )
-        storage = "ros2-mcap" if any(folder.glob("*.mcap")) else "ros2-sqlite3"
+        # ``run.mcap``, or ``run.mcap.zstd`` when rosbag2 compressed the whole file (which used to be called sqlite3)
+        mcap = any(".mcap" in p.suffixes for p in folder.iterdir() if p.is_file())
+        storage = "ros2-mcap" if mcap else "ros2-sqlite3"
         return _load_bag(folder, folder, folder.name, storage, options)

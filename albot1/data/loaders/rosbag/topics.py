@@ -15,6 +15,7 @@ from pathlib import Path
 from albot1.data.errors import TopicError
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
+MULTI_ECHO_LASER_SCAN = "sensor_msgs/msg/MultiEchoLaserScan"
 ODOMETRY = "nav_msgs/msg/Odometry"
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 #: The reference topic ``albot1 convert`` writes; an Odometry topic of this
@@ -58,12 +59,27 @@ def _error(path: Path, problem: str, topics: Mapping[str, TopicInfo]) -> TopicEr
     return TopicError(f"{path}: {problem}; the bag's topics: {describe(topics)}")
 
 
+def _multi_echo_note(topics: Mapping[str, TopicInfo]) -> str:
+    """What to say of ``MultiEchoLaserScan`` topics (several ranges per beam), which are not read."""
+    echoes = sorted(name for name, info in topics.items() if info.msgtype == MULTI_ECHO_LASER_SCAN)
+    if not echoes:
+        return ""
+    return (
+        f" ({', '.join(echoes)} {'is' if len(echoes) == 1 else 'are'} {MULTI_ECHO_LASER_SCAN}, several echoes per "
+        f"beam, which is not read: expected a LaserScan topic, such as the single-echo scan a multi-echo driver "
+        f"can publish beside it)"
+    )
+
+
 def _named(path: Path, topics: Mapping[str, TopicInfo], name: str, allowed: tuple[str, ...], option: str) -> str:
     if name not in topics:
         raise _error(path, f"topic {name!r} ({option}) is not in the bag", topics)
     if topics[name].msgtype not in allowed:
+        note = _multi_echo_note({name: topics[name]}) if LASER_SCAN in allowed else ""
         raise _error(
-            path, f"topic {name!r} ({option}) has type {topics[name].msgtype}, expected {' or '.join(allowed)}", topics
+            path,
+            f"topic {name!r} ({option}) has type {topics[name].msgtype}, expected {' or '.join(allowed)}{note}",
+            topics,
         )
     return name
 
@@ -96,7 +112,7 @@ def choose_topics(
     else:
         guessed = _single(path, topics, LASER_SCAN, "scan_topic / --scan-topic")
         if guessed is None:
-            raise _error(path, f"no {LASER_SCAN} topic", topics)
+            raise _error(path, f"no {LASER_SCAN} topic{_multi_echo_note(topics)}", topics)
         scan = guessed
 
     reference = None

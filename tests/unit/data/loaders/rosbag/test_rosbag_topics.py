@@ -84,3 +84,13 @@ def test_missing_scan_or_odometry() -> None:
 def test_ros1_type_names_are_normalised() -> None:
     assert normalize_type("sensor_msgs/LaserScan") == LASER_SCAN
     assert normalize_type(ODOMETRY) == ODOMETRY
+
+
+def test_a_multi_echo_scan_topic_is_named_as_not_read_whether_guessed_or_chosen() -> None:
+    """sensor_msgs/MultiEchoLaserScan (several ranges per beam) is refused saying what it is, not only 'no
+    LaserScan topic'."""
+    topics = table(echoes="sensor_msgs/msg/MultiEchoLaserScan", odom=ODOMETRY)
+    with pytest.raises(TopicError, match=r"no sensor_msgs/msg/LaserScan topic \(/echoes is .*MultiEchoLaserScan, "):
+        choose_topics(BAG, topics)
+    with pytest.raises(TopicError, match=r"has type .*MultiEchoLaserScan, expected .*\(/echoes is .*not read"):
+        choose_topics(BAG, topics, scan_topic="/echoes")
