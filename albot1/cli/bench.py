@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import contextlib
+import signal
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from albot1.cli.interrupt import Interrupts, noting_interrupts
+from albot1.cli.interrupt import Interrupts, noting_interrupts, terminating_as_interrupt
 from albot1.cli.progress import FigureBar, enabled
 from albot1.runs.output import writable_folder
 from albot1.settings import RESULTS_ROOT, get_settings
@@ -115,7 +116,11 @@ def bench(
     try:
         # What a method's module prints as the planner imports it (a plugin's banner) goes to stderr: stdout is
         # the tables (the cells' output goes to their logs; the forkserver's preload sends it to stderr too).
-        with noting_interrupts(ctrl_c), contextlib.redirect_stdout(sys.stderr):
+        with (
+            noting_interrupts(ctrl_c),
+            terminating_as_interrupt(ctrl_c),
+            contextlib.redirect_stdout(sys.stderr),
+        ):
             plan, summary, store = run_suite(
                 suite,
                 results=results,
@@ -132,9 +137,11 @@ def bench(
     finally:
         view.close()
     if interrupted:
-        # The cells got the same Ctrl-C and were recorded as interrupted; the store is consistent.
-        typer.echo("albot1: interrupted; completed cells are kept, run the same command again to resume", err=True)
-        raise typer.Exit(130)
+        # The cells got the same Ctrl-C (or the SIGINT a SIGTERM was handed on as) and stopped; the store is
+        # consistent. The exit status is the shell's for the signal that stopped it.
+        stopped = "terminated (SIGTERM)" if ctrl_c.terminated else "interrupted"
+        typer.echo(f"albot1: {stopped}; completed cells are kept, run the same command again to resume", err=True)
+        raise typer.Exit(128 + signal.SIGTERM if ctrl_c.terminated else 130)
     for skipped in plan.skipped_datasets:
         typer.echo(
             f"skipped dataset {skipped.name}: {skipped.reason}"

@@ -23,15 +23,21 @@ from contextlib import contextmanager
 from types import FrameType
 from typing import TYPE_CHECKING
 
+import psutil
+
 if TYPE_CHECKING:
     from sys import UnraisableHookArgs
 
 
 class Interrupts:
-    """``received`` becomes True at the first SIGINT inside :func:`noting_interrupts`."""
+    """``received`` becomes True at the first SIGINT inside :func:`noting_interrupts`.
+
+    ``terminated`` too when that stop came as SIGTERM, handed on by :func:`terminating_as_interrupt`.
+    """
 
     def __init__(self) -> None:
         self.received = False
+        self.terminated = False
 
     def heed(self) -> None:
         """Raise KeyboardInterrupt when Ctrl-C was noted: one whose exception went astray stops the work here.
@@ -80,3 +86,62 @@ def noting_interrupts(noted: Interrupts | None = None) -> Iterator[Interrupts]:
     finally:
         sys.unraisablehook = hook_before
         signal.signal(signal.SIGINT, before)
+
+
+@contextmanager
+def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
+    """SIGTERM stops the command as Ctrl-C does: its child processes get SIGINT, the main thread KeyboardInterrupt.
+
+    Why: ``kill PID``, ``timeout`` and batch schedulers stop a program with
+    SIGTERM sent to it alone. ``albot1 bench`` then died at once with exit
+    143 and no word, a script could not tell it from a crash. Ctrl-C
+    reaches the whole process group, so the runner's cells and its
+    forkserver each get SIGINT and stop, and the runner says "interrupted";
+    here the runner hands SIGINT on to every descendant it has and stops its
+    own work by the same KeyboardInterrupt, so SIGTERM takes the path Ctrl-C
+    takes (the command says which signal it was). The previous handler is back after the first
+    SIGTERM, so a second one ends the process at once, as usual. A process
+    that ignores SIGINT (all of them when the command was started in the
+    background of a script, ``cmd &``, which starts it with SIGINT ignored)
+    gets the SIGTERM instead, rather than the runner waiting for it forever.
+
+    Used inside :func:`noting_interrupts`. Nothing changes outside the main
+    thread or when SIGTERM is not at its default action (a host program's
+    handler is kept).
+    """
+    before = signal.getsignal(signal.SIGTERM)
+    if threading.current_thread() is not threading.main_thread() or before is not signal.SIG_DFL:
+        yield noted
+        return
+
+    def terminate(signum: int, frame: FrameType | None) -> None:
+        signal.signal(signal.SIGTERM, before)
+        noted.received = noted.terminated = True
+        try:
+            descendants = psutil.Process().children(recursive=True)
+        except psutil.Error:
+            descendants = []
+        for process in descendants:
+            try:
+                process.send_signal(signal.SIGTERM if _ignores_sigint(process.pid) else signal.SIGINT)
+            except psutil.Error:
+                continue  # it ended meanwhile
+        signal.default_int_handler(signal.SIGINT, frame)
+
+    signal.signal(signal.SIGTERM, terminate)
+    try:
+        yield noted
+    finally:
+        signal.signal(signal.SIGTERM, before)
+
+
+def _ignores_sigint(pid: int) -> bool:
+    """Whether process ``pid`` ignores SIGINT (``SigIgn`` of ``/proc/PID/status``); False where unknown."""
+    try:
+        with open(f"/proc/{pid}/status", "rb") as status:
+            for line in status:
+                if line.startswith(b"SigIgn:"):
+                    return bool(int(line.split()[1], 16) >> (signal.SIGINT - 1) & 1)
+    except (OSError, ValueError, IndexError):
+        pass
+    return False

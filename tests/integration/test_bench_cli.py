@@ -351,3 +351,49 @@ def test_ctrl_c_on_a_local_dask_cluster_prints_only_the_interrupted_line(tmp_pat
     ], stderr
     _, alive = psutil.wait_procs(descendants, timeout=30)
     assert alive == [], f"the Dask workers or their cells went on after Ctrl-C: {alive}"
+
+
+@pytest.mark.usefixtures("fault_plugin")
+def test_sigterm_to_the_runner_alone_stops_the_grid_as_ctrl_c_does_and_says_so(tmp_path: Path) -> None:
+    """``kill PID`` / ``timeout`` / a batch scheduler: one line and exit 143, the cells stopped as by Ctrl-C.
+
+    SIGTERM reaches the runner only (not its process group, as Ctrl-C would): it used to die at once with exit
+    143 and no word. As after Ctrl-C, the stopped cell has no result and no failure record: it runs again.
+    """
+    suite = tmp_path / "hangs.toml"
+    suite.write_text(
+        "[grid]\ndegradations = []\nseeds = [0]\n\n"
+        '[[methods]]\nname = "fault"\nset = { mode = "hang", at_scan = 2 }\n\n'
+        '[[datasets]]\nname = "synthetic-office-startstop[:5]"\n'
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent), *sys.path]))
+    runner = subprocess.Popen(
+        [*ALBOT1, "bench", str(suite), "-j", "1", "--results", str(tmp_path / "results"), "--no-progress"],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # nothing but the runner gets the signal
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while not list((tmp_path / "results").glob("hangs/runs/*/cell.log")) and time.monotonic() < deadline:
+            assert runner.poll() is None, runner.communicate()
+            time.sleep(0.1)
+        time.sleep(2.0)  # the cell process has started and hangs in its method
+        descendants = psutil.Process(runner.pid).children(recursive=True)
+        runner.send_signal(signal.SIGTERM)
+        _, stderr = runner.communicate(timeout=120)
+    finally:
+        if runner.poll() is None:
+            os.killpg(runner.pid, signal.SIGKILL)
+            runner.wait()
+    assert runner.returncode == 143, stderr
+    assert stderr.splitlines() == [
+        "albot1: terminated (SIGTERM); completed cells are kept, run the same command again to resume"
+    ], stderr
+    _, alive = psutil.wait_procs(descendants, timeout=30)
+    assert alive == [], f"the forkserver or the cell went on after SIGTERM: {alive}"
+    (run_dir,) = (tmp_path / "results").glob("hangs/runs/*")
+    assert not (run_dir / "DONE").exists() and not (run_dir / "FAILED.json").exists()

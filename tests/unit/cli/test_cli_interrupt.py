@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
 import sys
 from pathlib import Path
 from types import SimpleNamespace
@@ -93,3 +94,32 @@ def _bench(
         main()
     out, err = capsys.readouterr()
     return exited.value.code, out, err.splitlines()
+
+
+#: Run in a fresh interpreter: the handler signals every child of its process, and the test process's own children
+#: (a bench forkserver of an earlier test) must not get it. Two children: one as usual, one with SIGINT ignored.
+_SIGTERM_DRIVER = """
+import os, signal, subprocess, sys
+from albot1.cli.interrupt import Interrupts, terminating_as_interrupt
+child = "import signal, time; signal.signal(signal.SIGTERM, lambda *a: exit(15)); print(flush=True); time.sleep(60)"
+deaf = lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)
+kids = [subprocess.Popen([sys.executable, "-c", child], stdout=subprocess.PIPE, preexec_fn=f) for f in (None, deaf)]
+for kid in kids:
+    kid.stdout.readline()  # its handler is in place
+noted = Interrupts()
+try:
+    with terminating_as_interrupt(noted):
+        os.kill(os.getpid(), signal.SIGTERM)
+        sum(range(1000))  # where the KeyboardInterrupt is raised
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", noted.received, noted.terminated, signal.getsignal(signal.SIGTERM) is signal.SIG_DFL)
+print(*[kid.wait(timeout=30) for kid in kids])
+"""
+
+
+def test_sigterm_hands_sigint_on_to_children_and_sigterm_to_those_ignoring_sigint() -> None:
+    """A child started with SIGINT ignored (a script's ``cmd &``) would wait through SIGINT forever: it gets SIGTERM."""
+    done = subprocess.run([sys.executable, "-c", _SIGTERM_DRIVER], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    # the first child died of SIGINT (-2), the one ignoring it of SIGTERM (its handler's 15); the handler put back
+    assert done.stdout.splitlines() == ["KeyboardInterrupt True True True", "-2 15"], done.stderr
