@@ -146,6 +146,17 @@ def grids() -> dict[str, list[Cell]]:
         _cell("fr-clinic[:2000]", "offset:-0.1:0.1:-3"),
         _cell("fr-clinic[:2000]", "dropout:0.3", 0, "thesis"),
     ]
+    extreme = [
+        _cell(dataset, d, s, preset)
+        for preset in ("plus", "thesis", "literal", "exact")
+        for dataset in ("synthetic-office-loop", corrected("freiburg-101"))
+        for d, s in (("bias:1:0", 0), ("gauss:1:30", 0), ("offset:1:1:90", 0), ("dropout:0.95", 3), ("bias:0:45", 0))
+    ]
+    extreme += [
+        _cell("synthetic-places-loop", d, s, preset, "albot1-places")
+        for d, s in (("gauss:1:30", 0), ("dropout:0.95", 3))
+        for preset in ("default", "plus")
+    ]
     return {
         "whole": whole,
         "strided": strided,
@@ -156,6 +167,7 @@ def grids() -> dict[str, list[Cell]]:
         "faithful": faithful,
         "places": places,
         "extra": extra,
+        "extreme": extreme,
     }
 
 
