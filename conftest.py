@@ -244,6 +244,17 @@ def schedule_units(
     return sorted(units, key=lambda unit: -unit.seconds)
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_itemcollected(item: pytest.Item) -> None:
+    """A test that takes ``data_file`` reads the public logs: it is marked ``integration`` like the tests there.
+
+    Why: ``make test-fast`` promises "without the public logs" by deselecting that marker (``-m "not integration"``),
+    but a unit test that asks for a public log through the fixture was kept (and read it) unless its module said so.
+    """
+    if "data_file" in getattr(item, "fixturenames", ()):
+        item.add_marker(pytest.mark.integration)
+
+
 @pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Run the longest modules first, each kept together.

@@ -116,8 +116,8 @@ def evaluate(
       albot1 evaluate runs/3f2a9c0d11e4b7a2 --json | jq .ate.rmse_m\n
       albot1 evaluate --trajectory cartographer.tum --dataset intel-corrected \\
           --out carto.json\n
-      albot1 evaluate --trajectory intel.gfs.log --format carmen --dataset aces \\
-          --evo evo-results/\n
+      albot1 evaluate --trajectory intel.gfs.log --format carmen \\
+          --dataset intel-corrected --evo evo-results/\n
       albot1 evaluate --trajectory est.tum --reference gt.tum \\
           --align origin --time-offset 0.05
     """

@@ -28,9 +28,10 @@ def warm_up(
 ) -> None:
     """Compile (or load from numba's cache) the kernels of every preset of METHODS, so no run compiles them.
 
-    Albot1's kernels are compiled once per code version and machine and
-    cached on disk; this does it now, for every preset of albot1 and
-    albot1-places (or of the METHODS named), and says how long it took.
+    Albot1's kernels (and gtsam-graph's grid search) are compiled once per
+    code version and machine and cached on disk; this does it now, for every
+    preset of albot1, albot1-places and gtsam-graph (or of the METHODS
+    named), and says how long it took.
     `make venv` runs it after installing. A method without a start-up step
     has nothing to do here. Exit 1 with one line per method that failed
     (the others are still warmed up).

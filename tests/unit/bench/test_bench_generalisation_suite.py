@@ -41,6 +41,7 @@ def test_no_method_of_the_suite_but_gtsam_graph_and_albot1_plus_is_tuned_on_its_
         assert (HELD_OUT <= set(tuned)) if held_in else not HELD_OUT & set(tuned), entry.display
 
 
+@pytest.mark.integration  # plans on the held-out public logs (skipped without them)
 def test_the_plan_has_one_cell_per_method_dataset_perturbation_and_seed() -> None:
     settings = get_settings()
     if not all(catalog.is_available(n, settings) for n in HELD_OUT):

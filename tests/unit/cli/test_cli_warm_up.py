@@ -113,3 +113,12 @@ def test_a_failure_of_the_joint_pass_alone_is_a_warning_not_an_error(monkeypatch
     assert result.exit_code == 0, result.output
     assert f"albot1 warm-up: warning: {joint}\n" in result.output
     assert "every preset ready in" in result.output
+
+
+def test_the_help_names_every_method_warmed_up_by_default(warmed: list[list[str]]) -> None:
+    """`albot1 warm-up --help` said "every preset of albot1 and albot1-places" while gtsam-graph was warmed too."""
+    runner.invoke(app, ["warm-up"])
+    help_text = " ".join(runner.invoke(app, ["warm-up", "--help"], terminal_width=400).output.split())
+    for name in warmed[0]:
+        assert f"{name}," in help_text or f"{name} " in help_text, name
+    assert "gtsam-graph" in help_text
