@@ -53,6 +53,10 @@ class GtsamGraphConfig(MethodConfig):
     track_velocity_guess: bool = Field(
         description="also try the last tracked motion as the guess when it disagrees with the odometry increment"
     )
+    track_velocity_only_after_stall: bool = Field(
+        description="try the velocity guess only when this scan's or the previous scan's odometry increment is "
+        "exactly zero (a repeated odometry reading: a stall or its catch-up step)"
+    )
     track_velocity_max_shift: bool = Field(
         description="a velocity match may replace a passing odometry match only within the tracker's translation "
         "gate of the odometry guess (velocity_slide.py)"

@@ -28,7 +28,7 @@ from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.earned_choice import EarnedFactors
-from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, velocity_match_allowed
+from albot1.methods.baselines.gtsam_graph.gating import CorrectionScale, odometry_stalled, velocity_match_allowed
 from albot1.methods.baselines.gtsam_graph.match_covariance import floor_covariance, shaped_covariance
 from albot1.methods.baselines.gtsam_graph.odometry_runs import OdometryRuns
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, OdometryFactors, OdometryTrust
@@ -73,6 +73,9 @@ class FrontEnd:
         # unknown, not zero (edmonton-corrected[::3] moves 3 m between its first scans, and a "standing still"
         # guess matched a corridor 3 m short and won because the odometry guess's match failed).
         self._velocity: FloatArray | None = None
+        # The previous scan's odometry increment (``track_velocity_only_after_stall``: a repeat there makes this scan
+        # a catch-up step); None before the second scan.
+        self._previous_increment: FloatArray | None = None
         self._corrections = CorrectionScale(
             config.track_outlier_window, config.match_sigma_floor_xy_m, config.match_sigma_floor_theta_deg
         )
@@ -131,6 +134,7 @@ class FrontEnd:
         increment = se2.between(self.last_odometry, odometry)
         guess = se2.compose(self.track, increment)
         reg = self.follow(guess, increment, points)
+        self._previous_increment = increment
         pose = guess if reg is None else reg.pose
         if self.config.track_scans and (reg is not None or self._velocity is not None):
             self._velocity = se2.between(self.track, pose)
@@ -151,7 +155,10 @@ class FrontEnd:
         repeats its odometry on 87 scans and then jumps by up to 0.95 m; the
         tracked motion already holds what it missed), so when the odometry
         guess and the constant-velocity guess (the last tracked motion)
-        disagree, both are tried and the better fit wins.
+        disagree, both are tried and the better fit wins; with
+        ``track_velocity_only_after_stall`` only where this scan's or the
+        previous scan's odometry increment is exactly zero
+        (:func:`.gating.odometry_stalled`).
 
         How far the guess may be trusted depends on how much odometry it
         holds: a scan period of a few centimetres gets the tight ``track_*``
@@ -171,6 +178,7 @@ class FrontEnd:
         if (
             cfg.track_velocity_guess
             and self._velocity is not None
+            and (not cfg.track_velocity_only_after_stall or odometry_stalled(increment, self._previous_increment))
             and (math.hypot(gap[0], gap[1]) > limits[1] / 2 or abs(gap[2]) > math.radians(limits[2] / 2))
         ):
             alt, alt_good, _ = self.attempt(target, points, coasting, *limits)

@@ -31,6 +31,22 @@ from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 
 
+def odometry_stalled(increment: FloatArray, previous_increment: FloatArray | None) -> bool:
+    """Whether this scan's or the previous scan's odometry increment is exactly zero (a repeated reading).
+
+    A stalled odometry repeats its last reading, so the increment is exactly
+    (0, 0, 0), not merely small (a robot standing still with wheel odometry
+    still reads noise). During the stall the velocity guess holds the motion
+    the odometry missed; at the catch-up step (the first increment after a
+    repeat) the odometry guess, applied to a tracked pose that already moved,
+    overshoots. With a moving odometry there is nothing for the tracked
+    velocity to recover: on logs with scans dropped its guess lies metres
+    short of a right odometry guess (docs/baselines.md, gtsam-graph, "an
+    outsider's sweep").
+    """
+    return not increment.any() or (previous_increment is not None and not previous_increment.any())
+
+
 def turn_agrees(pose: FloatArray, odometry_guess: FloatArray, max_turn_deg: float) -> bool:
     """Whether ``pose`` turns ``odometry_guess`` by at most ``max_turn_deg`` (both in the same frame)."""
     return abs(float(se2.between(odometry_guess, pose)[2])) <= math.radians(max_turn_deg)
