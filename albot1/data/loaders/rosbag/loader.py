@@ -27,7 +27,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
@@ -46,6 +46,9 @@ from albot1.data.loaders.rosbag.msg import PoseTrack, laserscan_problem, reading
 from albot1.data.loaders.rosbag.reader import header_stamp, odometry_track, opened_bag, tf_track, topic_messages
 from albot1.data.loaders.rosbag.topics import LASER_SCAN, TopicChoice, TopicInfo, choose_topics, normalize_type
 from albot1.data.model import Frame, Scan, Sequence, SequenceMetadata
+
+if TYPE_CHECKING:
+    from rosbags.highlevel import AnyReader
 
 log = logging.getLogger(__name__)
 
@@ -78,14 +81,14 @@ class _BagSource:
         self._tracks: tuple[PoseTrack, PoseTrack | None] | None = None
         self._seam_said = False
 
-    def tracks(self) -> tuple[PoseTrack, PoseTrack | None]:
+    def tracks(self, reader: AnyReader) -> tuple[PoseTrack, PoseTrack | None]:
+        """The odometry and reference tracks, read from ``reader`` (the pass's open bag) on the first pass only."""
         if self._tracks is None:
-            with opened_bag(self.bag, self.shown) as reader:
-                if self.choice.odom_is_tf:
-                    odom = tf_track(reader, self.choice.odom, self.odom_frame, self.base_frame, self.shown)
-                else:
-                    odom = odometry_track(reader, self.choice.odom, self.shown)
-                ref = odometry_track(reader, self.choice.reference, self.shown) if self.choice.reference else None
+            if self.choice.odom_is_tf:
+                odom = tf_track(reader, self.choice.odom, self.odom_frame, self.base_frame, self.shown)
+            else:
+                odom = odometry_track(reader, self.choice.odom, self.shown)
+            ref = odometry_track(reader, self.choice.reference, self.shown) if self.choice.reference else None
             self._tracks = (odom, ref)
         return self._tracks
 
@@ -105,11 +108,13 @@ class _BagSource:
             raise ParseError(self.shown, f"topic {self.choice.scan}: {problem}", index=index)
 
     def frames(self) -> Iterator[Frame]:
-        odom, ref = self.tracks()
+        """One pass over the scans; the bag is opened once for it (opening parses its index: most of a small
+        bag's load), and the pose tracks are read in that same opening on the first pass."""
         topic = self.choice.scan
         out, dropped, last = 0, 0, -math.inf
         first_frame: str | None = None
         with opened_bag(self.bag, self.shown) as reader:
+            odom, ref = self.tracks(reader)
             for i, msg in topic_messages(reader, topic, self.shown):
                 t = header_stamp(msg)
                 frame_id = str(msg.header.frame_id).lstrip("/")
@@ -193,19 +198,21 @@ def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
 
 def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict[str, Any]) -> Sequence:
     opts = _options(options, shown)
+    # One opening for the topics and the laser's mount: opening parses the bag's index (a ROS2 bag's
+    # metadata.yaml), most of what loading a small bag costs; the scans' passes open it again, once each.
     with opened_bag(bag, shown) as reader:
         topics = {
             name_: TopicInfo(normalize_type(info.msgtype or "?"), int(info.msgcount))
             for name_, info in reader.topics.items()
         }
-    choice = choose_topics(shown, topics, opts["scan_topic"], opts["odom_topic"], opts["reference_topic"])
-    for topic, role in ((choice.scan, "scans"), (choice.odom, "odometry"), (choice.reference, "reference poses")):
-        if topic is not None and topics[topic].count == 0:
-            raise TopicError(f"{shown}: topic {topic} ({role}) has no messages; expected at least one")
+        choice = choose_topics(shown, topics, opts["scan_topic"], opts["odom_topic"], opts["reference_topic"])
+        for topic, role in ((choice.scan, "scans"), (choice.odom, "odometry"), (choice.reference, "reference poses")):
+            if topic is not None and topics[topic].count == 0:
+                raise TopicError(f"{shown}: topic {topic} ({role}) has no messages; expected at least one")
+        mounting = bag_mounting(reader, shown, topics, choice, opts["base_frame"], opts["odom_frame"])
     source = _BagSource(
         bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"], opts["max_pose_gap"]
     )
-    mounting = bag_mounting(bag, shown, topics, choice, opts["base_frame"], opts["odom_frame"])
     odom_desc = (
         f"{choice.odom} transforms {opts['odom_frame']} -> {opts['base_frame'] or '(its only child)'}"
         if choice.odom_is_tf

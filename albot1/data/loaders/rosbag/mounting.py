@@ -35,7 +35,7 @@ import numpy as np
 
 from albot1.data.errors import DataError, ParseError
 from albot1.data.loaders.rosbag.msg import quaternion_problem
-from albot1.data.loaders.rosbag.reader import opened_bag, topic_messages
+from albot1.data.loaders.rosbag.reader import topic_messages
 from albot1.data.loaders.rosbag.topics import TF_MESSAGE, TopicChoice, TopicInfo
 
 if TYPE_CHECKING:
@@ -201,7 +201,7 @@ def read_mounting(
 
 
 def bag_mounting(
-    bag: Path,
+    reader: AnyReader,
     shown: Path,
     topics: Mapping[str, TopicInfo],
     choice: TopicChoice,
@@ -211,16 +211,16 @@ def bag_mounting(
     """:func:`read_mounting` for a bag with chosen topics; the base frame defaults to the frame odometry moves
     (an Odometry topic's child frame, or the child of ``odom_frame`` on ``/tf``).
 
+    ``reader`` is the bag opened by the caller, which read its topics from it (one opening, not two).
     A missing mount is logged as a warning (and the caller records the note in the sequence metadata).
     """
-    with opened_bag(bag, shown) as reader:
-        if base_frame is None:
-            base_frame = (
-                tf_child_frame(reader, choice.odom, odom_frame, shown)
-                if choice.odom_is_tf
-                else odometry_child_frame(reader, choice.odom, shown)
-            )
-        mounting = read_mounting(reader, topics, choice.scan, base_frame, odom_frame, shown)
+    if base_frame is None:
+        base_frame = (
+            tf_child_frame(reader, choice.odom, odom_frame, shown)
+            if choice.odom_is_tf
+            else odometry_child_frame(reader, choice.odom, shown)
+        )
+    mounting = read_mounting(reader, topics, choice.scan, base_frame, odom_frame, shown)
     if not mounting.found:
         log.warning("%s: %s", shown, mounting.note)
     return mounting

@@ -308,3 +308,33 @@ def test_not_a_bag(tmp_path: Path) -> None:
         Ros1BagLoader().load(tmp_path / "trunc.bag")
     with pytest.raises(DataError, match="not a ROS2 bag"):
         Ros2BagLoader().load(tmp_path)
+
+
+@pytest.mark.parametrize("fmt", list(WRITERS))
+def test_a_load_opens_the_bag_once_and_each_pass_over_its_scans_once_more(
+    tmp_path: Path, fmt: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Opening a bag parses its index (a ROS2 bag's ``metadata.yaml`` too): most of what loading a small bag costs.
+
+    So the topics and the laser's mount are read in one opening, and a pass reads the pose tracks (first pass
+    only) and streams the scans in one more; four openings per load before (docs/benchmarking.md, "Session 23").
+    """
+    from rosbags.highlevel import AnyReader
+
+    writer, loader, name = WRITERS[fmt]
+    seq = synthetic(n=8)
+    writer().write(seq, tmp_path / name)
+    opened: list[int] = []
+    real_open = AnyReader.open
+
+    def counted(self: AnyReader) -> None:
+        opened.append(1)
+        real_open(self)
+
+    monkeypatch.setattr(AnyReader, "open", counted)
+    loaded = loader().load(tmp_path / name)
+    assert len(opened) == 1
+    assert_same(seq, loaded)  # one pass: the tracks and the scans from one opening
+    assert len(opened) == 2
+    assert len(list(loaded.frames())) == len(seq)  # a second pass: one more (the tracks were kept)
+    assert len(opened) == 3
