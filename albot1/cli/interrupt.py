@@ -99,11 +99,12 @@ def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
     forkserver each get SIGINT and stop, and the runner says "interrupted";
     here the runner hands SIGINT on to every descendant it has and stops its
     own work by the same KeyboardInterrupt, so SIGTERM takes the path Ctrl-C
-    takes (the command says which signal it was). The previous handler is back after the first
-    SIGTERM, so a second one ends the process at once, as usual. A process
-    that ignores SIGINT (all of them when the command was started in the
-    background of a script, ``cmd &``, which starts it with SIGINT ignored)
-    gets the SIGTERM instead, rather than the runner waiting for it forever.
+    takes (the command says which signal it was). The previous handler is
+    back after the first SIGTERM, so a second one ends the process at once,
+    as usual. A command started with SIGINT ignored (in the background of a
+    script, ``cmd &``) started everything under it so too: there the
+    descendants get the SIGTERM itself, rather than the runner waiting for
+    cells that ignore the SIGINT.
 
     Used inside :func:`noting_interrupts`. Nothing changes outside the main
     thread or when SIGTERM is not at its default action (a host program's
@@ -113,6 +114,7 @@ def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
     if threading.current_thread() is not threading.main_thread() or before is not signal.SIG_DFL:
         yield noted
         return
+    handed_on = signal.SIGTERM if signal.getsignal(signal.SIGINT) is signal.SIG_IGN else signal.SIGINT
 
     def terminate(signum: int, frame: FrameType | None) -> None:
         signal.signal(signal.SIGTERM, before)
@@ -123,7 +125,7 @@ def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
             descendants = []
         for process in descendants:
             try:
-                process.send_signal(signal.SIGTERM if _ignores_sigint(process.pid) else signal.SIGINT)
+                process.send_signal(handed_on)
             except psutil.Error:
                 continue  # it ended meanwhile
         signal.default_int_handler(signal.SIGINT, frame)
@@ -133,15 +135,3 @@ def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
         yield noted
     finally:
         signal.signal(signal.SIGTERM, before)
-
-
-def _ignores_sigint(pid: int) -> bool:
-    """Whether process ``pid`` ignores SIGINT (``SigIgn`` of ``/proc/PID/status``); False where unknown."""
-    try:
-        with open(f"/proc/{pid}/status", "rb") as status:
-            for line in status:
-                if line.startswith(b"SigIgn:"):
-                    return bool(int(line.split()[1], 16) >> (signal.SIGINT - 1) & 1)
-    except (OSError, ValueError, IndexError):
-        pass
-    return False

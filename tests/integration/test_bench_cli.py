@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -358,7 +359,9 @@ def test_sigterm_to_the_runner_alone_stops_the_grid_as_ctrl_c_does_and_says_so(t
     """``kill PID`` / ``timeout`` / a batch scheduler: one line and exit 143, the cells stopped as by Ctrl-C.
 
     SIGTERM reaches the runner only (not its process group, as Ctrl-C would): it used to die at once with exit
-    143 and no word. As after Ctrl-C, the stopped cell has no result and no failure record: it runs again.
+    143 and no word. As after Ctrl-C, the stopped cell has no result; whether its supervising thread recorded
+    why it stopped before the runner exited is a race (no record, "interrupted", or "executor" when the
+    forkserver went first): each is a cell the next run does again.
     """
     suite = tmp_path / "hangs.toml"
     suite.write_text(
@@ -396,4 +399,6 @@ def test_sigterm_to_the_runner_alone_stops_the_grid_as_ctrl_c_does_and_says_so(t
     _, alive = psutil.wait_procs(descendants, timeout=30)
     assert alive == [], f"the forkserver or the cell went on after SIGTERM: {alive}"
     (run_dir,) = (tmp_path / "results").glob("hangs/runs/*")
-    assert not (run_dir / "DONE").exists() and not (run_dir / "FAILED.json").exists()
+    assert not (run_dir / "DONE").exists()
+    if (run_dir / "FAILED.json").exists():  # a kind the next run does again (only "exception" may be kept)
+        assert json.loads((run_dir / "FAILED.json").read_text())["kind"] in ("interrupted", "executor")
