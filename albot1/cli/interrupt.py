@@ -92,8 +92,9 @@ def noting_interrupts(noted: Interrupts | None = None) -> Iterator[Interrupts]:
 def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
     """SIGTERM stops the command as Ctrl-C does: its child processes get SIGINT, the main thread KeyboardInterrupt.
 
-    Why: ``kill PID``, ``timeout`` and batch schedulers stop a program with
-    SIGTERM sent to it alone. ``albot1 bench`` then died at once with exit
+    Why: ``kill PID`` and batch schedulers stop a program with SIGTERM sent
+    to it alone (GNU ``timeout`` sends it to its whole group as well, which
+    this handles too: the cells then get both). ``albot1 bench`` then died at once with exit
     143 and no word, a script could not tell it from a crash. Ctrl-C
     reaches the whole process group, so the runner's cells and its
     forkserver each get SIGINT and stop, and the runner says "interrupted";

@@ -355,8 +355,12 @@ def test_ctrl_c_on_a_local_dask_cluster_prints_only_the_interrupted_line(tmp_pat
 
 
 @pytest.mark.usefixtures("fault_plugin")
-def test_sigterm_to_the_runner_alone_stops_the_grid_as_ctrl_c_does_and_says_so(tmp_path: Path) -> None:
+@pytest.mark.parametrize("to_group", [False, True], ids=["runner-alone", "then-its-group"])
+def test_sigterm_to_the_runner_alone_stops_the_grid_as_ctrl_c_does_and_says_so(tmp_path: Path, to_group: bool) -> None:
     """``kill PID`` / ``timeout`` / a batch scheduler: one line and exit 143, the cells stopped as by Ctrl-C.
+
+    ``then-its-group``: GNU ``timeout`` (without ``--foreground``) signals the runner and then its whole process
+    group, so the forkserver and the cell get SIGTERM themselves as well.
 
     SIGTERM reaches the runner only (not its process group, as Ctrl-C would): it used to die at once with exit
     143 and no word. As after Ctrl-C, the stopped cell has no result; whether its supervising thread recorded
@@ -387,6 +391,8 @@ def test_sigterm_to_the_runner_alone_stops_the_grid_as_ctrl_c_does_and_says_so(t
         time.sleep(2.0)  # the cell process has started and hangs in its method
         descendants = psutil.Process(runner.pid).children(recursive=True)
         runner.send_signal(signal.SIGTERM)
+        if to_group:
+            os.killpg(runner.pid, signal.SIGTERM)
         _, stderr = runner.communicate(timeout=120)
     finally:
         if runner.poll() is None:

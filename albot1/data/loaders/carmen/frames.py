@@ -143,9 +143,9 @@ class _FrameIterator:
             self.first_scan_line = min(line for line, _, _ in rows)
         for line, name, value in params:
             # before the first scan a PARAM block may restate a value (the last one counts); after it, the mount
-            # the scans were placed with must not change
-            if self.first_scan_line is not None and line > self.first_scan_line:
-                problem = geom.mount_change_problem(self.params, name, value, rear=rear)
+            # the scans were placed with must not change (unless the lines state it: each is checked above)
+            if not self.s.check_mount and self.first_scan_line is not None and line > self.first_scan_line:
+                problem = geom.mount_change_problem(self.params, name, value, self.s.mount, rear=rear)
                 if problem is not None:
                     raise ParseError(self.path, problem, line=line)
             self.params[name] = value

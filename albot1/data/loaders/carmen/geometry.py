@@ -175,24 +175,35 @@ def states_mount(params: dict[str, str], rear: bool = False) -> bool:
     return any(name in params for name in mount_params(rear))
 
 
-def mount_change_problem(params: dict[str, str], name: str, value: str, rear: bool = False) -> str | None:
-    """Why a PARAM line restating the laser's mount with another value cannot be read (None if it can).
+def mount_change_problem(
+    params: dict[str, str], name: str, value: str, mount: tuple[float, float, float], rear: bool = False
+) -> str | None:
+    """Why a PARAM line after the first scan that moves the laser off ``mount`` cannot be read (None if it can).
 
-    A sequence has one ``sensor_offset``; a log whose mount PARAM changes part
-    way (two recordings joined, a parameter changed while logging) would have
-    every scan on one side of the change placed with the other side's mount.
-    ``params`` holds the values in effect before this line; a value equal to
-    the one in effect (a logger repeating its parameters) is no change. The
-    caller asks only for PARAM lines after the first scan: a PARAM block before
-    it may restate a name (belgioioso-corrected: 0.0, then -0.04), the last
-    value counting.
+    A sequence has one ``sensor_offset`` (``mount``, what the loader placed
+    every scan with); a log whose mount PARAM changes part way (two
+    recordings joined, a parameter changed while logging) would have every
+    scan on one side of the change placed with the other side's mount.
+    ``params`` holds the values in effect before this line. The line is
+    compared with the mount it implies, not with the previous value: a
+    logger repeating its parameters is no change, and a part first stated
+    after the log's head (which the loader read the mount from) is one when
+    it differs from the 0 the loader took for it. The caller asks only for
+    PARAM lines after the first scan: a PARAM block before it may restate a
+    name (belgioioso-corrected: 0.0, then -0.04), the last value counting.
     """
-    if name not in mount_params(rear) or name not in params or float(params[name]) == float(value):
+    if name not in mount_params(rear):
         return None
+    implied = sensor_offset({**params, name: value}, rear=rear)
+    if implied == mount:
+        return None
+    before = f"from {params[name]}" if name in params else "(not stated before it: 0)"
+    shown, used = (", ".join(f"{v:.6g}" for v in pose) for pose in (implied, mount))
     return (
-        f"PARAM {name} changes from {params[name]} to {value}; expected one laser mount for the whole log (a "
-        f"sequence has one sensor_offset, so the scans on one side of this line would be placed with the other "
-        f"side's mount): split the log at this line and load each part"
+        f"PARAM {name} changes {before} to {value}; expected one laser mount for the whole log: it puts the laser "
+        f"at ({shown}) (x m, y m, yaw rad) on the robot, the scans were placed with ({used}) (a sequence has one "
+        f"sensor_offset, so the scans on one side of this line would be placed with the other side's mount): split "
+        f"the log at this line and load each part"
     )
 
 

@@ -107,3 +107,16 @@ def test_a_mount_param_restated_before_the_first_scan_takes_its_last_value(tmp_p
     lines = ["PARAM robot_frontlaser_offset 0.0 nohost 0", "PARAM robot_frontlaser_offset -0.04 nohost 0"]
     seq = load(str(_write(tmp_path, [*lines, _flaser(0), _flaser(1)])))
     assert len(list(seq.frames())) == 2 and seq.metadata.sensor_offset == (-0.04, 0.0, 0.0)
+
+
+def test_a_mount_param_first_stated_after_the_logs_head_is_refused_as_a_change(tmp_path: Path) -> None:
+    """The loader takes the mount from the log's head (the PARAMs up to the chunk of the first scan); a
+    robot_frontlaser_offset first stated past it used to be taken silently: every scan placed at (0, 0, 0), while
+    the log says 0.3 from there on. The same lines in a short log give the mount 0.3; past the head it is refused."""
+    before = [_flaser(k) for k in range(40_000)]  # 2.8 MB: past the 256 KiB head and the first 2 MiB chunk
+    path = _write(tmp_path, [*before, "PARAM robot_frontlaser_offset 0.3 0 host 0", _flaser(40_000)])
+    expected = r"log.clf:40001: PARAM robot_frontlaser_offset changes \(not stated before it: 0\) to 0.3; expected"
+    with pytest.raises(ParseError, match=expected):
+        list(load(str(path)).frames())
+    short = load(str(_write(tmp_path, [_flaser(0), "PARAM robot_frontlaser_offset 0.3 0 host 0", _flaser(1)], "s.clf")))
+    assert len(list(short.frames())) == 2 and short.metadata.sensor_offset == (0.3, 0.0, 0.0)
