@@ -20,36 +20,23 @@ ON_PUBLIC_LOGS = [
 ]
 
 
+def _collected(*arguments: str) -> str:
+    """The node ids ``pytest --collect-only -q ARGUMENTS`` lists, as its text."""
+    return subprocess.run(
+        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", *arguments],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    ).stdout
+
+
 @pytest.mark.slow
 def test_the_fast_lane_s_selection_leaves_out_the_tests_on_public_logs() -> None:
     files = sorted({nodeid.split("::")[0] for nodeid in ON_PUBLIC_LOGS})
-    collected = subprocess.run(
-        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", *files],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=True,
-    ).stdout
-    fast = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "pytest",
-            "--collect-only",
-            "-q",
-            "-p",
-            "no:cacheprovider",
-            "-m",
-            "not slow and not integration",
-            *files,
-        ],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=True,
-    ).stdout
+    collected = _collected(*files)
+    fast = _collected("-m", "not slow and not integration", *files)
     for nodeid in ON_PUBLIC_LOGS:
         assert nodeid in collected, nodeid  # the test exists ...
         assert nodeid not in fast, nodeid  # ... and the fast lane does not run it
