@@ -82,11 +82,14 @@ test-end-to-end: $(STAMP)
 test-all: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST)
 
-# The edit-test loop (285 CPU-s for 2,978 tests in 2026-11: about 2.5 min at best on 2 cores; README.md): unit and
-# property tests without the slow ones (marked `slow`: over about 1.5 s each) and without the public logs (marked
-# `integration`; conftest.py marks every test that takes `data_file`). `make test-all` runs them all.
+# The edit-test loop (docs/benchmarking.md, "Session 23, test-fast"): unit and property tests without the slow ones
+# and without the public logs (marked `integration`; conftest.py marks every test that takes `data_file`). Slow is
+# measured: conftest.py marks `slow` every test tests/durations.json lists (1 s or more in the recorded run) besides
+# the hand-set marks, so new tests start in the lane. The hypothesis profile `fast` (conftest.py) keeps every
+# property test but runs each with at most 10 examples. `make test` and CI run every one of these tests with its
+# own example count; `make test-all` runs them all.
 test-fast: $(STAMP)
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not slow and not integration" tests/unit tests/property
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not slow and not integration" --hypothesis-profile=fast tests/unit tests/property
 
 # The suites' grids run one after the other; each suite's report starts as soon as its own grid has ended (it
 # runs beside the next grid), the results page as soon as results/default and results/thesis are final

@@ -12,6 +12,7 @@ the derived list against the manifests folder and the datasets README.
 
 from __future__ import annotations
 
+import functools
 import gc
 import importlib
 import json
@@ -22,8 +23,10 @@ import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pytest
+from hypothesis import settings
 
 from albot1.data import catalog
 from albot1.methods.plugins import ENTRY_POINT_GROUP
@@ -244,15 +247,54 @@ def schedule_units(
     return sorted(units, key=lambda unit: -unit.seconds)
 
 
+# -- the edit-test loop (`make test-fast`): chosen by measured cost, property tests with fewer examples ----------
+
+#: A test that tests/durations.json lists at this many seconds or more is marked ``slow``, so ``make test-fast``
+#: (``-m "not slow ..."``) leaves it to ``make test``. The file holds every test that took ``RECORD_MIN_S`` or more
+#: in a recorded run, so the bound is that: a test it does not list (quicker, or new since the file was
+#: recorded) stays in the lane until a refreshed file lists it. Measured: docs/benchmarking.md, "Session 23, test-fast".
+FAST_MAX_S = RECORD_MIN_S
+#: The hypothesis profile ``make test-fast`` loads (``--hypothesis-profile=fast``): every property test runs, each
+#: with at most this many examples (its own ``@settings(max_examples=...)`` is capped, since a decorator's value
+#: wins over any profile's). ``make test`` and CI run the default profile: every test's own count.
+FAST_PROFILE = "fast"
+FAST_MAX_EXAMPLES = 10
+settings.register_profile(FAST_PROFILE, max_examples=FAST_MAX_EXAMPLES)
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_itemcollected(item: pytest.Item) -> None:
-    """A test that takes ``data_file`` reads the public logs: it is marked ``integration`` like the tests there.
+    """Markers from what a test reads and what it costs, before ``-m`` selects; fewer examples in the fast profile.
 
-    Why: ``make test-fast`` promises "without the public logs" by deselecting that marker (``-m "not integration"``),
-    but a unit test that asks for a public log through the fixture was kept (and read it) unless its module said so.
+    A test that takes ``data_file`` reads the public logs: it is marked ``integration`` like the tests there
+    (``make test-fast`` promises "without the public logs" by deselecting that marker, but a unit test that asked
+    for a public log through the fixture was kept unless its module said so). A test the durations file lists at
+    ``FAST_MAX_S`` or more is marked ``slow`` (:data:`FAST_MAX_S`): the lane is chosen by measured cost, not by
+    hand-set marks alone, so a test that grew slow leaves it at the next refresh of the file. Under the ``fast``
+    hypothesis profile a property test is kept whatever its recorded seconds (they were for its own example count)
+    and runs at most ``FAST_MAX_EXAMPLES`` examples.
     """
     if "data_file" in getattr(item, "fixturenames", ()):
         item.add_marker(pytest.mark.integration)
+    test = _hypothesis_test(item)
+    if test is not None and settings.get_current_profile_name() == FAST_PROFILE:
+        _cap_examples(test, FAST_MAX_EXAMPLES)  # its recorded seconds were for its own count: not this lane's cost
+    elif _durations().get(item.nodeid, 0.0) >= FAST_MAX_S:
+        item.add_marker(pytest.mark.slow)
+
+
+def _hypothesis_test(item: pytest.Item) -> Any:
+    """The function hypothesis's ``@given`` made of ``item``'s test (a method's function), or None."""
+    test = getattr(item, "obj", None)
+    test = getattr(test, "__func__", test)  # a method's function: the settings live on it
+    return test if getattr(test, "is_hypothesis_test", False) else None
+
+
+def _cap_examples(test: Any, most: int) -> None:
+    """Run a ``@given`` test with at most ``most`` examples: the settings it reads each time it is called."""
+    own = getattr(test, "_hypothesis_internal_use_settings", None)
+    if isinstance(own, settings) and own.max_examples > most:
+        test._hypothesis_internal_use_settings = settings(own, max_examples=most)
 
 
 @pytest.hookimpl(trylast=True)
@@ -288,7 +330,9 @@ def _shares_state(item: pytest.Item) -> bool:
     return any(d.scope in ("module", "class") for defs in definitions.values() for d in defs)
 
 
+@functools.cache
 def _durations() -> dict[str, float]:
+    """The durations file's seconds by node id, read once per process (every collected test looks itself up)."""
     try:
         values = json.loads(DURATIONS_FILE.read_text())
     except (OSError, ValueError):
