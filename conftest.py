@@ -16,6 +16,7 @@ import functools
 import gc
 import importlib
 import json
+import math
 import os
 import shutil
 import signal
@@ -240,7 +241,7 @@ def schedule_units(
         Unit(
             name,
             tuple(n for n, _ in (group if name in ordered else sorted(group, key=lambda test: -test[1]))),
-            sum(s for _, s in group),
+            math.fsum(s for _, s in group),  # exactly rounded: the same whatever the order (a test re-derives it)
         )
         for name, group in grouped.items()
     ]

@@ -99,3 +99,16 @@ def test_the_root_conftest_is_the_only_one() -> None:
     found = sorted(str(p.relative_to(root)) for p in (root / "tests").rglob("conftest.py"))
     found += sorted(str(p.relative_to(root)) for p in (root / "benchmarks").rglob("conftest.py"))
     assert found == [], found
+
+
+def test_a_module_s_estimate_does_not_depend_on_the_order_of_its_tests() -> None:
+    """1.1 + 1.5 + 1.2 is 3.8000000000000003 in collection order and 3.8 longest first: a tie with a 3.8 module flipped.
+
+    The session's order is worked out from the collection order, and the check of it above from the reordered
+    items (each module longest test first): a float sum made the two disagree (seen in a full `make test`).
+    """
+    durations = {"a.py::t1": 1.1, "a.py::t2": 1.5, "a.py::t3": 1.2, "b.py::t": 3.8}
+    tests = [(n, n.split("::")[0], False, False) for n in ("b.py::t", "a.py::t1", "a.py::t2", "a.py::t3")]
+    units = schedule_units(tests, durations)
+    reordered = [(n, u.name, False, False) for u in units for n in u.nodeids]
+    assert [u.name for u in schedule_units(reordered, durations)] == [u.name for u in units] == ["b.py", "a.py"]
