@@ -104,6 +104,12 @@ def default_geometry(beams: int) -> tuple[float, float]:
     return -math.pi / 2, math.pi / max(beams - 1, 1)
 
 
+def mount_params(rear: bool = False) -> tuple[str, str, str]:
+    """The PARAM names that state the front (or rear) laser's mount: its offset, side and angular parts."""
+    which = "rear" if rear else "front"
+    return f"robot_{which}laser_offset", f"robot_{which}laser_side_offset", f"robot_{which}laser_angular_offset"
+
+
 def _param_rules() -> dict[str, tuple[str, Callable[[float], bool]]]:
     """PARAM names this module interprets -> (what the value must be, its test). Other PARAMs are free text."""
     angle = ("an angle between beams in degrees, > 0 and <= 360", lambda v: 0 < v <= 360)
@@ -113,9 +119,9 @@ def _param_rules() -> dict[str, tuple[str, Callable[[float], bool]]]:
         rules[f"laser_{which}_laser_resolution"] = rules[f"laser_{which}laser_resolution"] = angle
         rules[f"laser_{which}_laser_fov"] = rules[f"laser_{which}laser_fov"] = fov
         rules[f"robot_{which}_laser_max"] = ("a maximum range in metres, > 0", lambda v: v > 0)
-        rules[f"robot_{which}laser_offset"] = ("an offset in metres", lambda v: True)
-        rules[f"robot_{which}laser_side_offset"] = ("an offset in metres", lambda v: True)
-        rules[f"robot_{which}laser_angular_offset"] = ("an angle in radians", lambda v: True)
+        offset, side, angular = mount_params(rear=which == "rear")
+        rules[offset] = rules[side] = ("an offset in metres", lambda v: True)
+        rules[angular] = ("an angle in radians", lambda v: True)
     return rules
 
 
@@ -162,12 +168,6 @@ def param_geometry(beams: int, params: dict[str, str], rear: bool = False) -> Be
         source = "PARAM resolution" if fov is None else "PARAM fov+resolution"
     max_range = _number(params, f"robot_{which}_laser_max")
     return BeamGeometry(start, step, max_range if max_range is not None else DEFAULT_MAX_RANGE, source)
-
-
-def mount_params(rear: bool = False) -> tuple[str, str, str]:
-    """The PARAM names that state the front (or rear) laser's mount: its offset, side and angular parts."""
-    which = "rear" if rear else "front"
-    return f"robot_{which}laser_offset", f"robot_{which}laser_side_offset", f"robot_{which}laser_angular_offset"
 
 
 def states_mount(params: dict[str, str], rear: bool = False) -> bool:
@@ -217,16 +217,7 @@ def sensor_offset(params: dict[str, str], rear: bool = False) -> tuple[float, fl
     angular)``; taken as ``(offset, side, angular)`` every rear scan was placed facing forwards (a map
     mirrored front to back).
     """
-    which = "rear" if rear else "front"
-
-    def get(name: str) -> float:
-        return float(params.get(name, "0"))  # checked by param_problem when parsed
-
-    x, y, theta = (
-        get(f"robot_{which}laser_offset"),
-        get(f"robot_{which}laser_side_offset"),
-        get(f"robot_{which}laser_angular_offset"),
-    )
+    x, y, theta = (float(params.get(name, "0")) for name in mount_params(rear))  # checked by param_problem
     if not rear:
         return x, y, theta
     return 0.0 - x, 0.0 - y, math.remainder(math.pi + theta, 2 * math.pi)

@@ -159,7 +159,8 @@ class CarmenLoader:
         # The values in effect at the first scan (a PARAM block may restate a name, the last value counts), then
         # those first stated after it; a mount PARAM changing after the first scan is refused (frames.py).
         first_scan = int(head.lasers[0].lines[0]) if head.lasers else None
-        params = {name: value for at, name, value in head.params if first_scan is None or at < first_scan}
+        before = {name: value for at, name, value in head.params if first_scan is None or at < first_scan}
+        params = dict(before)
         for _, name, value in head.params:
             params.setdefault(name, value)
         rear = laser in REAR_LASERS
@@ -194,7 +195,6 @@ class CarmenLoader:
             line = int(first.lines[0])
             start = None if first.start is None else float(first.start[0])
             step = None if first.step is None else float(first.step[0])
-            before = {name: value for at, name, value in head.params if at < line}
             for note in geom.first_line_notes(f"{path}:{line}", laser, first.beams, start, step, before):
                 log.warning(note)
         relations = (
