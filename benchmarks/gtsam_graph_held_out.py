@@ -24,6 +24,9 @@ match moved the odometry guess by more than 0.25 m, and which guess's match won 
 "sequential slides"). ``earned_odometry_match`` counts the earned choice's decisions (``odometry_trust_earned_level``;
 docs/baselines.md, gtsam-graph, "the earned choice"). ``odometry_run_factors`` counts the odometry's factors over
 runs of node steps (``odometry_trust_run_nodes``; docs/baselines.md, gtsam-graph, "edges spanning runs of steps").
+``--stamp-jitter F`` adds Gaussian noise of F x the log's median positive scan period to every stamp (seeded by the
+cell's seed; poses, odometry and scans untouched, ATE by scan index, relations dropped): a clock that lies, for
+``track_velocity_time_scaled`` (docs/baselines.md, gtsam-graph, "the velocity guess scaled by elapsed time").
 """
 
 from __future__ import annotations
@@ -34,10 +37,12 @@ import math
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
+from albot1.data.model import Sequence
 from albot1.data.open import open_sequence
 from albot1.geometry import se2
 from albot1.methods.baselines.gtsam_graph import backend, frontend, odometry_trust
@@ -213,14 +218,38 @@ def innovation_table(seen: list[tuple[float, float]]) -> list[dict[str, Any]]:
     return rows
 
 
+def jittered(seq: Sequence, fraction: float, seed: int) -> tuple[Sequence, dict[str, Any]]:
+    """``seq`` with every stamp moved by Gaussian noise of ``fraction`` x its median positive scan period.
+
+    The relations are dropped (they are matched to poses by stamp, so they would score a different pairing).
+    """
+    frames = list(seq.frames())
+    stamps = np.array([f.scan.timestamp for f in frames], dtype=float)
+    steps = np.diff(stamps)
+    period = float(np.median(steps[steps > 0])) if (steps > 0).any() else 0.0
+    noisy = stamps + np.random.default_rng(seed).normal(0.0, fraction * period, len(frames))
+    moved = [replace(f, scan=replace(f.scan, timestamp=float(t))) for f, t in zip(frames, noisy, strict=True)]
+    behind = int((np.diff(noisy) <= 0).sum())
+    info = {"jitter_sigma_s": round(fraction * period, 3), "stamps_not_after_previous": behind}
+    return Sequence.from_frames(seq.name, moved, seq.metadata, None), info
+
+
 def measure(
-    cell: str, overrides: dict[str, Any], innovations: bool = False, edges: bool = False, moves: bool = False
+    cell: str,
+    overrides: dict[str, Any],
+    innovations: bool = False,
+    edges: bool = False,
+    moves: bool = False,
+    stamp_jitter: float = 0.0,
 ) -> dict[str, Any]:
     """Run gtsam-graph on one cell and score it (with ``innovations``: the odometry trust's heading innovations too;
     with ``edges``: the edges' errors against the reference, :func:`edge_table`; with ``moves``: the tracked scans
     whose match moved the odometry guess far, :func:`recorded_moves`)."""
     dataset, degradation, seed = parse_cell(cell)
     seq = open_sequence(dataset).materialize()
+    jitter: dict[str, Any] = {}
+    if stamp_jitter > 0:
+        seq, jitter = jittered(seq, stamp_jitter, seed)
     wall, cpu = time.perf_counter(), time.process_time()
     with recorded_innovations() as seen, recorded_edges() as graph_edges, recorded_moves() as moved:
         result = run_method(
@@ -236,7 +265,9 @@ def measure(
         "place_closures": result.counters.get("place_closures_accepted"),
         "velocity_matches": result.counters.get("tracking_velocity_guess"),
         "slides_refused": result.counters.get("tracking_velocity_slides_refused"),
+        "velocity_time_scaled": result.counters.get("tracking_velocity_time_scaled"),
         "earned_odometry_match": [result.counters.get(f"odometry_earned_{k}", 0) for k in ("odometry", "match")],
+        **jitter,
     }
     if result.reference is not None:
         graph = ate(result.poses, result.reference)["rmse_m"]
@@ -269,11 +300,15 @@ def main() -> None:
     parser.add_argument(
         "--moves", action="store_true", help="also the tracked scans whose match moved the odometry guess > 0.25 m"
     )
+    parser.add_argument(
+        "--stamp-jitter", type=float, default=0.0, metavar="F", help="stamps moved by F x the median scan period"
+    )
     parser.add_argument("cells", nargs="+")
     args = parser.parse_args()
     overrides = {key: _value(value) for key, _, value in (s.partition("=") for s in args.settings)}
     for cell in args.cells:
-        print(json.dumps(measure(cell, overrides, args.innovations, args.edges, args.moves)), flush=True)
+        row = measure(cell, overrides, args.innovations, args.edges, args.moves, args.stamp_jitter)
+        print(json.dumps(row), flush=True)
 
 
 if __name__ == "__main__":

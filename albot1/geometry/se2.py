@@ -228,6 +228,32 @@ def integrate_steps(start: ArrayLike, steps: ArrayLike) -> FloatArray:
     return np.column_stack([x, y, wrap(heading)])
 
 
+def scale_motion(increment: ArrayLike, ratio: float) -> FloatArray:
+    """The increment's constant twist followed for ``ratio`` times as long: ``exp(ratio * log(increment))``.
+
+    A constant-velocity model that meets a different time step scales the
+    motion in the Lie algebra, not the pose's components: a turning robot
+    moves along an arc, so twice the time is ``increment * increment`` (the
+    heading doubles and the translation bends with it), half of it is the
+    increment's square root. In complex form the translation ``t`` becomes
+    ``t * (exp(i r theta) - 1) / (exp(i theta) - 1)``, written with half-angle
+    sines so that small turns lose no digits; a straight increment
+    (``theta == 0``) scales its translation by ``ratio``. The heading is the
+    wrapped increment's, so an increment turning by half a turn or more is
+    read as the shorter turn the other way. ``ratio == 1`` returns the
+    increment's values unchanged (no rounding).
+    """
+    x, y, theta = (float(v) for v in as_poses(increment).reshape(3))
+    if ratio == 1.0:
+        return np.array([x, y, theta])
+    if theta == 0.0:
+        return np.array([ratio * x, ratio * y, 0.0])
+    gain = math.sin(0.5 * ratio * theta) / math.sin(0.5 * theta)
+    turn = 0.5 * (ratio - 1.0) * theta
+    c, s = math.cos(turn), math.sin(turn)
+    return np.array([gain * (c * x - s * y), gain * (s * x + c * y), wrap_angle(ratio * theta)])
+
+
 def unwrap_headings(poses: ArrayLike) -> FloatArray:
     """A copy of a trajectory ``(N, 3)`` with its headings unwrapped (continuous, no 2 pi jumps).
 

@@ -109,3 +109,27 @@ def test_single_poses_take_the_fast_path_with_the_batch_s_bits(monkeypatch: pyte
         single = np.array([fn(p, q) for p, q in zip(a, b, strict=True)])
         assert single.dtype == np.float64 and single.shape == (n, 3)
         assert single.tobytes() == batch[name].tobytes(), name
+
+
+def test_scale_motion_follows_the_increment_s_arc_for_a_multiple_of_its_time() -> None:
+    quarter = np.array([1.0, 0.0, math.pi / 2])
+    # twice the time: the increment twice (the heading a half turn, wrapped to -pi)
+    assert np.allclose(se2.scale_motion(quarter, 2.0), [1.0, 1.0, -math.pi], atol=1e-15)
+    # half the time: half the arc, whose square is the increment again
+    half = se2.scale_motion(quarter, 0.5)
+    assert np.allclose(half, [0.5, -(math.sqrt(2.0) - 1.0) / 2.0, math.pi / 4], atol=1e-15)
+    assert np.allclose(se2.compose(half, half), quarter, atol=1e-15)
+    step = np.array([0.3, -0.1, 0.2])
+    assert np.allclose(se2.scale_motion(step, 3.0), se2.compose(step, se2.compose(step, step)), atol=1e-15)
+    assert np.allclose(se2.scale_motion(step, 3.0), [0.92914704, -0.11368646, 0.6], atol=1e-8)
+    assert np.array_equal(se2.scale_motion(step, 0.0), [0.0, 0.0, 0.0])
+
+
+def test_scale_motion_is_exact_at_ratio_one_and_continuous_through_a_straight_increment() -> None:
+    step = np.array([0.3, -0.1, 0.2])
+    assert se2.scale_motion(step, 1.0).tobytes() == step.tobytes()  # no rounding: the setting's "no change"
+    assert np.array_equal(se2.scale_motion(np.array([0.3, 0.1, 0.0]), 2.5), [0.75, 0.25, 0.0])
+    # a turn of 1e-12 rad scales like the straight step (half-angle sines: no cancellation)
+    assert np.allclose(se2.scale_motion(np.array([0.3, 0.1, 1e-12]), 2.5), [0.75, 0.25, 2.5e-12], atol=1e-14)
+    # a half turn either side of the seam: finite, and twice it is a whole turn
+    assert np.allclose(se2.scale_motion(np.array([0.0, 1.0, -math.pi]), 2.0), [0.0, 0.0, 0.0], atol=1e-15)

@@ -57,6 +57,13 @@ class GtsamGraphConfig(MethodConfig):
         description="try the velocity guess only when this scan's or the previous scan's odometry increment is "
         "exactly zero (a repeated odometry reading: a stall or its catch-up step)"
     )
+    track_velocity_time_scaled: bool = Field(
+        description="the velocity guess follows the last tracked motion's twist for this scan's elapsed time, not for "
+        "one scan: scaled by dt_now / dt_last where both stamp differences are positive (velocity_time.py)"
+    )
+    track_velocity_max_time_ratio: float = Field(
+        ge=1, description="... that ratio clamped to [1 / this, this] (a clock that jumps cannot fling the guess)"
+    )
     track_velocity_max_shift: bool = Field(
         description="a velocity match may replace a passing odometry match only within the tracker's translation "
         "gate of the odometry guess (velocity_slide.py)"
@@ -345,6 +352,11 @@ class GtsamGraphConfig(MethodConfig):
             raise ValueError(
                 "odometry_trust_translation_follows_heading needs odometry_trust_translation = true: without it it "
                 "does nothing"
+            )
+        if self.track_velocity_time_scaled and not (self.track_scans and self.track_velocity_guess):
+            raise ValueError(
+                "track_velocity_time_scaled needs track_scans = true and track_velocity_guess = true: without them "
+                "there is no velocity guess to scale"
             )
         if self.odometry_trust_run_nodes == 1:
             raise ValueError("odometry_trust_run_nodes = 1 would repeat the per-step factors: use 0 (off) or 2 or more")

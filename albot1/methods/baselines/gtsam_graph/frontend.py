@@ -35,6 +35,7 @@ from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor, 
 from albot1.methods.baselines.gtsam_graph.registration import IcpParams, Registration, Target, try_register
 from albot1.methods.baselines.gtsam_graph.span_edges import SpanEdge, span_guess, span_target_nodes
 from albot1.methods.baselines.gtsam_graph.velocity_slide import slide_refused
+from albot1.methods.baselines.gtsam_graph.velocity_time import elapsed, scaled_velocity
 
 
 def preprocess(config: GtsamGraphConfig, scan: Scan, index: int) -> FloatArray:
@@ -73,6 +74,10 @@ class FrontEnd:
         # unknown, not zero (edmonton-corrected[::3] moves 3 m between its first scans, and a "standing still"
         # guess matched a corridor 3 m short and won because the odometry guess's match failed).
         self._velocity: FloatArray | None = None
+        # Seconds the last tracked motion took, and since the previous scan (``track_velocity_time_scaled``; NaN:
+        # unknown).
+        self._velocity_dt = math.nan
+        self._elapsed = math.nan
         # The previous scan's odometry increment (``track_velocity_only_after_stall``: a repeat there makes this scan
         # a catch-up step); None before the second scan.
         self._previous_increment: FloatArray | None = None
@@ -118,19 +123,24 @@ class FrontEnd:
         # Odometry factors judged at the latest node (``odometry_trust_factors``), for the back end to add with it.
         self.odometry_factors: list[OdometryFactor] = []
         self.last_odometry: FloatArray | None = None
+        # The previous scan's timestamp (s), set beside ``last_odometry``.
+        self.last_stamp: float | None = None
         self._consecutive_fallbacks = 0
 
     def new_node(self) -> None:
         """The newest node is where the robot is now: tracking continues from its frame."""
         self.track = np.zeros(3)
 
-    def step(self, odometry: FloatArray, points: FloatArray) -> tuple[FloatArray, Registration | None]:
-        """Track one scan: its pose relative to the newest node, and the passing match.
+    def step(
+        self, odometry: FloatArray, points: FloatArray, stamp: float | None = None
+    ) -> tuple[FloatArray, Registration | None]:
+        """Track one scan (taken at ``stamp`` s): its pose relative to the newest node, and the passing match.
 
         The match is None when tracking is off or failed; the pose is then the
         odometry guess.
         """
         assert self.last_odometry is not None  # the first scan starts the map instead
+        self._elapsed = elapsed(stamp, self.last_stamp)
         increment = se2.between(self.last_odometry, odometry)
         guess = se2.compose(self.track, increment)
         reg = self.follow(guess, increment, points)
@@ -138,7 +148,25 @@ class FrontEnd:
         pose = guess if reg is None else reg.pose
         if self.config.track_scans and (reg is not None or self._velocity is not None):
             self._velocity = se2.between(self.track, pose)
+            self._velocity_dt = self._elapsed
         return pose, reg
+
+    def _coasting_velocity(self) -> FloatArray:
+        """The constant-velocity guess's motion for this scan: the last tracked one, or none yet.
+
+        With ``track_velocity_time_scaled`` it is followed for this scan's
+        elapsed time rather than for one scan (:mod:`.velocity_time`).
+        """
+        if self._velocity is None:
+            return np.zeros(3)
+        if not self.config.track_velocity_time_scaled:
+            return self._velocity
+        scaled = scaled_velocity(
+            self._velocity, self._elapsed, self._velocity_dt, self.config.track_velocity_max_time_ratio
+        )
+        if not np.array_equal(scaled, self._velocity):  # the key appears only in runs that scaled a guess
+            self.counters["tracking_velocity_time_scaled"] = self.counters.get("tracking_velocity_time_scaled", 0) + 1
+        return scaled
 
     def moved_enough(self, relative: FloatArray) -> bool:
         """Whether a pose relative to the newest node is far enough from it to become a node."""
@@ -158,7 +186,9 @@ class FrontEnd:
         disagree, both are tried and the better fit wins; with
         ``track_velocity_only_after_stall`` only where this scan's or the
         previous scan's odometry increment is exactly zero
-        (:func:`.gating.odometry_stalled`).
+        (:func:`.gating.odometry_stalled`). With ``track_velocity_time_scaled``
+        the last motion is followed for this scan's elapsed time rather than
+        for one scan (:meth:`_coasting_velocity`).
 
         How far the guess may be trusted depends on how much odometry it
         holds: a scan period of a few centimetres gets the tight ``track_*``
@@ -173,7 +203,7 @@ class FrontEnd:
         target = self._back.local_map()
         limits = self.track_limits(increment)
         reg, good, _ = self.attempt(target, points, guess, *limits)
-        coasting = se2.compose(self.track, np.zeros(3) if self._velocity is None else self._velocity)
+        coasting = se2.compose(self.track, self._coasting_velocity())
         gap = se2.between(guess, coasting)
         if (
             cfg.track_velocity_guess

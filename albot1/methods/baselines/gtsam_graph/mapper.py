@@ -119,7 +119,7 @@ class GtsamGraphMapper:
                 self.back.start(odometry, points, frame.index)
                 front.new_node()
             else:
-                pose, reg = front.step(odometry, points)
+                pose, reg = front.step(odometry, points, frame.scan.timestamp)
                 if front.moved_enough(pose):
                     self._add_node(odometry, pose, points, frame.index, reg)
                 else:
@@ -130,6 +130,7 @@ class GtsamGraphMapper:
         ) as exc:  # re-raised as the method's error so the runner names the dataset
             raise BaselineError(f"gtsam-graph: scan {frame.index}: {exc}") from exc
         front.last_odometry = odometry
+        front.last_stamp = frame.scan.timestamp
         self.back.add_scan(front.track, points)
 
     def _add_node(
