@@ -58,7 +58,11 @@ class MapperOutput:
     ``extras`` holds JSON-able, method-specific records (update trace, ...);
     ``files`` extra files of the run folder by name (``places.json``, ...): a
     str is written as text, anything else as JSON (see
-    :func:`albot1.runs.folder.write_run`).
+    :func:`albot1.runs.folder.write_run`); ``versions`` the version of each
+    program outside Python the run ran, by name, as the program reported it
+    in this run (MRPT's banner): recorded in ``result.json`` ``versions`` and
+    part of the run's key, as the planner read it before the run
+    (``Mapper.program_versions``).
     """
 
     poses: FloatArray
@@ -66,6 +70,7 @@ class MapperOutput:
     counters: dict[str, int | float]
     extras: dict[str, Any] = field(default_factory=dict)
     files: dict[str, Any] = field(default_factory=dict)
+    versions: dict[str, str | None] = field(default_factory=dict)
 
 
 @runtime_checkable
@@ -95,6 +100,9 @@ class Mapper(Protocol):
     # Optional too: ``preload_modules: ClassVar[tuple[str, ...]]``, the modules of its library the mapper imports
     # only when it is built; the bench's forkserver imports them once, before it forks any cell
     # (:mod:`albot1.bench.preload`), instead of each cell importing them again.
+    # Optional too: ``program_versions(cls) -> dict[str, str | None]`` (a classmethod), the versions of the programs
+    # outside Python the mapper runs (MRPT's applications), read before any run: the planner puts them in each
+    # cell's key (:func:`albot1.versions.run_versions`), and a run reports the same names in ``MapperOutput.versions``.
 
 
 @dataclass

@@ -6,6 +6,7 @@ import hashlib
 import json
 import subprocess
 import sys
+from collections.abc import Mapping
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
@@ -99,8 +100,9 @@ def commit_label(commit: str | None) -> str:
 #: What :func:`library_versions` records by default: the libraries a result is computed with. numba and llvmlite
 #: compile Albot1's kernels (and gtsam-graph's grid search): another numba or LLVM may compile them into
 #: different machine code (fused or reordered floating-point operations), so they name what ran as much as
-#: numpy does.
-RECORDED_LIBRARIES = ("numpy", "shapely", "scipy", "numba", "llvmlite", "kiss-icp", "gtsam", "rosbags")
+#: numpy does. networkx writes albot1-places' ``places.graphml``, a file of the run. Each is in every run's key
+#: (:func:`key_versions` says why).
+RECORDED_LIBRARIES = ("numpy", "shapely", "scipy", "numba", "llvmlite", "kiss-icp", "gtsam", "rosbags", "networkx")
 
 
 def library_versions(names: tuple[str, ...] = RECORDED_LIBRARIES) -> dict[str, str | None]:
@@ -134,3 +136,60 @@ def _version(name: str) -> str | None:
         except metadata.PackageNotFoundError:
             kept[name] = None
     return kept[name]
+
+
+#: What a run's versions block holds that its key leaves out: the commit is a label of the code, whose digest
+#: (``code``) the key holds; a commit label differs between a checkout and the wheel built from it, and gains
+#: ``-dirty`` with any edit of the build files, neither of which changes what a run computes.
+UNKEYED_VERSIONS = frozenset({"git"})
+
+
+def run_versions(programs: Mapping[str, str | None] | None = None, plugin: str | None = None) -> dict[str, str | None]:
+    """The ``versions`` block of a run: code, commit, every :data:`RECORDED_LIBRARIES` version, programs, plugin.
+
+    One block for what a run records (``result.json``) and what its key digests (:func:`key_versions`), built
+    here for both: the planner builds it before a cell runs, the cell after, and a difference between the two
+    is a result that would be stored under a key naming other versions. ``programs``: the versions of the
+    programs outside Python the method runs (MRPT's applications: ``Mapper.program_versions`` before a run,
+    ``MapperOutput.versions`` after it); ``plugin``: a plugin method's distribution and version.
+    """
+    problem = program_versions_problem(programs or {})
+    if problem is not None:
+        raise ValueError(problem)
+    block: dict[str, str | None] = {"code": code_version(), "git": git_commit(), **library_versions()}
+    block.update(programs or {})
+    if plugin is not None:
+        block["plugin"] = plugin
+    return block
+
+
+#: The names of a versions block that are not a program's (:func:`run_versions`).
+_TAKEN = ("code", "git", "plugin", *RECORDED_LIBRARIES)
+
+
+def program_versions_problem(programs: object) -> str | None:
+    """Why ``programs`` (a method's program versions) cannot go into a versions block, or None when they can."""
+    if not isinstance(programs, Mapping):
+        return f"program versions {programs!r}; expected a dict of program name -> version"
+    for name, version in programs.items():
+        if not isinstance(name, str) or name in _TAKEN or not (version is None or isinstance(version, str)):
+            return (
+                f"program version {name!r}: {version!r}; expected a program's name (not one of {', '.join(_TAKEN)}) "
+                "and its version as a string (None when unknown)"
+            )
+    return None
+
+
+def key_versions(recorded: Mapping[str, str | None]) -> dict[str, str | None]:
+    """The part of a run's versions block (:func:`run_versions`) its key digests: all but :data:`UNKEYED_VERSIONS`.
+
+    Why every library, for every method: the libraries a run's files depend on are not those its method imports
+    alone. Every run reads its data (shapely draws the synthetic worlds' scans, rosbags decodes bags), degrades
+    its odometry (numpy's generator), and is evaluated into ``metrics.json`` (numpy, scipy, shapely); gtsam-graph
+    computes with Albot1's numba kernels; a list kept per method would be wrong the day an import is added, and
+    that error is a stale result reused without a word. The cost of the wider key is a re-run of every cell
+    after an upgrade of any one of them, the same cost as any edit of this package's code (``code``), which the
+    key already takes. Not recorded, so not keyed: the libraries that draw ``preview.png`` (matplotlib), a
+    picture of the run no metric reads (the report's figures are keyed on them, ``albot1.report.figure_cache``).
+    """
+    return {name: recorded[name] for name in sorted(recorded) if name not in UNKEYED_VERSIONS}

@@ -13,9 +13,11 @@ killed last time) is only re-evaluated, not re-run.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, cast
 
+from albot1 import versions
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell
 from albot1.config.targets import resolve_target
@@ -28,6 +30,7 @@ from albot1.runs.folder import PreviewRenderer, is_complete, write_run
 from albot1.settings import Settings, get_settings
 
 __all__ = [
+    "check_versions",
     "config_difference",
     "execute_cell",
     "renderer_from_target",
@@ -67,6 +70,22 @@ def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
     )
 
 
+def check_versions(cell: Cell, ran: Mapping[str, str | None]) -> None:
+    """BenchError naming each version that differs between the cell's plan and its run (``ran``: a versions block).
+
+    The cell's key digests the versions planned (:attr:`Cell.versions`); a run with others (a library or MRPT
+    upgraded while the grid ran, a Dask worker with another install) would be stored under a key naming versions
+    it did not run with, so it is refused before it is stored, with what differs.
+    """
+    found = versions.key_versions(ran)
+    if found != cell.versions:
+        raise BenchError(
+            f"{cell.describe()}: the versions in the cell process differ from the planned ones "
+            f"({config_difference(cell.versions, found)}); was a library or MRPT installed while the grid was "
+            "planned or running, or does this worker run another install? Install the same versions and run it again"
+        )
+
+
 def execute_cell(
     cell: Cell,
     runs_root: Path,
@@ -83,6 +102,7 @@ def execute_cell(
     settings = settings or get_settings()
     run_dir = runs_root / cell.key
     if cell.trajectory is not None:  # another system's output: scored, not run (albot1.bench.external)
+        check_versions(cell, versions.run_versions())
         written = write_external_run(
             path=Path(cell.trajectory),
             format_name=cell.trajectory_format,
@@ -115,6 +135,7 @@ def execute_cell(
                 f"planned one ({config_difference(cell.config or {}, result.config)}); did a "
                 "baselines/*.toml file or an ALBOT1_* variable change during the run?"
             )
+        check_versions(cell, result.versions)
         written = write_run(result, runs_root, preview=preview)
         if written.name != cell.key:
             raise BenchError(

@@ -12,6 +12,13 @@ log, not of our degraded copies. The file's sha256 is part of the cell's
 key, so an edited file is scored again, and a dataset without its file is
 an error of the suite naming the path it expected (restrict the entry with
 ``datasets = [...]``).
+
+The rest of its key is what the scoring reads and computes with: the
+dataset's files and manifest loader options (its reference poses and
+relations), and the versions block of any run
+(:func:`albot1.versions.run_versions`: the code and the recorded libraries,
+which read the log and compute the metrics). It runs no method, so no
+program's or plugin's version is in it.
 """
 
 from __future__ import annotations
@@ -19,10 +26,12 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from albot1 import versions
 from albot1.bench.errors import SuiteError
 from albot1.bench.grid import Cell
 from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
 from albot1.data.fetch import sha256_of
+from albot1.data.model import SequenceMetadata
 from albot1.runs.external_run import external_config
 from albot1.runs.folder import run_key
 
@@ -47,8 +56,13 @@ def trajectory_path(suite: Suite, entry: MethodEntry, dataset: str) -> Path:
     return path
 
 
-def external_cell(suite: Suite, entry: MethodEntry, dataset: str, opts: DatasetOptions, seed: int, code: str) -> Cell:
-    """The one cell scoring ``entry``'s file for ``dataset``; SuiteError when the file is missing."""
+def external_cell(
+    suite: Suite, entry: MethodEntry, dataset: str, opts: DatasetOptions, seed: int, metadata: SequenceMetadata
+) -> Cell:
+    """The one cell scoring ``entry``'s file for ``dataset``; SuiteError when the file is missing.
+
+    ``metadata``: the dataset's, whose checksums and loader options go into the key (the run records them).
+    """
     path = trajectory_path(suite, entry, dataset)
     if not path.is_file():
         raise SuiteError(
@@ -57,6 +71,8 @@ def external_cell(suite: Suite, entry: MethodEntry, dataset: str, opts: DatasetO
             f"datasets = [...]"
         )
     config = external_config(path, entry.trajectory_format, sha256_of(path))
+    planned = versions.run_versions()  # what albot1.runs.external_run records
+    key = run_key(opts.label, entry.name, config, "none", seed, planned, metadata.checksums, metadata.manifest_loader)
     return Cell(
         suite=suite.name,
         dataset=dataset,
@@ -66,8 +82,8 @@ def external_cell(suite: Suite, entry: MethodEntry, dataset: str, opts: DatasetO
         preset="external",
         degradation="none",
         seed=seed,
-        key=run_key(opts.label, entry.name, config, "none", seed, code),
-        code_version=code,
+        key=key,
+        code_version=str(planned["code"]),
         time_s=opts.time_s or suite.limits.time_s,
         memory_mb=opts.memory_mb or suite.limits.memory_mb,
         limit=opts.limit,
@@ -75,4 +91,5 @@ def external_cell(suite: Suite, entry: MethodEntry, dataset: str, opts: DatasetO
         config=config,
         trajectory=str(path),
         trajectory_format=entry.trajectory_format,
+        versions=versions.key_versions(planned),
     )

@@ -22,9 +22,12 @@ class Cell:
     """One run of the grid: a dataset slice x method entry x degradation x seed, with its limits.
 
     ``key`` is the run folder name (:func:`albot1.runs.folder.run_key` of the
-    dataset label, method, resolved config, degradation, seed and code
-    version), so a stored result is found again exactly when every input is
-    the same.
+    dataset label, method, resolved config, degradation, seed, data and the
+    ``versions`` its run will record), so a stored result is found again
+    exactly when every input is the same. ``versions``: the part of the
+    planned versions block the key digests (:func:`albot1.versions.key_versions`:
+    code, libraries, programs, plugin), compared with what the cell's run
+    records before it is stored (:func:`albot1.bench.cells.execute_cell`).
     """
 
     suite: str
@@ -48,6 +51,7 @@ class Cell:
     trajectory: str | None = None
     """Another system's trajectory file, scored instead of running a method (:mod:`albot1.runs.external_run`)."""
     trajectory_format: str | None = None
+    versions: dict[str, str | None] = field(default_factory=dict)
 
     def describe(self) -> str:
         """One line naming the cell for humans (progress, failure lists)."""

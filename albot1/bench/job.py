@@ -211,23 +211,29 @@ def _given_up_by_dask() -> Callable[[], bool] | None:
 
 
 def _worker_code_mismatch(cell: Cell) -> str | None:
-    """Why this Dask worker must not run ``cell``: its albot1 code is not the code the cell's key names.
+    """Why this Dask worker must not run ``cell``: its albot1 code or a library is not what the cell's key names.
 
-    The key holds the planning machine's code version; a worker with other
-    code would store its results under a key that claims the wrong code.
-    Checked on Dask workers only: the local executor runs jobs in the
-    runner's own process, whose code planned the keys.
+    The key holds the planning machine's code version and library versions (:attr:`Cell.versions`); a worker
+    with other code or another library would compute a result the key does not name (its cells would fail one
+    by one, :func:`albot1.bench.cells.check_versions`). Checked on Dask workers only: the local executor runs
+    jobs in the runner's own process, whose code and libraries planned the keys.
     """
     worker = _dask_worker()
     if worker is None:
         return None
+    where = f"the Dask worker {worker.address} on {socket.gethostname()}"
     version = versions.code_version()
-    if version == cell.code_version:
+    if version != cell.code_version:
+        return (
+            f"{where} has albot1 code {version}, but the cells were planned with code {cell.code_version}; install "
+            "the same code on every worker (see `albot1 --version`)"
+        )
+    installed = versions.library_versions()
+    other = [name for name in sorted(installed) if name in cell.versions and installed[name] != cell.versions[name]]
+    if not other:
         return None
-    return (
-        f"the Dask worker {worker.address} on {socket.gethostname()} has albot1 code {version}, but the cells were "
-        f"planned with code {cell.code_version}; install the same code on every worker (see `albot1 --version`)"
-    )
+    found = ", ".join(f"{name} {installed[name]} (planned with {cell.versions[name]})" for name in other)
+    return f"{where} has {found}; install the same library versions on every worker"
 
 
 def _storage_failure(

@@ -16,6 +16,7 @@ import fnmatch
 import os
 import platform
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -34,13 +35,18 @@ from albot1.data.open import open_sequence, split_slice
 from albot1.data.synthetic import worlds
 from albot1.errors import Albot1Error, ConfigError
 from albot1.methods.plugins import ENTRY_POINT_GROUP
-from albot1.methods.registry import MethodRegistry, method_registry, resolve_config
+from albot1.methods.registry import MethodRegistry, MethodSpec, method_registry, resolve_config
 from albot1.runs.folder import run_key
 from albot1.settings import Settings
 
 
-def machine_info() -> dict[str, Any]:
-    """What the report states about where the numbers were measured."""
+def machine_info(programs: Mapping[str, str | None] | None = None) -> dict[str, Any]:
+    """What the report states about where the numbers were measured.
+
+    ``libraries``: the recorded libraries' versions, and those of the programs the planned cells run
+    (``programs``, MRPT's): the versions every planned cell's key names, so every result the report shows,
+    kept or new, was computed with them.
+    """
     import psutil
 
     return {
@@ -53,7 +59,7 @@ def machine_info() -> dict[str, Any]:
         "python": sys.version.split()[0],
         "code_version": versions.code_version(),
         "git": versions.git_commit(),
-        "libraries": versions.library_versions(),
+        "libraries": {**versions.library_versions(), **(programs or {})},
     }
 
 
@@ -98,6 +104,21 @@ def _resolve(suite: Suite, entry: MethodEntry, registry: MethodRegistry) -> tupl
     except Exception as exc:  # the method's config model itself is broken
         return None, f"cannot resolve the config of method {entry.name!r}: {type(exc).__name__}: {exc}"
     return config.model_dump(mode="json"), None
+
+
+def _program_versions(spec: MethodSpec, problem: str | None) -> tuple[dict[str, str | None], str | None]:
+    """The versions of the programs a cell of ``spec`` will run (in its key), and why the cell cannot run.
+
+    Read once per method and plan (:meth:`MethodSpec.program_versions`; the MRPT mapper keeps its answer while
+    the executable is the same file). A method whose class does not load (``problem``) or whose
+    ``program_versions`` fails is keyed without them, and its cells fail with the reason.
+    """
+    if problem is not None:
+        return {}, problem
+    try:
+        return spec.program_versions(), None
+    except Exception as exc:  # a plugin's program_versions is broken: a cell failure, not a runner crash
+        return {}, f"cannot read the program versions of method {spec.name!r}: {type(exc).__name__}: {exc}"
 
 
 def _methods(suite: Suite, registry: MethodRegistry) -> tuple[list[MethodEntry], list[Skipped]]:
@@ -248,6 +269,12 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
     code = versions.code_version()
     methods, skipped_methods = _methods(suite, registry)
     resolved = {entry.display: _resolve(suite, entry, registry) for entry in methods if entry.trajectories is None}
+    programs_of = {  # method name -> (its programs' versions, why its cells cannot run)
+        entry.name: _program_versions(registry.get(entry.name), resolved[entry.display][1])
+        for entry in methods
+        if entry.trajectories is None
+    }
+    programs: dict[str, str | None] = {}  # of the methods that have cells, for the report (machine_info)
     cells: list[Cell] = []
     skipped_datasets: list[Skipped] = []
     config_failures: dict[str, str] = {}
@@ -275,11 +302,15 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
                     continue
                 if entry.trajectories is not None:
                     if degradation == "none" and seed == sweep_seeds[0]:
-                        cells.append(external_cell(suite, entry, name, opts, seed, code))
+                        cells.append(external_cell(suite, entry, name, opts, seed, metadata))
                     continue
                 if seed != sweep_seeds[0] and _runs_once(degradation, entry.name, registry):
                     continue
                 config, problem = resolved[entry.display]
+                ran, versions_problem = programs_of[entry.name]
+                problem = problem or versions_problem
+                # the versions block the cell's run will record (albot1.runs.execute), so its folder is found again
+                planned = versions.run_versions(ran, registry.get(entry.name).plugin)
                 key_config = (
                     config
                     if config is not None
@@ -291,13 +322,13 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
                     key_config,
                     degradation,
                     seed,
-                    code,
+                    planned,
                     metadata.checksums,
                     metadata.manifest_loader,
-                    registry.get(entry.name).plugin,
                 )
                 if problem is not None:
                     config_failures[key] = problem
+                programs.update(ran)
                 cells.append(
                     Cell(
                         suite=suite.name,
@@ -317,6 +348,7 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
                         overrides=dict(entry.set),
                         config=config,
                         allow_failure=entry.allow_failure,
+                        versions=versions.key_versions(planned),
                     )
                 )
     _check_shared_folders(suite, cells)
@@ -332,5 +364,5 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
         config_failures=config_failures,
         seeds=seeds,
         degradations=degradations,
-        machine=machine_info(),
+        machine=machine_info(programs),
     )

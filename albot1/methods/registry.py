@@ -149,6 +149,21 @@ class MethodSpec:
             origin = f" (plugin of {self.plugin})" if self.plugin is not None else ""
             raise TargetError(f"method {self.name!r}{origin}: {exc}") from exc
 
+    def program_versions(self) -> dict[str, str | None]:
+        """The versions of the programs outside Python the method runs (its class's ``program_versions``), else {}.
+
+        Read by the planner for each cell's key (:func:`albot1.versions.run_versions`); raises as
+        :meth:`load_class` does, and ValueError naming the method when they could not be recorded.
+        """
+        from albot1 import versions  # here: listing the methods (`albot1 run --help`) reads no version
+
+        read = getattr(self.load_class(), "program_versions", None)
+        found = read() if callable(read) else {}
+        problem = versions.program_versions_problem(found)
+        if problem is not None:
+            raise ValueError(f"method {self.name!r}: program_versions(): {problem}")
+        return dict(found)
+
     def load_error_class(self) -> type[Exception]:
         cls = resolve_class(self.error_class)
         if not issubclass(cls, Exception):

@@ -194,13 +194,8 @@ def run_method(
         wall_s=time.perf_counter() - wall_start,
         cpu_s=cpu_time_s() - cpu_start,
         peak_mb=peak_rss_mb(),
-        versions={
-            "code": versions.code_version(),
-            "git": versions.git_commit(),
-            **versions.library_versions(),
-            # a plugin's own code is not in the code version (this package's digest): its distribution and version
-            **({"plugin": spec.plugin} if spec.plugin is not None else {}),
-        },
+        # a plugin's own code is not in the code version (this package's digest): its distribution and version
+        versions=versions.run_versions(programs=output.versions, plugin=spec.plugin),
         dataset_info={
             "source": seq.metadata.source,
             "format": seq.metadata.format,
@@ -366,9 +361,12 @@ def _check_output(output: object, n: int, method: str, dataset: str, error_class
     problem = map_problem(output.map)
     if problem is not None:
         raise error_class(f"{run}: {problem}")
-    for name in ("counters", "extras", "files"):
+    for name in ("counters", "extras", "files", "versions"):
         if not isinstance(getattr(output, name), dict):
             raise error_class(f"{run}: {name} is {type(getattr(output, name)).__name__}; expected a dict")
+    problem = versions.program_versions_problem(output.versions)
+    if problem is not None:
+        raise error_class(f"{run}: MapperOutput.versions: {problem}")
     for key in ("views", "updates"):
         if key not in output.counters:
             raise RunError(f"{run}: counters lack the required key {key!r}")

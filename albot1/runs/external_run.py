@@ -64,7 +64,8 @@ def write_external_run(
             f"{path}: sha256 {block['sha256']} differs from {config.get('sha256')} when the grid was planned; "
             "the file changed during the run (plan again)"
         )
-    arrays = open_sequence(dataset, settings=settings).arrays
+    sequence = open_sequence(dataset, settings=settings)
+    arrays = sequence.arrays
     file = read_trajectory(path, format_name)
     if file.timestamps is None:
         scans = np.arange(len(arrays.timestamps))
@@ -91,8 +92,17 @@ def write_external_run(
         total_s=0.0,
         wall_s=0.0,
         peak_mb=0.0,
-        versions={"code": versions.code_version(), "git": versions.git_commit()},
-        dataset_info={"source": str(path), "format": block["format"], "odometry_source": "", "reference_source": ""},
+        # the libraries that read the log and compute the metrics (in the key: albot1.bench.external)
+        versions=versions.run_versions(),
+        dataset_info={
+            "source": str(path),
+            "format": block["format"],
+            "odometry_source": "",
+            "reference_source": "",
+            # the files its reference poses and relations come from (in the key, as for a method's run)
+            "data_sha256": dict(sequence.metadata.checksums),
+            "manifest_loader": dict(sequence.metadata.manifest_loader),
+        },
     )
     run_dir = write_run(result, runs_root, preview=preview)
     scored.header["key"] = run_dir.name  # the run folder's key, as for a method's run

@@ -1,7 +1,7 @@
 """The run-folder contract (``docs/architecture.md``, "Contracts").
 
 One folder per run, named by a content hash of (dataset, method, config,
-degradation, seed, code version)::
+degradation, seed, code and library versions, data; :func:`run_key`)::
 
     trajectory.tum   estimated pose per scan (scan timestamps)
     odometry.tum     the odometry the method was given (after degradation)
@@ -45,6 +45,7 @@ from albot1.errors import Albot1Error
 from albot1.records import Record, ResultRecord, dump_record, json_value, parse_record, read_record
 from albot1.runs.errors import RunError
 from albot1.runs.map_files import write_map
+from albot1.versions import key_versions
 
 DONE = "DONE"
 RESULT_FILE = "result.json"
@@ -99,10 +100,9 @@ def run_key(
     config: dict[str, Any],
     degradation: str,
     seed: int,
-    code_version: str,
+    versions: Mapping[str, str | None],
     data: Mapping[str, str] | None = None,
     loader: Mapping[str, Any] | None = None,
-    plugin: str | None = None,
 ) -> str:
     """Content hash naming a run folder (16 hex digits).
 
@@ -114,10 +114,13 @@ def run_key(
     table of a registered dataset's manifest (``SequenceMetadata.manifest_loader``):
     a manifest edited or replaced (``ALBOT1_CONFIG_DIR``) with another
     ``max_range`` or odometry source reads other scans from the same files,
-    and its name does not say so. ``plugin`` is the distribution and version
-    of a plugin method (``MethodSpec.plugin``, ``versions.plugin`` in
-    ``result.json``): the code version digests this package only, so without
-    it a plugin upgraded since its run would keep the older version's result.
+    and its name does not say so. ``versions`` is the run's versions block
+    (``versions`` in ``result.json``, :func:`albot1.versions.run_versions`):
+    the code version, the version of every recorded library, of the programs
+    the method runs (MRPT's) and of a plugin method's distribution. All of it
+    but the commit label is digested (:func:`albot1.versions.key_versions`),
+    so a result computed with a library or program since upgraded, or by a
+    plugin's older release, is not taken for what the new one computes.
     """
     fields: dict[str, Any] = {
         "dataset": dataset,
@@ -125,14 +128,12 @@ def run_key(
         "config": config,
         "degradation": degradation,
         "seed": seed,
-        "code": code_version,
+        "versions": key_versions(versions),
     }
     if data:
         fields["data"] = dict(data)
     if loader:
         fields["loader"] = dict(loader)
-    if plugin:
-        fields["plugin"] = plugin
     payload = json.dumps(fields, sort_keys=True, default=str)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
@@ -162,10 +163,9 @@ def write_run(result: RunResult, root: Path, *, preview: PreviewRenderer | None 
         result.config,
         result.degradation,
         result.seed,
-        str(result.versions.get("code")),
+        result.versions,
         result.dataset_info.get("data_sha256"),
         result.dataset_info.get("manifest_loader"),
-        result.versions.get("plugin"),
     )
     run_dir = root / key
     run_dir.mkdir(parents=True, exist_ok=True)

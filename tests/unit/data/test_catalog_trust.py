@@ -82,9 +82,11 @@ def test_a_path_dataset_edited_after_its_run_gets_a_new_key(tmp_path: Path) -> N
     os.utime(log, (stamp, stamp))
     second = open_sequence(str(log)).metadata.checksums
     assert first == {"tiny.clf": SHA} and second == {"tiny.clf": hashlib.sha256(WRONG).hexdigest()}
-    keys = {run_key(str(log), "odometry", {}, "none", 0, "v", data) for data in (first, second)}
+    keys = {run_key(str(log), "odometry", {}, "none", 0, {"code": "v"}, data) for data in (first, second)}
     assert len(keys) == 2
-    assert run_key("w", "odometry", {}, "none", 0, "v", {}) == run_key("w", "odometry", {}, "none", 0, "v")
+    assert run_key("w", "odometry", {}, "none", 0, {"code": "v"}, {}) == run_key(
+        "w", "odometry", {}, "none", 0, {"code": "v"}
+    )
 
 
 @pytest.mark.parametrize(

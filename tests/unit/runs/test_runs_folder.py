@@ -68,7 +68,7 @@ def test_write_and_read_back(tmp_path: Path) -> None:
     info = json.loads((run_dir / "result.json").read_text())
     assert info["scans"] == 8 and info["counters"]["views"] == 8
     assert set(info["timing"]) >= {"per_scan_ms_median", "per_scan_ms_p95", "total_s", "peak_mb"}
-    assert run_dir.name == run_key("toy", "odometry", result.config, "none", 1, result.versions["code"])
+    assert run_dir.name == run_key("toy", "odometry", result.config, "none", 1, result.versions)
     assert stored.load_map().points is not None
 
 

@@ -15,7 +15,11 @@ Each run gets a fresh temporary folder (the applications delete everything
 in their output folder first), removed afterwards. The INI file and MRPT's
 own outputs (its per-step timing log, its path, the grid image) are kept as
 the run folder's ``mrpt-*`` files (``MapperOutput.files``); MRPT's version
-and timing statistics go into ``extras.mrpt``.
+and timing statistics go into ``extras.mrpt``. MRPT's version is also the
+run's ``versions.mrpt`` (``MapperOutput.versions``), part of its key: the
+planner reads it once per plan from the application's banner
+(:meth:`_MrptMapper.program_versions`), so a store made with another MRPT is
+run again, not reused.
 
 Success is checked, never assumed from the exit status: one pose per scan,
 finite, and a path whose length is within ``[min_path_ratio,
@@ -40,9 +44,11 @@ the other baselines.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import shutil
+import subprocess
 import tempfile
 import time
 from pathlib import Path
@@ -101,11 +107,56 @@ def _keep(out_dir: Path, names: dict[str, str]) -> dict[str, Any]:
 
 
 def _mrpt_version(stdout_text: str) -> str | None:
+    """MRPT's version from the banner an application prints first (``MRPT C++ Library: MRPT 2.5.8 - ...``)."""
     for line in stdout_text.splitlines()[:20]:
         marker = "MRPT C++ Library: MRPT "
         if marker in line:
             return line.split(marker, 1)[1].split()[0]
     return None
+
+
+#: The name of MRPT's version in a run's ``versions`` (``result.json``) and key.
+VERSION_NAME = "mrpt"
+#: How long the applications may take to print their banner and their usage when asked for their version (s).
+BANNER_TIMEOUT_S = 30.0
+
+
+def installed_version(app: str) -> str | None:
+    """MRPT's version as ``app`` reports it when started now (None: not on PATH, or no banner).
+
+    Why started: the version a run records is the banner of the library the application loads, and only the
+    application knows which that is (a build in ``/usr/local`` before the Debian package on ``PATH``). Asked with
+    no arguments, it prints its banner and its usage and exits (about 0.6 s), so the answer is kept for as long
+    as the executable is the same file (:func:`_banner_version`): once per plan, not once per cell.
+    """
+    executable = find_app(app)
+    if executable is None:
+        return None
+    try:
+        stat = os.stat(executable)
+    except OSError:
+        return None
+    return _banner_version(executable, stat.st_ino, stat.st_size, stat.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=8)
+def _banner_version(executable: str, inode: int, size: int, mtime_ns: int) -> str | None:
+    """The banner's version of ``executable`` (inode, size and time name the file: a reinstall reads it again)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    try:
+        done = subprocess.run(
+            [executable],
+            capture_output=True,
+            text=True,
+            errors="replace",
+            timeout=BANNER_TIMEOUT_S,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            check=False,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return _mrpt_version(done.stdout)
 
 
 class _MrptMapper:
@@ -121,6 +172,11 @@ class _MrptMapper:
         self.config = config
         self.seed = seed
         self._frames: list[Frame] = []
+
+    @classmethod
+    def program_versions(cls) -> dict[str, str | None]:
+        """MRPT's version before a run (``Mapper.program_versions``): the planner keys the run's cells with it."""
+        return {VERSION_NAME: installed_version(cls.app)}
 
     # -- per scan --------------------------------------------------------------------------------------------
 
@@ -196,10 +252,11 @@ class _MrptMapper:
             poses, points, counters, extras, files = self._read(out_dir, odometry)
 
         self._check_path(poses, odometry)
+        version = _mrpt_version(stdout_text)
         mrpt_block = {
             "app": self.app,
             "executable": executable,
-            "version": _mrpt_version(stdout_text),
+            "version": version,
             "rawlog_layout": self.layout,
             "rawlog_bytes": rawlog.bytes_written,
             "rawlog_invalid_beams": rawlog.invalid_beams,
@@ -228,7 +285,12 @@ class _MrptMapper:
         if total is not None:
             all_counters["mrpt_total_s"] = total
         return MapperOutput(
-            poses=poses, map=MapData(points=points), counters=all_counters, extras={"mrpt": mrpt_block}, files=files
+            poses=poses,
+            map=MapData(points=points),
+            counters=all_counters,
+            extras={"mrpt": mrpt_block},
+            files=files,
+            versions={VERSION_NAME: version},  # what ran, from this run's banner; the key was planned with the same
         )
 
     def _check_outcome(

@@ -6,7 +6,8 @@ a straight line 0.5 m per scan (the tests' odometry), or misbehaves as
 ``FAKE_MRPT_MODE`` says: ``short`` (a scan missing), ``frozen`` (the path
 never moves), ``jump`` (a 5 m teleport at scan 3), ``crash`` (an MRPT exception, status 255), ``signal`` (killed
 by SIGSEGV), ``sleep`` (never ends, burning no CPU), ``burn`` (never ends, burning CPU), ``hog`` (grows its
-memory).
+memory). Its banner names MRPT ``FAKE_MRPT_VERSION`` (default 2.5.8); run with no arguments, it prints the
+banner and its usage, as the real ones do.
 """
 
 from __future__ import annotations
@@ -20,13 +21,18 @@ from pathlib import Path
 
 
 def main() -> None:
-    app, ini_path, rawlog = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
+    app = sys.argv[1]
+    version = os.environ.get("FAKE_MRPT_VERSION", "2.5.8")
+    print(f"[x|INFO] {app} - Part of the MRPT\n MRPT C++ Library: MRPT {version} - Sources timestamp: x", flush=True)
+    if len(sys.argv) < 4:  # as the real applications: the banner, then their usage as an exception, status 255
+        print(f"==== MRPT exception ====\nMessage:  Usage: {app} <config_file> [dataset.rawlog]", file=sys.stderr)
+        sys.exit(255)
+    ini_path, rawlog = Path(sys.argv[2]), Path(sys.argv[3])
     mode = os.environ.get("FAKE_MRPT_MODE", "ok")
     scans = int(os.environ["FAKE_MRPT_SCANS"])
     ini = ini_path.read_text()
     out = Path(re.search(r"^logOutput_dir = (.*)$", ini, re.M).group(1))  # type: ignore[union-attr]
     out.mkdir()
-    print(f"[x|INFO] {app} - Part of the MRPT\n MRPT C++ Library: MRPT 2.5.8 - Sources timestamp: x")
     assert rawlog.is_file() and rawlog.stat().st_size > 0
     if mode == "crash":
         print("==== MRPT exception ====\nMessage:  Assert condition failed: fake", file=sys.stderr)

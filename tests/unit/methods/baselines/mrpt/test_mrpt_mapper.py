@@ -188,6 +188,18 @@ def test_runs_are_repeatable(fake_apps: Path) -> None:
     assert os.environ["FAKE_MRPT_SCANS"] == str(SCANS)
 
 
+def test_a_run_reports_the_mrpt_version_the_planner_read_before_it(fake_apps: Path) -> None:
+    """The planner keys an MRPT cell with the banner the application prints when started with no arguments
+    (``program_versions``); the run reports its own run's banner (``MapperOutput.versions``, recorded in
+    ``result.json`` and digested by the key its folder is stored under): one MRPT, one version, so the stored
+    run is found again; another MRPT installed (another executable file) is read again, not taken from before."""
+    assert MrptIcpMapper.program_versions() == MrptRbpfMapper.program_versions() == {"mrpt": "2.5.8"}
+    assert _run(_icp()).versions == _run(_rbpf()).versions == {"mrpt": "2.5.8"}
+    script = fake_apps / "icp-slam"
+    script.write_text(script.read_text().replace("exec ", "export FAKE_MRPT_VERSION=2.6.0\nexec ", 1))
+    assert MrptIcpMapper.program_versions() == _run(_icp()).versions == {"mrpt": "2.6.0"}
+
+
 def test_unusable_scan_stamps_are_filled_and_counted(fake_apps: Path) -> None:
     usable = _run(_icp()).extras["mrpt"]
     assert (usable["rawlog_replaced_stamps"], usable["rawlog_first_replaced_stamp"]) == (0, None)
