@@ -21,6 +21,7 @@ from albot1 import versions
 from albot1.bench.errors import BenchError
 from albot1.bench.grid import Cell
 from albot1.config.targets import resolve_target
+from albot1.data.model import Sequence
 from albot1.data.open import open_sequence
 from albot1.methods.registry import MethodRegistry
 from albot1.runs.evaluate import evaluate_run
@@ -117,6 +118,9 @@ def execute_cell(
         if written.name != cell.key:
             raise BenchError(f"{cell.describe()}: stored under {written.name}, expected key {cell.key}")
         return written
+    sequence: Sequence | None = (
+        None  # opened only to run the cell; a run stored earlier is only evaluated (it reopens its data)
+    )
     if not is_complete(run_dir):
         sequence = open_sequence(cell.dataset_label, settings=settings)
         result = run_method(
@@ -142,5 +146,5 @@ def execute_cell(
                 f"{cell.describe()}: stored under {written.name}, expected key {cell.key} "
                 "(the code or a data file changed while the grid was running?)"
             )
-    evaluate_run(run_dir, settings=settings)
+    evaluate_run(run_dir, settings=settings, opened=sequence)  # the log opened once a cell, not again for its metrics
     return run_dir

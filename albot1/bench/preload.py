@@ -106,6 +106,7 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
     ``methods``: only these registered methods (None: all of them).
     """
     from albot1.config.targets import resolve_target
+    from albot1.data.catalog import warm_manifests
     from albot1.data.loaders.registry import FORMATS
     from albot1.methods.registry import method_registry
     from albot1.methods.warm_ups import warm_up_methods
@@ -115,6 +116,9 @@ def warm(modules: Iterable[str] = MODULES, methods: Collection[str] | None = Non
         _attempt(f"module {name}", functools.partial(importlib.import_module, name), failures)
     for loader_target, _ in FORMATS.values():
         _attempt(f"loader {loader_target}", functools.partial(resolve_target, loader_target), failures)
+    # The dataset manifests, parsed here once instead of in every cell that opens a public log (~12-20 ms each,
+    # docs/benchmarking.md, "Session 24"); each cell still lists them, and says in its cell.log which are a user's.
+    _attempt("dataset manifests", warm_manifests, failures)
     registry: MethodRegistry | None = None
     try:
         registry = method_registry()

@@ -126,7 +126,12 @@ def _open_source(
 
 
 def open_as_run(
-    ref: str, degradation: str = "none", seed: int | None = None, *, settings: Settings | None = None
+    ref: str,
+    degradation: str = "none",
+    seed: int | None = None,
+    *,
+    settings: Settings | None = None,
+    opened: Sequence | None = None,
 ) -> Sequence:
     """``ref`` opened as a stored run saw it: with the run's degradation and seed (``result.json``).
 
@@ -136,9 +141,14 @@ def open_as_run(
     (evaluation's reference map, the thesis page's replay) reopens it with
     the same SPEC and seed, or it compares the run with other scans. A
     source without a seed (an external trajectory) was not degraded.
+    ``opened``: ``ref`` as :func:`open_sequence` opened it moments ago (a
+    bench cell's own, undegraded, whose run was just stored), used instead of
+    opening the log again: a sequence streams its frames afresh each time, so
+    it reads the same scans (docs/benchmarking.md, "Session 24").
     """
     spec = parse_spec(degradation, stored=True)
-    return degrade(open_sequence(ref, settings=settings), spec, seed=0 if seed is None else seed)
+    sequence = opened if opened is not None else open_sequence(ref, settings=settings)
+    return degrade(sequence, spec, seed=0 if seed is None else seed)
 
 
 def _checksums(path: Path | None, options: dict[str, Any]) -> dict[str, str]:

@@ -40,6 +40,7 @@ from albot1.metrics.errors import MetricsError
 from albot1.report.collect import CellRecord
 from albot1.report.mathtext_memo import share_parsed_math
 from albot1.report.tick_memo import share_tick_updates
+from albot1.report.tight_png import PNG_COMPRESS_LEVEL
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -360,11 +361,14 @@ def write_png(fig: Figure, png: Path) -> None:
     """Write ``fig`` as ``png`` at :data:`DPI` in one draw (the pixels of ``savefig(png, dpi=DPI)``).
 
     The layout engine runs inside that draw; ``savefig`` draws the figure once more before it, to lay it out.
+    Compressed at zlib level :data:`~albot1.report.tight_png.PNG_COMPRESS_LEVEL` as the run previews are,
+    not Pillow's default 6: the same pixels in less encoding time (docs/benchmarking.md, "Session 24").
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     fig.set_dpi(DPI)
-    FigureCanvasAgg(fig).print_png(png)  # type: ignore[no-untyped-call]
+    pil_kwargs = {"compress_level": PNG_COMPRESS_LEVEL}
+    FigureCanvasAgg(fig).print_png(png, pil_kwargs=pil_kwargs)  # type: ignore[no-untyped-call]
 
 
 def dense(artist: Any) -> Any:

@@ -50,10 +50,15 @@ if TYPE_CHECKING:
     from albot1.data.model import Sequence
 
 
-def evaluate_run(run_dir: Path, *, settings: Settings | None = None) -> MetricsRecord:
-    """Compute every metric of the run in ``run_dir``, write ``metrics.json`` there, return it."""
+def evaluate_run(run_dir: Path, *, settings: Settings | None = None, opened: Sequence | None = None) -> MetricsRecord:
+    """Compute every metric of the run in ``run_dir``, write ``metrics.json`` there, return it.
+
+    ``opened``: the run's dataset as the caller opened it for the run (undegraded; :func:`reopen`), so that a
+    metric needing the scans does not open the log a second time; the files' sha256 are checked all the same.
+    """
     run = read_run(run_dir)
-    record = score(scored_run(run), settings=settings, source=f"{run.path / METRICS_FILE} (being written)")
+    source = f"{run.path / METRICS_FILE} (being written)"
+    record = score(scored_run(run), settings=settings, source=source, opened=opened)
     write_record(run.path / METRICS_FILE, record)
     return record
 
@@ -119,6 +124,7 @@ def score(
     settings: Settings | None = None,
     source: str = "metrics",
     registry: MetricRegistry | None = None,
+    opened: Sequence | None = None,
 ) -> MetricsRecord:
     """Every metric of ``registry`` (default: the project's) for ``scored``, as a validated record.
 
@@ -126,9 +132,10 @@ def score(
     Albot1Error of its ``compute``), is null with the reason; ``source``
     names the file in errors. A block that does not fit its own model is the
     metric's bug and is raised (RecordError), never recorded as a reason.
+    ``opened``: see :func:`evaluate_run`.
     """
     registry = registry or metric_registry()
-    inputs = metric_inputs(scored, settings)
+    inputs = metric_inputs(scored, settings, opened)
     metrics: dict[str, Any] = {"run": scored.header, **scored.extra, "missing": MISSING_NOTE}
     for metric in registry:
         try:
@@ -145,8 +152,8 @@ def score(
     return parse_record(model, metrics, source)
 
 
-def metric_inputs(scored: Scored, settings: Settings | None = None) -> MetricInputs:
-    """What the metrics compute from: ``scored``, with the dataset reopened on demand (by ``settings``)."""
+def metric_inputs(scored: Scored, settings: Settings | None = None, opened: Sequence | None = None) -> MetricInputs:
+    """What the metrics compute from: ``scored``, with the dataset reopened on demand (``settings``; ``opened``)."""
     return MetricInputs(
         dataset=scored.dataset,
         timestamps=scored.timestamps,
@@ -156,7 +163,7 @@ def metric_inputs(scored: Scored, settings: Settings | None = None) -> MetricInp
         relations_source=scored.relations_source,
         relation_timestamps=scored.relation_timestamps,
         relation_poses=scored.relation_poses,
-        open_dataset=lambda: same_data(reopen(scored, settings), scored),
+        open_dataset=lambda: same_data(reopen(scored, settings, opened), scored),
         load_map=scored.load_map,
         counters=scored.counters,
         per_scan_ns=scored.per_scan_ns,
@@ -167,14 +174,17 @@ def metric_inputs(scored: Scored, settings: Settings | None = None) -> MetricInp
     )
 
 
-def reopen(scored: Scored, settings: Settings | None = None) -> Sequence:
+def reopen(scored: Scored, settings: Settings | None = None, opened: Sequence | None = None) -> Sequence:
     """The dataset of ``scored`` as its run saw it: its degradation and seed applied (:func:`open_as_run`).
 
     Without them a ``dropout`` run's scans would be compared with every scan
     of the log, and the reference map would be refused as data that changed.
+    ``opened``: the dataset already open (undegraded), not opened again: a bench cell evaluates the run it
+    just made from the sequence it made it from (~15-100 ms of CPU a cell on a public log).
     """
     header = scored.header
-    return open_as_run(scored.dataset, header.get("degradation") or "none", header.get("seed"), settings=settings)
+    degradation, seed = header.get("degradation") or "none", header.get("seed")
+    return open_as_run(scored.dataset, degradation, seed, settings=settings, opened=opened)
 
 
 def same_data(sequence: Sequence, scored: Scored) -> Sequence:

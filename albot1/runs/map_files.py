@@ -121,6 +121,14 @@ def write_map(run_dir: Path, data: MapData) -> str:
 
 
 def _write_npz(path: Path, points: np.ndarray) -> None:
-    """``points`` into ``path``, closed here: before :func:`atomic_write` syncs and renames it, not by the collector."""
+    """``points`` into ``path`` as an uncompressed ``.npz`` (``np.savez``), closed here.
+
+    Closed before :func:`atomic_write` syncs and renames it, not by the
+    collector. Stored, not deflated (``np.savez_compressed`` until session
+    24): these float32 coordinates deflate by only ~10 %, and zlib spent
+    ~9 ms of CPU on each point-map cell's file where storing them takes
+    ~0.6 ms; ``np.load`` reads the same array from either
+    (docs/benchmarking.md, "Session 24").
+    """
     with path.open("wb") as handle:
-        np.savez_compressed(handle, points=points)
+        np.savez(handle, points=points)

@@ -92,3 +92,33 @@ def test_the_start_up_is_carried_apart_from_the_per_scan_figures() -> None:
     assert block["process_total_s"] == pytest.approx(0.2)
     assert headline(CostBlock.model_validate(block)).endswith("start-up 1.50 s")
     assert cost(per_scan_ms * 1e6, {})["startup_s"] is None  # a run recorded before it was measured
+
+
+def test_the_kd_trees_are_built_for_speed_and_give_the_median_trees_distances(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Sliding-midpoint trees without shrunk nodes (session 24): every number the same as the median-split trees'."""
+    from scipy.spatial import cKDTree
+
+    from albot1.metrics import map_shape
+
+    rng = np.random.default_rng(5)
+    walls = np.concatenate([wall(0, 12, y) for y in (0.0, 2.5, 4.0)] + [wall(0, 4, 7.5, 0.02)])
+    reference = walls + rng.normal(0.0, 0.03, walls.shape)
+    estimate = np.concatenate([walls[::3] + (0.04, -0.02), rng.uniform(0, 12, (300, 2))])
+    built: list[dict[str, object]] = []
+
+    class Recording(cKDTree):  # type: ignore[misc]
+        def __init__(self, data: np.ndarray, **options: object) -> None:
+            built.append(options)
+            super().__init__(data, **options)
+
+    monkeypatch.setattr("scipy.spatial.cKDTree", Recording)
+    block = map_agreement(estimate, reference)
+    assert built == [map_shape.KD_TREE_OPTIONS] * 2 == [{"balanced_tree": False, "compact_nodes": False}] * 2
+    mp, rp = thin(estimate), thin(reference)
+    map_to_ref, ref_to_map = cKDTree(rp).query(mp)[0], cKDTree(mp).query(rp)[0]  # scipy's defaults
+    assert block["precision"] == float(np.mean(map_to_ref <= 0.3))
+    assert block["coverage"] == float(np.mean(ref_to_map <= 0.3))
+    assert block["map_to_reference_mean_m"] == float(np.mean(map_to_ref))
+    assert block["map_to_reference_median_m"] == float(np.median(map_to_ref))
+    assert block["reference_to_map_mean_m"] == float(np.mean(ref_to_map))
+    assert block["reference_to_map_median_m"] == float(np.median(ref_to_map))

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from albot1.report.plots import DPI, dense, pyplot, save
+from albot1.report.tight_png import PNG_COMPRESS_LEVEL
 
 
 def _figure(*, rasterize: bool) -> Any:
@@ -28,11 +29,18 @@ def _figure(*, rasterize: bool) -> Any:
 
 
 def test_the_png_is_the_one_savefig_writes_and_the_svg_embeds_the_dense_layer(tmp_path: Path) -> None:
-    fig = _figure(rasterize=False)
-    fig.savefig(tmp_path / "old.png", format="png", dpi=DPI)  # what save wrote before it laid out once
-    pyplot().close(fig)
+    from PIL import Image
+
+    for name, options in (("default.png", {}), ("old.png", {"pil_kwargs": {"compress_level": PNG_COMPRESS_LEVEL}})):
+        fig = _figure(rasterize=False)
+        fig.savefig(tmp_path / name, format="png", dpi=DPI, **options)  # what save wrote before it laid out once
+        pyplot().close(fig)
     png = save(_figure(rasterize=True), tmp_path / "new.png")
     assert png.read_bytes() == (tmp_path / "old.png").read_bytes()
+    # Pillow's default zlib level (6) until session 24: other bytes, the same pixels
+    with Image.open(png) as new, Image.open(tmp_path / "default.png") as default:
+        assert new.size == default.size and new.tobytes() == default.tobytes()
+    assert png.stat().st_size != (tmp_path / "default.png").stat().st_size
     svg = png.with_suffix(".svg").read_text()
     assert svg.count("<image") == 1  # the 399 segments are one picture
     assert svg.count("<path") < 100 and "two panels" in svg  # axes, ticks and text stay vectors

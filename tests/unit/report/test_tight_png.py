@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
-from albot1.report.tight_png import ink_box, save_tight_png
+from albot1.report.tight_png import ink_box, opaque_or_rgba, save_tight_png
 
 
 def test_ink_box_is_the_rows_and_columns_that_differ_from_the_background() -> None:
@@ -75,4 +75,35 @@ def test_saved_png_keeps_the_drawn_pixels(tmp_path: Path) -> None:
     pad = 5  # 0.1 inch at 50 dpi
     crop = canvas[max(0, top - pad) : bottom + pad, max(0, left - pad) : right + pad]
     with Image.open(path) as image:
-        np.testing.assert_array_equal(np.asarray(image), crop)
+        np.testing.assert_array_equal(np.asarray(image.convert("RGBA")), crop)
+
+
+def test_an_opaque_picture_is_written_as_rgb_with_the_same_colours(tmp_path: Path) -> None:
+    """A figure on its opaque background loses nothing without the alpha channel (255 everywhere): RGB, same pixels.
+
+    Every preview is such a picture: three channels to filter and compress instead of four (session 24).
+    """
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(2, 2), dpi=50)
+    ax = fig.add_subplot()
+    ax.scatter([0, 1, 0.3], [0, 1, 0.8], s=3, c="0.35", linewidths=0)
+    ax.set_xlabel("x (m)")
+    path = tmp_path / "p.png"
+    save_tight_png(fig, path)
+    canvas = np.asarray(fig.canvas.buffer_rgba())
+    assert (canvas[..., 3] == 255).all()
+    top, bottom, left, right = ink_box(canvas)
+    crop = canvas[max(0, top - 5) : bottom + 5, max(0, left - 5) : right + 5]
+    with Image.open(path) as image:
+        assert image.mode == "RGB"
+        np.testing.assert_array_equal(np.asarray(image), crop[..., :3])
+
+
+def test_a_picture_with_transparent_pixels_keeps_its_alpha_channel() -> None:
+    pixels = np.full((3, 4, 4), 255, dtype=np.uint8)
+    assert opaque_or_rgba(pixels).shape == (3, 4, 3)
+    pixels[1, 2, 3] = 128  # one half-transparent pixel: the alpha channel says something
+    kept = opaque_or_rgba(pixels[:, 1:])
+    assert kept.shape == (3, 3, 4) and kept.flags.c_contiguous
+    np.testing.assert_array_equal(kept, pixels[:, 1:])

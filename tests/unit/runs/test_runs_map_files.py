@@ -153,3 +153,17 @@ def test_the_point_map_file_is_closed_by_the_writer_not_left_to_the_collector(tm
     assert [str(w.message) for w in caught if issubclass(w.category, ResourceWarning)] == []
     with np.load(tmp_path / "map.npz") as npz:
         assert npz["points"].tolist() == [[0.5, 1.5]]
+
+
+def test_the_point_map_file_is_stored_not_deflated_and_reads_back_the_same_array(tmp_path: Path) -> None:
+    """``map.npz`` holds one ``points.npy`` member, stored: float32 coordinates deflate by ~10 % for ~15x the CPU
+    of storing them (session 24); ``np.load`` reads back exactly the float32 values written."""
+    import zipfile
+
+    points = np.random.default_rng(3).uniform(-40, 40, (5000, 2)).astype(np.float32)
+    assert write_map(tmp_path, MapData(points=points)) == "map.npz"
+    with zipfile.ZipFile(tmp_path / "map.npz") as archive:
+        assert [(m.filename, m.compress_type) for m in archive.infolist()] == [("points.npy", zipfile.ZIP_STORED)]
+    with np.load(tmp_path / "map.npz", allow_pickle=False) as npz:
+        assert npz["points"].dtype == np.float32
+        np.testing.assert_array_equal(npz["points"], points)

@@ -104,3 +104,39 @@ def test_a_closed_route_thinned_by_a_dropout_is_not_declared_closed(tmp_path: Pa
     assert route_declared_closed(metric_inputs(scored_run(whole)))
     thinned = read_run(_run(tmp_path / "b", "dropout:0.4", dataset=world))
     assert not route_declared_closed(metric_inputs(scored_run(thinned)))
+
+
+@pytest.mark.parametrize("degradation", ["thesis", "dropout:0.4"])
+def test_a_run_evaluated_with_the_sequence_it_ran_on_scores_as_when_reopened(tmp_path: Path, degradation: str) -> None:
+    """``evaluate_run(opened=...)``: a bench cell's own sequence, undegraded, stands for the log reopened."""
+    run_dir = _run(tmp_path, degradation)
+    evaluate_run(run_dir)
+    reopened = (run_dir / "metrics.json").read_bytes()
+    evaluate_run(run_dir, opened=open_sequence(WORLD))
+    assert (run_dir / "metrics.json").read_bytes() == reopened
+    assert b'"map_shape": null' not in reopened  # the metric that reads the scans was computed
+
+
+def test_a_bench_cell_opens_its_dataset_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The cell's metrics (the reference map) use the sequence the cell ran on: the log is not opened again."""
+    from albot1.bench import cells
+    from albot1.bench.plan import plan_suite
+    from albot1.bench.suite import parse_suite
+    from albot1.data import open as data_open
+    from albot1.settings import get_settings
+
+    data = {"grid": {"degradations": ["thesis"], "seeds": [0]}, "methods": [{"name": "odometry"}]}
+    data["datasets"] = [{"name": WORLD, "sweep": True}]
+    plan = plan_suite(parse_suite(data, name="once", source="once.toml"), get_settings())
+    opened: list[str] = []
+
+    def counting(ref: str, **options: object) -> object:
+        opened.append(str(ref))
+        return open_sequence(ref, **options)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(cells, "open_sequence", counting)
+    monkeypatch.setattr(data_open, "open_sequence", counting)
+    cell = next(c for c in plan.cells if c.degradation == "thesis")
+    run_dir = cells.execute_cell(cell, tmp_path / "runs")
+    assert opened.count(WORLD) == 1  # (its slice opens the whole world inside: named apart)
+    assert b'"map_shape": null' not in (run_dir / "metrics.json").read_bytes()
