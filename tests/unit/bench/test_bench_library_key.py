@@ -24,6 +24,8 @@ from albot1.bench.errors import BenchError
 from albot1.bench.external import dataset_stem
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.plan import plan_suite
+from albot1.bench.runner import kept_failure
+from albot1.bench.store import ResultsStore
 from albot1.bench.suite import load_suite
 from albot1.data.loaders.registry import writer_for
 from albot1.data.open import open_sequence
@@ -200,3 +202,17 @@ def test_a_dask_worker_with_another_library_runs_no_cell_and_says_which(
     assert outcome.reason is not None and outcome.reason.endswith(
         f"has gtsam 9.9 (planned with {cell.versions['gtsam']}); install the same library versions on every worker"
     )
+
+
+def test_a_run_refused_for_other_versions_is_no_allowed_method_failure_and_is_not_kept(tmp_path: Path) -> None:
+    """The refusal is the environment's fault (another MRPT on a worker, an upgrade mid-grid), not the method's.
+
+    Recorded as the method's own error (kind ``exception``) it was allowed by ``allow_failure`` (``albot1 bench``
+    exited 0 with MRPT "failing") and kept on every later run with the same plan, even once the install was fixed.
+    """
+    cell = replace(_cell(tmp_path), allow_failure=True)
+    planned = replace(cell, versions={**cell.versions, "numpy": "0.0.1-planned"})
+    outcome = job.run_cell_job(planned, str(tmp_path / "results"))
+    assert (outcome.status, outcome.kind, outcome.allowed) == ("failed", "executor", False)
+    assert outcome.reason is not None and "numpy: planned '0.0.1-planned'" in outcome.reason
+    assert kept_failure(ResultsStore(tmp_path / "results"), planned) is None  # the next run tries it again
