@@ -181,6 +181,8 @@ def _report(run_dir: Path, exc: BaseException) -> int:
         exc, kind, code = raised, "exception", EXIT_EXCEPTION
     elif _caused_by_memory(exc):  # run_method wraps library errors in the method's error class
         kind, code = "memory", EXIT_MEMORY
+    elif _plan_mismatch(exc):  # the install changed under the grid: never allowed, retried (not kept)
+        kind, code = "executor", EXIT_EXCEPTION
     else:
         kind, code = "exception", EXIT_EXCEPTION
     try:
@@ -188,6 +190,16 @@ def _report(run_dir: Path, exc: BaseException) -> int:
     except OSError:  # the error file does not fit either (disk full): the exit code alone must tell
         return EXIT_STORAGE
     return code
+
+
+def _plan_mismatch(exc: BaseException) -> bool:
+    """Whether ``exc`` says the cell process is not what its plan was made with (``PlanMismatchError``).
+
+    Looked up in ``sys.modules``, not imported: such an error was raised by the loaded module, and a cell
+    whose imports failed must still have its failure recorded.
+    """
+    errors = sys.modules.get("albot1.bench.errors")
+    return errors is not None and isinstance(exc, errors.PlanMismatchError)
 
 
 def storage_error(exc: BaseException) -> OSError | None:

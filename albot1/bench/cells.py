@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any, cast
 
 from albot1 import versions
-from albot1.bench.errors import BenchError
+from albot1.bench.errors import BenchError, PlanMismatchError
 from albot1.bench.grid import Cell
 from albot1.config.targets import resolve_target
 from albot1.data.model import Sequence
@@ -72,7 +72,7 @@ def config_difference(planned: dict[str, Any], ran: dict[str, Any]) -> str:
 
 
 def check_versions(cell: Cell, ran: Mapping[str, str | None]) -> None:
-    """BenchError naming each version that differs between the cell's plan and its run (``ran``: a versions block).
+    """PlanMismatchError naming each version that differs between the cell's plan and its run (``ran``: versions).
 
     The cell's key digests the versions planned (:attr:`Cell.versions`); a run with others (a library or MRPT
     upgraded while the grid ran, a Dask worker with another install) would be stored under a key naming versions
@@ -80,7 +80,7 @@ def check_versions(cell: Cell, ran: Mapping[str, str | None]) -> None:
     """
     found = versions.key_versions(ran)
     if found != cell.versions:
-        raise BenchError(
+        raise PlanMismatchError(
             f"{cell.describe()}: the versions in the cell process differ from the planned ones "
             f"({config_difference(cell.versions, found)}); was a library or MRPT installed while the grid was "
             "planned or running, or does this worker run another install? Install the same versions and run it again"
@@ -116,7 +116,7 @@ def execute_cell(
             preview=preview,
         )
         if written.name != cell.key:
-            raise BenchError(f"{cell.describe()}: stored under {written.name}, expected key {cell.key}")
+            raise PlanMismatchError(f"{cell.describe()}: stored under {written.name}, expected key {cell.key}")
         return written
     sequence: Sequence | None = (
         None  # opened only to run the cell; a run stored earlier is only evaluated (it reopens its data)
@@ -134,7 +134,7 @@ def execute_cell(
             registry=registry,
         )
         if result.config != cell.config:
-            raise BenchError(
+            raise PlanMismatchError(
                 f"{cell.describe()}: the config resolved in the cell process differs from the "
                 f"planned one ({config_difference(cell.config or {}, result.config)}); did a "
                 "baselines/*.toml file or an ALBOT1_* variable change during the run?"
@@ -142,7 +142,7 @@ def execute_cell(
         check_versions(cell, result.versions)
         written = write_run(result, runs_root, preview=preview)
         if written.name != cell.key:
-            raise BenchError(
+            raise PlanMismatchError(
                 f"{cell.describe()}: stored under {written.name}, expected key {cell.key} "
                 "(the code or a data file changed while the grid was running?)"
             )

@@ -11,3 +11,12 @@ class BenchError(Albot1Error):
 
 class SuiteError(BenchError):
     """A suite file does not parse or names something that does not exist (message names file and key)."""
+
+
+class PlanMismatchError(BenchError):
+    """A cell's process is not what its plan was made with: other versions, config or key than planned.
+
+    Not the method's failure: the install or the files changed under the grid (or a worker runs another
+    install), so a cell process records it as an ``executor`` failure, which no ``allow_failure`` allows and
+    the next run retries (:func:`albot1.bench.cell_main._report`), not as the method's own error.
+    """

@@ -106,15 +106,13 @@ def _resolve(suite: Suite, entry: MethodEntry, registry: MethodRegistry) -> tupl
     return config.model_dump(mode="json"), None
 
 
-def _program_versions(spec: MethodSpec, problem: str | None) -> tuple[dict[str, str | None], str | None]:
+def _program_versions(spec: MethodSpec) -> tuple[dict[str, str | None], str | None]:
     """The versions of the programs a cell of ``spec`` will run (in its key), and why the cell cannot run.
 
     Read once per method and plan (:meth:`MethodSpec.program_versions`; the MRPT mapper keeps its answer while
-    the executable is the same file). A method whose class does not load (``problem``) or whose
-    ``program_versions`` fails is keyed without them, and its cells fail with the reason.
+    the executable is the same file), for a method of which an entry resolved (the others fail with their own
+    reason). A method whose ``program_versions`` fails is keyed without them, and its cells fail with the reason.
     """
-    if problem is not None:
-        return {}, problem
     try:
         return spec.program_versions(), None
     except Exception as exc:  # a plugin's program_versions is broken: a cell failure, not a runner crash
@@ -269,10 +267,11 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
     code = versions.code_version()
     methods, skipped_methods = _methods(suite, registry)
     resolved = {entry.display: _resolve(suite, entry, registry) for entry in methods if entry.trajectories is None}
-    programs_of = {  # method name -> (its programs' versions, why its cells cannot run)
-        entry.name: _program_versions(registry.get(entry.name), resolved[entry.display][1])
-        for entry in methods
-        if entry.trajectories is None
+    # method name -> (its programs' versions, why they cannot be read): once per method, for the methods of which
+    # an entry resolved (an entry's config problem is its own, not its method's other entries')
+    programs_of = {
+        name: _program_versions(registry.get(name))
+        for name in dict.fromkeys(e.name for e in methods if e.trajectories is None and resolved[e.display][1] is None)
     }
     programs: dict[str, str | None] = {}  # of the methods that have cells, for the report (machine_info)
     cells: list[Cell] = []
@@ -307,7 +306,7 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
                 if seed != sweep_seeds[0] and _runs_once(degradation, entry.name, registry):
                     continue
                 config, problem = resolved[entry.display]
-                ran, versions_problem = programs_of[entry.name]
+                ran, versions_problem = programs_of.get(entry.name, ({}, None))
                 problem = problem or versions_problem
                 # the versions block the cell's run will record (albot1.runs.execute), so its folder is found again
                 planned = versions.run_versions(ran, registry.get(entry.name).plugin)

@@ -14,20 +14,25 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
+from typing import Any
 
 import pytest
 
 from albot1 import versions
 from albot1.bench import job
+from albot1.bench import plan as plan_module
 from albot1.bench.cells import execute_cell
 from albot1.bench.errors import BenchError
 from albot1.bench.external import dataset_stem
 from albot1.bench.grid import Cell, GridPlan
 from albot1.bench.plan import plan_suite
+from albot1.bench.runner import kept_failure
+from albot1.bench.store import ResultsStore
 from albot1.bench.suite import load_suite
 from albot1.data.loaders.registry import writer_for
 from albot1.data.open import open_sequence
 from albot1.data.trajectory import write_tum
+from albot1.methods.registry import resolve_config
 from albot1.settings import Settings
 
 WORLD = "synthetic-office-startstop[:12]"
@@ -200,3 +205,44 @@ def test_a_dask_worker_with_another_library_runs_no_cell_and_says_which(
     assert outcome.reason is not None and outcome.reason.endswith(
         f"has gtsam 9.9 (planned with {cell.versions['gtsam']}); install the same library versions on every worker"
     )
+
+
+def test_a_run_refused_for_other_versions_is_no_allowed_method_failure_and_is_not_kept(tmp_path: Path) -> None:
+    """The refusal is the environment's fault (another MRPT on a worker, an upgrade mid-grid), not the method's.
+
+    Recorded as the method's own error (kind ``exception``) it was allowed by ``allow_failure`` (``albot1 bench``
+    exited 0 with MRPT "failing") and kept on every later run with the same plan, even once the install was fixed.
+    """
+    cell = replace(_cell(tmp_path), allow_failure=True)
+    planned = replace(cell, versions={**cell.versions, "numpy": "0.0.1-planned"})
+    outcome = job.run_cell_job(planned, str(tmp_path / "results"))
+    assert (outcome.status, outcome.kind, outcome.allowed) == ("failed", "executor", False)
+    assert outcome.reason is not None and "numpy: planned '0.0.1-planned'" in outcome.reason
+    assert kept_failure(ResultsStore(tmp_path / "results"), planned) is None  # the next run tries it again
+
+
+def test_an_entry_whose_config_cannot_be_resolved_leaves_the_other_entries_of_its_method_alone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The program versions are read once per method, but a config problem is one entry's, not every entry's.
+
+    They were read per method with the problem of whichever entry of it came last, so a broken second entry
+    (a config model raising for its ``set``) failed the first entry's cells with its reason and left their keys
+    without the program versions their runs record.
+    """
+    real = resolve_config
+
+    def broken_for_overrides(method: str, preset: str, overrides: dict[str, Any], *args: Any, **kwargs: Any) -> Any:
+        if overrides:
+            raise RuntimeError("the config model fails on this entry's settings")
+        return real(method, preset, overrides, *args, **kwargs)
+
+    monkeypatch.setattr(plan_module, "resolve_config", broken_for_overrides)
+    suite = tmp_path / "two.toml"
+    suite.write_text(
+        '[[methods]]\nname = "kiss-icp"\n\n[[methods]]\nname = "kiss-icp"\nlabel = "kiss-icp-wide"\n'
+        f'set = {{ voxel_size_m = 0.3 }}\n\n[[datasets]]\nname = "{WORLD}"\nsweep = false\n'
+    )
+    plan = plan_suite(load_suite(suite), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    failing = {cell.method_label for cell in plan.cells if cell.key in plan.config_failures}
+    assert failing == {"kiss-icp-wide"}
