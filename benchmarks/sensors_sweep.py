@@ -113,6 +113,8 @@ METHODS = (
     ("gtsam-graph", ()),
     ("mrpt-icp", ()),
 )
+#: Run only when named (``--method mrpt-rbpf``): the particle filter is not in the default sweep.
+EXTRA_METHODS = (("mrpt-rbpf", ()),)
 ODOMETRY = (("noisy", ""), ("perfect", "?odometry=reference"))
 
 
@@ -277,7 +279,7 @@ def run(
         if not sensors or s.name in sensors
         for odo, query in ODOMETRY
         if not odometry or odo in odometry
-        for m, extra in METHODS
+        for m, extra in METHODS + (EXTRA_METHODS if methods else ())
         if (not methods or m + (f":{extra[1]}" if extra else "") in methods)
         and (s.name, m + (f":{extra[1]}" if extra else ""), odo) not in done
     ]
