@@ -96,10 +96,11 @@ def cast(walls: ArrayLike, pose: ArrayLike, angles: ArrayLike, max_range: float)
     """Exact ranges of one scan taken at ``pose`` (x, y, theta): NaN where no wall is within ``max_range``.
 
     The sensor sits at the pose's origin looking along its heading; ``angles``
-    must be ascending. Walls are two-sided: a ray stops at the first segment
-    it meets, whichever side. A ray running exactly along a wall does not hit
-    it (zero-thickness walls have no end face); in a closed plan it stops at
-    the next wall meeting that one at a corner.
+    must be ascending, in any range (0 to 2 pi as well as -pi to pi). Walls
+    are two-sided: a ray stops at the first segment it meets, whichever side.
+    A ray running exactly along a wall does not hit it (zero-thickness walls
+    have no end face); in a closed plan it stops at the next wall meeting that
+    one at a corner.
     """
     ranges: FloatArray = cast_many(walls, np.asarray(pose, dtype=float).reshape(1, 3), angles, max_range)[0]
     return ranges
@@ -122,6 +123,16 @@ def cast_many(
     beam = np.asarray(angles, dtype=float)
     if beam.ndim != 1 or np.any(np.diff(beam) < 0):
         raise SyntheticWorldError("laser: beam angles must be a 1-D ascending array")
+    outside = (beam < -math.pi) | (beam > math.pi)
+    if outside.any():
+        # Walls are found by their bearings in [-pi, pi]; a beam given beyond them (a 360-degree scanner
+        # from 0 to 359 deg, as a TurtleBot's LDS-01 reports) is cast at its bearing there and put back in
+        # its place. Such beams used to find no wall at all: every beam past 180 deg read "no return".
+        wrapped = np.where(outside, np.remainder(beam + math.pi, 2.0 * math.pi) - math.pi, beam)
+        order = np.argsort(wrapped, kind="stable")
+        ranges = np.empty((len(p), len(beam)))
+        ranges[:, order] = cast_many(seg, p, wrapped[order], max_range, batch=batch)
+        return ranges
     out = np.full((len(p), len(beam)), np.inf)
     if len(seg) and len(beam):
         cos_b, sin_b = np.cos(beam), np.sin(beam)

@@ -76,6 +76,8 @@ class _BagSource:
     outside: str
     #: largest gap (s) between the two pose messages a scan's pose is interpolated between (loaders/base.py)
     max_gap: float = DEFAULT_MAX_POSE_GAP_S
+    #: the laser is mounted upside down (mounting.Mounting.mirrored): every scan's beam angles are mirrored
+    mirrored: bool = False
 
     def __post_init__(self) -> None:
         self._tracks: tuple[PoseTrack, PoseTrack | None] | None = None
@@ -171,7 +173,7 @@ class _BagSource:
             problem = reading_problem(raw, geometry[2], geometry[3])
         if problem is not None:
             raise ParseError(self.shown, f"topic {self.choice.scan}: LaserScan {problem}", index=index)
-        ranges, angles = scan_arrays(raw, *geometry)
+        ranges, angles = scan_arrays(raw, *geometry, mirrored=self.mirrored)
         if ranges.shape[0] < n and not self._seam_said:
             self._seam_said = True
             log.warning(seam_note(str(self.shown), f"topic {self.choice.scan} (message #{index})", n))
@@ -211,7 +213,14 @@ def _load_bag(bag: Path, shown: Path, name: str, format_name: str, options: dict
                 raise TopicError(f"{shown}: topic {topic} ({role}) has no messages; expected at least one")
         mounting = bag_mounting(reader, shown, topics, choice, opts["base_frame"], opts["odom_frame"])
     source = _BagSource(
-        bag, shown, choice, opts["odom_frame"], opts["base_frame"], opts["outside_odometry"], opts["max_pose_gap"]
+        bag,
+        shown,
+        choice,
+        opts["odom_frame"],
+        opts["base_frame"],
+        opts["outside_odometry"],
+        opts["max_pose_gap"],
+        mounting.mirrored,
     )
     odom_desc = (
         f"{choice.odom} transforms {opts['odom_frame']} -> {opts['base_frame'] or '(its only child)'}"

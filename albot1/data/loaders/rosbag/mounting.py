@@ -16,11 +16,17 @@ tree does not reach the laser (older bags publish mounts on ``/tf``), adding
 the links the static tree lacks and taking each link's first transform (a
 mount is rigid). Odometry on ``/tf`` names its base as an Odometry topic does
 (the child of ``odom_frame``), so a laser tree that does not reach it gets
-the same warning, never an unrelated root's mount. A laser tilted more than
-:data:`MAX_TILT_DEG` from the base's plane (mounted upside down, or looking
-at the floor) cannot be put on the plane by an (x, y, yaw) offset and is
-refused. When no transform is found the offset is zero and the result says
-so; the loader logs it as a warning and records it in the metadata.
+the same warning, never an unrelated root's mount. A laser mounted upside
+down (its z axis within :data:`MAX_TILT_DEG` of the base's -z, a roll or
+pitch of pi, as many robots carry a Hokuyo under a plate) still scans the
+base's plane, but its y axis points to the base's right: a beam at angle
+``a`` of the scan lies at ``-a`` in the plane. Its mount is the (x, y, yaw)
+of its x axis and ``mirrored`` is set, for the loader to mirror each scan's
+beam angles (``msg.scan_arrays``); such a mount used to be refused, so no
+bag of such a robot could be read. A laser tilted more than
+:data:`MAX_TILT_DEG` from both (looking at the floor) cannot be put on the
+plane and is refused. When no transform is found the offset is zero and the
+result says so; the loader logs it as a warning and records it in the metadata.
 """
 
 from __future__ import annotations
@@ -59,6 +65,8 @@ class Mounting:
     offset: tuple[float, float, float]
     found: bool
     note: str
+    #: mounted upside down: beam angle ``a`` of a scan lies at ``-a`` in the base's plane
+    mirrored: bool = False
 
 
 @dataclass(frozen=True)
@@ -139,7 +147,8 @@ def _chain(links: Mapping[str, _Link], laser: str, base: str | None, odom_frame:
     return path[::-1]
 
 
-def _planar(path: list[_Link], laser: str, base: str, shown: Path) -> tuple[float, float, float]:
+def _planar(path: list[_Link], laser: str, base: str, shown: Path) -> tuple[tuple[float, float, float], bool]:
+    """The (x, y, yaw) of the laser on the base's plane, and whether it is mounted upside down (mirrored)."""
     from scipy.spatial.transform import Rotation
 
     translation, rotation = np.zeros(3), Rotation.identity()
@@ -148,14 +157,16 @@ def _planar(path: list[_Link], laser: str, base: str, shown: Path) -> tuple[floa
         rotation = rotation * link.rotation
     z_axis = rotation.apply([0.0, 0.0, 1.0])
     tilt = math.degrees(math.acos(max(-1.0, min(1.0, float(z_axis[2])))))
-    if tilt > MAX_TILT_DEG:
+    mirrored = tilt >= 180.0 - MAX_TILT_DEG
+    if MAX_TILT_DEG < tilt < 180.0 - MAX_TILT_DEG:
         raise DataError(
             f"{shown}: the laser frame {laser!r} is tilted {tilt:.1f} deg from the base frame {base!r} "
-            f"(upside down or not level); expected at most {MAX_TILT_DEG} deg, as a 2D scan is taken in the "
-            f"base's plane"
+            f"(not level); expected at most {MAX_TILT_DEG} deg (or upside down within {MAX_TILT_DEG} deg), as a "
+            f"2D scan is taken in the base's plane"
         )
     x_axis = rotation.apply([1.0, 0.0, 0.0])
-    return float(translation[0]), float(translation[1]), math.atan2(float(x_axis[1]), float(x_axis[0]))
+    yaw = math.atan2(float(x_axis[1]), float(x_axis[0]))
+    return (float(translation[0]), float(translation[1]), yaw), mirrored
 
 
 def read_mounting(
@@ -187,9 +198,11 @@ def read_mounting(
             return Mounting((0.0, 0.0, 0.0), True, f"the scans' frame {laser!r} is the base frame ({where})")
         if path is not None:
             base = base_frame or path[0].parent
-            offset = _planar(path, laser, base, shown)
+            offset, mirrored = _planar(path, laser, base, shown)
             shown_offset = ", ".join(f"{v:.6g}" for v in offset)
-            return Mounting(offset, True, f"{where} {base} -> {laser}: (x, y, yaw) = ({shown_offset})")
+            flipped = "; mounted upside down: beam angles mirrored (a -> -a)" if mirrored else ""
+            note = f"{where} {base} -> {laser}: (x, y, yaw) = ({shown_offset}){flipped}"
+            return Mounting(offset, True, note, mirrored)
     where = " or ".join(searched) if searched else "the bag (it has no /tf_static or /tf topic)"
     base = base_frame or "the base frame"
     return Mounting(

@@ -163,7 +163,13 @@ def quaternion_from_yaw(theta: float) -> tuple[float, float, float, float]:
 
 
 def scan_arrays(
-    ranges: ArrayLike, angle_min: float, angle_increment: float, range_min: float, range_max: float
+    ranges: ArrayLike,
+    angle_min: float,
+    angle_increment: float,
+    range_min: float,
+    range_max: float,
+    *,
+    mirrored: bool = False,
 ) -> tuple[FloatArray, FloatArray]:
     """``(ranges, angles)`` of a LaserScan in the data model's conventions.
 
@@ -179,12 +185,17 @@ def scan_arrays(
     the caller sees fewer ranges than the message holds and says so. A
     negative increment (a clockwise scanner, or one mounted upside down) is
     reversed so angles ascend as the model requires; ranges are reversed with
-    them.
+    them. ``mirrored``: the laser is mounted upside down
+    (:class:`~albot1.data.loaders.rosbag.mounting.Mounting`), so beam ``i``
+    lies at ``-(angle_min + i * angle_increment)`` in the base's plane: the
+    angles are negated, then ordered as above.
     """
     r = np.asarray(ranges, dtype=np.float64).copy()
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(r) | (r < float(range_min)) | (r > float(range_max)) | (r == 0.0)
     r[bad] = np.nan
+    if mirrored:
+        angle_min, angle_increment = -angle_min, -angle_increment
     angles = float(angle_min) + np.arange(r.shape[0], dtype=np.float64) * float(angle_increment)
     if seam_repeat(angles):
         r, angles = r[:-1], angles[:-1]

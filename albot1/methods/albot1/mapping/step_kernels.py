@@ -41,7 +41,7 @@ from albot1.methods.albot1.mapping.ambiguity import measurement_costs
 from albot1.methods.albot1.mapping.pose_kernels import refine_pose, scan_points
 from albot1.methods.albot1.perception.kernels import build_view, landmark_rows
 from albot1.methods.albot1.perception.landmarks import Landmarks
-from albot1.methods.albot1.perception.view import View, ViewParams
+from albot1.methods.albot1.perception.view import View, ViewParams, seam_at_gap
 
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
@@ -178,8 +178,12 @@ def perceive_scan(
     ``points_stride`` 0: no points (``(0, 2)``). The beams are passed as
     :func:`~albot1.methods.albot1.compiled.readonly_float64` arrays, as
     Albot1+'s points were, so the kernel has one signature. ``kernel``:
-    :func:`perceive`, compiled or as written.
+    :func:`perceive`, compiled or as written. A 360-degree scan starts at its
+    widest gap, as in ``construct_view`` (:func:`.view.seam_at_gap`).
     """
+    ranges, angles = seam_at_gap(
+        np.asarray(ranges, dtype=np.float64), np.asarray(angles, dtype=np.float64), params.max_range
+    )
     surfaces, kinds, beams, cluster, rows, lm_surfaces, lm_kinds, points = kernel(
         readonly_float64(ranges),
         readonly_float64(angles),

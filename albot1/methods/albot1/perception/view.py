@@ -78,15 +78,52 @@ class View:
         return np.hypot(s[:, 2] - s[:, 0], s[:, 3] - s[:, 1])
 
 
+def seam_at_gap(ranges: FloatArray, angles: FloatArray, max_range: float) -> tuple[FloatArray, FloatArray]:
+    """A full-turn scan's beams restarted at its widest gap between returns; any other scan as it is.
+
+    A view treats a scan's beams as an arc with two ends: a surface cannot run past the first or last beam,
+    and an end there is unstable (the field of view cuts it). A 360-degree scanner has no such edge, but its
+    beams still begin somewhere (a TurtleBot's LDS-01 at 0 deg, straight ahead), so a wall across that seam
+    was cut in two with two unstable ends where it is continuous. The seam is moved to the widest gap
+    between consecutive returns (circularly; beams without a return, as step 1 of the view drops them, do
+    not count), where clustering would break the wall anyway when the gap exceeds the cluster gap. The
+    beams from there to the end are put first and the rest after them, their angles 2 pi on, so angles still
+    ascend. A scan is a full turn when the gap its beams leave between the last and the first is at most
+    1.5 of their mean spacing.
+    """
+    n = angles.shape[0]
+    if n < 3:
+        return ranges, angles
+    span = float(angles[-1] - angles[0])
+    if not (0.0 < span and 2.0 * math.pi - span <= 1.5 * span / (n - 1)):
+        return ranges, angles
+    with np.errstate(invalid="ignore"):
+        hit = np.flatnonzero(np.isfinite(ranges) & (ranges > 0.0) & (ranges <= max_range))
+    if hit.size < 2:
+        return ranges, angles
+    x, y = ranges[hit] * np.cos(angles[hit]), ranges[hit] * np.sin(angles[hit])
+    gaps = np.hypot(np.roll(x, -1) - x, np.roll(y, -1) - y)  # return k to return k + 1, the last to the first
+    start = int(hit[(int(np.argmax(gaps)) + 1) % hit.size])
+    if start == 0:
+        return ranges, angles
+    turned = np.concatenate([angles[start:], angles[:start] + 2.0 * math.pi])
+    return np.concatenate([ranges[start:], ranges[:start]]), turned
+
+
 def construct_view(
     ranges: FloatArray, angles: FloatArray, params: ViewParams, kernels: PerceptionKernels | None = None
 ) -> View:
     """``constructView`` of Algorithm 4 for a REP-103 scan (angles ascending, counter-clockwise).
 
     The thesis orders surfaces left to right, i.e. by *descending* beam
-    angle, so the beams are reversed before the pass.
+    angle, so the beams are reversed before the pass. A 360-degree scan
+    starts at its widest gap (:func:`seam_at_gap`); ``View.beams`` then count
+    from there.
     """
     k = kernels or PerceptionKernels()
+    ranges, angles = seam_at_gap(
+        np.asarray(ranges, dtype=np.float64), np.asarray(angles, dtype=np.float64), params.max_range
+    )
     r = np.ascontiguousarray(np.asarray(ranges, dtype=np.float64)[::-1])
     a = np.ascontiguousarray(np.asarray(angles, dtype=np.float64)[::-1])
     surfaces, kinds, beams, cluster = k.build_view(

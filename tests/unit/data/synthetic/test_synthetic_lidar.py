@@ -66,6 +66,16 @@ def test_a_full_circle_scanner_sees_behind_itself() -> None:
         np.testing.assert_allclose(got, square_ranges(1.5, laser.angles + heading), atol=1e-12)
 
 
+@pytest.mark.parametrize("first_deg", [0.0, -360.0, 90.0])
+def test_beams_given_beyond_plus_minus_180_deg_hit_the_walls_there(first_deg: float) -> None:
+    # A TurtleBot's LDS-01 lists its 360 beams from 0 to 359 deg: the beams past 180 deg (behind and to the
+    # right) used to hit nothing and read NaN. Each beam must read the square's wall along its own direction.
+    angles = np.radians(first_deg + np.arange(360.0))
+    for heading in (0.0, 0.7, -2.5):
+        got = cast(square(1.5), [0.0, 0.0, heading], angles, 30.0)
+        np.testing.assert_allclose(got, square_ranges(1.5, angles + heading), rtol=0, atol=1e-12)
+
+
 def test_off_centre_pose_against_a_hand_computed_scan() -> None:
     got = cast(square(2.0), [1.0, 0.5, 0.0], SICK.angles, 30.0)
     assert got[90] == pytest.approx(1.0)  # forward to x = 2

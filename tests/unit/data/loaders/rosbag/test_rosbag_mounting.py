@@ -109,9 +109,13 @@ def _tf(ts: Any, msgs: RosMessages, ns: int, links: list[tuple[str, str, tuple[f
 
 
 def write_bag(
-    path: Path, topic: str | None, links: list[tuple[str, str, tuple[float, ...], tuple[float, ...]]]
+    path: Path,
+    topic: str | None,
+    links: list[tuple[str, str, tuple[float, ...], tuple[float, ...]]],
+    scans: Sequence | None = None,
 ) -> None:
-    """Scans in frame ``laser``, odometry of ``base_link``, and ``links`` on ``topic`` (None: no tf at all)."""
+    """Scans in frame ``laser`` (``scans``, else ``sequence(3)``), odometry of ``base_link``, and ``links`` on
+    ``topic`` (None: no tf at all)."""
     from rosbags.rosbag2 import Writer
     from rosbags.typesys import Stores, get_typestore
 
@@ -121,7 +125,7 @@ def write_bag(
         scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
         odom = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
         tf = bag.add_connection(topic, "tf2_msgs/msg/TFMessage", typestore=ts) if topic else None
-        for f in sequence(3).frames():
+        for f in (sequence(3) if scans is None else scans).frames():
             ns = seconds_to_ns(f.scan.timestamp)
             if tf is not None:
                 bag.write(tf, ns, ts.serialize_cdr(_tf(ts, msgs, ns, links), "tf2_msgs/msg/TFMessage"))
@@ -161,7 +165,7 @@ def test_chained_mount_on_tf_composes_to_the_base(tmp_path: Path) -> None:
     assert loaded.metadata.extra["sensor_offset_source"].startswith("/tf base_link -> laser:")
 
 
-def test_small_tilt_is_projected_and_upside_down_refused(tmp_path: Path) -> None:
+def test_small_tilt_is_projected_and_a_laser_looking_down_refused(tmp_path: Path) -> None:
     tilt = math.radians(2.0)  # 2 deg roll: projected onto the plane
     write_bag(
         tmp_path / "tilted",
@@ -169,9 +173,49 @@ def test_small_tilt_is_projected_and_upside_down_refused(tmp_path: Path) -> None
         [("base_link", "laser", (0.1, 0.0, 0.2), (math.sin(tilt / 2), 0, 0, math.cos(tilt / 2)))],
     )
     assert Ros2BagLoader().load(tmp_path / "tilted").metadata.sensor_offset == pytest.approx((0.1, 0.0, 0.0), abs=1e-12)
-    write_bag(tmp_path / "flipped", "/tf_static", [("base_link", "laser", (0.1, 0.0, 0.2), (1.0, 0.0, 0.0, 0.0))])
-    with pytest.raises(DataError, match=r"the laser frame 'laser' is tilted 180.0 deg from the base frame 'base_link'"):
-        Ros2BagLoader().load(tmp_path / "flipped")
+    pitch = math.radians(30.0)  # looking at the floor: neither level nor upside down
+    write_bag(
+        tmp_path / "down",
+        "/tf_static",
+        [("base_link", "laser", (0.1, 0.0, 0.2), (0, math.sin(pitch / 2), 0, math.cos(pitch / 2)))],
+    )
+    with pytest.raises(DataError, match=r"the laser frame 'laser' is tilted 30.0 deg from the base frame 'base_link'"):
+        Ros2BagLoader().load(tmp_path / "down")
+
+
+def distinct_ranges(n: int = 2) -> Sequence:
+    """Scans whose every beam has its own range (1 m + 1 cm per beam), so a mirrored beam order shows."""
+    ranges = 1.0 + 0.01 * np.arange(ANGLES.size)
+    frames = [
+        Frame(i, Scan(ranges.copy(), ANGLES.copy(), 10.0 + i, 30.0), np.array([0.5 * i, 0.0, 0.0])) for i in range(n)
+    ]
+    return Sequence.from_frames("distinct", frames)
+
+
+@pytest.mark.parametrize(
+    ("quaternion", "yaw"),
+    [
+        ((1.0, 0.0, 0.0, 0.0), 0.0),  # rolled by pi: facing forwards, its y axis to the robot's right
+        ((0.0, 1.0, 0.0, 0.0), math.pi),  # pitched by pi: facing backwards, upside down
+        ((math.cos(0.25), math.sin(0.25), 0.0, 0.0), 0.5),  # yawed 0.5 rad, then rolled by pi
+    ],
+)
+def test_upside_down_laser_is_read_with_mirrored_beams(
+    tmp_path: Path, quaternion: tuple[float, float, float, float], yaw: float
+) -> None:
+    # A laser rolled (or pitched) by pi scans the base's plane with its y axis pointing right: a beam at
+    # angle a of its scan lies at -a on the plane. Such a mount used to be refused as "tilted 180.0 deg".
+    write_bag(
+        tmp_path / "flipped", "/tf_static", [("base_link", "laser", (0.1, 0.0, 0.2), quaternion)], distinct_ranges()
+    )
+    loaded = Ros2BagLoader().load(tmp_path / "flipped")
+    assert loaded.metadata.sensor_offset == pytest.approx((0.1, 0.0, yaw), abs=1e-12)
+    assert loaded.metadata.extra["sensor_offset_source"].endswith("mounted upside down: beam angles mirrored (a -> -a)")
+    written = ANGLES.astype(np.float32).astype(np.float64)  # the message's float32 angle_min and increment
+    for frame in loaded.frames():
+        # the beam written at angle a (range 1 m + 1 cm * its index) is read at -a, angles ascending
+        np.testing.assert_allclose(frame.scan.angles, -written[::-1], atol=1e-6)
+        np.testing.assert_allclose(frame.scan.ranges, (1.0 + 0.01 * np.arange(ANGLES.size))[::-1], atol=1e-6)
 
 
 def test_static_mount_not_reaching_the_odometry_base_is_missing(tmp_path: Path) -> None:

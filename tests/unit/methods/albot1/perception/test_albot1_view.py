@@ -234,3 +234,51 @@ def test_a_landmark_is_at_least_40_cm_long_with_an_occluding_or_corner_end(accel
     assert got.index.tolist() == [0, 2, 4]
     np.testing.assert_array_equal(got.surfaces, surfaces[[0, 2, 4]])
     np.testing.assert_array_equal(got.kinds, kinds[[0, 2, 4]])
+
+
+# A 360-degree scanner (a TurtleBot's LDS-01: 360 beams, 1 deg apart, beam 0 straight ahead): three separate
+# walls, one across the seam straight ahead (x = 3 from y = -1 to 1), one to the left (y = 4 from x = -2 to 2) and
+# one behind (x = -3 from y = -1.5 to 1.5).
+FULL_TURN_WALLS = np.array([[3.0, -1.0, 3.0, 1.0], [-2.0, 4.0, 2.0, 4.0], [-3.0, -1.5, -3.0, 1.5]])
+
+
+@pytest.mark.parametrize("first_deg", [0.0, -90.0, -180.0, 45.0])
+def test_full_turn_view_does_not_depend_on_where_the_beams_begin(first_deg: float) -> None:
+    # Each wall is one surface whatever beam the scanner starts from; a scan starting straight ahead (as the
+    # LDS-01 does) used to cut the wall ahead in two at its first beam, with two unstable "field of view" ends.
+    angles = np.radians(first_deg + np.arange(360.0))
+    ranges = cast(FULL_TURN_WALLS, np.zeros(3), angles, 30.0)
+    view = construct_view(ranges, angles, ViewParams())
+    assert len(view) == 3
+    rep = np.column_stack([view.surfaces[:, 1], -view.surfaces[:, 0], view.surfaces[:, 3], -view.surfaces[:, 2]])
+    ends = sorted(tuple(np.sort(row.reshape(2, 2), axis=0).ravel()) for row in rep)
+    # each surface runs between the hits of the outermost whole-degree beams on its wall: -18..18 deg on the wall
+    # ahead (its ends at +-18.4 deg), 64..116 deg on the left one, 154..206 deg on the one behind
+    t = math.tan
+    expected = [
+        (-3.0, -3.0 * t(math.radians(26.0)), -3.0, 3.0 * t(math.radians(26.0))),
+        (-4.0 / t(math.radians(64.0)), 4.0, 4.0 / t(math.radians(64.0)), 4.0),
+        (3.0, -3.0 * t(math.radians(18.0)), 3.0, 3.0 * t(math.radians(18.0))),
+    ]
+    np.testing.assert_allclose(ends, expected, rtol=0, atol=1e-9)
+    # Albot1+'s fused call (view, landmarks and points in one kernel) moves the seam the same way
+    from albot1.methods.albot1.mapping.step_kernels import perceive_scan
+
+    fused, _, _ = perceive_scan(ranges, angles, ViewParams(), 0.4, 30.0, 0)
+    np.testing.assert_array_equal(fused.surfaces, view.surfaces)
+    np.testing.assert_array_equal(fused.kinds, view.kinds)
+
+
+def test_seam_moves_only_for_a_full_turn() -> None:
+    from albot1.methods.albot1.perception.view import seam_at_gap
+
+    angles = np.radians(np.arange(360.0))
+    ranges = cast(FULL_TURN_WALLS, np.zeros(3), angles, 30.0)
+    r, a = seam_at_gap(ranges, angles, 30.0)
+    assert np.all(np.diff(a) > 0) and a[-1] - a[0] == pytest.approx(np.radians(359.0))
+    # the widest gap between returns lies between the back wall and the wall ahead, or the wall on the left
+    assert set(np.round(np.degrees(a[[0, -1]]) % 360.0)) != {0.0, 359.0}
+    np.testing.assert_array_equal(np.sort(r[np.isfinite(r)]), np.sort(ranges[np.isfinite(ranges)]))
+    half = np.radians(np.arange(-135.0, 135.25, 0.25))  # 270 deg: its own edges, never moved
+    r2, a2 = seam_at_gap(cast(FULL_TURN_WALLS, np.zeros(3), half, 30.0), half, 30.0)
+    assert a2 is half
