@@ -1,11 +1,10 @@
 """The velocity guess scaled by elapsed time (``track_velocity_time_scaled``): the ratio's edge cases, the scaled
-motion's numbers, which guess the tracker tries (ICP replaced by a stub, as in the stall tests), the mapper passing
-each scan's stamp, and the config's validation."""
+motion's numbers, the mapper passing each scan's stamp, and the config's validation (which guesses the tracker tries
+with it: ``test_gtsam_graph_velocity_guess.py``)."""
 
 from __future__ import annotations
 
 import math
-from collections import defaultdict
 from typing import Any
 
 import numpy as np
@@ -14,11 +13,8 @@ from pydantic import ValidationError
 
 from albot1.data.model import Frame, Scan
 from albot1.geometry import se2
-from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
-from albot1.methods.baselines.gtsam_graph.frontend import FrontEnd
 from albot1.methods.baselines.gtsam_graph.mapper import GtsamGraphMapper
-from albot1.methods.baselines.gtsam_graph.registration import Registration
 from albot1.methods.baselines.gtsam_graph.velocity_time import elapsed, scaled_velocity, time_ratio
 from albot1.methods.registry import resolve_config
 
@@ -53,71 +49,6 @@ def test_the_scaled_velocity_is_the_last_motion_repeated_over_the_elapsed_time()
     # duplicate stamps: unchanged, bit for bit
     assert scaled_velocity(motion, 0.0, 0.0, 10.0).tobytes() == motion.tobytes()
     assert scaled_velocity(motion, 0.1, 0.0, 10.0).tobytes() == motion.tobytes()
-
-
-def _front(scaled: bool, monkeypatch: pytest.MonkeyPatch) -> tuple[FrontEnd, list[list[np.ndarray]]]:
-    """A front end whose every ICP passes at its guess: the first try of a scan fits 0.8, a second (velocity) 0.9."""
-    cfg = _config(track_velocity_time_scaled=scaled)
-    counters: defaultdict[str, int] = defaultdict(int)
-    back = BackEnd(cfg, counters)
-    monkeypatch.setattr(back, "local_map", lambda: None)
-    front = FrontEnd(cfg, back, counters)
-    tried: list[list[np.ndarray]] = []
-
-    def attempt(target: Any, points: Any, guess: np.ndarray, *rest: Any) -> tuple[Registration, bool, bool]:
-        tried[-1].append(guess)
-        fitness = 0.8 if len(tried[-1]) == 1 else 0.9
-        return Registration(guess.copy(), True, 3, fitness, 0.01, 100, np.eye(3)), True, False
-
-    monkeypatch.setattr(front, "attempt", attempt)
-    return front, tried
-
-
-def _drive(
-    front: FrontEnd, tried: list[list[np.ndarray]], odometry: list[tuple[float, float, float]], stamps: list[float]
-) -> list[list[np.ndarray]]:
-    """Feed the odometry readings at their stamps (no node is made); the guesses each scan after the first tried."""
-    front.last_odometry, front.last_stamp = np.asarray(odometry[0], dtype=float), stamps[0]
-    for reading, stamp in zip(odometry[1:], stamps[1:], strict=True):
-        tried.append([])
-        pose, _ = front.step(np.asarray(reading, dtype=float), np.zeros((0, 2)), stamp)
-        front.track = pose
-        front.last_odometry, front.last_stamp = np.asarray(reading, dtype=float), stamp
-    return tried
-
-
-# 0.2 m per second, then two scans dropped: the last step is 0.6 m over 3 s (the odometry, perfect, says so).
-DROPPED = [(0.0, 0.0, 0.0), (0.2, 0.0, 0.0), (0.4, 0.0, 0.0), (1.0, 0.0, 0.0)]
-DROPPED_STAMPS = [0.0, 1.0, 2.0, 5.0]
-
-
-def test_after_dropped_scans_the_time_scaled_guess_agrees_with_the_odometry_and_no_slide_is_tried(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    front, tried = _front(False, monkeypatch)
-    last = _drive(front, tried, DROPPED, DROPPED_STAMPS)[-1]
-    assert len(last) == 2 and np.allclose(last[1], [0.6, 0.0, 0.0])  # per scan: 0.4 m short of the odometry
-    front, tried = _front(True, monkeypatch)
-    last = _drive(front, tried, DROPPED, DROPPED_STAMPS)[-1]
-    assert len(last) == 1 and np.allclose(last[0], [1.0, 0.0, 0.0])  # 3 s at 0.2 m/s: the odometry's own guess
-    assert front.counters["tracking_velocity_guess"] == 0
-    assert front.counters["tracking_velocity_time_scaled"] == 1
-
-
-@pytest.mark.parametrize(
-    "stamps",
-    [[0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 1.0, 4.0], [0.0, 1.0, 2.0, 1.5], [0.0, 1.0, 2.0, 2.0], [math.nan] * 4],
-    ids=["all-zero", "duplicate-then-jump", "backwards", "duplicate-last", "unknown"],
-)
-def test_stamps_that_say_nothing_leave_the_per_scan_guess_as_with_the_setting_off(
-    stamps: list[float], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    front, tried = _front(False, monkeypatch)
-    off = _drive(front, tried, DROPPED, stamps)
-    front, tried = _front(True, monkeypatch)
-    on = _drive(front, tried, DROPPED, stamps)
-    assert [[g.tobytes() for g in scan] for scan in on] == [[g.tobytes() for g in scan] for scan in off]
-    assert "tracking_velocity_time_scaled" not in front.counters
 
 
 def test_the_mapper_hands_each_scan_s_stamp_to_the_tracker(monkeypatch: pytest.MonkeyPatch) -> None:
