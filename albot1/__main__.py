@@ -8,7 +8,7 @@ package and cannot be directly executed").
 
 from __future__ import annotations
 
-from albot1.cli.app import main
+from albot1.cli.entry import main
 
 if __name__ == "__main__":
     main()

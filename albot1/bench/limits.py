@@ -148,11 +148,15 @@ def start_forkserver(methods: Iterable[str] | None = None) -> None:
     A server already running is kept as it is.
     """
     if launcher() == "forkserver":
-        from multiprocessing import forkserver
+        from multiprocessing import forkserver, resource_tracker
 
         _forkserver()
         with _START_LOCK, _preloading(methods):  # cell threads call this too: one environment change at a time
-            forkserver.ensure_running()
+            # The server's resource tracker first: starting it unblocks SIGINT in this thread (multiprocessing's
+            # own hold, released with SIG_UNBLOCK), which would undo the hold below.
+            resource_tracker.ensure_running()
+            with _sigint_held():
+                forkserver.ensure_running()
 
 
 @contextmanager
@@ -170,6 +174,26 @@ def _preloading(methods: Iterable[str] | None) -> Iterator[None]:
             os.environ.pop(METHODS_ENV, None)
         else:
             os.environ[METHODS_ENV] = before
+
+
+@contextmanager
+def _sigint_held() -> Iterator[None]:
+    """SIGINT blocked in this thread while it starts the server, which inherits the mask through ``exec``.
+
+    Ctrl-C reaches the whole process group, the server too. In its first ~0.1 s (Python's start, ``site``,
+    multiprocessing's imports: before :mod:`albot1.bench.preload` can take SIGINT's default action) a Ctrl-C
+    printed a KeyboardInterrupt traceback from the server above the runner's one line, and so did the SIGINT
+    the runner hands on after a SIGTERM. Blocked, it waits until the preload's first line unblocks it: the
+    server then ends at once and silently, as during the rest of its preload. Ignoring it instead would lose
+    it: the server would preload on (tens of seconds of cold compiles) after the runner stopped. Only this
+    thread's mask changes: a SIGINT to the runner is handled by its main thread as usual (or, when this is the
+    main thread, a few milliseconds later).
+    """
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
 def launcher() -> str:

@@ -18,21 +18,7 @@ of a method left out imports and warms it up itself).
 
 from __future__ import annotations
 
-import contextlib
-import functools
-import gc
-import importlib
-import logging
-import os
 import signal
-import sys
-from collections.abc import Callable, Collection, Iterable
-from typing import TYPE_CHECKING
-
-from albot1 import versions
-
-if TYPE_CHECKING:
-    from albot1.methods.registry import MethodRegistry, MethodSpec
 
 # Ctrl-C reaches the whole process group, this server too, and its preload (a cold numba compile takes tens of
 # seconds) is what it interrupts. Python's KeyboardInterrupt escaped ``multiprocessing.forkserver.main``, which
@@ -41,8 +27,28 @@ if TYPE_CHECKING:
 # preloads, the server takes SIGINT's default action: it ends at once and says nothing (the runner says what
 # happened, and its compile helpers end the same way, :func:`albot1.methods.albot1.warm_up.helper_main`).
 # Put back at the end (:func:`_preloaded`): the server hands its SIGINT handler to every cell it forks, which
-# records Ctrl-C as "interrupted".
+# records Ctrl-C as "interrupted". First thing, before the module's other imports (in which a Ctrl-C still printed
+# the traceback; docs/benchmarking.md, "The runner").
 _SIGINT_BEFORE = signal.signal(signal.SIGINT, signal.SIG_DFL)
+# The runner started this server with SIGINT blocked (albot1.bench.limits._sigint_held): a Ctrl-C in the server's
+# own start waited for this line, and now ends it as it would during the preload.
+signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+import contextlib  # noqa: E402
+import functools  # noqa: E402
+import gc  # noqa: E402
+import importlib  # noqa: E402
+import logging  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
+from collections.abc import Callable, Collection, Iterable  # noqa: E402
+from typing import TYPE_CHECKING  # noqa: E402
+
+from albot1 import versions  # noqa: E402
+
+if TYPE_CHECKING:
+    from albot1.methods.registry import MethodRegistry, MethodSpec
+
 
 # First, before the slow imports: every cell forked from this server shares this value, so the cells of
 # one grid agree on the code version the runner planned with (see albot1.bench.cells).

@@ -94,8 +94,10 @@ def main() -> None:
     Typer's standalone mode already turns usage errors into a usage message
     with exit 2; the project's own errors, and the operating system's refusals
     that reach this far (a disk that fills up mid-command, a file whose
-    permissions changed), are one line naming the path (Typer itself turns
-    Ctrl-C into exit 130). Any other exception is a bug and keeps its traceback.
+    permissions changed), are one line naming the path. Any other exception is
+    a bug and keeps its traceback. Ctrl-C and SIGTERM are the console script's
+    (:mod:`albot1.cli.entry`, which runs this): Typer turns Ctrl-C into a silent
+    exit 130, and the console script says which stop it was.
     """
     try:
         app()

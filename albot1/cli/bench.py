@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import signal
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -139,9 +138,8 @@ def bench(
     if interrupted:
         # The cells got the same Ctrl-C (or the SIGINT a SIGTERM was handed on as) and stopped; the store is
         # consistent. The exit status is the shell's for the signal that stopped it.
-        stopped = "terminated (SIGTERM)" if ctrl_c.terminated else "interrupted"
-        typer.echo(f"albot1: {stopped}; completed cells are kept, run the same command again to resume", err=True)
-        raise typer.Exit(128 + signal.SIGTERM if ctrl_c.terminated else 130)
+        typer.echo(ctrl_c.line("completed cells are kept, run the same command again to resume"), err=True)
+        raise typer.Exit(ctrl_c.status())
     for skipped in plan.skipped_datasets:
         typer.echo(
             f"skipped dataset {skipped.name}: {skipped.reason}"

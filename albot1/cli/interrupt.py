@@ -21,12 +21,14 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
-from typing import TYPE_CHECKING
-
-import psutil
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from sys import UnraisableHookArgs
+
+#: The handlers these context managers installed, with the record each keeps: a command run inside the console
+#: script's (:mod:`albot1.cli.entry`) sees them where it expects Python's, and its own record is kept in theirs too.
+_OURS: dict[Any, Interrupts] = {}
 
 
 class Interrupts:
@@ -38,6 +40,32 @@ class Interrupts:
     def __init__(self) -> None:
         self.received = False
         self.terminated = False
+        #: The console script's record (:mod:`albot1.cli.entry`) while a command notes its own inside it.
+        self.outer: Interrupts | None = None
+        #: Whether the command already said how it stopped (its one line): the console script says nothing more.
+        self.told = False
+
+    def note(self, *, terminated: bool = False) -> None:
+        """The signal came: remembered here and in the record this one is nested in."""
+        self.received = True
+        self.terminated = self.terminated or terminated
+        if self.outer is not None:
+            self.outer.note(terminated=terminated)
+
+    def line(self, detail: str = "") -> str:
+        """``albot1: interrupted`` or ``albot1: terminated (SIGTERM)``, then ``; detail``: the command's one line.
+
+        Saying it marks it told (here and outward), so that the console script does not say it a second time.
+        """
+        record: Interrupts | None = self
+        while record is not None:
+            record.told, record = True, record.outer
+        stopped = "terminated (SIGTERM)" if self.terminated else "interrupted"
+        return f"albot1: {stopped}" + (f"; {detail}" if detail else "")
+
+    def status(self) -> int:
+        """The shell's exit status for the signal that stopped the command: 130 (SIGINT) or 143 (SIGTERM)."""
+        return 128 + (signal.SIGTERM if self.terminated else signal.SIGINT)
 
     def heed(self) -> None:
         """Raise KeyboardInterrupt when Ctrl-C was noted: one whose exception went astray stops the work here.
@@ -64,12 +92,15 @@ def noting_interrupts(noted: Interrupts | None = None) -> Iterator[Interrupts]:
     """
     noted = Interrupts() if noted is None else noted
     before = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or before is not signal.default_int_handler:
+    if threading.current_thread() is not threading.main_thread() or (
+        before is not signal.default_int_handler and before not in _OURS
+    ):
         yield noted
         return
+    noted.outer = _OURS.get(before)
 
     def note(signum: int, frame: FrameType | None) -> None:
-        noted.received = True
+        noted.note()
         signal.default_int_handler(signum, frame)
 
     hook_before = sys.unraisablehook
@@ -81,9 +112,11 @@ def noting_interrupts(noted: Interrupts | None = None) -> Iterator[Interrupts]:
 
     signal.signal(signal.SIGINT, note)
     sys.unraisablehook = unraisable
+    _OURS[note] = noted
     try:
         yield noted
     finally:
+        del _OURS[note]
         sys.unraisablehook = hook_before
         signal.signal(signal.SIGINT, before)
 
@@ -100,7 +133,7 @@ def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
     forkserver each get SIGINT and stop, and the runner says "interrupted";
     here the runner hands SIGINT on to every descendant it has and stops its
     own work by the same KeyboardInterrupt, so SIGTERM takes the path Ctrl-C
-    takes (the command says which signal it was). The previous handler is
+    takes (the command says which signal it was). SIGTERM's default action is
     back after the first SIGTERM, so a second one ends the process at once,
     as usual. A command started with SIGINT ignored (in the background of a
     script, ``cmd &``) started everything under it so too: there the
@@ -109,17 +142,23 @@ def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
 
     Used inside :func:`noting_interrupts`. Nothing changes outside the main
     thread or when SIGTERM is not at its default action (a host program's
-    handler is kept).
+    handler is kept); the console script's handler (:mod:`albot1.cli.entry`)
+    counts as the default, and a SIGTERM noted here is noted in its record too.
     """
     before = signal.getsignal(signal.SIGTERM)
-    if threading.current_thread() is not threading.main_thread() or before is not signal.SIG_DFL:
+    if threading.current_thread() is not threading.main_thread() or (
+        before is not signal.SIG_DFL and before not in _OURS
+    ):
         yield noted
         return
+    noted.outer = _OURS.get(before, noted.outer)
     handed_on = signal.SIGTERM if signal.getsignal(signal.SIGINT) is signal.SIG_IGN else signal.SIGINT
 
     def terminate(signum: int, frame: FrameType | None) -> None:
-        signal.signal(signal.SIGTERM, before)
-        noted.received = noted.terminated = True
+        import psutil  # here, not at the top: the console script installs this handler before its slow imports
+
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        noted.note(terminated=True)
         try:
             descendants = psutil.Process().children(recursive=True)
         except psutil.Error:
@@ -132,7 +171,10 @@ def terminating_as_interrupt(noted: Interrupts) -> Iterator[Interrupts]:
         signal.default_int_handler(signal.SIGINT, frame)
 
     signal.signal(signal.SIGTERM, terminate)
+    _OURS[terminate] = noted
     try:
         yield noted
     finally:
-        signal.signal(signal.SIGTERM, before)
+        del _OURS[terminate]
+        if signal.getsignal(signal.SIGTERM) is terminate:  # after a SIGTERM, a second one still ends it at once
+            signal.signal(signal.SIGTERM, before)

@@ -22,7 +22,7 @@ from conftest import PluginInstaller
 pytestmark = pytest.mark.end_to_end
 
 #: the console entry point in a fresh interpreter, as a user runs it
-ALBOT1 = [sys.executable, "-c", "from albot1.cli.app import main; main()"]
+ALBOT1 = [sys.executable, "-c", "from albot1.cli.entry import main; main()"]
 
 
 def test_dry_run_lists_the_planned_cells_without_running_them(tmp_path: Path) -> None:
@@ -291,6 +291,63 @@ def test_ctrl_c_during_the_forkservers_cold_warm_up_prints_only_the_interrupted_
     ], stderr
     _, alive = psutil.wait_procs([server, *helpers], timeout=30)
     assert alive == [], f"the forkserver or its compile helpers went on after Ctrl-C: {alive}"
+
+
+#: Starts the cell forkserver as the runner does, says so, and waits; its stderr is the server's.
+_STARTS_THE_FORKSERVER = """
+import sys
+from albot1.bench.limits import start_forkserver
+start_forkserver(["odometry"])
+print("started", flush=True)
+sys.stdin.read()
+"""
+
+
+def _catches_sigint(process: psutil.Process) -> bool:
+    """Whether Python has installed its SIGINT handler in ``process`` (``SigCgt``): its start is under way."""
+    status = Path(f"/proc/{process.pid}/status").read_text()
+    caught = next(line for line in status.splitlines() if line.startswith("SigCgt:"))
+    return bool(int(caught.split()[1], 16) & (1 << (signal.SIGINT - 1)))
+
+
+def _alive(process: psutil.Process) -> bool:
+    """Still running: neither gone nor a zombie (the driver, its parent, reaps it only when it exits)."""
+    try:
+        return process.status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads the server's signal mask from /proc")
+def test_ctrl_c_while_the_forkserver_starts_ends_it_without_a_traceback() -> None:
+    """Before its preload's first line the server raised KeyboardInterrupt from Python's start or its imports.
+
+    Ctrl-C reaches the server with the runner's process group; so does the SIGINT the runner hands on after a
+    SIGTERM. The test signals the server once Python's handler is in place (its imports under way).
+    """
+    driver = subprocess.Popen(
+        [sys.executable, "-c", _STARTS_THE_FORKSERVER],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert driver.stdout is not None and driver.stdout.readline() == "started\n", driver.communicate()
+        (server,) = [c for c in psutil.Process(driver.pid).children() if "forkserver" in " ".join(c.cmdline())]
+        deadline = time.monotonic() + 60
+        while not _catches_sigint(server) and time.monotonic() < deadline:
+            time.sleep(0.001)
+        server.send_signal(signal.SIGINT)
+        while _alive(server) and time.monotonic() < deadline + 60:
+            time.sleep(0.01)
+        assert not _alive(server), "the forkserver went on after Ctrl-C"
+        _, stderr = driver.communicate("", timeout=60)
+    finally:
+        if driver.poll() is None:
+            driver.kill()
+            driver.wait()
+    assert stderr == "", stderr
 
 
 def test_what_a_plugin_module_prints_on_import_stays_out_of_the_bench_tables(

@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from albot1.cli.app import main
-from albot1.cli.interrupt import noting_interrupts
+from albot1.cli.interrupt import Interrupts, noting_interrupts, terminating_as_interrupt
 
 INTERRUPTED = "albot1: interrupted; completed cells are kept, run the same command again to resume"
 
@@ -81,6 +81,24 @@ def test_outside_the_command_ctrl_c_and_dropped_exceptions_behave_as_python_says
     with noting_interrupts():
         assert sys.unraisablehook is not hook
     assert sys.unraisablehook is hook and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_inside_the_console_scripts_handlers_a_command_notes_ctrl_c_and_says_the_only_line() -> None:
+    """``albot1 bench`` runs inside the console script's handlers (``albot1.cli.entry``), which it took for a host's.
+
+    Its own record stayed empty and its "lost Ctrl-C" guard was off; the console script must not say a second line.
+    """
+    script = Interrupts()
+    with noting_interrupts(script), terminating_as_interrupt(script):
+        command = Interrupts()
+        with noting_interrupts(command), terminating_as_interrupt(command), pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGINT)
+            sum(range(1000))
+        assert (command.received, script.received, script.told) == (True, True, False)
+        assert command.line("kept") == "albot1: interrupted; kept" and command.status() == 130
+        assert script.told  # the command said it: the console script says nothing more
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
 
 
 def _bench(
