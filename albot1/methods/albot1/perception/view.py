@@ -124,8 +124,8 @@ def construct_view(
     ranges, angles = seam_at_gap(
         np.asarray(ranges, dtype=np.float64), np.asarray(angles, dtype=np.float64), params.max_range
     )
-    r = np.ascontiguousarray(np.asarray(ranges, dtype=np.float64)[::-1])
-    a = np.ascontiguousarray(np.asarray(angles, dtype=np.float64)[::-1])
+    r = np.ascontiguousarray(ranges[::-1])  # float64 already (above)
+    a = np.ascontiguousarray(angles[::-1])
     surfaces, kinds, beams, cluster = k.build_view(
         r,
         a,
