@@ -181,7 +181,7 @@ def _report(run_dir: Path, exc: BaseException) -> int:
         exc, kind, code = raised, "exception", EXIT_EXCEPTION
     elif _caused_by_memory(exc):  # run_method wraps library errors in the method's error class
         kind, code = "memory", EXIT_MEMORY
-    elif _plan_mismatch(exc):  # the install changed under the grid: never allowed, retried (not kept)
+    elif _install_failure(exc):  # a broken install, or one changed under the grid: never allowed, retried
         kind, code = "executor", EXIT_EXCEPTION
     else:
         kind, code = "exception", EXIT_EXCEPTION
@@ -192,14 +192,15 @@ def _report(run_dir: Path, exc: BaseException) -> int:
     return code
 
 
-def _plan_mismatch(exc: BaseException) -> bool:
-    """Whether ``exc`` says the cell process is not what its plan was made with (``PlanMismatchError``).
+def _install_failure(exc: BaseException) -> bool:
+    """Whether ``exc`` or an error in its chain is an ``InstallError`` (a program that cannot start, a plan mismatch).
 
     Looked up in ``sys.modules``, not imported: such an error was raised by the loaded module, and a cell
-    whose imports failed must still have its failure recorded.
+    whose imports failed must still have its failure recorded. The chain, not only ``exc``: a method's run
+    wraps what its program said in the method's own error class (:func:`albot1.runs.execute.run_method`).
     """
-    errors = sys.modules.get("albot1.bench.errors")
-    return errors is not None and isinstance(exc, errors.PlanMismatchError)
+    errors = sys.modules.get("albot1.errors")
+    return errors is not None and any(isinstance(current, errors.InstallError) for current in _chain(exc))
 
 
 def storage_error(exc: BaseException) -> OSError | None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from albot1.errors import Albot1Error
+from albot1.errors import Albot1Error, InstallError
 
 
 class BenchError(Albot1Error):
@@ -13,7 +13,7 @@ class SuiteError(BenchError):
     """A suite file does not parse or names something that does not exist (message names file and key)."""
 
 
-class PlanMismatchError(BenchError):
+class PlanMismatchError(BenchError, InstallError):
     """A cell's process is not what its plan was made with: other versions, config or key than planned.
 
     Not the method's failure: the install or the files changed under the grid (or a worker runs another

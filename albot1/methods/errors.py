@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
-from albot1.errors import Albot1Error, ConfigError
+from albot1.errors import Albot1Error, ConfigError, InstallError
 
 
 class UnknownMethodError(ConfigError):
     """A method name is not registered, or its dependencies are missing."""
+
+
+class MethodUnavailableError(UnknownMethodError, InstallError):
+    """A registered method's imports or programs are not installed here (an install's failure: ``InstallError``)."""
 
 
 class PluginError(ConfigError):

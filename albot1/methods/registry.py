@@ -31,7 +31,7 @@ from albot1.config.keyvalue import parse_key_values
 from albot1.config.resolve import FROM_OVERRIDE, ResolvedConfig, resolve
 from albot1.config.suggest import unknown_name_message
 from albot1.config.targets import TargetError, check_target, resolve_class
-from albot1.methods.errors import UnknownMethodError
+from albot1.methods.errors import MethodUnavailableError, UnknownMethodError
 from albot1.methods.plugins import PLUGIN_ERROR_CLASS, installed_plugins
 
 _log = logging.getLogger(__name__)
@@ -140,7 +140,7 @@ class MethodSpec:
         reason = self.unavailable_reason()
         if reason is not None:
             hint = self.install_command()
-            raise UnknownMethodError(
+            raise MethodUnavailableError(
                 f"method {self.name!r} is unavailable: {reason}" + (f" (install: {hint})" if hint else "")
             )
         try:

@@ -63,6 +63,7 @@ from albot1.data.errors import DataError
 from albot1.data.loaders.rawlog.serialize import GaussianMotionModel
 from albot1.data.loaders.rawlog.writer import RawlogLayout, write_frames
 from albot1.data.model import Frame
+from albot1.errors import InstallError
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
@@ -159,6 +160,20 @@ def _banner_version(executable: str, inode: int, size: int, mtime_ns: int) -> st
     return _mrpt_version(done.stdout)
 
 
+#: A program that never ran: the loader's status (a library missing), "not executable" (MRPT's own failures: 255).
+LOADER_EXIT_STATUSES = frozenset({126, 127})
+
+
+def _broken_install(message: str, cause: BaseException | None = None) -> BaselineError:
+    """The method's error for a program this machine cannot run, caused by an ``InstallError``: a bench cell
+    records it as an ``executor`` failure, which ``allow_failure`` (for MRPT's own failures) does not allow."""
+    install = InstallError(message)
+    install.__cause__ = cause
+    error = BaselineError(message)
+    error.__cause__ = install
+    return error
+
+
 class _MrptMapper:
     """Shared bookkeeping of the two applications (see the module doc)."""
 
@@ -205,7 +220,7 @@ class _MrptMapper:
             raise BaselineError(f"{self.name}: no scans were given; {self.app} needs at least one")
         executable = find_app(self.app)
         if executable is None:
-            raise BaselineError(
+            raise _broken_install(
                 f"{self.name}: MRPT's {self.app} is not on PATH; install the Debian package {APT_PACKAGE} (`make mrpt`)"
             )
         odometry = np.asarray([f.odometry for f in self._frames], dtype=float)
@@ -235,16 +250,21 @@ class _MrptMapper:
             # One thread: MRPT's OpenMP loops draw from one global random generator, so more
             # threads would make a seeded run irreproducible; the cost is measured single-threaded.
             env["OMP_NUM_THREADS"] = "1"
-            outcome = run_limited(
-                [executable, INI_NAME, RAWLOG_NAME],
-                cwd=work,
-                timeout_s=self.config.wall_limit_s,  # the backstop for a hang; the limit is cpu_limit_s
-                cpu_limit_s=self.config.cpu_limit_s,
-                memory_limit_mb=self.config.memory_limit_mb,
-                stdout_path=work / "stdout.txt",
-                stderr_path=work / "stderr.txt",
-                env=env,
-            )
+            try:
+                outcome = run_limited(
+                    [executable, INI_NAME, RAWLOG_NAME],
+                    cwd=work,
+                    timeout_s=self.config.wall_limit_s,  # the backstop for a hang; the limit is cpu_limit_s
+                    cpu_limit_s=self.config.cpu_limit_s,
+                    memory_limit_mb=self.config.memory_limit_mb,
+                    stdout_path=work / "stdout.txt",
+                    stderr_path=work / "stderr.txt",
+                    env=env,
+                )
+            except OSError as exc:  # gone since found, not executable, not a program (a full disk: the store's)
+                if exc.filename != executable:
+                    raise
+                raise _broken_install(f"{self.name}: {self.app} cannot be started: {exc}", exc)  # noqa: B904
             stdout_text = (work / "stdout.txt").read_text(encoding="utf-8", errors="replace")
             stderr_text = (work / "stderr.txt").read_text(encoding="utf-8", errors="replace")
             out_dir = work / OUTPUT_DIR
@@ -321,6 +341,8 @@ class _MrptMapper:
             else:
                 how = f"exited with status {outcome.returncode}"
             reason = outputs.last_error_line(stderr_text + "\n" + stdout_text)
+            if outcome.returncode in LOADER_EXIT_STATUSES:
+                raise _broken_install(f"{self.name}: {self.app} {how}: it could not start (broken install?): {reason}")
             raise BaselineError(f"{self.name}: {self.app} {how}, {progress}: {reason}")
 
     def _progress(self, out_dir: Path, scans: int) -> str:

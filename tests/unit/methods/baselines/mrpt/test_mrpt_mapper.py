@@ -17,7 +17,7 @@ import pytest
 
 from albot1.contract import MapperOutput
 from albot1.data.model import Frame, Scan
-from albot1.errors import ConfigError
+from albot1.errors import ConfigError, InstallError
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.mrpt import MrptIcpMapper, MrptRbpfMapper
 from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig
@@ -122,6 +122,38 @@ def test_icp_failures_name_their_reason(
     monkeypatch.setenv("FAKE_MRPT_MODE", mode)
     with pytest.raises(BaselineError, match=message):
         _run(_icp())
+
+
+def _install_failure(error: BaseException) -> bool:
+    """Whether an ``InstallError`` is in ``error``'s chain (how a bench cell tells the install's failure)."""
+    current: BaseException | None = error
+    while current is not None:
+        if isinstance(current, InstallError):
+            return True
+        current = current.__cause__
+    return False
+
+
+def test_a_program_that_cannot_start_is_the_install_s_failure_not_mrpt_s(
+    fake_apps: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    script = fake_apps / "icp-slam"
+    script.write_text('#!/bin/sh\necho "icp-slam: loading shared libraries: libmrpt-slam.so" >&2\nexit 127\n')
+    with pytest.raises(BaselineError, match=r"icp-slam exited with status 127: it could not start .*libmrpt") as caught:
+        _run(_icp())
+    assert _install_failure(caught.value)
+    mapper = _icp()
+    script.chmod(0o644)  # found by an earlier lookup, then not executable: Popen's PermissionError
+    monkeypatch.setattr("albot1.methods.baselines.mrpt.mapper.find_app", lambda app: str(script))
+    with pytest.raises(BaselineError, match=r"icp-slam cannot be started: .*Permission denied") as caught:
+        _run(mapper)
+    assert _install_failure(caught.value)
+    monkeypatch.setenv("FAKE_MRPT_MODE", "crash")  # a program that runs and fails: MRPT's own failure
+    script.chmod(0o755)
+    script.write_text(f'#!/bin/sh\nexec "{sys.executable}" "{fake_mrpt_app.__file__}" icp-slam "$@"\n')
+    with pytest.raises(BaselineError, match="exited with status 255") as caught:
+        _run(_icp())
+    assert not _install_failure(caught.value)
 
 
 def test_rbpf_short_log_is_a_failure(fake_apps: Path, monkeypatch: pytest.MonkeyPatch) -> None:
