@@ -103,3 +103,13 @@ def test_rbpf_filter_choices_are_accepted_as_set_on_the_command_line() -> None:
     for bad in ("4", "x", "-1", "2.0"):
         with pytest.raises(ConfigError, match="pf_algorithm"):
             resolve_config("mrpt-rbpf", overrides={"pf_algorithm": bad})
+
+
+def test_auxiliary_standard_preset_is_the_filter_measured_for_issue_21() -> None:
+    """The preset must stay the configuration of its rows in docs/baselines.md (PF_algorithm 1, powFactor 1,
+    GMapping's odometry noise in the rawlog's motion model), else those rows describe another filter."""
+    config = MrptRbpfConfig.model_validate(MrptRbpfMapper.presets["auxiliary-standard"])
+    ini = _ini(render("rbpf-slam", config, rawlog_file="in.rawlog", output_dir="out", seed=0))
+    assert ini["PF_algorithm"] == "1" and ini["powFactor"] == "1.0" and ini["sampleSize"] == "30"
+    motion = (config.motion_a1, config.motion_a2, config.motion_a3, config.motion_a4)
+    assert motion == (0.1, 0.1, 0.2, 0.2)
