@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from albot1.config.method_model import MethodConfig
 
@@ -119,10 +119,12 @@ class MrptIcpConfig(MrptRunConfig):
 class MrptRbpfConfig(MrptRunConfig):
     """``rbpf-slam`` (``CMetricMapBuilderRBPF``): a Rao-Blackwellized particle filter over occupancy grids."""
 
-    pf_algorithm: Literal[2, 3] = Field(
+    pf_algorithm: Literal[0, 1, 2, 3] = Field(
         description=(
-            "[MappingApplication] PF_algorithm: 2 = optimal proposal approximated by ICP against each particle's "
-            "grid (GMapping, Grisetti et al. 2007), 3 = optimal sampling (auxiliary PF, Blanco et al. 2010)"
+            "[MappingApplication] PF_algorithm: 0 = standard proposal (each particle drawn from the odometry's "
+            "motion model, weighted by the scan likelihood), 1 = auxiliary PF with the standard proposal, "
+            "2 = optimal proposal approximated by ICP against each particle's grid (GMapping, Grisetti et al. "
+            "2007), 3 = optimal sampling (auxiliary PF, Blanco et al. 2010)"
         )
     )
     particles: int = Field(ge=1, le=10_000, description="[MappingApplication] sampleSize: fixed number of particles")
@@ -196,3 +198,13 @@ class MrptRbpfConfig(MrptRunConfig):
     map_occupied_probability: float = Field(
         gt=0.5, lt=1, description="grid cells at least this likely occupied become the stored map's points"
     )
+
+    @field_validator("pf_algorithm", "resampling_method", mode="before")
+    @classmethod
+    def _choice_from_text(cls, value: Any) -> Any:
+        """``--set pf_algorithm=0`` arrives as the text ``"0"``, which a ``Literal`` of integers refuses (pydantic
+        converts text only for plain ``int`` fields); ASCII digits become the integer, anything else is left for
+        the ``Literal`` to refuse with its usual message."""
+        if isinstance(value, str) and value.isascii() and value.isdigit():
+            return int(value)
+        return value

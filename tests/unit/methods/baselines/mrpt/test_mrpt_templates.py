@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import hashlib
+
 import pytest
 from pydantic import BaseModel
 
+from albot1.errors import ConfigError
 from albot1.methods.baselines.errors import BaselineError
 from albot1.methods.baselines.mrpt.config import MrptIcpConfig, MrptRbpfConfig
 from albot1.methods.baselines.mrpt.mapper import MrptIcpMapper, MrptRbpfMapper
 from albot1.methods.baselines.mrpt.templates import ini_value, render
+from albot1.methods.registry import resolve_config
 
 
 def _ini(text: str) -> dict[str, str]:
@@ -73,3 +77,39 @@ def test_values_are_written_as_mrpt_reads_them() -> None:
     )
     with pytest.raises(BaselineError, match="non-finite"):
         ini_value(float("nan"))
+
+
+#: sha256 of the default preset's rendered INI (rawlog in.rawlog, output out, seed 0) as of main d1e7791.
+#: Why pinned: fields added for issue 21 (PF_algorithm 0 and 1, ...) must leave the default filter's INI,
+#: and so its runs, bit for bit the same; a deliberate change of the default updates this value.
+DEFAULT_RBPF_INI_SHA256 = "2d1f4b65864e0233227171b5ba39f8675d658c38b6660b3828cb52b50f3774d1"
+
+
+def test_default_rbpf_ini_is_unchanged() -> None:
+    config = MrptRbpfConfig.model_validate(MrptRbpfMapper.presets["default"])
+    text = render("rbpf-slam", config, rawlog_file="in.rawlog", output_dir="out", seed=0)
+    ini = _ini(text)
+    assert ini["PF_algorithm"] == "2" and ini["adaptiveSampleSize"] == "0" and ini["powFactor"] == "0.01"
+    assert hashlib.sha256(text.encode("ascii")).hexdigest() == DEFAULT_RBPF_INI_SHA256
+
+
+def test_rbpf_filter_choices_are_accepted_as_set_on_the_command_line() -> None:
+    """``--set pf_algorithm=0`` comes as text; the standard proposal (0) and the auxiliary PF (1) are MRPT's too."""
+    config = resolve_config("mrpt-rbpf", overrides={"pf_algorithm": "0", "resampling_method": "3"})
+    assert isinstance(config, MrptRbpfConfig) and (config.pf_algorithm, config.resampling_method) == (0, 3)
+    ini = _ini(render("rbpf-slam", config, rawlog_file="in.rawlog", output_dir="out", seed=0))
+    assert ini["PF_algorithm"] == "0" and ini["resamplingMethod"] == "3"
+    assert resolve_config("mrpt-rbpf", overrides={"pf_algorithm": "1"}).pf_algorithm == 1  # type: ignore[attr-defined]
+    for bad in ("4", "x", "-1", "2.0"):
+        with pytest.raises(ConfigError, match="pf_algorithm"):
+            resolve_config("mrpt-rbpf", overrides={"pf_algorithm": bad})
+
+
+def test_auxiliary_standard_preset_is_the_filter_measured_for_issue_21() -> None:
+    """The preset must stay the configuration of its rows in docs/baselines.md (PF_algorithm 1, powFactor 1,
+    GMapping's odometry noise in the rawlog's motion model), else those rows describe another filter."""
+    config = MrptRbpfConfig.model_validate(MrptRbpfMapper.presets["auxiliary-standard"])
+    ini = _ini(render("rbpf-slam", config, rawlog_file="in.rawlog", output_dir="out", seed=0))
+    assert ini["PF_algorithm"] == "1" and ini["powFactor"] == "1.0" and ini["sampleSize"] == "30"
+    motion = (config.motion_a1, config.motion_a2, config.motion_a3, config.motion_a4)
+    assert motion == (0.1, 0.1, 0.2, 0.2)
