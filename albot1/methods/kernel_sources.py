@@ -19,11 +19,12 @@ from __future__ import annotations
 from pathlib import Path
 
 from albot1.methods.albot1 import kernel_bundle_build
-from albot1.methods.baselines.gtsam_graph import block_sums, nearest
+from albot1.methods.baselines.gtsam_graph import block_sums, icp_loop, nearest
 
 #: the kernels of methods other than Albot1 (whose kernel sets the build knows): (warm-up, sample calls) each
 OTHERS: tuple[kernel_bundle_build.KernelSource, ...] = (
     (nearest.warm_up, nearest.sample_calls),
+    (icp_loop.warm_up, icp_loop.sample_calls),
     (block_sums.warm_up, block_sums.sample_calls),
 )
 

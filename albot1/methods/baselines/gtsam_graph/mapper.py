@@ -48,7 +48,7 @@ from albot1.data.model import Frame
 from albot1.geometry import se2
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.errors import BaselineError
-from albot1.methods.baselines.gtsam_graph import block_sums, nearest
+from albot1.methods.baselines.gtsam_graph import block_sums, icp_loop, nearest
 from albot1.methods.baselines.gtsam_graph.backend import BackEnd
 from albot1.methods.baselines.gtsam_graph.config import GtsamGraphConfig
 from albot1.methods.baselines.gtsam_graph.errors import GraphError, RegistrationError
@@ -95,11 +95,12 @@ class GtsamGraphMapper:
         self.places = PlaceRecognition(config, self.back, self.loops, self.counters)
 
     def warm_up(self, announce: Callable[[str], None] | None = None) -> None:
-        """Compile ICP's grid search and place recognition's block sums (or load numba's cache) before the timed loop.
+        """Compile ICP's grid search and loop and place recognition's block sums (or load numba's cache) first.
 
         ``Mapper.warm_up``: the bench's forkserver and ``albot1 warm-up`` call it once.
         """
         nearest.warm_up(announce)
+        icp_loop.warm_up(announce)
         block_sums.warm_up(announce)
 
     # ------------------------------------------------------------------ input

@@ -343,8 +343,7 @@ class Matches:
         gives the target's ``cKDTree``, asked only about ambiguous queries),
         their correspondences the same, and the terms the same bit for bit.
         """
-        if not (math.isfinite(gate) and gate > 0):
-            raise RegistrationError(f"grid search: expected a finite positive correspondence gate, got {gate}")
+        check_gate(gate)
         px, py = float(pose[0]), float(pose[1])
         idx, jac, res, w, wj = self.idx, self.jac, self.res, self.w, self.wj
         m = linearise_terms(
@@ -352,11 +351,21 @@ class Matches:
             inv_var, idx, jac, res, w, wj,
         )  # fmt: skip
         if m < 0:
-            unsure = (idx == AMBIGUOUS).nonzero()[0]
-            dist, found = tree().query(rot[unsure] + pose[:2], k=1, distance_upper_bound=gate)
-            idx[unsure] = np.where(dist < gate, found, NONE)
+            self.ask_tree(tree(), rot, pose[:2], gate)
             m = terms(lines, rot, px, py, cauchy, inv_var, idx, jac, res, w, wj)
         return jac[:m], res[:m], w[:m], wj[:m]
+
+    def ask_tree(self, tree: Any, rot: FloatArray, position: FloatArray, gate: float) -> None:
+        """The k-d tree's answers in ``idx`` for the queries the grid search marked :data:`AMBIGUOUS`."""
+        unsure = (self.idx == AMBIGUOUS).nonzero()[0]
+        dist, found = tree.query(rot[unsure] + position, k=1, distance_upper_bound=gate)
+        self.idx[unsure] = np.where(dist < gate, found, NONE)
+
+
+def check_gate(gate: float) -> None:
+    """Raise :class:`RegistrationError` unless the correspondence gate is finite and positive."""
+    if not (math.isfinite(gate) and gate > 0):
+        raise RegistrationError(f"grid search: expected a finite positive correspondence gate, got {gate}")
 
 
 def _sample() -> tuple[FloatArray, FloatArray, FloatArray]:

@@ -27,8 +27,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from albot1.geometry.types import FloatArray
+from albot1.methods.baselines.gtsam_graph import icp_loop
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
-from albot1.methods.baselines.gtsam_graph.nearest import Grid, Matches
+from albot1.methods.baselines.gtsam_graph.nearest import Grid, Matches, check_gate
 
 if TYPE_CHECKING:
     from scipy.spatial import cKDTree
@@ -182,7 +183,7 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
     too few points); a match that simply does not fit comes back with
     ``converged=False`` or a low ``fitness`` for the caller to judge.
     """
-    src = np.asarray(source, dtype=float).reshape(-1, 2)
+    src = np.ascontiguousarray(np.asarray(source, dtype=float).reshape(-1, 2))
     init = np.asarray(initial, dtype=float).reshape(3)
     if not np.isfinite(init).all():
         raise RegistrationError(f"initial guess must be finite, got {init.tolist()}")
@@ -194,7 +195,73 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
             f"got {len(src)} source and {len(target)} target"
         )
 
-    prior_info = np.diag([params.prior_sigma_xy_m**-2, params.prior_sigma_xy_m**-2, params.prior_sigma_theta_rad**-2])
+    matches = Matches(len(src))
+    prior = np.diag([params.prior_sigma_xy_m**-2, params.prior_sigma_xy_m**-2, params.prior_sigma_theta_rad**-2])
+    inv_var = params.point_sigma_m**-2
+    if params.min_points >= 2 and icp_loop.available():  # numpy's matmul special-cases a single row or match
+        x, y, theta, iterations, converged, settled = _iterate_compiled(target, src, init, params, prior, matches)
+    else:
+        x, y, theta, iterations, converged, settled = _iterate(target, src, init, params, prior, matches)
+    converged = converged or (settled and iterations == params.max_iterations)
+    pose = np.array([x, y, theta])
+    jac, res, _, wj = _linearise(
+        target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches
+    )
+    inliers = int(len(res))
+    information = wj.T @ jac if inliers else np.zeros((3, 3))
+    rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")
+    return Registration(
+        pose=pose,
+        converged=converged,
+        iterations=iterations,
+        fitness=inliers / len(src),
+        rmse_m=rmse,
+        inliers=inliers,
+        information=information,
+    )
+
+
+#: what a Gauss-Newton loop leaves: the pose, the iterations run, whether it converged, whether its last step settled
+Outcome = tuple[float, float, float, int, bool, bool]
+
+
+def _iterate_compiled(
+    target: Target, src: FloatArray, init: FloatArray, params: IcpParams, prior: FloatArray, matches: Matches
+) -> Outcome:
+    """:func:`_iterate` in one compiled call (:func:`.icp_loop.icp_run`), back here only for the k-d tree's answers.
+
+    The same operations on the same data (numpy's own BLAS and LAPACK
+    functions, CPython's ``cos``, ``sin``, ``remainder`` and ``hypot``), so the
+    same bits; it saves the numpy calls' overhead around them, most of an
+    iteration's CPU before (docs/baselines.md, "Cost (issue 24), fourth round").
+    """
+    x0, y0, theta0 = init.tolist()
+    knobs = np.array([
+        params.max_iterations, params.min_correspondence_m, params.cauchy_scale_m, params.point_sigma_m**-2,
+        params.gate_decay, params.tolerance_m, params.tolerance_rad, params.settle_factor, params.min_points,
+        x0, y0, theta0,
+    ], dtype=float)  # fmt: skip
+    state = np.array([x0, y0, theta0, params.max_correspondence_m, 1.0, 0.0, 0.0, 0.0])
+    grid, rot, scratch = target.grid, np.empty_like(src), np.zeros(icp_loop.SCRATCH)
+    while True:
+        status = icp_loop.icp_run(
+            grid.origin, grid.dims, grid.cell, grid.starts, grid.xy, grid.order, target.lines, src, prior, knobs,
+            state, matches.idx, matches.jac, matches.res, matches.w, matches.wj, rot, scratch,
+        )  # fmt: skip
+        if status != icp_loop.ASK_TREE:
+            break
+        matches.ask_tree(target.tree, rot, state[icp_loop.S_X : icp_loop.S_Y + 1], state[icp_loop.S_GATE])
+        state[icp_loop.S_RESUME] = 1.0
+    if status == icp_loop.BAD_GATE:
+        check_gate(float(state[icp_loop.S_GATE]))
+    x, y, theta, _, ran, settled, converged, _ = state.tolist()
+    return x, y, theta, min(int(ran), params.max_iterations), bool(converged), bool(settled)
+
+
+def _iterate(
+    target: Target, src: FloatArray, init: FloatArray, params: IcpParams, prior: FloatArray, matches: Matches
+) -> Outcome:
+    """Gauss-Newton from ``init`` with the gate annealed, through numpy's calls (numba off, or another BLAS)."""
     inv_var = params.point_sigma_m**-2
     tau = 2.0 * math.pi
     pose = init.copy()
@@ -202,7 +269,6 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
     converged = False
     settled = False
     iterations = 0
-    matches = Matches(len(src))
     for iterations in range(1, params.max_iterations + 1):  # noqa: B007 -- read after the loop (the count run)
         jac, res, _, wj = _linearise(target, src, pose, gate, params.cauchy_scale_m, inv_var, matches)
         if len(res) < params.min_points:
@@ -210,7 +276,7 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         offset = pose - init
         offset[2] = math.remainder(offset[2], tau)
         try:
-            step = -np.linalg.solve(wj.T @ jac + prior_info, wj.T @ res + prior_info @ offset)
+            step = -np.linalg.solve(wj.T @ jac + prior, wj.T @ res + prior @ offset)
         except np.linalg.LinAlgError:
             break
         dx, dy, dtheta = step.tolist()
@@ -232,23 +298,8 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         )
         # Anneal the gate: wide while the guess may be far off, then down to the inlier gate.
         gate = max(params.min_correspondence_m, gate * params.gate_decay)
-
-    converged = converged or (settled and iterations == params.max_iterations)
-    jac, res, _, wj = _linearise(
-        target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches
-    )
-    inliers = int(len(res))
-    information = wj.T @ jac if inliers else np.zeros((3, 3))
-    rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")
-    return Registration(
-        pose=pose,
-        converged=converged,
-        iterations=iterations,
-        fitness=inliers / len(src),
-        rmse_m=rmse,
-        inliers=inliers,
-        information=information,
-    )
+    x, y, theta = pose.tolist()
+    return x, y, theta, iterations, converged, settled
 
 
 def _linearise(

@@ -247,14 +247,20 @@ def test_the_build_refuses_two_kernels_of_one_name(tmp_path: Path, monkeypatch: 
 
 
 def test_the_gtsam_graph_kernels_are_bundled_without_gtsam(tmp_path: Path) -> None:
-    """The build imports gtsam-graph's grid search and block sums, which need no GTSAM: a build without it works."""
+    """The build imports gtsam-graph's grid search, ICP loop and block sums, which need no GTSAM: a build works."""
     code = (
         "import sys\nsys.modules['gtsam'] = None\n"  # import gtsam now raises ImportError
         "from albot1.methods import kernel_sources\n"
         "print(sorted(name for name, _, _ in kernel_sources.calls() if name.startswith('gtsam_graph.')))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=True)
-    expected = ["gtsam_graph.block_sums", "gtsam_graph.build_grid", "gtsam_graph.linearise_terms", "gtsam_graph.terms"]
+    expected = [
+        "gtsam_graph.block_sums",
+        "gtsam_graph.build_grid",
+        "gtsam_graph.icp_run",
+        "gtsam_graph.linearise_terms",
+        "gtsam_graph.terms",
+    ]
     assert out.stdout.strip() == str(expected)
 
 
