@@ -326,3 +326,20 @@ def test_a_tree_split_over_tf_and_tf_static_reaches_the_odometry_base(
     assert loaded.metadata.sensor_offset == pytest.approx((0.05, 0.2, math.pi / 2), abs=1e-12)
     assert loaded.metadata.extra["sensor_offset_source"].startswith("/tf_static + /tf base_footprint -> laser: (")
     assert caplog.records == []
+
+
+def test_a_mount_far_off_the_robot_is_refused_when_the_bag_is_opened(tmp_path: Path) -> None:
+    """A /tf_static written in millimetres (200 for 0.2 m) used to load, every scan placed 200 m off the robot
+    without a word; the laser mount is now held to MAX_MOUNT_M, in one line naming the link it came from."""
+    from albot1.data.errors import ParseError
+    from albot1.data.open import open_sequence
+
+    write_bag(tmp_path / "mm", "/tf_static", [("base_link", "laser", (200.0, 0.0, 0.1), yaw_q(0.0))])
+    with pytest.raises(
+        ParseError,
+        match=r"mm: laser mount .* puts the laser 200 m from the robot's base; expected at "
+        r"most 20 m .*\(from /tf_static base_link -> laser: \(x, y, yaw\) = \(200, 0, 0\)\)",
+    ):
+        open_sequence(str(tmp_path / "mm"))
+    write_bag(tmp_path / "far", "/tf_static", [("base_link", "laser", (19.0, 0.0, 0.1), yaw_q(0.0))])
+    assert open_sequence(str(tmp_path / "far")).metadata.sensor_offset == pytest.approx((19.0, 0.0, 0.0))
