@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from albot1.data.errors import DataError, ParseError, TopicError
+from albot1.data.loaders.base import DEFAULT_TIME_TOLERANCE_S
 from albot1.data.loaders.rosbag.bag1_check import describe_failure
 from albot1.data.loaders.rosbag.msg import PoseTrack, quaternion_problem, stamp_seconds, yaw_from_quaternion
 
@@ -115,6 +116,33 @@ def _planar_pose(shown: Path, topic: str, index: int, p: Any, q: Any) -> tuple[f
     return x, y, yaw_from_quaternion(*quaternion)
 
 
+class _StampOrder:
+    """A pose topic's header stamps may go back at most :data:`DEFAULT_TIME_TOLERANCE_S` (they are sorted within it).
+
+    The track is sorted by stamp, so one message stamped seconds back (a clock jump, a second publisher of the
+    same frames on ``/tf``) used to land among poses of another time and be interpolated into the scans beside
+    it without a word (a glitch 5.8 s back moved a scan 1.1 m and stretched a 3.0 m path to 5.2 m); CARMEN's
+    reader refuses such a step back of its ODOM/TRUEPOS lines the same way.
+    """
+
+    def __init__(self, shown: Path, topic: str) -> None:
+        self.shown, self.topic = shown, topic
+        self.latest, self.latest_index = -math.inf, -1
+
+    def check(self, t: float, index: int) -> None:
+        if t < self.latest - DEFAULT_TIME_TOLERANCE_S:
+            raise ParseError(
+                self.shown,
+                f"topic {self.topic}: pose stamp {t:.9f} s is {self.latest - t:.3f} s before message "
+                f"#{self.latest_index}'s {self.latest:.9f} s; expected the topic's stamps in time order (up to "
+                f"{DEFAULT_TIME_TOLERANCE_S:g} s back: a clock jump or a second publisher's poses would be "
+                f"interpolated into the scans beside them)",
+                index=index,
+            )
+        if t > self.latest:
+            self.latest, self.latest_index = t, index
+
+
 def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
     """The poses of a ``nav_msgs/Odometry`` topic as a track; all in one ``frame_id -> child_frame_id`` pair.
 
@@ -123,6 +151,7 @@ def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
     """
     times, poses = [], []
     frames: tuple[str, str] | None = None
+    order = _StampOrder(shown, topic)
     for i, msg in topic_messages(reader, topic, shown):
         pair = (str(msg.header.frame_id).lstrip("/"), str(msg.child_frame_id).lstrip("/"))
         if frames is None:
@@ -136,6 +165,7 @@ def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
                 index=i,
             )
         pose = _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation)
+        order.check(header_stamp(msg), i)
         times.append(header_stamp(msg))
         poses.append(pose)
     if not times:
@@ -151,6 +181,7 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
     """
     by_child: dict[str, tuple[list[float], list[tuple[float, float, float]]]] = {}
     pairs: set[tuple[str, str]] = set()
+    orders: dict[str, _StampOrder] = {}
     for i, msg in topic_messages(reader, topic, shown):
         for tf in msg.transforms:
             parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
@@ -161,6 +192,7 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
                 shown, f"{topic} ({parent} -> {child})", i, tf.transform.translation, tf.transform.rotation
             )
             times, poses = by_child.setdefault(child, ([], []))
+            orders.setdefault(child, _StampOrder(shown, f"{topic} ({parent} -> {child})")).check(header_stamp(tf), i)
             times.append(header_stamp(tf))
             poses.append(pose)
     seen = ", ".join(f"{p} -> {c}" for p, c in sorted(pairs)) or "none"

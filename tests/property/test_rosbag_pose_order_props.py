@@ -1,0 +1,69 @@
+"""A bag's odometry stamps: sorted when they go back at most 1 s, refused at the first message that goes further.
+
+The pose track is sorted by header stamp, so a message stamped seconds back (a clock jump, a second
+publisher) used to be interpolated into the scans beside its stamp without a word.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from albot1.data.errors import ParseError
+from albot1.data.loaders.rosbag.loader import Ros2BagLoader
+from albot1.data.loaders.rosbag.msg import seconds_to_ns
+from albot1.data.loaders.rosbag.writer import RosMessages
+from albot1.data.model import Frame, Scan
+
+ANGLES = np.deg2rad(np.arange(-90.0, 91.0, 10.0))
+#: offsets (s) of each odometry stamp from its message's bag time; never within 1e-3 of the 1 s limit
+SHIFTS = st.one_of(st.floats(-0.95, 0.0), st.floats(-30.0, -1.05))
+
+
+def write(path: Path, shifts: list[float]) -> None:
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    msgs = RosMessages(ts, ros1=False)
+    with Writer(path, version=9) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        odom = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
+        end = 100.0 + len(shifts)
+        for k, shift in enumerate(shifts):
+            t = 100.0 + k
+            data = msgs.odometry(np.array([0.1 * k, 0.0, 0.0]), seconds_to_ns(t + shift), "odom", k)
+            bag.write(odom, seconds_to_ns(t), ts.serialize_cdr(data, "nav_msgs/msg/Odometry"))
+        data = msgs.odometry(np.zeros(3), seconds_to_ns(end), "odom", 0)  # the track always spans the scan
+        bag.write(odom, seconds_to_ns(end), ts.serialize_cdr(data, "nav_msgs/msg/Odometry"))
+        f = Frame(0, Scan(np.full(ANGLES.shape, 5.0), ANGLES.copy(), end, 30.0), np.zeros(3))
+        bag.write(
+            scan, seconds_to_ns(end), ts.serialize_cdr(msgs.scan(f, seconds_to_ns(end)), "sensor_msgs/msg/LaserScan")
+        )
+
+
+@pytest.mark.slow
+@settings(max_examples=25, deadline=None)
+@given(shifts=st.lists(SHIFTS, min_size=1, max_size=12))
+def test_odometry_stamps_are_sorted_within_one_second_and_refused_beyond(shifts: list[float]) -> None:
+    stamps = [100.0 + k + s for k, s in enumerate(shifts)]
+    latest, first_bad = -np.inf, None
+    for k, t in enumerate(stamps):
+        if t < latest - 1.0:
+            first_bad = k
+            break
+        latest = max(latest, t)
+    with tempfile.TemporaryDirectory() as folder:
+        write(Path(folder) / "b", shifts)
+        if first_bad is None:
+            assert len(list(Ros2BagLoader().load(Path(folder) / "b").frames())) == 1
+            return
+        with pytest.raises(ParseError) as error:
+            list(Ros2BagLoader().load(Path(folder) / "b").frames())
+    assert f"b[message #{first_bad}]: topic /odom: pose stamp " in str(error.value)
+    assert "expected the topic's stamps in time order (up to 1 s back" in str(error.value)
