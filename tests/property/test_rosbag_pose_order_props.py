@@ -67,3 +67,48 @@ def test_odometry_stamps_are_sorted_within_one_second_and_refused_beyond(shifts:
             list(Ros2BagLoader().load(Path(folder) / "b").frames())
     assert f"b[message #{first_bad}]: topic /odom: pose stamp " in str(error.value)
     assert "expected the topic's stamps in time order (up to 1 s back" in str(error.value)
+
+
+def write_poses(path: Path, messages: list[tuple[float, float]]) -> None:
+    """Odometry messages ``(stamp, x)`` in bag order, each received 1 ms after the previous; a scan at the end."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    msgs = RosMessages(ts, ros1=False)
+    end = max(t for t, _ in messages)
+    with Writer(path, version=9) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        odom = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
+        for k, (t, x) in enumerate(messages):
+            data = msgs.odometry(np.array([x, 0.0, 0.0]), seconds_to_ns(t), "odom", k)
+            bag.write(odom, seconds_to_ns(100.0 + 0.001 * k), ts.serialize_cdr(data, "nav_msgs/msg/Odometry"))
+        f = Frame(0, Scan(np.full(ANGLES.shape, 5.0), ANGLES.copy(), end, 30.0), np.zeros(3))
+        ns = seconds_to_ns(end)
+        bag.write(scan, ns, ts.serialize_cdr(msgs.scan(f, ns), "sensor_msgs/msg/LaserScan"))
+
+
+@pytest.mark.slow
+@settings(max_examples=25, deadline=None)
+@given(
+    messages=st.lists(
+        st.tuples(st.sampled_from([100.0, 100.25, 100.5, 100.75]), st.sampled_from([0.0, 0.5])), min_size=1, max_size=8
+    )
+)
+def test_one_stamp_holds_one_pose(messages: list[tuple[float, float]]) -> None:
+    """Repeated as it was, a message is read once; two poses of one stamp are refused naming a stamp that has two."""
+    poses_at: dict[float, set[float]] = {}
+    for t, x in messages:
+        poses_at.setdefault(t, set()).add(x)
+    with tempfile.TemporaryDirectory() as folder:
+        write_poses(Path(folder) / "b", messages)
+        if all(len(xs) == 1 for xs in poses_at.values()):
+            frame = next(iter(Ros2BagLoader().load(Path(folder) / "b").frames()))
+            assert frame.odometry[0] == poses_at[max(poses_at)].pop()
+            return
+        with pytest.raises(ParseError) as error:
+            list(Ros2BagLoader().load(Path(folder) / "b").frames())
+    text = str(error.value)
+    assert "expected one pose per stamp" in text
+    stamp = float(text.split("are both stamped ")[1].split(" s")[0])
+    assert len(poses_at[stamp]) == 2

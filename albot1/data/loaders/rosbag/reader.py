@@ -116,20 +116,27 @@ def _planar_pose(shown: Path, topic: str, index: int, p: Any, q: Any) -> tuple[f
     return x, y, yaw_from_quaternion(*quaternion)
 
 
-class _StampOrder:
-    """A pose topic's header stamps may go back at most :data:`DEFAULT_TIME_TOLERANCE_S` (they are sorted within it).
+class _PoseStream:
+    """One pose topic's (or ``/tf`` link's) messages as they are read; :meth:`track` sorts them by stamp.
 
-    The track is sorted by stamp, so one message stamped seconds back (a clock jump, a second publisher of the
-    same frames on ``/tf``) used to land among poses of another time and be interpolated into the scans beside
-    it without a word (a glitch 5.8 s back moved a scan 1.1 m and stretched a 3.0 m path to 5.2 m); CARMEN's
-    reader refuses such a step back of its ODOM/TRUEPOS lines the same way.
+    Stamps may go back at most :data:`DEFAULT_TIME_TOLERANCE_S` (they are sorted within it): one message
+    stamped seconds back (a clock jump, a second publisher of the same frames on ``/tf``) used to land among
+    poses of another time and be interpolated into the scans beside it without a word (a glitch 5.8 s back
+    moved a scan 1.1 m and stretched a 3.0 m path to 5.2 m); CARMEN's reader refuses such a step back of its
+    ODOM/TRUEPOS lines the same way. Two messages of one stamp must hold one pose: the track used to take
+    the first at that instant and jump to the second right after it, as a trajectory file's two poses of one
+    time are refused (:func:`albot1.data.trajectory.refuse_repeated_stamps`); a message repeated as it was
+    is read once.
     """
 
     def __init__(self, shown: Path, topic: str) -> None:
         self.shown, self.topic = shown, topic
         self.latest, self.latest_index = -math.inf, -1
+        self.times: list[float] = []
+        self.poses: list[tuple[float, float, float]] = []
+        self.indexes: list[int] = []
 
-    def check(self, t: float, index: int) -> None:
+    def add(self, t: float, pose: tuple[float, float, float], index: int) -> None:
         if t < self.latest - DEFAULT_TIME_TOLERANCE_S:
             raise ParseError(
                 self.shown,
@@ -141,6 +148,33 @@ class _StampOrder:
             )
         if t > self.latest:
             self.latest, self.latest_index = t, index
+        self.times.append(t)
+        self.poses.append(pose)
+        self.indexes.append(index)
+
+    def track(self) -> PoseTrack:
+        """The poses sorted by stamp; a ParseError naming both messages of a stamp that holds two poses."""
+        order = sorted(range(len(self.times)), key=self.times.__getitem__)
+        for a, b in zip(order, order[1:], strict=False):
+            if self.times[a] == self.times[b] and self.poses[a] != self.poses[b]:
+                a, b = sorted((a, b), key=self.indexes.__getitem__)
+                where = (
+                    f"messages #{self.indexes[a]} and #{self.indexes[b]} are"
+                    if self.indexes[a] != self.indexes[b]
+                    else f"message #{self.indexes[a]} holds two transforms"
+                )
+                raise ParseError(
+                    self.shown,
+                    f"topic {self.topic}: {where} both stamped {self.times[a]:.9f} s with two poses "
+                    f"{_shown_pose(self.poses[a])} and {_shown_pose(self.poses[b])}; expected one pose per stamp "
+                    f"(which one holds at that time cannot be told)",
+                    index=self.indexes[b],
+                )
+        return PoseTrack.build(self.times, self.poses)
+
+
+def _shown_pose(pose: tuple[float, float, float]) -> str:
+    return "(" + ", ".join(f"{v:.6g}" for v in pose) + ")"
 
 
 def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
@@ -149,9 +183,8 @@ def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
     Two publishers on one topic (wheel odometry and a filter's both on ``/odom``) would otherwise be
     interleaved into one track that jumps between two estimates at every message.
     """
-    times, poses = [], []
+    stream = _PoseStream(shown, topic)
     frames: tuple[str, str] | None = None
-    order = _StampOrder(shown, topic)
     for i, msg in topic_messages(reader, topic, shown):
         pair = (str(msg.header.frame_id).lstrip("/"), str(msg.child_frame_id).lstrip("/"))
         if frames is None:
@@ -164,13 +197,12 @@ def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
                 f"interleaved would make one track jump between them)",
                 index=i,
             )
-        pose = _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation)
-        order.check(header_stamp(msg), i)
-        times.append(header_stamp(msg))
-        poses.append(pose)
-    if not times:
+        stream.add(
+            header_stamp(msg), _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation), i
+        )
+    if not stream.times:
         raise DataError(f"{shown}: topic {topic} has no messages, so there is no pose to give the scans")
-    return PoseTrack.build(times, poses)
+    return stream.track()
 
 
 def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | None, shown: Path) -> PoseTrack:
@@ -179,22 +211,17 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
     Only direct transforms count (no chaining through intermediate frames);
     ``base_frame`` is guessed when ``odom_frame`` has exactly one child.
     """
-    by_child: dict[str, tuple[list[float], list[tuple[float, float, float]]]] = {}
+    by_child: dict[str, _PoseStream] = {}
     pairs: set[tuple[str, str]] = set()
-    orders: dict[str, _StampOrder] = {}
     for i, msg in topic_messages(reader, topic, shown):
         for tf in msg.transforms:
             parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
             pairs.add((parent, child))
             if parent != odom_frame or (base_frame is not None and child != base_frame):
                 continue
-            pose = _planar_pose(
-                shown, f"{topic} ({parent} -> {child})", i, tf.transform.translation, tf.transform.rotation
-            )
-            times, poses = by_child.setdefault(child, ([], []))
-            orders.setdefault(child, _StampOrder(shown, f"{topic} ({parent} -> {child})")).check(header_stamp(tf), i)
-            times.append(header_stamp(tf))
-            poses.append(pose)
+            link = f"{topic} ({parent} -> {child})"
+            pose = _planar_pose(shown, link, i, tf.transform.translation, tf.transform.rotation)
+            by_child.setdefault(child, _PoseStream(shown, link)).add(header_stamp(tf), pose, i)
     seen = ", ".join(f"{p} -> {c}" for p, c in sorted(pairs)) or "none"
     if len(by_child) != 1:
         wanted = f"{odom_frame} -> {base_frame}" if base_frame else f"{odom_frame} -> <one child frame>"
@@ -203,5 +230,4 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
             f"{shown}: topic {topic}: expected transforms {wanted} ({problem}); transforms seen: {seen}; "
             f"choose the frames with odom_frame= / base_frame="
         )
-    times, poses = next(iter(by_child.values()))
-    return PoseTrack.build(times, poses)
+    return next(iter(by_child.values())).track()

@@ -343,3 +343,19 @@ def test_a_mount_far_off_the_robot_is_refused_when_the_bag_is_opened(tmp_path: P
         open_sequence(str(tmp_path / "mm"))
     write_bag(tmp_path / "far", "/tf_static", [("base_link", "laser", (19.0, 0.0, 0.1), yaw_q(0.0))])
     assert open_sequence(str(tmp_path / "far")).metadata.sensor_offset == pytest.approx((19.0, 0.0, 0.0))
+
+
+def test_two_poses_of_one_stamp_on_tf_are_refused(tmp_path: Path) -> None:
+    """Two publishers of odom -> base_link (a wheel controller and a filter, a classic misconfiguration) put two
+    poses at one stamp; the track used to take one at that instant and jump to the other right after it (a pose
+    repeated as it was is read once: tests/property/test_rosbag_pose_order_props.py)."""
+    from albot1.data.errors import ParseError
+
+    other = [("odom", "base_link", (5.0, 5.0, 0.0), yaw_q(0.0))]
+    write_tf_odometry_bag(tmp_path / "two", "base_link", [("base_link", "laser", (0.1, 0.0, 0.0), yaw_q(0.0))], other)
+    with pytest.raises(
+        ParseError,
+        match=r"two\[message #0\]: topic /tf \(odom -> base_link\): message #0 holds two transforms both stamped "
+        r"10\.000000000 s with two poses \(0, 0, 0\) and \(5, 5, 0\); expected one pose per stamp",
+    ):
+        list(Ros2BagLoader().load(tmp_path / "two").frames())
