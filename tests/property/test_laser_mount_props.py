@@ -39,7 +39,7 @@ def opened(name: str, text: str) -> tuple[tuple[float, float, float] | None, str
 @given(x=METRES, y=METRES, theta=st.floats(-3.0, 3.0), again=st.sampled_from(["same", "other", "none"]))
 def test_albot_log_mount_is_read_iff_within_the_limit(x: float, y: float, theta: float, again: str) -> None:
     mount = f"MOUNT {x!r} {y!r} {theta!r}\n"
-    second = {"same": f"NAME r\n{mount}", "other": f"MOUNT {x + 1.0!r} {y!r} {theta!r}\n", "none": ""}[again]
+    second = {"same": f"NAME r\n{mount}", "other": f"MOUNT {x!r} {y!r} {theta + 1.0!r}\n", "none": ""}[again]
     offset, error = opened("m.albotlog", HEADER + mount + second + BODY)
     if math.hypot(x, y) > LIMIT_M:
         assert offset is None and ":4: MOUNT " in error and f"expected at most {LIMIT_M:g} m" in error
