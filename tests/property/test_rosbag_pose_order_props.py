@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from albot1.data.errors import ParseError
-from albot1.data.loaders.rosbag.loader import Ros2BagLoader
+from albot1.data.loaders.rosbag.loader import Ros1BagLoader, Ros2BagLoader
 from albot1.data.loaders.rosbag.msg import seconds_to_ns
 from albot1.data.loaders.rosbag.writer import RosMessages
 from albot1.data.model import Frame, Scan
@@ -112,3 +112,41 @@ def test_one_stamp_holds_one_pose(messages: list[tuple[float, float]]) -> None:
     assert "expected one pose per stamp" in text
     stamp = float(text.split("are both stamped ")[1].split(" s")[0])
     assert len(poses_at[stamp]) == 2
+
+
+@pytest.mark.slow
+@settings(max_examples=20, deadline=None)
+@given(nodes=st.lists(st.sampled_from(["/diff_drive", "/ekf"]), min_size=1, max_size=8))
+def test_ros1_poses_come_from_one_node(nodes: list[str]) -> None:
+    """A ROS1 bag records each message's node: Odometry from two nodes is refused at the first of the second."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    from albot1.data.loaders.rosbag.writer import _with_tf
+
+    ts = _with_tf(get_typestore(Stores.ROS1_NOETIC))  # RosMessages builds /tf messages too
+    msgs = RosMessages(ts, ros1=True)
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "b.bag"
+        with Writer(path) as bag:
+            conns = {
+                n: bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts, callerid=n)
+                for n in dict.fromkeys(nodes)
+            }
+            scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+            for k, node in enumerate(nodes):
+                ns = seconds_to_ns(100.0 + k)
+                data = msgs.odometry(np.array([0.1 * k, 0.0, 0.0]), ns, "odom", k)
+                bag.write(conns[node], ns, ts.serialize_ros1(data, "nav_msgs/msg/Odometry"))
+            f = Frame(0, Scan(np.full(ANGLES.shape, 5.0), ANGLES.copy(), 100.0, 30.0), np.zeros(3))
+            ns = seconds_to_ns(100.0)
+            bag.write(scan, ns, ts.serialize_ros1(msgs.scan(f, ns), "sensor_msgs/msg/LaserScan"))
+        other = next((k for k, n in enumerate(nodes) if n != nodes[0]), None)
+        if other is None:
+            assert len(list(Ros1BagLoader().load(path).frames())) == 1
+            return
+        with pytest.raises(ParseError) as error:
+            list(Ros1BagLoader().load(path).frames())
+    assert f"b.bag[message #{other}]: topic /odom: pose published by {nodes[other]}, but message #0's by " in str(
+        error.value
+    )

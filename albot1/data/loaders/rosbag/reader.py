@@ -95,9 +95,17 @@ def _decode(reader: AnyReader, raw: bytes, msgtype: str, shown: Path, topic: str
 
 def topic_messages(reader: AnyReader, topic: str, shown: Path) -> Iterator[tuple[int, Any]]:
     """Decoded messages of one topic in bag order, with their index in the topic."""
+    for i, _, msg in published_messages(reader, topic, shown):
+        yield i, msg
+
+
+def published_messages(reader: AnyReader, topic: str, shown: Path) -> Iterator[tuple[int, str | None, Any]]:
+    """``(index, publisher, message)`` of one topic in bag order; the publisher is the node a ROS1 bag
+    records per connection (``callerid``), None where the bag records none (ROS2 bags)."""
     connections = [c for c in reader.connections if c.topic == topic]
     for i, (conn, _, raw) in _guarded(reader.messages(connections=connections), shown, topic):
-        yield i, _decode(reader, raw, conn.msgtype, shown, topic, i)
+        publisher = getattr(conn.ext, "callerid", None)
+        yield i, (str(publisher) if publisher else None), _decode(reader, raw, conn.msgtype, shown, topic, i)
 
 
 def header_stamp(msg: Any) -> float:
@@ -123,7 +131,9 @@ class _PoseStream:
     stamped seconds back (a clock jump, a second publisher of the same frames on ``/tf``) used to land among
     poses of another time and be interpolated into the scans beside it without a word (a glitch 5.8 s back
     moved a scan 1.1 m and stretched a 3.0 m path to 5.2 m); CARMEN's reader refuses such a step back of its
-    ODOM/TRUEPOS lines the same way. Two messages of one stamp must hold one pose: the track used to take
+    ODOM/TRUEPOS lines the same way. In a ROS1 bag, which records each message's node, the poses must come
+    from one node (a wheel controller and a filter both publishing ``odom -> base_link``). Two messages of
+    one stamp must hold one pose: the track used to take
     the first at that instant and jump to the second right after it, as a trajectory file's two poses of one
     time are refused (:func:`albot1.data.trajectory.refuse_repeated_stamps`); a message repeated as it was
     is read once.
@@ -135,8 +145,20 @@ class _PoseStream:
         self.times: list[float] = []
         self.poses: list[tuple[float, float, float]] = []
         self.indexes: list[int] = []
+        self.publisher: tuple[str, int] | None = None  # the first message's node and index (ROS1 bags)
 
-    def add(self, t: float, pose: tuple[float, float, float], index: int) -> None:
+    def add(self, t: float, pose: tuple[float, float, float], index: int, publisher: str | None = None) -> None:
+        if publisher is not None:
+            if self.publisher is None:
+                self.publisher = (publisher, index)
+            elif publisher != self.publisher[0]:
+                raise ParseError(
+                    self.shown,
+                    f"topic {self.topic}: pose published by {publisher}, but message #{self.publisher[1]}'s by "
+                    f"{self.publisher[0]}; expected one publisher of these poses (two nodes' estimates "
+                    f"interleaved make one track jump between them)",
+                    index=index,
+                )
         if t < self.latest - DEFAULT_TIME_TOLERANCE_S:
             raise ParseError(
                 self.shown,
@@ -185,7 +207,7 @@ def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
     """
     stream = _PoseStream(shown, topic)
     frames: tuple[str, str] | None = None
-    for i, msg in topic_messages(reader, topic, shown):
+    for i, publisher, msg in published_messages(reader, topic, shown):
         pair = (str(msg.header.frame_id).lstrip("/"), str(msg.child_frame_id).lstrip("/"))
         if frames is None:
             frames = pair
@@ -197,9 +219,8 @@ def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
                 f"interleaved would make one track jump between them)",
                 index=i,
             )
-        stream.add(
-            header_stamp(msg), _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation), i
-        )
+        pose = _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation)
+        stream.add(header_stamp(msg), pose, i, publisher)
     if not stream.times:
         raise DataError(f"{shown}: topic {topic} has no messages, so there is no pose to give the scans")
     return stream.track()
@@ -213,7 +234,7 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
     """
     by_child: dict[str, _PoseStream] = {}
     pairs: set[tuple[str, str]] = set()
-    for i, msg in topic_messages(reader, topic, shown):
+    for i, publisher, msg in published_messages(reader, topic, shown):
         for tf in msg.transforms:
             parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
             pairs.add((parent, child))
@@ -221,7 +242,7 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
                 continue
             link = f"{topic} ({parent} -> {child})"
             pose = _planar_pose(shown, link, i, tf.transform.translation, tf.transform.rotation)
-            by_child.setdefault(child, _PoseStream(shown, link)).add(header_stamp(tf), pose, i)
+            by_child.setdefault(child, _PoseStream(shown, link)).add(header_stamp(tf), pose, i, publisher)
     seen = ", ".join(f"{p} -> {c}" for p, c in sorted(pairs)) or "none"
     if len(by_child) != 1:
         wanted = f"{odom_frame} -> {base_frame}" if base_frame else f"{odom_frame} -> <one child frame>"

@@ -359,3 +359,53 @@ def test_two_poses_of_one_stamp_on_tf_are_refused(tmp_path: Path) -> None:
         r"10\.000000000 s with two poses \(0, 0, 0\) and \(5, 5, 0\); expected one pose per stamp",
     ):
         list(Ros2BagLoader().load(tmp_path / "two").frames())
+
+
+def write_ros1_publishers(path: Path, publishers: list[str], tf: bool) -> None:
+    """A ROS1 bag whose odometry (``odom -> base_link`` on /tf, or /odom) comes from ``publishers`` in turn,
+    one connection per node as ROS1 records them, at stamps that never coincide; a scan between each two."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    from albot1.data.loaders.rosbag.writer import _with_tf
+
+    ts = _with_tf(get_typestore(Stores.ROS1_NOETIC))
+    msgs = RosMessages(ts, ros1=True)
+    kind = "tf2_msgs/msg/TFMessage" if tf else "nav_msgs/msg/Odometry"
+    with Writer(path) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        conns = {p: bag.add_connection("/tf" if tf else "/odom", kind, typestore=ts, callerid=p) for p in publishers}
+        for k in range(8):
+            ns = seconds_to_ns(10.0 + 0.1 * k)
+            x = 0.1 * k + (5.0 if publishers[k % len(publishers)] == "/ekf" else 0.0)
+            data = (
+                _tf(ts, msgs, ns, [("odom", "base_link", (x, 0.0, 0.0), yaw_q(0.0))])
+                if tf
+                else msgs.odometry(np.array([x, 0.0, 0.0]), ns, "odom", k)
+            )
+            bag.write(conns[publishers[k % len(publishers)]], ns, ts.serialize_ros1(data, kind))
+            if 0 < k < 7:
+                f = Frame(k, Scan(np.full(ANGLES.shape, 2.0), ANGLES.copy(), 10.05 + 0.1 * k, 30.0), np.zeros(3))
+                bag.write(
+                    scan,
+                    ns,
+                    ts.serialize_ros1(msgs.scan(f, seconds_to_ns(10.05 + 0.1 * k)), "sensor_msgs/msg/LaserScan"),
+                )
+
+
+@pytest.mark.parametrize("tf", [True, False])
+def test_ros1_odometry_from_two_nodes_is_refused(tmp_path: Path, tf: bool) -> None:
+    """A wheel controller (/diff_drive) and a filter (/ekf) both publishing the robot's pose, at stamps that never
+    coincide: interleaved, the track jumped 5 m at every message. A ROS1 bag records each message's node."""
+    from albot1.data.errors import ParseError
+
+    write_ros1_publishers(tmp_path / "two.bag", ["/diff_drive", "/ekf"], tf)
+    topic = r"/tf \(odom -> base_link\)" if tf else "/odom"
+    with pytest.raises(
+        ParseError,
+        match=rf"two\.bag\[message #1\]: topic {topic}: pose published by /ekf, but message #0's by /diff_drive; "
+        r"expected one publisher of these poses",
+    ):
+        list(Ros1BagLoader().load(tmp_path / "two.bag").frames())
+    write_ros1_publishers(tmp_path / "one.bag", ["/diff_drive"], tf)
+    assert len(list(Ros1BagLoader().load(tmp_path / "one.bag").frames())) == 6
