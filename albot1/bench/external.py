@@ -11,7 +11,10 @@ the methods run. It exists only for the dataset's own odometry (degradation
 log, not of our degraded copies. The file's sha256 is part of the cell's
 key, so an edited file is scored again, and a dataset without its file is
 an error of the suite naming the path it expected (restrict the entry with
-``datasets = [...]``).
+``datasets = [...]``). Two datasets of different logs whose ``{dataset}`` is one
+file (``d1/run.clf`` and ``d2/run.clf`` both give ``run``) are an error of the
+suite too (:func:`one_log_per_file`): the one file would be scored against
+both logs.
 
 The rest of its key is what the scoring reads and computes with: the
 dataset's files and manifest loader options (its reference poses and
@@ -54,6 +57,28 @@ def trajectory_path(suite: Suite, entry: MethodEntry, dataset: str) -> Path:
     if not path.is_absolute() and suite.path is not None:
         path = suite.path.parent / path
     return path
+
+
+def one_log_per_file(
+    suite: Suite, entry: MethodEntry, cell: Cell, metadata: SequenceMetadata, seen: dict[str, tuple[str, str]]
+) -> None:
+    """SuiteError when ``cell``'s file was already given to a dataset read from another log.
+
+    ``seen`` maps each external cell's file to (its dataset, the log it was read from) and is filled here.
+    Slices and loader options of one log (``aces[:500]``, ``robot.mcap?reference=gt.tum``) share its file, as
+    ``{dataset}`` says; two logs of one file name in two folders used to share it too, and the file made on
+    one was scored against the other without a word (where their times overlapped).
+    """
+    assert cell.trajectory is not None
+    log = str(Path(metadata.source).resolve()) if metadata.source else dataset_stem(cell.dataset)
+    first = seen.setdefault(cell.trajectory, (cell.dataset, log))
+    if first[1] != log:
+        raise SuiteError(
+            f"{suite.path or suite.name}: method {cell.method_label!r}: datasets {first[0]!r} and {cell.dataset!r} "
+            f"are two logs ({first[1]}, {log}) but trajectories = {entry.trajectories!r} gives both "
+            f"the file {cell.trajectory}; expected one file per log: rename one log, or restrict the entry with "
+            f"datasets = [...]"
+        )
 
 
 def external_cell(

@@ -22,7 +22,7 @@ from typing import Any
 
 from albot1 import versions
 from albot1.bench.errors import SuiteError
-from albot1.bench.external import external_cell
+from albot1.bench.external import external_cell, one_log_per_file
 from albot1.bench.grid import Cell, GridPlan, Skipped
 from albot1.bench.suite import DatasetOptions, MethodEntry, Suite
 from albot1.config.suggest import unknown_name_message
@@ -278,6 +278,7 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
     skipped_datasets: list[Skipped] = []
     config_failures: dict[str, str] = {}
     literals = set(suite.literal_datasets())
+    external_logs: dict[str, tuple[str, str]] = {}  # an external file -> (its first dataset, that dataset's log)
     for name in _candidate_datasets(suite):
         opts = suite.options_for(name)
         assert opts is not None  # _candidate_datasets keeps selected names only
@@ -302,6 +303,7 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
                 if entry.trajectories is not None:
                     if degradation == "none" and seed == sweep_seeds[0]:
                         cells.append(external_cell(suite, entry, name, opts, seed, metadata))
+                        one_log_per_file(suite, entry, cells[-1], metadata, external_logs)
                     continue
                 if seed != sweep_seeds[0] and _runs_once(degradation, entry.name, registry):
                     continue

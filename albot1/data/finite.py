@@ -14,6 +14,10 @@ with its source, index and timestamp:
   then its own ``trajectory.tum`` was refused by ``albot1 evaluate``); its beam angles finite. Ranges may be NaN or
   infinite: loaders use those for "no return" (``docs/formats.md``); a
   kept reading is at most ``MAX_COORDINATE_M`` (a max range of 1e31 m lets 1e30 m through).
+
+The sequence's laser mount (``metadata.sensor_offset``) is checked once, when it is opened
+(:func:`~albot1.data.model.mount_problem`): finite and within
+:data:`~albot1.data.model.MAX_MOUNT_M` of the robot's base, wherever the loader found it.
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from albot1.data.errors import ParseError
-from albot1.data.model import MAX_COORDINATE_M, MAX_TIMESTAMP_S, Frame, Sequence
+from albot1.data.model import MAX_COORDINATE_M, MAX_TIMESTAMP_S, Frame, Sequence, mount_problem
 
 
 def pose_problem(pose: object, what: str) -> str | None:
@@ -81,8 +85,16 @@ def _far_reading(ranges: np.ndarray, max_range: float) -> str | None:
 
 
 def checked(sequence: Sequence) -> Sequence:
-    """``sequence`` whose frames are checked as they stream by (ParseError naming source, scan and time)."""
+    """``sequence`` whose frames are checked as they stream by (ParseError naming source, scan and time).
+
+    Its laser mount is checked at once: every scan is placed with it, so a wrong one is refused before
+    any scan is read, with the loader's note of where it came from (a bag's ``/tf_static`` link, ...).
+    """
     source = sequence.metadata.source or sequence.name
+    mount = mount_problem(sequence.metadata.sensor_offset)
+    if mount is not None:
+        note = str(sequence.metadata.extra.get("sensor_offset_source") or "")
+        raise ParseError(source, f"{mount}{f' (from {note})' if note else ''}")
 
     def check(frames: Iterator[Frame]) -> Iterator[Frame]:
         for frame in frames:

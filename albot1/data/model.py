@@ -19,6 +19,7 @@ and says in its name that it may cost a full pass.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -38,6 +39,26 @@ MAX_COORDINATE_M = 1e8
 #: Trajectory and relations files and every loaded frame (:mod:`albot1.data.finite`) are held to it, so a log
 #: whose stamps a run's own ``trajectory.tum`` could not be read back with is refused when it is loaded.
 MAX_TIMESTAMP_S = 1e11
+#: Largest accepted distance (m) of the laser from the robot's base (``SequenceMetadata.sensor_offset``): the longest
+#: road vehicles are about 20 m long. A mount written in millimetres (``200`` for 0.2 m) or a corrupt ``/tf_static``
+#: used to place every scan that far off the robot without a word; a mount of 1e300 m made each run fail as
+#: "diverged". Every loaded sequence (:mod:`albot1.data.finite`), the albot log's ``MOUNT`` line and CARMEN's
+#: ``robot_*laser_offset`` PARAMs are held to it (:func:`mount_problem`).
+MAX_MOUNT_M = 20.0
+
+
+def mount_problem(offset: tuple[float, float, float]) -> str | None:
+    """Why ``offset`` (x, y, yaw of the laser on the robot) cannot be a laser mount, or None."""
+    x, y, yaw = (float(v) for v in offset)
+    if not all(map(math.isfinite, (x, y, yaw))):
+        return f"laser mount (x, y, yaw) = ({x!r}, {y!r}, {yaw!r}) is not finite; expected metres and radians"
+    distance = math.hypot(x, y)
+    if distance <= MAX_MOUNT_M:
+        return None
+    return (
+        f"laser mount (x, y, yaw) = ({x:.6g} m, {y:.6g} m, {yaw:.6g} rad) puts the laser {distance:.6g} m from the "
+        f"robot's base; expected at most {MAX_MOUNT_M:g} m (metres on a robot: a mount in millimetres?)"
+    )
 
 
 class _BeamDirections:

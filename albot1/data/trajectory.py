@@ -8,7 +8,8 @@ it with this suite's metrics:
 
 ``tum``
     ``t x y z qx qy qz qw`` per line, ``#`` comments; the heading is the yaw
-    of the quaternion (any roll or pitch is ignored: the poses are planar).
+    of the quaternion (a small roll or pitch is ignored: the poses are planar;
+    a tilt beyond :data:`MAX_TILT_DEG` is refused).
 ``kitti``
     12 numbers per line, the row-major 3x4 matrix ``[R | t]`` of each pose,
     no timestamps (one pose per scan, in order). The poses must lie in the
@@ -31,6 +32,9 @@ expected (:class:`~albot1.data.errors.ParseError`). What is refused, and why:
   few decimals) is normalised away, a larger one means the four numbers are
   not a unit quaternion (another column order, or no rotation at all) and
   reading a heading from them would be a guess;
+* a TUM quaternion tilting the pose more than :data:`MAX_TILT_DEG` from
+  upright: the heading of a planar pose is its turn about z, and a yaw-only
+  quaternion written w first (``qw qx qy qz``) reads as a roll whose yaw is 0;
 * a KITTI matrix whose 3x3 part is not a rotation (``R R^T`` off the
   identity by more than :data:`ROTATION_TOLERANCE`, or a reflection);
 * (:func:`read_trajectory`) two poses with one timestamp: which of the two
@@ -63,6 +67,9 @@ TUM_COLUMNS = "t x y z qx qy qz qw"
 CARMEN_SUFFIXES = (".clf", ".log", ".gfs", ".carmen")
 #: Largest accepted | |q| - 1 | of a TUM quaternion; within it the quaternion is normalised.
 QUATERNION_TOLERANCE = 1e-2
+#: Largest accepted tilt (deg) of a TUM pose's z axis from the world's: a planar robot's base is upright
+#: (a ramp is a few degrees); beyond it the quaternion's yaw is no heading (:func:`_check_tilt`).
+MAX_TILT_DEG = 45.0
 #: Largest accepted entry of ``R R^T - I`` of a KITTI rotation.
 ROTATION_TOLERANCE = 1e-2
 
@@ -188,7 +195,31 @@ def read_tum(path: Path) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     # bit for bit as before (run folders, fingerprints).
     rescale = np.abs(norm - 1.0) > 1e-6
     rows[rescale, 4:8] /= norm[rescale, None]
+    _check_tilt(path, rows)
     return rows[:, 0], _planar(rows)
+
+
+def _check_tilt(path: Path, rows: NDArray[np.float64]) -> None:
+    """ParseError naming the first TUM line whose (unit) quaternion tilts the pose beyond :data:`MAX_TILT_DEG`.
+
+    The heading is read as the yaw of the quaternion, which is the heading only of a pose turned (nearly)
+    about z. A yaw-only quaternion written w first (``qw qx qy qz``, Eigen's coefficient order) reads as a
+    roll of up to 180 deg whose yaw is 0 whatever the robot's heading: every rotation metric was silently
+    scored against a heading of 0. The tilt is the angle between the pose's z axis and the world's.
+    """
+    qx, qy = rows[:, 4], rows[:, 5]
+    tilt = np.degrees(np.arccos(np.clip(1.0 - 2.0 * (qx * qx + qy * qy), -1.0, 1.0)))
+    bad = np.flatnonzero(tilt > MAX_TILT_DEG)
+    if len(bad):
+        row = int(bad[0])
+        q = ", ".join(f"{v:.6g}" for v in rows[row, 4:8])
+        raise ParseError(
+            path,
+            f"quaternion (qx qy qz qw) = ({q}) tilts the pose {tilt[row]:.1f} deg from upright; expected a planar "
+            f"pose, turned about z (tilt at most {MAX_TILT_DEG:g} deg); a quaternion written w first "
+            "(qw qx qy qz) reads so: TUM's order is qx qy qz qw",
+            line=_line_of(path, row),
+        )
 
 
 def _check_coordinates(path: Path, xy: NDArray[np.float64]) -> None:

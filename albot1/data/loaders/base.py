@@ -89,6 +89,13 @@ def reference_presence_problem(
     )
 
 
+#: Largest step back (s) of a log's timestamps: CARMEN's ``time_tolerance`` default, and how far a bag's odometry
+#: and reference stamps may go back (they are sorted within it). The Intel log's stamps jitter back by up to
+#: 0.9 s; a larger step is a clock jump or a second publisher, whose poses sorted among the others would be
+#: interpolated into the scans between them.
+DEFAULT_TIME_TOLERANCE_S = 1.0
+
+
 #: Largest time (s) between the two pose samples (odometry or reference) a scan's pose is interpolated between,
 #: the loaders' option ``max_pose_gap``. Across a longer gap the robot may have moved any way while nothing was
 #: recorded, so the interpolated pose would be invented, not measured. Chosen above the largest such gap of

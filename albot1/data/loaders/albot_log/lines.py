@@ -19,7 +19,7 @@ import numpy as np
 
 from albot1.data.errors import ParseError, UnwritableError
 from albot1.data.loaders.beams import even_spacing
-from albot1.data.model import Frame, Scan
+from albot1.data.model import Frame, Scan, mount_problem
 from albot1.data.tokens import parse_floats
 from albot1.geometry.types import FloatArray
 
@@ -234,6 +234,9 @@ def _mount(path: Path, line: int, value: str) -> tuple[float, float, float]:
     x, y, theta = (float(v) for v in _numbers(path, line, tokens, "MOUNT"))
     if not all(np.isfinite((x, y, theta))):
         raise ParseError(path, f"MOUNT {value}: expected three finite numbers (m, m, rad)", line=line)
+    problem = mount_problem((x, y, theta))
+    if problem is not None:
+        raise ParseError(path, f"MOUNT {value}: {problem}", line=line)
     return x, y, theta
 
 
@@ -250,7 +253,8 @@ def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[Header, l
             path, f"unsupported {MAGIC} version {tokens[1]!r}; this reader knows version {VERSION}", line=1
         )
     seen: dict[str, str] = {}
-    seen_at: dict[str, tuple[int, str]] = {}
+    seen_at: dict[str, int] = {}
+    mount = (0.0, 0.0, 0.0)  # absent: the laser sits at the robot's centre, facing forwards
     for lineno, text in lines:
         stripped = text.strip()
         if not stripped or stripped.startswith("#"):
@@ -265,18 +269,27 @@ def read_header(path: Path, lines: Iterator[tuple[int, str]]) -> tuple[Header, l
                     f"(expected 'UNITS {UNITS}' and 'FRAME {FRAME}')",
                     line=lineno,
                 )
-            mount = _mount(path, *seen_at["MOUNT"]) if "MOUNT" in seen_at else (0.0, 0.0, 0.0)
             return Header(seen.get("NAME"), mount), [(lineno, text)]
         if key not in ("UNITS", "FRAME", "NAME", "MOUNT"):
             raise ParseError(
                 path, f"unknown header line {key!r}; expected UNITS, FRAME, NAME, MOUNT, SENSOR or VIEW", line=lineno
             )
-        seen_at[key] = (lineno, value)
         value = " ".join(value.split())
         if key == "UNITS" and value != UNITS:
             raise ParseError(path, f"expected 'UNITS {UNITS}' (no other units are defined), got {value!r}", line=lineno)
         if key == "FRAME" and value != FRAME:
             raise ParseError(path, f"expected 'FRAME {FRAME}', got {value!r}", line=lineno)
+        if key == "MOUNT":
+            mount = _mount(path, lineno, value)  # each MOUNT line checked at its own line
+        if key in seen and value != seen[key]:
+            # two recordings' headers joined, or an edit that added a line: which one holds cannot be told
+            raise ParseError(
+                path,
+                f"{key} {value!r}, but line {seen_at[key]} says {key} {seen[key]!r}; expected one {key} line "
+                f"(or the same value repeated)",
+                line=lineno,
+            )
+        seen_at.setdefault(key, lineno)  # the first line of each: what a repeat is compared with
         seen[key] = value
     raise ParseError(path, "the file has a header but no SENSOR or VIEW line")
 

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import gzip
 import itertools
-import math
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, ClassVar
@@ -54,7 +53,7 @@ from albot1.data.loaders.albot_log.lines import (
 from albot1.data.loaders.base import COMMON_OPTIONS, reference_keyword_problem, reference_presence_problem
 from albot1.data.loaders.compressed import DamagedStream, iter_lines, read_head
 from albot1.data.loaders.output import prepare_output, writing
-from albot1.data.model import Frame, Sequence, SequenceMetadata
+from albot1.data.model import Frame, Sequence, SequenceMetadata, mount_problem
 from albot1.geometry.types import FloatArray
 
 __all__ = ["AlbotLogLoader", "AlbotLogWriter"]
@@ -160,8 +159,9 @@ class AlbotLogWriter:
                 fh.write(f"UNITS {UNITS}\nFRAME {FRAME}\nNAME {' '.join(sequence.name.split()) or 'unnamed'}\n")
                 offset = tuple(float(v) for v in sequence.metadata.sensor_offset)
                 if any(offset):  # the laser's mount: without it the scans would be read as taken at the robot's centre
-                    if not all(map(math.isfinite, offset)):
-                        raise UnwritableError(f"the laser mount {offset} is not three finite numbers")
+                    problem = mount_problem((offset[0], offset[1], offset[2]))  # the reader's own rule
+                    if problem is not None:
+                        raise UnwritableError(problem)
                     fh.write(mount_line((offset[0], offset[1], offset[2])) + "\n")
                 geometry: tuple[FloatArray, float] | None = None
                 first: Frame | None = None

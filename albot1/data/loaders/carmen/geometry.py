@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from albot1.data.loaders.beams import seam_note, seam_repeat
+from albot1.data.model import MAX_MOUNT_M
 from albot1.geometry.types import FloatArray
 
 #: SICK LMS 2xx maximum (8191 cm is its "no echo" code); used when a log states no maximum.
@@ -120,7 +121,9 @@ def _param_rules() -> dict[str, tuple[str, Callable[[float], bool]]]:
         rules[f"laser_{which}_laser_fov"] = rules[f"laser_{which}laser_fov"] = fov
         rules[f"robot_{which}_laser_max"] = ("a maximum range in metres, > 0", lambda v: v > 0)
         offset, side, angular = mount_params(rear=which == "rear")
-        rules[offset] = rules[side] = ("an offset in metres", lambda v: True)
+        # the combined mount is held to MAX_MOUNT_M again when the log is opened (data/finite.py)
+        mount = (f"an offset in metres, at most {MAX_MOUNT_M:g} m (metres on a robot)", lambda v: abs(v) <= MAX_MOUNT_M)
+        rules[offset] = rules[side] = mount
         rules[angular] = ("an angle in radians", lambda v: True)
     return rules
 

@@ -18,7 +18,7 @@ from typing import Any
 
 from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
-from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, max_pose_gap
+from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, DEFAULT_TIME_TOLERANCE_S, max_pose_gap
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 from albot1.data.relations import RepeatPolicy, repeat_policy
 
@@ -34,7 +34,7 @@ class CarmenOptions:
     reference: str = "auto"
     laser: str | None = None
     max_range: float | None = None
-    time_tolerance: float = 1.0
+    time_tolerance: float = DEFAULT_TIME_TOLERANCE_S
     #: largest gap (s) between the ODOM/TRUEPOS lines a scan's pose is interpolated between (loaders/base.py)
     max_pose_gap: float = DEFAULT_MAX_POSE_GAP_S
     name: str | None = None

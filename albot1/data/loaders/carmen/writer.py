@@ -45,7 +45,7 @@ from albot1.data.loaders.base import reference_presence_problem
 from albot1.data.loaders.carmen.checks import beam_count_problem, geometry_problem, ranges_problem, time_problem
 from albot1.data.loaders.carmen.geometry import NO_RETURN_MARGIN
 from albot1.data.loaders.output import prepare_output, writing
-from albot1.data.model import Frame, Scan, Sequence
+from albot1.data.model import Frame, Scan, Sequence, mount_problem
 from albot1.geometry import se2
 
 HOST = "albot1"
@@ -180,8 +180,9 @@ class CarmenWriter:
     def write(self, sequence: Sequence, path: Path) -> None:
         path = prepare_output(path)
         offset = np.asarray(sequence.metadata.sensor_offset, dtype=np.float64)
-        if not np.isfinite(offset).all():
-            raise UnwritableError(f"{path}: sensor offset {offset.tolist()} is not finite; expected metres and radians")
+        mount = mount_problem((float(offset[0]), float(offset[1]), float(offset[2])))  # the reader's own rule
+        if mount is not None:
+            raise UnwritableError(f"{path}: {mount}")
         latest = -math.inf
 
         def write_lines(tmp: Path) -> None:

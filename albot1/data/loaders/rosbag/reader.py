@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from albot1.data.errors import DataError, ParseError, TopicError
+from albot1.data.loaders.base import DEFAULT_TIME_TOLERANCE_S
 from albot1.data.loaders.rosbag.bag1_check import describe_failure
 from albot1.data.loaders.rosbag.msg import PoseTrack, quaternion_problem, stamp_seconds, yaw_from_quaternion
 
@@ -94,9 +95,17 @@ def _decode(reader: AnyReader, raw: bytes, msgtype: str, shown: Path, topic: str
 
 def topic_messages(reader: AnyReader, topic: str, shown: Path) -> Iterator[tuple[int, Any]]:
     """Decoded messages of one topic in bag order, with their index in the topic."""
+    for i, _, msg in published_messages(reader, topic, shown):
+        yield i, msg
+
+
+def published_messages(reader: AnyReader, topic: str, shown: Path) -> Iterator[tuple[int, str | None, Any]]:
+    """``(index, publisher, message)`` of one topic in bag order; the publisher is the node a ROS1 bag
+    records per connection (``callerid``), None where the bag records none (ROS2 bags)."""
     connections = [c for c in reader.connections if c.topic == topic]
     for i, (conn, _, raw) in _guarded(reader.messages(connections=connections), shown, topic):
-        yield i, _decode(reader, raw, conn.msgtype, shown, topic, i)
+        publisher = getattr(conn.ext, "callerid", None)
+        yield i, (str(publisher) if publisher else None), _decode(reader, raw, conn.msgtype, shown, topic, i)
 
 
 def header_stamp(msg: Any) -> float:
@@ -115,15 +124,90 @@ def _planar_pose(shown: Path, topic: str, index: int, p: Any, q: Any) -> tuple[f
     return x, y, yaw_from_quaternion(*quaternion)
 
 
+class _PoseStream:
+    """One pose topic's (or ``/tf`` link's) messages as they are read; :meth:`track` sorts them by stamp.
+
+    Stamps may go back at most :data:`DEFAULT_TIME_TOLERANCE_S` (they are sorted within it): one message
+    stamped seconds back (a clock jump, a second publisher of the same frames on ``/tf``) used to land among
+    poses of another time and be interpolated into the scans beside it without a word (a glitch 5.8 s back
+    moved a scan 1.1 m and stretched a 3.0 m path to 5.2 m); CARMEN's reader refuses such a step back of its
+    ODOM/TRUEPOS lines the same way. In a ROS1 bag, which records each message's node, the poses must come
+    from one node (a wheel controller and a filter both publishing ``odom -> base_link``). Two messages of
+    one stamp must hold one pose: the track used to take
+    the first at that instant and jump to the second right after it, as a trajectory file's two poses of one
+    time are refused (:func:`albot1.data.trajectory.refuse_repeated_stamps`); a message repeated as it was
+    is read once.
+    """
+
+    def __init__(self, shown: Path, topic: str) -> None:
+        self.shown, self.topic = shown, topic
+        self.latest, self.latest_index = -math.inf, -1
+        self.times: list[float] = []
+        self.poses: list[tuple[float, float, float]] = []
+        self.indexes: list[int] = []
+        self.publisher: tuple[str, int] | None = None  # the first message's node and index (ROS1 bags)
+
+    def add(self, t: float, pose: tuple[float, float, float], index: int, publisher: str | None = None) -> None:
+        if publisher is not None:
+            if self.publisher is None:
+                self.publisher = (publisher, index)
+            elif publisher != self.publisher[0]:
+                raise ParseError(
+                    self.shown,
+                    f"topic {self.topic}: pose published by {publisher}, but message #{self.publisher[1]}'s by "
+                    f"{self.publisher[0]}; expected one publisher of these poses (two nodes' estimates "
+                    f"interleaved make one track jump between them)",
+                    index=index,
+                )
+        if t < self.latest - DEFAULT_TIME_TOLERANCE_S:
+            raise ParseError(
+                self.shown,
+                f"topic {self.topic}: pose stamp {t:.9f} s is {self.latest - t:.3f} s before message "
+                f"#{self.latest_index}'s {self.latest:.9f} s; expected the topic's stamps in time order (up to "
+                f"{DEFAULT_TIME_TOLERANCE_S:g} s back: a clock jump or a second publisher's poses would be "
+                f"interpolated into the scans beside them)",
+                index=index,
+            )
+        if t > self.latest:
+            self.latest, self.latest_index = t, index
+        self.times.append(t)
+        self.poses.append(pose)
+        self.indexes.append(index)
+
+    def track(self) -> PoseTrack:
+        """The poses sorted by stamp; a ParseError naming both messages of a stamp that holds two poses."""
+        order = sorted(range(len(self.times)), key=self.times.__getitem__)
+        for a, b in zip(order, order[1:], strict=False):
+            if self.times[a] == self.times[b] and self.poses[a] != self.poses[b]:
+                a, b = sorted((a, b), key=self.indexes.__getitem__)
+                where = (
+                    f"messages #{self.indexes[a]} and #{self.indexes[b]} are"
+                    if self.indexes[a] != self.indexes[b]
+                    else f"message #{self.indexes[a]} holds two transforms"
+                )
+                raise ParseError(
+                    self.shown,
+                    f"topic {self.topic}: {where} both stamped {self.times[a]:.9f} s with two poses "
+                    f"{_shown_pose(self.poses[a])} and {_shown_pose(self.poses[b])}; expected one pose per stamp "
+                    f"(which one holds at that time cannot be told)",
+                    index=self.indexes[b],
+                )
+        return PoseTrack.build(self.times, self.poses)
+
+
+def _shown_pose(pose: tuple[float, float, float]) -> str:
+    return "(" + ", ".join(f"{v:.6g}" for v in pose) + ")"
+
+
 def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
     """The poses of a ``nav_msgs/Odometry`` topic as a track; all in one ``frame_id -> child_frame_id`` pair.
 
     Two publishers on one topic (wheel odometry and a filter's both on ``/odom``) would otherwise be
     interleaved into one track that jumps between two estimates at every message.
     """
-    times, poses = [], []
+    stream = _PoseStream(shown, topic)
     frames: tuple[str, str] | None = None
-    for i, msg in topic_messages(reader, topic, shown):
+    for i, publisher, msg in published_messages(reader, topic, shown):
         pair = (str(msg.header.frame_id).lstrip("/"), str(msg.child_frame_id).lstrip("/"))
         if frames is None:
             frames = pair
@@ -136,11 +220,10 @@ def odometry_track(reader: AnyReader, topic: str, shown: Path) -> PoseTrack:
                 index=i,
             )
         pose = _planar_pose(shown, topic, i, msg.pose.pose.position, msg.pose.pose.orientation)
-        times.append(header_stamp(msg))
-        poses.append(pose)
-    if not times:
+        stream.add(header_stamp(msg), pose, i, publisher)
+    if not stream.times:
         raise DataError(f"{shown}: topic {topic} has no messages, so there is no pose to give the scans")
-    return PoseTrack.build(times, poses)
+    return stream.track()
 
 
 def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | None, shown: Path) -> PoseTrack:
@@ -149,20 +232,17 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
     Only direct transforms count (no chaining through intermediate frames);
     ``base_frame`` is guessed when ``odom_frame`` has exactly one child.
     """
-    by_child: dict[str, tuple[list[float], list[tuple[float, float, float]]]] = {}
+    by_child: dict[str, _PoseStream] = {}
     pairs: set[tuple[str, str]] = set()
-    for i, msg in topic_messages(reader, topic, shown):
+    for i, publisher, msg in published_messages(reader, topic, shown):
         for tf in msg.transforms:
             parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
             pairs.add((parent, child))
             if parent != odom_frame or (base_frame is not None and child != base_frame):
                 continue
-            pose = _planar_pose(
-                shown, f"{topic} ({parent} -> {child})", i, tf.transform.translation, tf.transform.rotation
-            )
-            times, poses = by_child.setdefault(child, ([], []))
-            times.append(header_stamp(tf))
-            poses.append(pose)
+            link = f"{topic} ({parent} -> {child})"
+            pose = _planar_pose(shown, link, i, tf.transform.translation, tf.transform.rotation)
+            by_child.setdefault(child, _PoseStream(shown, link)).add(header_stamp(tf), pose, i, publisher)
     seen = ", ".join(f"{p} -> {c}" for p, c in sorted(pairs)) or "none"
     if len(by_child) != 1:
         wanted = f"{odom_frame} -> {base_frame}" if base_frame else f"{odom_frame} -> <one child frame>"
@@ -171,5 +251,4 @@ def tf_track(reader: AnyReader, topic: str, odom_frame: str, base_frame: str | N
             f"{shown}: topic {topic}: expected transforms {wanted} ({problem}); transforms seen: {seen}; "
             f"choose the frames with odom_frame= / base_frame="
         )
-    times, poses = next(iter(by_child.values()))
-    return PoseTrack.build(times, poses)
+    return next(iter(by_child.values())).track()

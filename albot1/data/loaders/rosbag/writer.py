@@ -61,7 +61,7 @@ from albot1.data.loaders.rosbag.msg import (
     split_ns,
 )
 from albot1.data.loaders.rosbag.topics import LASER_SCAN, ODOMETRY, TF_MESSAGE, WRITTEN_REFERENCE
-from albot1.data.model import Frame, Sequence
+from albot1.data.model import Frame, Sequence, mount_problem
 
 if TYPE_CHECKING:
     from rosbags.typesys.store import Typestore
@@ -216,6 +216,9 @@ def _write_frames(
     scan_conn, odom_conn = add(SCAN_TOPIC, LASER_SCAN, False), add(ODOM_TOPIC, ODOMETRY, False)
     static_conn, tf_conn = add(TF_STATIC_TOPIC, TF_MESSAGE, True), add(TF_TOPIC, TF_MESSAGE, False)
     mount = np.asarray(sequence.metadata.sensor_offset, dtype=np.float64)
+    mount_refused = mount_problem((float(mount[0]), float(mount[1]), float(mount[2])))  # the reader's own rule
+    if mount_refused is not None:
+        raise UnwritableError(mount_refused)
     ref_conn = None
     previous = -1
     first: Frame | None = None

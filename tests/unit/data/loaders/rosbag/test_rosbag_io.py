@@ -338,3 +338,40 @@ def test_a_load_opens_the_bag_once_and_each_pass_over_its_scans_once_more(
     assert len(opened) == 2
     assert len(list(loaded.frames())) == len(seq)  # a second pass: one more (the tracks were kept)
     assert len(opened) == 3
+
+
+@pytest.mark.parametrize("back_s", [0.85, 5.7])
+def test_a_pose_stamped_seconds_back_is_refused_at_its_message(tmp_path: Path, back_s: float) -> None:
+    """Odometry at 10 Hz between scans at 5 Hz; message #41 carries the pose of its time but a stamp ``back_s``
+    earlier. Sorted by stamp, a 5.7 s glitch used to be interpolated into the scan beside its stamp without a
+    word (a scan moved 1.1 m, the path stretched); now it is refused as CARMEN's reader refuses an ODOM line
+    that far back. Within 1 s (transport jitter, the Intel log's 0.9 s) the stamps are still sorted (0.85 s: not
+    onto another message's stamp, which would be two poses of one stamp)."""
+
+    def build(bag: Any, ts: Any, msgs: RosMessages) -> None:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        odom = bag.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
+        for k in range(60):
+            t = 10.0 + 0.1 * k + 0.03
+            stamp = t - back_s if k == 41 else t
+            pose = np.array([0.05 * k, 0.0, 0.0])
+            data = msgs.odometry(pose, seconds_to_ns(stamp), "odom", k)
+            bag.write(odom, seconds_to_ns(t), ts.serialize_cdr(data, "nav_msgs/msg/Odometry"))
+            if k % 2 == 0 and k < 58:
+                f = Frame(k // 2, Scan(np.full(ANGLES.shape, 5.0), ANGLES.copy(), 10.1 + 0.1 * k, 30.0), pose)
+                bag.write(
+                    scan,
+                    seconds_to_ns(10.1 + 0.1 * k),
+                    ts.serialize_cdr(msgs.scan(f, seconds_to_ns(10.1 + 0.1 * k)), "sensor_msgs/msg/LaserScan"),
+                )
+
+    write_ros2(tmp_path / "glitch", build)
+    if back_s < 1.0:
+        assert len(list(Ros2BagLoader().load(tmp_path / "glitch").frames())) == 29
+        return
+    with pytest.raises(
+        ParseError,
+        match=r"glitch\[message #41\]: topic /odom: pose stamp 8\.43.* s is 5\.600 s before message #40's "
+        r"14\.03.* s; expected the topic's stamps in time order \(up to 1 s back",
+    ):
+        list(Ros2BagLoader().load(tmp_path / "glitch").frames())

@@ -326,3 +326,86 @@ def test_a_tree_split_over_tf_and_tf_static_reaches_the_odometry_base(
     assert loaded.metadata.sensor_offset == pytest.approx((0.05, 0.2, math.pi / 2), abs=1e-12)
     assert loaded.metadata.extra["sensor_offset_source"].startswith("/tf_static + /tf base_footprint -> laser: (")
     assert caplog.records == []
+
+
+def test_a_mount_far_off_the_robot_is_refused_when_the_bag_is_opened(tmp_path: Path) -> None:
+    """A /tf_static written in millimetres (200 for 0.2 m) used to load, every scan placed 200 m off the robot
+    without a word; the laser mount is now held to MAX_MOUNT_M, in one line naming the link it came from."""
+    from albot1.data.errors import ParseError
+    from albot1.data.open import open_sequence
+
+    write_bag(tmp_path / "mm", "/tf_static", [("base_link", "laser", (200.0, 0.0, 0.1), yaw_q(0.0))])
+    with pytest.raises(
+        ParseError,
+        match=r"mm: laser mount .* puts the laser 200 m from the robot's base; expected at "
+        r"most 20 m .*\(from /tf_static base_link -> laser: \(x, y, yaw\) = \(200, 0, 0\)\)",
+    ):
+        open_sequence(str(tmp_path / "mm"))
+    write_bag(tmp_path / "far", "/tf_static", [("base_link", "laser", (19.0, 0.0, 0.1), yaw_q(0.0))])
+    assert open_sequence(str(tmp_path / "far")).metadata.sensor_offset == pytest.approx((19.0, 0.0, 0.0))
+
+
+def test_two_poses_of_one_stamp_on_tf_are_refused(tmp_path: Path) -> None:
+    """Two publishers of odom -> base_link (a wheel controller and a filter, a classic misconfiguration) put two
+    poses at one stamp; the track used to take one at that instant and jump to the other right after it (a pose
+    repeated as it was is read once: tests/property/test_rosbag_pose_order_props.py)."""
+    from albot1.data.errors import ParseError
+
+    other = [("odom", "base_link", (5.0, 5.0, 0.0), yaw_q(0.0))]
+    write_tf_odometry_bag(tmp_path / "two", "base_link", [("base_link", "laser", (0.1, 0.0, 0.0), yaw_q(0.0))], other)
+    with pytest.raises(
+        ParseError,
+        match=r"two\[message #0\]: topic /tf \(odom -> base_link\): message #0 holds two transforms both stamped "
+        r"10\.000000000 s with two poses \(0, 0, 0\) and \(5, 5, 0\); expected one pose per stamp",
+    ):
+        list(Ros2BagLoader().load(tmp_path / "two").frames())
+
+
+def write_ros1_publishers(path: Path, publishers: list[str], tf: bool) -> None:
+    """A ROS1 bag whose odometry (``odom -> base_link`` on /tf, or /odom) comes from ``publishers`` in turn,
+    one connection per node as ROS1 records them, at stamps that never coincide; a scan between each two."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    from albot1.data.loaders.rosbag.writer import _with_tf
+
+    ts = _with_tf(get_typestore(Stores.ROS1_NOETIC))
+    msgs = RosMessages(ts, ros1=True)
+    kind = "tf2_msgs/msg/TFMessage" if tf else "nav_msgs/msg/Odometry"
+    with Writer(path) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        conns = {p: bag.add_connection("/tf" if tf else "/odom", kind, typestore=ts, callerid=p) for p in publishers}
+        for k in range(8):
+            ns = seconds_to_ns(10.0 + 0.1 * k)
+            x = 0.1 * k + (5.0 if publishers[k % len(publishers)] == "/ekf" else 0.0)
+            data = (
+                _tf(ts, msgs, ns, [("odom", "base_link", (x, 0.0, 0.0), yaw_q(0.0))])
+                if tf
+                else msgs.odometry(np.array([x, 0.0, 0.0]), ns, "odom", k)
+            )
+            bag.write(conns[publishers[k % len(publishers)]], ns, ts.serialize_ros1(data, kind))
+            if 0 < k < 7:
+                f = Frame(k, Scan(np.full(ANGLES.shape, 2.0), ANGLES.copy(), 10.05 + 0.1 * k, 30.0), np.zeros(3))
+                bag.write(
+                    scan,
+                    ns,
+                    ts.serialize_ros1(msgs.scan(f, seconds_to_ns(10.05 + 0.1 * k)), "sensor_msgs/msg/LaserScan"),
+                )
+
+
+@pytest.mark.parametrize("tf", [True, False])
+def test_ros1_odometry_from_two_nodes_is_refused(tmp_path: Path, tf: bool) -> None:
+    """A wheel controller (/diff_drive) and a filter (/ekf) both publishing the robot's pose, at stamps that never
+    coincide: interleaved, the track jumped 5 m at every message. A ROS1 bag records each message's node."""
+    from albot1.data.errors import ParseError
+
+    write_ros1_publishers(tmp_path / "two.bag", ["/diff_drive", "/ekf"], tf)
+    topic = r"/tf \(odom -> base_link\)" if tf else "/odom"
+    with pytest.raises(
+        ParseError,
+        match=rf"two\.bag\[message #1\]: topic {topic}: pose published by /ekf, but message #0's by /diff_drive; "
+        r"expected one publisher of these poses",
+    ):
+        list(Ros1BagLoader().load(tmp_path / "two.bag").frames())
+    write_ros1_publishers(tmp_path / "one.bag", ["/diff_drive"], tf)
+    assert len(list(Ros1BagLoader().load(tmp_path / "one.bag").frames())) == 6
