@@ -23,7 +23,7 @@ from typing import Any
 from albot1 import versions
 from albot1.bench.cell_main import ERROR_FILE, EXIT_OK, EXIT_STORAGE, STORAGE_ERRNOS, storage_error
 from albot1.bench.grid import Cell, CellOutcome, FailureKind
-from albot1.bench.limits import ChildExit, run_limited
+from albot1.bench.limits import ChildExit, check_launching, run_limited
 from albot1.bench.store import ATTEMPT, LOG, ResultsStore
 from albot1.records import AttemptRecord
 from albot1.runs.folder import write_record
@@ -78,9 +78,10 @@ def judge(cell: Cell, store: ResultsStore, ended: ChildExit) -> tuple[FailureKin
             f"limit of {cell.memory_mb:g} MB (killed)"
         )
     if ended.pool_lost is not None:
+        during = "while the cell ran, so the cell was stopped" if ended.started else "before it started the cell"
         return "executor", (
-            f"the cell process pool was shut down: its forkserver {ended.pool_lost} while the cell ran, "
-            "so the cell was stopped; run `albot1 bench` again to retry it"
+            f"the cell process pool was shut down: its forkserver {ended.pool_lost} {during}; "
+            "run `albot1 bench` again to retry it"
         )
     if ended.exit_code is not None and ended.exit_code < 0:
         name = _signal_name(-ended.exit_code)
@@ -142,6 +143,7 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
     A results folder that cannot be written (full, read-only) fails the cell
     with kind ``storage`` and halts the grid; nothing about it raises.
     """
+    check_launching(cell)  # before its folder is made: a cell the stopping runner never started leaves none
     store = ResultsStore(results_root)
     mismatch = _worker_code_mismatch(cell)
     if mismatch is not None:
@@ -174,7 +176,10 @@ def run_cell_job(cell: Cell, results_root: str, preview: str | None = None) -> C
     )
     if problem is not None:
         reason = f"{reason} [not recorded: {problem}]"
-    halts = kind == "storage" or ended.pool_lost is not None
+    # An interrupted cell halts the grid too: the Ctrl-C (or the SIGINT a SIGTERM was handed on as) that stopped
+    # it stopped the forkserver as well, and this thread's next cell restarted the server (its preload: seconds
+    # to a minute) and ran on, unwatched by the runner, which waited for it (the pool's shutdown) before exiting.
+    halts = kind in ("storage", "interrupted") or ended.pool_lost is not None
     return CellOutcome.of(cell, "failed", ended.elapsed_s, reason, kind, halts_grid=halts)
 
 

@@ -58,6 +58,34 @@ _FORKSERVER: Any = None
 _START_LOCK = threading.Lock()
 #: Held while a forkserver child is started or its exit status read (:class:`ForkserverChild`).
 _STATUS_LOCK = threading.Lock()
+#: Set while the runner stops (:func:`stop_launching`).
+_STOPPING = threading.Event()
+
+
+class CellNotStarted(Exception):  # noqa: N818 -- a signal to the runner, not an error
+    """The runner is stopping, so the cell was not started: it stays to do, like a cell the grid never reached."""
+
+
+def stop_launching() -> None:
+    """Start no cell and no forkserver in this process from now on (until :func:`allow_launching`).
+
+    Why: Ctrl-C reaches the runner, its cells and their forkserver at once. A cell thread that was past the
+    grid's halt check (its previous cell ended a moment before) started the forkserver again (its preload:
+    seconds to a minute), forked its next cell and supervised it to its end, while the runner, interrupted,
+    waited for that thread before it could exit: 9-116 s after a Ctrl-C (``benchmarks/stop_signals.py``).
+    """
+    _STOPPING.set()
+
+
+def allow_launching() -> None:
+    """Cells may be started again (a new grid in this process)."""
+    _STOPPING.clear()
+
+
+def check_launching(cell: Cell) -> None:
+    """CellNotStarted when the runner is stopping (:func:`stop_launching`)."""
+    if _STOPPING.is_set():
+        raise CellNotStarted(cell.key)
 
 
 @dataclass(frozen=True)
@@ -72,6 +100,8 @@ class ChildExit:
     cell (the child was then stopped and its exit status is unknown).
     ``abandoned``: the supervisor stopped the child because the runner gave
     the cell up (a Dask client that closed or cancelled it: ``run_limited``'s ``abandoned``).
+    ``started``: False when the forkserver was lost before it forked the child
+    (``pool_lost`` says how; e.g. the Ctrl-C that stopped the grid reached it).
 
     ``elapsed_s`` is the cell's wall time from the moment its process existed
     (the moment its time limit starts counting) to its end; ``launch_s`` the
@@ -89,6 +119,7 @@ class ChildExit:
     pool_lost: str | None = None
     launch_s: float | None = None
     abandoned: bool = False
+    started: bool = True
 
 
 class ForkserverChild:
@@ -107,6 +138,10 @@ class ForkserverChild:
     def __init__(self, target: Callable[..., object], args: tuple[Any, ...], name: str) -> None:
         self._proc = _forkserver().Process(target=target, args=args, name=name, daemon=False)
         with _STATUS_LOCK:
+            # Asked again under the lock: a thread waits here while another's fork waits for the server's preload;
+            # when a Ctrl-C ends that server, ``start`` would start a new one (multiprocessing's own restart).
+            if _STOPPING.is_set():
+                raise CellNotStarted(name)
             self._proc.start()
 
     @property
@@ -310,12 +345,18 @@ def run_limited(
     """
     args = child_args(cell, runs_root, log_path, preview)
     start = time.monotonic()
+    check_launching(cell)
     if (how or launcher()) == "forkserver":
         # The forkserver, not this process, is the child's parent; it exits when this process dies.
         args["parent_pid"] = None
         start_forkserver((cell.method,))  # where no runner started it (a Dask worker), or after it was lost
+        check_launching(cell)  # asked again: a server started anew makes the fork below wait for its preload
         # Returns once the server has forked the child: after its preload when the server is still starting.
-        forked = ForkserverChild(process_entry, (args,), name=f"cell-{cell.key}")
+        try:
+            forked = ForkserverChild(process_entry, (args,), name=f"cell-{cell.key}")
+        except (EOFError, ConnectionError) as exc:  # its pipe closed before it sent the child's pid
+            fate = f"ended ({type(exc).__name__} on its pipe)"
+            return ChildExit(None, False, 0.0, pool_lost=fate, launch_s=time.monotonic() - start, started=False)
         launched = time.monotonic()
         process = watch(forked.pid)
         server = _parent_of(process)

@@ -29,7 +29,7 @@ from albot1.bench.errors import BenchError
 from albot1.bench.executors import check_jobs, executor_failure, executor_lost, open_executor, parse_executor
 from albot1.bench.grid import Cell, CellOutcome, GridPlan
 from albot1.bench.job import results_path, run_cell_job
-from albot1.bench.limits import start_forkserver
+from albot1.bench.limits import CellNotStarted, allow_launching, start_forkserver, stop_launching
 from albot1.bench.order import longest_first, past_costs
 from albot1.bench.plan import plan_suite
 from albot1.bench.store import LOG, UNREADABLE_FAILURE, ResultsStore
@@ -92,7 +92,10 @@ def _unless_halted(job: Callable[[Cell, str], CellOutcome], grid_id: str, cell: 
     """
     if grid_id in _HALTED_GRIDS:
         return None
-    outcome = job(cell, root)
+    try:
+        outcome = job(cell, root)
+    except CellNotStarted:  # the runner stops (Ctrl-C): this cell is one it never reached
+        return None
     if outcome.halts_grid:
         _HALTED_GRIDS.add(grid_id)
     return outcome
@@ -172,6 +175,7 @@ def run_grid(
     # quadratic in the cells (16 s of bookkeeping for 5,000 trivial jobs).
     cancelled: set[cf.Future[CellOutcome | None]] = set()
     started_at = time.time()
+    allow_launching()
     try:
         for future in _completed(futures, cancelled):
             halt: str | None = None
@@ -192,6 +196,9 @@ def run_grid(
                 summary.halted = halt
                 cancelled.update([f for f in futures if not f.done() and f.cancel()])
                 summary.not_started += [futures[f] for f in futures if f in cancelled]
+    except BaseException:  # Ctrl-C, SIGTERM: no cell thread may start another cell (limits.stop_launching)
+        stop_launching()
+        raise
     finally:
         for future in futures:
             future.cancel()

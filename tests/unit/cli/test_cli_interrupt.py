@@ -131,15 +131,36 @@ try:
         os.kill(os.getpid(), signal.SIGTERM)
         sum(range(1000))  # where the KeyboardInterrupt is raised
 except KeyboardInterrupt:
-    print("KeyboardInterrupt", noted.received, noted.terminated, signal.getsignal(signal.SIGTERM) is signal.SIG_DFL)
+    print("KeyboardInterrupt", noted.received, noted.terminated)
 print(kid.wait(timeout=30))
+os.kill(os.getpid(), signal.SIGTERM)  # the same stop's copy (GNU timeout's to the group): ignored
+print("still here", flush=True)
+if sys.argv[2] == "later":
+    import time
+    time.sleep(1.2)
+    os.kill(os.getpid(), signal.SIGTERM)  # a later one ends the command at once, with its line
+    time.sleep(5)
+    print("not reached")
 """
 
 
 @pytest.mark.parametrize(("sigint", "child_exit"), [("default", -signal.SIGINT), ("ignored", 15)])
 def test_sigterm_hands_sigint_on_to_children_or_sigterm_where_sigint_is_ignored(sigint: str, child_exit: int) -> None:
     """A command started with SIGINT ignored (a script's ``cmd &``) has children that would wait through SIGINT."""
-    done = subprocess.run([sys.executable, "-c", _SIGTERM_DRIVER, sigint], capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-c", _SIGTERM_DRIVER, sigint, "none"], capture_output=True, text=True, timeout=120
+    )
     assert done.returncode == 0, done.stderr
-    # the child died of SIGINT (-2), or of SIGTERM (its handler's 15) where SIGINT was ignored; the handler put back
-    assert done.stdout.splitlines() == ["KeyboardInterrupt True True True", str(child_exit)], done.stderr
+    # the child died of SIGINT (-2), or of SIGTERM (its handler's 15) where SIGINT was ignored
+    assert done.stdout.splitlines() == ["KeyboardInterrupt True True", str(child_exit), "still here"], done.stderr
+
+
+def test_a_second_sigterm_at_once_is_the_same_stop_and_a_later_one_ends_the_command_with_its_line() -> None:
+    """GNU ``timeout`` signals the command, then its group: the copy used to end the runner with -15, no word."""
+    done = subprocess.run(
+        [sys.executable, "-c", _SIGTERM_DRIVER, "default", "later"], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 143, done.stderr
+    assert done.stdout.splitlines() == ["KeyboardInterrupt True True", str(-signal.SIGINT), "still here"]
+    # (above it, the child's own KeyboardInterrupt traceback: it is a plain Python child, not ours)
+    assert done.stderr.splitlines()[-1] == "albot1: terminated (SIGTERM)" and done.stderr.count("albot1:") == 1
