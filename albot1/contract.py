@@ -41,12 +41,28 @@ class MapData:
             seg = np.asarray(self.segments, dtype=float)
             lengths = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1])
             counts = np.maximum(2, np.ceil(lengths / spacing).astype(int) + 1)
-            for s, n in zip(seg, counts):
-                t = np.linspace(0.0, 1.0, n)[:, None]
-                parts.append(s[:2] + t * (s[2:] - s[:2]))
+            parts.append(_sample_segments(seg, counts))
         if self.points is not None and len(self.points):
             parts.append(np.asarray(self.points, dtype=float))
         return np.concatenate(parts) if parts else np.empty((0, 2))
+
+
+def _sample_segments(seg: FloatArray, counts: NDArray[np.int_]) -> FloatArray:
+    """``counts[i]`` points along segment ``i``, in segment order: the bits of one ``np.linspace`` per segment.
+
+    A loop of ``linspace`` calls cost ~10 us a segment (a default report samples ~160,000 segments); the same
+    arithmetic on all of them at once: the k-th of n points is ``start + t * (end - start)`` with
+    ``t = k * (1 / (n - 1))`` and the last ``t`` exactly 1, as ``linspace(0, 1, n)`` computes it.
+    """
+    owner = np.repeat(np.arange(len(seg)), counts)
+    first = np.cumsum(counts) - counts
+    k = np.arange(len(owner)) - first[owner]
+    t = k * (1.0 / (counts - 1))[owner]
+    t[first[1:] - 1] = 1.0
+    if len(t):
+        t[-1] = 1.0
+    start, end = seg[owner, :2], seg[owner, 2:]
+    return start + t[:, None] * (end - start)
 
 
 @dataclass

@@ -167,3 +167,28 @@ def test_the_point_map_file_is_stored_not_deflated_and_reads_back_the_same_array
     with np.load(tmp_path / "map.npz", allow_pickle=False) as npz:
         assert npz["points"].dtype == np.float32
         np.testing.assert_array_equal(npz["points"], points)
+
+
+def test_geometry_points_are_the_bits_of_one_linspace_per_segment() -> None:
+    """MapData.geometry_points samples every segment at once: the same points, bit for bit, as a loop of linspace."""
+    import numpy as np
+
+    from albot1.contract import MapData
+
+    def by_loop(segments: np.ndarray, spacing: float = 0.05) -> np.ndarray:
+        lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
+        counts = np.maximum(2, np.ceil(lengths / spacing).astype(int) + 1)
+        return np.concatenate(
+            [s[:2] + np.linspace(0.0, 1.0, n)[:, None] * (s[2:] - s[:2]) for s, n in zip(segments, counts)]
+        )
+
+    rng = np.random.default_rng(11)
+    for scale in (0.001, 0.03, 1.0, 40.0):
+        segments = rng.normal(scale=scale, size=(500, 4)) + rng.normal(scale=80.0, size=(1, 4))
+        segments[:50, 2:] = segments[:50, :2]  # zero-length segments: two points each
+        got = MapData(segments=segments).geometry_points()
+        assert got.shape == by_loop(segments).shape
+        assert got.tobytes() == by_loop(segments).tobytes()
+    points = rng.normal(size=(7, 2))
+    both = MapData(segments=segments[:3], points=points).geometry_points()
+    assert both.tobytes() == np.concatenate([by_loop(segments[:3]), points]).tobytes()
