@@ -11,6 +11,7 @@ the CLI).
 from __future__ import annotations
 
 import functools
+import logging
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -124,6 +125,15 @@ def _planar_pose(shown: Path, topic: str, index: int, p: Any, q: Any) -> tuple[f
     return x, y, yaw_from_quaternion(*quaternion)
 
 
+log = logging.getLogger(__name__)
+
+#: Two poses of one stamp at most this far apart are one estimate published again before its stamp moved on
+#: (tf2's TF_REPEATED_DATA: robot_state_publisher, Gazebo's odometry, robot_localization): the first is kept, as
+#: tf2 keeps it, and the loader says how many it dropped. Further apart they are two estimates: refused.
+SAME_ESTIMATE_M = 0.1
+SAME_ESTIMATE_DEG = 5.0
+
+
 class _PoseStream:
     """One pose topic's (or ``/tf`` link's) messages as they are read; :meth:`track` sorts them by stamp.
 
@@ -175,24 +185,55 @@ class _PoseStream:
         self.indexes.append(index)
 
     def track(self) -> PoseTrack:
-        """The poses sorted by stamp; a ParseError naming both messages of a stamp that holds two poses."""
-        order = sorted(range(len(self.times)), key=self.times.__getitem__)
-        for a, b in zip(order, order[1:], strict=False):
-            if self.times[a] == self.times[b] and self.poses[a] != self.poses[b]:
-                a, b = sorted((a, b), key=self.indexes.__getitem__)
-                where = (
-                    f"messages #{self.indexes[a]} and #{self.indexes[b]} are"
-                    if self.indexes[a] != self.indexes[b]
-                    else f"message #{self.indexes[a]} holds two transforms"
-                )
-                raise ParseError(
-                    self.shown,
-                    f"topic {self.topic}: {where} both stamped {self.times[a]:.9f} s with two poses "
-                    f"{_shown_pose(self.poses[a])} and {_shown_pose(self.poses[b])}; expected one pose per stamp "
-                    f"(which one holds at that time cannot be told)",
-                    index=self.indexes[b],
-                )
-        return PoseTrack.build(self.times, self.poses)
+        """The poses sorted by stamp, the first of each stamp; a ParseError naming both messages of a stamp that
+        holds two estimates (poses further apart than :data:`SAME_ESTIMATE_M` / :data:`SAME_ESTIMATE_DEG`)."""
+        order = sorted(range(len(self.times)), key=lambda i: (self.times[i], self.indexes[i]))
+        kept: list[int] = []
+        repeated: list[int] = []  # later poses of a stamp, close to its first: dropped, and said
+        for i in order:
+            if kept and self.times[kept[-1]] == self.times[i]:
+                if self.poses[i] == self.poses[kept[-1]]:
+                    continue  # the same message again: read once
+                if _same_estimate(self.poses[kept[-1]], self.poses[i]):
+                    repeated.append(i)
+                    continue
+                self._refuse_two_estimates(kept[-1], i)
+            kept.append(i)
+        if repeated:
+            first = repeated[0]
+            log.warning(
+                "%s: topic %s: %d pose(s) at a stamp already given (first: message #%d at %.9f s), each within "
+                "%g m and %g deg of that stamp's first pose; kept the first of each stamp, as tf2 does "
+                "(TF_REPEATED_DATA)",
+                self.shown, self.topic, len(repeated), self.indexes[first], self.times[first], SAME_ESTIMATE_M,
+                SAME_ESTIMATE_DEG,
+            )  # fmt: skip
+        return PoseTrack.build([self.times[i] for i in kept], [self.poses[i] for i in kept])
+
+    def _refuse_two_estimates(self, a: int, b: int) -> None:
+        """A ParseError naming the two messages whose poses of one stamp are two estimates."""
+        where = (
+            f"messages #{self.indexes[a]} and #{self.indexes[b]} are"
+            if self.indexes[a] != self.indexes[b]
+            else f"message #{self.indexes[a]} holds two transforms"
+        )
+        raise ParseError(
+            self.shown,
+            f"topic {self.topic}: {where} both stamped {self.times[a]:.9f} s with two poses "
+            f"{_shown_pose(self.poses[a])} and {_shown_pose(self.poses[b])}; expected one pose per stamp (poses "
+            f"within {SAME_ESTIMATE_M:g} m and {SAME_ESTIMATE_DEG:g} deg are read as one estimate repeated; these "
+            f"are two, and which one holds at that time cannot be told)",
+            index=self.indexes[b],
+        )
+
+
+def _same_estimate(first: tuple[float, float, float], other: tuple[float, float, float]) -> bool:
+    """Whether ``other`` is within :data:`SAME_ESTIMATE_M` and :data:`SAME_ESTIMATE_DEG` of ``first``."""
+    turn = math.remainder(other[2] - first[2], math.tau)
+    return (
+        math.hypot(other[0] - first[0], other[1] - first[1]) <= SAME_ESTIMATE_M
+        and abs(math.degrees(turn)) <= SAME_ESTIMATE_DEG
+    )
 
 
 def _shown_pose(pose: tuple[float, float, float]) -> str:

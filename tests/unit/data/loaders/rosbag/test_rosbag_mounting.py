@@ -361,6 +361,37 @@ def test_two_poses_of_one_stamp_on_tf_are_refused(tmp_path: Path) -> None:
         list(Ros2BagLoader().load(tmp_path / "two").frames())
 
 
+def test_a_pose_repeated_at_its_stamp_a_little_off_is_one_estimate_the_first_kept_and_said(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """tf2's TF_REPEATED_DATA: a publisher sends odom -> base_link again before its stamp moved on (Gazebo,
+    robot_state_publisher, robot_localization), the pose updated by a few centimetres. tf2 keeps the first; the
+    reader did too once, then refused the whole bag; now it keeps the first and says how many it dropped."""
+    import logging
+
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    msgs = RosMessages(ts, ros1=False)
+    with Writer(tmp_path / "again", version=9) as bag:
+        scan = bag.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=ts)
+        tf = bag.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=ts)
+        for f in sequence(3).frames():
+            ns = seconds_to_ns(f.scan.timestamp)
+            x, theta = float(f.odometry[0]), float(f.odometry[2])
+            for dx in (0.0, 0.02):  # the second 2 cm further on, under the same stamp
+                moved = [("odom", "base_link", (x + dx, 0.0, 0.0), yaw_q(theta))]
+                bag.write(tf, ns, ts.serialize_cdr(_tf(ts, msgs, ns, moved), "tf2_msgs/msg/TFMessage"))
+            bag.write(scan, ns, ts.serialize_cdr(msgs.scan(f, ns), "sensor_msgs/msg/LaserScan"))
+    with caplog.at_level(logging.WARNING, logger="albot1.data.loaders.rosbag.reader"):
+        frames = list(Ros2BagLoader().load(tmp_path / "again").frames())
+    expected = [float(f.odometry[0]) for f in sequence(3).frames()]
+    assert [float(f.odometry[0]) for f in frames] == pytest.approx(expected, abs=1e-12)  # each stamp's first pose
+    [said] = [r.getMessage() for r in caplog.records if "TF_REPEATED_DATA" in r.getMessage()]
+    assert "topic /tf (odom -> base_link): 3 pose(s) at a stamp already given (first: message #1 at" in said
+
+
 def write_ros1_publishers(path: Path, publishers: list[str], tf: bool) -> None:
     """A ROS1 bag whose odometry (``odom -> base_link`` on /tf, or /odom) comes from ``publishers`` in turn,
     one connection per node as ROS1 records them, at stamps that never coincide; a scan between each two."""
