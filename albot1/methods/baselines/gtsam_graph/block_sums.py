@@ -19,7 +19,6 @@ Lookups are clipped to the table, as ``np.clip`` and a 2-D lookup did.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -27,8 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1 import compiled, kernel_bundle
 from albot1.methods.albot1.compiled import jitable, kernel
+from albot1.methods.baselines.gtsam_graph.warming import warm_kernels
 
 IntArray = NDArray[np.int64]
 
@@ -163,18 +162,5 @@ def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
 
 
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
-    """Compile :func:`block_sums` (or load numba's cache) before a run's first scan, as :func:`.nearest.warm_up`.
-
-    The wheel's kernel bundle is tried first (:func:`kernel_bundle.seed`);
-    ``announce`` hears of a real compilation only.
-    """
-    if compiled.needs_compile(block_sums):
-        kernel_bundle.seed(sample_calls(), compiled.needs_compile)
-    cold = compiled.needs_compile(block_sums)
-    if cold and announce is not None:
-        announce(f"gtsam-graph: compiling its block sums once for this code version (cache: {compiled.CACHE_DIR})")
-    start = time.perf_counter()
-    for _, fn, args in sample_calls():
-        fn(*args)
-    if cold and announce is not None:
-        announce(f"gtsam-graph: block sums compiled in {time.perf_counter() - start:.1f} s")
+    """Compile :func:`block_sums` (or load numba's cache or the wheel's bundle) before a run's first scan."""
+    warm_kernels((block_sums,), sample_calls, "block sums", announce)

@@ -46,7 +46,6 @@ import functools
 import glob
 import math
 import os
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -54,10 +53,11 @@ import numpy as np
 from numba import types
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1 import compiled, kernel_bundle
+from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import jitable, kernel
 from albot1.methods.albot1.mapping.localise_kernels import python_hypot
 from albot1.methods.baselines.gtsam_graph.nearest import AMBIGUOUS, IntArray, _nearest_one, _terms
+from albot1.methods.baselines.gtsam_graph.warming import warm_kernels
 
 #: numpy's BLAS and LAPACK functions this module calls, by their symbols in numpy's scipy-openblas64 library
 SYMBOLS = ("scipy_cblas_dgemm64_", "scipy_cblas_dgemv64_", "scipy_dgesv_64_")
@@ -329,19 +329,10 @@ def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
 
 
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
-    """Compile :func:`icp_run` (or load numba's cache or the wheel's bundle) before a run, as :func:`.nearest.warm_up`.
+    """Compile :func:`icp_run` (or load numba's cache or the wheel's bundle) before a run's first scan.
 
-    Nothing to do where :func:`available` is False (ICP then never calls them).
+    Nothing to do where :func:`available` is False (ICP then never calls it). The first sample query is an exact
+    tie: it stops at ``ASK_TREE``, typed as a run calls it.
     """
-    if not available():
-        return
-    if compiled.needs_compile(icp_run):
-        kernel_bundle.seed(sample_calls(), compiled.needs_compile)
-    cold = compiled.needs_compile(icp_run)
-    if cold and announce is not None:
-        announce(f"gtsam-graph: compiling its ICP step once for this code version (cache: {compiled.CACHE_DIR})")
-    start = time.perf_counter()
-    for _, fn, args in sample_calls():
-        fn(*args)  # the first sample query is an exact tie: it stops at ASK_TREE, typed as a run calls it
-    if cold and announce is not None:
-        announce(f"gtsam-graph: ICP step compiled in {time.perf_counter() - start:.1f} s")
+    if available():
+        warm_kernels((icp_run,), sample_calls, "ICP step", announce)

@@ -33,7 +33,6 @@ the same operations in the same order as the numpy formulation they replace
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -41,9 +40,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.albot1 import compiled, kernel_bundle
+from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import jitable, kernel
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
+from albot1.methods.baselines.gtsam_graph.warming import warm_kernels
 
 #: ambiguous when two squared distances (or one and the gate squared) are this close, relative to the gate squared
 #: plus the gate times the coordinates' size (the k-d tree's rounding grows with both: see :func:`_nearest_one`)
@@ -420,17 +420,11 @@ def warm_up(announce: Callable[[str], None] | None = None) -> None:
     """
     from scipy.spatial import cKDTree
 
-    kernels = (build_grid, linearise_terms, terms)
-    if any(compiled.needs_compile(k) for k in kernels):
-        kernel_bundle.seed(sample_calls(), compiled.needs_compile)
-    cold = any(compiled.needs_compile(k) for k in kernels)
-    if cold and announce is not None:
-        announce(f"gtsam-graph: compiling its grid search once for this code version (cache: {compiled.CACHE_DIR})")
-    start = time.perf_counter()
-    points, normals, source = _sample()
-    lines = np.hstack([points, normals])
-    Matches(len(source)).find(
-        Grid(points), lambda: cKDTree(points), lines, source @ np.eye(2), np.zeros(3), 1.0, 0.1, 1.0
-    )
-    if cold and announce is not None:
-        announce(f"gtsam-graph: grid search compiled in {time.perf_counter() - start:.1f} s")
+    def run() -> None:
+        points, normals, source = _sample()
+        lines = np.hstack([points, normals])
+        Matches(len(source)).find(
+            Grid(points), lambda: cKDTree(points), lines, source @ np.eye(2), np.zeros(3), 1.0, 0.1, 1.0
+        )
+
+    warm_kernels((build_grid, linearise_terms, terms), sample_calls, "grid search", announce, run)
