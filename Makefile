@@ -19,7 +19,7 @@ endif
 endif
 export MPLBACKEND := Agg
 
-.PHONY: venv test test-whole-log test-end-to-end test-all test-fast bench bench-timing lint wheel-check clean mrpt chromium
+.PHONY: venv test test-whole-log test-end-to-end test-compile test-all test-fast bench bench-timing lint wheel-check clean mrpt chromium
 
 venv: $(STAMP)
 
@@ -57,13 +57,14 @@ $(STAMP): pyproject.toml
 	@if [ "$(WARM_UP)" = 1 ]; then $(BIN)/albot1 warm-up \
 	  || echo "make venv: NOTICE: albot1 warm-up failed (above); the first run will compile its kernels itself" >&2; fi
 
-# Every test but two lanes (unit, property, integration on the public logs when ALBOT1_DATA_DIR has them, on
+# Every test but three lanes (unit, property, integration on the public logs when ALBOT1_DATA_DIR has them, on
 # slices), spread over TEST_JOBS worker processes (pytest-xdist; auto = one per core).
 # `make test-whole-log` runs the tests marked `whole_log` (a whole public log or synthetic world run for quality,
 # parity or scale, tens of seconds each: docs/benchmarking.md, "The whole-log lane"); `make test-end-to-end` the
 # tests marked `end_to_end` (the `albot1 bench` command run end to end: grids in worker processes or a Dask cluster,
-# faults injected, reports built; seconds to a minute each: "The end-to-end lane"). CI runs all three (.ci/run),
-# `make test-all` runs them all here in one session.
+# faults injected, reports built; seconds to a minute each: "The end-to-end lane"); `make test-compile` the tests
+# marked `compile` (the numba kernels compiled cold, cached, bundled into a wheel or switched off, in fresh processes;
+# ten to thirty seconds each: "The compile lane"). CI runs all four (.ci/run), `make test-all` them all in one session.
 # --dist loadscope: a worker that is nearly done is handed the next module (whole: its module fixtures are
 # built once) in conftest.py's order, longest first by tests/durations.json, so the modules of the whole-log
 # tests start at once and the short ones fill the gaps at the end; docs/benchmarking.md has the times.
@@ -71,13 +72,16 @@ $(STAMP): pyproject.toml
 # test modules and the compiled package instead of compiling ~300 modules again in every worker.
 XDIST := -n $(TEST_JOBS) --dist loadscope --no-loadscope-reorder
 test: $(STAMP)
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not whole_log and not end_to_end"
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not whole_log and not end_to_end and not compile"
 
 test-whole-log: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m whole_log
 
 test-end-to-end: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "end_to_end and not whole_log"
+
+test-compile: $(STAMP)
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "compile and not whole_log and not end_to_end"
 
 test-all: $(STAMP)
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST)
@@ -89,7 +93,7 @@ test-all: $(STAMP)
 # property test but runs each with at most 10 examples. `make test` and CI run every one of these tests with its
 # own example count; `make test-all` runs them all.
 test-fast: $(STAMP)
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not slow and not integration" --hypothesis-profile=fast tests/unit tests/property
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -q $(XDIST) -m "not slow and not integration and not compile" --hypothesis-profile=fast tests/unit tests/property
 
 # The suites' grids run one after the other; each suite's report starts as soon as its own grid has ended (it
 # runs beside the next grid), the results page as soon as results/default and results/thesis are final

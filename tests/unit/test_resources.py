@@ -96,6 +96,7 @@ def test_installed_package_uses_the_bundle(tmp_path: Path, monkeypatch: pytest.M
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_the_build_step_bundles_every_toml_file(tmp_path: Path) -> None:
     """setup.py's build_py copies the top-level folders into the package tree of the build, and the kernels.
 

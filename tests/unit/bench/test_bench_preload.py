@@ -98,6 +98,7 @@ print(json.dumps({name: n for name, n in counts.items() if name not in MappingKe
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_the_forkserver_compiles_every_kernel_before_any_cell_is_forked() -> None:
     """A cell forked after the preload finds every Albot1 kernel compiled: its start-up compiles nothing."""
     import json

@@ -548,6 +548,7 @@ def test_kernels_are_cached_in_a_folder_named_by_the_code_version() -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_an_unwritable_user_cache_falls_back_to_a_per_user_temporary_folder() -> None:
     """As for an installed wheel whose user cache cannot be written: numba still caches, elsewhere."""
     code = (
@@ -570,6 +571,7 @@ def test_without_acceleration_a_mapper_calls_the_kernels_as_written() -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_numba_s_switch_runs_every_kernel_as_written_with_the_same_results() -> None:
     """``NUMBA_DISABLE_JIT=1``: the decorators hand back the functions; a short run gives the same bits."""
     code = (

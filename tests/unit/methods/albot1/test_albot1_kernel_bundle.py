@@ -123,6 +123,7 @@ def _always_cold(kernel: object) -> bool:
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_a_fresh_cache_loads_every_bundled_kernel_without_compiling(bundle: Path, tmp_path: Path) -> None:
     names = sorted({name for name, _, _ in _calls()})
     assert {"gtsam_graph.build_grid", "gtsam_graph.linearise_terms", "gtsam_graph.terms"} <= set(names)
@@ -133,6 +134,7 @@ def test_a_fresh_cache_loads_every_bundled_kernel_without_compiling(bundle: Path
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_gtsam_graph_s_warm_up_loads_its_kernels_from_the_bundle(bundle: Path, tmp_path: Path) -> None:
     """Its first run after a wheel install: no compile, nothing announced; without a bundle it compiles, as before."""
     loaded = _fresh_process(bundle, tmp_path / "cache", _GTSAM_WARM_UP)

@@ -50,6 +50,7 @@ print(json.dumps({"warmed": warmed, "added": added}))
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_whole_runs_after_the_warm_up_compile_nothing_new() -> None:
     out = subprocess.run(
         [sys.executable, "-c", _CODE], env=dict(os.environ), capture_output=True, text=True, timeout=900
@@ -74,6 +75,7 @@ print(json.dumps(found))
 """
 
 
+@pytest.mark.compile
 def test_a_thesis_preset_s_warm_up_leaves_out_the_kernels_only_albot1_plus_calls() -> None:
     """The first run of a thesis preset does not pay for Albot1+'s pose kernels; ``plus`` warms them (in that order)."""
     out = subprocess.run(
@@ -133,6 +135,7 @@ print(json.dumps({"cached": cached, "stats": stats}))
 """
 
 
+@pytest.mark.compile
 def test_a_helper_s_kernels_are_loaded_from_numba_s_cache_by_the_next_process(tmp_path: Path) -> None:
     """The mechanism of a parallel warm-up: what a helper compiles for its claims, another process loads."""
     claims = tmp_path / "claims"
@@ -151,6 +154,7 @@ def test_a_helper_s_kernels_are_loaded_from_numba_s_cache_by_the_next_process(tm
 
 
 @pytest.mark.slow
+@pytest.mark.compile
 def test_a_cold_warm_up_in_two_processes_fills_the_cache_with_every_kernel_of_its_preset(tmp_path: Path) -> None:
     """``ALBOT1_COMPILE_PROCESSES=2`` on an empty cache: each kernel cached once, the next process compiles nothing.
 
