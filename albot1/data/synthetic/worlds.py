@@ -23,7 +23,7 @@ import functools
 import math
 from typing import Any
 
-from albot1.data.loaders.base import COMMON_OPTIONS, reference_keyword_problem
+from albot1.data.loaders.base import COMMON_OPTIONS, option_names, reference_keyword_problem, unknown_option_hint
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
 from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError
@@ -191,6 +191,7 @@ def variant(name: str, options: dict[str, Any]) -> WorldSpec:
         raise WorldOptionError(
             f"synthetic world {name!r}: unknown loader option(s) {', '.join(unknown)}; "
             f"expected {' or '.join(WORLD_OPTIONS)} (and the options of every source: {', '.join(COMMON_OPTIONS)})"
+            f"{unknown_option_hint(unknown, option_names(WORLD_OPTIONS))}"
         )
     if not options:
         return spec

@@ -18,7 +18,13 @@ from typing import Any
 
 from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
-from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, DEFAULT_TIME_TOLERANCE_S, max_pose_gap
+from albot1.data.loaders.base import (
+    DEFAULT_MAX_POSE_GAP_S,
+    DEFAULT_TIME_TOLERANCE_S,
+    max_pose_gap,
+    option_names,
+    unknown_option_hint,
+)
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 from albot1.data.relations import RepeatPolicy, repeat_policy
 
@@ -45,9 +51,10 @@ class CarmenOptions:
         known = set(CarmenOptions.__dataclass_fields__)
         unknown = sorted(set(options) - known)
         if unknown:
+            names = option_names(sorted(known))
             raise DataError(
                 f"{path}: unknown CARMEN loader option(s) {', '.join(unknown)}; "
-                f"expected some of {', '.join(sorted(known) + list(COMMON_OPTIONS))}"
+                f"expected some of {', '.join(names)}{unknown_option_hint(unknown, names)}"
             )
         for key in ("max_range", "time_tolerance"):
             if options.get(key) is not None:
