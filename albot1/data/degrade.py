@@ -65,6 +65,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from albot1.config.numbers import is_number
+from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
 from albot1.data.finite import pose_problem
 from albot1.data.model import Frame, Sequence
@@ -189,7 +190,9 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
         # `thesis:1` used to read "unknown kind 'thesis'"
         raise DegradationSpecError(f"degradation {spec!r}: {kind} takes no values; {EXPECTED_SPEC}")
     if kind not in _ARITY:
-        raise DegradationSpecError(f"degradation {spec!r} not understood (unknown kind {kind!r}); {EXPECTED_SPEC}")
+        raise DegradationSpecError(
+            f"degradation {spec!r} not understood (unknown kind {kind!r}){did_you_mean(kind, _KINDS)}; {EXPECTED_SPEC}"
+        )
     parts = [part.strip() for part in rest.split(":")] if rest else []
     if len(parts) != _ARITY[kind]:
         raise DegradationSpecError(

@@ -85,3 +85,20 @@ def test_a_turn_per_step_is_its_exact_remainder_of_a_whole_turn(
     assert deg.b == math.radians(exact + 0.0)
     assert abs(math.degrees(deg.b)) < 360.0
     assert parse_spec(deg.spec) == deg  # the one spelling names the turn that runs
+
+
+@given(kind=st.sampled_from(["none", "thesis", "gauss", "bias", "offset", "dropout"]), data=st.data())
+def test_a_kind_with_one_letter_missing_is_suggested(kind: str, data: st.DataObject) -> None:
+    """out49: `gaus:0.1:1` read "unknown kind 'gaus'" without the "did you mean" every other name gets."""
+    at = data.draw(st.integers(0, len(kind) - 1))
+    typo = kind[:at] + kind[at + 1 :]
+    spec = f"{typo}:0.1:1"
+    try:
+        parse_spec(spec)
+    except DegradationSpecError as exc:
+        message = str(exc)
+    else:
+        raise AssertionError(f"{spec!r} parsed")
+    assert message.startswith(f"degradation {spec!r} not understood (unknown kind {typo!r}) (did you mean ")
+    assert repr(kind) in message.split("did you mean ", 1)[1].split("?)", 1)[0]
+    assert message.endswith(EXPECTED_SPEC) and "\n" not in message
