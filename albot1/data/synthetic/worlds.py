@@ -226,12 +226,12 @@ def _generated(name: str, options: tuple[tuple[str, Any], ...]) -> WorldData:
     return generate(variant(name, dict(options)))
 
 
-def world_data(name: str, **options: Any) -> WorldData:
+def world_data(name: str, /, **options: Any) -> WorldData:
     """The generated world ``name`` (with loader options; cached per process)."""
     return _generated(name, tuple(sorted(options.items())))
 
 
-def load_world(name: str, **options: Any) -> Sequence:
+def load_world(name: str, /, **options: Any) -> Sequence:
     """The embedded world ``name`` (with loader options) as a streamed Sequence (reference = exact poses)."""
     data = world_data(name, **options)
     return Sequence(data.spec.name, functools.partial(stream_frames, data), world_metadata(data), scan_count=data.scans)

@@ -63,6 +63,8 @@ class CarmenOptions:
                 except (TypeError, ValueError):
                     raise DataError(f"{path}: {key}={options[key]!r}; expected a number") from None
         options["max_pose_gap"] = max_pose_gap(options.get("max_pose_gap"), path)
+        if "parallel_bz2" in options:
+            options["parallel_bz2"] = _flag(path, "parallel_bz2", options["parallel_bz2"])
         opts = CarmenOptions(**options)
         if opts.odometry not in ODOMETRY_SOURCES:
             raise DataError(  # "reference" is taken by albot1.data.open before the loader runs
@@ -78,6 +80,19 @@ class CarmenOptions:
         if not opts.time_tolerance >= 0:  # inf disables the check (logs whose stamps are garbage)
             raise DataError(f"{path}: time_tolerance={opts.time_tolerance!r}; expected seconds >= 0 (or inf)")
         return opts
+
+
+def _flag(path: Path, key: str, value: object) -> bool:
+    """``true`` / ``false`` (any case, as a query writes them) or a bool; else a DataError naming the value.
+
+    A query's ``parallel_bz2=false`` reached the loader as the text ``'false'``, which is true: the documented
+    switch did nothing, and ``parallel_bz2=maybe`` was accepted.
+    """
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.lower() in ("true", "false"):
+        return value.lower() == "true"
+    raise DataError(f"{path}: {key}={value!r}; expected true or false")
 
 
 @dataclass(frozen=True)

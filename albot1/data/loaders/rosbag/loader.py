@@ -194,7 +194,9 @@ def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
     opts = {k: options.get(k) for k in _OPTIONS}
     opts["outside_odometry"] = opts["outside_odometry"] or "error"
     if opts["outside_odometry"] not in _OUTSIDE:
-        raise DataError(f"outside_odometry={opts['outside_odometry']!r}; expected one of {', '.join(_OUTSIDE)}")
+        raise DataError(
+            f"{shown}: outside_odometry={opts['outside_odometry']!r}; expected one of {', '.join(_OUTSIDE)}"
+        )
     opts["odom_frame"] = opts["odom_frame"] or "odom"
     opts["max_pose_gap"] = max_pose_gap(opts["max_pose_gap"], shown)
     return opts
