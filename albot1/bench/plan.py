@@ -223,6 +223,23 @@ def _sweep(opts: DatasetOptions, suite: Suite, has_reference: bool) -> list[tupl
     return runs
 
 
+def _no_runs(opts: DatasetOptions, suite: Suite, has_reference: bool) -> str:
+    """Why a dataset that opened plans no run: no undegraded seed, and no degradation swept on it.
+
+    Such a dataset used to vanish from the grid without a word (and a suite of only such datasets
+    ended in "every dataset or method it selects was skipped", naming none).
+    """
+    if opts.sweep == "auto" and not has_reference:
+        why = 'no degradation is swept on it (sweep = "auto" and it has no reference poses)'
+    elif opts.sweep is False:
+        why = "no degradation is swept on it (sweep = false)"
+    elif opts.degradations if opts.degradations is not None else suite.grid.degradations:
+        why = "its degradations list names only `none` (the undegraded run, which has no seed here)"
+    else:
+        why = "its degradations list is empty"
+    return f"no cell planned: undegraded_seeds is empty and {why}"
+
+
 def _runs_once(degradation: str, method: str, registry: MethodRegistry) -> bool:
     """A deterministic degradation of a deterministic method runs with the first seed only.
 
@@ -294,7 +311,11 @@ def plan_suite(suite: Suite, settings: Settings, registry: MethodRegistry | None
         if skipped is not None:
             skipped_datasets.append(skipped)
             continue
-        for degradation, sweep_seeds in _sweep(opts, suite, bool(has_reference)):
+        runs = _sweep(opts, suite, bool(has_reference))
+        if not any(seeds for _, seeds in runs):
+            skipped_datasets.append(Skipped(name, _no_runs(opts, suite, bool(has_reference))))
+            continue
+        for degradation, sweep_seeds in runs:
             for seed, entry in ((s, e) for s in sweep_seeds for e in methods):
                 if opts.methods is not None and entry.display not in opts.methods:
                     continue

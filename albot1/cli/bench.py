@@ -90,7 +90,7 @@ def bench(
     # The bench and report layers are imported by the command, not by this module: see albot1.cli.app.
     from tqdm import tqdm
 
-    from albot1.bench.executors import scheduler_executor
+    from albot1.bench.executors import check_jobs, parse_executor, scheduler_executor
     from albot1.bench.plan import plan_suite
     from albot1.bench.progress import TqdmProgress, plan_table, summary_table
     from albot1.bench.runner import run_suite
@@ -100,6 +100,9 @@ def bench(
     if scheduler is not None:
         executor = scheduler_executor(scheduler, executor)
     if dry_run:
+        # What the run would refuse, the dry run refuses too: `-j 0` or `--executor ray` passed it with exit 0.
+        check_jobs(jobs)
+        parse_executor(executor)
         with contextlib.redirect_stdout(sys.stderr):  # what a method's module prints as it is imported (below)
             plan = plan_suite(load_suite(find_suite(suite)), get_settings(data_dir=data_dir))
         typer.echo(plan_table(plan))

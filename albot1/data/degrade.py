@@ -46,7 +46,9 @@ move a robot that stands still. A SPEC whose values are all 0 is refused
 ``bias`` or ``offset`` that only turns by whole turns (``bias:0:720``).
 Each value is taken to the 12 significant digits of the SPEC's one spelling
 (:attr:`Degradation.spec`, what ``albot1 run`` and suites run and key), and
-checked there: ``dropout:0.9999999999999`` is ``dropout:1``, refused.
+checked there: ``dropout:0.9999999999999`` is ``dropout:1``, refused. A
+``bias`` or ``offset`` rotation is its remainder of a whole turn, exactly
+(``bias:0.1:370`` is ``bias:0.1:10``; ``bias:0:1e20`` turns 280 deg per step).
 
 Otherwise only the odometry changes; scans, reference poses and relations are
 kept. The random stream is a ``numpy.random.default_rng(seed)`` re-created for
@@ -63,6 +65,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from albot1.config.numbers import is_number
+from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
 from albot1.data.finite import pose_problem
 from albot1.data.model import Frame, Sequence
@@ -187,7 +190,9 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
         # `thesis:1` used to read "unknown kind 'thesis'"
         raise DegradationSpecError(f"degradation {spec!r}: {kind} takes no values; {EXPECTED_SPEC}")
     if kind not in _ARITY:
-        raise DegradationSpecError(f"degradation {spec!r} not understood (unknown kind {kind!r}); {EXPECTED_SPEC}")
+        raise DegradationSpecError(
+            f"degradation {spec!r} not understood (unknown kind {kind!r}){did_you_mean(kind, _KINDS)}; {EXPECTED_SPEC}"
+        )
     parts = [part.strip() for part in rest.split(":")] if rest else []
     if len(parts) != _ARITY[kind]:
         raise DegradationSpecError(
@@ -213,21 +218,27 @@ def parse_spec(spec: str, *, stored: bool = False) -> Degradation:
             f"degradation {spec!r}: the dropout probability must be in [0, 1) (the first scan is always kept)"
             f"{digits}; {EXPECTED_SPEC}"
         )
+    turn = values[-1]  # bias's and offset's rotation (deg) is their last value
+    if kind in ("bias", "offset"):
+        # A turn per step acts as its remainder, taken exactly (fmod) in degrees: radians(1e20) rounded away the
+        # whole turns' multiples of 2 pi, so `bias:0:1e20` turned each step by float noise, not 1e20 deg = 280 deg.
+        # Spelt again to the label's 12 digits (then 360 is 0), so the label re-parses to this very turn.
+        values[-1] = math.fmod(float(_label(math.fmod(turn, 360.0))), 360.0) + 0.0
     if kind == "offset":
         deg = Degradation(kind, values[0], math.radians(values[2]), values[1])
     else:
         deg = Degradation(kind, values[0], math.radians(values[1]) if len(values) > 1 else 0.0)
-    if not (stored or deg.a or deg.b or deg.c):
-        raise DegradationSpecError(
-            f"degradation {spec!r} changes nothing (every value is 0): its runs would repeat the undegraded run "
-            f"under a degraded label; write none"
-        )
-    turn = values[-1]  # bias's and offset's rotation (deg) is their last value
-    if not stored and kind in ("bias", "offset") and not (deg.a or deg.c) and math.remainder(turn, 360.0) == 0.0:
+    whole = kind in ("bias", "offset") and turn != 0.0 and math.remainder(turn, 360.0) == 0.0
+    if not stored and whole and not (deg.a or deg.c):
         # `bias:0:720` turns every step by two whole turns: the odometry is the undegraded one (to rounding)
         raise DegradationSpecError(
             f"degradation {spec!r} changes nothing (no translation, and {turn:g} deg is a whole number of "
             f"turns{digits}): its runs would repeat the undegraded run under a degraded label; write none"
+        )
+    if not (stored or deg.a or deg.b or deg.c):
+        raise DegradationSpecError(
+            f"degradation {spec!r} changes nothing (every value is 0): its runs would repeat the undegraded run "
+            f"under a degraded label; write none"
         )
     return deg
 

@@ -56,6 +56,9 @@ from albot1.settings import Settings, get_settings
 
 #: ``odometry=reference``: the value that selects the reference poses as odometry on any dataset.
 REFERENCE = "reference"
+#: Keyword names the opening functions take themselves: as ``?key=value`` they ended in a TypeError traceback
+#: ("open_sequence() got multiple values for keyword argument 'settings'"); no loader has such an option.
+NOT_LOADER_OPTIONS = ("format_name", "manifest_relations", "path", "ref", "self", "settings")
 
 
 def open_sequence(
@@ -108,6 +111,11 @@ def _open_source(
     settings = settings or get_settings()
     _check_option_files(options, text)
     if text in catalog.names():
+        if "name" in options:  # a log file's option (the sequence's name); it clashed with open_dataset's own
+            raise DatasetNotFoundError(
+                f"{text!r}: name={options['name']} names the sequence of a log file given by path; a registered "
+                f"dataset keeps its own name ({text})"
+            )
         checksums = _checksums(None, options)
         dataset = catalog.open_dataset(text, settings, manifest_relations=manifest_relations, **options)
         return _attach(checked(dataset), checksums)
@@ -325,6 +333,12 @@ def parse_options(query: str, ref: str) -> dict[str, Any]:
         pairs = parse_query(query, what="loader option")
     except KeyValueError as exc:
         raise DatasetNotFoundError(f"{ref!r}: {exc}") from None
+    taken = [key for key in pairs if key in NOT_LOADER_OPTIONS]
+    if taken:
+        raise DatasetNotFoundError(
+            f"{ref!r}: loader option {taken[0]!r} is not an option of any loader (a name the opening code keeps "
+            "for itself); expected the options of the dataset's loader (docs/formats.md, docs/datasets.md)"
+        )
     return {key: parse_scalar(value) for key, value in pairs.items()}
 
 

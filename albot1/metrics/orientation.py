@@ -11,7 +11,11 @@ Stop points are every ``every_m`` metres of *reference* travel (the same
 scans for every method on a dataset) plus the final scan. A bearing is
 undefined at the start itself, so rows whose reference distance to the start
 is below ``min_distance_m`` keep their distances but leave the bearing error
-out (``null``), and the block counts them.
+out (``null``), and the block counts them. So do rows where the *estimate*
+puts the robot on its own start (within :data:`AT_START_M`, e.g. a run that
+never moved): its bearing home would be ``atan2(0, 0)``, a direction made up
+by the arithmetic (it used to score a standing run 180 deg off on a straight
+route); ``estimate_bearing_deg`` is null there and the distance error stays.
 """
 
 from __future__ import annotations
@@ -27,6 +31,8 @@ from albot1.metrics.errors import MetricsError
 
 EVERY_M = 10.0
 MIN_DISTANCE_M = 1.0
+#: An estimate closer than this to its own start has no direction home (float round-off, not a bearing).
+AT_START_M = 1e-6
 
 
 def stop_indices(reference: ArrayLike, every_m: float = EVERY_M) -> NDArray[np.int64]:
@@ -67,14 +73,15 @@ def orientation_table(
             continue
         b_est, d_est = home_vector(est, int(k))
         b_ref, d_ref = home_vector(ref, int(k))
-        defined = d_ref >= min_distance_m
+        at_start = d_est < AT_START_M  # the estimate says the robot is home: no bearing to point
+        defined = d_ref >= min_distance_m and not at_start
         b_diff = float(np.degrees(se2.wrap(np.radians(b_est - b_ref)))) if defined else None
         rows.append(
             {
                 "scan": int(k),
                 "timestamp": float(stamps[k]) if stamps is not None else None,
                 "travel_m": float(travel[k]),
-                "estimate_bearing_deg": b_est,
+                "estimate_bearing_deg": None if at_start else b_est,
                 "estimate_distance_m": d_est,
                 "reference_bearing_deg": b_ref,
                 "reference_distance_m": d_ref,

@@ -60,3 +60,45 @@ def test_valid_gauss_specs_parse_to_their_values(sigma_xy: float, sigma_deg: flo
     # to the 12 significant digits of the label, which is what `albot1 run` and suites run
     assert deg.a == float(f"{sigma_xy:.12g}")
     assert deg.b == math.radians(float(f"{sigma_deg:.12g}"))
+
+
+@given(
+    kind=st.sampled_from(["bias", "offset"]),
+    mantissa=st.integers(1, 10**12 - 1),
+    exponent=st.integers(0, 290),
+    sign=st.sampled_from([1, -1]),
+)
+def test_a_turn_per_step_is_its_exact_remainder_of_a_whole_turn(
+    kind: str, mantissa: int, exponent: int, sign: int
+) -> None:
+    """out49: `bias:0:1e20` turned each step by radians(1e20)'s float noise, not by 1e20 deg = 280 deg.
+
+    A rotation of at most 12 significant digits (what the SPEC keeps) acts as its remainder of 360 deg,
+    computed exactly here with integers; below a whole turn nothing changes.
+    """
+    written = sign * mantissa * 10**exponent
+    text = f"{written:.12g}"
+    rest = float(text)
+    exact = math.copysign(abs(int(rest)) % 360, rest) if abs(rest) >= 360 else rest  # the float's own value mod 360
+    values = f"0.1:{text}" if kind == "bias" else f"0.1:0:{text}"
+    deg = parse_spec(f"{kind}:{values}")
+    assert deg.b == math.radians(exact + 0.0)
+    assert abs(math.degrees(deg.b)) < 360.0
+    assert parse_spec(deg.spec) == deg  # the one spelling names the turn that runs
+
+
+@given(kind=st.sampled_from(["none", "thesis", "gauss", "bias", "offset", "dropout"]), data=st.data())
+def test_a_kind_with_one_letter_missing_is_suggested(kind: str, data: st.DataObject) -> None:
+    """out49: `gaus:0.1:1` read "unknown kind 'gaus'" without the "did you mean" every other name gets."""
+    at = data.draw(st.integers(0, len(kind) - 1))
+    typo = kind[:at] + kind[at + 1 :]
+    spec = f"{typo}:0.1:1"
+    try:
+        parse_spec(spec)
+    except DegradationSpecError as exc:
+        message = str(exc)
+    else:
+        raise AssertionError(f"{spec!r} parsed")
+    assert message.startswith(f"degradation {spec!r} not understood (unknown kind {typo!r}) (did you mean ")
+    assert repr(kind) in message.split("did you mean ", 1)[1].split("?)", 1)[0]
+    assert message.endswith(EXPECTED_SPEC) and "\n" not in message

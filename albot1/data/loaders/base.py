@@ -12,16 +12,35 @@ import math
 from pathlib import Path
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
+from albot1.config.suggest import closest
 from albot1.data.errors import DataError
 from albot1.data.model import Frame, Sequence
 
 #: The options every source takes besides its loader's own (applied by :mod:`albot1.data.open` and
 #: :mod:`albot1.data.attach`, not by a loader): loaders name them in their unknown-option errors.
-COMMON_OPTIONS = ("relations", "reference", "reference_max_dt", "odometry=reference", "views")
+COMMON_OPTIONS = ("relations", "relations_repeats", "reference", "reference_max_dt", "odometry=reference", "views")
 
 #: Values of ``reference`` that a CARMEN log reads as a keyword (which lines hold the reference), not as a file
 #: name (:mod:`albot1.data.attach` attaches every other value as a trajectory file).
 REFERENCE_KEYWORDS = ("none", "laser-pose", "truepos", "auto")
+
+
+def option_names(own: tuple[str, ...] | list[str]) -> list[str]:
+    """A loader's own options, then each of :data:`COMMON_OPTIONS` it does not take itself, every name once.
+
+    A CARMEN log takes ``reference`` and ``odometry`` itself: its unknown-option error listed ``reference``
+    twice and ``odometry=reference`` beside ``odometry``.
+    """
+    taken = set(own)
+    return [*own, *(name for name in COMMON_OPTIONS if name.partition("=")[0] not in taken)]
+
+
+def unknown_option_hint(unknown: list[str], names: list[str]) -> str:
+    """``" (did you mean 'odometry' for 'odometr'?)"`` for the unknown options close to a known one, else ``""``."""
+    bare = list(dict.fromkeys(name.partition("=")[0] for name in names))
+    found = [(name, closest(name, bare, n=1)) for name in unknown]
+    hints = [f"{near[0]!r} for {name!r}" for name, near in found if near]
+    return f" (did you mean {', '.join(hints)}?)" if hints else ""
 
 
 def reference_keyword_problem(options: dict[str, Any], what: str) -> str | None:

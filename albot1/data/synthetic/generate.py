@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from albot1.data.model import Frame, Scan, SequenceMetadata
 from albot1.data.synthetic import lidar
+from albot1.data.synthetic.errors import WorldOptionError
 from albot1.data.synthetic.floorplan import DoorwayCrossing, FloorPlan, check_route
 from albot1.data.synthetic.floorplan import doorway_crossings as find_crossings
 from albot1.data.synthetic.lidar import LaserSpec
@@ -77,12 +78,24 @@ class WorldData:
         return index if self.spec.laps == 1 else index % (lap - 1)
 
 
+#: The most scans a generated world may hold (its poses and times are built whole: ~0.25 KB a scan, so about
+#: 0.5 GB here; synthetic-office-long, the largest embedded world, has 37,401).
+MAX_WORLD_SCANS = 2_000_000
+
+
 def generate(spec: WorldSpec) -> WorldData:
     """Build a world from its spec (uncached; ``worlds.load_world`` caches the embedded ones by name)."""
     plan = spec.plan()
     route = spec.route()
     check_route(plan, route.waypoints, clearance=ROBOT_RADIUS)
     lap = sample(route, spec.sampling)
+    scans = (len(lap) - 1) * spec.laps + 1 if spec.laps > 1 else len(lap)
+    if scans > MAX_WORLD_SCANS:
+        # `?laps=999999999` asked numpy for 40.8 TiB and ended in an ArrayMemoryError traceback
+        raise WorldOptionError(
+            f"synthetic world {spec.name!r}: {spec.laps} laps of {len(lap) - 1} scans would be {scans:,} scans; "
+            f"expected at most {MAX_WORLD_SCANS:,} (a world is generated whole, in memory): give fewer laps"
+        )
     reference = repeat_laps(lap, spec.laps)
     odometry = simulate(reference, spec.odometry, seed=np.random.default_rng([spec.seed, 0]))
     lap_ranges = lidar.cast_many(plan.walls, lap, spec.laser.angles, spec.laser.max_range)

@@ -23,7 +23,7 @@ import functools
 import math
 from typing import Any
 
-from albot1.data.loaders.base import COMMON_OPTIONS, reference_keyword_problem
+from albot1.data.loaders.base import COMMON_OPTIONS, option_names, reference_keyword_problem, unknown_option_hint
 from albot1.data.model import Sequence
 from albot1.data.synthetic import layouts
 from albot1.data.synthetic.errors import UnknownWorldError, WorldOptionError
@@ -191,6 +191,7 @@ def variant(name: str, options: dict[str, Any]) -> WorldSpec:
         raise WorldOptionError(
             f"synthetic world {name!r}: unknown loader option(s) {', '.join(unknown)}; "
             f"expected {' or '.join(WORLD_OPTIONS)} (and the options of every source: {', '.join(COMMON_OPTIONS)})"
+            f"{unknown_option_hint(unknown, option_names(WORLD_OPTIONS))}"
         )
     if not options:
         return spec
@@ -225,12 +226,12 @@ def _generated(name: str, options: tuple[tuple[str, Any], ...]) -> WorldData:
     return generate(variant(name, dict(options)))
 
 
-def world_data(name: str, **options: Any) -> WorldData:
+def world_data(name: str, /, **options: Any) -> WorldData:
     """The generated world ``name`` (with loader options; cached per process)."""
     return _generated(name, tuple(sorted(options.items())))
 
 
-def load_world(name: str, **options: Any) -> Sequence:
+def load_world(name: str, /, **options: Any) -> Sequence:
     """The embedded world ``name`` (with loader options) as a streamed Sequence (reference = exact poses)."""
     data = world_data(name, **options)
     return Sequence(data.spec.name, functools.partial(stream_frames, data), world_metadata(data), scan_count=data.scans)

@@ -234,3 +234,31 @@ def test_a_suite_set_int_for_a_float_field_is_fine(tmp_path: Path) -> None:
     plan = _methods_plan(tmp_path, '[[methods]]\nname = "odometry"\nset = { map_voxel_m = 1, map_every = 3 }\n')
     config = plan.cells[0].config
     assert (config["map_voxel_m"], config["map_every"]) == (1.0, 3)
+
+
+@pytest.mark.parametrize(
+    ("grid", "entry", "why"),
+    [
+        ("[grid]\nundegraded_seeds = []\ndegradations = []", "", "its degradations list is empty"),
+        ("[grid]\nundegraded_seeds = []", "sweep = false\n", "no degradation is swept on it (sweep = false)"),
+        (
+            "[grid]\nundegraded_seeds = []",
+            'degradations = ["none"]\n',
+            "its degradations list names only `none` (the undegraded run, which has no seed here)",
+        ),
+    ],
+)
+def test_a_dataset_that_plans_no_run_is_listed_as_skipped_with_why(
+    tmp_path: Path, grid: str, entry: str, why: str
+) -> None:
+    """out49: it vanished from the grid without a word; the bench then blamed skipped datasets it never named."""
+    path = tmp_path / "tiny.toml"
+    path.write_text(
+        f'{grid}\n[[methods]]\nname = "odometry"\n\n[[datasets]]\nname = "{WORLD}"\n{entry}'
+        '\n[[datasets]]\nname = "synthetic-corridor"\nundegraded_seeds = [0]\n'
+    )
+    plan = plan_suite(load_suite(path), Settings(data_dir=None, cache_dir=tmp_path / "cache"))
+    assert [(s.name, s.reason) for s in plan.skipped_datasets] == [
+        (WORLD, f"no cell planned: undegraded_seeds is empty and {why}")
+    ]
+    assert {(c.dataset, c.degradation) for c in plan.cells} == {("synthetic-corridor", "none")}

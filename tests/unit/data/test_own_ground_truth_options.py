@@ -105,9 +105,9 @@ def test_bad_reference_max_dt(tmp_path: Path) -> None:
 
 def test_unknown_option_errors_list_the_options_of_every_source(sources: dict[str, Path]) -> None:
     for fmt in ("carmen", "ros1", "ros2-sqlite3", "ros2-mcap"):
-        with pytest.raises(DataError, match=r"unknown .*relations, reference, reference_max_dt"):
+        with pytest.raises(DataError, match=r"unknown .*relations, relations_repeats, (reference, )?reference_max_dt"):
             open_sequence(f"{sources[fmt]}?bogus=1")
-    with pytest.raises(DataError, match=r"options of every source: relations, reference"):
+    with pytest.raises(DataError, match=r"options of every source: relations, relations_repeats, reference"):
         open_sequence(f"{WORLD}?bogus=1")
 
 

@@ -18,7 +18,13 @@ from typing import Any
 
 from albot1.config.suggest import did_you_mean
 from albot1.data.errors import DataError
-from albot1.data.loaders.base import COMMON_OPTIONS, DEFAULT_MAX_POSE_GAP_S, DEFAULT_TIME_TOLERANCE_S, max_pose_gap
+from albot1.data.loaders.base import (
+    DEFAULT_MAX_POSE_GAP_S,
+    DEFAULT_TIME_TOLERANCE_S,
+    max_pose_gap,
+    option_names,
+    unknown_option_hint,
+)
 from albot1.data.loaders.carmen.parse import LASER_MESSAGES, OLD_LASERS
 from albot1.data.relations import RepeatPolicy, repeat_policy
 
@@ -45,9 +51,10 @@ class CarmenOptions:
         known = set(CarmenOptions.__dataclass_fields__)
         unknown = sorted(set(options) - known)
         if unknown:
+            names = option_names(sorted(known))
             raise DataError(
                 f"{path}: unknown CARMEN loader option(s) {', '.join(unknown)}; "
-                f"expected some of {', '.join(sorted(known) + list(COMMON_OPTIONS))}"
+                f"expected some of {', '.join(names)}{unknown_option_hint(unknown, names)}"
             )
         for key in ("max_range", "time_tolerance"):
             if options.get(key) is not None:
@@ -56,6 +63,8 @@ class CarmenOptions:
                 except (TypeError, ValueError):
                     raise DataError(f"{path}: {key}={options[key]!r}; expected a number") from None
         options["max_pose_gap"] = max_pose_gap(options.get("max_pose_gap"), path)
+        if "parallel_bz2" in options:
+            options["parallel_bz2"] = _flag(path, "parallel_bz2", options["parallel_bz2"])
         opts = CarmenOptions(**options)
         if opts.odometry not in ODOMETRY_SOURCES:
             raise DataError(  # "reference" is taken by albot1.data.open before the loader runs
@@ -71,6 +80,19 @@ class CarmenOptions:
         if not opts.time_tolerance >= 0:  # inf disables the check (logs whose stamps are garbage)
             raise DataError(f"{path}: time_tolerance={opts.time_tolerance!r}; expected seconds >= 0 (or inf)")
         return opts
+
+
+def _flag(path: Path, key: str, value: object) -> bool:
+    """``true`` / ``false`` (any case, as a query writes them) or a bool; else a DataError naming the value.
+
+    A query's ``parallel_bz2=false`` reached the loader as the text ``'false'``, which is true: the documented
+    switch did nothing, and ``parallel_bz2=maybe`` was accepted.
+    """
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.lower() in ("true", "false"):
+        return value.lower() == "true"
+    raise DataError(f"{path}: {key}={value!r}; expected true or false")
 
 
 @dataclass(frozen=True)

@@ -33,11 +33,12 @@ import numpy as np
 
 from albot1.data.errors import DataError, ParseError, TopicError
 from albot1.data.loaders.base import (
-    COMMON_OPTIONS,
     DEFAULT_MAX_POSE_GAP_S,
     max_pose_gap,
+    option_names,
     pose_gap_problem,
     reference_keyword_problem,
+    unknown_option_hint,
 )
 from albot1.data.loaders.beams import seam_note
 from albot1.data.loaders.rosbag.bag1_check import version_problem
@@ -187,12 +188,15 @@ def _options(options: dict[str, Any], shown: Path) -> dict[str, Any]:
     unknown = sorted(k for k, v in options.items() if k not in _OPTIONS and v is not None)
     if unknown:
         raise DataError(
-            f"{shown}: unknown bag option(s) {', '.join(unknown)}; expected: {', '.join(_OPTIONS + COMMON_OPTIONS)}"
+            f"{shown}: unknown bag option(s) {', '.join(unknown)}; expected: {', '.join(option_names(_OPTIONS))}"
+            f"{unknown_option_hint(unknown, option_names(_OPTIONS))}"
         )
     opts = {k: options.get(k) for k in _OPTIONS}
     opts["outside_odometry"] = opts["outside_odometry"] or "error"
     if opts["outside_odometry"] not in _OUTSIDE:
-        raise DataError(f"outside_odometry={opts['outside_odometry']!r}; expected one of {', '.join(_OUTSIDE)}")
+        raise DataError(
+            f"{shown}: outside_odometry={opts['outside_odometry']!r}; expected one of {', '.join(_OUTSIDE)}"
+        )
     opts["odom_frame"] = opts["odom_frame"] or "odom"
     opts["max_pose_gap"] = max_pose_gap(opts["max_pose_gap"], shown)
     return opts
