@@ -34,7 +34,7 @@ IntArray = NDArray[np.int64]
 #: numpy's ``PW_BLOCKSIZE``: rows up to this long are summed with eight running sums, longer ones split in two
 _BLOCK = 128
 #: frames of the explicit recursion: rows up to 2**60 values
-_DEPTH = 64
+DEPTH = 64
 
 
 @jitable
@@ -131,8 +131,8 @@ def block_sums(table: FloatArray, base: IntArray, rot: IntArray, origin: IntArra
             low[r, 0], high[r, 0] = min(low[r, 0], i), max(high[r, 0], i)
             low[r, 1], high[r, 1] = min(low[r, 1], j), max(high[r, 1], j)
     buf = np.empty(points)
-    stack = np.empty((_DEPTH, 3), dtype=np.int64)
-    partial = np.empty(_DEPTH)
+    stack = np.empty((DEPTH, 3), dtype=np.int64)
+    partial = np.empty(DEPTH)
     for k in range(rot.shape[0]):
         r = rot[k]
         o0, o1 = origin[k, 0], origin[k, 1]
