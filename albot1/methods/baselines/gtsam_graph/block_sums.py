@@ -148,19 +148,62 @@ def block_sums(table: FloatArray, base: IntArray, rot: IntArray, origin: IntArra
         out[k] = 0.0 + pairwise_sum(buf, points, stack, partial)
 
 
+@kernel
+def pose_sums(
+    field: FloatArray, moved: FloatArray, grid: FloatArray, lo0: float, lo1: float, cell_m: float, out: FloatArray
+) -> None:
+    """``out[r, g]``: the sum of ``field`` at ``moved[r]`` shifted by ``grid[g]``, 0 outside: the correlative scores.
+
+    :func:`.correlative._pose_scores` as it was computed with numpy, lookup
+    for lookup: the cell of a point is ``floor(v)`` of ``v = ((moved + grid)
+    - lo) / cell_m`` on each axis (the same IEEE operations, no fast-math); a
+    cell outside the field reads 0.0, and each row is summed as ``sum(axis=1)``
+    sums it (:func:`pairwise_sum`, from 0.0). numpy kept exactly the floors in
+    ``[0, n)`` (an unsigned test on the cast index: negative, NaN and
+    out-of-range casts fail it); those are exactly the ``v`` with ``0 <= v < n``
+    (``n`` is an integer; ``-0.0`` is kept, as its floor casts to 0), and for
+    those the floor is the truncation ``int(v)``: so no ``floor`` call (a C
+    library call here, most of the kernel's time) and no cast of a value out of
+    range. Without the grid x points temporaries of every rotation
+    (docs/baselines.md, "Cost (issue 24), fifth round").
+    """
+    n0, n1 = field.shape
+    flat = field.ravel()
+    rotations, points = moved.shape[0], moved.shape[1]
+    buf = np.empty(points)
+    stack = np.empty((DEPTH, 3), dtype=np.int64)
+    partial = np.empty(DEPTH)
+    for r in range(rotations):
+        for g in range(grid.shape[0]):
+            gx, gy = grid[g, 0], grid[g, 1]
+            for p in range(points):
+                vi = ((moved[r, p, 0] + gx) - lo0) / cell_m
+                vj = ((moved[r, p, 1] + gy) - lo1) / cell_m
+                if 0.0 <= vi < n0 and 0.0 <= vj < n1:
+                    buf[p] = flat[int(vi) * n1 + int(vj)]
+                else:
+                    buf[p] = 0.0
+            out[r, g] = 0.0 + pairwise_sum(buf, points, stack, partial)
+
+
 def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
-    """``(kernel name, kernel, arguments)`` typed as :func:`.correlative._sum_at` calls it (bundle, warm-up).
+    """``(kernel name, kernel, arguments)`` typed as :func:`.correlative._sum_at` and ``_pose_scores`` call them.
 
     numba keys a cached kernel by its argument types, so these are a run's:
-    C-ordered float64 table and int64 index arrays.
+    C-ordered float64 tables, points and offsets, int64 index arrays.
     """
     table = np.arange(12.0).reshape(3, 4)
     base = np.array([[[0, 0], [2, 3], [-1, 5]]], dtype=np.int64)
     rot = np.zeros(2, dtype=np.int64)
     origin = np.array([[0, 0], [1, -1]], dtype=np.int64)
-    return [("gtsam_graph.block_sums", block_sums, (table, base, rot, origin, np.empty(2)))]
+    moved = np.array([[[0.05, 0.05], [0.25, 0.35], [-1.0, 0.2]]])
+    grid = np.array([[0.0, 0.0], [0.1, -0.1]])
+    return [
+        ("gtsam_graph.block_sums", block_sums, (table, base, rot, origin, np.empty(2))),
+        ("gtsam_graph.pose_sums", pose_sums, (table, moved, grid, 0.0, 0.0, 0.1, np.empty((1, 2)))),
+    ]
 
 
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
-    """Compile :func:`block_sums` (or load numba's cache or the wheel's bundle) before a run's first scan."""
-    warm_kernels((block_sums,), sample_calls, "block sums", announce)
+    """Compile :func:`block_sums` and :func:`pose_sums` (or load numba's cache or the wheel's bundle) before a run."""
+    warm_kernels((block_sums, pose_sums), sample_calls, "block sums", announce)

@@ -330,7 +330,7 @@ def _final_terms(
     rot: FloatArray,
     scratch: FloatArray,
 ) -> int:
-    """The terms at the final pose within the smallest gate, their ``J^T W J`` and RMS residual: what ``register`` reports.
+    """The terms at the final pose within the smallest gate, their ``J^T W J`` and RMS: what ``register`` reports.
 
     What :func:`.registration.register` computed after the loop with numpy's
     calls (``_linearise`` at the final pose and ``min_correspondence_m``,
