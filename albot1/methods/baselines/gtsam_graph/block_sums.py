@@ -19,6 +19,7 @@ Lookups are clipped to the table, as ``np.clip`` and a 2-D lookup did.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -186,6 +187,57 @@ def pose_sums(
             out[r, g] = 0.0 + pairwise_sum(buf, points, stack, partial)
 
 
+#: :func:`line_moments` sums each point's neighbours in order, as numpy sums fewer than eight values; more go to numpy
+MOMENT_NEIGHBOURS = 7
+
+
+@kernel
+def line_moments(
+    pts: FloatArray,
+    dist: FloatArray,
+    idx: IntArray,
+    counts: IntArray,
+    cxx: FloatArray,
+    cyy: FloatArray,
+    cxy: FloatArray,
+) -> None:
+    """Each point's neighbour count and second moments about their mean, as :func:`.registration.line_normals` had numpy
+    compute them from the k-d tree's ``dist`` and ``idx`` (``k <= MOMENT_NEIGHBOURS`` columns).
+
+    The same operations per value: a neighbour is one with a finite
+    distance (weight 1.0; the others are the point itself at weight 0.0),
+    ``mean = sum(nb * w) / max(count, 1)``, ``d = (nb - mean) * w`` and the
+    sums of ``d_x ** 2``, ``d_y ** 2`` and ``d_x * d_y``. numpy sums fewer than
+    eight values one after the other from 0.0, whichever axis (its pairwise
+    blocks start at eight), and so does this loop; no fast-math, so no fused
+    multiply-add. One pass instead of about twenty numpy calls on ``(n, k, 2)``
+    temporaries for every node's scan (docs/baselines.md, "Cost (issue 24), fifth round").
+    """
+    n, k = dist.shape
+    for i in range(n):
+        c = 0
+        sx, sy = 0.0, 0.0
+        for j in range(k):
+            ok = math.isfinite(dist[i, j])
+            q = idx[i, j] if ok else i
+            w = 1.0 if ok else 0.0
+            c += 1 if ok else 0
+            sx += pts[q, 0] * w
+            sy += pts[q, 1] * w
+        mx, my = sx / max(c, 1), sy / max(c, 1)
+        xx, yy, xy = 0.0, 0.0, 0.0
+        for j in range(k):
+            ok = math.isfinite(dist[i, j])
+            q = idx[i, j] if ok else i
+            w = 1.0 if ok else 0.0
+            dx = (pts[q, 0] - mx) * w
+            dy = (pts[q, 1] - my) * w
+            xx += dx * dx
+            yy += dy * dy
+            xy += dx * dy
+        counts[i], cxx[i], cyy[i], cxy[i] = c, xx, yy, xy
+
+
 def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
     """``(kernel name, kernel, arguments)`` typed as :func:`.correlative._sum_at` and ``_pose_scores`` call them.
 
@@ -198,12 +250,15 @@ def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
     origin = np.array([[0, 0], [1, -1]], dtype=np.int64)
     moved = np.array([[[0.05, 0.05], [0.25, 0.35], [-1.0, 0.2]]])
     grid = np.array([[0.0, 0.0], [0.1, -0.1]])
+    pts, dist = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 2.0]]), np.array([[0.0, 1.0], [0.0, np.inf], [0.0, 1.0]])
+    idx, out = np.array([[0, 1], [1, 3], [2, 0]], dtype=np.int64), np.empty(3)
     return [
         ("gtsam_graph.block_sums", block_sums, (table, base, rot, origin, np.empty(2))),
         ("gtsam_graph.pose_sums", pose_sums, (table, moved, grid, 0.0, 0.0, 0.1, np.empty((1, 2)))),
+        ("gtsam_graph.line_moments", line_moments, (pts, dist, idx, np.empty(3, dtype=np.int64), out, out, out)),
     ]
 
 
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
-    """Compile :func:`block_sums` and :func:`pose_sums` (or load numba's cache or the wheel's bundle) before a run."""
-    warm_kernels((block_sums, pose_sums), sample_calls, "block sums", announce)
+    """Compile this module's kernels (or load numba's cache or the wheel's bundle) before a run's first scan."""
+    warm_kernels((block_sums, pose_sums, line_moments), sample_calls, "block sums", announce)

@@ -28,6 +28,7 @@ import numpy as np
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph import icp_loop
+from albot1.methods.baselines.gtsam_graph.block_sums import MOMENT_NEIGHBOURS, line_moments
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
 from albot1.methods.baselines.gtsam_graph.nearest import Grid, Matches, check_gate
 
@@ -94,16 +95,24 @@ def line_normals(
         return np.empty((0, 2)), np.empty((0, 2))
     k = min(neighbours, len(pts))
     dist, idx = cKDTree(pts).query(pts, k=k, distance_upper_bound=radius_m)
-    ok = np.isfinite(dist)
-    counts = ok.sum(axis=1)
-    idx = np.where(ok, idx, np.arange(len(pts))[:, None])  # pad with the point itself, weight 0
-    w = ok[..., None].astype(float)
-    nb = pts[idx]
-    mean = (nb * w).sum(axis=1) / np.maximum(counts, 1)[:, None]
-    d = (nb - mean[:, None, :]) * w
-    cxx = (d[..., 0] ** 2).sum(axis=1)
-    cyy = (d[..., 1] ** 2).sum(axis=1)
-    cxy = (d[..., 0] * d[..., 1]).sum(axis=1)
+    if k <= MOMENT_NEIGHBOURS:
+        counts = np.empty(len(pts), dtype=np.int64)
+        cxx, cyy, cxy = np.empty(len(pts)), np.empty(len(pts)), np.empty(len(pts))
+        line_moments(
+            np.ascontiguousarray(pts), np.ascontiguousarray(dist), np.ascontiguousarray(idx, dtype=np.int64), counts,
+            cxx, cyy, cxy,
+        )  # fmt: skip
+    else:  # the same sums through numpy (more neighbours than the kernel sums one after the other)
+        ok = np.isfinite(dist)
+        counts = ok.sum(axis=1)
+        idx = np.where(ok, idx, np.arange(len(pts))[:, None])  # pad with the point itself, weight 0
+        w = ok[..., None].astype(float)
+        nb = pts[idx]
+        mean = (nb * w).sum(axis=1) / np.maximum(counts, 1)[:, None]
+        d = (nb - mean[:, None, :]) * w
+        cxx = (d[..., 0] ** 2).sum(axis=1)
+        cyy = (d[..., 1] ** 2).sum(axis=1)
+        cxy = (d[..., 0] * d[..., 1]).sum(axis=1)
     root = np.sqrt((0.5 * (cxx - cyy)) ** 2 + cxy**2)
     lam_max = 0.5 * (cxx + cyy) + root
     lam_min = 0.5 * (cxx + cyy) - root

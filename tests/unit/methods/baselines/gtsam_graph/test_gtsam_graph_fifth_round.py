@@ -25,6 +25,7 @@ from albot1.methods.baselines.gtsam_graph.registration import (
     IcpParams,
     Registration,
     Target,
+    line_normals,
     register,
     rotate,
     side_by_side,
@@ -211,3 +212,53 @@ def test_register_s_final_terms_are_numpy_s_with_none_one_or_many_inliers(min_ga
     assert _same([fast.rmse_m, fast.fitness], [slow.rmse_m, slow.fitness])
     if min_gate == 0.2:
         assert fast.inliers > 128  # numpy's pairwise sum splits the row: the recursion is exercised
+
+
+def _old_line_normals(pts: np.ndarray, neighbours: int, radius_m: float = 0.5, max_planarity: float = 0.2):  # type: ignore[no-untyped-def]
+    """``line_normals`` as numpy computed it before the fifth round (points already checked, three or more)."""
+    from scipy.spatial import cKDTree
+
+    k = min(neighbours, len(pts))
+    dist, idx = cKDTree(pts).query(pts, k=k, distance_upper_bound=radius_m)
+    ok = np.isfinite(dist)
+    counts = ok.sum(axis=1)
+    idx = np.where(ok, idx, np.arange(len(pts))[:, None])
+    w = ok[..., None].astype(float)
+    nb = pts[idx]
+    mean = (nb * w).sum(axis=1) / np.maximum(counts, 1)[:, None]
+    d = (nb - mean[:, None, :]) * w
+    cxx = (d[..., 0] ** 2).sum(axis=1)
+    cyy = (d[..., 1] ** 2).sum(axis=1)
+    cxy = (d[..., 0] * d[..., 1]).sum(axis=1)
+    root = np.sqrt((0.5 * (cxx - cyy)) ** 2 + cxy**2)
+    lam_max = 0.5 * (cxx + cyy) + root
+    lam_min = 0.5 * (cxx + cyy) - root
+    axis = 0.5 * np.arctan2(2.0 * cxy, cxx - cyy)
+    keep = (counts >= 3) & (lam_max > 1e-12) & (lam_min <= max_planarity * np.maximum(lam_max, 1e-12))
+    return pts[keep], np.column_stack([-np.sin(axis[keep]), np.cos(axis[keep])])
+
+
+def test_line_normals_are_the_numpy_moments_bits_on_lattices_signed_zeros_and_sparse_points() -> None:
+    rng = np.random.default_rng(8)
+    plain_differs = 0
+    for trial in range(600):
+        n = int(rng.integers(3, 300))
+        if trial % 3 == 0:
+            pts = rng.normal(size=(n, 2)) * rng.uniform(0.1, 5.0)  # sparse: many points with fewer neighbours
+        elif trial % 3 == 1:
+            pts = rng.integers(-5, 5, size=(n, 2)) * 0.1  # a lattice: equidistant neighbours, exact zeros
+            pts[rng.random((n, 2)) < 0.3] *= -1.0
+        else:
+            th, r = rng.uniform(0.0, 6.3, n), rng.uniform(0.5, 8.0, n)
+            pts = np.column_stack([r * np.cos(th), r * np.sin(th)])
+            pts[: n // 3, 1] = -0.0
+        for neighbours in (3, 6, 7, 9):  # 9: past the kernel's in-order sums, numpy's own path
+            new, old = line_normals(pts, neighbours), _old_line_normals(pts, neighbours)
+            assert new[0].tobytes() == old[0].tobytes() and new[1].tobytes() == old[1].tobytes(), (trial, neighbours)
+        # the mean's sum in another order (last neighbour first) is not always numpy's
+        from scipy.spatial import cKDTree
+
+        dist, idx = cKDTree(pts).query(pts, k=6, distance_upper_bound=0.5)
+        vals = np.where(np.isfinite(dist), pts[np.minimum(idx, n - 1), 0], 0.0)
+        plain_differs += not np.array_equal(vals.sum(axis=1), vals[:, ::-1].sum(axis=1))
+    assert plain_differs > 50
