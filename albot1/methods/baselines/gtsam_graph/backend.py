@@ -30,7 +30,7 @@ from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
 from albot1.methods.baselines.gtsam_graph.loop_closure import LoopMatch
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor
 from albot1.methods.baselines.gtsam_graph.refine import RefineTests, accept, seed_poses
-from albot1.methods.baselines.gtsam_graph.registration import Target, line_normals, rotate, try_register
+from albot1.methods.baselines.gtsam_graph.registration import Target, line_normals, rotate_runs, try_register
 from albot1.methods.baselines.gtsam_graph.span_edges import SpanEdge
 
 
@@ -129,8 +129,7 @@ class BackEnd:
         if any(factor.key - 1 < first for factor in odometry_factors) or any(span.first < first for span in spans):
             self.estimates = self.graph.estimates()
         else:
-            for k in range(first, key + 1):
-                self.estimates[k] = self.graph.estimate(k)
+            self.estimates[first : key + 1] = self.graph.estimate_rows(range(first, key + 1))
         return key
 
     def _remember_node(self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int) -> None:
@@ -180,15 +179,16 @@ class BackEnd:
         """
         at = self.estimates if poses is None else poses
         origin = at[frame_node]
-        parts, nrm, moves, counts = [], [], [], []
+        parts, nrm, moves, counts, turns = [], [], [], [], []
         for n in nodes:
             rel = se2.between(origin, at[n])
             points, normals = self.lines[n]
             parts.append(points)
-            nrm.append(rotate(normals, rel[2]))
+            nrm.append(normals)
+            turns.append(rel[2])
             moves.append((rel[0], rel[1], np.cos(rel[2]), np.sin(rel[2])))
             counts.append(len(points))
-        return Target(transform_batch(np.concatenate(parts), np.array(moves), counts), np.concatenate(nrm))
+        return Target(transform_batch(np.concatenate(parts), np.array(moves), counts), rotate_runs(nrm, turns))
 
     def local_map(self) -> Target:
         """The last ``local_map_nodes`` node scans in the newest node's frame (built once per node and estimate)."""

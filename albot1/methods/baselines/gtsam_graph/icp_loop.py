@@ -379,8 +379,31 @@ def _final_terms(
     return DONE
 
 
+@kernel
+def rotate_runs(vectors: FloatArray, angles: FloatArray, counts: IntArray, out: FloatArray) -> None:
+    """Each run of ``vectors`` (``counts[r]`` rows, in order) turned by ``angles[r]`` into ``out``, as
+    :func:`.registration.rotate` turns it: CPython's ``cos`` and ``sin``, numpy's dgemm with numpy's arguments.
+
+    Runs of fewer than two rows are left as they are (numpy's matmul takes
+    another branch for a single row; the caller has numpy turn it).
+    """
+    turn = np.empty(4)
+    start = 0
+    for r in range(counts.shape[0]):
+        n = counts[r]
+        if n >= 2:
+            c, s = _cos(angles[r]), _sin(angles[r])
+            turn[0], turn[1], turn[2], turn[3] = c, s, -s, c
+            _dgemm(
+                _ROW, _NOTRANS, _NOTRANS, n, 2, 2, 1.0, vectors[start:].ctypes, 2, turn.ctypes, 2, 0.0,
+                out[start:].ctypes, 2,
+            )  # fmt: skip
+        start += n
+
+
 def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
-    """``(kernel name, kernel, arguments)`` typed as :func:`.registration.register` calls :func:`icp_run` (bundle).
+    """``(kernel name, kernel, arguments)`` typed as :func:`.registration.register` calls :func:`icp_run`, and as
+    :func:`.registration.rotate_runs` calls :func:`rotate_runs` (bundle).
 
     None where :func:`available` is False: the kernel cannot be linked there, and ICP never calls it.
     """
@@ -407,7 +430,11 @@ def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
         source,
         np.diag([1.0, 1.0, 25.0]),
     )
-    return [("gtsam_graph.icp_run", icp_run, (*args, knobs, state, np.zeros(n, dtype=np.int64), *buffers))]
+    runs = (source, np.array([0.3]), np.array([n], dtype=np.int64), np.empty_like(source))
+    return [
+        ("gtsam_graph.icp_run", icp_run, (*args, knobs, state, np.zeros(n, dtype=np.int64), *buffers)),
+        ("gtsam_graph.rotate_runs", rotate_runs, runs),
+    ]
 
 
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
@@ -417,4 +444,4 @@ def warm_up(announce: Callable[[str], None] | None = None) -> None:
     tie: it stops at ``ASK_TREE``, typed as a run calls it.
     """
     if available():
-        warm_kernels((icp_run,), sample_calls, "ICP step", announce)
+        warm_kernels((icp_run, rotate_runs), sample_calls, "ICP step", announce)

@@ -149,6 +149,10 @@ class OdometryTrust:
         self.floor_turn_rad = floor_turn_rad
         self._pooled: deque[FloatArray] = deque(maxlen=window)
         self._kinds: tuple[deque[FloatArray], deque[FloatArray]] = (deque(maxlen=window), deque(maxlen=window))
+        # Each history's median and spread, kept until the next step is recorded (several judgements per node
+        # read the same history): id of the deque -> (steps recorded then, centre, spread)
+        self._recorded = 0
+        self._medians: dict[int, tuple[int, FloatArray, FloatArray]] = {}
         self.turn_rad = turn_rad
         self.kind_min_steps = kind_min_steps
         self.bias_horizon = bias_horizon
@@ -175,6 +179,7 @@ class OdometryTrust:
     def add(self, odometry_step: FloatArray, match_step: FloatArray) -> None:
         """Record one matched node step's innovation (the match seen from the odometry step), with its kind."""
         d = innovation(odometry_step, match_step)
+        self._recorded += 1
         self._pooled.append(d)
         self._kinds[self.kind(odometry_step)].append(d)
         if self.scale is not None:
@@ -220,9 +225,14 @@ class OdometryTrust:
         """:meth:`variances` learnt from ``history`` alone, a trusted one never below ``floor`` times the match's;
         ``scale``: the heading variance the turn scale error adds to this step (:class:`.odometry_scale.TurnScale`)."""
         n = len(history)
-        h = np.asarray(history, dtype=float)
-        centre = column_medians(h)
-        spread = MAD_TO_SIGMA * column_medians(np.abs(h - centre))
+        known = self._medians.get(id(history))
+        if known is not None and known[0] == self._recorded:
+            centre, spread = known[1], known[2]
+        else:
+            h = np.asarray(history, dtype=float)
+            centre = column_medians(h)
+            spread = MAD_TO_SIGMA * column_medians(np.abs(h - centre))
+            self._medians[id(history)] = (self._recorded, centre, spread)
         out = np.full(3, np.inf)
         for k in self.components:
             if spread[k] <= 0.0:

@@ -193,6 +193,30 @@ def rotate(vectors: FloatArray, angle: float) -> FloatArray:
     return rotated
 
 
+def rotate_runs(parts: list[FloatArray], angles: list[float]) -> FloatArray:
+    """``np.concatenate([rotate(v, a) for v, a in zip(parts, angles)])``: the same bits, in one compiled call.
+
+    Where ICP's loop is compiled (:func:`.icp_loop.available`), every part of
+    two rows or more is turned by :func:`.icp_loop.rotate_runs` with the
+    dgemm numpy's matmul calls and CPython's ``cos`` and ``sin``; a single row
+    is turned here by numpy, as before (its matmul branch differs). Saves
+    numpy's per-call overhead on each node of a target (docs/baselines.md,
+    "Cost (issue 24), fifth round").
+    """
+    vectors = np.ascontiguousarray(np.concatenate(parts), dtype=np.float64)
+    if not icp_loop.available():
+        return np.concatenate([rotate(v, a) for v, a in zip(parts, angles, strict=True)])
+    counts = np.array([len(v) for v in parts], dtype=np.int64)
+    out = np.empty_like(vectors)
+    icp_loop.rotate_runs(vectors, np.array(angles, dtype=np.float64), counts, out)
+    start = 0
+    for v, a, n in zip(parts, angles, counts.tolist(), strict=True):
+        if n == 1:
+            out[start : start + 1] = rotate(v, a)
+        start += n
+    return out
+
+
 def try_register(target: Target, points: FloatArray, guess: FloatArray, params: IcpParams) -> Registration | None:
     """:func:`register`, or None when either side has too few usable points to try (a miss, not an error)."""
     if len(points) < params.min_points or len(target) < params.min_points:

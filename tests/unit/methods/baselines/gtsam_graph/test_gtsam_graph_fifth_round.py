@@ -28,6 +28,7 @@ from albot1.methods.baselines.gtsam_graph.registration import (
     line_normals,
     register,
     rotate,
+    rotate_runs,
     side_by_side,
 )
 from albot1.methods.registry import resolve_config
@@ -114,6 +115,20 @@ def test_targets_are_moved_with_transform_points_bits(seed: int) -> None:
     pose = np.array([1.5, -2.0, 2.9])
     c, s = np.cos(pose[2]), np.sin(pose[2])
     assert _same(transform_batch(run, np.array([[pose[0], pose[1], c, s]]), [50]), se2.transform_points(pose, run))
+
+
+def test_rotate_runs_are_numpy_s_products_for_runs_of_every_length() -> None:
+    rng = np.random.default_rng(9)
+    parts = [rng.normal(size=(n, 2)) * 10.0 ** rng.uniform(-3, 3) for n in (0, 1, 2, 5, 1, 300, 3, 0, 64)]
+    angles = [float(a) for a in rng.uniform(-4.0, 4.0, len(parts))]
+    want = np.concatenate([rotate(v, a) for v, a in zip(parts, angles, strict=True)])
+    assert rotate_runs(parts, angles).tobytes() == want.tobytes()
+    real = icp_loop.available
+    try:
+        icp_loop.available = lambda: False  # type: ignore[assignment]
+        assert rotate_runs(parts, angles).tobytes() == want.tobytes()
+    finally:
+        icp_loop.available = real  # type: ignore[assignment]
 
 
 def _old_graph_distances(back: BackEnd, key: int) -> np.ndarray:
