@@ -277,3 +277,22 @@ def test_line_normals_are_the_numpy_moments_bits_on_lattices_signed_zeros_and_sp
         vals = np.where(np.isfinite(dist), pts[np.minimum(idx, n - 1), 0], 0.0)
         plain_differs += not np.array_equal(vals.sum(axis=1), vals[:, ::-1].sum(axis=1))
     assert plain_differs > 50
+
+
+def test_the_warm_up_compiles_the_new_kernels_with_a_run_s_types() -> None:
+    """A run after the warm-ups adds no signature to the three kernels of this round (no compile in a timed scan)."""
+    from albot1.data import open_sequence
+    from albot1.methods.baselines.gtsam_graph import block_sums, nearest
+    from albot1.runs.execute import run_method
+
+    for module in (nearest, icp_loop, block_sums):
+        module.warm_up()
+    kernels = [block_sums.line_moments, block_sums.pose_sums]
+    if icp_loop.available():
+        kernels.append(icp_loop.rotate_runs)
+    before = [len(k.signatures) for k in kernels]
+    run_method("gtsam-graph", open_sequence("synthetic-office-loop[:200]"))
+    rng = np.random.default_rng(10)
+    field, src = rng.uniform(size=(20, 30)), rng.normal(size=(40, 2))
+    _pose_scores(field, np.zeros(2), src, np.zeros(3), np.zeros((3, 2)), np.array([0.0, 0.1]), 0.1)
+    assert [len(k.signatures) for k in kernels] == before
