@@ -30,8 +30,28 @@ from albot1.methods.baselines.gtsam_graph.graph import PoseGraph
 from albot1.methods.baselines.gtsam_graph.loop_closure import LoopMatch
 from albot1.methods.baselines.gtsam_graph.odometry_trust import OdometryFactor
 from albot1.methods.baselines.gtsam_graph.refine import RefineTests, accept, seed_poses
-from albot1.methods.baselines.gtsam_graph.registration import Target, line_normals, rotate, try_register
+from albot1.methods.baselines.gtsam_graph.registration import Target, line_normals, rotate_runs, try_register
 from albot1.methods.baselines.gtsam_graph.span_edges import SpanEdge
+
+
+def transform_batch(points: FloatArray, moves: FloatArray, counts: Sequence[int]) -> FloatArray:
+    """Consecutive runs of ``points`` (``counts`` rows each) moved by one pose each: ``se2.transform_points``'s bits.
+
+    ``moves`` holds per run the pose's ``x``, ``y`` and the ``np.cos`` and
+    ``np.sin`` of its heading, each computed as :func:`.se2.transform_points`
+    computes them for one pose (the same ufunc on one value); the
+    per-point arithmetic ``x + c * px - s * py`` and ``y + s * px + c * py``
+    is then one elementwise pass over every run at once, the same IEEE
+    operations in the same order. One call instead of one per node: a local
+    map's ten nodes cost ten times numpy's per-call overhead before
+    (docs/baselines.md, "Cost (issue 24), fifth round").
+    """
+    per_point = np.repeat(moves, counts, axis=0)
+    x, y, c, s = per_point[:, 0], per_point[:, 1], per_point[:, 2], per_point[:, 3]
+    out = np.empty_like(points)
+    out[:, 0] = x + c * points[:, 0] - s * points[:, 1]
+    out[:, 1] = y + s * points[:, 0] + c * points[:, 1]
+    return out
 
 
 class BackEnd:
@@ -45,6 +65,7 @@ class BackEnd:
         # Per node.
         self.odometry: list[FloatArray] = []
         self.steps: list[FloatArray] = []  # measured pose of node k in node k-1's frame (node 0: zeros)
+        self._step_rows: FloatArray = np.empty((0, 3))  # the steps as rows (the first len(steps)): graph_distances
         self.scans: list[FloatArray] = []
         self.lines: list[tuple[FloatArray, FloatArray]] = []  # line-like points and normals, node frame
         self.frames: list[int] = []  # the frame index of each node's scan
@@ -108,14 +129,18 @@ class BackEnd:
         if any(factor.key - 1 < first for factor in odometry_factors) or any(span.first < first for span in spans):
             self.estimates = self.graph.estimates()
         else:
-            for k in range(first, key + 1):
-                self.estimates[k] = self.graph.estimate(k)
+            self.estimates[first : key + 1] = self.graph.estimate_rows(range(first, key + 1))
         return key
 
     def _remember_node(self, odometry: FloatArray, step: FloatArray, points: FloatArray, index: int) -> None:
         """Keep what later scan matching needs of a new node: its odometry, measured step, scan, lines, frame."""
         self.odometry.append(odometry)
         self.steps.append(np.asarray(step, dtype=float))
+        if len(self.steps) > len(self._step_rows):  # the same rows as the list, kept as one array (doubling)
+            grown = np.empty((max(16, 2 * len(self._step_rows)), 3))
+            grown[: len(self.steps) - 1] = self._step_rows[: len(self.steps) - 1]
+            self._step_rows = grown
+        self._step_rows[len(self.steps) - 1] = self.steps[-1]
         self._local = None
         self.scans.append(points)
         self.lines.append(
@@ -154,12 +179,16 @@ class BackEnd:
         """
         at = self.estimates if poses is None else poses
         origin = at[frame_node]
-        pts, nrm = [], []
+        parts, nrm, moves, counts, turns = [], [], [], [], []
         for n in nodes:
             rel = se2.between(origin, at[n])
-            pts.append(se2.transform_points(rel, self.lines[n][0]))
-            nrm.append(rotate(self.lines[n][1], rel[2]))
-        return Target(np.concatenate(pts), np.concatenate(nrm))
+            points, normals = self.lines[n]
+            parts.append(points)
+            nrm.append(normals)
+            turns.append(rel[2])
+            moves.append((rel[0], rel[1], np.cos(rel[2]), np.sin(rel[2])))
+            counts.append(len(points))
+        return Target(transform_batch(np.concatenate(parts), np.array(moves), counts), rotate_runs(nrm, turns))
 
     def local_map(self) -> Target:
         """The last ``local_map_nodes`` node scans in the newest node's frame (built once per node and estimate)."""
@@ -174,13 +203,14 @@ class BackEnd:
         from scipy.sparse.csgraph import dijkstra
 
         n = key + 1
-        steps = np.asarray(self.steps[1:n], dtype=float).reshape(-1, 3)
-        rows = [*range(n - 1), *(a for a, _ in self.loop_edges)]
-        cols = [*range(1, n), *(b for _, b in self.loop_edges)]
-        lengths = [
-            *np.hypot(steps[:, 0], steps[:, 1]),
-            *(math.hypot(*(self.estimates[a, :2] - self.estimates[b, :2])) for a, b in self.loop_edges),
-        ]
+        # The same values as lists of Python numbers gave (sequential edges, then loop edges in their order), built
+        # as arrays: the rows kept by _remember_node, the loop edges' differences elementwise, math.hypot of each.
+        steps = self._step_rows[1:n]
+        ends = np.array(self.loop_edges, dtype=np.int64).reshape(-1, 2)
+        gaps = (self.estimates[ends[:, 0], :2] - self.estimates[ends[:, 1], :2]).tolist()
+        rows = np.concatenate([np.arange(n - 1), ends[:, 0]])
+        cols = np.concatenate([np.arange(1, n), ends[:, 1]])
+        lengths = np.concatenate([np.hypot(steps[:, 0], steps[:, 1]), [math.hypot(dx, dy) for dx, dy in gaps]])
         # csgraph treats a zero weight as a missing edge; a node step can be a pure rotation.
         graph = coo_matrix((np.maximum(lengths, 1e-6), (rows, cols)), shape=(n, n)).tocsr()
         return np.asarray(dijkstra(graph, directed=False, indices=key), dtype=np.float64)

@@ -19,6 +19,7 @@ Lookups are clipped to the table, as ``np.clip`` and a 2-D lookup did.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -34,7 +35,7 @@ IntArray = NDArray[np.int64]
 #: numpy's ``PW_BLOCKSIZE``: rows up to this long are summed with eight running sums, longer ones split in two
 _BLOCK = 128
 #: frames of the explicit recursion: rows up to 2**60 values
-_DEPTH = 64
+DEPTH = 64
 
 
 @jitable
@@ -131,8 +132,8 @@ def block_sums(table: FloatArray, base: IntArray, rot: IntArray, origin: IntArra
             low[r, 0], high[r, 0] = min(low[r, 0], i), max(high[r, 0], i)
             low[r, 1], high[r, 1] = min(low[r, 1], j), max(high[r, 1], j)
     buf = np.empty(points)
-    stack = np.empty((_DEPTH, 3), dtype=np.int64)
-    partial = np.empty(_DEPTH)
+    stack = np.empty((DEPTH, 3), dtype=np.int64)
+    partial = np.empty(DEPTH)
     for k in range(rot.shape[0]):
         r = rot[k]
         o0, o1 = origin[k, 0], origin[k, 1]
@@ -148,19 +149,116 @@ def block_sums(table: FloatArray, base: IntArray, rot: IntArray, origin: IntArra
         out[k] = 0.0 + pairwise_sum(buf, points, stack, partial)
 
 
+@kernel
+def pose_sums(
+    field: FloatArray, moved: FloatArray, grid: FloatArray, lo0: float, lo1: float, cell_m: float, out: FloatArray
+) -> None:
+    """``out[r, g]``: the sum of ``field`` at ``moved[r]`` shifted by ``grid[g]``, 0 outside: the correlative scores.
+
+    :func:`.correlative._pose_scores` as it was computed with numpy, lookup
+    for lookup: the cell of a point is ``floor(v)`` of ``v = ((moved + grid)
+    - lo) / cell_m`` on each axis (the same IEEE operations, no fast-math); a
+    cell outside the field reads 0.0, and each row is summed as ``sum(axis=1)``
+    sums it (:func:`pairwise_sum`, from 0.0). numpy kept exactly the floors in
+    ``[0, n)`` (an unsigned test on the cast index: negative, NaN and
+    out-of-range casts fail it); those are exactly the ``v`` with ``0 <= v < n``
+    (``n`` is an integer; ``-0.0`` is kept, as its floor casts to 0), and for
+    those the floor is the truncation ``int(v)``: so no ``floor`` call (a C
+    library call here, most of the kernel's time) and no cast of a value out of
+    range. Without the grid x points temporaries of every rotation
+    (docs/baselines.md, "Cost (issue 24), fifth round").
+    """
+    n0, n1 = field.shape
+    flat = field.ravel()
+    rotations, points = moved.shape[0], moved.shape[1]
+    buf = np.empty(points)
+    stack = np.empty((DEPTH, 3), dtype=np.int64)
+    partial = np.empty(DEPTH)
+    for r in range(rotations):
+        for g in range(grid.shape[0]):
+            gx, gy = grid[g, 0], grid[g, 1]
+            for p in range(points):
+                vi = ((moved[r, p, 0] + gx) - lo0) / cell_m
+                vj = ((moved[r, p, 1] + gy) - lo1) / cell_m
+                if 0.0 <= vi < n0 and 0.0 <= vj < n1:
+                    buf[p] = flat[int(vi) * n1 + int(vj)]
+                else:
+                    buf[p] = 0.0
+            out[r, g] = 0.0 + pairwise_sum(buf, points, stack, partial)
+
+
+#: :func:`line_moments` sums each point's neighbours in order, as numpy sums fewer than eight values; more go to numpy
+MOMENT_NEIGHBOURS = 7
+
+
+@kernel
+def line_moments(
+    pts: FloatArray,
+    dist: FloatArray,
+    idx: IntArray,
+    counts: IntArray,
+    cxx: FloatArray,
+    cyy: FloatArray,
+    cxy: FloatArray,
+) -> None:
+    """Each point's neighbour count and second moments about their mean, as :func:`.registration.line_normals` had numpy
+    compute them from the k-d tree's ``dist`` and ``idx`` (``k <= MOMENT_NEIGHBOURS`` columns).
+
+    The same operations per value: a neighbour is one with a finite
+    distance (weight 1.0; the others are the point itself at weight 0.0),
+    ``mean = sum(nb * w) / max(count, 1)``, ``d = (nb - mean) * w`` and the
+    sums of ``d_x ** 2``, ``d_y ** 2`` and ``d_x * d_y``. numpy sums fewer than
+    eight values one after the other from 0.0, whichever axis (its pairwise
+    blocks start at eight), and so does this loop; no fast-math, so no fused
+    multiply-add. One pass instead of about twenty numpy calls on ``(n, k, 2)``
+    temporaries for every node's scan (docs/baselines.md, "Cost (issue 24), fifth round").
+    """
+    n, k = dist.shape
+    for i in range(n):
+        c = 0
+        sx, sy = 0.0, 0.0
+        for j in range(k):
+            ok = math.isfinite(dist[i, j])
+            q = idx[i, j] if ok else i
+            w = 1.0 if ok else 0.0
+            c += 1 if ok else 0
+            sx += pts[q, 0] * w
+            sy += pts[q, 1] * w
+        mx, my = sx / max(c, 1), sy / max(c, 1)
+        xx, yy, xy = 0.0, 0.0, 0.0
+        for j in range(k):
+            ok = math.isfinite(dist[i, j])
+            q = idx[i, j] if ok else i
+            w = 1.0 if ok else 0.0
+            dx = (pts[q, 0] - mx) * w
+            dy = (pts[q, 1] - my) * w
+            xx += dx * dx
+            yy += dy * dy
+            xy += dx * dy
+        counts[i], cxx[i], cyy[i], cxy[i] = c, xx, yy, xy
+
+
 def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
-    """``(kernel name, kernel, arguments)`` typed as :func:`.correlative._sum_at` calls it (bundle, warm-up).
+    """``(kernel name, kernel, arguments)`` typed as :func:`.correlative._sum_at` and ``_pose_scores`` call them.
 
     numba keys a cached kernel by its argument types, so these are a run's:
-    C-ordered float64 table and int64 index arrays.
+    C-ordered float64 tables, points and offsets, int64 index arrays.
     """
     table = np.arange(12.0).reshape(3, 4)
     base = np.array([[[0, 0], [2, 3], [-1, 5]]], dtype=np.int64)
     rot = np.zeros(2, dtype=np.int64)
     origin = np.array([[0, 0], [1, -1]], dtype=np.int64)
-    return [("gtsam_graph.block_sums", block_sums, (table, base, rot, origin, np.empty(2)))]
+    moved = np.array([[[0.05, 0.05], [0.25, 0.35], [-1.0, 0.2]]])
+    grid = np.array([[0.0, 0.0], [0.1, -0.1]])
+    pts, dist = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 2.0]]), np.array([[0.0, 1.0], [0.0, np.inf], [0.0, 1.0]])
+    idx, out = np.array([[0, 1], [1, 3], [2, 0]], dtype=np.int64), np.empty(3)
+    return [
+        ("gtsam_graph.block_sums", block_sums, (table, base, rot, origin, np.empty(2))),
+        ("gtsam_graph.pose_sums", pose_sums, (table, moved, grid, 0.0, 0.0, 0.1, np.empty((1, 2)))),
+        ("gtsam_graph.line_moments", line_moments, (pts, dist, idx, np.empty(3, dtype=np.int64), out, out, out)),
+    ]
 
 
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
-    """Compile :func:`block_sums` (or load numba's cache or the wheel's bundle) before a run's first scan."""
-    warm_kernels((block_sums,), sample_calls, "block sums", announce)
+    """Compile this module's kernels (or load numba's cache or the wheel's bundle) before a run's first scan."""
+    warm_kernels((block_sums, pose_sums, line_moments), sample_calls, "block sums", announce)

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from albot1.geometry.types import FloatArray
-from albot1.methods.baselines.gtsam_graph.block_sums import block_sums
+from albot1.methods.baselines.gtsam_graph.block_sums import block_sums, pose_sums
 
 
 @dataclass(frozen=True)
@@ -115,28 +115,22 @@ def _pose_scores(
 ) -> FloatArray:
     """``scores[r, g]``: the sum of ``field`` at ``src`` turned by ``thetas[r]`` and moved to ``guess + grid[g]``.
 
-    A point outside the field scores 0. The field is read through its flat
-    table with one zero appended, where every outside lookup goes; unsigned,
-    a negative cell index is huge, so one comparison per axis finds them.
-    The cells are those of ``floor((moved + offset - lo) / cell_m)`` on
-    ``(x, y)`` pairs, computed axis by axis with the same operations, and
-    each row sums the same values in the same order as a bounds test and a
-    clipped 2-D lookup would (a unit test compares the bits) in about a third
-    of the time.
+    A point outside the field scores 0. The points are turned by numpy
+    (``src @ R``: BLAS) and moved to the guess here; the lookups and the row
+    sums are one compiled pass (:func:`.block_sums.pose_sums`) with the same
+    cells, values and sums as the numpy formulation, which read the field
+    through its flat table with one zero appended (every outside lookup went
+    there: unsigned, a negative cell index is huge, so one comparison per
+    axis found them) and summed each row with ``sum(axis=1)`` (a unit test
+    compares the bits with it and with a bounds test and clipped 2-D lookup).
     """
-    n0, n1 = field.shape
-    flat = np.append(field.ravel(), 0.0)
-    scores = np.empty((len(thetas), len(grid)))
+    moved = np.empty((len(thetas), len(src), 2))
     for r, theta in enumerate(thetas):
         c, s = math.cos(theta), math.sin(theta)
-        moved = src @ np.array([[c, s], [-s, c]]) + guess[:2]
-        i = np.floor((moved[None, :, 0] + grid[:, None, 0] - lo[0]) / cell_m).astype(np.int64)
-        j = np.floor((moved[None, :, 1] + grid[:, None, 1] - lo[1]) / cell_m).astype(np.int64)
-        inside = i.view(np.uint64) < n0
-        inside &= j.view(np.uint64) < n1
-        i *= n1
-        i += j
-        scores[r] = flat.take(np.where(inside, i, n0 * n1)).sum(axis=1)
+        moved[r] = src @ np.array([[c, s], [-s, c]]) + guess[:2]
+    scores = np.empty((len(thetas), len(grid)))
+    field64 = np.ascontiguousarray(field, dtype=np.float64)
+    pose_sums(field64, moved, np.ascontiguousarray(grid, dtype=np.float64), float(lo[0]), float(lo[1]), cell_m, scores)
     return scores
 
 

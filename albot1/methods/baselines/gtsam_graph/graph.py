@@ -133,6 +133,14 @@ class PoseGraph:
         p = self._isam.calculateEstimatePose2(key)
         return np.array([p.x(), p.y(), p.theta()])
 
+    def estimate_rows(self, keys: range) -> FloatArray:
+        """:meth:`estimate` of each of ``keys``, as the rows of one array (the same values, one array built)."""
+        rows = []
+        for key in keys:
+            p = self._isam.calculateEstimatePose2(key)
+            rows.append((p.x(), p.y(), p.theta()))
+        return np.array(rows, dtype=np.float64).reshape(-1, 3)
+
     def estimates(self) -> FloatArray:
         """The current ISAM2 estimates of all nodes, ``(N, 3)`` in key order."""
         if self._size == 0:

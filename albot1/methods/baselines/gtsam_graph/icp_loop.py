@@ -56,6 +56,7 @@ from albot1.geometry.types import FloatArray
 from albot1.methods.albot1 import compiled
 from albot1.methods.albot1.compiled import jitable, kernel
 from albot1.methods.albot1.mapping.localise_kernels import python_hypot
+from albot1.methods.baselines.gtsam_graph.block_sums import DEPTH, pairwise_sum
 from albot1.methods.baselines.gtsam_graph.nearest import AMBIGUOUS, IntArray, _nearest_one, _terms
 from albot1.methods.baselines.gtsam_graph.warming import warm_kernels
 
@@ -83,8 +84,8 @@ _sin: Any = types.ExternalFunction("albot1_gtsam_graph_sin", types.float64(types
 _fmod: Any = types.ExternalFunction("albot1_gtsam_graph_fmod", types.float64(types.float64, types.float64))
 
 #: the scratch buffer's layout: the rotation (2x2), J^T W J + prior (3x3), its column-ordered copy for LAPACK,
-#: J^T W r, prior @ offset, the offset, and the solution (negated: the step)
-_R, _A, _AF, _G, _P, OFFSET, STEP, SCRATCH = 0, 4, 13, 22, 25, 28, 31, 34
+#: J^T W r, prior @ offset, the offset, the solution (negated: the step), and the final terms' J^T W J (3x3)
+_R, _A, _AF, _G, _P, OFFSET, STEP, INFORMATION, SCRATCH = 0, 4, 13, 22, 25, 28, 31, 34, 43
 
 
 @functools.cache
@@ -167,10 +168,11 @@ def _solve_step(
     K_THETA0,
 ) = range(12)
 KNOBS = 12
-#: ``state``, carried across calls: the pose, the gate, the iteration, whether it settled or converged, and whether
-#: the next call resumes an iteration whose ambiguous queries the k-d tree answered
-S_X, S_Y, S_THETA, S_GATE, S_ITERATION, S_SETTLED, S_CONVERGED, S_RESUME = range(8)
-STATE = 8
+#: ``state``, carried across calls: the pose, the gate, the iteration, whether it settled or converged, whether
+#: the next call resumes an iteration whose ambiguous queries the k-d tree answered, whether the loop is over and
+#: the final terms are being found, and what they gave: the inliers and their RMS residual
+S_X, S_Y, S_THETA, S_GATE, S_ITERATION, S_SETTLED, S_CONVERGED, S_RESUME, S_FINAL, S_INLIERS, S_RMSE = range(11)
+STATE = 11
 #: :func:`icp_run`'s outcomes: done, ambiguous queries to answer (then call again), a gate that is not usable
 DONE, ASK_TREE, BAD_GATE = 0, 1, 2
 
@@ -236,8 +238,14 @@ def icp_run(
     gate annealed as Python's ``max`` picks. An iteration with an ambiguous
     query stops at :data:`ASK_TREE` (``rot`` and ``idx`` as
     :func:`.nearest.linearise_terms` leaves them); the caller fills ``idx``
-    from the k-d tree, sets ``state[S_RESUME]`` and calls again.
+    from the k-d tree, sets ``state[S_RESUME]`` and calls again. After the
+    loop the same call finds the terms ``register`` reports
+    (:func:`_final_terms`; ``state[S_FINAL]`` set, the gate at its minimum).
     """
+    if state[S_FINAL] != 0.0:
+        return _final_terms(
+            origin, dims, cell, starts, xy, order, lines, src, knobs, state, idx, jac, res, w, wj, rot, scratch
+        )  # fmt: skip
     tau = 2.0 * math.pi
     x, y, theta, gate = state[S_X], state[S_Y], state[S_THETA], state[S_GATE]
     it, settled, converged = int(state[S_ITERATION]), state[S_SETTLED] != 0.0, False
@@ -294,11 +302,108 @@ def icp_run(
     state[S_SETTLED] = 1.0 if settled else 0.0
     state[S_CONVERGED] = 1.0 if converged else 0.0
     state[S_RESUME] = 0.0
-    return status
+    if status != DONE:
+        return status
+    state[S_FINAL], state[S_GATE] = 1.0, min_gate
+    return _final_terms(
+        origin, dims, cell, starts, xy, order, lines, src, knobs, state, idx, jac, res, w, wj, rot, scratch
+    )  # fmt: skip
+
+
+@jitable
+def _final_terms(
+    origin: FloatArray,
+    dims: IntArray,
+    cell: float,
+    starts: IntArray,
+    xy: FloatArray,
+    order: IntArray,
+    lines: FloatArray,
+    src: FloatArray,
+    knobs: FloatArray,
+    state: FloatArray,
+    idx: IntArray,
+    jac: FloatArray,
+    res: FloatArray,
+    w: FloatArray,
+    wj: FloatArray,
+    rot: FloatArray,
+    scratch: FloatArray,
+) -> int:
+    """The terms at the final pose within the smallest gate, their ``J^T W J`` and RMS: what ``register`` reports.
+
+    What :func:`.registration.register` computed after the loop with numpy's
+    calls (``_linearise`` at the final pose and ``min_correspondence_m``,
+    ``wj.T @ jac``, ``sqrt(mean(res ** 2))``), here with the same operations:
+    the rotation and the search as an iteration does them, ``wj.T @ jac`` by
+    the dgemm numpy calls (into ``scratch[INFORMATION:]``, for at least two
+    inliers; the caller has numpy multiply one), the squares summed as
+    ``np.add.reduce`` sums them (:func:`.block_sums.pairwise_sum`, from 0.0),
+    divided by the count, and the square root (exact either way).
+    ``state[S_INLIERS]`` and ``state[S_RMSE]`` receive the count and the RMS.
+    An ambiguous query stops at :data:`ASK_TREE` as in the loop; a gate that
+    is not usable at :data:`BAD_GATE`.
+    """
+    x, y, theta, gate = state[S_X], state[S_Y], state[S_THETA], state[S_GATE]
+    n = src.shape[0]
+    if state[S_RESUME] == 0.0:
+        if not (math.isfinite(gate) and gate > 0):
+            return BAD_GATE
+        c, s = _cos(theta), _sin(theta)
+        scratch[_R], scratch[_R + 1], scratch[_R + 2], scratch[_R + 3] = c, s, -s, c
+        _dgemm(
+            _ROW, _NOTRANS, _NOTRANS, n, 2, 2, 1.0, src.ctypes, 2, scratch[_R : _R + 4].ctypes, 2, 0.0, rot.ctypes, 2
+        )  # fmt: skip
+        gate2 = gate * gate
+        ambiguous = False
+        for i in range(n):
+            at, unsure = _nearest_one(origin, dims, cell, starts, xy, rot[i, 0] + x, rot[i, 1] + y, gate2)
+            if unsure:
+                idx[i] = AMBIGUOUS
+                ambiguous = True
+            else:
+                idx[i] = order[at] if at >= 0 else -1
+        if ambiguous:
+            return ASK_TREE
+    state[S_RESUME] = 0.0
+    m = _terms(lines, rot, x, y, knobs[K_CAUCHY], knobs[K_INV_VAR], idx, jac, res, w, wj)
+    state[S_INLIERS] = m
+    if m >= 2:
+        info = scratch[INFORMATION : INFORMATION + 9]
+        _dgemm(_ROW, _TRANS, _NOTRANS, 3, 3, m, 1.0, wj.ctypes, 3, jac.ctypes, 3, 0.0, info.ctypes, 3)
+    if m > 0:
+        for i in range(m):  # the weights are not reported: their buffer takes the squares
+            w[i] = res[i] * res[i]
+        total = 0.0 + pairwise_sum(w, m, np.empty((DEPTH, 3), dtype=np.int64), np.empty(DEPTH))
+        state[S_RMSE] = math.sqrt(total / m)
+    return DONE
+
+
+@kernel
+def rotate_runs(vectors: FloatArray, angles: FloatArray, counts: IntArray, out: FloatArray) -> None:
+    """Each run of ``vectors`` (``counts[r]`` rows, in order) turned by ``angles[r]`` into ``out``, as
+    :func:`.registration.rotate` turns it: CPython's ``cos`` and ``sin``, numpy's dgemm with numpy's arguments.
+
+    Runs of fewer than two rows are left as they are (numpy's matmul takes
+    another branch for a single row; the caller has numpy turn it).
+    """
+    turn = np.empty(4)
+    start = 0
+    for r in range(counts.shape[0]):
+        n = counts[r]
+        if n >= 2:
+            c, s = _cos(angles[r]), _sin(angles[r])
+            turn[0], turn[1], turn[2], turn[3] = c, s, -s, c
+            _dgemm(
+                _ROW, _NOTRANS, _NOTRANS, n, 2, 2, 1.0, vectors[start:].ctypes, 2, turn.ctypes, 2, 0.0,
+                out[start:].ctypes, 2,
+            )  # fmt: skip
+        start += n
 
 
 def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
-    """``(kernel name, kernel, arguments)`` typed as :func:`.registration.register` calls :func:`icp_run` (bundle).
+    """``(kernel name, kernel, arguments)`` typed as :func:`.registration.register` calls :func:`icp_run`, and as
+    :func:`.registration.rotate_runs` calls :func:`rotate_runs` (bundle).
 
     None where :func:`available` is False: the kernel cannot be linked there, and ICP never calls it.
     """
@@ -312,7 +417,7 @@ def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
     xy = np.ascontiguousarray(pts[order])
     n = len(source)
     knobs = np.array([3.0, 0.2, 0.1, 400.0, 0.7, 5e-4, 1e-4, 10.0, 1.0, 0.0, 0.0, 0.0])
-    state = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+    state = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     buffers = (np.empty((n, 3)), np.empty(n), np.empty(n), np.empty((n, 3)), np.empty((n, 2)), np.zeros(SCRATCH))
     args = (
         origin,
@@ -325,7 +430,11 @@ def sample_calls() -> list[tuple[str, Callable[..., Any], tuple[Any, ...]]]:
         source,
         np.diag([1.0, 1.0, 25.0]),
     )
-    return [("gtsam_graph.icp_run", icp_run, (*args, knobs, state, np.zeros(n, dtype=np.int64), *buffers))]
+    runs = (source, np.array([0.3]), np.array([n], dtype=np.int64), np.empty_like(source))
+    return [
+        ("gtsam_graph.icp_run", icp_run, (*args, knobs, state, np.zeros(n, dtype=np.int64), *buffers)),
+        ("gtsam_graph.rotate_runs", rotate_runs, runs),
+    ]
 
 
 def warm_up(announce: Callable[[str], None] | None = None) -> None:
@@ -335,4 +444,4 @@ def warm_up(announce: Callable[[str], None] | None = None) -> None:
     tie: it stops at ``ASK_TREE``, typed as a run calls it.
     """
     if available():
-        warm_kernels((icp_run,), sample_calls, "ICP step", announce)
+        warm_kernels((icp_run, rotate_runs), sample_calls, "ICP step", announce)

@@ -149,6 +149,10 @@ class OdometryTrust:
         self.floor_turn_rad = floor_turn_rad
         self._pooled: deque[FloatArray] = deque(maxlen=window)
         self._kinds: tuple[deque[FloatArray], deque[FloatArray]] = (deque(maxlen=window), deque(maxlen=window))
+        # Each history's median and spread, kept until the next step is recorded (several judgements per node
+        # read the same history): id of the deque -> (steps recorded then, centre, spread)
+        self._recorded = 0
+        self._medians: dict[int, tuple[int, FloatArray, FloatArray]] = {}
         self.turn_rad = turn_rad
         self.kind_min_steps = kind_min_steps
         self.bias_horizon = bias_horizon
@@ -175,6 +179,7 @@ class OdometryTrust:
     def add(self, odometry_step: FloatArray, match_step: FloatArray) -> None:
         """Record one matched node step's innovation (the match seen from the odometry step), with its kind."""
         d = innovation(odometry_step, match_step)
+        self._recorded += 1
         self._pooled.append(d)
         self._kinds[self.kind(odometry_step)].append(d)
         if self.scale is not None:
@@ -220,9 +225,14 @@ class OdometryTrust:
         """:meth:`variances` learnt from ``history`` alone, a trusted one never below ``floor`` times the match's;
         ``scale``: the heading variance the turn scale error adds to this step (:class:`.odometry_scale.TurnScale`)."""
         n = len(history)
-        h = np.asarray(history, dtype=float)
-        centre = np.median(h, axis=0)
-        spread = MAD_TO_SIGMA * np.median(np.abs(h - centre), axis=0)
+        known = self._medians.get(id(history))
+        if known is not None and known[0] == self._recorded:
+            centre, spread = known[1], known[2]
+        else:
+            h = np.asarray(history, dtype=float)
+            centre = column_medians(h)
+            spread = MAD_TO_SIGMA * column_medians(np.abs(h - centre))
+            self._medians[id(history)] = (self._recorded, centre, spread)
         out = np.full(3, np.inf)
         for k in self.components:
             if spread[k] <= 0.0:
@@ -367,6 +377,30 @@ def squared_bias(median: float, spread: float, n: int) -> float:
     """
     standard_error = MEDIAN_EFFICIENCY * spread / math.sqrt(n)
     return max(0.0, median**2 - standard_error**2)
+
+
+def column_medians(values: FloatArray) -> FloatArray:
+    """``np.median(values, axis=0)`` of a 2-D float64 array, the same bits, without the wrapper's overhead.
+
+    The very steps of numpy's ``_median``: ``np.partition`` with the same
+    ``kth`` (the middle one or two rows, and the last for its NaN check), then
+    the mean of the middle rows as ``np.mean`` computes it (``np.add.reduce``
+    divided by the row count). A column with a NaN, or no rows, is left to
+    ``np.median`` itself. Called twice per matched node step, where
+    ``np.median``'s argument handling cost more than the arithmetic
+    (docs/baselines.md, "Cost (issue 24), fifth round").
+    """
+    n = values.shape[0]
+    if n == 0 or values.ndim != 2:
+        return np.asarray(np.median(values, axis=0), dtype=np.float64)
+    half = n // 2
+    kth = [half - 1, half, -1] if n % 2 == 0 else [(n - 1) // 2, -1]
+    part = np.partition(values, kth, axis=0)
+    if np.isnan(part[-1]).any():
+        return np.asarray(np.median(values, axis=0), dtype=np.float64)
+    rows = part[half - 1 : half + 1] if n % 2 == 0 else part[half : half + 1]
+    medians: FloatArray = np.add.reduce(rows, axis=0) / len(rows)
+    return medians
 
 
 def innovation(reference: FloatArray, other: FloatArray) -> FloatArray:

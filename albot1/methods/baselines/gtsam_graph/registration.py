@@ -28,6 +28,7 @@ import numpy as np
 
 from albot1.geometry.types import FloatArray
 from albot1.methods.baselines.gtsam_graph import icp_loop
+from albot1.methods.baselines.gtsam_graph.block_sums import MOMENT_NEIGHBOURS, line_moments
 from albot1.methods.baselines.gtsam_graph.errors import RegistrationError
 from albot1.methods.baselines.gtsam_graph.nearest import Grid, Matches, check_gate
 
@@ -94,16 +95,24 @@ def line_normals(
         return np.empty((0, 2)), np.empty((0, 2))
     k = min(neighbours, len(pts))
     dist, idx = cKDTree(pts).query(pts, k=k, distance_upper_bound=radius_m)
-    ok = np.isfinite(dist)
-    counts = ok.sum(axis=1)
-    idx = np.where(ok, idx, np.arange(len(pts))[:, None])  # pad with the point itself, weight 0
-    w = ok[..., None].astype(float)
-    nb = pts[idx]
-    mean = (nb * w).sum(axis=1) / np.maximum(counts, 1)[:, None]
-    d = (nb - mean[:, None, :]) * w
-    cxx = (d[..., 0] ** 2).sum(axis=1)
-    cyy = (d[..., 1] ** 2).sum(axis=1)
-    cxy = (d[..., 0] * d[..., 1]).sum(axis=1)
+    if k <= MOMENT_NEIGHBOURS:
+        counts = np.empty(len(pts), dtype=np.int64)
+        cxx, cyy, cxy = np.empty(len(pts)), np.empty(len(pts)), np.empty(len(pts))
+        line_moments(
+            np.ascontiguousarray(pts), np.ascontiguousarray(dist), np.ascontiguousarray(idx, dtype=np.int64), counts,
+            cxx, cyy, cxy,
+        )  # fmt: skip
+    else:  # the same sums through numpy (more neighbours than the kernel sums one after the other)
+        ok = np.isfinite(dist)
+        counts = ok.sum(axis=1)
+        idx = np.where(ok, idx, np.arange(len(pts))[:, None])  # pad with the point itself, weight 0
+        w = ok[..., None].astype(float)
+        nb = pts[idx]
+        mean = (nb * w).sum(axis=1) / np.maximum(counts, 1)[:, None]
+        d = (nb - mean[:, None, :]) * w
+        cxx = (d[..., 0] ** 2).sum(axis=1)
+        cyy = (d[..., 1] ** 2).sum(axis=1)
+        cxy = (d[..., 0] * d[..., 1]).sum(axis=1)
     root = np.sqrt((0.5 * (cxx - cyy)) ** 2 + cxy**2)
     lam_max = 0.5 * (cxx + cyy) + root
     lam_min = 0.5 * (cxx + cyy) - root
@@ -111,6 +120,21 @@ def line_normals(
     keep = (counts >= 3) & (lam_max > 1e-12) & (lam_min <= max_planarity * np.maximum(lam_max, 1e-12))
     normals = np.column_stack([-np.sin(axis[keep]), np.cos(axis[keep])])
     return pts[keep], normals
+
+
+def side_by_side(left: FloatArray, right: FloatArray) -> FloatArray:
+    """``np.hstack([left, right])`` of two ``(n, 2)`` float64 arrays: the same bytes, copied a row pair at a time.
+
+    numpy copies into a ``(n, 4)`` array's column pairs two values per inner
+    loop (about 15 ns a value); seen as one complex128 per row, each side is
+    one strided copy of ``n`` 16-byte items, a plain copy of the same bytes
+    (no arithmetic), several times faster on a local map of 1,500 points.
+    """
+    out = np.empty((len(left), 4))
+    pairs = out.view(np.complex128)
+    pairs[:, 0] = np.ascontiguousarray(left).view(np.complex128)[:, 0]
+    pairs[:, 1] = np.ascontiguousarray(right).view(np.complex128)[:, 0]
+    return out
 
 
 class Target:
@@ -131,7 +155,7 @@ class Target:
         if not (np.isfinite(self.points).all() and np.isfinite(self.normals).all()):
             raise RegistrationError("target points and normals must be finite")
         # Each point beside its normal: one gather per ICP iteration fetches both (:func:`_linearise`).
-        self.lines: FloatArray = np.hstack([self.points, self.normals])
+        self.lines: FloatArray = side_by_side(self.points, self.normals)
 
     @functools.cached_property
     def tree(self) -> cKDTree | None:
@@ -169,6 +193,30 @@ def rotate(vectors: FloatArray, angle: float) -> FloatArray:
     return rotated
 
 
+def rotate_runs(parts: list[FloatArray], angles: list[float]) -> FloatArray:
+    """``np.concatenate([rotate(v, a) for v, a in zip(parts, angles)])``: the same bits, in one compiled call.
+
+    Where ICP's loop is compiled (:func:`.icp_loop.available`), every part of
+    two rows or more is turned by :func:`.icp_loop.rotate_runs` with the
+    dgemm numpy's matmul calls and CPython's ``cos`` and ``sin``; a single row
+    is turned here by numpy, as before (its matmul branch differs). Saves
+    numpy's per-call overhead on each node of a target (docs/baselines.md,
+    "Cost (issue 24), fifth round").
+    """
+    vectors = np.ascontiguousarray(np.concatenate(parts), dtype=np.float64)
+    if not icp_loop.available():
+        return np.concatenate([rotate(v, a) for v, a in zip(parts, angles, strict=True)])
+    counts = np.array([len(v) for v in parts], dtype=np.int64)
+    out = np.empty_like(vectors)
+    icp_loop.rotate_runs(vectors, np.array(angles, dtype=np.float64), counts, out)
+    start = 0
+    for v, a, n in zip(parts, angles, counts.tolist(), strict=True):
+        if n == 1:
+            out[start : start + 1] = rotate(v, a)
+        start += n
+    return out
+
+
 def try_register(target: Target, points: FloatArray, guess: FloatArray, params: IcpParams) -> Registration | None:
     """:func:`register`, or None when either side has too few usable points to try (a miss, not an error)."""
     if len(points) < params.min_points or len(target) < params.min_points:
@@ -196,20 +244,23 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
         )
 
     matches = Matches(len(src))
-    prior = np.diag([params.prior_sigma_xy_m**-2, params.prior_sigma_xy_m**-2, params.prior_sigma_theta_rad**-2])
+    prior = _prior(params.prior_sigma_xy_m, params.prior_sigma_theta_rad)
     inv_var = params.point_sigma_m**-2
     if params.min_points >= 2 and icp_loop.available():  # numpy's matmul special-cases a single row or match
-        x, y, theta, iterations, converged, settled = _iterate_compiled(target, src, init, params, prior, matches)
+        (x, y, theta, iterations, converged, settled), (inliers, information, rmse) = _iterate_compiled(
+            target, src, init, params, prior, matches
+        )
+        pose = np.array([x, y, theta])
     else:
         x, y, theta, iterations, converged, settled = _iterate(target, src, init, params, prior, matches)
+        pose = np.array([x, y, theta])
+        jac, res, _, wj = _linearise(
+            target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches
+        )
+        inliers = int(len(res))
+        information = wj.T @ jac if inliers else np.zeros((3, 3))
+        rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")
     converged = converged or (settled and iterations == params.max_iterations)
-    pose = np.array([x, y, theta])
-    jac, res, _, wj = _linearise(
-        target, src, pose, params.min_correspondence_m, params.cauchy_scale_m, inv_var, matches
-    )
-    inliers = int(len(res))
-    information = wj.T @ jac if inliers else np.zeros((3, 3))
-    rmse = float(np.sqrt(np.mean(res**2))) if inliers else float("inf")
     return Registration(
         pose=pose,
         converged=converged,
@@ -221,19 +272,36 @@ def register(target: Target, source: FloatArray, initial: FloatArray, params: Ic
     )
 
 
+@functools.lru_cache(maxsize=64)
+def _prior(sigma_xy_m: float, sigma_theta_rad: float) -> FloatArray:
+    """The odometry prior's information ``diag(sigma_xy^-2, sigma_xy^-2, sigma_theta^-2)``, built once per pair.
+
+    Shared, so never written (ICP's loops only read it; a read-only flag
+    would give numba another argument type, so none is set); cached because
+    the tracker asks for the same few pairs thousands of times and ``np.diag``
+    of a list costs more than the rest of a small registration's set-up.
+    """
+    return np.diag([sigma_xy_m**-2, sigma_xy_m**-2, sigma_theta_rad**-2])
+
+
 #: what a Gauss-Newton loop leaves: the pose, the iterations run, whether it converged, whether its last step settled
 Outcome = tuple[float, float, float, int, bool, bool]
+#: the final terms' inlier count, information ``J^T W J`` and RMS residual (inf without inliers)
+Final = tuple[int, FloatArray, float]
 
 
 def _iterate_compiled(
     target: Target, src: FloatArray, init: FloatArray, params: IcpParams, prior: FloatArray, matches: Matches
-) -> Outcome:
-    """:func:`_iterate` in one compiled call (:func:`.icp_loop.icp_run`), back here only for the k-d tree's answers.
+) -> tuple[Outcome, Final]:
+    """:func:`_iterate` and the final terms in one compiled call (:func:`.icp_loop.icp_run`), back here only for the
+    k-d tree's answers.
 
     The same operations on the same data (numpy's own BLAS and LAPACK
     functions, CPython's ``cos``, ``sin``, ``remainder`` and ``hypot``), so the
     same bits; it saves the numpy calls' overhead around them, most of an
-    iteration's CPU before (docs/baselines.md, "Cost (issue 24), fourth round").
+    iteration's CPU before (docs/baselines.md, "Cost (issue 24), fourth round"),
+    and since the fifth round those of the final linearisation, ``wj.T @ jac``
+    and the RMS too (one information from a single inlier is numpy's product here).
     """
     x0, y0, theta0 = init.tolist()
     knobs = np.array([
@@ -241,7 +309,7 @@ def _iterate_compiled(
         params.gate_decay, params.tolerance_m, params.tolerance_rad, params.settle_factor, params.min_points,
         x0, y0, theta0,
     ], dtype=float)  # fmt: skip
-    state = np.array([x0, y0, theta0, params.max_correspondence_m, 1.0, 0.0, 0.0, 0.0])
+    state = np.array([x0, y0, theta0, params.max_correspondence_m, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     grid, rot, scratch = target.grid, np.empty_like(src), np.zeros(icp_loop.SCRATCH)
     while True:
         status = icp_loop.icp_run(
@@ -254,8 +322,14 @@ def _iterate_compiled(
         state[icp_loop.S_RESUME] = 1.0
     if status == icp_loop.BAD_GATE:
         check_gate(float(state[icp_loop.S_GATE]))
-    x, y, theta, _, ran, settled, converged, _ = state.tolist()
-    return x, y, theta, min(int(ran), params.max_iterations), bool(converged), bool(settled)
+    x, y, theta, _, ran, settled, converged, _, _, found, rmse = state.tolist()
+    inliers = int(found)
+    if inliers >= 2:
+        information = scratch[icp_loop.INFORMATION : icp_loop.INFORMATION + 9].reshape(3, 3).copy()
+    else:
+        information = matches.wj[:inliers].T @ matches.jac[:inliers] if inliers else np.zeros((3, 3))
+    outcome = (x, y, theta, min(int(ran), params.max_iterations), bool(converged), bool(settled))
+    return outcome, (inliers, information, rmse if inliers else float("inf"))
 
 
 def _iterate(
