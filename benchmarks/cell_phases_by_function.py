@@ -10,7 +10,8 @@ less that of the wrapped calls inside it, and runs each cell of a suite in a for
     python benchmarks/cell_phases_by_function.py SUITE.toml --rounds 3 [--only fr-clinic]
 
 Per cell it prints the cell's CPU (each round) and each function's median exclusive CPU-s and share of the
-cell. The wrapper costs ~1 us a call (a few ms a thousand scans). Used for docs/benchmarking.md, "Session 26".
+cell, with the clock reads taken off (a ``process_time`` read is a system call, ~9 us on the VM of session 26:
+measured in each fork and subtracted per call). Used for docs/benchmarking.md, "Session 26".
 The run folders go to a temporary folder that is removed.
 """
 
@@ -54,23 +55,42 @@ TARGETS = (
 )
 
 
+def _clock_cost() -> float:
+    """CPU-s of one ``time.process_time()`` read here (a system call: ~9 us on the 2-core VM of session 26)."""
+    reads = 2_000
+    start = time.process_time()
+    for _ in range(reads):
+        time.process_time()
+    return (time.process_time() - start) / reads
+
+
 def _install(totals: collections.Counter[str]) -> None:
-    """Wrap :data:`TARGETS` and every metric's ``compute`` with exclusive CPU timers adding into ``totals``."""
-    stack: list[float] = []
+    """Wrap :data:`TARGETS` and every metric's ``compute`` with exclusive CPU timers adding into ``totals``.
+
+    Each wrapped call reads the clock twice; about one read falls inside the call's own span and one in its
+    caller's, so ``<label> calls`` and ``<label> inner calls`` are counted too and :func:`main` takes one read's
+    cost off each (on a log of 13,631 scans, four wrapped calls a scan are ~1 CPU-s of clock reads here).
+    """
+    stack: list[tuple[str, float]] = []
 
     def wrap(function: Callable[..., Any], label: str) -> Callable[..., Any]:
         @functools.wraps(function)
         def timed(*args: Any, **kwargs: Any) -> Any:
             start = time.process_time()
-            stack.append(0.0)
+            stack.append((label, 0.0))
             try:
                 return function(*args, **kwargs)
             finally:
                 spent = time.process_time() - start
-                inner = stack.pop()
+                inner = stack.pop()[1]
                 totals[label] += spent - inner
+                totals[f"{label} calls"] += 1
                 if stack:
-                    stack[-1] += spent
+                    caller, below = stack[-1]
+                    stack[-1] = (caller, below + spent)
+                    totals[f"{caller} inner calls"] += 1
+                else:
+                    totals["unwrapped inner calls"] += 1
 
         return timed
 
@@ -112,6 +132,7 @@ def _cell_in_fork(cell: Any, out: Path) -> dict[str, float]:
         execute_cell(cell, out, preview=render_preview)
         after = resource.getrusage(resource.RUSAGE_SELF)
         totals["cell"] = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+        totals["clock"] = _clock_cost()
         os.write(write, json.dumps(totals).encode())
         os._exit(0)
     os.close(write)
@@ -119,6 +140,16 @@ def _cell_in_fork(cell: Any, out: Path) -> dict[str, float]:
         data: dict[str, float] = json.loads(pipe.read())
     os.waitpid(pid, 0)
     return data
+
+
+def _corrected(found: dict[str, float]) -> dict[str, float]:
+    """Each label's CPU-s less a clock read per call of it and per wrapped call inside it; the cell two a call."""
+    clock = found["clock"]
+    labels = {k for k in found if not k.endswith(" calls") and k != "clock"} - {"cell"}
+    out = {k: found[k] - clock * (found.get(f"{k} calls", 0.0) + found.get(f"{k} inner calls", 0.0)) for k in labels}
+    calls = sum(v for k, v in found.items() if k.endswith(" calls") and not k.endswith(" inner calls"))
+    out["cell"] = found["cell"] - 2 * clock * calls
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -145,12 +176,16 @@ def main(argv: list[str] | None = None) -> int:
                 shutil.rmtree(Path(tmp) / cell.key, ignore_errors=True)  # the whole cell each round
                 runs[f"{cell.method}|{cell.dataset_label}|{cell.degradation}"].append(_cell_in_fork(cell, Path(tmp)))
     for name, found in runs.items():
-        labels = sorted({k for r in found for k in r} - {"cell"}, key=lambda k: -sum(r.get(k, 0.0) for r in found))
-        whole = sorted(r["cell"] for r in found)[len(found) // 2]
-        each = " ".join(f"{r['cell']:.3f}" for r in found)
-        print(f"{name}: cell CPU-s {each} (median {whole:.3f})")
+        corrected = [_corrected(r) for r in found]
+        labels = sorted(
+            {k for r in corrected for k in r} - {"cell"}, key=lambda k: -sum(r.get(k, 0.0) for r in corrected)
+        )
+        whole = sorted(r["cell"] for r in corrected)[len(corrected) // 2]
+        each = " ".join(f"{r['cell']:.3f}" for r in corrected)
+        reads = sorted(r["clock"] for r in found)[len(found) // 2]
+        print(f"{name}: cell CPU-s {each} (median {whole:.3f}; clock reads taken off, {1e6 * reads:.1f} us each)")
         for label in labels:
-            median = sorted(r.get(label, 0.0) for r in found)[len(found) // 2]
+            median = sorted(r.get(label, 0.0) for r in corrected)[len(corrected) // 2]
             if median >= 0.0005:
                 print(f"    {label:34s} {median:7.3f}  {100 * median / whole:5.1f} %")
     return 0

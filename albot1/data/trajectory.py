@@ -112,7 +112,9 @@ def write_tum(path: Path | IO[str], timestamps: NDArray[np.float64], poses: NDAr
     )
     text = _TUM_HEADER + (_TUM_LINE * len(values)) % tuple(values.ravel().tolist())
     if isinstance(path, (str, Path)):
-        with open(path, "w", encoding="latin-1") as handle:  # numpy.savetxt's own encoding and text mode
+        # text mode as numpy.savetxt opened a path (its encoding was the locale's; the text is ASCII either way);
+        # UTF-8, whose codec every process has imported, not latin-1, which a forked cell would import itself
+        with open(path, "w", encoding="utf-8") as handle:
             handle.write(text)
     else:
         path.write(text)
