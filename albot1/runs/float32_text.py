@@ -95,7 +95,7 @@ def _decimal(values: NDArray[np.float32]) -> tuple[NDArray[np.uint64], NDArray[n
     size = np.abs(values.astype(np.float64))
     with np.errstate(divide="ignore"):
         first = np.floor(np.log10(np.where(zero, 1.0, size))).astype(np.int64)  # E, or one off: still exact
-    decimals = 9 - first  # J: 9 to 13 decimals
+    decimals = 9 - first  # J: 4 (below 1e6) to 13 (from 1e-4) decimals, one more or less where E is one off
     shift = np.where(zero, 0, 2 - (e + decimals))  # J' + 2 >= 2 in range
     five = _POW5[decimals]
     scaled = (m << np.uint64(2)) * five
@@ -144,7 +144,8 @@ def _positional_fields(
     without trailing ones, each at least one digit (``0.5``, ``100.0``, ``-0.0``) as numpy writes them.
 
     Values are taken a number of decimals at a time (a handful of groups), so every division is by a constant
-    and every digit lands in a fixed column: slot 1 + i holds the digit of 10**(_WHOLE_DIGITS - 1 - i).
+    and every digit lands in a fixed column: slots 1-7 hold the places 10**6 .. 10**0, slot 8 the point, slots
+    9-22 the places 10**-1 .. 10**-14.
     """
     rows = np.zeros((len(values), FIELD), dtype=np.uint8)
     rows[:, 0] = np.where(np.signbit(values), ord("-"), 0)
