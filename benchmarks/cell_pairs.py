@@ -22,7 +22,8 @@ kept under ``--out/old`` and ``--out/new``; ``--compare`` then compares them fil
 ``metrics.json``'s ``run`` and ``cost``, ``cell.json``'s key and code version; ``attempt.json``,
 ``cell.log``, ``DONE`` and ``per_scan_ns.npy`` left out); a ``.npz`` or ``.png`` whose bytes differ is
 compared by what it decodes to (arrays; RGBA pixels) and counted apart. Used for
-docs/benchmarking.md, "Session 22" and "Session 24".
+docs/benchmarking.md, "Session 22", "Session 24" and "Session 26" (``--by-dataset``: a line per dataset and
+degradation too).
 """
 
 from __future__ import annotations
@@ -166,6 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, required=True, help="the run folders: OUT/old, OUT/new")
     parser.add_argument("--preload", default="", help="ALBOT1_PRELOAD_METHODS for the workers (the suite's methods)")
     parser.add_argument("--compare", action="store_true", help="only compare OUT/old and OUT/new, byte for byte")
+    parser.add_argument("--by-dataset", action="store_true", help="also sum by dataset and degradation")
     parser.add_argument("--worker", nargs=2, metavar=("SUITE", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
@@ -207,7 +209,8 @@ def main(argv: list[str] | None = None) -> int:
                 procs[tag].stdin.write(name + "\n")  # type: ignore[union-attr]
                 procs[tag].stdin.flush()  # type: ignore[union-attr]
                 data = json.loads(procs[tag].stdout.readline())  # type: ignore[union-attr]
-                for key in ("all", name.split("|")[0]):
+                keys = ["all", name.split("|")[0]] + (["|".join(name.split("|")[2:4])] if args.by_dataset else [])
+                for key in keys:
                     sums[key][f"{tag} cpu"] += data["cpu"]
                     sums[key][f"{tag} method"] += data["method"]
                     sums[key][f"{tag} cells"] += 1

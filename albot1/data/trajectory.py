@@ -84,10 +84,10 @@ class PoseFile:
     timestamps: NDArray[np.float64] | None
 
 
-def _tum_rows(timestamps: NDArray[np.float64], poses: NDArray[np.float64]) -> NDArray[np.float64]:
-    half = poses[:, 2] / 2.0
-    zeros = np.zeros(len(poses))
-    return np.column_stack([timestamps, poses[:, 0], poses[:, 1], zeros, zeros, zeros, np.sin(half), np.cos(half)])
+#: One TUM line as :func:`write_tum` writes it: z, qx and qy of a planar pose are 0, which ``%.9f`` always spells
+#: ``0.000000000`` (``numpy.savetxt(fmt="%.9f")`` wrote these files until session 26, byte for byte the same).
+_TUM_LINE = "%.9f %.9f %.9f 0.000000000 0.000000000 0.000000000 %.9f %.9f\n"
+_TUM_HEADER = "# timestamp x y z qx qy qz qw\n"
 
 
 def _planar(rows: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -98,8 +98,26 @@ def _planar(rows: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def write_tum(path: Path | IO[str], timestamps: NDArray[np.float64], poses: NDArray[np.float64]) -> None:
-    """Write planar poses as TUM (z = 0, yaw-only quaternion, 9 decimals)."""
-    np.savetxt(path, _tum_rows(timestamps, poses), fmt="%.9f", header="timestamp x y z qx qy qz qw", comments="# ")
+    """Write planar poses as TUM (z = 0, yaw-only quaternion, 9 decimals).
+
+    One ``%`` of the whole file's format over the values as Python floats: ``numpy.savetxt`` formatted a row at a
+    time from numpy scalars, ~6 us a line, and every run folder holds two or three of these files (13,631 lines
+    each on intel); the text is the same (the same ``%.9f`` of the same doubles, the zero columns written as
+    ``%.9f`` writes 0.0).
+    """
+    poses = np.asarray(poses, dtype=float).reshape(-1, 3)
+    half = poses[:, 2] / 2.0
+    values = np.column_stack(
+        [np.asarray(timestamps, dtype=float), poses[:, 0], poses[:, 1], np.sin(half), np.cos(half)]
+    )
+    text = _TUM_HEADER + (_TUM_LINE * len(values)) % tuple(values.ravel().tolist())
+    if isinstance(path, (str, Path)):
+        # text mode as numpy.savetxt opened a path (its encoding was the locale's; the text is ASCII either way);
+        # UTF-8, whose codec every process has imported, not latin-1, which a forked cell would import itself
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+    else:
+        path.write(text)
 
 
 def as_stored(timestamps: NDArray[np.float64], poses: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -11,6 +11,7 @@ first scan to see a cell wins). The one-shot form of the same thinning is
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from albot1.geometry.grid import cell_keys
 from albot1.geometry.types import FloatArray
@@ -24,6 +25,12 @@ class ThinnedPointMap:
     of a fixed per-call overhead in a mapper's timed per-scan update, and the
     result is the same as thinning scan by scan (first point per cell wins,
     in insertion order).
+
+    The cells already claimed are one sorted int64 array (:func:`cell_keys`), searched and extended by numpy;
+    until session 26 they were a Python set of ints, and turning each batch's keys into Python ints and
+    through the set's difference and update was most of the map's cost: 0.6-0.9 CPU-s of an odometry cell on
+    fr-clinic (505,764 cells), about 50 bytes a cell where the array holds 8 (docs/benchmarking.md,
+    "Session 26: the cell cost that grows with the log").
     """
 
     def __init__(self, cell_m: float, batch_points: int = 50_000) -> None:
@@ -31,7 +38,7 @@ class ThinnedPointMap:
             raise ValueError(f"expected a positive grid cell size, got {cell_m}")
         self.cell_m = cell_m
         self.batch_points = batch_points
-        self._cells: set[int] = set()
+        self._claimed: NDArray[np.int64] = np.empty(0, dtype=np.int64)  # sorted, each cell once
         self._kept: list[FloatArray] = []
         self._pending: list[FloatArray] = []
         self._pending_count = 0
@@ -49,14 +56,17 @@ class ThinnedPointMap:
             return
         points = np.concatenate(self._pending)
         self._pending, self._pending_count = [], 0
-        # One int64 key per cell keeps the bookkeeping in C-level set ops.
-        unique, first = np.unique(cell_keys(points, self.cell_m), return_index=True)
-        fresh_keys = set(unique.tolist()).difference(self._cells)
-        if not fresh_keys:
+        # One int64 key per cell keeps the bookkeeping in numpy: a sort, a search and an insert per batch.
+        unique, first = np.unique(cell_keys(points, self.cell_m), return_index=True)  # sorted; first occurrences
+        claimed = self._claimed
+        at = np.searchsorted(claimed, unique)  # where each key is, or would be inserted, in the claimed cells
+        fresh = np.ones(len(unique), dtype=np.bool_)
+        inside = at < len(claimed)
+        fresh[inside] = claimed[at[inside]] != unique[inside]
+        if not fresh.any():
             return
-        self._cells.update(fresh_keys)
-        fresh = np.fromiter(fresh_keys, dtype=np.int64, count=len(fresh_keys))
-        self._kept.append(points[np.sort(first[np.isin(unique, fresh)])])
+        self._claimed = np.insert(claimed, at[fresh], unique[fresh])  # still sorted: positions in the old array
+        self._kept.append(points[np.sort(first[fresh])])
 
     def __len__(self) -> int:
         self._flush()
