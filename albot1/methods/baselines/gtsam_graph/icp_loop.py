@@ -178,6 +178,52 @@ DONE, ASK_TREE, BAD_GATE = 0, 1, 2
 
 
 @jitable
+def _correspond(
+    origin: FloatArray,
+    dims: IntArray,
+    cell: float,
+    starts: IntArray,
+    xy: FloatArray,
+    order: IntArray,
+    src: FloatArray,
+    x: float,
+    y: float,
+    theta: float,
+    gate: float,
+    idx: IntArray,
+    rot: FloatArray,
+    scratch: FloatArray,
+) -> int:
+    """``src`` turned by ``theta`` into ``rot``, each point's nearest line within ``gate`` of ``(x, y)`` in ``idx``.
+
+    One iteration's correspondences as :func:`.nearest.linearise_terms` finds
+    them (the rotation by CPython's ``cos`` and ``sin`` and numpy's dgemm, the
+    grid search): :data:`DONE`, :data:`BAD_GATE` for a gate that is not
+    usable, or :data:`ASK_TREE` with the ambiguous queries marked
+    :data:`.nearest.AMBIGUOUS` for the k-d tree. The loop and the final terms
+    call it alike.
+    """
+    if not (math.isfinite(gate) and gate > 0):
+        return BAD_GATE
+    n = src.shape[0]
+    c, s = _cos(theta), _sin(theta)
+    scratch[_R], scratch[_R + 1], scratch[_R + 2], scratch[_R + 3] = c, s, -s, c
+    _dgemm(
+        _ROW, _NOTRANS, _NOTRANS, n, 2, 2, 1.0, src.ctypes, 2, scratch[_R : _R + 4].ctypes, 2, 0.0, rot.ctypes, 2
+    )  # fmt: skip
+    gate2 = gate * gate
+    ambiguous = False
+    for i in range(n):
+        at, unsure = _nearest_one(origin, dims, cell, starts, xy, rot[i, 0] + x, rot[i, 1] + y, gate2)
+        if unsure:
+            idx[i] = AMBIGUOUS
+            ambiguous = True
+        else:
+            idx[i] = order[at] if at >= 0 else -1
+    return ASK_TREE if ambiguous else DONE
+
+
+@jitable
 def python_remainder(x: float, y: float) -> float:
     """``math.remainder(x, y)`` as CPython 3.11 computes it (``m_remainder``), step for step: every step is exact.
 
@@ -252,30 +298,11 @@ def icp_run(
     resume = state[S_RESUME] != 0.0
     last, least, min_gate = int(knobs[K_ITERATIONS]), int(knobs[K_LEAST]), knobs[K_MIN_GATE]
     tol_m, tol_rad, settle = knobs[K_TOL_M], knobs[K_TOL_RAD], knobs[K_SETTLE]
-    n = src.shape[0]
     status = DONE
     while it <= last:
         if not resume:
-            if not (math.isfinite(gate) and gate > 0):
-                status = BAD_GATE
-                break
-            c, s = _cos(theta), _sin(theta)
-            scratch[_R], scratch[_R + 1], scratch[_R + 2], scratch[_R + 3] = c, s, -s, c
-            _dgemm(
-                _ROW, _NOTRANS, _NOTRANS, n, 2, 2, 1.0, src.ctypes, 2, scratch[_R : _R + 4].ctypes, 2, 0.0,
-                rot.ctypes, 2,
-            )  # fmt: skip
-            gate2 = gate * gate
-            ambiguous = False
-            for i in range(n):
-                at, unsure = _nearest_one(origin, dims, cell, starts, xy, rot[i, 0] + x, rot[i, 1] + y, gate2)
-                if unsure:
-                    idx[i] = AMBIGUOUS
-                    ambiguous = True
-                else:
-                    idx[i] = order[at] if at >= 0 else -1
-            if ambiguous:
-                status = ASK_TREE
+            status = _correspond(origin, dims, cell, starts, xy, order, src, x, y, theta, gate, idx, rot, scratch)
+            if status != DONE:
                 break
         resume = False
         m = _terms(lines, rot, x, y, knobs[K_CAUCHY], knobs[K_INV_VAR], idx, jac, res, w, wj)
@@ -345,26 +372,10 @@ def _final_terms(
     is not usable at :data:`BAD_GATE`.
     """
     x, y, theta, gate = state[S_X], state[S_Y], state[S_THETA], state[S_GATE]
-    n = src.shape[0]
     if state[S_RESUME] == 0.0:
-        if not (math.isfinite(gate) and gate > 0):
-            return BAD_GATE
-        c, s = _cos(theta), _sin(theta)
-        scratch[_R], scratch[_R + 1], scratch[_R + 2], scratch[_R + 3] = c, s, -s, c
-        _dgemm(
-            _ROW, _NOTRANS, _NOTRANS, n, 2, 2, 1.0, src.ctypes, 2, scratch[_R : _R + 4].ctypes, 2, 0.0, rot.ctypes, 2
-        )  # fmt: skip
-        gate2 = gate * gate
-        ambiguous = False
-        for i in range(n):
-            at, unsure = _nearest_one(origin, dims, cell, starts, xy, rot[i, 0] + x, rot[i, 1] + y, gate2)
-            if unsure:
-                idx[i] = AMBIGUOUS
-                ambiguous = True
-            else:
-                idx[i] = order[at] if at >= 0 else -1
-        if ambiguous:
-            return ASK_TREE
+        status = _correspond(origin, dims, cell, starts, xy, order, src, x, y, theta, gate, idx, rot, scratch)
+        if status != DONE:
+            return status
     state[S_RESUME] = 0.0
     m = _terms(lines, rot, x, y, knobs[K_CAUCHY], knobs[K_INV_VAR], idx, jac, res, w, wj)
     state[S_INLIERS] = m
