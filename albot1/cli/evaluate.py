@@ -280,13 +280,22 @@ def _print_held_in(metrics: MetricsRecord) -> None:
 
 
 def headlines(metrics: MetricsRecord) -> list[str]:
-    """One line per metric of the registry: its own headline, or ``null:`` and the reason it does not apply."""
+    """One line per metric of the registry: its own headline, or ``null:`` and the reason it does not apply.
+
+    A number the report leaves out although it was computed (a column's ``applies``: a loop gap on a route that
+    never returns) says so, with the report's reason: it used to print ``route gap 3.552 m`` for a straight
+    corridor, or for a robot that never moved, where the report's column says n/a.
+    """
     from albot1.metrics.registry import metric_registry
 
     lines = []
     for metric in metric_registry():
         block = metrics.block(metric.name)
         line = metric.headline(block) if block is not None else f"null: {metrics.reason(metric.name)}"
+        for spec in metric.columns if block is not None else ():
+            why = spec.applies(block, metrics) if spec.applies is not None else None
+            if why is not None and why not in line:  # a headline that says it already (orientation, places)
+                line += f"; the report's {spec.header.split(' (')[0]} column: n/a ({why})"
         lines.append(f"  {metric.name:12s} {line}")
     return lines
 

@@ -70,6 +70,7 @@ WORSE: Final = "worse"
 SAME: Final = "indistinguishable"
 NOT_APPLICABLE: Final = "n/a"
 PERFECT_REFERENCE: Final = f"the reference error is below {ZERO_ERROR:g} (perfect): no ratio"
+NEGATIVE_ERROR: Final = "a negative error (expected magnitudes >= 0: a distance or an absolute angle)"
 UNBOUNDED: Final = (
     "the reference error is zero in too many resamples (zero on nearly every pair): the interval is unbounded"
 )
@@ -306,9 +307,10 @@ def compare(
     """A's errors against B's (per group, the same scans or relations): ratio, interval and verdict.
 
     Not applicable (with the reason) when the groups hold fewer than
-    :data:`MIN_PAIRS` pairs, when a group's two arrays differ in length or
-    hold a non-finite error, or when B's pooled error is below
-    :data:`ZERO_ERROR` (a perfect reference: no ratio).
+    :data:`MIN_PAIRS` pairs, when a group's arrays hold a non-finite or a
+    negative error (:data:`NEGATIVE_ERROR`), or when B's pooled error is below
+    :data:`ZERO_ERROR` (a perfect reference: no ratio). Arrays of a group
+    that differ in length are a ValueError (the caller paired them wrongly).
     """
     arrays: list[Pair] = []
     for a, b in pairs:
@@ -322,6 +324,10 @@ def compare(
         return not_applicable(f"{count} pairs, fewer than {MIN_PAIRS}", count, len(arrays))
     if not all(np.isfinite(x).all() and np.isfinite(y).all() for x, y in arrays):
         return not_applicable("a non-finite error", count, len(arrays))
+    if any((x < 0).any() or (y < 0).any() for x, y in arrays):
+        # errors are magnitudes: signed ones (a distance error, a bearing error) summed at power 1 gave a negative
+        # "ratio" called better (-1 [-1–-1]) while the pooled errors beside it took their absolute values
+        return not_applicable(NEGATIVE_ERROR, count, len(arrays))
     error_a = _pooled(sum(float(np.sum(np.abs(x) ** power)) for x, _ in arrays), float(count), power)
     reference = _pooled(sum(float(np.sum(np.abs(y) ** power)) for _, y in arrays), float(count), power)
     if reference < ZERO_ERROR:

@@ -14,6 +14,7 @@ the reference keeps the pairs identical for every method on a dataset.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Literal
 
 import numpy as np
@@ -34,8 +35,9 @@ def pair_indices(reference: ArrayLike, delta: float, unit: DeltaUnit) -> NDArray
     """``(K, 2)`` consecutive index pairs ``delta`` frames or metres apart."""
     ref = np.asarray(reference, dtype=float)
     n = len(ref)
-    if delta <= 0:
-        raise MetricsError(f"RPE: expected a positive delta, got {delta} {unit}")
+    if not (math.isfinite(delta) and delta > 0):
+        # NaN and inf used to escape as ValueError / OverflowError (int(delta)) or give 0 pairs "of nan m"
+        raise MetricsError(f"RPE: expected a positive finite delta, got {delta} {unit}")
     if unit == "frames":
         if int(delta) != delta:
             raise MetricsError(f"RPE: a delta in frames must be a whole number, got {delta}")
