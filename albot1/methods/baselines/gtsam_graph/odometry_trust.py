@@ -150,9 +150,10 @@ class OdometryTrust:
         self._pooled: deque[FloatArray] = deque(maxlen=window)
         self._kinds: tuple[deque[FloatArray], deque[FloatArray]] = (deque(maxlen=window), deque(maxlen=window))
         # Each history's median and spread, kept until the next step is recorded (several judgements per node
-        # read the same history): id of the deque -> (steps recorded then, centre, spread)
+        # read the same history): id of the deque -> (the deque, steps recorded then, centre, spread); the deque is
+        # kept and compared, so another history that happens to get a freed one's id is never served its medians
         self._recorded = 0
-        self._medians: dict[int, tuple[int, FloatArray, FloatArray]] = {}
+        self._medians: dict[int, tuple[deque[FloatArray], int, FloatArray, FloatArray]] = {}
         self.turn_rad = turn_rad
         self.kind_min_steps = kind_min_steps
         self.bias_horizon = bias_horizon
@@ -226,13 +227,13 @@ class OdometryTrust:
         ``scale``: the heading variance the turn scale error adds to this step (:class:`.odometry_scale.TurnScale`)."""
         n = len(history)
         known = self._medians.get(id(history))
-        if known is not None and known[0] == self._recorded:
-            centre, spread = known[1], known[2]
+        if known is not None and known[0] is history and known[1] == self._recorded:
+            centre, spread = known[2], known[3]
         else:
             h = np.asarray(history, dtype=float)
             centre = column_medians(h)
             spread = MAD_TO_SIGMA * column_medians(np.abs(h - centre))
-            self._medians[id(history)] = (self._recorded, centre, spread)
+            self._medians[id(history)] = (history, self._recorded, centre, spread)
         out = np.full(3, np.inf)
         for k in self.components:
             if spread[k] <= 0.0:
